@@ -1,0 +1,13 @@
+/**
+ * @file rcb.h
+ * @brief librcb umbrella header: lateral dynamics of rotor-coupling-bearing
+ * systems (model, FRFs, unbalance response, modes, Campbell).
+ */
+#ifndef RCB_H
+#define RCB_H
+
+#include "rcb/rcb_core.h"
+#include "rcb/rcb_model.h"
+#include "rcb/rcb_analysis.h"
+
+#endif /* RCB_H */

@@ -1,0 +1,139 @@
+/**
+ * @file rcb_analysis.h
+ * @brief Analyses on a finalized model: FRFs, unbalance response, damped
+ * modes, Campbell data and critical speeds.
+ *
+ * Each analysis object is sized once at creation (all its memory comes from
+ * the allocator hooks then); evaluations allocate nothing, so a sweep in a
+ * loop is allocation-free. Objects keep a pointer to the model: the model
+ * must outlive them. Two objects on two threads never share state.
+ */
+#ifndef RCB_ANALYSIS_H
+#define RCB_ANALYSIS_H
+
+#include "rcb/rcb_core.h"
+#include "rcb/rcb_model.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---------------------------------------------------------------- FRF -- */
+
+/** @brief What an FRF relates to force. */
+typedef enum rcb_frf_kind {
+  RCB_RECEPTANCE = 0, /**< displacement / force, m/N (rad/(N m) for rotations) */
+  RCB_MOBILITY = 1,   /**< velocity / force, m/(N s) */
+  RCB_INERTANCE = 2   /**< acceleration / force, m/(N s^2) */
+} rcb_frf_kind;
+
+/** @brief Linear solver used for the dynamic stiffness. */
+typedef enum rcb_solver_kind {
+  RCB_SOLVER_AUTO = 0,   /**< banded when it pays, dense otherwise */
+  RCB_SOLVER_DENSE = 1,  /**< LAPACK zgesv */
+  RCB_SOLVER_BANDED = 2  /**< LAPACK zgbsv */
+} rcb_solver_kind;
+
+typedef struct rcb_frf rcb_frf;
+
+/**
+ * @brief Prepare FRF evaluation for chosen outputs x inputs.
+ * @param nout number of output DOFs @param outputs output DOFs
+ * @param nin number of input (force) DOFs, may be 0 for unbalance-only use
+ * @param inputs input DOFs
+ * @param solver RCB_SOLVER_AUTO, _DENSE or _BANDED
+ * @param alloc allocator hooks, NULL for malloc
+ */
+RCB_API rcb_status rcb_frf_create(rcb_frf **out, const rcb_model *m, size_t nout,
+                                  const rcb_dof *outputs, size_t nin, const rcb_dof *inputs,
+                                  rcb_solver_kind solver, const rcb_allocator *alloc);
+RCB_API void rcb_frf_destroy(rcb_frf *f);
+RCB_API const char *rcb_frf_errmsg(const rcb_frf *f);
+/** @brief Solver actually chosen (dense or banded). */
+RCB_API rcb_solver_kind rcb_frf_solver(const rcb_frf *f);
+/** @brief Bytes held by the object (its whole workspace). */
+RCB_API size_t rcb_frf_memory(const rcb_frf *f);
+
+/**
+ * @brief H(omega) at rotor speed @p speed: one factorisation, all inputs as
+ * right-hand sides.
+ * @param omega excitation frequency, rad/s @param speed rotor speed Omega, rad/s
+ * (pass speed = omega for a synchronous FRF)
+ * @param H output, nout x nin column-major (H[o + nout * i])
+ */
+RCB_API rcb_status rcb_frf_eval(rcb_frf *f, double omega, double speed, rcb_frf_kind kind,
+                                rcb_complex *H);
+
+/**
+ * @brief Steady unbalance response at rotor speed @p speed (rad/s), from the
+ * model's unbalances (paper eqs. 3-4, solved as the complex system at
+ * omega = Omega). q(t) = Re(Q e^{i Omega t}).
+ * @param Q output displacement phasors at the nout outputs, m (rad for rotations)
+ */
+RCB_API rcb_status rcb_frf_unbalance(rcb_frf *f, double speed, rcb_complex *Q);
+
+/* -------------------------------------------------------------- modes -- */
+
+/** @brief Whirl direction of a mode. */
+typedef enum rcb_whirl {
+  RCB_WHIRL_BACKWARD = -1,
+  RCB_WHIRL_MIXED = 0,
+  RCB_WHIRL_FORWARD = 1
+} rcb_whirl;
+
+/** @brief One damped mode: lambda = -zeta wn + i wd. */
+typedef struct rcb_mode {
+  rcb_complex lambda; /**< eigenvalue, 1/s */
+  double wn;          /**< undamped natural frequency |lambda|, rad/s */
+  double wd;          /**< damped natural frequency Im(lambda), rad/s */
+  double zeta;        /**< damping ratio -Re(lambda)/|lambda| (-) */
+  double logdec;      /**< logarithmic decrement 2 pi zeta / sqrt(1 - zeta^2) (-) */
+  rcb_whirl whirl;    /**< forward, backward or mixed whirl */
+} rcb_mode;
+
+typedef struct rcb_modes rcb_modes;
+
+RCB_API rcb_status rcb_modes_create(rcb_modes **out, const rcb_model *m,
+                                    const rcb_allocator *alloc);
+RCB_API void rcb_modes_destroy(rcb_modes *e);
+RCB_API const char *rcb_modes_errmsg(const rcb_modes *e);
+
+/**
+ * @brief Damped modes at rotor speed @p speed (rad/s) from the state-space
+ * pencil, sorted by increasing wd; only oscillating modes (wd > 0) are kept,
+ * rigid-body and overdamped roots are left out.
+ * @param max_modes capacity of @p modes
+ * @param modes output @param nmodes number written
+ * @param shapes optional (NULL): n x max_modes column-major complex right
+ * eigenvectors (displacement part), n = rcb_model_dof_count(), each scaled to
+ * unit largest translation
+ */
+RCB_API rcb_status rcb_modes_compute(rcb_modes *e, double speed, size_t max_modes,
+                                     rcb_mode *modes, size_t *nmodes, rcb_complex *shapes);
+
+/**
+ * @brief Campbell data: the first @p nmodes damped modes at each speed.
+ * @param speeds rad/s, @p nspeeds of them
+ * @param wd output damped frequencies rad/s, nmodes x nspeeds column-major
+ * (NaN where fewer modes exist) @param logdec output, same shape, may be NULL
+ * @param whirl output, same shape, may be NULL
+ */
+RCB_API rcb_status rcb_campbell(rcb_modes *e, size_t nspeeds, const double *speeds,
+                                size_t nmodes, double *wd, double *logdec, rcb_whirl *whirl);
+
+/**
+ * @brief Critical speeds: where a Campbell curve crosses the line
+ * wd = ratio * speed (ratio 1 for 1X), by linear interpolation between
+ * table rows. Inputs as produced by rcb_campbell.
+ * @param crit output speeds rad/s, capacity @p max_crit @param mode_of output,
+ * index of the curve crossing (may be NULL) @param ncrit number found
+ */
+RCB_API rcb_status rcb_critical_speeds(size_t nspeeds, const double *speeds, size_t nmodes,
+                                       const double *wd, double ratio, size_t max_crit,
+                                       double *crit, size_t *mode_of, size_t *ncrit);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* RCB_ANALYSIS_H */

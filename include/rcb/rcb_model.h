@@ -1,0 +1,232 @@
+/**
+ * @file rcb_model.h
+ * @brief Building a rotor-coupling-bearing model: from an INI file, an INI
+ * string, or element by element.
+ *
+ * A model holds materials, shafts (ordered segments of Timoshenko elements),
+ * rigid disks, linear bearings to ground, couplings between shafts,
+ * unbalances and named measurement stations. Positions are absolute axial
+ * coordinates z (m) along the machine; every station must fall on a node
+ * (a segment end or an element boundary).
+ *
+ * Life cycle: rcb_model_create -> rcb_model_load_* or rcb_model_add_* ->
+ * rcb_model_finalize (done by the loaders) -> analyses -> rcb_model_destroy.
+ * After finalize the model is read-only for the analyses; rcb_model_set_param
+ * may still change numeric values (not the mesh).
+ */
+#ifndef RCB_MODEL_H
+#define RCB_MODEL_H
+
+#include "rcb/rcb_core.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Longest name (materials, shafts, stations...) including the NUL. */
+#define RCB_NAME_MAX 48
+
+typedef struct rcb_model rcb_model;
+
+/** @brief Create an empty model. @param alloc allocator hooks, NULL for malloc. */
+RCB_API rcb_status rcb_model_create(rcb_model **out, const rcb_allocator *alloc);
+/** @brief Free a model and everything it owns (NULL is a no-op). */
+RCB_API void rcb_model_destroy(rcb_model *m);
+/** @brief Message of the last error on this model ("" if none). */
+RCB_API const char *rcb_model_errmsg(const rcb_model *m);
+
+/**
+ * @brief Load an INI model file and finalize the model.
+ * Errors name the file, line, section, key, what is wrong and what is expected.
+ */
+RCB_API rcb_status rcb_model_load_file(rcb_model *m, const char *path);
+/**
+ * @brief Load a model from INI text held in memory (no file system needed).
+ * @param source_name name used in error messages (e.g. "<firmware>").
+ */
+RCB_API rcb_status rcb_model_load_string(rcb_model *m, const char *text,
+                                         const char *source_name);
+
+/* ---- element-by-element construction (before finalize) ---- */
+
+/** @param density kg/m^3 @param young Pa @param poisson - */
+RCB_API rcb_status rcb_model_add_material(rcb_model *m, const char *name, double density,
+                                          double young, double poisson);
+/**
+ * @brief A shaft: starts at axial position z_start (m), built of segments.
+ * @param shear_factor Timoshenko shear coefficient kappa (-), e.g. 0.9.
+ */
+RCB_API rcb_status rcb_model_add_shaft(rcb_model *m, const char *name, const char *material,
+                                       double z_start, double shear_factor);
+/**
+ * @brief Proportional damping of a shaft's elements: C = qz_m M + qz_k K.
+ * @param qz_m mass-proportional factor, 1/s @param qz_k stiffness-proportional factor, s
+ */
+RCB_API rcb_status rcb_model_set_shaft_damping(rcb_model *m, const char *shaft, double qz_m,
+                                               double qz_k);
+/**
+ * @brief Append a uniform segment to a shaft.
+ * @param length m @param outer_d outer diameter, m @param inner_d bore, m (0 = solid)
+ * @param n_elements number of equal elements (>= 1)
+ */
+RCB_API rcb_status rcb_model_add_segment(rcb_model *m, const char *shaft, double length,
+                                         double outer_d, double inner_d, int n_elements);
+/**
+ * @brief Rigid disk at (shaft, z).
+ * @param mass kg @param Id diametral inertia, kg m^2 @param Ip polar inertia, kg m^2
+ */
+RCB_API rcb_status rcb_model_add_disk(rcb_model *m, const char *name, const char *shaft,
+                                      double z, double mass, double Id, double Ip);
+/**
+ * @brief Mass and inertias of a uniform annular disk (also used for coupling hubs).
+ * @param density kg/m^3 @param outer_d m @param inner_d m @param width axial, m
+ * @param mass kg @param Id kg m^2 (about a diameter through the centre) @param Ip kg m^2
+ */
+RCB_API rcb_status rcb_disk_from_geometry(double density, double outer_d, double inner_d,
+                                          double width, double *mass, double *Id, double *Ip);
+
+/** @brief Linear bearing coefficients: N/m and N s/m, force = -K q - C q'. */
+typedef struct rcb_bearing_coefs {
+  double kxx, kxy, kyx, kyy; /**< N/m */
+  double cxx, cxy, cyx, cyy; /**< N s/m */
+} rcb_bearing_coefs;
+
+/** @brief Constant linear bearing to ground at (shaft, z). */
+RCB_API rcb_status rcb_model_add_bearing(rcb_model *m, const char *name, const char *shaft,
+                                         double z, const rcb_bearing_coefs *c);
+/**
+ * @brief Speed-dependent bearing: coefficients tabulated against rotor speed,
+ * linearly interpolated, held constant outside the table.
+ * @param n number of rows (>= 1) @param speeds rad/s, strictly increasing
+ */
+RCB_API rcb_status rcb_model_add_bearing_table(rcb_model *m, const char *name,
+                                               const char *shaft, double z, size_t n,
+                                               const double *speeds,
+                                               const rcb_bearing_coefs *c);
+
+/** @brief The five coupling models of Tapia & Cavalca (paper section 3). */
+typedef enum rcb_coupling_model {
+  RCB_COUPLING_KRAMER_1 = 0,         /**< translations tied (DOF elimination) */
+  RCB_COUPLING_KRAMER_2 = 1,         /**< translations tied, plus kr, cr */
+  RCB_COUPLING_NELSON_CRANDALL_1 = 2, /**< kt, kr */
+  RCB_COUPLING_NELSON_CRANDALL_2 = 3, /**< kt, kr, ct, cr */
+  RCB_COUPLING_RIGID = 4             /**< all four DOFs tied */
+} rcb_coupling_model;
+
+/** @brief Name used in INI files ("kramer_1", ...), NULL if out of range. */
+RCB_API const char *rcb_coupling_model_name(rcb_coupling_model t);
+/** @brief Parse an INI name; RCB_ERR_NOT_FOUND if unknown. */
+RCB_API rcb_status rcb_coupling_model_parse(const char *name, rcb_coupling_model *t);
+
+/**
+ * @brief Coupling parameters. Values a model does not use must be 0.
+ * Hub inertia: one rigid disk at each of the two coupling stations (a, b).
+ */
+typedef struct rcb_coupling_params {
+  double kt; /**< translational stiffness, N/m */
+  double kr; /**< rotational stiffness, N m/rad */
+  double ct; /**< translational damping, N s/m */
+  double cr; /**< rotational damping, N m s/rad */
+  double mass[2]; /**< hub mass at station a, b: kg */
+  double Id[2];   /**< hub diametral inertia at a, b: kg m^2 */
+  double Ip[2];   /**< hub polar inertia at a, b: kg m^2 */
+} rcb_coupling_params;
+
+/**
+ * @brief Hub inertia from the paper's Table 1 description: an annulus of
+ * equivalent density and thickness, split in two equal halves, one per
+ * coupling station. Writes mass[], Id[], Ip[] of @p p.
+ * @param density kg/m^3 @param r_inner m @param r_outer m @param thickness whole coupling, m
+ */
+RCB_API rcb_status rcb_coupling_hubs_from_geometry(double density, double r_inner,
+                                                   double r_outer, double thickness,
+                                                   rcb_coupling_params *p);
+
+/**
+ * @brief Coupling joining station a (shaft_a, z_a) and station b (shaft_b, z_b).
+ * Station names "NAME.SHAFT_A" and "NAME.SHAFT_B" are created, and "NAME"
+ * alone means station a.
+ */
+RCB_API rcb_status rcb_model_add_coupling(rcb_model *m, const char *name,
+                                          rcb_coupling_model type, const char *shaft_a,
+                                          double z_a, const char *shaft_b, double z_b,
+                                          const rcb_coupling_params *p);
+/**
+ * @brief Unbalance at (shaft, z).
+ * @param amount kg m @param phase rad, from +x towards +y (direction of rotation)
+ */
+RCB_API rcb_status rcb_model_add_unbalance(rcb_model *m, const char *name, const char *shaft,
+                                           double z, double amount, double phase);
+/** @brief A named measurement station (probe position) at (shaft, z). */
+RCB_API rcb_status rcb_model_add_station(rcb_model *m, const char *name, const char *shaft,
+                                         double z);
+/** @brief Build the mesh and the DOF map, check consistency. */
+RCB_API rcb_status rcb_model_finalize(rcb_model *m);
+
+/* ---- queries (after finalize) ---- */
+
+/** @brief Number of nodes (4 DOFs each before coupling constraints). */
+RCB_API size_t rcb_model_node_count(const rcb_model *m);
+/** @brief Number of independent DOFs (matrix size) after constraint elimination. */
+RCB_API size_t rcb_model_dof_count(const rcb_model *m);
+/** @brief Number of shaft elements. */
+RCB_API size_t rcb_model_element_count(const rcb_model *m);
+
+/** @brief What is known about a node. */
+typedef struct rcb_node_info {
+  const char *shaft; /**< owning shaft name */
+  double z;          /**< axial position, m */
+  long dof[4];       /**< matrix row of x, y, rot_x, rot_y (shared when tied) */
+} rcb_node_info;
+RCB_API rcb_status rcb_model_node_info(const rcb_model *m, size_t node, rcb_node_info *out);
+
+/** @brief Kind of a named station. */
+typedef enum rcb_station_kind {
+  RCB_STATION_DISK = 0,
+  RCB_STATION_BEARING = 1,
+  RCB_STATION_COUPLING = 2,
+  RCB_STATION_UNBALANCE = 3,
+  RCB_STATION_PROBE = 4
+} rcb_station_kind;
+
+/** @brief Named stations, in definition order. */
+RCB_API size_t rcb_model_station_count(const rcb_model *m);
+typedef struct rcb_station_info {
+  const char *name;
+  rcb_station_kind kind;
+  size_t node;
+} rcb_station_info;
+RCB_API rcb_status rcb_model_station_info(const rcb_model *m, size_t i, rcb_station_info *out);
+
+/**
+ * @brief Resolve a channel spec to a DOF: "STATION.DIR", where DIR is x, y,
+ * rx or ry, and STATION is a station name or "#N" for node N (0-based).
+ * Examples: "DA.x", "C.B.y", "B2.ry", "#11.x".
+ */
+RCB_API rcb_status rcb_model_find_dof(const rcb_model *m, const char *spec, rcb_dof *out);
+/** @brief Matrix row of a DOF (after constraint elimination). */
+RCB_API rcb_status rcb_model_dof_index(const rcb_model *m, rcb_dof dof, size_t *index);
+
+/**
+ * @brief Global matrices at rotor speed @p speed (rad/s; it selects the
+ * coefficients of speed-dependent bearings). Each output is n x n column-major,
+ * n = rcb_model_dof_count(); any pointer may be NULL.
+ * M kg, C N s/m (shaft proportional damping, bearings, couplings), G (multiplied
+ * by Omega in the equation of motion), K N/m.
+ */
+RCB_API rcb_status rcb_model_matrices(const rcb_model *m, double speed, double *M, double *C,
+                                      double *G, double *K);
+
+/**
+ * @brief Unbalance force phasors at rotor speed @p speed (rad/s): F (length n)
+ * such that f(t) = Re(F e^{i Omega t}): F_x = me Omega^2 e^{i phase},
+ * F_y = -i F_x.
+ */
+RCB_API rcb_status rcb_model_unbalance_force(const rcb_model *m, double speed,
+                                             rcb_complex *F);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* RCB_MODEL_H */

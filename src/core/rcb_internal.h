@@ -1,0 +1,149 @@
+/*
+ * Internal definitions shared by the library's stages. Not installed.
+ * Layers (each uses only those below it):
+ *   analyses -> solvers -> assembly -> elements -> model -> core
+ */
+#ifndef RCB_INTERNAL_H
+#define RCB_INTERNAL_H
+
+#include <complex.h>
+#include <stdarg.h>
+#include <stddef.h>
+
+#include "rcb/rcb.h"
+
+#define RCB_ERRMSG_MAX 512
+#define RCB_PI 3.14159265358979323846
+
+/* ---- core/alloc.c ---- */
+void *rcb_alloc(const rcb_allocator *a, size_t size);   /* zeroed, NULL on failure */
+void rcb_free(const rcb_allocator *a, void *p);
+void rcb_allocator_init(rcb_allocator *dst, const rcb_allocator *src);
+/* Grow a dynamic array to hold at least need items: 0 or -1. */
+int rcb_grow(const rcb_allocator *a, void **items, size_t *cap, size_t need, size_t item_size);
+
+/* ---- core/errmsg.c ---- */
+/* printf into an object's error buffer, returns st for "return rcb_fail(...)" */
+rcb_status rcb_set_error(char *buf, rcb_status st, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+/* ---- model/ ---- */
+typedef struct rcb_material_s {
+  char name[RCB_NAME_MAX];
+  double rho, E, nu; /* kg/m^3, Pa, - */
+} rcb_material_t;
+
+typedef struct rcb_segment_s {
+  double L, od, id; /* m */
+  int nel;
+} rcb_segment_t;
+
+typedef struct rcb_shaft_s {
+  char name[RCB_NAME_MAX];
+  size_t material;
+  double z0;          /* m */
+  double kappa;       /* shear factor */
+  double qz_m, qz_k;  /* proportional damping 1/s, s */
+  rcb_segment_t *seg;
+  size_t nseg, capseg;
+  size_t first_node, nnodes; /* after finalize */
+} rcb_shaft_t;
+
+/* A position on a shaft, resolved to a node by finalize. */
+typedef struct rcb_place_s {
+  size_t shaft;
+  double z;   /* m */
+  size_t node;
+} rcb_place_t;
+
+typedef struct rcb_disk_s {
+  char name[RCB_NAME_MAX];
+  rcb_place_t at;
+  double m, Id, Ip; /* kg, kg m^2, kg m^2 */
+} rcb_disk_t;
+
+typedef struct rcb_bearing_s {
+  char name[RCB_NAME_MAX];
+  rcb_place_t at;
+  size_t n;             /* table rows (1 = constant) */
+  double *speeds;       /* rad/s, n of them */
+  rcb_bearing_coefs *c; /* n of them */
+} rcb_bearing_t;
+
+typedef struct rcb_coupling_s {
+  char name[RCB_NAME_MAX];
+  rcb_coupling_model type;
+  rcb_place_t at[2];
+  rcb_coupling_params p;
+} rcb_coupling_t;
+
+typedef struct rcb_unbalance_s {
+  char name[RCB_NAME_MAX];
+  rcb_place_t at;
+  double amount, phase; /* kg m, rad */
+} rcb_unbalance_t;
+
+typedef struct rcb_probe_s {
+  char name[RCB_NAME_MAX];
+  rcb_place_t at;
+} rcb_probe_t;
+
+/* One station name -> node (built by finalize, definition order). */
+typedef struct rcb_station_s {
+  char name[2 * RCB_NAME_MAX + 2];
+  rcb_station_kind kind;
+  size_t index; /* into the owning array */
+  size_t node;
+} rcb_station_t;
+
+typedef struct rcb_node_s {
+  size_t shaft;
+  double z;     /* m */
+  long dof[4];  /* reduced matrix row of each DOF */
+} rcb_node_t;
+
+typedef struct rcb_element_s {
+  size_t shaft, node0; /* element joins node0 and node0+1 */
+  double L, od, id;    /* m */
+} rcb_element_t;
+
+#define RCB_ARRAY(type, name) \
+  type *name;                 \
+  size_t n_##name, cap_##name
+
+struct rcb_model {
+  rcb_allocator alloc;
+  char errmsg[RCB_ERRMSG_MAX];
+  int finalized;
+  RCB_ARRAY(rcb_material_t, materials);
+  RCB_ARRAY(rcb_shaft_t, shafts);
+  RCB_ARRAY(rcb_disk_t, disks);
+  RCB_ARRAY(rcb_bearing_t, bearings);
+  RCB_ARRAY(rcb_coupling_t, couplings);
+  RCB_ARRAY(rcb_unbalance_t, unbalances);
+  RCB_ARRAY(rcb_probe_t, probes);
+  /* built by finalize */
+  RCB_ARRAY(rcb_station_t, stations);
+  RCB_ARRAY(rcb_node_t, nodes);
+  RCB_ARRAY(rcb_element_t, elements);
+  size_t ndof;      /* independent DOFs */
+  size_t bandwidth; /* max |row - col| of any nonzero (kl = ku) */
+};
+
+/* Bearing coefficients at a rotor speed (linear interpolation, clamped). */
+void rcb_bearing_eval(const rcb_bearing_t *b, double speed, rcb_bearing_coefs *out);
+
+/* ---- elements/ : local matrices, 8x8 column-major on
+ * [x0, y0, rx0, ry0, x1, y1, rx1, ry1] for shafts, 4x4 on [x, y, rx, ry]. ---- */
+typedef struct rcb_beam_props_s {
+  double L, od, id;      /* m */
+  double rho, E, nu;     /* kg/m^3, Pa, - */
+  double kappa;          /* shear factor (0 disables shear: Rayleigh beam) */
+} rcb_beam_props;
+void rcb_shaft_element(const rcb_beam_props *p, double Me[64], double Ge[64], double Ke[64]);
+void rcb_disk_element(double m, double Id, double Ip, double Md[16], double Gd[16]);
+
+#endif /* RCB_INTERNAL_H */
