@@ -14,6 +14,8 @@
 
 #define RCB_ERRMSG_MAX 512
 #define RCB_PI 3.14159265358979323846
+/* The imaginary unit as double complex (complex.h's I is a float complex). */
+#define RCB_J CMPLX(0.0, 1.0)
 
 /* ---- core/alloc.c ---- */
 void *rcb_alloc(const rcb_allocator *a, size_t size);   /* zeroed, NULL on failure */

@@ -1,0 +1,196 @@
+/*
+ * Frequency response functions (paper eqs. 5-6) and unbalance response
+ * (eqs. 3-4, solved as the complex system at omega = Omega):
+ *   Z(w, W) = K - w^2 M + i w (C + W G),  H = Z^-1,
+ * one factorisation per frequency with all inputs as right-hand sides.
+ * Everything is sized in rcb_frf_create; evaluations allocate nothing.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "assembly/assembly.h"
+#include "solvers/zsolver.h"
+
+struct rcb_frf {
+  rcb_allocator alloc;
+  char errmsg[RCB_ERRMSG_MAX];
+  const rcb_model *m;
+  const rcb_zsolver_ops *ops;
+  rcb_layout L;
+  double *M, *C, *G, *K; /* structure without bearings, in layout L */
+  rcb_complex *Z;        /* dynamic stiffness, factored in place */
+  rcb_complex *B;        /* n x max(nin, 1) right-hand sides / solutions */
+  int *ipiv;
+  size_t nout, nin, *out_row, *in_row;
+  size_t bytes;
+};
+
+/* Banded storage pays once the band is well below the order. */
+static const rcb_zsolver_ops *choose_solver(rcb_solver_kind kind, size_t n, size_t bw) {
+  if (kind == RCB_SOLVER_DENSE) return rcb_zsolver_dense();
+  if (kind == RCB_SOLVER_BANDED) return rcb_zsolver_banded();
+  return (n >= 32 && 4 * bw < n) ? rcb_zsolver_banded() : rcb_zsolver_dense();
+}
+
+static void *frf_alloc(rcb_frf *f, size_t size) {
+  f->bytes += size;
+  return rcb_alloc(&f->alloc, size);
+}
+
+static rcb_status map_dofs(rcb_frf *f, size_t k, const rcb_dof *dofs, size_t *rows,
+                           const char *what) {
+  size_t i;
+  for (i = 0; i < k; i++)
+    if (rcb_model_dof_index(f->m, dofs[i], &rows[i]) != RCB_OK)
+      return rcb_set_error(f->errmsg, RCB_ERR_ARG, "%s %zu: node %zu direction %d not in model",
+                           what, i, dofs[i].node, (int)dofs[i].dir);
+  return RCB_OK;
+}
+
+static rcb_status frf_setup(rcb_frf *f, size_t nout, const rcb_dof *outputs, size_t nin,
+                            const rcb_dof *inputs, rcb_solver_kind solver) {
+  const rcb_model *m = f->m;
+  size_t n = m->ndof, sz, ncol = nin ? nin : 1;
+  rcb_status st;
+  f->ops = choose_solver(solver, n, m->bandwidth);
+  f->ops->layout(&f->L, n, m->bandwidth);
+  sz = rcb_layout_size(&f->L);
+  f->M = frf_alloc(f, sz * sizeof *f->M);
+  f->C = frf_alloc(f, sz * sizeof *f->C);
+  f->G = frf_alloc(f, sz * sizeof *f->G);
+  f->K = frf_alloc(f, sz * sizeof *f->K);
+  f->Z = frf_alloc(f, sz * sizeof *f->Z);
+  f->B = frf_alloc(f, n * ncol * sizeof *f->B);
+  f->ipiv = frf_alloc(f, n * sizeof *f->ipiv);
+  f->out_row = frf_alloc(f, (nout ? nout : 1) * sizeof *f->out_row);
+  f->in_row = frf_alloc(f, ncol * sizeof *f->in_row);
+  if (!f->M || !f->C || !f->G || !f->K || !f->Z || !f->B || !f->ipiv || !f->out_row ||
+      !f->in_row)
+    return rcb_set_error(f->errmsg, RCB_ERR_NOMEM, "out of memory sizing the FRF workspace");
+  f->nout = nout;
+  f->nin = nin;
+  if ((st = map_dofs(f, nout, outputs, f->out_row, "output"))) return st;
+  if ((st = map_dofs(f, nin, inputs, f->in_row, "input"))) return st;
+  rcb_assemble_structure(m, &f->L, f->M, f->C, f->G, f->K);
+  return RCB_OK;
+}
+
+rcb_status rcb_frf_create(rcb_frf **out, const rcb_model *m, size_t nout,
+                          const rcb_dof *outputs, size_t nin, const rcb_dof *inputs,
+                          rcb_solver_kind solver, const rcb_allocator *alloc) {
+  rcb_allocator a;
+  rcb_frf *f;
+  rcb_status st;
+  if (!out) return RCB_ERR_ARG;
+  *out = NULL;
+  if (!m || (nout && !outputs) || (nin && !inputs)) return RCB_ERR_ARG;
+  if (!m->finalized) return RCB_ERR_STATE;
+  rcb_allocator_init(&a, alloc);
+  f = rcb_alloc(&a, sizeof *f);
+  if (!f) return RCB_ERR_NOMEM;
+  f->alloc = a;
+  f->m = m;
+  f->bytes = sizeof *f;
+  st = frf_setup(f, nout, outputs, nin, inputs, solver);
+  if (st) {
+    rcb_frf_destroy(f);
+    return st;
+  }
+  *out = f;
+  return RCB_OK;
+}
+
+void rcb_frf_destroy(rcb_frf *f) {
+  rcb_allocator a;
+  if (!f) return;
+  a = f->alloc;
+  rcb_free(&a, f->M);
+  rcb_free(&a, f->C);
+  rcb_free(&a, f->G);
+  rcb_free(&a, f->K);
+  rcb_free(&a, f->Z);
+  rcb_free(&a, f->B);
+  rcb_free(&a, f->ipiv);
+  rcb_free(&a, f->out_row);
+  rcb_free(&a, f->in_row);
+  rcb_free(&a, f);
+}
+
+const char *rcb_frf_errmsg(const rcb_frf *f) { return f ? f->errmsg : "no FRF object"; }
+
+rcb_solver_kind rcb_frf_solver(const rcb_frf *f) {
+  return (f && f->L.banded) ? RCB_SOLVER_BANDED : RCB_SOLVER_DENSE;
+}
+
+size_t rcb_frf_memory(const rcb_frf *f) { return f ? f->bytes : 0; }
+
+/* Z = K - w^2 M + i w (C + W G) + bearings at speed W, then factor and solve
+ * Z X = B in place. */
+static rcb_status factor_solve(rcb_frf *f, double omega, double speed, size_t nrhs) {
+  const rcb_model *m = f->m;
+  size_t k, sz = rcb_layout_size(&f->L), b;
+  double w2 = omega * omega;
+  rcb_status st;
+  for (k = 0; k < sz; k++)
+    f->Z[k] = CMPLX(f->K[k] - w2 * f->M[k], omega * (f->C[k] + speed * f->G[k]));
+  for (b = 0; b < m->n_bearings; b++) {
+    rcb_entry e[4];
+    int j;
+    rcb_bearing_entries(m, b, speed, e);
+    for (j = 0; j < 4; j++) f->Z[rcb_layout_at(&f->L, e[j].row, e[j].col)] +=
+        CMPLX(e[j].k, omega * e[j].c);
+  }
+  st = f->ops->solve(&f->L, f->Z, f->ipiv, f->B, nrhs);
+  if (st == RCB_ERR_SINGULAR)
+    return rcb_set_error(f->errmsg, st,
+                         "dynamic stiffness singular at %g rad/s, speed %g rad/s (a free-free "
+                         "model at omega = 0, or an undamped resonance hit exactly)",
+                         omega, speed);
+  if (st) return rcb_set_error(f->errmsg, st, "%s solver failed at %g rad/s", f->ops->name,
+                               omega);
+  return RCB_OK;
+}
+
+static int bad_speed(double omega, double speed) {
+  return !isfinite(omega) || !isfinite(speed) || omega < 0;
+}
+
+rcb_status rcb_frf_eval(rcb_frf *f, double omega, double speed, rcb_frf_kind kind,
+                        rcb_complex *H) {
+  size_t n, i, o;
+  double complex scale;
+  rcb_status st;
+  if (!f || !H) return RCB_ERR_ARG;
+  if (f->nin == 0)
+    return rcb_set_error(f->errmsg, RCB_ERR_ARG, "no input DOF: created for unbalance only");
+  if (bad_speed(omega, speed))
+    return rcb_set_error(f->errmsg, RCB_ERR_ARG,
+                         "frequency %g rad/s and speed %g rad/s: expected finite, omega >= 0",
+                         omega, speed);
+  n = f->m->ndof;
+  memset(f->B, 0, n * f->nin * sizeof *f->B);
+  for (i = 0; i < f->nin; i++) f->B[f->in_row[i] + n * i] = 1.0;
+  if ((st = factor_solve(f, omega, speed, f->nin))) return st;
+  switch (kind) {
+    case RCB_MOBILITY: scale = CMPLX(0.0, omega); break;
+    case RCB_INERTANCE: scale = -omega * omega; break;
+    default: scale = 1.0; break;
+  }
+  for (i = 0; i < f->nin; i++)
+    for (o = 0; o < f->nout; o++) H[o + f->nout * i] = scale * f->B[f->out_row[o] + n * i];
+  return RCB_OK;
+}
+
+rcb_status rcb_frf_unbalance(rcb_frf *f, double speed, rcb_complex *Q) {
+  size_t o;
+  rcb_status st;
+  if (!f || !Q) return RCB_ERR_ARG;
+  if (bad_speed(speed, speed))
+    return rcb_set_error(f->errmsg, RCB_ERR_ARG,
+                         "speed %g rad/s: expected a finite value >= 0", speed);
+  rcb_model_unbalance_force(f->m, speed, f->B);
+  if ((st = factor_solve(f, speed, speed, 1))) return st;
+  for (o = 0; o < f->nout; o++) Q[o] = f->B[f->out_row[o]];
+  return RCB_OK;
+}

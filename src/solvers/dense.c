@@ -1,0 +1,27 @@
+/* Dense backend: LAPACK zgesv (LU with partial pivoting), all right-hand
+ * sides in one call. The _work variant allocates nothing. */
+#include <lapacke.h>
+
+#include "solvers/zsolver.h"
+
+_Static_assert(sizeof(lapack_int) == sizeof(int), "librcb expects 32-bit LAPACK integers");
+
+static void dense_layout(rcb_layout *L, size_t n, size_t bw) {
+  (void)bw;
+  rcb_layout_dense(L, n);
+}
+
+static rcb_status dense_solve(const rcb_layout *L, rcb_complex *Z, int *ipiv, rcb_complex *B,
+                              size_t nrhs) {
+  lapack_int n = (lapack_int)L->n, info;
+  info = LAPACKE_zgesv_work(LAPACK_COL_MAJOR, n, (lapack_int)nrhs, (lapack_complex_double *)Z,
+                            (lapack_int)L->ld, (lapack_int *)ipiv, (lapack_complex_double *)B,
+                            n);
+  if (info > 0) return RCB_ERR_SINGULAR;
+  if (info < 0) return RCB_ERR_LAPACK;
+  return RCB_OK;
+}
+
+static const rcb_zsolver_ops dense_ops = {"dense", dense_layout, dense_solve};
+
+const rcb_zsolver_ops *rcb_zsolver_dense(void) { return &dense_ops; }
