@@ -214,12 +214,39 @@ static void test_disk_and_bearing_rows(void **state) {
   rcb_model_destroy(m);
 }
 
+/* Tabulated bearing: linear interpolation between rows, constant outside. */
+static void test_bearing_table(void **state) {
+  rcb_model *m = free_shaft(1.0, 0.05, 0.0, 2, 0.9);
+  const double speeds[3] = {0.0, 100.0, 300.0};
+  rcb_bearing_coefs c[3] = {{1e6, 0, 0, 2e6, 10, 0, 0, 20},
+                            {3e6, 1e5, -1e5, 4e6, 30, 0, 0, 40},
+                            {7e6, 3e5, -3e5, 8e6, 70, 0, 0, 80}};
+  double K[144], C[144], K0[144];
+  size_t r;
+  rcb_dof d = {1, RCB_DIR_X};
+  (void)state;
+  assert_int_equal(rcb_model_add_bearing_table(m, "B", "S", 0.5, 3, speeds, c), RCB_OK);
+  assert_int_equal(rcb_model_finalize(m), RCB_OK);
+  assert_int_equal(rcb_model_dof_count(m), 12);
+  assert_int_equal(rcb_model_dof_index(m, d, &r), RCB_OK);
+  assert_int_equal(rcb_model_matrices(m, -50.0, NULL, C, NULL, K0), RCB_OK);
+  K0[r + 12 * r] -= 1e6; /* shaft-only stiffness at that entry */
+  assert_int_equal(rcb_model_matrices(m, 200.0, NULL, C, NULL, K), RCB_OK);
+  assert_true(rcb_test_close(K[r + 12 * r] - K0[r + 12 * r], 5e6, 1e-12, 0));
+  assert_true(rcb_test_close(K[r + 12 * (r + 1)], 2e5, 1e-12, 0));
+  assert_true(rcb_test_close(C[(r + 1) + 12 * (r + 1)], 60, 1e-12, 0));
+  assert_int_equal(rcb_model_matrices(m, 1e4, NULL, C, NULL, K), RCB_OK);
+  assert_true(rcb_test_close(K[r + 12 * r] - K0[r + 12 * r], 7e6, 1e-12, 0));
+  rcb_model_destroy(m);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_element_symmetry),
       cmocka_unit_test(test_rigid_body),
       cmocka_unit_test(test_cantilever_shear),
       cmocka_unit_test(test_disk_and_bearing_rows),
+      cmocka_unit_test(test_bearing_table),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
