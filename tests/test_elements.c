@@ -85,6 +85,7 @@ static void test_rigid_body(void **state) {
   rcb_model *m = free_shaft(L, od, id, 16, 0.8);
   size_t n, i, k;
   double *M, *G, *K, *v[3], *Kv;
+  (void)state;
   assert_int_equal(rcb_model_finalize(m), RCB_OK);
   n = rcb_model_dof_count(m);
   assert_int_equal(n, 68);

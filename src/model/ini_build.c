@@ -1,0 +1,399 @@
+/*
+ * INI model loader, second pass: turn the stored sections into builder calls.
+ * Items are built in dependency order (materials, shafts, then everything
+ * placed on shafts), whatever their order in the file, and every builder or
+ * finalize message is prefixed with the file and the line of the section
+ * header of the item concerned.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "model/ini_load.h"
+#include "model/model_util.h"
+
+#define TRY(x)              \
+  do {                      \
+    rcb_status st_ = (x);   \
+    if (st_) return st_;    \
+  } while (0)
+
+/* Re-raise the builder's message with the file and the section's line. */
+static rcb_status builder_fail(ini_ctx *c, const ini_section *s, int line, rcb_status st) {
+  char msg[RCB_ERRMSG_MAX];
+  snprintf(msg, sizeof msg, "%s", rcb_model_errmsg(c->m));
+  return rcb_ini_error(c, st, line, s, NULL, "%s", msg);
+}
+
+/* ---- one builder per section type ---- */
+
+static rcb_status build_material(ini_ctx *c, const ini_section *s) {
+  double rho, E, nu;
+  rcb_status st;
+  TRY(rcb_ini_get_num(c, s, "density", "density in kg/m^3, e.g. 7850", 1, 0, &rho));
+  TRY(rcb_ini_get_num(c, s, "young", "Young's modulus in Pa, e.g. 2.1e11", 1, 0, &E));
+  TRY(rcb_ini_get_num(c, s, "poisson", "Poisson's ratio (-), 0 <= nu < 0.5, e.g. 0.3", 1, 0, &nu));
+  st = rcb_model_add_material(c->m, s->name, rho, E, nu);
+  return st ? builder_fail(c, s, s->line, st) : RCB_OK;
+}
+
+static rcb_status segment(ini_ctx *c, ini_section *s, const ini_entry *e) {
+  static const char *const what[3] = {"segment length in m", "outer diameter in m",
+                                      "inner diameter in m (0 = solid)"};
+  double v[4];
+  const char *p = e->val, *t;
+  size_t n = rcb_ini_count_tok(e->val, e->val + e->len), len;
+  int k;
+  rcb_status st;
+  if (n != 4)
+    return rcb_ini_error(c, RCB_ERR_PARSE, e->line, s, e->key,
+                         "%zu fields in '%s'; expected 4: length (m), outer diameter (m), "
+                         "inner diameter (m), number of elements",
+                         n, e->val);
+  for (k = 0; k < 4; k++) {
+    t = rcb_ini_next_tok(&p, e->val + e->len, &len);
+    TRY(rcb_ini_parse_num(c, s, e, t, len, k < 3 ? what[k] : "a whole number of elements >= 1",
+                          &v[k]));
+  }
+  if (v[3] != floor(v[3]) || v[3] < 1 || v[3] > 100000)
+    return rcb_ini_error(c, RCB_ERR_PARSE, e->line, s, e->key,
+                         "%g elements; expected a whole number of elements from 1 to 100000",
+                         v[3]);
+  st = rcb_model_add_segment(c->m, s->name, v[0], v[1], v[2], (int)v[3]);
+  if (st) return builder_fail(c, s, e->line, st);
+  s->z1 += v[0];
+  return RCB_OK;
+}
+
+static rcb_status build_shaft(ini_ctx *c, ini_section *s) {
+  char mat[RCB_NAME_MAX], hint[200];
+  double z0, kappa, qm, qk;
+  size_t i, nseg = 0;
+  rcb_status st;
+  TRY(rcb_ini_get_word(c, s, "material", "the name of a [material NAME] section", mat, sizeof mat));
+  if (!rcb_ini_find_sec(c, INI_SEC_MATERIAL, mat)) {
+    rcb_ini_name_hint(c, INI_TYPE_BIT(INI_SEC_MATERIAL), NULL, mat, hint, sizeof hint);
+    return rcb_ini_error(c, RCB_ERR_NOT_FOUND, rcb_ini_get(s, "material")->line, s, "material",
+                         "material '%s' is not defined (%s); expected the name of a "
+                         "[material NAME] section",
+                         mat, hint);
+  }
+  TRY(rcb_ini_get_num(c, s, "start", "axial position of the first node in m", 0, 0.0, &z0));
+  TRY(rcb_ini_get_num(c, s, "shear_factor",
+              "Timoshenko shear factor (-), e.g. 0.9 for a solid circular section, 0 for no "
+              "shear",
+              1, 0, &kappa));
+  TRY(rcb_ini_get_num(c, s, "damping_mass", "mass-proportional damping qz_m in 1/s", 0, 0.0, &qm));
+  TRY(rcb_ini_get_num(c, s, "damping_stiffness", "stiffness-proportional damping qz_k in s", 0, 0.0,
+              &qk));
+  for (i = 0; i < s->n_ent; i++) nseg += strcmp(s->ent[i].key, "segment") == 0;
+  if (nseg == 0)
+    return rcb_ini_missing(c, s, "segment",
+                   "length (m) outer_diameter (m) inner_diameter (m) elements, e.g. "
+                   "segment = 0.50 0.017 0 10");
+  if ((st = rcb_model_add_shaft(c->m, s->name, mat, z0, kappa)) ||
+      (st = rcb_model_set_shaft_damping(c->m, s->name, qm, qk)))
+    return builder_fail(c, s, s->line, st);
+  s->z0 = s->z1 = z0;
+  for (i = 0; i < s->n_ent; i++)
+    if (strcmp(s->ent[i].key, "segment") == 0) TRY(segment(c, s, &s->ent[i]));
+  s->built = 1;
+  return RCB_OK;
+}
+
+/* First key of the list present in s, or NULL. */
+static const ini_entry *first_of(const ini_section *s, const char *const *keys, size_t n) {
+  size_t i;
+  const ini_entry *best = NULL;
+  for (i = 0; i < n; i++) {
+    const ini_entry *e = rcb_ini_get(s, keys[i]);
+    if (e && (!best || e->line < best->line)) best = e;
+  }
+  return best;
+}
+
+/* Explicit inertia (3 keys) or geometry (4 keys), never both. */
+static rcb_status inertia_kind(ini_ctx *c, const ini_section *s, const char *const *mk,
+                               const char *const *gk, const char *what, int *geometry) {
+  const ini_entry *em = first_of(s, mk, 3), *eg = first_of(s, gk, 4);
+  if (em && eg) {
+    const ini_entry *later = em->line > eg->line ? em : eg;
+    return rcb_ini_error(c, RCB_ERR_PARSE, later->line, s, later->key,
+                         "both explicit inertia (%s, %s, %s) and geometry (%s, %s, %s, %s) "
+                         "are given; expected one or the other",
+                         mk[0], mk[1], mk[2], gk[0], gk[1], gk[2], gk[3]);
+  }
+  if (!em && !eg)
+    return rcb_ini_error(c, RCB_ERR_PARSE, s->line, s, NULL,
+                         "missing %s inertia; expected either %s, %s, %s (kg, kg m^2, kg m^2) "
+                         "or %s (kg/m^3), %s, %s, %s (m)",
+                         what, mk[0], mk[1], mk[2], gk[0], gk[1], gk[2], gk[3]);
+  *geometry = eg != NULL;
+  return RCB_OK;
+}
+
+static rcb_status build_disk(ini_ctx *c, const ini_section *s) {
+  static const char *const mk[3] = {"mass", "Id", "Ip"};
+  static const char *const gk[4] = {"density", "outer_diameter", "inner_diameter", "width"};
+  const char *shaft;
+  double z, m, Id, Ip;
+  int geo;
+  rcb_status st;
+  TRY(rcb_ini_get_at(c, s, &shaft, &z));
+  TRY(inertia_kind(c, s, mk, gk, "the disk's", &geo));
+  if (geo) {
+    double rho, od, id, w;
+    TRY(rcb_ini_get_num(c, s, "density", "density in kg/m^3", 1, 0, &rho));
+    TRY(rcb_ini_get_num(c, s, "outer_diameter", "outer diameter in m", 1, 0, &od));
+    TRY(rcb_ini_get_num(c, s, "inner_diameter", "bore diameter in m (0 = solid)", 0, 0.0, &id));
+    TRY(rcb_ini_get_num(c, s, "width", "axial width in m", 1, 0, &w));
+    if (rcb_disk_from_geometry(rho, od, id, w, &m, &Id, &Ip))
+      return rcb_ini_error(c, RCB_ERR_PARSE, s->line, s, NULL,
+                           "invalid geometry (density %g, outer_diameter %g, inner_diameter "
+                           "%g, width %g); expected density > 0, outer_diameter > "
+                           "inner_diameter >= 0, width > 0",
+                           rho, od, id, w);
+  } else {
+    TRY(rcb_ini_get_num(c, s, "mass", "mass in kg", 1, 0, &m));
+    TRY(rcb_ini_get_num(c, s, "Id", "diametral moment of inertia in kg m^2", 1, 0, &Id));
+    TRY(rcb_ini_get_num(c, s, "Ip", "polar moment of inertia in kg m^2", 1, 0, &Ip));
+  }
+  st = rcb_model_add_disk(c->m, s->name, shaft, z, m, Id, Ip);
+  return st ? builder_fail(c, s, s->line, st) : RCB_OK;
+}
+
+static const char *const coef_keys[8] = {"kxx", "kxy", "kyx", "kyy",
+                                         "cxx", "cxy", "cyx", "cyy"};
+
+/* Fill column k of the coefficient table rows (one value = constant). */
+static rcb_status bearing_coef(ini_ctx *c, const ini_section *s, int k, const char *speed_key,
+                               size_t nspeed, rcb_bearing_coefs *rows, size_t nrows) {
+  const ini_entry *e = rcb_ini_get(s, coef_keys[k]);
+  double *v;
+  size_t n, i;
+  if (!e) return RCB_OK; /* rows are zeroed */
+  TRY(rcb_ini_get_list(c, s, e, k < 4 ? "stiffness in N/m" : "damping in N s/m", &v, &n));
+  if (n > 1 && nspeed == 0) {
+    rcb_free(&c->m->alloc, v);
+    return rcb_ini_error(c, RCB_ERR_PARSE, e->line, s, e->key,
+                         "%zu values but the bearing has no speed table; expected one value, "
+                         "or speed_rpm = ... (or speed = ... in rad/s) with one speed per value",
+                         n);
+  }
+  if (n != 1 && n != nspeed) {
+    rcb_free(&c->m->alloc, v);
+    return rcb_ini_error(c, RCB_ERR_PARSE, e->line, s, e->key,
+                         "%zu values but %s lists %zu speeds; expected 1 value (constant) or "
+                         "%zu (one per speed)",
+                         n, speed_key, nspeed, nspeed);
+  }
+  for (i = 0; i < nrows; i++) (&rows[i].kxx)[k] = v[n == 1 ? 0 : i];
+  rcb_free(&c->m->alloc, v);
+  return RCB_OK;
+}
+
+static rcb_status build_bearing(ini_ctx *c, const ini_section *s) {
+  const ini_entry *rpm = rcb_ini_get(s, "speed_rpm"), *rad = rcb_ini_get(s, "speed");
+  const char *shaft, *speed_key = rpm ? "speed_rpm" : "speed";
+  double z, *speeds = NULL;
+  size_t ns = 0, nrows, i;
+  int k;
+  rcb_bearing_coefs *rows;
+  rcb_status st = RCB_OK;
+  TRY(rcb_ini_get_at(c, s, &shaft, &z));
+  if (rpm && rad) {
+    const ini_entry *later = rpm->line > rad->line ? rpm : rad;
+    return rcb_ini_error(c, RCB_ERR_PARSE, later->line, s, later->key,
+                         "both speed_rpm and speed are given; expected one speed table "
+                         "(speed_rpm in rpm or speed in rad/s)");
+  }
+  if (rpm || rad) {
+    TRY(rcb_ini_get_list(c, s, rpm ? rpm : rad,
+                 rpm ? "rotor speeds in rpm, increasing" : "rotor speeds in rad/s, increasing",
+                 &speeds, &ns));
+    if (rpm)
+      for (i = 0; i < ns; i++) speeds[i] *= RCB_PI / 30.0; /* rpm -> rad/s */
+  }
+  nrows = ns ? ns : 1;
+  rows = rcb_alloc(&c->m->alloc, nrows * sizeof *rows);
+  if (!rows) {
+    rcb_free(&c->m->alloc, speeds);
+    return rcb_ini_error(c, RCB_ERR_NOMEM, s->line, s, NULL, "out of memory");
+  }
+  for (k = 0; k < 8 && !st; k++) st = bearing_coef(c, s, k, speed_key, ns, rows, nrows);
+  if (!st) {
+    st = rcb_model_add_bearing_table(c->m, s->name, shaft, z, nrows, speeds, rows);
+    if (st) builder_fail(c, s, s->line, st);
+  }
+  rcb_free(&c->m->alloc, rows);
+  rcb_free(&c->m->alloc, speeds);
+  return st;
+}
+
+static const char *const model_names[5] = {"kramer_1", "kramer_2", "nelson_crandall_1",
+                                           "nelson_crandall_2", "rigid"};
+
+/* Which of kt, kr, ct, cr (bits 0..3) each coupling model uses (paper section 3). */
+static const unsigned model_uses[5] = {0x0u, 0xAu, 0x3u, 0xFu, 0x0u};
+
+static rcb_status coupling_params(ini_ctx *c, const ini_section *s, rcb_coupling_model type,
+                                  rcb_coupling_params *p) {
+  static const char *const pk[4] = {"kt", "kr", "ct", "cr"};
+  static const char *const pe[4] = {
+      "translational stiffness in N/m", "rotational stiffness in N m/rad",
+      "translational damping in N s/m", "rotational damping in N m s/rad"};
+  double *dst[4];
+  char uses[64];
+  const char *used[4];
+  size_t nu = 0, k;
+  unsigned mask = model_uses[type];
+  dst[0] = &p->kt;
+  dst[1] = &p->kr;
+  dst[2] = &p->ct;
+  dst[3] = &p->cr;
+  for (k = 0; k < 4; k++)
+    if (mask & (1u << k)) used[nu++] = pk[k];
+  uses[0] = '\0';
+  for (k = 0; k < nu; k++)
+    snprintf(uses + strlen(uses), sizeof uses - strlen(uses), "%s%s", k ? ", " : "", used[k]);
+  for (k = 0; k < 4; k++) {
+    const ini_entry *e = rcb_ini_get(s, pk[k]);
+    if (e && !(mask & (1u << k)))
+      return rcb_ini_error(c, RCB_ERR_PARSE, e->line, s, e->key,
+                           "not used by model %s; expected %s%s (remove %s or change the "
+                           "model)",
+                           model_names[type], nu ? "only " : "no stiffness or damping keys",
+                           uses, pk[k]);
+    if (!e && (mask & (1u << k)))
+      return rcb_ini_error(c, RCB_ERR_PARSE, s->line, s, NULL,
+                           "missing key '%s'; expected %s = %s (model %s needs %s)", pk[k],
+                           pk[k], pe[k], model_names[type], uses);
+    if (e) TRY(rcb_ini_get_num(c, s, pk[k], pe[k], 1, 0, dst[k]));
+  }
+  return RCB_OK;
+}
+
+static rcb_status coupling_hubs(ini_ctx *c, const ini_section *s, rcb_coupling_params *p) {
+  static const char *const mk[3] = {"hub_mass", "hub_Id", "hub_Ip"};
+  static const char *const gk[4] = {"hub_density", "hub_inner_radius", "hub_outer_radius",
+                                    "hub_thickness"};
+  const ini_entry *em = first_of(s, mk, 3), *eg = first_of(s, gk, 4);
+  int geo, k;
+  if (!em && !eg) return RCB_OK; /* massless coupling */
+  TRY(inertia_kind(c, s, mk, gk, "hub", &geo));
+  if (geo) {
+    double rho, ri, ro, t;
+    TRY(rcb_ini_get_num(c, s, "hub_density", "equivalent density in kg/m^3", 1, 0, &rho));
+    TRY(rcb_ini_get_num(c, s, "hub_inner_radius", "inner radius in m", 1, 0, &ri));
+    TRY(rcb_ini_get_num(c, s, "hub_outer_radius", "outer radius in m", 1, 0, &ro));
+    TRY(rcb_ini_get_num(c, s, "hub_thickness", "equivalent thickness of the whole coupling in m",
+                        1, 0, &t));
+    if (rcb_coupling_hubs_from_geometry(rho, ri, ro, t, p))
+      return rcb_ini_error(c, RCB_ERR_PARSE, s->line, s, NULL,
+                           "invalid hub geometry (density %g, inner radius %g, outer radius "
+                           "%g, thickness %g); expected density > 0, outer radius > inner "
+                           "radius >= 0, thickness > 0",
+                           rho, ri, ro, t);
+    return RCB_OK;
+  }
+  TRY(rcb_ini_get_num(c, s, "hub_mass", "hub mass at each station in kg", 1, 0, &p->mass[0]));
+  TRY(rcb_ini_get_num(c, s, "hub_Id", "hub diametral inertia at each station in kg m^2", 1, 0,
+              &p->Id[0]));
+  TRY(rcb_ini_get_num(c, s, "hub_Ip", "hub polar inertia at each station in kg m^2", 1, 0,
+                      &p->Ip[0]));
+  for (k = 1; k < 2; k++) {
+    p->mass[k] = p->mass[0];
+    p->Id[k] = p->Id[0];
+    p->Ip[k] = p->Ip[0];
+  }
+  return RCB_OK;
+}
+
+static rcb_status build_coupling(ini_ctx *c, const ini_section *s) {
+  char name[64], all[120];
+  const char *sh[2];
+  double z[2];
+  rcb_coupling_model type;
+  rcb_coupling_params p;
+  rcb_status st;
+  memset(&p, 0, sizeof p);
+  snprintf(all, sizeof all, "%s, %s, %s, %s or %s", model_names[0], model_names[1],
+           model_names[2], model_names[3], model_names[4]);
+  TRY(rcb_ini_get_word(c, s, "model", all, name, sizeof name));
+  if (rcb_coupling_model_parse(name, &type)) {
+    const char *near = rcb_ini_closest(name, model_names, 5);
+    return rcb_ini_error(c, RCB_ERR_PARSE, rcb_ini_get(s, "model")->line, s, "model",
+                         "unknown coupling model '%s'%s%s%s; expected %s", name,
+                         near ? " (did you mean " : "", near ? near : "", near ? "?)" : "",
+                         all);
+  }
+  TRY(rcb_ini_between(c, s, sh, z, 0));
+  TRY(coupling_params(c, s, type, &p));
+  TRY(coupling_hubs(c, s, &p));
+  st = rcb_model_add_coupling(c->m, s->name, type, sh[0], z[0], sh[1], z[1], &p);
+  return st ? builder_fail(c, s, s->line, st) : RCB_OK;
+}
+
+static rcb_status build_unbalance(ini_ctx *c, const ini_section *s) {
+  const char *shaft;
+  double z, amount, deg;
+  rcb_status st;
+  TRY(rcb_ini_get_at(c, s, &shaft, &z));
+  TRY(rcb_ini_get_num(c, s, "amount", "unbalance m e in kg m", 1, 0, &amount));
+  TRY(rcb_ini_get_num(c, s, "phase_deg", "angle in degrees from +x towards +y", 0, 0.0, &deg));
+  st = rcb_model_add_unbalance(c->m, s->name, shaft, z, amount, deg * RCB_PI / 180.0);
+  return st ? builder_fail(c, s, s->line, st) : RCB_OK;
+}
+
+static rcb_status build_station(ini_ctx *c, const ini_section *s) {
+  const char *shaft;
+  double z;
+  rcb_status st;
+  TRY(rcb_ini_get_at(c, s, &shaft, &z));
+  st = rcb_model_add_station(c->m, s->name, shaft, z);
+  return st ? builder_fail(c, s, s->line, st) : RCB_OK;
+}
+
+/* A finalize message starts "KIND 'NAME'": find that item's section. */
+static const ini_section *section_of_message(const ini_ctx *c, const char *msg) {
+  char kind[32], name[2 * RCB_NAME_MAX];
+  size_t i;
+  if (sscanf(msg, "%31s '%95[^']'", kind, name) != 2) return NULL;
+  for (i = 0; i < c->n_sec; i++)
+    if (strcmp(rcb_ini_type_name(c->sec[i].type), kind) == 0 &&
+        strcmp(c->sec[i].name, name) == 0)
+      return &c->sec[i];
+  return NULL;
+}
+
+rcb_status rcb_ini_build(ini_ctx *c) {
+  /* dependency order: what is placed on a shaft comes after the shafts */
+  static const ini_sec_type order[] = {INI_SEC_MATERIAL,  INI_SEC_SHAFT,    INI_SEC_DISK,
+                                       INI_SEC_BEARING,   INI_SEC_COUPLING, INI_SEC_UNBALANCE,
+                                       INI_SEC_STATION};
+  size_t k, i;
+  rcb_status st = RCB_OK;
+  for (k = 0; k < sizeof order / sizeof order[0] && !st; k++)
+    for (i = 0; i < c->n_sec && !st; i++) {
+      ini_section *s = &c->sec[i];
+      if (s->type != order[k]) continue;
+      switch (s->type) {
+        case INI_SEC_MATERIAL: st = build_material(c, s); break;
+        case INI_SEC_SHAFT: st = build_shaft(c, s); break;
+        case INI_SEC_DISK: st = build_disk(c, s); break;
+        case INI_SEC_BEARING: st = build_bearing(c, s); break;
+        case INI_SEC_COUPLING: st = build_coupling(c, s); break;
+        case INI_SEC_UNBALANCE: st = build_unbalance(c, s); break;
+        case INI_SEC_STATION: st = build_station(c, s); break;
+        default: break;
+      }
+    }
+  if (st) return st;
+  st = rcb_model_finalize(c->m);
+  if (st) {
+    const ini_section *s = section_of_message(c, rcb_model_errmsg(c->m));
+    return builder_fail(c, s, s ? s->line : 0, st);
+  }
+  return RCB_OK;
+}
