@@ -99,10 +99,33 @@ RCB_API void rcb_modes_destroy(rcb_modes *e);
 RCB_API const char *rcb_modes_errmsg(const rcb_modes *e);
 
 /**
+ * @brief Leave out modes whose damping ratio exceeds @p max_zeta (default 1:
+ * every oscillating root is kept, as ROSS does). With strong
+ * stiffness-proportional damping (qz_k), the overdamped high-frequency modes
+ * leave a cluster of roots near -1/qz_k that gyroscopic coupling turns into
+ * pairs with tiny wd and zeta ~ 1 - 1e-9; sorted by wd they come first and
+ * would fill a Campbell diagram (and cross 1X at a few rad/s). A value such
+ * as 0.99 (logdec ~ 44) removes them. Applies to rcb_modes_compute and
+ * rcb_campbell. @return RCB_ERR_ARG unless 0 < max_zeta <= 1
+ */
+RCB_API rcb_status rcb_modes_set_max_zeta(rcb_modes *e, double max_zeta);
+
+/**
  * @brief Damped modes at rotor speed @p speed (rad/s) from the state-space
  * pencil, sorted by increasing wd; only oscillating modes (wd > 0) are kept,
  * rigid-body and overdamped roots are left out.
- * @param max_modes capacity of @p modes
+ *
+ * A root counts as oscillating when wd > 1e-7 max|lambda| (max over all 2n
+ * roots): the rigid-body roots (lambda = 0) of a free rotor come out of the
+ * eigensolver scattered at ~ sqrt(machine eps) max|lambda|. The gyroscopic
+ * nutation of a free rotor at speed (wd ~ Ip Omega / Id) is a true
+ * oscillation and is kept when above that floor. Whirl: from the translations
+ * (x, y) of every node moving more than 1e-3 of the largest, forward radius
+ * |X + iY|/2 against backward |X - iY|/2; FORWARD if all such nodes whirl
+ * forward, BACKWARD if all backward, MIXED otherwise (also for planar motion).
+ * Errors: RCB_ERR_MODEL if M is not positive definite, RCB_ERR_LAPACK if the
+ * eigensolver fails; the message is in rcb_modes_errmsg(). Allocates nothing.
+ * @param max_modes capacity of @p modes (the lowest max_modes are written)
  * @param modes output @param nmodes number written
  * @param shapes optional (NULL): n x max_modes column-major complex right
  * eigenvectors (displacement part), n = rcb_model_dof_count(), each scaled to
@@ -112,11 +135,14 @@ RCB_API rcb_status rcb_modes_compute(rcb_modes *e, double speed, size_t max_mode
                                      rcb_mode *modes, size_t *nmodes, rcb_complex *shapes);
 
 /**
- * @brief Campbell data: the first @p nmodes damped modes at each speed.
+ * @brief Campbell data: the first @p nmodes damped modes at each speed
+ * (k-th lowest wd at each speed, no mode tracking: curves that cross swap
+ * indices). Allocates nothing.
  * @param speeds rad/s, @p nspeeds of them
  * @param wd output damped frequencies rad/s, nmodes x nspeeds column-major
  * (NaN where fewer modes exist) @param logdec output, same shape, may be NULL
- * @param whirl output, same shape, may be NULL
+ * @param whirl output, same shape, may be NULL (RCB_WHIRL_MIXED where fewer
+ * modes exist)
  */
 RCB_API rcb_status rcb_campbell(rcb_modes *e, size_t nspeeds, const double *speeds,
                                 size_t nmodes, double *wd, double *logdec, rcb_whirl *whirl);
@@ -124,9 +150,16 @@ RCB_API rcb_status rcb_campbell(rcb_modes *e, size_t nspeeds, const double *spee
 /**
  * @brief Critical speeds: where a Campbell curve crosses the line
  * wd = ratio * speed (ratio 1 for 1X), by linear interpolation between
- * table rows. Inputs as produced by rcb_campbell.
+ * table rows. Inputs as produced by rcb_campbell. Pure function (no state,
+ * no allocation). A row where a curve lies exactly on the line counts once;
+ * NaN entries break a curve (no crossing across them). Results are sorted by
+ * increasing speed.
+ * @param speeds rad/s, strictly increasing (else RCB_ERR_ARG)
+ * @param wd nmodes x nspeeds column-major, rad/s
  * @param crit output speeds rad/s, capacity @p max_crit @param mode_of output,
- * index of the curve crossing (may be NULL) @param ncrit number found
+ * index of the curve crossing (may be NULL) @param ncrit number written
+ * @return RCB_OK, or RCB_ERR_WORKSPACE when more than max_crit crossings
+ * exist (the lowest max_crit are written)
  */
 RCB_API rcb_status rcb_critical_speeds(size_t nspeeds, const double *speeds, size_t nmodes,
                                        const double *wd, double ratio, size_t max_crit,
