@@ -1,0 +1,187 @@
+/**
+ * @file cli.h
+ * @brief rcbtool internals shared by the subcommands: option parsing, model
+ * loading, channel lists, output (CSV/JSON, atomic -o), progress and exit codes.
+ *
+ * rcbtool uses only the public librcb header. Units at this edge: speeds in
+ * rpm and frequencies in Hz; they are converted to rad/s for the library.
+ */
+#ifndef RCBTOOL_CLI_H
+#define RCBTOOL_CLI_H
+
+#include <stdio.h>
+
+#include <rcb/rcb.h>
+
+/** Exit codes (the CLI contract). */
+enum {
+  CLI_EXIT_OK = 0,
+  CLI_EXIT_USAGE = 2,   /**< bad command line */
+  CLI_EXIT_INPUT = 3,   /**< bad input: model file or data */
+  CLI_EXIT_NUMERIC = 4, /**< numerical failure in an analysis */
+  CLI_EXIT_IO = 5       /**< output could not be written */
+};
+
+#define CLI_PI 3.14159265358979323846
+#define CLI_RPM_TO_RAD_S (CLI_PI / 30.0) /* rad/s per rpm */
+#define CLI_HZ_TO_RAD_S (2.0 * CLI_PI)   /* rad/s per Hz */
+
+/** One command-specific option, e.g. {"--rpm", "R"}; metavar NULL = flag. */
+typedef struct cli_opt {
+  const char *name;
+  const char *metavar;
+  const char *value; /**< filled by cli_parse: the argument, "" for a flag, NULL if absent */
+} cli_opt;
+
+/** A parsed command line. */
+typedef struct cli_args {
+  const char *cmd;    /**< subcommand name */
+  const char *model;  /**< MODEL.ini path */
+  const char *output; /**< -o FILE, NULL = stdout */
+  int json;           /**< --json */
+  int progress;       /**< --progress */
+  int help;           /**< --help / -h */
+  cli_opt *opts;
+  size_t nopts;
+} cli_args;
+
+/** A subcommand: name, one-line summary, help text, entry point. */
+typedef struct cli_command {
+  const char *name;
+  const char *summary;
+  const char *help;
+  int (*run)(int argc, char **argv);
+} cli_command;
+
+/* ---- messages (cli_common.c) ---- */
+
+/** Print "rcbtool: <message>" to stderr and return @p code. */
+int cli_fail(int code, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+/** A usage error: message plus a pointer to --help; returns CLI_EXIT_USAGE. */
+int cli_usage(const char *cmd, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+/** @p msg if it says something, else the status text. */
+const char *cli_msg(const char *msg, rcb_status st);
+/** Exit code for a failed analysis call (numerical failure unless it is the input). */
+int cli_status_exit(rcb_status st);
+
+/* ---- options (cli_args.c) ---- */
+
+/**
+ * @brief Parse "rcbtool CMD [MODEL] [options]" (argv[0] is CMD). Common options
+ * (-o/--output, --json, --progress, --help) are handled here, command
+ * options go to @p opts. Accepts "--opt value" and "--opt=value".
+ * @return 0, or CLI_EXIT_USAGE after printing what is wrong.
+ */
+int cli_parse(int argc, char **argv, cli_opt *opts, size_t nopts, cli_args *a);
+/** The option's value, NULL if not given. */
+const char *cli_opt_value(const cli_args *a, const char *name);
+/** A finite number from option @p name (default @p def when absent). */
+int cli_opt_double(const cli_args *a, const char *name, const char *unit, double def,
+                   double *out);
+/** A whole number >= 1 from option @p name (default @p def when absent). */
+int cli_opt_count(const cli_args *a, const char *name, size_t def, size_t *out);
+/** Like cli_opt_double, also requires the value to be >= 0. */
+int cli_opt_nonneg(const cli_args *a, const char *name, const char *unit, double def,
+                   double *out);
+/**
+ * @brief One of @p n words from option @p name: *out is its index (@p def when
+ * absent); anything else is a usage error listing the choices.
+ */
+int cli_opt_choice(const cli_args *a, const char *name, const char *const *choices, size_t n,
+                   int def, int *out);
+/** The option must be present: usage error naming what is expected otherwise. */
+int cli_opt_require(const cli_args *a, const char *name, const char *what);
+/** Evenly spaced grid: x_i = lo + i (hi - lo)/(n - 1) (x_0 = lo when n = 1). */
+void cli_linspace(double lo, double hi, size_t n, double *x);
+
+/* ---- model and channels (cli_model.c) ---- */
+
+/** Load and finalize MODEL.ini; on failure print the library message, exit 3. */
+int cli_load_model(const cli_args *a, rcb_model **out);
+
+/** A list of channels "STATION.DIR,..." resolved against a model. */
+typedef struct cli_channels {
+  char *buf;     /**< one copy of the list, split in place */
+  char **names;  /**< n channel names (point into buf) */
+  rcb_dof *dofs; /**< n resolved DOFs */
+  size_t n;
+} cli_channels;
+
+/** Resolve option @p opt's channel list; unknown channel = usage error (exit 2). */
+int cli_channels_parse(const cli_args *a, rcb_model *m, const char *opt, cli_channels *ch);
+void cli_channels_free(cli_channels *ch);
+
+/* ---- output (cli_output.c) ---- */
+
+/** Where results go: stdout, or a temporary file renamed onto -o FILE at the end. */
+typedef struct cli_out {
+  FILE *fp;
+  const char *path; /**< final path, NULL for stdout */
+  char *tmp;        /**< temporary path while writing */
+} cli_out;
+
+/** Open the destination; refuses to write over the model file. 0 or exit 5. */
+int cli_out_open(cli_out *o, const cli_args *a);
+/** Flush and commit (rename the temporary file); on any error remove it, exit 5. */
+int cli_out_close(cli_out *o);
+/** Abandon the output: the temporary file is removed, nothing is left. */
+void cli_out_abort(cli_out *o);
+
+/** Number as CSV field: "%.17g" ("nan", "inf" as printf spells them). */
+void cli_csv_num(FILE *fp, double x);
+/** Number as JSON: "%.17g", null for NaN and infinities. */
+void cli_json_num(FILE *fp, double x);
+/** String as a JSON string literal (escaped). */
+void cli_json_str(FILE *fp, const char *s);
+/** JSON array of n numbers x[0], x[stride], ... */
+void cli_json_nums(FILE *fp, const double *x, size_t n, size_t stride);
+/** JSON list of the model's nodes: [{"node", "shaft", "z", "dof": [4]}, ...]. */
+void cli_json_nodes(FILE *fp, const rcb_model *m);
+/** "forward", "backward" or "mixed". */
+const char *cli_whirl_name(rcb_whirl w);
+
+/* ---- progress line on stderr (cli_output.c) ---- */
+
+typedef struct cli_progress {
+  int on;
+  int tty; /**< stderr is a terminal: update the line in place */
+  const char *label; /**< e.g. "frf" */
+  const char *unit;  /**< e.g. "frequencies" */
+  size_t total;
+  size_t shown; /**< last count printed */
+} cli_progress;
+
+/** On when --progress is given, or when stderr is a terminal and the sweep is long. */
+void cli_progress_start(cli_progress *p, const cli_args *a, const char *label,
+                        const char *unit, size_t total);
+void cli_progress_step(cli_progress *p, size_t done);
+void cli_progress_end(cli_progress *p);
+
+/* ---- subcommands (one file each) ---- */
+
+int cmd_check(int argc, char **argv);
+int cmd_matrices(int argc, char **argv);
+int cmd_frf(int argc, char **argv);
+int cmd_unbalance(int argc, char **argv);
+int cmd_modes(int argc, char **argv);
+int cmd_campbell(int argc, char **argv);
+
+extern const char cli_help_check[];
+extern const char cli_help_matrices[];
+extern const char cli_help_frf[];
+extern const char cli_help_unbalance[];
+extern const char cli_help_modes[];
+extern const char cli_help_campbell[];
+
+/** Print a command's help text to stdout; returns 0 (or 5 if stdout fails). */
+int cli_print_help(const char *text);
+
+#endif /* RCBTOOL_CLI_H */

@@ -1,0 +1,78 @@
+/* rcbtool: command-line front end of librcb (lateral rotordynamics of
+ * rotor-coupling-bearing systems). Dispatches to one file per subcommand. */
+#include <stdio.h>
+#include <string.h>
+
+#include "cli.h"
+
+static const cli_command commands[] = {
+    {"check", "validate a model, print its node/DOF and station tables", cli_help_check,
+     cmd_check},
+    {"matrices", "global M, C, G, K matrices at a speed", cli_help_matrices, cmd_matrices},
+    {"frf", "frequency response functions between channels", cli_help_frf, cmd_frf},
+    {"unbalance", "steady unbalance response over a speed range", cli_help_unbalance,
+     cmd_unbalance},
+    {"modes", "damped natural frequencies, damping and whirl at a speed", cli_help_modes,
+     cmd_modes},
+    {"campbell", "Campbell diagram data and 1X critical speeds", cli_help_campbell,
+     cmd_campbell},
+};
+#define N_COMMANDS (sizeof commands / sizeof commands[0])
+
+static const cli_command *find_command(const char *name) {
+  size_t i;
+  for (i = 0; i < N_COMMANDS; i++)
+    if (strcmp(commands[i].name, name) == 0) return &commands[i];
+  return NULL;
+}
+
+static void print_usage(FILE *fp) {
+  size_t i;
+  fputs("usage: rcbtool <command> MODEL.ini [options]\n"
+        "       rcbtool help [command]\n"
+        "       rcbtool --version\n\n"
+        "Commands:\n",
+        fp);
+  for (i = 0; i < N_COMMANDS; i++)
+    fprintf(fp, "  %-10s %s\n", commands[i].name, commands[i].summary);
+  fputs("\nCommon options: --json (JSON instead of CSV), -o FILE (write FILE atomically),\n"
+        "--progress (progress line on stderr), --help.\n"
+        "Speeds are in rpm and frequencies in Hz on the command line.\n"
+        "Exit codes: 0 ok, 2 usage error, 3 bad input (model or data),\n"
+        "4 numerical failure, 5 output I/O error.\n",
+        fp);
+}
+
+static int cmd_help(int argc, char **argv) {
+  const cli_command *c;
+  if (argc < 2) {
+    print_usage(stdout);
+    return cli_print_help("");
+  }
+  c = find_command(argv[1]);
+  if (!c) return cli_usage(NULL, "unknown command '%s'", argv[1]);
+  return cli_print_help(c->help);
+}
+
+static int print_version(void) {
+  printf("rcbtool %d.%d.%d (librcb %s)\n", RCB_VERSION_MAJOR, RCB_VERSION_MINOR,
+         RCB_VERSION_PATCH, rcb_version_string());
+  return cli_print_help("");
+}
+
+int main(int argc, char **argv) {
+  const cli_command *c;
+  if (argc < 2) {
+    print_usage(stderr);
+    return CLI_EXIT_USAGE;
+  }
+  if (strcmp(argv[1], "--version") == 0 || strcmp(argv[1], "-V") == 0) return print_version();
+  if (strcmp(argv[1], "help") == 0 || strcmp(argv[1], "--help") == 0 ||
+      strcmp(argv[1], "-h") == 0)
+    return cmd_help(argc - 1, argv + 1);
+  c = find_command(argv[1]);
+  if (!c) return cli_usage(NULL, "unknown command '%s'; expected one of check, matrices, "
+                                 "frf, unbalance, modes, campbell, help",
+                           argv[1]);
+  return c->run(argc - 1, argv + 1);
+}
