@@ -1,2 +1,84 @@
-# Install rules: headers, libraries, rcb::rcb export, rcbConfig.cmake, rcb.pc.
-# (Completed in the build/install task.)
+# Install rules: public headers (plus the generated rcb_config.h), the shared
+# and static libraries, rcbtool, the rcb::rcb export (rcbConfig.cmake +
+# rcbConfigVersion.cmake) and rcb.pc for pkg-config users.
+#
+# Consumers:
+#   find_package(rcb CONFIG REQUIRED)  ->  target_link_libraries(app PRIVATE rcb::rcb)
+#   cc app.c $(pkg-config --cflags --libs rcb)          (shared)
+#   cc app.c $(pkg-config --static --cflags --libs rcb) (static)
+# rcb::rcb is the shared library when it was built, else an alias of
+# rcb::rcb_static (made by rcbConfig.cmake).
+include(CMakePackageConfigHelpers)
+
+set(RCB_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/rcb CACHE STRING
+  "Where rcbConfig.cmake is installed, relative to the prefix")
+mark_as_advanced(RCB_INSTALL_CMAKEDIR)
+
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/rcb
+  DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} COMPONENT dev
+  FILES_MATCHING PATTERN "*.h")
+install(FILES ${PROJECT_BINARY_DIR}/include/rcb/rcb_config.h
+  DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/rcb COMPONENT dev)
+
+# Consumers of the export get rcb::rcb (EXPORT_NAME of target rcb) and
+# rcb::rcb_static.
+install(TARGETS ${RCB_LIB_TARGETS} EXPORT rcbTargets
+  LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT runtime
+    NAMELINK_COMPONENT dev
+  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT dev
+  RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
+
+if(TARGET rcbtool)
+  # tools/CMakeLists.txt installs rcbtool to bin; the installed tool finds the
+  # installed librcb.so through a relative rpath, wherever the prefix is.
+  file(RELATIVE_PATH _rcb_bin_to_lib ${CMAKE_INSTALL_FULL_BINDIR}
+    ${CMAKE_INSTALL_FULL_LIBDIR})
+  set_target_properties(rcbtool PROPERTIES INSTALL_RPATH "$ORIGIN/${_rcb_bin_to_lib}")
+endif()
+
+install(EXPORT rcbTargets NAMESPACE rcb:: FILE rcbTargets.cmake
+  DESTINATION ${RCB_INSTALL_CMAKEDIR} COMPONENT dev)
+
+# What the static library needs at link time, for rcbConfig.cmake.
+set(RCB_CONFIG_WITH_SUITESPARSE ${RCB_WITH_SUITESPARSE})
+set(RCB_CONFIG_WITH_NLOPT ${RCB_WITH_NLOPT})
+set(RCB_CONFIG_WITH_SUNDIALS ${RCB_WITH_SUNDIALS})
+configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/rcbConfig.cmake.in
+  ${PROJECT_BINARY_DIR}/rcbConfig.cmake
+  INSTALL_DESTINATION ${RCB_INSTALL_CMAKEDIR})
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/rcbConfigVersion.cmake
+  VERSION ${PROJECT_VERSION} COMPATIBILITY SameMajorVersion)
+set(_rcb_cmake_files ${PROJECT_BINARY_DIR}/rcbConfig.cmake
+  ${PROJECT_BINARY_DIR}/rcbConfigVersion.cmake)
+if(RCB_WITH_SUITESPARSE)
+  list(APPEND _rcb_cmake_files ${PROJECT_SOURCE_DIR}/cmake/FindKLU.cmake)
+endif()
+install(FILES ${_rcb_cmake_files} DESTINATION ${RCB_INSTALL_CMAKEDIR} COMPONENT dev)
+
+# pkg-config: the shared library by default; --static adds Libs.private.
+set(RCB_PC_LIBS_PRIVATE "-llapacke -llapack -lblas")
+set(RCB_PC_REQUIRES_PRIVATE "inih")
+if(RCB_WITH_SUITESPARSE)
+  string(APPEND RCB_PC_LIBS_PRIVATE " -lklu -lamd -lcolamd -lbtf -lsuitesparseconfig")
+endif()
+if(RCB_WITH_NLOPT)
+  string(APPEND RCB_PC_REQUIRES_PRIVATE " nlopt")
+endif()
+string(APPEND RCB_PC_LIBS_PRIVATE " -lm")
+# prefix is found from the .pc file's own place (${pcfiledir}), so the package
+# stays right when installed with `cmake --install --prefix DIR` or moved.
+file(RELATIVE_PATH _rcb_pc_to_prefix ${CMAKE_INSTALL_FULL_LIBDIR}/pkgconfig
+  ${CMAKE_INSTALL_PREFIX})
+string(REGEX REPLACE "/$" "" _rcb_pc_to_prefix "${_rcb_pc_to_prefix}")
+set(RCB_PC_PREFIX "\${pcfiledir}/${_rcb_pc_to_prefix}")
+# Absolute install dirs are kept as given.
+foreach(_d LIBDIR INCLUDEDIR)
+  if(IS_ABSOLUTE "${CMAKE_INSTALL_${_d}}")
+    set(RCB_PC_${_d} "${CMAKE_INSTALL_${_d}}")
+  else()
+    set(RCB_PC_${_d} "\${prefix}/${CMAKE_INSTALL_${_d}}")
+  endif()
+endforeach()
+configure_file(${PROJECT_SOURCE_DIR}/cmake/rcb.pc.in ${PROJECT_BINARY_DIR}/rcb.pc @ONLY)
+install(FILES ${PROJECT_BINARY_DIR}/rcb.pc
+  DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig COMPONENT dev)

@@ -1,0 +1,78 @@
+#!/usr/bin/env bash
+# ctest driver (test "install_consumer"): install a librcb build tree into a
+# scratch prefix, build this consumer against it with find_package(rcb) and
+# with pkg-config (shared and static), run each, and check the printed
+# values against the closed form below.
+#
+# usage: run_consumer_test.sh CMAKE BUILD_DIR WORK_DIR [C_COMPILER]
+set -euo pipefail
+cmake_cmd=$1
+build_dir=$2
+work=$3
+cc=${4:-cc}
+here=$(cd "$(dirname "$0")" && pwd)
+
+rm -rf "$work"
+mkdir -p "$work"
+prefix=$work/prefix
+"$cmake_cmd" --install "$build_dir" --prefix "$prefix" > "$work/install.log"
+# The installed rcbtool (when built) must find the installed library by itself.
+if [[ -e $prefix/bin/rcbtool ]]; then
+  env -u LD_LIBRARY_PATH "$prefix/bin/rcbtool" --version
+fi
+
+# 1. CMake package: rcb::rcb (shared) and rcb::rcb_static.
+"$cmake_cmd" -S "$here" -B "$work/build" -DCMAKE_PREFIX_PATH="$prefix" \
+  -DCMAKE_C_COMPILER="$cc" -DCMAKE_BUILD_TYPE=Release > "$work/configure.log"
+"$cmake_cmd" --build "$work/build" > "$work/build.log"
+runs=("$work/build/rcb_consumer")
+[[ -x $work/build/rcb_consumer_static ]] && runs+=("$work/build/rcb_consumer_static")
+
+# 2. pkg-config, shared (rpath to the scratch prefix) and --static.
+pcfile=$(find "$prefix" -name rcb.pc | head -n 1)
+PKG_CONFIG_PATH=$(dirname "$pcfile")
+export PKG_CONFIG_PATH
+libdir=$(pkg-config --variable=libdir rcb)
+if [[ -f $libdir/librcb.so ]]; then
+  # shellcheck disable=SC2046
+  "$cc" -std=c11 -O2 -o "$work/consumer_pc" "$here/main.c" \
+    $(pkg-config --cflags --libs rcb) -lm -Wl,-rpath,"$libdir"
+  runs+=("$work/consumer_pc")
+fi
+if [[ -f $libdir/librcb.a ]]; then
+  # shellcheck disable=SC2046
+  "$cc" -std=c11 -O2 -o "$work/consumer_pc_static" "$here/main.c" \
+    $(pkg-config --static --cflags rcb) "$libdir/librcb.a" \
+    $(pkg-config --static --libs-only-l rcb | sed 's/-lrcb//') -lm
+  runs+=("$work/consumer_pc_static")
+fi
+
+# Closed form. The shaft (EI -> 48 EI/L^3 ~ 4.9e7 N/m at mid-span) is ~2400
+# times stiffer than the two bearings in parallel (2k = 2e4 N/m), so the
+# first mode is the rigid shaft bouncing on its bearings (disk at mid-span:
+# translation and tilt decouple by symmetry), and
+#   f1 = sqrt(2k / (m_disk + rho pi d^2/4 L)) / (2 pi)            (Hz)
+# with the whole shaft mass moving (a consistent mass matrix keeps rigid
+# translation exact). The receptance of the disk, x to x, below f1:
+#   H(w) = 1 / (2k - w^2 m_total)                                 (m/N)
+# Shaft flexibility shifts both by ~2k/(48EI/L^3) ~ 4e-4: assert to 1 %.
+expected=$(awk 'BEGIN {
+  pi = 3.14159265358979; rho = 7850; d = 0.05; L = 0.4; md = 10; k = 1e4; f = 2;
+  mt = md + rho * pi * d * d / 4 * L; w = 2 * pi * f;
+  printf "%.9g %.9g", sqrt(2 * k / mt) / (2 * pi), 1 / (2 * k - w * w * mt) }')
+read -r f1_ref h_ref <<< "$expected"
+echo "closed form: f1 = $f1_ref Hz, H(2 Hz) = $h_ref m/N"
+
+status=0
+for exe in "${runs[@]}"; do
+  out=$("$exe")
+  f1=$(awk '$1 == "f1_hz" { print $2 }' <<< "$out")
+  h=$(awk '$1 == "h_dx_dx_m_per_n" { print $2 }' <<< "$out")
+  verdict=$(awk -v a="$f1" -v b="$f1_ref" -v c="$h" -v e="$h_ref" 'BEGIN {
+    if (a == "" || c == "") { print "FAIL missing output"; exit }
+    ra = (a - b) / b; rc = (c - e) / e; if (ra < 0) ra = -ra; if (rc < 0) rc = -rc;
+    printf "%s f1 rel.err %.2e, H rel.err %.2e", (ra < 0.01 && rc < 0.01) ? "ok" : "FAIL", ra, rc }')
+  echo "$(basename "$exe"): f1 = $f1 Hz, H = $h m/N: $verdict"
+  [[ $verdict == ok* ]] || status=1
+done
+exit $status

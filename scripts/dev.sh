@@ -1,0 +1,275 @@
+#!/usr/bin/env bash
+# librcb developer entry point. Run from anywhere inside the repository.
+#
+#   ./scripts/dev.sh demo       install what is missing, build, run the paper-system demo
+#   ./scripts/dev.sh test       install what is missing, build, run every test:
+#                               ctest, Python cross-validation against ROSS, the core
+#                               configuration (no optional backend), ASan+UBSan build
+#   ./scripts/dev.sh deps       Debian packages + the pinned Python venv (.venv)
+#   ./scripts/dev.sh build      configure + build in build/ (Release)
+#   ./scripts/dev.sh core       build + ctest with every optional backend OFF (build-core/)
+#   ./scripts/dev.sh sanitize   AddressSanitizer + UBSan build and ctest (build-asan/)
+#   ./scripts/dev.sh bench      FRF sweep benchmark (C dense/banded; SciPy and ROSS if .venv)
+#
+# Environment: CI=true turns warnings into errors; RCB_BUILD_DIR (default build)
+# and RCB_VENV (default .venv) move the build tree and the venv;
+# RCB_SKIP_SANITIZE=1 leaves the sanitizer build out of `test`; JOBS sets the
+# build parallelism (default: all processors).
+set -euo pipefail
+
+ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$ROOT"
+
+BUILD_DIR=${RCB_BUILD_DIR:-build}
+[[ $BUILD_DIR == /* ]] || BUILD_DIR=$ROOT/$BUILD_DIR
+VENV=${RCB_VENV:-.venv}
+JOBS=${JOBS:-$(nproc 2>/dev/null || echo 2)}
+CI=${CI:-false}
+MODEL=examples/paper_system.ini
+
+DEB_PACKAGES=(build-essential cmake pkg-config libopenblas-dev liblapacke-dev
+  libsuitesparse-dev libnlopt-dev libsundials-dev libcmocka-dev libinih-dev
+  python3-venv python3-pip)
+
+say() { printf '\n==> %s\n' "$*"; }
+die() { printf 'dev.sh: %s\n' "$*" >&2; exit 1; }
+
+as_root() {
+  if [[ $(id -u) -eq 0 ]]; then "$@"; else sudo "$@"; fi
+}
+
+# Debian packages: install only the missing ones; apt-get update only then.
+deps_debian() {
+  if ! command -v dpkg-query > /dev/null; then
+    echo "not a Debian system: install the equivalents of: ${DEB_PACKAGES[*]}"
+    return 0
+  fi
+  local missing=() p
+  for p in "${DEB_PACKAGES[@]}"; do
+    if ! dpkg-query -W -f='${Status}' "$p" 2> /dev/null | grep -q 'install ok installed'; then
+      missing+=("$p")
+    fi
+  done
+  if ((${#missing[@]} == 0)); then
+    echo "Debian packages: all present"
+    return 0
+  fi
+  say "installing Debian packages: ${missing[*]}"
+  as_root apt-get update
+  as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends \
+    "${missing[@]}"
+}
+
+# The pinned Python venv for the cross-validation; pip runs only when
+# requirements.txt changed since the last successful install (stamp file).
+deps_python() {
+  [[ -f requirements.txt ]] || die "requirements.txt missing at $ROOT"
+  if [[ ! -x $VENV/bin/python ]]; then
+    say "creating the Python venv $VENV"
+    rm -rf "$VENV"
+    python3 -m venv "$VENV"
+  fi
+  local stamp=$VENV/.requirements.sha256 want
+  want=$(sha256sum requirements.txt | cut -d' ' -f1)
+  if [[ -f $stamp && $(cat "$stamp") == "$want" ]]; then
+    echo "Python venv $VENV: up to date"
+    return 0
+  fi
+  say "installing requirements.txt into $VENV"
+  "$VENV/bin/python" -m pip install --quiet --upgrade pip
+  "$VENV/bin/python" -m pip install --quiet -r requirements.txt
+  echo "$want" > "$stamp"
+}
+
+cmd_deps() {
+  say "dependencies"
+  deps_debian
+  deps_python
+}
+
+# configure_build DIR [cmake options...]
+configure_build() {
+  local dir=$1
+  shift
+  local opts=(-DCMAKE_BUILD_TYPE=Release -DRCB_WARNINGS_AS_ERRORS=OFF)
+  [[ $CI == true ]] && opts+=(-DRCB_WARNINGS_AS_ERRORS=ON)
+  mkdir -p "$dir"
+  cmake -S . -B "$dir" "${opts[@]}" "$@" > "$dir/configure.log" 2>&1 ||
+    { cat "$dir/configure.log"; die "cmake configure failed in $dir"; }
+  cmake --build "$dir" -j "$JOBS"
+}
+
+cmd_build() {
+  say "build ($BUILD_DIR, Release, warnings as errors: $CI)"
+  configure_build "$BUILD_DIR"
+}
+
+# The rcbtool executable of a build tree (tools/rcbtool/rcbtool or tools/rcbtool).
+rcbtool_exe() {
+  if [[ -f $BUILD_DIR/tools/rcbtool/rcbtool ]]; then
+    echo "$BUILD_DIR/tools/rcbtool/rcbtool"
+  else
+    echo "$BUILD_DIR/tools/rcbtool"
+  fi
+}
+rcbtool() { "$(rcbtool_exe)" "$@"; }
+
+cmd_demo() {
+  cmd_deps
+  cmd_build
+  [[ -x $(rcbtool_exe) && -f $(rcbtool_exe) ]] || die "rcbtool was not built"
+  local out=out/demo
+  mkdir -p "$out"
+  say "the paper's system: $MODEL"
+  rcbtool check "$MODEL"
+
+  say "damped modes at standstill and at 10000 rpm"
+  local rpm
+  for rpm in 0 10000; do
+    echo "$rpm rpm:"
+    rcbtool modes "$MODEL" --rpm "$rpm" --modes 8 | awk -F, '
+      NR == 1 { for (j = 1; j <= NF; j++) c[$j] = j
+                printf "  %4s %10s %8s %8s  %s\n", "mode", "fd_hz", "zeta", "logdec", "whirl"; next }
+      { printf "  %4s %10.2f %8.4f %8.4f  %s\n", $c["mode"], $c["fd_hz"], $c["zeta"],
+               $c["logdec"], $c["whirl"] }'
+  done
+
+  say "Campbell diagram 0-20000 rpm (first 6 modes), critical speeds"
+  rcbtool campbell "$MODEL" --rpm-min 0 --rpm-max 20000 --points 81 --modes 6 \
+    -o "$out/campbell.csv"
+  rcbtool campbell "$MODEL" --rpm-min 0 --rpm-max 20000 --points 81 --modes 6 --json \
+    -o "$out/campbell.json"
+  # Damped frequencies (Hz) every 5000 rpm, from the fd*_hz columns.
+  awk -F, 'NR == 1 { for (j = 1; j <= NF; j++) if ($j ~ /^fd[0-9]+_hz$/) fd[++n] = j
+                     printf "  %7s", "rpm"; for (k = 1; k <= n; k++) printf " %9s", "fd" k "_hz"
+                     print ""; next }
+    $1 ~ /^[0-9.]+$/ && ($1 % 5000) == 0 && n {
+      printf "  %7.0f", $1; for (k = 1; k <= n; k++) printf " %9.2f", $fd[k]; print "" }' \
+    "$out/campbell.csv"
+  "$(python_for_summary)" - "$out/campbell.json" << 'EOF'
+import json, sys
+d = json.load(open(sys.argv[1]))
+crit = d.get("critical_rpm", [])
+print("1X critical speeds (rpm):", ", ".join("%.0f" % c for c in crit) if crit else "none in range")
+EOF
+
+  say "FRF at 10000 rpm, coupling hubs per disk-A force, 0-500 Hz"
+  rcbtool frf "$MODEL" --out C.A.x,C.A.y,C.B.x,C.B.y --in DA.x --fmin 0 --fmax 500 \
+    --points 2001 --rpm 10000 -o "$out/frf.csv"
+  awk -F, 'NR == 1 { for (j = 2; j <= NF; j += 2) { n[j] = $j; sub(/ re$/, "", n[j]) } next }
+    { for (j = 2; j <= NF; j += 2) { a = sqrt($j * $j + $(j + 1) * $(j + 1));
+        if (a > pk[j]) { pk[j] = a; f[j] = $1 } } }
+    END { for (j = 2; j in n; j += 2)
+            printf "  %-14s peak |H| = %.3e m/N at %.2f Hz\n", n[j], pk[j], f[j] }' \
+    "$out/frf.csv"
+
+  say "unbalance response 0-20000 rpm (UA at DA phase 0, UB at DB phase 90 deg)"
+  rcbtool unbalance "$MODEL" --out DA.x,DA.y,DB.x,DB.y --rpm-min 0 --rpm-max 20000 \
+    --points 401 -o "$out/unbalance.csv"
+  awk -F, 'NR == 1 { for (j = 2; j <= NF; j += 2) { n[j] = $j; sub(/ amp$/, "", n[j]) } next }
+    { for (j = 2; j <= NF; j += 2) if ($j > pk[j]) { pk[j] = $j; r[j] = $1 } }
+    END { for (j = 2; j in n; j += 2)
+            printf "  %-6s max amplitude %.3e m at %.0f rpm\n", n[j], pk[j], r[j] }' \
+    "$out/unbalance.csv"
+  echo
+  echo "full tables (CSV, JSON) in $out/"
+}
+
+python_for_summary() {
+  if [[ -x $VENV/bin/python ]]; then echo "$VENV/bin/python"; else echo python3; fi
+}
+
+run_ctest() {
+  (cd "$1" && OPENBLAS_NUM_THREADS=1 ctest --output-on-failure -j "$JOBS")
+}
+
+cmd_core() {
+  local dir=$BUILD_DIR-core
+  say "core configuration: SuiteSparse, NLopt, SUNDIALS OFF ($dir)"
+  configure_build "$dir" -DRCB_WITH_SUITESPARSE=OFF -DRCB_WITH_NLOPT=OFF \
+    -DRCB_WITH_SUNDIALS=OFF
+  run_ctest "$dir"
+}
+
+cmd_sanitize() {
+  local dir=$BUILD_DIR-asan
+  say "AddressSanitizer + UBSan build ($dir)"
+  configure_build "$dir" -DCMAKE_BUILD_TYPE=Debug -DRCB_ENABLE_SANITIZERS=ON
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
+    UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 run_ctest "$dir"
+}
+
+cmd_pytest() {
+  say "Python cross-validation (tests/python, against ROSS)"
+  local rc=0
+  RCBTOOL=$(rcbtool_exe) OPENBLAS_NUM_THREADS=1 \
+    "$VENV/bin/python" -m pytest tests/python -q || rc=$?
+  if ((rc == 5)); then
+    echo "dev.sh: WARNING: pytest collected no test in tests/python" >&2
+  elif ((rc != 0)); then
+    die "Python cross-validation failed (pytest exit $rc)"
+  fi
+}
+
+cmd_ctest() {
+  say "C tests (ctest, $BUILD_DIR)"
+  run_ctest "$BUILD_DIR"
+}
+
+# Run every stage even when one fails, so one run shows every failure; each
+# stage runs in a subshell with errexit on.
+cmd_test() {
+  local t0=$SECONDS failed=() stage rc
+  cmd_deps
+  cmd_build
+  local stages=(ctest pytest core)
+  [[ ${RCB_SKIP_SANITIZE:-0} == 1 ]] || stages+=(sanitize)
+  for stage in "${stages[@]}"; do
+    set +e
+    (
+      set -e
+      "cmd_$stage"
+    )
+    rc=$?
+    set -e
+    ((rc == 0)) || failed+=("$stage")
+  done
+  if ((${#failed[@]})); then
+    die "FAILED stages: ${failed[*]} ($((SECONDS - t0)) s)"
+  fi
+  say "all tests passed: ${stages[*]} ($((SECONDS - t0)) s)"
+}
+
+cmd_bench() {
+  cmd_build
+  local bench=$BUILD_DIR/tools/bench/bench_frf
+  [[ -x $bench ]] || die "$bench was not built (RCB_BUILD_TOOLS=ON, tools/bench)"
+  say "machine"
+  lscpu | grep -E '^(Model name|CPU\(s\)|Thread\(s\) per core)' || true
+  echo "load average (1, 5, 15 min): $(cut -d' ' -f1-3 /proc/loadavg 2> /dev/null)"
+  say "librcb FRF sweep (one core: OPENBLAS_NUM_THREADS=1)"
+  OPENBLAS_NUM_THREADS=1 "$bench" "$MODEL"
+  say "where the banded time goes: zgbsv against an inline band LU"
+  OPENBLAS_NUM_THREADS=1 "$BUILD_DIR/tools/bench/bench_band_lu" "$MODEL"
+  if [[ -x $VENV/bin/python ]]; then
+    say "reference: SciPy solve loop and ROSS run_freq_response on the same model"
+    OPENBLAS_NUM_THREADS=1 "$VENV/bin/python" tools/bench/bench_frf_ref.py \
+      --rcbtool "$(rcbtool_exe)" "$MODEL"
+  else
+    echo "(no $VENV: run ./scripts/dev.sh deps for the SciPy/ROSS comparison)"
+  fi
+}
+
+usage() { awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$ROOT/scripts/dev.sh"; }
+
+case ${1:-} in
+  deps) cmd_deps ;;
+  build) cmd_build ;;
+  demo) cmd_demo ;;
+  test) cmd_test ;;
+  core) cmd_core ;;
+  sanitize) cmd_sanitize ;;
+  bench) cmd_bench ;;
+  -h | --help | help) usage ;;
+  *) usage >&2; exit 2 ;;
+esac
