@@ -90,7 +90,7 @@ rcb_status rcb_ini_get_num(ini_ctx *c, const ini_section *s, const char *key, co
                           int required, double def, double *out) {
   const ini_entry *e = rcb_ini_get(s, key);
   const char *p, *t;
-  size_t n, len;
+  size_t n, len = 0;
   if (!e) {
     if (required) return rcb_ini_missing(c, s, key, expect);
     *out = def;
@@ -133,7 +133,7 @@ rcb_status rcb_ini_get_word(ini_ctx *c, const ini_section *s, const char *key, c
                            char *buf, size_t size) {
   const ini_entry *e = rcb_ini_get(s, key);
   const char *p, *t;
-  size_t n, len;
+  size_t n, len = 0;
   if (!e) return rcb_ini_missing(c, s, key, expect);
   n = rcb_ini_count_tok(e->val, e->val + e->len);
   if (n == 0)
