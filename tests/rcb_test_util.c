@@ -31,3 +31,21 @@ rcb_model *rcb_test_model_from_example(const char *name) {
   if (st != RCB_OK) fail_msg("model load failed: %s", rcb_model_errmsg(m));
   return m;
 }
+
+static void *count_alloc(void *user, size_t size) {
+  ((rcb_test_counter *)user)->allocs++;
+  return malloc(size);
+}
+
+static void count_free(void *user, void *p) {
+  ((rcb_test_counter *)user)->frees++;
+  free(p);
+}
+
+rcb_allocator rcb_test_counting_allocator(rcb_test_counter *c) {
+  rcb_allocator a;
+  a.alloc = count_alloc;
+  a.free = count_free;
+  a.user = c;
+  return a;
+}

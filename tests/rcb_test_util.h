@@ -11,4 +11,10 @@ int rcb_test_close(double a, double b, double rtol, double atol);
 rcb_model *rcb_test_model_from_string(const char *ini);
 /* Load examples/<name> or abort. */
 rcb_model *rcb_test_model_from_example(const char *name);
+/* Allocation counts seen through rcb_test_counting_allocator's hooks. */
+typedef struct rcb_test_counter {
+  size_t allocs, frees;
+} rcb_test_counter;
+/* Allocator hooks (malloc/free) that count every call into *c. */
+rcb_allocator rcb_test_counting_allocator(rcb_test_counter *c);
 #endif

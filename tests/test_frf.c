@@ -314,22 +314,9 @@ static void test_dense_banded_kinds(void **state) {
   rcb_model_destroy(m);
 }
 
-/* Allocator that counts calls. */
-typedef struct {
-  size_t allocs, frees;
-} counter;
-static void *count_alloc(void *user, size_t size) {
-  ((counter *)user)->allocs++;
-  return malloc(size);
-}
-static void count_free(void *user, void *p) {
-  ((counter *)user)->frees++;
-  free(p);
-}
-
 static void test_sweep_allocates_nothing(void **state) {
-  counter cnt = {0, 0};
-  rcb_allocator a = {count_alloc, count_free, &cnt};
+  rcb_test_counter cnt = {0, 0};
+  rcb_allocator a = rcb_test_counting_allocator(&cnt);
   rcb_model *m = two_shafts(RCB_COUPLING_NELSON_CRANDALL_2, 46.095e3, 220.76, 10.949,
                             10.949e-6, 0.02, 1);
   rcb_dof d[2];

@@ -221,22 +221,9 @@ static void test_table_bearing(void **state) {
   rcb_model_destroy(m);
 }
 
-/* Allocator that counts, to show that everything goes through the hooks. */
-typedef struct counting {
-  size_t allocs, frees;
-} counting;
-static void *count_alloc(void *user, size_t size) {
-  ((counting *)user)->allocs++;
-  return malloc(size);
-}
-static void count_free(void *user, void *p) {
-  ((counting *)user)->frees++;
-  free(p);
-}
-
 static void test_load_string_no_files(void **state) {
-  counting cnt = {0, 0};
-  rcb_allocator a = {count_alloc, count_free, &cnt};
+  rcb_test_counter cnt = {0, 0};
+  rcb_allocator a = rcb_test_counting_allocator(&cnt);
   rcb_model *m = NULL;
   char text[2048];
   (void)state;

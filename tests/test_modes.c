@@ -27,19 +27,6 @@
 
 static rcb_mode g_modes[MAXM];
 
-/* Counting allocator hooks: every call through them is counted. */
-typedef struct counter {
-  long allocs, frees;
-} counter;
-static void *count_alloc(void *user, size_t size) {
-  ((counter *)user)->allocs++;
-  return malloc(size);
-}
-static void count_free(void *user, void *p) {
-  ((counter *)user)->frees++;
-  free(p);
-}
-
 /* Uniform shaft S from z = 0, nel elements; isotropic bearings of stiffness
  * kb (N/m) and damping cb (N s/m) at both ends when kb > 0. */
 static rcb_model *beam(double L, double d, int nel, double kappa, double rho, double E,
@@ -406,8 +393,8 @@ static void test_paper_max_zeta(void **state) {
 /* ----------------------------------------------------------- allocation -- */
 
 static void test_no_allocation(void **state) {
-  counter cnt = {0, 0};
-  rcb_allocator al = {count_alloc, count_free, &cnt};
+  rcb_test_counter cnt = {0, 0};
+  rcb_allocator al = rcb_test_counting_allocator(&cnt);
   rcb_model *m = disk_rotor(0.2, 50.0, &al);
   rcb_modes *e = NULL;
   size_t n, ndof = rcb_model_dof_count(m);

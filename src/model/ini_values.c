@@ -85,25 +85,34 @@ rcb_status rcb_ini_missing(ini_ctx *c, const ini_section *s, const char *key,
                        key, key, expect);
 }
 
+/* The one token of entry e ("value" or "word" in the messages). */
+static rcb_status single_token(ini_ctx *c, const ini_section *s, const ini_entry *e,
+                               const char *what, const char *expect, const char **t,
+                               size_t *len) {
+  const char *p = e->val;
+  size_t n = rcb_ini_count_tok(e->val, e->val + e->len);
+  if (n == 0)
+    return rcb_ini_error(c, RCB_ERR_PARSE, e->line, s, e->key, "no value; expected %s", expect);
+  if (n > 1)
+    return rcb_ini_error(c, RCB_ERR_PARSE, e->line, s, e->key,
+                         "%zu %ss in '%s'; expected one %s: %s", n, what, e->val, what, expect);
+  *t = rcb_ini_next_tok(&p, e->val + e->len, len);
+  return RCB_OK;
+}
+
 /* One number. *given (may be NULL) tells whether the key was present. */
 rcb_status rcb_ini_get_num(ini_ctx *c, const ini_section *s, const char *key, const char *expect,
                           int required, double def, double *out) {
   const ini_entry *e = rcb_ini_get(s, key);
-  const char *p, *t;
-  size_t n, len = 0;
+  const char *t;
+  size_t len = 0;
+  rcb_status st;
   if (!e) {
     if (required) return rcb_ini_missing(c, s, key, expect);
     *out = def;
     return RCB_OK;
   }
-  n = rcb_ini_count_tok(e->val, e->val + e->len);
-  if (n == 0)
-    return rcb_ini_error(c, RCB_ERR_PARSE, e->line, s, key, "no value; expected %s", expect);
-  if (n > 1)
-    return rcb_ini_error(c, RCB_ERR_PARSE, e->line, s, key,
-                         "%zu values in '%s'; expected one value: %s", n, e->val, expect);
-  p = e->val;
-  t = rcb_ini_next_tok(&p, e->val + e->len, &len);
+  if ((st = single_token(c, s, e, "value", expect, &t, &len))) return st;
   return rcb_ini_parse_num(c, s, e, t, len, expect, out);
 }
 
@@ -132,17 +141,11 @@ rcb_status rcb_ini_get_list(ini_ctx *c, const ini_section *s, const ini_entry *e
 rcb_status rcb_ini_get_word(ini_ctx *c, const ini_section *s, const char *key, const char *expect,
                            char *buf, size_t size) {
   const ini_entry *e = rcb_ini_get(s, key);
-  const char *p, *t;
-  size_t n, len = 0;
+  const char *t;
+  size_t len = 0;
+  rcb_status st;
   if (!e) return rcb_ini_missing(c, s, key, expect);
-  n = rcb_ini_count_tok(e->val, e->val + e->len);
-  if (n == 0)
-    return rcb_ini_error(c, RCB_ERR_PARSE, e->line, s, key, "no value; expected %s", expect);
-  if (n > 1)
-    return rcb_ini_error(c, RCB_ERR_PARSE, e->line, s, key,
-                         "%zu words in '%s'; expected one word: %s", n, e->val, expect);
-  p = e->val;
-  t = rcb_ini_next_tok(&p, e->val + e->len, &len);
+  if ((st = single_token(c, s, e, "word", expect, &t, &len))) return st;
   if (len >= size)
     return rcb_ini_error(c, RCB_ERR_PARSE, e->line, s, key, "'%s' is too long; expected %s",
                          e->val, expect);
