@@ -1,7 +1,8 @@
 /**
  * @file rcb.h
  * @brief librcb umbrella header: lateral dynamics of rotor-coupling-bearing
- * systems (model, FRFs, unbalance response, modes, Campbell).
+ * systems (model, FRFs, unbalance response, modes, Campbell,
+ * measurements, identification).
  */
 #ifndef RCB_H
 #define RCB_H
@@ -9,5 +10,7 @@
 #include "rcb/rcb_core.h"
 #include "rcb/rcb_model.h"
 #include "rcb/rcb_analysis.h"
+#include "rcb/rcb_measure.h"
+#include "rcb/rcb_identify.h"
 
 #endif /* RCB_H */

@@ -48,6 +48,11 @@ RCB_API rcb_status rcb_frf_create(rcb_frf **out, const rcb_model *m, size_t nout
                                   const rcb_dof *outputs, size_t nin, const rcb_dof *inputs,
                                   rcb_solver_kind solver, const rcb_allocator *alloc);
 RCB_API void rcb_frf_destroy(rcb_frf *f);
+/**
+ * @brief Re-assemble after rcb_model_set_param changed the model (same mesh,
+ * no allocation).
+ */
+RCB_API rcb_status rcb_frf_refresh(rcb_frf *f);
 RCB_API const char *rcb_frf_errmsg(const rcb_frf *f);
 /** @brief Solver actually chosen (dense or banded). */
 RCB_API rcb_solver_kind rcb_frf_solver(const rcb_frf *f);

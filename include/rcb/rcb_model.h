@@ -225,6 +225,43 @@ RCB_API rcb_status rcb_model_matrices(const rcb_model *m, double speed, double *
 RCB_API rcb_status rcb_model_unbalance_force(const rcb_model *m, double speed,
                                              rcb_complex *F);
 
+
+/* ---- parameters by name (identification, issue #3) ---- */
+
+/**
+ * Every numeric value that can be fitted has a name "KIND.ITEM.KEY", with the
+ * keys of the INI format:
+ *  - coupling.C.kt | kr | ct | cr (those its model uses), coupling.C.hub_mass,
+ *    hub_Id, hub_Ip (both stations together)
+ *  - bearing.B2.kxx ... cyy (constant bearings; tabulated ones are not fittable)
+ *  - disk.DA.mass | Id | Ip
+ *  - shaft.A.damping_mass | damping_stiffness
+ *  - material.steel.density | young
+ *  - unbalance.UA.amount (kg m) | phase (rad)
+ * All of them enter M, C, G, K (and the unbalance force) affinely, which the
+ * analytic sensitivities rely on. Units are those of the INI keys (SI; phase in rad).
+ */
+RCB_API rcb_status rcb_model_get_param(const rcb_model *m, const char *name, double *value);
+/**
+ * @brief Change a parameter of a finalized (or not yet finalized) model. The
+ * mesh is unchanged; analysis objects made before must be refreshed
+ * (rcb_frf_refresh). Values are checked as the builder checks them.
+ */
+RCB_API rcb_status rcb_model_set_param(rcb_model *m, const char *name, double value);
+/** @brief Number of fittable parameters of the model. */
+RCB_API size_t rcb_model_param_count(const rcb_model *m);
+/** @brief Name of fittable parameter i (0-based) into buf. */
+RCB_API rcb_status rcb_model_param_name(const rcb_model *m, size_t i, char *buf, size_t size);
+
+/**
+ * @brief The model as INI text that rcb_model_load_string reads back to the
+ * same matrices (values printed with 17 significant digits). Two-call sizing:
+ * with buf NULL or too small, *needed gets the size including the NUL and the
+ * call returns RCB_ERR_WORKSPACE (RCB_OK when it fits).
+ */
+RCB_API rcb_status rcb_model_write_ini(const rcb_model *m, char *buf, size_t size,
+                                       size_t *needed);
+
 #ifdef __cplusplus
 }
 #endif

@@ -9,22 +9,8 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "assembly/assembly.h"
-#include "solvers/zsolver.h"
+#include "analyses/frf_internal.h"
 
-struct rcb_frf {
-  rcb_allocator alloc;
-  char errmsg[RCB_ERRMSG_MAX];
-  const rcb_model *m;
-  const rcb_zsolver_ops *ops;
-  rcb_layout L;
-  double *M, *C, *G, *K; /* structure without bearings, in layout L */
-  rcb_complex *Z;        /* dynamic stiffness, factored in place */
-  rcb_complex *B;        /* n x max(nin, 1) right-hand sides / solutions */
-  int *ipiv;
-  size_t nout, nin, *out_row, *in_row;
-  size_t bytes;
-};
 
 /* Banded storage pays once the band is well below the order. */
 static const rcb_zsolver_ops *choose_solver(rcb_solver_kind kind, size_t n, size_t bw) {
@@ -117,6 +103,12 @@ void rcb_frf_destroy(rcb_frf *f) {
   rcb_free(&a, f);
 }
 
+rcb_status rcb_frf_refresh(rcb_frf *f) {
+  if (!f) return RCB_ERR_ARG;
+  rcb_assemble_structure(f->m, &f->L, f->M, f->C, f->G, f->K);
+  return RCB_OK;
+}
+
 const char *rcb_frf_errmsg(const rcb_frf *f) { return f ? f->errmsg : "no FRF object"; }
 
 rcb_solver_kind rcb_frf_solver(const rcb_frf *f) {
@@ -127,7 +119,7 @@ size_t rcb_frf_memory(const rcb_frf *f) { return f ? f->bytes : 0; }
 
 /* Z = K - w^2 M + i w (C + W G) + bearings at speed W, then factor and solve
  * Z X = B in place. */
-static rcb_status factor_solve(rcb_frf *f, double omega, double speed, size_t nrhs) {
+rcb_status rcb_frf_factor_solve(rcb_frf *f, double omega, double speed, size_t nrhs) {
   const rcb_model *m = f->m;
   size_t k, sz = rcb_layout_size(&f->L), b;
   double w2 = omega * omega;
@@ -171,7 +163,7 @@ rcb_status rcb_frf_eval(rcb_frf *f, double omega, double speed, rcb_frf_kind kin
   n = f->m->ndof;
   memset(f->B, 0, n * f->nin * sizeof *f->B);
   for (i = 0; i < f->nin; i++) f->B[f->in_row[i] + n * i] = 1.0;
-  if ((st = factor_solve(f, omega, speed, f->nin))) return st;
+  if ((st = rcb_frf_factor_solve(f, omega, speed, f->nin))) return st;
   switch (kind) {
     case RCB_MOBILITY: scale = CMPLX(0.0, omega); break;
     case RCB_INERTANCE: scale = -omega * omega; break;
@@ -190,7 +182,7 @@ rcb_status rcb_frf_unbalance(rcb_frf *f, double speed, rcb_complex *Q) {
     return rcb_set_error(f->errmsg, RCB_ERR_ARG,
                          "speed %g rad/s: expected a finite value >= 0", speed);
   rcb_model_unbalance_force(f->m, speed, f->B);
-  if ((st = factor_solve(f, speed, speed, 1))) return st;
+  if ((st = rcb_frf_factor_solve(f, speed, speed, 1))) return st;
   for (o = 0; o < f->nout; o++) Q[o] = f->B[f->out_row[o]];
   return RCB_OK;
 }

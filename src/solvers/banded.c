@@ -16,6 +16,18 @@ static rcb_status banded_solve(const rcb_layout *L, rcb_complex *Z, int *ipiv, r
   return RCB_OK;
 }
 
-static const rcb_zsolver_ops banded_ops = {"banded", rcb_layout_banded, banded_solve};
+static rcb_status banded_resolve(const rcb_layout *L, const rcb_complex *Z, const int *ipiv,
+                                 rcb_complex *B, size_t nrhs, char trans) {
+  lapack_int n = (lapack_int)L->n;
+  lapack_int info = LAPACKE_zgbtrs_work(LAPACK_COL_MAJOR, trans, n, (lapack_int)L->kl,
+                                        (lapack_int)L->ku, (lapack_int)nrhs,
+                                        (const lapack_complex_double *)Z, (lapack_int)L->ld,
+                                        (const lapack_int *)ipiv,
+                                        (lapack_complex_double *)B, n);
+  return info ? RCB_ERR_LAPACK : RCB_OK;
+}
+
+static const rcb_zsolver_ops banded_ops = {"banded", rcb_layout_banded, banded_solve,
+                                           banded_resolve};
 
 const rcb_zsolver_ops *rcb_zsolver_banded(void) { return &banded_ops; }

@@ -22,6 +22,16 @@ static rcb_status dense_solve(const rcb_layout *L, rcb_complex *Z, int *ipiv, rc
   return RCB_OK;
 }
 
-static const rcb_zsolver_ops dense_ops = {"dense", dense_layout, dense_solve};
+static rcb_status dense_resolve(const rcb_layout *L, const rcb_complex *Z, const int *ipiv,
+                                rcb_complex *B, size_t nrhs, char trans) {
+  lapack_int n = (lapack_int)L->n;
+  lapack_int info = LAPACKE_zgetrs_work(LAPACK_COL_MAJOR, trans, n, (lapack_int)nrhs,
+                                        (const lapack_complex_double *)Z, (lapack_int)L->ld,
+                                        (const lapack_int *)ipiv,
+                                        (lapack_complex_double *)B, n);
+  return info ? RCB_ERR_LAPACK : RCB_OK;
+}
+
+static const rcb_zsolver_ops dense_ops = {"dense", dense_layout, dense_solve, dense_resolve};
 
 const rcb_zsolver_ops *rcb_zsolver_dense(void) { return &dense_ops; }

@@ -15,6 +15,9 @@ typedef struct rcb_zsolver_ops_s {
   /* Solve in place; ipiv has n entries. RCB_ERR_SINGULAR when a pivot is 0. */
   rcb_status (*solve)(const rcb_layout *L, rcb_complex *Z, int *ipiv, rcb_complex *B,
                       size_t nrhs);
+  /* Solve again with the factors left by solve: op(Z) X = B, trans 'N' or 'T'. */
+  rcb_status (*resolve)(const rcb_layout *L, const rcb_complex *Z, const int *ipiv,
+                        rcb_complex *B, size_t nrhs, char trans);
 } rcb_zsolver_ops;
 
 const rcb_zsolver_ops *rcb_zsolver_dense(void);

@@ -1,0 +1,133 @@
+/**
+ * @file rcb_identify.h
+ * @brief Fitting model parameters to measured FRFs or unbalance responses by
+ * non-linear least squares (paper sections 6-7, eqs. 11-18), or by NLopt,
+ * with standard errors and an identifiability check.
+ *
+ * The objective (eq. 12) is F = r^T W r with residuals r_i = s(m_i) - s(e_i)
+ * between model m and measurement e at every (channel, abscissa) point of the
+ * selected band, on a scale s: |.|, log10|.|, 20 log10|.|, or the complex value
+ * (real and imaginary parts as two residuals). W is diagonal.
+ */
+#ifndef RCB_IDENTIFY_H
+#define RCB_IDENTIFY_H
+
+#include "rcb/rcb_analysis.h"
+#include "rcb/rcb_core.h"
+#include "rcb/rcb_measure.h"
+#include "rcb/rcb_model.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum rcb_fit_scale {
+  RCB_SCALE_LINEAR = 0, /**< |H| */
+  RCB_SCALE_LOG10 = 1,  /**< log10 |H| */
+  RCB_SCALE_DB = 2,     /**< 20 log10 |H| */
+  RCB_SCALE_COMPLEX = 3 /**< Re H, Im H */
+} rcb_fit_scale;
+
+typedef enum rcb_fit_method {
+  RCB_FIT_PAPER = 0, /**< Gauss-Newton by pseudo-inverse, Coggins line search,
+                          lambda Q damping, exterior penalty (eqs. 14-18) */
+  RCB_FIT_NLOPT = 1  /**< an NLopt algorithm by name (needs RCB_WITH_NLOPT) */
+} rcb_fit_method;
+
+typedef struct rcb_fit rcb_fit;
+
+/**
+ * @brief Prepare a fit of model @p m (changed in place by rcb_fit_run) to @p meas.
+ * Channels are resolved against the model here (unknown station: error).
+ */
+RCB_API rcb_status rcb_fit_create(rcb_fit **out, rcb_model *m, const rcb_meas *meas,
+                                  const rcb_allocator *alloc);
+RCB_API void rcb_fit_destroy(rcb_fit *f);
+RCB_API const char *rcb_fit_errmsg(const rcb_fit *f);
+
+/**
+ * @brief Add a parameter to fit (see rcb_model_get_param for names).
+ * @param lo lower bound @param hi upper bound (lo < hi; the current value is the
+ * start) @param log_param optimise log(p) instead of p (needs lo > 0)
+ */
+RCB_API rcb_status rcb_fit_add_param(rcb_fit *f, const char *name, double lo, double hi,
+                                     int log_param);
+RCB_API rcb_status rcb_fit_set_scale(rcb_fit *f, rcb_fit_scale scale);
+/** @brief Keep only abscissa values in [lo, hi], rad/s. */
+RCB_API rcb_status rcb_fit_set_band(rcb_fit *f, double lo, double hi);
+/**
+ * @brief Diagonal weights, one per (channel, point) in channel-major order
+ * (w[c * npoints + i]); NULL restores unit weights. 0 drops a point.
+ */
+RCB_API rcb_status rcb_fit_set_weights(rcb_fit *f, const double *w);
+/**
+ * @brief Noise-aware weights from the eq. 19 noise model: each point weighted
+ * by the inverse variance of its residual on the chosen scale, and points whose
+ * measured magnitude lies near the channel's additive noise floor dropped.
+ * @param beta_a random factor, % @param beta_s systematic factor, %
+ */
+RCB_API rcb_status rcb_fit_set_noise_model(rcb_fit *f, double beta_a, double beta_s);
+/** @brief Method and, for RCB_FIT_NLOPT, the algorithm name ("LN_BOBYQA", "LD_LBFGS", "GN_DIRECT_L", ...). */
+RCB_API rcb_status rcb_fit_set_method(rcb_fit *f, rcb_fit_method method, const char *algorithm);
+/** @brief Analytic sensitivities (eq. 9, default) or finite differences (eq. 11). */
+RCB_API rcb_status rcb_fit_set_analytic(rcb_fit *f, int analytic);
+/** @brief Stopping rules: iterations, relative objective change, relative step. */
+RCB_API rcb_status rcb_fit_set_limits(rcb_fit *f, size_t max_iter, double ftol_rel,
+                                      double xtol_rel);
+/**
+ * @brief Progress callback, called once per iteration; a nonzero return stops
+ * the fit (status RCB_ERR_STATE "stopped by the caller").
+ */
+RCB_API rcb_status rcb_fit_set_progress(rcb_fit *f,
+                                        int (*cb)(void *user, size_t iter, size_t evals,
+                                                  double objective),
+                                        void *user);
+
+/** @brief Run the fit; on success the model holds the fitted values. */
+RCB_API rcb_status rcb_fit_run(rcb_fit *f);
+
+/** @brief Summary of the last run. */
+typedef struct rcb_fit_report {
+  size_t iterations;   /**< outer iterations */
+  size_t evaluations;  /**< model evaluations (each a full sweep), Jacobians included */
+  size_t residuals;    /**< residuals used (after band and weights) */
+  double objective0;   /**< F at the start */
+  double objective;    /**< F at the end */
+  double error0_pct;   /**< paper's error: 100 ||m - e|| / ||e|| on the scale, at the start */
+  double error_pct;    /**< the same at the end */
+  double sigma;        /**< residual standard deviation sqrt(F / (N - np)) */
+  int converged;       /**< 1 when a convergence criterion was met */
+} rcb_fit_report;
+RCB_API rcb_status rcb_fit_get_report(const rcb_fit *f, rcb_fit_report *out);
+
+/** @brief One fitted parameter with its uncertainty. */
+typedef struct rcb_fit_param {
+  const char *name;
+  double start, value; /**< parameter units */
+  double stderr_;      /**< standard error from (J^T W J)^-1 sigma^2 */
+  double ci_lo, ci_hi; /**< 95 % confidence interval */
+  int identifiable;    /**< 0 when the data cannot determine it (SVD test) */
+} rcb_fit_param;
+RCB_API size_t rcb_fit_param_count(const rcb_fit *f);
+RCB_API rcb_status rcb_fit_get_param(const rcb_fit *f, size_t k, rcb_fit_param *out);
+/** @brief Parameter correlation matrix, np x np column-major. */
+RCB_API rcb_status rcb_fit_correlation(const rcb_fit *f, double *C);
+
+/* ---- building blocks, exposed for checks and for other optimisers ---- */
+
+/** @brief Number of residuals (after band and zero weights). */
+RCB_API size_t rcb_fit_residual_count(const rcb_fit *f);
+/** @brief Weighted residuals sqrt(W) r at the model's current parameters. */
+RCB_API rcb_status rcb_fit_residuals(rcb_fit *f, double *r);
+/**
+ * @brief Jacobian of the weighted residuals with respect to the parameters
+ * (d/dp, not d/dlog p), residual_count x np column-major: analytic (eq. 9,
+ * reusing each frequency's factorisation) or finite differences (eq. 11).
+ */
+RCB_API rcb_status rcb_fit_jacobian(rcb_fit *f, int analytic, double *J);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* RCB_IDENTIFY_H */

@@ -1,0 +1,120 @@
+/**
+ * @file rcb_measure.h
+ * @brief Measured (or simulated) responses: FRFs at a fixed rotor speed, or
+ * unbalance responses over a speed range, on one common abscissa; read and
+ * written as UFF dataset 58 (ASCII and binary 58b) and CSV.
+ *
+ * Values are kept in SI as the kind they were given in (receptance m/N,
+ * mobility m/(N s), inertance m/(N s^2); unbalance responses in m or rad);
+ * rcb_meas_convert changes the kind. Channels are named by model stations:
+ * response "DA.x" and, for FRFs, reference (force) "C.B.y".
+ */
+#ifndef RCB_MEASURE_H
+#define RCB_MEASURE_H
+
+#include <stdint.h>
+
+#include "rcb/rcb_analysis.h"
+#include "rcb/rcb_core.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** @brief What the abscissa and the values are. */
+typedef enum rcb_meas_type {
+  RCB_MEAS_FRF = 0,      /**< abscissa: excitation frequency, rad/s */
+  RCB_MEAS_UNBALANCE = 1 /**< abscissa: rotor speed, rad/s; response to the unbalances */
+} rcb_meas_type;
+
+typedef struct rcb_meas rcb_meas;
+
+RCB_API rcb_status rcb_meas_create(rcb_meas **out, const rcb_allocator *alloc);
+RCB_API void rcb_meas_destroy(rcb_meas *ms);
+/** @brief Last error, with file name and line (or record number) where it applies. */
+RCB_API const char *rcb_meas_errmsg(const rcb_meas *ms);
+
+/**
+ * @brief Set the common abscissa (before adding channels; clears channels).
+ * @param x n values, rad/s, finite, strictly increasing, >= 0
+ * @param speed for RCB_MEAS_FRF the rotor speed (rad/s) during the test, or a
+ * negative value for a synchronous FRF (rotor speed = excitation frequency);
+ * ignored for RCB_MEAS_UNBALANCE
+ */
+RCB_API rcb_status rcb_meas_set_grid(rcb_meas *ms, rcb_meas_type type, size_t n,
+                                     const double *x, double speed);
+/**
+ * @brief Add a channel of n = rcb_meas_point_count values (copied).
+ * @param response station channel "STATION.DIR" @param reference force channel
+ * for FRFs, NULL for unbalance responses @param kind receptance, mobility or
+ * inertance (RCB_RECEPTANCE for unbalance responses: displacement)
+ */
+RCB_API rcb_status rcb_meas_add_channel(rcb_meas *ms, const char *response,
+                                        const char *reference, rcb_frf_kind kind,
+                                        const rcb_complex *data);
+
+RCB_API rcb_meas_type rcb_meas_get_type(const rcb_meas *ms);
+RCB_API size_t rcb_meas_point_count(const rcb_meas *ms);
+RCB_API size_t rcb_meas_channel_count(const rcb_meas *ms);
+/** @brief The abscissa, rad/s (rcb_meas_point_count values). */
+RCB_API const double *rcb_meas_grid(const rcb_meas *ms);
+/** @brief Rotor speed of an FRF test, rad/s (negative: synchronous). */
+RCB_API double rcb_meas_speed(const rcb_meas *ms);
+
+typedef struct rcb_meas_channel_info {
+  const char *response;     /**< "DA.x" */
+  const char *reference;    /**< "C.B.y", NULL for unbalance responses */
+  rcb_frf_kind kind;        /**< what the values are */
+  const rcb_complex *data;  /**< rcb_meas_point_count values, owned by ms */
+} rcb_meas_channel_info;
+RCB_API rcb_status rcb_meas_channel(const rcb_meas *ms, size_t i, rcb_meas_channel_info *out);
+
+/** @brief Convert every FRF channel to @p kind (multiplying by (i w)^k). */
+RCB_API rcb_status rcb_meas_convert(rcb_meas *ms, rcb_frf_kind kind);
+
+/**
+ * @brief The noise model of the paper's eq. 19, applied to every channel:
+ * f_e = f_s (1 + beta_a/100 r1) + (sqrt(sum_j |f_sj|^2)/n) (beta_s/100) r2 e^{i phi},
+ * r1, r2 uniform in [-1, 1], phi uniform in [0, 2 pi), from a PRNG seeded by
+ * @p seed (same seed, same noise on every platform).
+ * @param beta_a random (proportional) factor, % @param beta_s systematic factor, %
+ */
+RCB_API rcb_status rcb_meas_add_noise(rcb_meas *ms, double beta_a, double beta_s,
+                                      uint64_t seed);
+
+/** @brief UFF node number <-> model station, for dataset 58 files. */
+typedef struct rcb_uff_node {
+  long node;           /**< UFF node number */
+  const char *station; /**< model station name, e.g. "DA" */
+} rcb_uff_node;
+
+/**
+ * @brief Read UFF dataset 58 records (ASCII 58 or binary 58b, any mix; other
+ * datasets are skipped). Node numbers map through @p map; a node without an
+ * entry maps to model node "#N". Directions: UFF 1, 2, 4, 5 (+/-) are x, y,
+ * rx, ry (a negative direction flips the sign). All records must share one
+ * abscissa (Hz in the file). Ordinate units/type decide the kind (function
+ * type 4 FRF: displacement, velocity or acceleration over force; type 1 with
+ * reference node 0: unbalance response).
+ */
+RCB_API rcb_status rcb_meas_read_uff(rcb_meas *ms, const char *path, size_t nmap,
+                                     const rcb_uff_node *map);
+/** @brief Write dataset 58 records (binary 58b if @p binary), atomically. */
+RCB_API rcb_status rcb_meas_write_uff(const rcb_meas *ms, const char *path, int binary,
+                                      size_t nmap, const rcb_uff_node *map);
+/**
+ * @brief Read CSV as written by rcbtool frf/unbalance: first column freq_hz
+ * (FRF) or rpm (unbalance), then per channel "RESP/REF re","RESP/REF im" or
+ * "RESP/REF mag","RESP/REF phase_deg" (unbalance: "RESP re"/"RESP im" or
+ * "RESP amp"/"RESP phase_deg"); optional "# key = value" lines before the
+ * header: kind = receptance|mobility|inertance, rpm = rotor speed of an FRF test.
+ */
+RCB_API rcb_status rcb_meas_read_csv(rcb_meas *ms, const char *path);
+/** @brief Write CSV (re/im columns) that rcb_meas_read_csv reads back, atomically. */
+RCB_API rcb_status rcb_meas_write_csv(const rcb_meas *ms, const char *path);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* RCB_MEASURE_H */
