@@ -39,6 +39,8 @@ typedef struct rcb_fit rcb_fit;
 /**
  * @brief Prepare a fit of model @p m (changed in place by rcb_fit_run) to @p meas.
  * Channels are resolved against the model here (unknown station: error).
+ * On failure *out may still hold an object carrying the message
+ * (rcb_fit_errmsg); destroy it in every case.
  */
 RCB_API rcb_status rcb_fit_create(rcb_fit **out, rcb_model *m, const rcb_meas *meas,
                                   const rcb_allocator *alloc);

@@ -1,0 +1,368 @@
+/*
+ * Fit set-up and the public fit API: channels resolved against the model,
+ * parameters by name, the residual layout (band, weights, noise model),
+ * running the chosen optimiser, and the results.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "identify/fit_internal.h"
+
+rcb_status rcb_fit_fail(rcb_fit *f, rcb_status st, const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(f->errmsg, sizeof f->errmsg, fmt, ap);
+  va_end(ap);
+  return st;
+}
+
+/* Index of dof in list (appending it when new). */
+static size_t dof_slot(rcb_dof *list, size_t *n, rcb_dof d) {
+  size_t i;
+  for (i = 0; i < *n; i++)
+    if (list[i].node == d.node && list[i].dir == d.dir) return i;
+  list[*n] = d;
+  return (*n)++;
+}
+
+static rcb_status resolve_channels(rcb_fit *f, rcb_dof *outs, rcb_dof *ins) {
+  size_t c;
+  for (c = 0; c < f->nch; c++) {
+    rcb_meas_channel_info ci;
+    rcb_dof d;
+    if (rcb_meas_channel(f->meas, c, &ci)) return rcb_fit_fail(f, RCB_ERR_ARG, "channel %zu", c);
+    if (rcb_model_find_dof(f->m, ci.response, &d))
+      return rcb_fit_fail(f, RCB_ERR_NOT_FOUND, "measurement channel %zu: %s", c + 1,
+                          rcb_model_errmsg(f->m));
+    f->ch_out[c] = dof_slot(outs, &f->nout, d);
+    f->ch_kind[c] = ci.kind;
+    if (f->unbalance) continue;
+    if (!ci.reference || rcb_model_find_dof(f->m, ci.reference, &d))
+      return rcb_fit_fail(f, RCB_ERR_NOT_FOUND, "measurement channel %zu (%s): %s", c + 1,
+                          ci.response, ci.reference ? rcb_model_errmsg(f->m)
+                                                    : "an FRF channel needs a reference");
+    f->ch_in[c] = dof_slot(ins, &f->nin, d);
+  }
+  return RCB_OK;
+}
+
+static rcb_status fit_setup(rcb_fit *f) {
+  size_t nch = f->nch;
+  rcb_dof *outs = rcb_alloc(&f->alloc, nch * sizeof *outs);
+  rcb_dof *ins = rcb_alloc(&f->alloc, nch * sizeof *ins);
+  rcb_status st;
+  f->ch_out = rcb_alloc(&f->alloc, nch * sizeof *f->ch_out);
+  f->ch_in = rcb_alloc(&f->alloc, nch * sizeof *f->ch_in);
+  f->ch_kind = rcb_alloc(&f->alloc, nch * sizeof *f->ch_kind);
+  f->Hmod = rcb_alloc(&f->alloc, nch * f->npts * sizeof *f->Hmod);
+  if (!outs || !ins || !f->ch_out || !f->ch_in || !f->ch_kind || !f->Hmod)
+    st = rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory setting up the fit");
+  else if (!(st = resolve_channels(f, outs, ins))) {
+    st = rcb_frf_create(&f->frf, f->m, f->nout, outs, f->nin, ins, RCB_SOLVER_AUTO, &f->alloc);
+    if (st) rcb_fit_fail(f, st, "FRF workspace: %s", rcb_status_str(st));
+    f->Hwork = rcb_alloc(&f->alloc, f->nout * (f->nin ? f->nin : 1) * sizeof *f->Hwork);
+    if (!st && !f->Hwork) st = rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory");
+  }
+  rcb_free(&f->alloc, outs);
+  rcb_free(&f->alloc, ins);
+  return st;
+}
+
+rcb_status rcb_fit_create(rcb_fit **out, rcb_model *m, const rcb_meas *meas,
+                          const rcb_allocator *alloc) {
+  rcb_allocator a;
+  rcb_fit *f;
+  rcb_status st;
+  if (!out) return RCB_ERR_ARG;
+  *out = NULL;
+  if (!m || !meas) return RCB_ERR_ARG;
+  if (rcb_model_dof_count(m) == 0) return RCB_ERR_STATE;
+  rcb_allocator_init(&a, alloc);
+  f = rcb_alloc(&a, sizeof *f);
+  if (!f) return RCB_ERR_NOMEM;
+  f->alloc = a;
+  f->m = m;
+  f->meas = meas;
+  f->nch = rcb_meas_channel_count(meas);
+  f->npts = rcb_meas_point_count(meas);
+  f->grid = rcb_meas_grid(meas);
+  f->unbalance = rcb_meas_get_type(meas) == RCB_MEAS_UNBALANCE;
+  f->speed = rcb_meas_speed(meas);
+  f->scale = RCB_SCALE_LINEAR;
+  f->band_lo = 0.0;
+  f->band_hi = HUGE_VAL;
+  f->method = RCB_FIT_PAPER;
+  f->analytic = 1;
+  f->max_iter = 100;
+  f->ftol_rel = 1e-10;
+  f->xtol_rel = 1e-8;
+  *out = f;
+  if (f->nch == 0 || f->npts == 0)
+    return rcb_fit_fail(f, RCB_ERR_ARG, "the measurement has no channel or no point");
+  st = fit_setup(f);
+  return st;
+}
+
+void rcb_fit_free_layout(rcb_fit *f) {
+  rcb_free(&f->alloc, f->res_ch);
+  rcb_free(&f->alloc, f->res_pt);
+  rcb_free(&f->alloc, f->res_part);
+  rcb_free(&f->alloc, f->res_sqrtw);
+  rcb_free(&f->alloc, f->res_meas);
+  rcb_free(&f->alloc, f->pt_used);
+  rcb_free(&f->alloc, f->J);
+  rcb_free(&f->alloc, f->r);
+  rcb_free(&f->alloc, f->dmat);
+  rcb_free(&f->alloc, f->rhs);
+  rcb_free(&f->alloc, f->dF);
+  rcb_free(&f->alloc, f->cov);
+  rcb_free(&f->alloc, f->corr);
+  f->res_ch = f->res_pt = NULL;
+  f->res_part = f->pt_used = NULL;
+  f->res_sqrtw = f->res_meas = f->J = f->r = f->dmat = f->cov = f->corr = NULL;
+  f->rhs = f->dF = NULL;
+  f->nres = 0;
+  f->prepared = 0;
+}
+
+void rcb_fit_destroy(rcb_fit *f) {
+  rcb_allocator a;
+  if (!f) return;
+  a = f->alloc;
+  rcb_fit_free_layout(f);
+  rcb_frf_destroy(f->frf);
+  rcb_free(&a, f->ch_out);
+  rcb_free(&a, f->ch_in);
+  rcb_free(&a, f->ch_kind);
+  rcb_free(&a, f->Hmod);
+  rcb_free(&a, f->Hwork);
+  rcb_free(&a, f->wuser);
+  rcb_free(&a, f->par);
+  rcb_free(&a, f);
+}
+
+const char *rcb_fit_errmsg(const rcb_fit *f) { return f ? f->errmsg : "no fit object"; }
+
+/* ---- settings ---- */
+
+rcb_status rcb_fit_add_param(rcb_fit *f, const char *name, double lo, double hi,
+                             int log_param) {
+  rcb_fit_par *p;
+  double v;
+  size_t k;
+  if (!f || !name) return RCB_ERR_ARG;
+  if (strlen(name) >= RCB_PARAM_NAME_MAX)
+    return rcb_fit_fail(f, RCB_ERR_ARG, "parameter name '%s' too long", name);
+  if (rcb_model_get_param(f->m, name, &v))
+    return rcb_fit_fail(f, RCB_ERR_NOT_FOUND, "parameter: %s", rcb_model_errmsg(f->m));
+  for (k = 0; k < f->np; k++)
+    if (strcmp(f->par[k].name, name) == 0)
+      return rcb_fit_fail(f, RCB_ERR_ARG, "parameter '%s' is given twice", name);
+  if (!isfinite(lo) || !isfinite(hi) || !(lo < hi))
+    return rcb_fit_fail(f, RCB_ERR_ARG, "parameter '%s': bounds [%g, %g], expected lo < hi",
+                        name, lo, hi);
+  if (log_param && !(lo > 0))
+    return rcb_fit_fail(f, RCB_ERR_ARG,
+                        "parameter '%s': log parametrisation needs a lower bound > 0, got %g",
+                        name, lo);
+  if (v < lo || v > hi)
+    return rcb_fit_fail(f, RCB_ERR_ARG,
+                        "parameter '%s': start value %g is outside the bounds [%g, %g]", name,
+                        v, lo, hi);
+  if (rcb_grow(&f->alloc, (void **)&f->par, &f->cap_par, f->np + 1, sizeof *f->par))
+    return rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory");
+  rcb_fit_free_layout(f); /* sized by the parameter count */
+  p = &f->par[f->np++];
+  memset(p, 0, sizeof *p);
+  snprintf(p->name, sizeof p->name, "%s", name);
+  p->lo = lo;
+  p->hi = hi;
+  p->log_param = log_param;
+  p->start = p->value = v;
+  p->scale = v != 0.0 ? fabs(v) : (fabs(lo) > fabs(hi) ? fabs(lo) : fabs(hi));
+  p->identifiable = 1;
+  f->prepared = 0;
+  return RCB_OK;
+}
+
+rcb_status rcb_fit_set_scale(rcb_fit *f, rcb_fit_scale scale) {
+  if (!f || (int)scale < 0 || (int)scale > 3) return RCB_ERR_ARG;
+  f->scale = scale;
+  f->prepared = 0;
+  return RCB_OK;
+}
+
+rcb_status rcb_fit_set_band(rcb_fit *f, double lo, double hi) {
+  if (!f) return RCB_ERR_ARG;
+  if (!(lo >= 0) || !(hi > lo))
+    return rcb_fit_fail(f, RCB_ERR_ARG, "band [%g, %g] rad/s: expected 0 <= lo < hi", lo, hi);
+  f->band_lo = lo;
+  f->band_hi = hi;
+  f->prepared = 0;
+  return RCB_OK;
+}
+
+rcb_status rcb_fit_set_weights(rcb_fit *f, const double *w) {
+  size_t i, n;
+  if (!f) return RCB_ERR_ARG;
+  n = f->nch * f->npts;
+  if (!w) {
+    rcb_free(&f->alloc, f->wuser);
+    f->wuser = NULL;
+    f->prepared = 0;
+    return RCB_OK;
+  }
+  for (i = 0; i < n; i++)
+    if (!isfinite(w[i]) || w[i] < 0)
+      return rcb_fit_fail(f, RCB_ERR_ARG, "weight %zu = %g: expected a finite value >= 0", i,
+                          w[i]);
+  if (!f->wuser && !(f->wuser = rcb_alloc(&f->alloc, n * sizeof *f->wuser)))
+    return rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory");
+  memcpy(f->wuser, w, n * sizeof *w);
+  f->prepared = 0;
+  return RCB_OK;
+}
+
+rcb_status rcb_fit_set_noise_model(rcb_fit *f, double beta_a, double beta_s) {
+  if (!f) return RCB_ERR_ARG;
+  if (!(beta_a >= 0) || !(beta_s >= 0) || !isfinite(beta_a) || !isfinite(beta_s))
+    return rcb_fit_fail(f, RCB_ERR_ARG, "noise factors %g %%, %g %%: expected >= 0", beta_a,
+                        beta_s);
+  f->beta_a = beta_a;
+  f->beta_s = beta_s;
+  f->prepared = 0;
+  return RCB_OK;
+}
+
+rcb_status rcb_fit_set_method(rcb_fit *f, rcb_fit_method method, const char *algorithm) {
+  if (!f || ((int)method != 0 && (int)method != 1)) return RCB_ERR_ARG;
+  f->method = method;
+  snprintf(f->algorithm, sizeof f->algorithm, "%s", algorithm ? algorithm : "");
+  return RCB_OK;
+}
+
+rcb_status rcb_fit_set_analytic(rcb_fit *f, int analytic) {
+  if (!f) return RCB_ERR_ARG;
+  f->analytic = analytic != 0;
+  return RCB_OK;
+}
+
+rcb_status rcb_fit_set_limits(rcb_fit *f, size_t max_iter, double ftol_rel, double xtol_rel) {
+  if (!f || max_iter == 0 || !(ftol_rel >= 0) || !(xtol_rel >= 0)) return RCB_ERR_ARG;
+  f->max_iter = max_iter;
+  f->ftol_rel = ftol_rel;
+  f->xtol_rel = xtol_rel;
+  return RCB_OK;
+}
+
+rcb_status rcb_fit_set_progress(rcb_fit *f,
+                                int (*cb)(void *user, size_t iter, size_t evals,
+                                          double objective),
+                                void *user) {
+  if (!f) return RCB_ERR_ARG;
+  f->progress = cb;
+  f->progress_user = user;
+  return RCB_OK;
+}
+
+/* ---- run and results ---- */
+
+rcb_status rcb_fit_run(rcb_fit *f) {
+  rcb_status st;
+  size_t k;
+  if (!f) return RCB_ERR_ARG;
+  if (f->np == 0)
+    return rcb_fit_fail(f, RCB_ERR_ARG, "no parameter to fit (add one with --params)");
+  for (k = 0; k < f->np; k++) {
+    rcb_model_get_param(f->m, f->par[k].name, &f->par[k].start);
+    f->par[k].value = f->par[k].start;
+  }
+  if ((st = rcb_fit_prepare(f))) return st;
+  rcb_frf_refresh(f->frf); /* the caller may have changed the model */
+  f->iterations = f->evaluations = 0;
+  f->converged = 0;
+  if ((st = rcb_fit_eval(f, f->r))) return st;
+  f->obj0 = rcb_fit_sumsq(f->r, f->nres);
+  f->err0 = rcb_fit_error_pct(f);
+  st = f->method == RCB_FIT_NLOPT ? rcb_fit_run_nlopt(f) : rcb_fit_run_paper(f);
+  if (st) return st;
+  for (k = 0; k < f->np; k++) rcb_model_get_param(f->m, f->par[k].name, &f->par[k].value);
+  if ((st = rcb_fit_eval(f, f->r))) return st;
+  f->obj = rcb_fit_sumsq(f->r, f->nres);
+  f->err = rcb_fit_error_pct(f);
+  return rcb_fit_uncertainty(f);
+}
+
+rcb_status rcb_fit_get_report(const rcb_fit *f, rcb_fit_report *out) {
+  if (!f || !out) return RCB_ERR_ARG;
+  out->iterations = f->iterations;
+  out->evaluations = f->evaluations;
+  out->residuals = f->nres;
+  out->objective0 = f->obj0;
+  out->objective = f->obj;
+  out->error0_pct = f->err0;
+  out->error_pct = f->err;
+  out->sigma = f->nres > f->np ? sqrt(f->obj / (double)(f->nres - f->np)) : (double)NAN;
+  out->converged = f->converged;
+  return RCB_OK;
+}
+
+size_t rcb_fit_param_count(const rcb_fit *f) { return f ? f->np : 0; }
+
+rcb_status rcb_fit_get_param(const rcb_fit *f, size_t k, rcb_fit_param *out) {
+  const rcb_fit_par *p;
+  if (!f || !out || k >= f->np) return RCB_ERR_ARG;
+  p = &f->par[k];
+  out->name = p->name;
+  out->start = p->start;
+  out->value = p->value;
+  out->stderr_ = p->se;
+  out->ci_lo = p->ci_lo;
+  out->ci_hi = p->ci_hi;
+  out->identifiable = p->identifiable;
+  return RCB_OK;
+}
+
+rcb_status rcb_fit_correlation(const rcb_fit *f, double *C) {
+  if (!f || !C) return RCB_ERR_ARG;
+  if (!f->corr) return rcb_fit_fail((rcb_fit *)f, RCB_ERR_STATE, "run the fit first");
+  memcpy(C, f->corr, f->np * f->np * sizeof *C);
+  return RCB_OK;
+}
+
+size_t rcb_fit_residual_count(const rcb_fit *f) {
+  if (!f) return 0;
+  if (rcb_fit_prepare((rcb_fit *)f)) return 0;
+  return f->nres;
+}
+
+rcb_status rcb_fit_residuals(rcb_fit *f, double *r) {
+  rcb_status st;
+  if (!f || !r) return RCB_ERR_ARG;
+  if ((st = rcb_fit_prepare(f))) return st;
+  rcb_frf_refresh(f->frf);
+  return rcb_fit_eval(f, r);
+}
+
+rcb_status rcb_fit_jacobian(rcb_fit *f, int analytic, double *J) {
+  rcb_status st;
+  int keep;
+  size_t k, i;
+  if (!f || !J) return RCB_ERR_ARG;
+  if ((st = rcb_fit_prepare(f))) return st;
+  rcb_frf_refresh(f->frf);
+  keep = f->analytic;
+  f->analytic = analytic != 0;
+  st = rcb_fit_eval_jac(f, f->r, J);
+  f->analytic = keep;
+  if (st) return st;
+  /* d/dx -> d/dp */
+  for (k = 0; k < f->np; k++) {
+    double v, dpdx;
+    rcb_model_get_param(f->m, f->par[k].name, &v);
+    dpdx = f->par[k].log_param ? v : f->par[k].scale;
+    for (i = 0; i < f->nres; i++) J[i + f->nres * k] /= dpdx;
+  }
+  return RCB_OK;
+}

@@ -1,0 +1,388 @@
+/*
+ * Residuals of eq. 12 and their sensitivities: analytic (eq. 9,
+ * dH/dp = -Z^-1 dZ/dp Z^-1, with the factorisation of each frequency reused
+ * for all parameters at once) or by finite differences with the paper's step
+ * rule (eq. 11).
+ */
+#include <math.h>
+#include <string.h>
+
+#include "identify/fit_internal.h"
+
+double rcb_fit_sumsq(const double *r, size_t n) {
+  double s = 0.0;
+  size_t i;
+  for (i = 0; i < n; i++) s += r[i] * r[i];
+  return s;
+}
+
+/* Value of H on the fit's scale (part 1: imaginary, complex scale only). */
+static double on_scale(rcb_fit_scale s, double complex h, int part) {
+  switch (s) {
+    case RCB_SCALE_LOG10: return log10(cabs(h));
+    case RCB_SCALE_DB: return 20.0 * log10(cabs(h));
+    case RCB_SCALE_COMPLEX: return part ? cimag(h) : creal(h);
+    default: return cabs(h);
+  }
+}
+
+/* Derivative of on_scale(H) along dH. */
+static double on_scale_d(rcb_fit_scale s, double complex h, double complex dh, int part) {
+  double a = cabs(h), g = a > 0 ? creal(conj(h) * dh) / a : 0.0; /* d|H| */
+  switch (s) {
+    case RCB_SCALE_LOG10: return a > 0 ? g / (a * log(10.0)) : 0.0;
+    case RCB_SCALE_DB: return a > 0 ? 20.0 * g / (a * log(10.0)) : 0.0;
+    case RCB_SCALE_COMPLEX: return part ? cimag(dh) : creal(dh);
+    default: return g;
+  }
+}
+
+/* Variance of a measured value on the scale under the eq. 19 noise model:
+ * proportional part (beta_a |e| r1, r1 uniform: variance 1/3) and additive
+ * part of amplitude a (random phase: 1/6 per component). */
+static double noise_var(const rcb_fit *f, double complex e, double a, int part) {
+  double ba = f->beta_a / 100.0, mag = cabs(e), v;
+  if (f->scale == RCB_SCALE_COMPLEX) {
+    double c = part ? cimag(e) : creal(e);
+    return ba * ba * c * c / 3.0 + a * a / 6.0;
+  }
+  v = ba * ba * mag * mag / 3.0 + a * a / 6.0;
+  if (f->scale == RCB_SCALE_LINEAR) return v;
+  v /= mag * mag * log(10.0) * log(10.0);
+  return f->scale == RCB_SCALE_DB ? 400.0 * v : v;
+}
+
+/* Weight of point (c, i) before the noise model, 0 when left out. */
+static double base_weight(const rcb_fit *f, size_t c, size_t i, double complex e) {
+  double w = f->wuser ? f->wuser[c * f->npts + i] : 1.0;
+  if (f->grid[i] < f->band_lo || f->grid[i] > f->band_hi) return 0.0;
+  if (!isfinite(creal(e)) || !isfinite(cimag(e))) return 0.0;
+  if ((f->scale == RCB_SCALE_LOG10 || f->scale == RCB_SCALE_DB) && cabs(e) == 0.0) return 0.0;
+  return w;
+}
+
+/* Walk every residual; fill the layout when fill != 0. Returns the count. */
+static size_t layout(rcb_fit *f, int fill) {
+  size_t c, i, n = 0;
+  int part, nparts = f->scale == RCB_SCALE_COMPLEX ? 2 : 1;
+  int noisy = f->beta_a > 0 || f->beta_s > 0;
+  for (c = 0; c < f->nch; c++) {
+    rcb_meas_channel_info ci;
+    double s2 = 0.0, a;
+    rcb_meas_channel(f->meas, c, &ci);
+    for (i = 0; i < f->npts; i++) s2 += creal(ci.data[i] * conj(ci.data[i]));
+    a = f->beta_s / 100.0 * sqrt(s2) / (double)f->npts; /* eq. 19 additive amplitude */
+    for (i = 0; i < f->npts; i++) {
+      double complex e = ci.data[i];
+      double w = base_weight(f, c, i, e);
+      if (w == 0.0) continue;
+      /* points at the additive noise floor carry no information on the model */
+      if (noisy && cabs(e) < 2.0 * a) continue;
+      for (part = 0; part < nparts; part++, n++) {
+        double wp = noisy ? w / noise_var(f, e, a, part) : w;
+        if (!fill) continue;
+        f->res_ch[n] = c;
+        f->res_pt[n] = i;
+        f->res_part[n] = (unsigned char)part;
+        f->res_sqrtw[n] = sqrt(wp);
+        f->res_meas[n] = on_scale(f->scale, e, part);
+        f->pt_used[i] = 1;
+      }
+    }
+  }
+  return n;
+}
+
+rcb_status rcb_fit_prepare(rcb_fit *f) {
+  size_t n, sz, ncol;
+  if (f->prepared) return RCB_OK;
+  n = layout(f, 0);
+  if (n == 0)
+    return rcb_fit_fail(f, RCB_ERR_ARG,
+                        "no measured point left to fit (check the band, the weights and the "
+                        "noise floor)");
+  rcb_fit_free_layout(f);
+  sz = rcb_layout_size(&f->frf->L);
+  ncol = f->np * (f->nin ? f->nin : 1);
+  f->res_ch = rcb_alloc(&f->alloc, n * sizeof *f->res_ch);
+  f->res_pt = rcb_alloc(&f->alloc, n * sizeof *f->res_pt);
+  f->res_part = rcb_alloc(&f->alloc, n);
+  f->res_sqrtw = rcb_alloc(&f->alloc, n * sizeof *f->res_sqrtw);
+  f->res_meas = rcb_alloc(&f->alloc, n * sizeof *f->res_meas);
+  f->pt_used = rcb_alloc(&f->alloc, f->npts);
+  f->r = rcb_alloc(&f->alloc, 2 * n * sizeof *f->r);
+  f->J = rcb_alloc(&f->alloc, n * (f->np ? f->np : 1) * sizeof *f->J);
+  f->dmat = rcb_alloc(&f->alloc, 4 * sz * (f->np + 1) * sizeof *f->dmat);
+  f->dF = rcb_alloc(&f->alloc, f->m->ndof * (f->np + 1) * sizeof *f->dF);
+  f->rhs = rcb_alloc(&f->alloc, f->m->ndof * (ncol ? ncol : 1) * sizeof *f->rhs);
+  f->cov = rcb_alloc(&f->alloc, (f->np ? f->np * f->np : 1) * sizeof *f->cov);
+  f->corr = rcb_alloc(&f->alloc, (f->np ? f->np * f->np : 1) * sizeof *f->corr);
+  if (!f->res_ch || !f->res_pt || !f->res_part || !f->res_sqrtw || !f->res_meas ||
+      !f->pt_used || !f->r || !f->J || !f->dmat || !f->dF || !f->rhs || !f->cov || !f->corr) {
+    rcb_fit_free_layout(f);
+    return rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory sizing the fit");
+  }
+  f->nres = layout(f, 1);
+  f->prepared = 1;
+  return RCB_OK;
+}
+
+/* ---- parameters <-> internal coordinates ---- */
+
+void rcb_fit_get_x(const rcb_fit *f, double *x) {
+  size_t k;
+  for (k = 0; k < f->np; k++) {
+    double v;
+    rcb_model_get_param(f->m, f->par[k].name, &v);
+    x[k] = f->par[k].log_param ? log(v) : v / f->par[k].scale;
+  }
+}
+
+/* The model is evaluated at x projected onto the bounds (the optimisers'
+ * penalty or NLopt keep x itself honest). */
+rcb_status rcb_fit_set_x(rcb_fit *f, const double *x) {
+  size_t k;
+  rcb_status st;
+  for (k = 0; k < f->np; k++) {
+    const rcb_fit_par *p = &f->par[k];
+    double v = p->log_param ? exp(x[k]) : x[k] * p->scale;
+    if (!(v >= p->lo)) v = p->lo;
+    if (v > p->hi) v = p->hi;
+    if ((st = rcb_model_set_param(f->m, p->name, v)))
+      return rcb_fit_fail(f, st, "setting %s = %g: %s", p->name, v, rcb_model_errmsg(f->m));
+  }
+  return rcb_frf_refresh(f->frf);
+}
+
+/* ---- model values ---- */
+
+static double complex kind_factor(rcb_frf_kind kind, double w) {
+  if (kind == RCB_MOBILITY) return CMPLX(0.0, w);
+  if (kind == RCB_INERTANCE) return -w * w;
+  return 1.0;
+}
+
+/* Solve the model at point i: leaves the factors in the FRF workspace and
+ * the solution vectors in its B; fills Hmod for every channel. */
+static rcb_status solve_point(rcb_fit *f, size_t i) {
+  double w = f->grid[i];
+  size_t c;
+  rcb_status st;
+  if (f->unbalance) {
+    st = rcb_frf_unbalance(f->frf, w, f->Hwork);
+  } else {
+    st = rcb_frf_eval(f->frf, w, f->speed < 0 ? w : f->speed, RCB_RECEPTANCE, f->Hwork);
+  }
+  if (st) return rcb_fit_fail(f, st, "model at %g rad/s: %s", w, rcb_frf_errmsg(f->frf));
+  for (c = 0; c < f->nch; c++) {
+    size_t o = f->ch_out[c], in = f->unbalance ? 0 : f->ch_in[c];
+    f->Hmod[c * f->npts + i] =
+        f->Hwork[o + f->nout * in] * (f->unbalance ? 1.0 : kind_factor(f->ch_kind[c], w));
+  }
+  return RCB_OK;
+}
+
+static void residuals_from_model(const rcb_fit *f, double *r) {
+  size_t j;
+  for (j = 0; j < f->nres; j++) {
+    double complex h = f->Hmod[f->res_ch[j] * f->npts + f->res_pt[j]];
+    r[j] = f->res_sqrtw[j] * (on_scale(f->scale, h, f->res_part[j]) - f->res_meas[j]);
+  }
+}
+
+rcb_status rcb_fit_eval(rcb_fit *f, double *r) {
+  size_t i;
+  rcb_status st;
+  for (i = 0; i < f->npts; i++)
+    if (f->pt_used[i] && (st = solve_point(f, i))) return st;
+  residuals_from_model(f, r);
+  f->evaluations++;
+  return RCB_OK;
+}
+
+double rcb_fit_error_pct(const rcb_fit *f) {
+  double num = 0.0, den = 0.0;
+  size_t j;
+  for (j = 0; j < f->nres; j++) {
+    rcb_meas_channel_info ci;
+    double em, mm;
+    if (f->res_part[j]) continue;
+    rcb_meas_channel(f->meas, f->res_ch[j], &ci);
+    em = cabs(ci.data[f->res_pt[j]]);
+    mm = cabs(f->Hmod[f->res_ch[j] * f->npts + f->res_pt[j]]);
+    num += (mm - em) * (mm - em);
+    den += em * em;
+  }
+  return den > 0 ? 100.0 * sqrt(num / den) : (double)NAN;
+}
+
+/* ---- sensitivities ---- */
+
+static double dpdx(const rcb_fit *f, size_t k) {
+  double v;
+  rcb_model_get_param(f->m, f->par[k].name, &v);
+  return f->par[k].log_param ? v : f->par[k].scale;
+}
+
+/* Forward differences with the paper's step rule, eq. 11. */
+static rcb_status jac_fd(rcb_fit *f, double *r, double *Jx) {
+  double *r2 = f->r + f->nres;
+  size_t k, j;
+  rcb_status st;
+  if ((st = rcb_fit_eval(f, r))) return st;
+  for (k = 0; k < f->np; k++) {
+    const char *name = f->par[k].name;
+    double p, dp, g = dpdx(f, k);
+    rcb_model_get_param(f->m, name, &p);
+    dp = fabs(p) < 1e-6 ? 1e-9 : 1e-3 * fabs(p);
+    if ((st = rcb_model_set_param(f->m, name, p + dp)))
+      return rcb_fit_fail(f, st, "%s", rcb_model_errmsg(f->m));
+    rcb_frf_refresh(f->frf);
+    st = rcb_fit_eval(f, r2);
+    rcb_model_set_param(f->m, name, p);
+    rcb_frf_refresh(f->frf);
+    if (st) return st;
+    for (j = 0; j < f->nres; j++) Jx[j + f->nres * k] = (r2[j] - r[j]) / dp * g;
+  }
+  return rcb_fit_eval(f, r); /* Hmod back to the unperturbed model */
+}
+
+/* Matrices and unbalance force (at unit speed) of the whole model in the FRF
+ * layout, bearings included. */
+static void full_system(rcb_fit *f, double *A, rcb_complex *F1) {
+  const rcb_layout *L = &f->frf->L;
+  size_t sz = rcb_layout_size(L), b;
+  int e;
+  rcb_assemble_structure(f->m, L, A, A + sz, A + 2 * sz, A + 3 * sz);
+  for (b = 0; b < f->m->n_bearings; b++) {
+    rcb_entry en[4];
+    rcb_bearing_entries(f->m, b, 0.0, en);
+    for (e = 0; e < 4; e++) {
+      A[sz + rcb_layout_at(L, en[e].row, en[e].col)] += en[e].c;
+      A[3 * sz + rcb_layout_at(L, en[e].row, en[e].col)] += en[e].k;
+    }
+  }
+  rcb_model_unbalance_force(f->m, 1.0, F1);
+}
+
+/* dM, dC, dG, dK and dF/dp per parameter: every fittable parameter enters the
+ * matrices affinely, so a forward difference of any size is exact there; the
+ * unbalance phase enters F through e^{i phase}, hence a small central step. */
+static rcb_status derivative_matrices(rcb_fit *f) {
+  size_t sz = 4 * rcb_layout_size(&f->frf->L), n = f->m->ndof, k, i;
+  double *base = f->dmat + f->np * sz;
+  rcb_complex *F0 = f->dF + f->np * n, *Fk;
+  rcb_status st;
+  full_system(f, base, F0);
+  for (k = 0; k < f->np; k++) {
+    const char *name = f->par[k].name;
+    double *dk = f->dmat + k * sz, p, h;
+    Fk = f->dF + k * n;
+    rcb_model_get_param(f->m, name, &p);
+    h = strncmp(name, "unbalance.", 10) == 0 ? 1e-6 * (fabs(p) > 1e-3 ? fabs(p) : 1e-3)
+                                             : (p != 0.0 ? 1e-3 * fabs(p) : 1e-3);
+    if ((st = rcb_model_set_param(f->m, name, p + h))) goto fail;
+    full_system(f, dk, Fk);
+    if (strncmp(name, "unbalance.", 10) == 0) {
+      if ((st = rcb_model_set_param(f->m, name, p - h))) goto fail;
+      full_system(f, dk, F0); /* F0 reused as scratch, rebuilt below */
+      for (i = 0; i < n; i++) Fk[i] = (Fk[i] - F0[i]) / (2 * h);
+      memset(dk, 0, sz * sizeof *dk);
+      rcb_model_set_param(f->m, name, p);
+      full_system(f, base, F0);
+      continue;
+    }
+    rcb_model_set_param(f->m, name, p);
+    for (i = 0; i < sz; i++) dk[i] = (dk[i] - base[i]) / h;
+    for (i = 0; i < n; i++) Fk[i] = 0.0;
+  }
+  return RCB_OK;
+fail:
+  return rcb_fit_fail(f, st, "sensitivity of %s: %s", f->par[k].name, rcb_model_errmsg(f->m));
+}
+
+/* y = dZ x with dZ = dK - w^2 dM + i w (dC + W dG), over the layout's band. */
+static void dz_times(const rcb_layout *L, const double *d, double w, double W,
+                     const rcb_complex *x, rcb_complex *y) {
+  size_t sz = rcb_layout_size(L), i, j, n = L->n;
+  memset(y, 0, n * sizeof *y);
+  for (j = 0; j < n; j++) {
+    size_t i0 = j > L->ku ? j - L->ku : 0, i1 = j + L->kl < n ? j + L->kl : n - 1;
+    if (x[j] == 0.0) continue;
+    for (i = i0; i <= i1; i++) {
+      size_t a = rcb_layout_at(L, i, j);
+      double complex z = CMPLX(d[3 * sz + a] - w * w * d[a], w * (d[sz + a] + W * d[2 * sz + a]));
+      y[i] += z * x[j];
+    }
+  }
+}
+
+/* Analytic Jacobian, eq. 9, one point: X = Z^-1 B (kept by the solve), then
+ * dX/dp_k = Z^-1 (dF_k - dZ_k X), all parameters and inputs in one re-solve. */
+static rcb_status jac_point(rcb_fit *f, size_t i, double *Jx) {
+  const rcb_frf *fr = f->frf;
+  size_t n = f->m->ndof, nin = f->nin ? f->nin : 1, k, q, j, sz = 4 * rcb_layout_size(&fr->L);
+  double w = f->grid[i], W = f->unbalance ? w : (f->speed < 0 ? w : f->speed);
+  rcb_status st;
+  for (k = 0; k < f->np; k++)
+    for (q = 0; q < nin; q++) {
+      rcb_complex *y = f->rhs + n * (k * nin + q);
+      size_t d;
+      dz_times(&fr->L, f->dmat + k * sz, w, W, fr->B + n * q, y);
+      for (d = 0; d < n; d++) y[d] = -y[d] + (f->unbalance ? w * w * f->dF[k * n + d] : 0.0);
+    }
+  st = fr->ops->resolve(&fr->L, fr->Z, fr->ipiv, f->rhs, f->np * nin, 'N');
+  if (st) return rcb_fit_fail(f, st, "sensitivity solve at %g rad/s failed", w);
+  for (j = 0; j < f->nres; j++) {
+    size_t c = f->res_ch[j];
+    double complex h;
+    if (f->res_pt[j] != i) continue;
+    h = f->Hmod[c * f->npts + i];
+    for (k = 0; k < f->np; k++) {
+      size_t col = k * nin + (f->unbalance ? 0 : f->ch_in[c]);
+      double complex dh = f->rhs[n * col + fr->out_row[f->ch_out[c]]];
+      if (!f->unbalance) dh *= kind_factor(f->ch_kind[c], w);
+      Jx[j + f->nres * k] = f->res_sqrtw[j] * on_scale_d(f->scale, h, dh, f->res_part[j]);
+    }
+  }
+  return RCB_OK;
+}
+
+static rcb_status jac_analytic(rcb_fit *f, double *r, double *Jx) {
+  size_t i, k, j;
+  rcb_status st;
+  if ((st = derivative_matrices(f))) return st;
+  for (i = 0; i < f->npts; i++) {
+    if (!f->pt_used[i]) continue;
+    if ((st = solve_point(f, i)) || (st = jac_point(f, i, Jx))) return st;
+  }
+  residuals_from_model(f, r);
+  f->evaluations++;
+  for (k = 0; k < f->np; k++) {
+    double g = dpdx(f, k);
+    for (j = 0; j < f->nres; j++) Jx[j + f->nres * k] *= g;
+  }
+  return RCB_OK;
+}
+
+rcb_status rcb_fit_eval_jac(rcb_fit *f, double *r, double *Jx) {
+  return f->analytic ? jac_analytic(f, r, Jx) : jac_fd(f, r, Jx);
+}
+
+rcb_status rcb_fit_objective(rcb_fit *f, const double *x, double *F, double *grad) {
+  rcb_status st;
+  size_t k, j;
+  if ((st = rcb_fit_set_x(f, x))) return st;
+  if (!grad) {
+    if ((st = rcb_fit_eval(f, f->r))) return st;
+  } else {
+    if ((st = rcb_fit_eval_jac(f, f->r, f->J))) return st;
+    for (k = 0; k < f->np; k++) {
+      double g = 0.0;
+      for (j = 0; j < f->nres; j++) g += f->J[j + f->nres * k] * f->r[j];
+      grad[k] = 2.0 * g;
+    }
+  }
+  *F = rcb_fit_sumsq(f->r, f->nres);
+  return RCB_OK;
+}

@@ -1,0 +1,116 @@
+/*
+ * The fit object, shared by the identification files: fit.c (set-up,
+ * residuals, Jacobians, report), fit_paper.c (the paper's algorithm,
+ * eqs. 14-18), fit_nlopt.c (NLopt adapter), uncertainty.c.
+ *
+ * Optimisers work in internal coordinates x: x_k = ln p_k for log
+ * parameters, x_k = p_k / s_k otherwise (s_k = |start| or 1), so that all
+ * coordinates are of order one.
+ */
+#ifndef RCB_FIT_INTERNAL_H
+#define RCB_FIT_INTERNAL_H
+
+#include "analyses/frf_internal.h"
+#include "core/rcb_internal.h"
+
+#define RCB_PARAM_NAME_MAX (3 * RCB_NAME_MAX)
+
+typedef struct rcb_fit_par_s {
+  char name[RCB_PARAM_NAME_MAX];
+  double lo, hi;    /* bounds, parameter units */
+  int log_param;    /* x = ln p */
+  double scale;     /* s: x = p / s when not log */
+  double start;     /* value at rcb_fit_run start */
+  double value;     /* current / fitted value */
+  double se, ci_lo, ci_hi;
+  int identifiable;
+} rcb_fit_par;
+
+struct rcb_fit {
+  rcb_allocator alloc;
+  char errmsg[RCB_ERRMSG_MAX];
+  rcb_model *m;
+  const rcb_meas *meas;
+  rcb_frf *frf;          /* outputs: distinct response DOFs; inputs: distinct references */
+  size_t nch, npts;      /* channels, abscissa points */
+  size_t *ch_out, *ch_in; /* per channel: index into the frf outputs / inputs */
+  rcb_frf_kind *ch_kind; /* per channel: kind of the measured values */
+  const double *grid;    /* rad/s, npts */
+  int unbalance;         /* 1: unbalance responses over speed */
+  double speed;          /* rotor speed of an FRF test, rad/s (< 0: synchronous) */
+  rcb_fit_scale scale;
+  double band_lo, band_hi; /* rad/s */
+  double *wuser;         /* nch * npts user weights, NULL: 1 */
+  double beta_a, beta_s; /* noise model, %, both 0: none */
+  rcb_fit_method method;
+  char algorithm[64];
+  int analytic;
+  size_t max_iter;
+  double ftol_rel, xtol_rel;
+  int (*progress)(void *user, size_t iter, size_t evals, double objective);
+  void *progress_user;
+
+  /* parameters */
+  rcb_fit_par *par;
+  size_t np, cap_par;
+
+  /* residual layout, rebuilt by rcb_fit_prepare: residual j comes from
+   * (channel res_ch[j], point res_pt[j]); with the complex scale each point
+   * gives two residuals (res_part 0: real, 1: imaginary). */
+  size_t nres;
+  size_t *res_ch, *res_pt;
+  unsigned char *res_part;
+  double *res_sqrtw;     /* sqrt of the weight */
+  double *res_meas;      /* measured value on the scale */
+  rcb_complex *Hmod;     /* model values, nch * npts (kind of each channel) */
+  rcb_complex *Hwork;    /* frf output buffer, nout * nin */
+  size_t nout, nin;
+  unsigned char *pt_used; /* npts: 1 when some residual needs the model there */
+  double *J, *r;         /* nres x np, nres (workspace for optimisers) */
+  double *dmat;          /* np x 4 x layout size: dM, dC, dG, dK per parameter */
+  rcb_complex *rhs;      /* n x (np * max(nin, 1)): sensitivity right-hand sides */
+  rcb_complex *dF;       /* n x (np + 1): dF/dp at unit speed, then F itself */
+  int prepared;          /* residual layout matches the settings */
+
+  /* results */
+  size_t iterations, evaluations;
+  double obj0, obj, err0, err;
+  int converged;
+  double *cov, *corr;    /* np x np */
+};
+
+rcb_status rcb_fit_fail(rcb_fit *f, rcb_status st, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+double rcb_fit_sumsq(const double *r, size_t n);
+void rcb_fit_free_layout(rcb_fit *f);
+
+/* Resolve the residual layout (band, weights, noise model) and size the
+ * workspaces; called by rcb_fit_run and the building-block functions. */
+rcb_status rcb_fit_prepare(rcb_fit *f);
+/* Parameters <-> internal coordinates. set_x writes the model and refreshes
+ * the FRF workspace. */
+void rcb_fit_get_x(const rcb_fit *f, double *x);
+rcb_status rcb_fit_set_x(rcb_fit *f, const double *x);
+/* Weighted residuals at the current model (counts one evaluation). */
+rcb_status rcb_fit_eval(rcb_fit *f, double *r);
+/* Residuals and their Jacobian d r / d x (internal coordinates), nres x np
+ * column-major, analytic or finite-difference per f->analytic. */
+rcb_status rcb_fit_eval_jac(rcb_fit *f, double *r, double *Jx);
+/* F = r^T r at x (sets the model), and its gradient d F / d x when grad is
+ * not NULL. */
+rcb_status rcb_fit_objective(rcb_fit *f, const double *x, double *F, double *grad);
+/* Paper's error % of residual vector r (unweighted distance on the scale). */
+double rcb_fit_error_pct(const rcb_fit *f);
+
+/* Optimisers: each leaves the best point in the model and fills
+ * iterations/evaluations/converged. */
+rcb_status rcb_fit_run_paper(rcb_fit *f);
+rcb_status rcb_fit_run_nlopt(rcb_fit *f);
+/* Standard errors, confidence intervals, correlation, identifiability at the
+ * current (fitted) point. */
+rcb_status rcb_fit_uncertainty(rcb_fit *f);
+
+#endif
