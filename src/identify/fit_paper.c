@@ -2,7 +2,9 @@
  * The paper's non-linear least-squares algorithm (Tapia & Cavalca, eqs.
  * 14-18, after Arruda): at each iteration the sensitivity matrix S (eq. 14),
  * the Gauss-Newton step by pseudo-inverse (eq. 16), a derivative-free line
- * search along it (Davies-Swann-Campey with a quadratic (Coggins) fit, eq. 17);
+ * search along it (Davies-Swann-Campey with a quadratic (Coggins) fit, eq. 17)
+ * unless the full step already achieves half the reduction its linearisation
+ * predicts (then it is taken as is: fewer model evaluations than the paper);
  * if the search fails, the damped system [S; lambda Q] with
  * Q = diag(||S_:,i||) and growing lambda (eq. 18). Bounds by the exterior
  * penalty w (p - bound)^2, written as extra residuals so the same
@@ -17,6 +19,8 @@
 typedef struct paper_ws {
   size_t n, np, m;  /* residuals, parameters, rows of the damped system */
   double wpen;      /* penalty weight (x units) */
+  double pred;      /* reduction of Phi the linear model predicts for the step */
+  int capped;       /* the step was shortened to one unit of x */
   double *R, *JA;   /* augmented residuals (n + np) and Jacobian ((n + np) x np) */
   double *A, *b;    /* least-squares copy: (m x np), (m) */
   double *s, *work; /* singular values, LAPACK work */
@@ -84,13 +88,22 @@ static rcb_status gn_step(rcb_fit *f, paper_ws *ws, double lambda) {
                              ws->work, ws->lwork);
   if (info) return rcb_fit_fail(f, RCB_ERR_LAPACK, "dgelss failed (info %d)", (int)info);
   /* An almost unidentifiable parameter (the coupling's cR) gets a huge
-   * pseudo-inverse component; cap the step at one unit of x (a factor e for
-   * log parameters, the start value otherwise) and let the line search
-   * expand it when that pays. */
+   * pseudo-inverse component; clip each component of the step to one unit of
+   * x (a factor e for log parameters, the start value otherwise), so that it
+   * cannot dictate the others' steps, and let the line search expand it. */
   {
-    double big = 0.0;
-    for (k = 0; k < ws->np; k++) big = fmax(big, fabs(ws->b[k]));
-    for (k = 0; k < ws->np; k++) ws->dx[k] = big > 1.0 ? ws->b[k] / big : ws->b[k];
+    ws->capped = 0;
+    for (k = 0; k < ws->np; k++) {
+      ws->dx[k] = fmax(-1.0, fmin(1.0, ws->b[k]));
+      if (ws->dx[k] != ws->b[k]) ws->capped = 1;
+    }
+  }
+  /* Phi - ||R + JA dx||^2: what the linearised model promises */
+  ws->pred = 0.0;
+  for (i = 0; i < rows; i++) {
+    double lin = ws->R[i];
+    for (k = 0; k < ws->np; k++) lin += ws->JA[i + rows * k] * ws->dx[k];
+    ws->pred += ws->R[i] * ws->R[i] - lin * lin;
   }
   return RCB_OK;
 }
@@ -118,6 +131,14 @@ static rcb_status line_search(rcb_fit *f, paper_ws *ws, double phi0, double *phi
   p[0] = phi0;
   along(ws, 1.0, ws->xt);
   if ((st = phi_at(f, ws, ws->xt, &p[1]))) return st;
+  if (!ws->capped && p[1] < phi0 && phi0 - p[1] >= 0.5 * ws->pred) {
+    /* the full Gauss-Newton step did at least half of what the linear model
+     * promised: take it without spending evaluations on the search */
+    along(ws, 1.0, ws->x);
+    *phi = p[1];
+    *ok = 1;
+    return RCB_OK;
+  }
   if (p[1] < phi0) {
     for (k = 0; k < 4; k++) { /* expand: 1, 2, 4, ... */
       along(ws, a[2], ws->xt);
