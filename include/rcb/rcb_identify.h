@@ -95,7 +95,7 @@ typedef struct rcb_fit_report {
   size_t residuals;    /**< residuals used (after band and weights) */
   double objective0;   /**< F at the start */
   double objective;    /**< F at the end */
-  double error0_pct;   /**< paper's error: 100 ||m - e|| / ||e|| on the scale, at the start */
+  double error0_pct;   /**< paper's error % at the start (see rcb_fit_error) */
   double error_pct;    /**< the same at the end */
   double sigma;        /**< residual standard deviation sqrt(F / (N - np)) */
   int converged;       /**< 1 when a convergence criterion was met */
@@ -117,6 +117,11 @@ RCB_API rcb_status rcb_fit_correlation(const rcb_fit *f, double *C);
 
 /* ---- building blocks, exposed for checks and for other optimisers ---- */
 
+/**
+ * @brief The paper's error % of the model as it is now, over the fit's points:
+ * 100 ||(|m| - |e|)|| / || |e| || on linear magnitudes (before any fit: E0).
+ */
+RCB_API rcb_status rcb_fit_error(rcb_fit *f, double *error_pct);
 /** @brief Number of residuals (after band and zero weights). */
 RCB_API size_t rcb_fit_residual_count(const rcb_fit *f);
 /** @brief Weighted residuals sqrt(W) r at the model's current parameters. */

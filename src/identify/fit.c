@@ -345,6 +345,16 @@ rcb_status rcb_fit_residuals(rcb_fit *f, double *r) {
   return rcb_fit_eval(f, r);
 }
 
+rcb_status rcb_fit_error(rcb_fit *f, double *error_pct) {
+  rcb_status st;
+  if (!f || !error_pct) return RCB_ERR_ARG;
+  if ((st = rcb_fit_prepare(f))) return st;
+  rcb_frf_refresh(f->frf);
+  if ((st = rcb_fit_eval(f, f->r))) return st;
+  *error_pct = rcb_fit_error_pct(f);
+  return RCB_OK;
+}
+
 rcb_status rcb_fit_jacobian(rcb_fit *f, int analytic, double *J) {
   rcb_status st;
   int keep;
