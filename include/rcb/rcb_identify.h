@@ -122,6 +122,15 @@ RCB_API rcb_status rcb_fit_correlation(const rcb_fit *f, double *C);
  * 100 ||(|m| - |e|)|| / || |e| || on linear magnitudes (before any fit: E0).
  */
 RCB_API rcb_status rcb_fit_error(rcb_fit *f, double *error_pct);
+/**
+ * @brief Sensitivity of each measurement channel to each parameter (paper
+ * Figs. 7 and 11): S[c + nch * k] = RMS over the channel's points of
+ * p_k d s(H)/d p_k (the change on the fit's scale for a 100 % change of p_k,
+ * weights not applied). Use a noise-free simulated measurement with many
+ * candidate channels to pick the most sensitive ones.
+ * @param S output, nch x np column-major (nch = rcb_meas_channel_count)
+ */
+RCB_API rcb_status rcb_fit_channel_sensitivity(rcb_fit *f, double *S);
 /** @brief Number of residuals (after band and zero weights). */
 RCB_API size_t rcb_fit_residual_count(const rcb_fit *f);
 /** @brief Weighted residuals sqrt(W) r at the model's current parameters. */

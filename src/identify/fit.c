@@ -355,6 +355,39 @@ rcb_status rcb_fit_error(rcb_fit *f, double *error_pct) {
   return RCB_OK;
 }
 
+rcb_status rcb_fit_channel_sensitivity(rcb_fit *f, double *S) {
+  size_t *cnt, j, k, c, n;
+  double *J;
+  rcb_status st;
+  if (!f || !S) return RCB_ERR_ARG;
+  if ((st = rcb_fit_prepare(f))) return st;
+  n = f->nres;
+  J = rcb_alloc(&f->alloc, n * (f->np ? f->np : 1) * sizeof *J);
+  cnt = rcb_alloc(&f->alloc, f->nch * sizeof *cnt);
+  if (!J || !cnt) {
+    st = rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory");
+    goto done;
+  }
+  if ((st = rcb_fit_jacobian(f, f->analytic, J))) goto done;
+  memset(S, 0, f->nch * f->np * sizeof *S);
+  for (j = 0; j < n; j++) cnt[f->res_ch[j]]++;
+  for (k = 0; k < f->np; k++) {
+    double p;
+    rcb_model_get_param(f->m, f->par[k].name, &p);
+    for (j = 0; j < n; j++) {
+      double v = J[j + n * k] * p / f->res_sqrtw[j]; /* unweighted, relative change */
+      if (f->res_sqrtw[j] > 0) S[f->res_ch[j] + f->nch * k] += v * v;
+    }
+  }
+  for (k = 0; k < f->np; k++)
+    for (c = 0; c < f->nch; c++)
+      S[c + f->nch * k] = cnt[c] ? sqrt(S[c + f->nch * k] / (double)cnt[c]) : 0.0;
+done:
+  rcb_free(&f->alloc, J);
+  rcb_free(&f->alloc, cnt);
+  return st;
+}
+
 rcb_status rcb_fit_jacobian(rcb_fit *f, int analytic, double *J) {
   rcb_status st;
   int keep;

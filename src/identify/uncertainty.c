@@ -4,8 +4,10 @@
  * units), sigma^2 = F / (N - np); 95 % intervals p +/- 1.96 se (N large);
  * correlation; and an SVD test on the column-scaled Jacobian: a parameter is
  * not identifiable when it loads on a singular value below 1e-6 of the
- * largest (the data cannot tell it apart), or its relative standard error
- * exceeds 100 % (the data do not pin it down; the paper's "infinite" cR error).
+ * largest (the data cannot tell it apart), or when the data cannot tell the
+ * fitted value from half or twice of it: F(2p) and F(p/2) both stay within
+ * the 95 % chi-square(1) level (3.84 sigma^2) of F(p) (the paper's "infinite"
+ * cR error). These evaluations are not counted in the fit's evaluations.
  */
 #include <lapacke.h>
 #include <math.h>
@@ -40,6 +42,37 @@ static void flag_and_fill(rcb_fit *f, const double *s, const double *Vt, const d
       f->corr[i + np * j] = f->cov[i + np * j] / (f->par[i].se * f->par[j].se);
 }
 
+/* Objective with parameter k set to v (the model is restored afterwards). */
+static rcb_status objective_with(rcb_fit *f, size_t k, double v, double *F) {
+  double p;
+  rcb_status st;
+  rcb_model_get_param(f->m, f->par[k].name, &p);
+  if ((st = rcb_model_set_param(f->m, f->par[k].name, v))) return st;
+  rcb_frf_refresh(f->frf);
+  st = rcb_fit_eval(f, f->r + f->nres);
+  rcb_model_set_param(f->m, f->par[k].name, p);
+  rcb_frf_refresh(f->frf);
+  if (!st) *F = rcb_fit_sumsq(f->r + f->nres, f->nres);
+  return st;
+}
+
+/* Can the data tell p from 2p and p/2? */
+static rcb_status factor_two_test(rcb_fit *f, double sigma2) {
+  size_t k, evals = f->evaluations;
+  double F0 = rcb_fit_sumsq(f->r, f->nres);
+  rcb_status st = RCB_OK;
+  for (k = 0; k < f->np && !st; k++) {
+    rcb_fit_par *p = &f->par[k];
+    double v = p->value, F2, Fh;
+    if (v <= 0.0 || !(sigma2 > 0)) continue;
+    if ((st = objective_with(f, k, 2.0 * v, &F2)) || (st = objective_with(f, k, 0.5 * v, &Fh)))
+      break;
+    if (fmin(F2, Fh) - F0 < 3.84 * sigma2) p->identifiable = 0;
+  }
+  f->evaluations = evals;
+  return st ? rcb_fit_fail(f, st, "identifiability test: %s", rcb_model_errmsg(f->m)) : RCB_OK;
+}
+
 rcb_status rcb_fit_uncertainty(rcb_fit *f) {
   size_t n = f->nres, np = f->np, i, k;
   double *A = rcb_alloc(&f->alloc, n * np * sizeof *A);
@@ -51,7 +84,12 @@ rcb_status rcb_fit_uncertainty(rcb_fit *f) {
     st = rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory (uncertainty)");
     goto done;
   }
-  if ((st = rcb_fit_eval_jac(f, f->r, f->J))) goto done;
+  {
+    size_t evals = f->evaluations;
+    st = rcb_fit_eval_jac(f, f->r, f->J);
+    f->evaluations = evals;
+    if (st) goto done;
+  }
   sigma2 = n > np ? rcb_fit_sumsq(f->r, n) / (double)(n - np) : (double)NAN;
   /* J in internal units -> columns scaled to relative parameter changes */
   for (k = 0; k < np; k++) {
@@ -72,6 +110,7 @@ rcb_status rcb_fit_uncertainty(rcb_fit *f) {
     goto done;
   }
   flag_and_fill(f, s, Vt, d, sigma2);
+  st = factor_two_test(f, sigma2);
 done:
   rcb_free(&f->alloc, A);
   rcb_free(&f->alloc, s);
