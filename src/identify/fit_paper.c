@@ -212,11 +212,25 @@ static rcb_status iterate(rcb_fit *f, paper_ws *ws, double *phi, int *moved) {
   double phi0 = *phi, lambda;
   int ok;
   rcb_status st;
-  if ((st = linearise(f, ws, ws->x, &phi0)) || (st = gn_step(f, ws, 0.0)) ||
-      (st = line_search(f, ws, phi0, phi, &ok)))
-    return st;
-  for (lambda = 1e-3; !ok && lambda <= 1e3; lambda *= 10.0)
-    if ((st = gn_step(f, ws, lambda)) || (st = line_search(f, ws, phi0, phi, &ok))) return st;
+  if ((st = linearise(f, ws, ws->x, &phi0)) || (st = gn_step(f, ws, 0.0))) return st;
+  if (ws->pred <= f->ftol_rel * phi0) { /* nothing left to gain: at a minimum */
+    *moved = 0;
+    *phi = phi0;
+    return RCB_OK;
+  }
+  if ((st = line_search(f, ws, phi0, phi, &ok))) return st;
+  /* eq. 18: damped steps, one trial each, lambda growing tenfold */
+  for (lambda = 1e-3; !ok && lambda <= 1e3; lambda *= 10.0) {
+    double p1;
+    if ((st = gn_step(f, ws, lambda))) return st;
+    along(ws, 1.0, ws->xt);
+    if ((st = phi_at(f, ws, ws->xt, &p1))) return st;
+    if (p1 < phi0) {
+      memcpy(ws->x, ws->xt, ws->np * sizeof *ws->x);
+      *phi = p1;
+      ok = 1;
+    }
+  }
   *moved = ok;
   if (!ok) *phi = phi0;
   return RCB_OK;

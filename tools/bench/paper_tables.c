@@ -191,6 +191,9 @@ static void one_seed(const char *ini, const rcb_model *truth, const rcb_meas *cl
   rs->it[s] = (double)rep.iterations;
   rs->ev[s] = (double)rep.evaluations;
   if (rep.error_pct <= 1.05 * rs->floor[s]) rs->reached++;
+  if (getenv("RCB_TABLES_VERBOSE"))
+    fprintf(stderr, "  seed %u %s: error %.4g %% (floor %.4g), %zu iterations, %zu evaluations\n", s,
+            v->model, rep.error_pct, rs->floor[s], rep.iterations, rep.evaluations);
   for (k = 0; k < (int)rcb_fit_param_count(f); k++) {
     rcb_fit_param p;
     int j;
