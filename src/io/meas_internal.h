@@ -1,0 +1,77 @@
+/*
+ * Measurement container internals shared by the I/O files (meas.c, csv.c,
+ * uff58.c, noise.c). Not installed.
+ */
+#ifndef RCB_MEAS_INTERNAL_H
+#define RCB_MEAS_INTERNAL_H
+
+#include <stdio.h>
+
+#include "core/rcb_internal.h"
+#include "rcb/rcb_measure.h"
+
+/* "STATION.DIR": station names may be "C.A" (coupling side), up to
+ * 2 RCB_NAME_MAX + 2, plus ".rx". */
+#define RCB_MEAS_CH_MAX (2 * RCB_NAME_MAX + 8)
+
+typedef struct rcb_meas_ch {
+  char resp[RCB_MEAS_CH_MAX];
+  char ref[RCB_MEAS_CH_MAX]; /* "" for unbalance responses */
+  rcb_frf_kind kind;
+  rcb_complex *data; /* n values */
+} rcb_meas_ch;
+
+struct rcb_meas {
+  rcb_allocator alloc;
+  char errmsg[RCB_ERRMSG_MAX];
+  rcb_meas_type type;
+  size_t n;     /* points */
+  double *x;    /* rad/s, n of them */
+  double speed; /* rad/s (FRF test speed, < 0 synchronous) */
+  rcb_meas_ch *ch;
+  size_t nch, capch;
+};
+
+/* printf into ms->errmsg, returns st. */
+rcb_status rcb_meas_fail(rcb_meas *ms, rcb_status st, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+/* Drop grid and channels (the object stays usable). */
+void rcb_meas_clear(rcb_meas *ms);
+
+/*
+ * Set the grid / add a channel with the errors reported as coming from
+ * @p where (e.g. "f.uff: record 3 (line 40)"; NULL for API calls) and the
+ * status @p bad used for invalid data (RCB_ERR_ARG from the API,
+ * RCB_ERR_PARSE from a file).
+ */
+rcb_status rcb_meas_set_grid_at(rcb_meas *ms, rcb_meas_type type, size_t n, const double *x,
+                                double speed, const char *where, rcb_status bad);
+rcb_status rcb_meas_add_channel_at(rcb_meas *ms, const char *response, const char *reference,
+                                   rcb_frf_kind kind, const rcb_complex *data,
+                                   const char *where, rcb_status bad);
+
+/* Split "STATION.DIR": dir index 0..3 (x, y, rx, ry) or -1 if the suffix is
+ * not one of them; *stlen = length of the station part. */
+int rcb_meas_channel_dir(const char *name, size_t *stlen);
+/* "receptance" / "mobility" / "inertance" */
+const char *rcb_meas_kind_name(rcb_frf_kind k);
+int rcb_meas_kind_parse(const char *s, rcb_frf_kind *k);
+
+/* Atomic output: write to a temporary file next to @p path, then rename. */
+typedef struct rcb_atomic_file {
+  FILE *fp;
+  char tmp[4096];
+} rcb_atomic_file;
+rcb_status rcb_atomic_open(rcb_meas *ms, rcb_atomic_file *af, const char *path, int binary);
+/* Close and rename onto @p path; on any error the temporary file is removed. */
+rcb_status rcb_atomic_commit(rcb_meas *ms, rcb_atomic_file *af, const char *path);
+void rcb_atomic_abort(rcb_atomic_file *af);
+
+/* Whole file into memory (NUL-terminated), through the object's allocator. */
+rcb_status rcb_meas_slurp(rcb_meas *ms, const char *path, char **buf, size_t *len);
+
+#endif /* RCB_MEAS_INTERNAL_H */

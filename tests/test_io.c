@@ -1,0 +1,747 @@
+/*
+ * Measurements: container, UFF dataset 58 (ASCII and binary 58b), CSV, eq. 19
+ * noise. Checked against things that could prove them wrong:
+ *  - round trips: binary UFF and CSV bit-for-bit (1e-15), ASCII UFF to the
+ *    13 significant digits of its E20.12 fields;
+ *  - hand-written UFF records in the documented fixed-column layout (the same
+ *    bytes pyuff writes), with known values, signs and node maps;
+ *  - kind conversion identities: mobility = i w receptance, inertance =
+ *    -w^2 receptance;
+ *  - noise: the bound |f_e/f_s - 1| <= beta_a/100 and its coverage, the
+ *    systematic bound, and the PRNG stream against an independent Python
+ *    implementation of splitmix64 + xoshiro256**;
+ *  - every kind of bad data gives RCB_ERR_PARSE (file) or RCB_ERR_ARG (API)
+ *    with a message naming the problem and the line or record.
+ */
+#define _POSIX_C_SOURCE 200809L /* mkdtemp, fmemopen, access */
+#include <complex.h>
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <cmocka.h>
+#include <unistd.h>
+
+#include "core/rcb_internal.h"
+#include "rcb_test_util.h"
+
+#define TWO_PI (2.0 * RCB_PI)
+#define NPT 37
+
+static char tmpdir[256];
+
+static int setup_dir(void **state) {
+  (void)state;
+  snprintf(tmpdir, sizeof tmpdir, "/tmp/rcb_test_io_XXXXXX");
+  return mkdtemp(tmpdir) ? 0 : -1;
+}
+
+static int teardown_dir(void **state) {
+  char cmd[300];
+  (void)state;
+  snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
+  return system(cmd) == 0 ? 0 : -1;
+}
+
+static const char *tpath(const char *name) {
+  static char buf[4][512];
+  static int k;
+  k = (k + 1) % 4;
+  snprintf(buf[k], sizeof buf[k], "%s/%s", tmpdir, name);
+  return buf[k];
+}
+
+static void write_text(const char *path, const char *text) {
+  FILE *fp = fopen(path, "wb");
+  assert_non_null(fp);
+  fputs(text, fp);
+  fclose(fp);
+}
+
+static int cclose(double complex a, double complex b, double rtol) {
+  return cabs(a - b) <= rtol * fmax(cabs(a), cabs(b));
+}
+
+/* An FRF measurement with values spanning many decades and both signs. */
+static rcb_meas *sample_frf(double speed, int uneven) {
+  rcb_meas *ms = NULL;
+  double x[NPT];
+  rcb_complex d[NPT];
+  static const char *const resp[] = {"DA.x", "C.A.y", "#7.rx"};
+  static const char *const ref[] = {"C.B.y", "DA.x", "DB.ry"};
+  size_t i, c;
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  for (i = 0; i < NPT; i++)
+    x[i] = TWO_PI * (uneven ? 10.0 + 3.0 * (double)i + 0.1234567891 * (double)(i * i)
+                            : 10.0 + 2.5 * (double)i);
+  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, NPT, x, speed), RCB_OK);
+  for (c = 0; c < 3; c++) {
+    for (i = 0; i < NPT; i++)
+      d[i] = CMPLX(sin(0.3 * (double)i + (double)c) * pow(10.0, -9.0 + 0.2 * (double)i),
+                   -cos(0.7 * (double)i) / 3.0 * pow(10.0, -6.0 - 0.1 * (double)i));
+    assert_int_equal(rcb_meas_add_channel(ms, resp[c], ref[c], (rcb_frf_kind)c, d), RCB_OK);
+  }
+  return ms;
+}
+
+static const rcb_uff_node MAP[] = {{10, "DA"}, {20, "C.A"}, {21, "C.B"}, {30, "DB"}};
+
+static void assert_same(const rcb_meas *a, const rcb_meas *b, double xtol, double vtol) {
+  size_t i, c, n = rcb_meas_point_count(a);
+  assert_int_equal(rcb_meas_get_type(a), rcb_meas_get_type(b));
+  assert_int_equal(n, rcb_meas_point_count(b));
+  assert_int_equal(rcb_meas_channel_count(a), rcb_meas_channel_count(b));
+  assert_true(rcb_test_close(rcb_meas_speed(a), rcb_meas_speed(b), 1e-7, 0.0));
+  for (i = 0; i < n; i++)
+    assert_true(rcb_test_close(rcb_meas_grid(a)[i], rcb_meas_grid(b)[i], xtol, 0.0));
+  for (c = 0; c < rcb_meas_channel_count(a); c++) {
+    rcb_meas_channel_info ia, ib;
+    assert_int_equal(rcb_meas_channel(a, c, &ia), RCB_OK);
+    assert_int_equal(rcb_meas_channel(b, c, &ib), RCB_OK);
+    assert_string_equal(ia.response, ib.response);
+    if (ia.reference) assert_string_equal(ia.reference, ib.reference);
+    assert_int_equal(ia.kind, ib.kind);
+    for (i = 0; i < n; i++) {
+      if (!cclose(ia.data[i], ib.data[i], vtol))
+        fail_msg("channel %zu point %zu: %.17g%+.17gi vs %.17g%+.17gi", c, i,
+                 creal(ia.data[i]), cimag(ia.data[i]), creal(ib.data[i]), cimag(ib.data[i]));
+    }
+  }
+}
+
+/* ---------------------------------------------------------- round trips -- */
+
+static void roundtrip_uff(int binary, int uneven, double speed, double xtol, double vtol) {
+  rcb_meas *a = sample_frf(speed, uneven), *b = NULL;
+  const char *p = tpath(binary ? "rt.bin.uff" : "rt.uff");
+  assert_int_equal(rcb_meas_write_uff(a, p, binary, 4, MAP), RCB_OK);
+  assert_int_equal(rcb_meas_create(&b, NULL), RCB_OK);
+  if (rcb_meas_read_uff(b, p, 4, MAP) != RCB_OK) fail_msg("%s", rcb_meas_errmsg(b));
+  assert_same(a, b, xtol, vtol);
+  rcb_meas_destroy(a);
+  rcb_meas_destroy(b);
+}
+
+static void test_uff_ascii_roundtrip(void **state) {
+  (void)state;
+  /* E20.12: 13 significant digits; an even grid written as min + i inc */
+  roundtrip_uff(0, 0, 10000.0 * RCB_PI / 30.0, 1e-15, 5e-13);
+  /* uneven abscissa: E13.5-wide fields (7 digits here) */
+  roundtrip_uff(0, 1, -1.0, 5e-7, 5e-13);
+}
+
+static void test_uff_binary_roundtrip(void **state) {
+  (void)state;
+  roundtrip_uff(1, 0, 3000.0 * RCB_PI / 30.0, 1e-15, 1e-15);
+  roundtrip_uff(1, 1, 0.0, 1e-15, 1e-15); /* uneven: abscissa as doubles */
+}
+
+static void test_csv_roundtrip(void **state) {
+  rcb_meas *a = sample_frf(4500.0 * RCB_PI / 30.0, 1), *b = NULL;
+  const char *p = tpath("rt.csv");
+  (void)state;
+  /* CSV has one kind line: mixed kinds are refused, nothing is written */
+  assert_int_equal(rcb_meas_write_csv(a, p), RCB_ERR_ARG);
+  assert_non_null(strstr(rcb_meas_errmsg(a), "differ in kind"));
+  assert_int_equal(access(p, F_OK), -1);
+  assert_int_equal(rcb_meas_convert(a, RCB_MOBILITY), RCB_OK);
+  assert_int_equal(rcb_meas_write_csv(a, p), RCB_OK);
+  assert_int_equal(rcb_meas_create(&b, NULL), RCB_OK);
+  if (rcb_meas_read_csv(b, p) != RCB_OK) fail_msg("%s", rcb_meas_errmsg(b));
+  assert_same(a, b, 1e-15, 1e-15);
+  rcb_meas_destroy(a);
+  rcb_meas_destroy(b);
+}
+
+static void test_unbalance_roundtrip(void **state) {
+  rcb_meas *a = NULL, *b = NULL;
+  double x[5];
+  rcb_complex d[5];
+  size_t i, f;
+  (void)state;
+  assert_int_equal(rcb_meas_create(&a, NULL), RCB_OK);
+  for (i = 0; i < 5; i++) {
+    x[i] = (300.0 + 4500.0 * (double)i) * RCB_PI / 30.0;
+    d[i] = CMPLX(1e-5 * (double)(i + 1), -2e-6 * (double)i);
+  }
+  assert_int_equal(rcb_meas_set_grid(a, RCB_MEAS_UNBALANCE, 5, x, 0.0), RCB_OK);
+  assert_int_equal(rcb_meas_add_channel(a, "C.A.x", NULL, RCB_RECEPTANCE, d), RCB_OK);
+  assert_int_equal(rcb_meas_add_channel(a, "C.B.ry", NULL, RCB_RECEPTANCE, d), RCB_OK);
+  assert_int_equal(rcb_meas_add_channel(a, "DA.y", NULL, RCB_MOBILITY, d), RCB_ERR_ARG);
+  for (f = 0; f < 3; f++) {
+    const char *p = tpath(f == 2 ? "unb.csv" : "unb.uff");
+    assert_int_equal(f == 2 ? rcb_meas_write_csv(a, p) : rcb_meas_write_uff(a, p, (int)f, 4, MAP),
+                     RCB_OK);
+    assert_int_equal(rcb_meas_create(&b, NULL), RCB_OK);
+    if ((f == 2 ? rcb_meas_read_csv(b, p) : rcb_meas_read_uff(b, p, 4, MAP)) != RCB_OK)
+      fail_msg("%s", rcb_meas_errmsg(b));
+    assert_same(a, b, f == 1 ? 1e-15 : 1e-12, f == 0 ? 5e-13 : 1e-15);
+    rcb_meas_destroy(b);
+  }
+  rcb_meas_destroy(a);
+}
+
+/* ------------------------------------------- files from other writers -- */
+
+/* One ASCII dataset 58 record in pyuff's fixed columns. */
+static void rec58(FILE *fp, int ftype, long rn, int rd, long fn, int fd, int otype, long npts,
+                  int even, double x0, double dx, double z, int s8, int s9, int s10, int s11,
+                  const char *values) {
+  fprintf(fp, "%6d\n%6d%74s\n", -1, 58, "");
+  fprintf(fp, "%-80s\n%-80s\n%-80s\n%-80s\n%-80s\n", "id1", "NONE", "NONE", "NONE", "NONE");
+  fprintf(fp, "%5d%10d%5d%10d %10s%10ld%4d %10s%10ld%4d\n", ftype, 0, 0, 0, "NONE", rn, rd,
+          "NONE", fn, fd);
+  fprintf(fp, "%10d%10ld%10d%13.5e%13.5e%13.5e\n", otype, npts, even, x0, dx, z);
+  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", s8, 0, 0, 0, "NONE", "NONE");
+  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", s9, 0, 0, 0, "NONE", "NONE");
+  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", s10, 0, 0, 0, "NONE", "NONE");
+  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", s11, 0, 0, 0, "NONE", "NONE");
+  fputs(values, fp);
+  fprintf(fp, "%6d\n", -1);
+}
+
+/* Three even points (10, 20, 30 Hz) of 1+2i, 3+4i, 5+6i as 4E20.12 (pyuff's %20.11e). */
+static const char V3[] =
+    "   1.00000000000e+00   2.00000000000e+00   3.00000000000e+00   4.00000000000e+00\n"
+    "   5.00000000000e+00   6.00000000000e+00\n";
+
+static void test_uff_read_hand_written(void **state) {
+  const char *p = tpath("hand.uff");
+  FILE *fp = fopen(p, "w");
+  rcb_meas *ms = NULL;
+  rcb_meas_channel_info c;
+  rcb_uff_node map[] = {{10, "DA"}};
+  (void)state;
+  assert_non_null(fp);
+  /* a dataset we skip (164, units), an FRF with a negative response
+   * direction (velocity / force), a coherence record (type 6: skipped),
+   * an acceleration FRF from node 3 (unmapped -> "#3") in uneven spacing */
+  fputs("    -1\n   164\n         1  SI - mks (Newton)  2\n    -1\n", fp);
+  rec58(fp, 4, 10, -2, 3, 1, 6, 3, 1, 10.0, 10.0, 1200.0, 18, 11, 13, 19, V3);
+  rec58(fp, 6, 10, 1, 3, 1, 4, 3, 1, 10.0, 10.0, 0.0, 18, 0, 0, 0,
+        "   1.00000000000e+00   1.00000000000e+00   1.00000000000e+00\n");
+  rec58(fp, 4, 3, 5, 10, -4, 6, 3, 0, 0.0, 0.0, 1200.0, 18, 12, 13, 19,
+        "  1.00000e+01   1.00000000000e+00   2.00000000000e+00\n"
+        "  2.00000e+01   3.00000000000e+00   4.00000000000e+00\n"
+        "  3.00000e+01   5.00000000000e+00   6.00000000000e+00\n");
+  /* single-precision complex (type 5, 6E13.5) */
+  rec58(fp, 4, 10, 1, 3, 2, 5, 3, 1, 10.0, 10.0, 1200.0, 18, 8, 13, 19,
+        "  1.00000e+00  2.00000e+00  3.00000e+00  4.00000e+00  5.00000e+00  6.50000e+00\n");
+  fclose(fp);
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  if (rcb_meas_read_uff(ms, p, 1, map) != RCB_OK) fail_msg("%s", rcb_meas_errmsg(ms));
+  assert_int_equal(rcb_meas_get_type(ms), RCB_MEAS_FRF);
+  assert_int_equal(rcb_meas_point_count(ms), 3);
+  assert_int_equal(rcb_meas_channel_count(ms), 3);
+  assert_true(rcb_test_close(rcb_meas_grid(ms)[2], TWO_PI * 30.0, 1e-15, 0));
+  assert_true(rcb_test_close(rcb_meas_speed(ms), 1200.0 * RCB_PI / 30.0, 1e-15, 0));
+  assert_int_equal(rcb_meas_channel(ms, 0, &c), RCB_OK);
+  assert_string_equal(c.response, "DA.y");
+  assert_string_equal(c.reference, "#3.x");
+  assert_int_equal(c.kind, RCB_MOBILITY);
+  assert_true(c.data[1] == CMPLX(-3.0, -4.0)); /* -Y flips the sign */
+  assert_int_equal(rcb_meas_channel(ms, 1, &c), RCB_OK);
+  assert_string_equal(c.response, "#3.ry");
+  assert_string_equal(c.reference, "DA.rx");
+  assert_int_equal(c.kind, RCB_INERTANCE);
+  assert_true(c.data[2] == CMPLX(-5.0, -6.0));
+  assert_int_equal(rcb_meas_channel(ms, 2, &c), RCB_OK);
+  assert_string_equal(c.response, "DA.x");
+  assert_string_equal(c.reference, "#3.y");
+  assert_int_equal(c.kind, RCB_RECEPTANCE);
+  assert_true(c.data[2] == CMPLX(5.0, 6.5));
+  rcb_meas_destroy(ms);
+}
+
+static void test_csv_read_rcbtool_output(void **state) {
+  const char *p = tpath("frf.csv"), *q = tpath("unb_amp.csv");
+  rcb_meas *ms = NULL;
+  rcb_meas_channel_info c;
+  (void)state;
+  /* as rcbtool frf writes it (no comment lines: receptance at standstill) */
+  write_text(p, "freq_hz,C.A.x/DA.x re,C.A.x/DA.x im,DB.y/DA.x mag,DB.y/DA.x phase_deg\n"
+                "0,1e-6,0,2,90\n"
+                "50,-2e-6,5e-7,4,-180\n");
+  write_text(q, "rpm,DA.x amp,DA.x phase_deg,DA.y amp,DA.y phase_deg\n"
+                "300,1e-5,0,1e-5,-90\n"
+                "600,2e-5,45,2e-5,-45\n");
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  if (rcb_meas_read_csv(ms, p) != RCB_OK) fail_msg("%s", rcb_meas_errmsg(ms));
+  assert_int_equal(rcb_meas_get_type(ms), RCB_MEAS_FRF);
+  assert_true(rcb_meas_speed(ms) == 0.0);
+  assert_true(rcb_meas_grid(ms)[1] == TWO_PI * 50.0);
+  assert_int_equal(rcb_meas_channel(ms, 1, &c), RCB_OK);
+  assert_string_equal(c.response, "DB.y");
+  assert_string_equal(c.reference, "DA.x");
+  assert_int_equal(c.kind, RCB_RECEPTANCE);
+  assert_true(cclose(c.data[0], CMPLX(0.0, 2.0), 1e-15));
+  assert_true(cclose(c.data[1], CMPLX(-4.0, 0.0), 1e-15));
+  if (rcb_meas_read_csv(ms, q) != RCB_OK) fail_msg("%s", rcb_meas_errmsg(ms));
+  assert_int_equal(rcb_meas_get_type(ms), RCB_MEAS_UNBALANCE);
+  assert_true(rcb_test_close(rcb_meas_grid(ms)[1], 600.0 * RCB_PI / 30.0, 1e-15, 0));
+  assert_int_equal(rcb_meas_channel(ms, 1, &c), RCB_OK);
+  assert_null(c.reference);
+  assert_true(cclose(c.data[0], CMPLX(0.0, -1e-5), 1e-15));
+  assert_true(cclose(c.data[1], 2e-5 * CMPLX(sqrt(0.5), -sqrt(0.5)), 1e-15));
+  rcb_meas_destroy(ms);
+}
+
+/* "# kind" and "# rpm" comment lines. */
+static void test_csv_comments(void **state) {
+  const char *p = tpath("kind.csv");
+  rcb_meas *ms = NULL;
+  rcb_meas_channel_info c;
+  (void)state;
+  write_text(p, "# measured on the rig\n# kind = inertance\n# rpm = synchronous\n"
+                "freq_hz,DA.x/DA.x re,DA.x/DA.x im\n10,1,2\n20,3,4\n");
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  if (rcb_meas_read_csv(ms, p) != RCB_OK) fail_msg("%s", rcb_meas_errmsg(ms));
+  assert_true(rcb_meas_speed(ms) < 0.0);
+  assert_int_equal(rcb_meas_channel(ms, 0, &c), RCB_OK);
+  assert_int_equal(c.kind, RCB_INERTANCE);
+  write_text(p, "# rpm = 1500\nfreq_hz,DA.x/DA.x re,DA.x/DA.x im\n10,1,2\n");
+  assert_int_equal(rcb_meas_read_csv(ms, p), RCB_OK);
+  assert_true(rcb_test_close(rcb_meas_speed(ms), 50.0 * RCB_PI, 1e-15, 0));
+  rcb_meas_destroy(ms);
+}
+
+/* Binary 58b written by hand: big-endian, uneven abscissa stored as 4-byte
+ * floats (n_bytes = 20 n, the UC-SDRL layout), two points. */
+static void be_double(FILE *fp, double v) {
+  unsigned char b[8];
+  uint64_t u;
+  int i;
+  memcpy(&u, &v, 8);
+  for (i = 0; i < 8; i++) b[i] = (unsigned char)(u >> (56 - 8 * i));
+  fwrite(b, 1, 8, fp);
+}
+
+static void be_float(FILE *fp, float v) {
+  unsigned char b[4];
+  uint32_t u;
+  int i;
+  memcpy(&u, &v, 4);
+  for (i = 0; i < 4; i++) b[i] = (unsigned char)(u >> (24 - 8 * i));
+  fwrite(b, 1, 4, fp);
+}
+
+static void test_uff_binary_big_endian(void **state) {
+  const char *p = tpath("be.uff");
+  FILE *fp = fopen(p, "wb");
+  rcb_meas *ms = NULL;
+  rcb_meas_channel_info c;
+  (void)state;
+  assert_non_null(fp);
+  fprintf(fp, "%6d\n%6db%6d%6d%12d%12d%6d%6d%12d%12d\n", -1, 58, 2, 2, 11, 40, 0, 0, 0, 0);
+  fprintf(fp, "NONE\nNONE\nNONE\nNONE\nNONE\n");
+  fprintf(fp, "%5d%10d%5d%10d %10s%10ld%4d %10s%10ld%4d\n", 4, 1, 0, 0, "NONE", 4L, 2, "NONE",
+          5L, 1);
+  fprintf(fp, "%10d%10d%10d%13.5e%13.5e%13.5e\n", 6, 2, 0, 0.0, 0.0, 0.0);
+  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", 18, 0, 0, 0, "NONE", "NONE");
+  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", 8, 0, 0, 0, "NONE", "NONE");
+  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", 13, 0, 0, 0, "NONE", "NONE");
+  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", 0, 0, 0, 0, "NONE", "NONE");
+  be_float(fp, 12.5f);
+  be_double(fp, 1.0 / 3.0);
+  be_double(fp, -2e-9);
+  be_float(fp, 40.0f);
+  be_double(fp, 10.0); /* 0x4024...: contains no '\n', but 0x0a may appear in others */
+  be_double(fp, -1e300);
+  fprintf(fp, "%6d\n", -1);
+  fclose(fp);
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  if (rcb_meas_read_uff(ms, p, 0, NULL) != RCB_OK) fail_msg("%s", rcb_meas_errmsg(ms));
+  assert_int_equal(rcb_meas_point_count(ms), 2);
+  assert_true(rcb_meas_grid(ms)[0] == TWO_PI * 12.5);
+  assert_true(rcb_meas_grid(ms)[1] == TWO_PI * 40.0);
+  assert_int_equal(rcb_meas_channel(ms, 0, &c), RCB_OK);
+  assert_string_equal(c.response, "#4.y");
+  assert_string_equal(c.reference, "#5.x");
+  assert_true(c.data[0] == CMPLX(1.0 / 3.0, -2e-9));
+  assert_true(c.data[1] == CMPLX(10.0, -1e300));
+  rcb_meas_destroy(ms);
+}
+
+/* ------------------------------------------------------------- kinds -- */
+
+static void test_kind_conversion(void **state) {
+  rcb_meas *ms = NULL;
+  double x[3] = {1.0, 10.0, 100.0};
+  rcb_complex r[3] = {CMPLX(1.0, 2.0), CMPLX(-3.0, 0.5), CMPLX(1e-7, -1e-8)};
+  rcb_meas_channel_info c;
+  size_t i;
+  (void)state;
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, 3, x, 0.0), RCB_OK);
+  assert_int_equal(rcb_meas_add_channel(ms, "DA.x", "DA.y", RCB_RECEPTANCE, r), RCB_OK);
+  assert_int_equal(rcb_meas_convert(ms, RCB_INERTANCE), RCB_OK);
+  assert_int_equal(rcb_meas_channel(ms, 0, &c), RCB_OK);
+  assert_int_equal(c.kind, RCB_INERTANCE);
+  for (i = 0; i < 3; i++) assert_true(cclose(c.data[i], -x[i] * x[i] * r[i], 1e-15));
+  assert_int_equal(rcb_meas_convert(ms, RCB_MOBILITY), RCB_OK);
+  for (i = 0; i < 3; i++) assert_true(cclose(c.data[i], CMPLX(0.0, x[i]) * r[i], 1e-15));
+  assert_int_equal(rcb_meas_convert(ms, RCB_RECEPTANCE), RCB_OK);
+  for (i = 0; i < 3; i++) assert_true(cclose(c.data[i], r[i], 1e-15));
+  /* dividing by i w at 0 Hz is refused before anything changes */
+  x[0] = 0.0;
+  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, 3, x, 0.0), RCB_OK);
+  assert_int_equal(rcb_meas_add_channel(ms, "DA.x", "DA.y", RCB_INERTANCE, r), RCB_OK);
+  assert_int_equal(rcb_meas_convert(ms, RCB_RECEPTANCE), RCB_ERR_ARG);
+  assert_non_null(strstr(rcb_meas_errmsg(ms), "0 Hz"));
+  assert_int_equal(rcb_meas_channel(ms, 0, &c), RCB_OK);
+  assert_int_equal(c.kind, RCB_INERTANCE);
+  assert_true(c.data[1] == r[1]);
+  rcb_meas_destroy(ms);
+}
+
+/* ------------------------------------------------------------- noise -- */
+
+#define NN 20000
+
+static rcb_meas *ones(size_t n, rcb_complex v) {
+  rcb_meas *ms = NULL;
+  double *x = malloc(n * sizeof *x);
+  rcb_complex *d = malloc(n * sizeof *d);
+  size_t i;
+  assert_non_null(x);
+  assert_non_null(d);
+  for (i = 0; i < n; i++) {
+    x[i] = 1.0 + (double)i;
+    d[i] = v * (1.0 + 0.001 * (double)i);
+  }
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, n, x, 0.0), RCB_OK);
+  assert_int_equal(rcb_meas_add_channel(ms, "DA.x", "DA.x", RCB_RECEPTANCE, d), RCB_OK);
+  assert_int_equal(rcb_meas_add_channel(ms, "DB.x", "DA.x", RCB_RECEPTANCE, d), RCB_OK);
+  free(x);
+  free(d);
+  return ms;
+}
+
+static const rcb_complex *chan(const rcb_meas *ms, size_t c) {
+  rcb_meas_channel_info info;
+  assert_int_equal(rcb_meas_channel(ms, c, &info), RCB_OK);
+  return info.data;
+}
+
+static void test_noise_proportional(void **state) {
+  const rcb_complex v = CMPLX(2e-6, -1e-6);
+  rcb_meas *ms = ones(NN, v);
+  const rcb_complex *d = chan(ms, 0);
+  int bins[10] = {0};
+  double lo = 1.0, hi = -1.0;
+  size_t i;
+  (void)state;
+  assert_int_equal(rcb_meas_add_noise(ms, 10.0, 0.0, 7), RCB_OK);
+  for (i = 0; i < NN; i++) {
+    rcb_complex ratio = d[i] / (v * (1.0 + 0.001 * (double)i));
+    double e = creal(ratio) - 1.0;
+    assert_true(fabs(cimag(ratio)) < 1e-14); /* proportional: real factor */
+    assert_true(fabs(e) <= 0.1 * (1.0 + 1e-14));
+    lo = fmin(lo, e);
+    hi = fmax(hi, e);
+    bins[(int)fmin(9.0, floor((e + 0.1) / 0.02))]++;
+  }
+  /* covers [-0.1, 0.1]: both ends reached, each tenth holds ~NN/10 */
+  assert_true(lo < -0.0995 && hi > 0.0995);
+  for (i = 0; i < 10; i++) assert_true(abs(bins[i] - NN / 10) < NN / 40);
+  rcb_meas_destroy(ms);
+}
+
+static void test_noise_systematic(void **state) {
+  const rcb_complex v = CMPLX(0.0, 3.0);
+  rcb_meas *ms = ones(1000, v);
+  const rcb_complex *d = chan(ms, 1);
+  double sum = 0.0, level, top = 0.0;
+  size_t i;
+  (void)state;
+  for (i = 0; i < 1000; i++) sum += pow(3.0 * (1.0 + 0.001 * (double)i), 2);
+  level = sqrt(sum) / 1000.0 * 0.05; /* beta_s = 5 % */
+  assert_int_equal(rcb_meas_add_noise(ms, 0.0, 5.0, 99), RCB_OK);
+  for (i = 0; i < 1000; i++) {
+    double e = cabs(d[i] - v * (1.0 + 0.001 * (double)i));
+    assert_true(e <= level * (1.0 + 1e-12));
+    top = fmax(top, e);
+  }
+  assert_true(top > 0.99 * level);
+  rcb_meas_destroy(ms);
+}
+
+static void test_noise_seeds(void **state) {
+  rcb_meas *a = ones(100, 1.0), *b = ones(100, 1.0), *c = ones(100, 1.0);
+  size_t i, differ = 0;
+  (void)state;
+  assert_int_equal(rcb_meas_add_noise(a, 10.0, 1.0, 12345), RCB_OK);
+  assert_int_equal(rcb_meas_add_noise(b, 10.0, 1.0, 12345), RCB_OK);
+  assert_int_equal(rcb_meas_add_noise(c, 10.0, 1.0, 12346), RCB_OK);
+  assert_memory_equal(chan(a, 1), chan(b, 1), 100 * sizeof(rcb_complex));
+  for (i = 0; i < 100; i++) differ += chan(a, 0)[i] != chan(c, 0)[i];
+  assert_true(differ == 100);
+  /* the two channels draw different numbers */
+  for (i = 0, differ = 0; i < 100; i++) differ += chan(a, 0)[i] != chan(a, 1)[i];
+  assert_true(differ == 100);
+  assert_int_equal(rcb_meas_add_noise(a, -1.0, 0.0, 1), RCB_ERR_ARG);
+  rcb_meas_destroy(a);
+  rcb_meas_destroy(b);
+  rcb_meas_destroy(c);
+}
+
+/* The stream itself, against an independent Python implementation of
+ * splitmix64 seeding + xoshiro256** (r1 of points 1..3, seed 42). */
+static void test_noise_stream(void **state) {
+  static const double r1[3] = {-0.6645481157604711, 0.6987717813015502,
+                               -0.12296568848833767};
+  rcb_meas *ms = NULL;
+  double x[3] = {1.0, 2.0, 3.0};
+  rcb_complex d[3] = {1.0, 1.0, 1.0};
+  const rcb_complex *e;
+  size_t i;
+  (void)state;
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, 3, x, 0.0), RCB_OK);
+  assert_int_equal(rcb_meas_add_channel(ms, "DA.x", "DA.x", RCB_RECEPTANCE, d), RCB_OK);
+  assert_int_equal(rcb_meas_add_noise(ms, 100.0, 0.0, 42), RCB_OK);
+  e = chan(ms, 0);
+  for (i = 0; i < 3; i++) assert_true(creal(e[i]) - 1.0 == r1[i]);
+  rcb_meas_destroy(ms);
+}
+
+/* ---------------------------------------------------------- bad data -- */
+
+/* Read @p text as UFF; expect RCB_ERR_PARSE and each of the NULL-ended
+ * fragments in the message. */
+static void bad_uff(const char *text, ...) {
+  const char *p = tpath("bad.uff"), *frag;
+  rcb_meas *ms = NULL;
+  va_list ap;
+  write_text(p, text);
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  if (rcb_meas_read_uff(ms, p, 0, NULL) != RCB_ERR_PARSE)
+    fail_msg("expected RCB_ERR_PARSE, message '%s'", rcb_meas_errmsg(ms));
+  va_start(ap, text);
+  while ((frag = va_arg(ap, const char *)) != NULL)
+    if (!strstr(rcb_meas_errmsg(ms), frag))
+      fail_msg("message '%s' lacks '%s'", rcb_meas_errmsg(ms), frag);
+  va_end(ap);
+  assert_int_equal(rcb_meas_point_count(ms), 0);
+  assert_int_equal(rcb_meas_channel_count(ms), 0);
+  rcb_meas_destroy(ms);
+}
+
+static char *uff_text(int nrec, ...) {
+  static char buf[16384];
+  FILE *fp = fmemopen(buf, sizeof buf, "w");
+  va_list ap;
+  int k;
+  assert_non_null(fp);
+  va_start(ap, nrec);
+  for (k = 0; k < nrec; k++) {
+    int ftype = va_arg(ap, int), rd = va_arg(ap, int), otype = va_arg(ap, int);
+    long npts = va_arg(ap, long);
+    int even = va_arg(ap, int);
+    double x0 = va_arg(ap, double);
+    int s9 = va_arg(ap, int), s10 = va_arg(ap, int);
+    const char *vals = va_arg(ap, const char *);
+    rec58(fp, ftype, 1, rd, ftype == 1 ? 0 : 2, ftype == 1 ? 0 : 1, otype, npts, even, x0, 10.0,
+          0.0, 18, s9, s10, 0, vals);
+  }
+  va_end(ap);
+  fclose(fp);
+  return buf;
+}
+
+static void test_bad_uff(void **state) {
+  static const char uneven_dec[] =
+      "  1.00000e+01   1.00000000000e+00   2.00000000000e+00\n"
+      "  3.00000e+01   1.00000000000e+00   2.00000000000e+00\n"
+      "  2.00000e+01   1.00000000000e+00   2.00000000000e+00\n";
+  static const char uneven_neg[] =
+      " -1.00000e+01   1.00000000000e+00   2.00000000000e+00\n"
+      "  3.00000e+01   1.00000000000e+00   2.00000000000e+00\n"
+      "  4.00000e+01   1.00000000000e+00   2.00000000000e+00\n";
+  static const char nan3[] =
+      "   1.00000000000e+00   2.00000000000e+00                 nan   4.00000000000e+00\n"
+      "   5.00000000000e+00   6.00000000000e+00\n";
+  static const char short3[] =
+      "   1.00000000000e+00   2.00000000000e+00   3.00000000000e+00   4.00000000000e+00\n";
+  (void)state;
+  bad_uff(uff_text(1, 4, 1, 6, 3L, 0, 0.0, 8, 13, uneven_dec), "not increasing", "record 1",
+          "point 3", NULL);
+  bad_uff(uff_text(1, 4, 1, 6, 3L, 0, 0.0, 8, 13, uneven_neg), "point 1 is -10", NULL);
+  bad_uff(uff_text(1, 4, 1, 6, 3L, 1, 10.0, 8, 13, nan3), "bad.uff:14:", "not finite", NULL);
+  bad_uff(uff_text(1, 4, 1, 6, 3L, 1, 10.0, 8, 13, short3), "truncated", "4 of 6 values",
+          NULL);
+  bad_uff(uff_text(2, 4, 1, 6, 3L, 1, 10.0, 8, 13, V3, 4, 2, 6, 2L, 1, 10.0, 8, 13,
+                   "   1.00000000000e+00   2.00000000000e+00   3.00000000000e+00   "
+                   "4.00000000000e+00\n"),
+          "record 2", "mismatched lengths", NULL);
+  bad_uff(uff_text(2, 4, 1, 6, 3L, 1, 10.0, 8, 13, V3, 4, 2, 6, 3L, 1, 11.0, 8, 13, V3),
+          "record 2", "abscissa differs from record 1", NULL);
+  bad_uff(uff_text(1, 4, 3, 6, 3L, 1, 10.0, 8, 13, V3), "unknown response direction code 3",
+          "bad.uff:8:", NULL);
+  bad_uff(uff_text(1, 4, 1, 6, 3L, 1, 10.0, 9, 13, V3), "wrong units", "ordinate data type 9",
+          NULL);
+  bad_uff(uff_text(1, 4, 1, 6, 3L, 1, 10.0, 8, 0, V3), "wrong units", "denominator", NULL);
+  bad_uff(uff_text(1, 4, 1, 4, 3L, 1, 10.0, 8, 13, V3), "real", NULL);
+  bad_uff(uff_text(2, 4, 1, 6, 3L, 1, 10.0, 8, 13, V3, 4, 1, 6, 3L, 1, 10.0, 8, 13, V3),
+          "record 2", "duplicate channel #1.x/#2.x", NULL);
+  bad_uff(uff_text(2, 4, 1, 6, 3L, 1, 10.0, 8, 13, V3, 1, 2, 6, 3L, 1, 10.0, 8, 0, V3),
+          "record 2", "all FRFs or all unbalance", NULL);
+  bad_uff("    -1\n    58\nid1\n", "truncated", NULL);
+  bad_uff("    -1\n   164\nx\n    -1\n", "no dataset 58 record", NULL);
+}
+
+static void test_bad_uff_binary(void **state) {
+  rcb_meas *a = sample_frf(0.0, 0), *b = NULL;
+  const char *p = tpath("trunc.uff");
+  FILE *fp;
+  long size;
+  char *buf;
+  (void)state;
+  assert_int_equal(rcb_meas_write_uff(a, p, 1, 4, MAP), RCB_OK);
+  fp = fopen(p, "rb");
+  assert_non_null(fp);
+  fseek(fp, 0, SEEK_END);
+  size = ftell(fp);
+  rewind(fp);
+  buf = malloc((size_t)size);
+  assert_non_null(buf);
+  assert_int_equal(fread(buf, 1, (size_t)size, fp), (size_t)size);
+  fclose(fp);
+  fp = fopen(p, "wb"); /* cut inside the last record's binary data */
+  assert_non_null(fp);
+  fwrite(buf, 1, (size_t)size - 100, fp);
+  fclose(fp);
+  free(buf);
+  assert_int_equal(rcb_meas_create(&b, NULL), RCB_OK);
+  assert_int_equal(rcb_meas_read_uff(b, p, 4, MAP), RCB_ERR_PARSE);
+  assert_non_null(strstr(rcb_meas_errmsg(b), "record 3"));
+  assert_non_null(strstr(rcb_meas_errmsg(b), "truncated binary data"));
+  rcb_meas_destroy(a);
+  rcb_meas_destroy(b);
+}
+
+static void bad_csv(const char *text, const char *f1, const char *f2) {
+  const char *p = tpath("bad.csv");
+  rcb_meas *ms = NULL;
+  write_text(p, text);
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  if (rcb_meas_read_csv(ms, p) != RCB_ERR_PARSE)
+    fail_msg("expected RCB_ERR_PARSE, message '%s'", rcb_meas_errmsg(ms));
+  if (!strstr(rcb_meas_errmsg(ms), f1) || (f2 && !strstr(rcb_meas_errmsg(ms), f2)))
+    fail_msg("message '%s' lacks '%s' / '%s'", rcb_meas_errmsg(ms), f1, f2 ? f2 : "");
+  rcb_meas_destroy(ms);
+}
+
+static void test_bad_csv(void **state) {
+  static const char h[] = "freq_hz,DA.x/DA.x re,DA.x/DA.x im\n";
+  char t[512];
+  (void)state;
+  snprintf(t, sizeof t, "%s10,1,2\n5,1,2\n", h);
+  bad_csv(t, "bad.csv:3:", "not increasing");
+  snprintf(t, sizeof t, "%s-10,1,2\n5,1,2\n", h);
+  bad_csv(t, "bad.csv:2:", "negative");
+  snprintf(t, sizeof t, "%s10,1,2\n20,nan,2\n", h);
+  bad_csv(t, "bad.csv:3: column 2 (DA.x/DA.x)", "not finite");
+  snprintf(t, sizeof t, "%s10,1,2\n20,1\n", h);
+  bad_csv(t, "bad.csv:3:", "2 fields, the header has 3");
+  bad_csv("freq_hz,DA.x/DA.x re,DA.x/DA.x im,DA.x/DA.x re,DA.x/DA.x im\n1,1,2,3,4\n",
+          "duplicate channel DA.x/DA.x", "columns 4-5");
+  bad_csv("freq_hz,DA.z/DA.x re,DA.z/DA.x im\n1,1,2\n", "unknown direction", "DA.z");
+  bad_csv("freq_hz,DA.x/DA.x re,DA.x/DA.x imag\n1,1,2\n", "bad.csv:1: column 3", "imag");
+  bad_csv("freq_hz,DA.x/DA.x re,DB.x/DA.x im\n1,1,2\n", "bad.csv:1: column 2", "pair");
+  bad_csv("freq_hz,DA.x re,DA.x im\n1,1,2\n", "RESPONSE/REFERENCE", NULL);
+  bad_csv("# kind = velocity\nfreq_hz,DA.x/DA.x re,DA.x/DA.x im\n1,1,2\n", "bad.csv:1:",
+          "receptance, mobility or inertance");
+  bad_csv("time_s,DA.x/DA.x re,DA.x/DA.x im\n1,1,2\n", "first column 'time_s'", NULL);
+  bad_csv("freq_hz,DA.x/DA.x re,DA.x/DA.x im\n", "no data rows", NULL);
+}
+
+static void test_bad_api(void **state) {
+  rcb_meas *ms = NULL;
+  double x[3] = {1.0, 2.0, 2.0};
+  rcb_complex d[3] = {1.0, NAN, 1.0};
+  (void)state;
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  assert_int_equal(rcb_meas_add_channel(ms, "DA.x", "DA.x", RCB_RECEPTANCE, d), RCB_ERR_STATE);
+  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, 3, x, 0.0), RCB_ERR_ARG);
+  assert_non_null(strstr(rcb_meas_errmsg(ms), "not increasing"));
+  x[0] = -1.0;
+  x[2] = 3.0;
+  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, 3, x, 0.0), RCB_ERR_ARG);
+  assert_non_null(strstr(rcb_meas_errmsg(ms), "negative"));
+  x[0] = 1.0;
+  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, 3, x, 0.0), RCB_OK);
+  assert_int_equal(rcb_meas_add_channel(ms, "DA.x", "DA.x", RCB_RECEPTANCE, d), RCB_ERR_ARG);
+  assert_non_null(strstr(rcb_meas_errmsg(ms), "point 2"));
+  d[1] = 2.0;
+  assert_int_equal(rcb_meas_add_channel(ms, "DA.z", "DA.x", RCB_RECEPTANCE, d), RCB_ERR_ARG);
+  assert_non_null(strstr(rcb_meas_errmsg(ms), "unknown direction"));
+  assert_int_equal(rcb_meas_add_channel(ms, "DA.x", NULL, RCB_RECEPTANCE, d), RCB_ERR_ARG);
+  assert_int_equal(rcb_meas_add_channel(ms, "DA.x", "DA.x", RCB_RECEPTANCE, d), RCB_OK);
+  assert_int_equal(rcb_meas_add_channel(ms, "DA.x", "DA.x", RCB_MOBILITY, d), RCB_ERR_ARG);
+  assert_non_null(strstr(rcb_meas_errmsg(ms), "duplicate"));
+  assert_int_equal(rcb_meas_channel_count(ms), 1);
+  rcb_meas_destroy(ms);
+}
+
+/* ------------------------------------------------- writing, allocator -- */
+
+static void test_write_atomic(void **state) {
+  rcb_meas *a = sample_frf(0.0, 0);
+  const char *p = tpath("nomap.uff");
+  char cmd[600];
+  (void)state;
+  /* station DA without a node number: refused, nothing left behind */
+  assert_int_equal(rcb_meas_write_uff(a, p, 0, 0, NULL), RCB_ERR_ARG);
+  assert_non_null(strstr(rcb_meas_errmsg(a), "no UFF node number"));
+  assert_int_equal(access(p, F_OK), -1);
+  assert_int_equal(rcb_meas_write_uff(a, tpath("no/such/dir.uff"), 0, 4, MAP), RCB_ERR_IO);
+  assert_non_null(strstr(rcb_meas_errmsg(a), "no/such/dir.uff"));
+  /* an existing file is replaced whole */
+  write_text(p, "old");
+  assert_int_equal(rcb_meas_write_uff(a, p, 1, 4, MAP), RCB_OK);
+  snprintf(cmd, sizeof cmd, "test $(ls '%s' | grep -c tmp) -eq 0", tmpdir);
+  assert_int_equal(system(cmd), 0);
+  rcb_meas_destroy(a);
+}
+
+static void test_allocator(void **state) {
+  rcb_test_counter cnt = {0, 0};
+  rcb_allocator al = rcb_test_counting_allocator(&cnt);
+  rcb_meas *ms = NULL;
+  const char *p = tpath("alloc.uff");
+  rcb_meas *src = sample_frf(0.0, 0);
+  (void)state;
+  assert_int_equal(rcb_meas_write_uff(src, p, 1, 4, MAP), RCB_OK);
+  rcb_meas_destroy(src);
+  assert_int_equal(rcb_meas_create(&ms, &al), RCB_OK);
+  assert_int_equal(rcb_meas_read_uff(ms, p, 4, MAP), RCB_OK);
+  assert_int_equal(rcb_meas_write_csv(ms, tpath("alloc.csv")), RCB_ERR_ARG); /* mixed kinds */
+  assert_int_equal(rcb_meas_convert(ms, RCB_RECEPTANCE), RCB_OK);
+  assert_int_equal(rcb_meas_write_csv(ms, tpath("alloc.csv")), RCB_OK);
+  assert_int_equal(rcb_meas_read_csv(ms, tpath("alloc.csv")), RCB_OK);
+  rcb_meas_destroy(ms);
+  assert_true(cnt.allocs > 5);
+  assert_int_equal(cnt.allocs, cnt.frees);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_uff_ascii_roundtrip),   cmocka_unit_test(test_uff_binary_roundtrip),
+      cmocka_unit_test(test_csv_roundtrip),         cmocka_unit_test(test_unbalance_roundtrip),
+      cmocka_unit_test(test_uff_read_hand_written), cmocka_unit_test(test_csv_read_rcbtool_output),
+      cmocka_unit_test(test_csv_comments),          cmocka_unit_test(test_kind_conversion),
+      cmocka_unit_test(test_noise_proportional),    cmocka_unit_test(test_noise_systematic),
+      cmocka_unit_test(test_noise_seeds),           cmocka_unit_test(test_noise_stream),
+      cmocka_unit_test(test_bad_uff),               cmocka_unit_test(test_bad_uff_binary),
+      cmocka_unit_test(test_bad_csv),               cmocka_unit_test(test_bad_api),
+      cmocka_unit_test(test_write_atomic),          cmocka_unit_test(test_allocator),
+      cmocka_unit_test(test_uff_binary_big_endian),
+  };
+  return cmocka_run_group_tests(tests, setup_dir, teardown_dir);
+}
