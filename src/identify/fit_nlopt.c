@@ -28,7 +28,8 @@
  * (RCB_ERR_STATE). The best point seen (the start included) is left in the
  * model, whatever the outcome. converged = NLopt result > 0 other than
  * MAXEVAL/MAXTIME_REACHED (so MLSL and a global method without polish never
- * report convergence). ROUNDOFF_LIMITED is a success that did not converge;
+ * report convergence). ROUNDOFF_LIMITED (and FAILURE of a gradient method
+ * after some progress: its line search stalled) is a success that did not converge;
  * INVALID_ARGS -> RCB_ERR_ARG, OUT_OF_MEMORY -> RCB_ERR_NOMEM, FAILURE ->
  * RCB_ERR_STATE, each with a message naming the NLopt result.
  *
@@ -252,6 +253,12 @@ static rcb_status nl_result(rcb_fit *f, const nl_ctx *c, nlopt_result res, nlopt
    * (LBFGS reports it on zero-residual data at the optimum): success, but
    * not "converged". */
   if (res > 0 || res == NLOPT_ROUNDOFF_LIMITED) return RCB_OK;
+  /* LBFGS and MMA report a bare FAILURE when their line search cannot make
+   * progress at a minimum of noisy data; after some progress that is the same
+   * outcome as ROUNDOFF_LIMITED (the best point is kept, not "converged"). */
+  if (res == NLOPT_FAILURE && c->calls > 1 && (int)a >= 0 &&
+      strncmp(an ? an : "", "LD_", 3) == 0)
+    return RCB_OK;
   switch (res) {
     case NLOPT_INVALID_ARGS:
       return rcb_set_error(f->errmsg, RCB_ERR_ARG, "fit: NLopt %s returned %s (%s)", an, rn,
