@@ -229,6 +229,221 @@ progress_stderr)
   run frf "$MODEL" --out DA.x --in DA.x --fmax 100 --points 5; expect_rc 0
   [ ! -s "$W/err" ] || fail "progress printed to a non-terminal without --progress" ;;
 
+# ---- simulate / convert (measurements: UFF dataset 58, CSV) ----
+simulate_frf_uff_roundtrip)
+  # simulate (no noise) -> UFF ASCII and binary -> convert to CSV = rcbtool frf
+  run frf "$MODEL" --out DA.x,C.A.y --in DA.x,C.B.y --fmin 200 --fmax 400 --points 21 --rpm 10000 -o "$W/ref.csv"
+  expect_rc 0
+  for b in "" --binary; do
+    run simulate "$MODEL" --frf --out DA.x,C.A.y --in DA.x,C.B.y --fmin 200 --fmax 400 --points 21 \
+      --rpm 10000 --map 1=DA,2=C.A,3=C.B -o "$W/s.uff" $b
+    expect_rc 0; out_empty
+    run convert "$W/s.uff" "$W/s.csv" --map 1=DA,2=C.A,3=C.B; expect_rc 0
+    grep -q "^# rpm = 10000$" "$W/s.csv" || fail "rotor speed not carried through UFF"
+    python3 - "$W/ref.csv" "$W/s.csv" "${b:-ascii}" <<'EOF' || fail "simulate/convert values differ from rcbtool frf"
+import sys
+def rd(p):
+    rows = [l.rstrip("\n").split(",") for l in open(p) if not l.startswith("#")]
+    return rows[0], [[float(v) for v in r] for r in rows[1:]]
+(h1, a), (h2, b) = rd(sys.argv[1]), rd(sys.argv[2])
+assert h1 == h2, (h1, h2)
+tol = 1e-15 if sys.argv[3] == "--binary" else 5e-13
+for r1, r2 in zip(a, b):
+    for x, y in zip(r1, r2):
+        assert abs(x - y) <= tol * max(abs(x), 1e-300) * 4, (x, y)
+EOF
+  done ;;
+simulate_unbalance_csv)
+  run unbalance "$MODEL" --out C.A.x,C.B.y --rpm-min 300 --rpm-max 18300 --points 7 -o "$W/ref.csv"; expect_rc 0
+  run simulate "$MODEL" --unbalance --out C.A.x,C.B.y --rpm-min 300 --rpm-max 18300 --points 7 -o "$W/s.csv"
+  expect_rc 0
+  # rcbtool unbalance's amp/phase CSV reads back as the same measurement
+  run convert "$W/ref.csv" "$W/ref2.csv"; expect_rc 0
+  python3 - "$W/ref2.csv" "$W/s.csv" <<'EOF' || fail "unbalance amp/phase CSV differs from simulate"
+import sys
+rows = [[l.rstrip("\n").split(",") for l in open(p) if not l.startswith("#")] for p in sys.argv[1:]]
+assert rows[0][0] == rows[1][0] == ["rpm", "C.A.x re", "C.A.x im", "C.B.y re", "C.B.y im"], rows[0][0]
+for r1, r2 in zip(rows[0][1:], rows[1][1:]):
+    for x, y in zip(map(float, r1), map(float, r2)):
+        assert abs(x - y) <= 1e-12 * max(abs(y), 1e-30), (x, y)
+EOF
+  ;;
+simulate_noise_seed)
+  for s in 5 5 6; do
+    run simulate "$MODEL" --frf --out DA.x --in DA.x --fmax 100 --points 11 --noise 10,1 --seed $s -o "$W/n$s.csv"
+    expect_rc 0; cp "$W/n$s.csv" "$W/n$s.$$.csv"
+  done
+  cmp -s "$W/n5.csv" "$W/n5.$$.csv" || fail "same seed gave different data"
+  cmp -s "$W/n5.csv" "$W/n6.csv" && fail "different seeds gave the same data"
+  run simulate "$MODEL" --frf --out DA.x --in DA.x --fmax 100 --points 11 -o "$W/clean.csv"; expect_rc 0
+  python3 - "$W/clean.csv" "$W/n5.csv" <<'EOF' || fail "noise outside the eq. 19 bound"
+import sys, math
+rows = [[list(map(float, l.split(","))) for l in open(p) if l[0].isdigit()] for p in sys.argv[1:]]
+clean = [complex(r[1], r[2]) for r in rows[0]]
+noisy = [complex(r[1], r[2]) for r in rows[1]]
+lvl = math.sqrt(sum(abs(c) ** 2 for c in clean)) / len(clean) * 0.01
+for c, n in zip(clean, noisy):
+    assert abs(n - c) <= 0.10 * abs(c) + lvl + 1e-20, (c, n)
+assert any(n != c for c, n in zip(clean, noisy))
+EOF
+  ;;
+simulate_usage)
+  usage simulate "$MODEL" --out DA.x --in DA.x --fmax 100 -o "$W/x.csv"; err_has "exactly one of --frf"
+  usage simulate "$MODEL" --frf --out DA.x --in DA.x --fmax 100; err_has "-o FILE is required"
+  usage simulate "$MODEL" --frf --out DA.x --in DA.x --fmax 100 -o "$W/x.txt"; err_has "unknown file type"
+  usage simulate "$MODEL" --frf --out DA.x --in DA.x --fmax 100 -o "$W/x.csv" --binary; err_has "UFF output only"
+  usage simulate "$MODEL" --frf --out DA.x --in DA.x --fmax 100 -o "$W/x.csv" --noise 10; err_has "BETA_A,BETA_S"
+  usage simulate "$MODEL" --unbalance --out DA.x --rpm-max 100 --in DA.x -o "$W/x.csv"; err_has "belong to --frf"
+  usage simulate "$MODEL" --frf --out DA.x --in DA.x --fmax 100 -o "$W/x.uff" --map 1=DA,2=DA; err_has "appears twice"
+  [ ! -e "$W/x.csv" ] && [ ! -e "$W/x.uff" ] || fail "a usage error left an output file" ;;
+convert_bad_input)
+  printf 'freq_hz,DA.x/DA.x re,DA.x/DA.x im\n10,1,2\n5,1,2\n' >"$W/bad.csv"
+  run convert "$W/bad.csv" "$W/out.uff"; expect_rc 3; err_has "bad.csv:3:"; err_has "not increasing"
+  [ ! -e "$W/out.uff" ] || fail "output written from bad input"
+  run convert "$W/missing.uff" "$W/out.csv"; expect_rc 3; err_has "missing.uff"
+  usage convert "$W/bad.csv"; err_has "missing the output file"
+  usage convert; err_has "missing the input file"
+  usage convert "$W/bad.csv" "$W/x.csv" --kind speed; err_has "receptance | mobility | inertance" ;;
+convert_kind_and_io_error)
+  run simulate "$MODEL" --frf --out DA.x --in DA.x --fmin 10 --fmax 100 --points 4 -o "$W/r.csv"; expect_rc 0
+  run convert "$W/r.csv" "$W/i.csv" --kind inertance; expect_rc 0
+  grep -q "^# kind = inertance$" "$W/i.csv" || fail "kind line missing"
+  python3 - "$W/r.csv" "$W/i.csv" <<'EOF' || fail "inertance != -w^2 receptance"
+import sys, math
+rows = [[list(map(float, l.split(","))) for l in open(p) if l[0].isdigit()] for p in sys.argv[1:]]
+for a, b in zip(*rows):
+    w = 2 * math.pi * a[0]
+    r, i = complex(a[1], a[2]), complex(b[1], b[2])
+    assert abs(i + w * w * r) <= 1e-14 * abs(i), (r, i)
+EOF
+  run convert "$W/r.csv" "$W/no/such/dir/x.uff"; expect_rc 5; err_has "no/such/dir/x.uff"
+  run convert "$W/r.csv" "$W/u.uff"; expect_rc 0; err_has "1=DA" ;;
+
+# ==== rcbtool fit / rcbtool sensitivity (issue #3) ====
+# fit_setup: the paper system's inertances at the four coupling DOFs, force at
+# DA.x, 200-400 Hz, 101 points, 10000 rpm (the paper's Table 3 set-up), and a
+# model copy with kt, kr, ct at 1/10 of the true values.
+fit_round_trip)
+  if "$T" help | grep -q '^  simulate '; then
+    run simulate "$MODEL" --frf --out C.A.x,C.A.y,C.B.x,C.B.y --in DA.x --fmin 200 --fmax 400 \
+      --points 101 --rpm 10000 --kind inertance -o "$W/meas.csv"; expect_rc 0
+  else
+    run frf "$MODEL" --out C.A.x,C.A.y,C.B.x,C.B.y --in DA.x --fmin 200 --fmax 400 \
+      --points 101 --rpm 10000 --kind inertance -o "$W/frf.csv"; expect_rc 0
+    { printf '# kind = inertance\n# rpm = 10000\n'; cat "$W/frf.csv"; } >"$W/meas.csv"
+  fi
+  sed -e 's/^kt = 46.095e3 /kt = 4.6095e3 /' -e 's/^kr = 220.76 /kr = 22.076 /' \
+      -e 's/^ct = 10.949 /ct = 1.0949 /' "$MODEL" >"$W/start.ini"
+  grep -q '^kt = 4.6095e3 ' "$W/start.ini" && grep -q '^kr = 22.076 ' "$W/start.ini" &&
+    grep -q '^ct = 1.0949 ' "$W/start.ini" || fail "sed did not change kt, kr, ct"
+  cp "$W/start.ini" "$W/start.orig"
+  run fit "$W/start.ini" "$W/meas.csv" --params coupling.C.kt,coupling.C.kr,coupling.C.ct \
+    --log --scale log10 -o "$W/fitted.ini" --json
+  expect_rc 0; json_ok
+  cmp -s "$W/start.ini" "$W/start.orig" || fail "the input model was changed"
+  python3 - "$W/out" <<'EOF' || fail "fitted values or E0/E1 wrong"
+import json, sys
+d = json.load(open(sys.argv[1]))
+true = {"coupling.C.kt": 46.095e3, "coupling.C.kr": 220.76, "coupling.C.ct": 10.949}
+assert [p["name"] for p in d["params"]] == list(true), d["params"]
+for p in d["params"]:
+    assert abs(p["fitted"] / true[p["name"]] - 1) < 1e-4, p
+    assert abs(p["start"] / true[p["name"]] - 0.1) < 1e-12, p
+    assert p["identifiable"] is True and p["log"] is True, p
+assert d["error_pct"] < 1e-3 and d["error0_pct"] > 10, d
+assert d["converged"] is True and d["iterations"] >= 1 and d["evaluations"] >= d["iterations"]
+assert d["residuals"] == 4 * 101, d["residuals"]
+c = d["correlation"]
+assert len(c) == 3 and all(abs(c[i][i] - 1) < 1e-9 for i in range(3)), c
+assert all(abs(c[i][j] - c[j][i]) < 1e-12 for i in range(3) for j in range(3)), c
+EOF
+  run check "$W/fitted.ini"; expect_rc 0
+  run frf "$W/fitted.ini" --out C.A.x,C.A.y,C.B.x,C.B.y --in DA.x --fmin 200 --fmax 400 \
+    --points 101 --rpm 10000 --kind inertance -o "$W/refit.csv"; expect_rc 0
+  python3 - "$W/meas.csv" "$W/refit.csv" <<'EOF' || fail "the fitted model does not reproduce the measurement"
+import sys
+rows = [[list(map(float, l.split(","))) for l in open(p) if l[0].isdigit()] for p in sys.argv[1:]]
+assert len(rows[0]) == len(rows[1]) == 101
+for c in range(1, 9, 2):
+    amp = max(abs(complex(r[c], r[c + 1])) for r in rows[0])
+    for a, b in zip(*rows):
+        assert abs(a[0] - b[0]) <= 1e-12 * b[0], (a[0], b[0])
+        assert abs(complex(a[c], a[c + 1]) - complex(b[c], b[c + 1])) <= 1e-6 * amp, (a[0], c)
+EOF
+  # the text report: table header, E0/E1, correlation matrix
+  run fit "$W/start.ini" "$W/meas.csv" --params coupling.C.kt,coupling.C.kr,coupling.C.ct --log
+  expect_rc 0; out_has "identifiable"; out_has "95 % CI"; out_has "error at start (E0)"
+  out_has "error at end (E1)"; out_has "converged: yes"; out_has "correlation matrix"
+  # -o onto the input model: refused (exit 5), model untouched
+  run fit "$W/start.ini" "$W/meas.csv" --params coupling.C.kt -o "$W/start.ini"
+  expect_rc 5; err_has "refusing"
+  cmp -s "$W/start.ini" "$W/start.orig" || fail "the input model was changed by -o MODEL" ;;
+fit_not_identifiable)
+  # eq. 19 noise (10 %, 1 %): cR no longer shows in the data (the paper's
+  # Table 3 gives it an "infinite" error); the fit must say so
+  run simulate "$MODEL" --frf --out C.A.x,C.A.y,C.B.x,C.B.y --in DA.x --fmin 200 --fmax 400 \
+    --points 201 --rpm 10000 --kind inertance --noise 10,1 --seed 3 --map 10=C.A,20=C.B,30=DA \
+    -o "$W/noisy.uff"
+  [ "$RC" -eq 0 ] || { [ "$RC" -eq 2 ] && grep -q "unknown command" "$W/err" && exit 77; fail "simulate failed"; }
+  run fit "$MODEL" "$W/noisy.uff" --map 10=C.A,20=C.B,30=DA --noise 10,1 --log \
+    --params coupling.C.kt,coupling.C.kr,coupling.C.ct,coupling.C.cr:1e-9:1e-2
+  expect_rc 0
+  out_has "note: coupling.C.cr is not identifiable from these data: its value is arbitrary"
+  grep -q '^coupling.C.kt .* yes$' "$W/out" || fail "kt should be identifiable"
+  # without the node map the UFF nodes are model nodes "#N": a clear error
+  run fit "$MODEL" "$W/noisy.uff" --params coupling.C.kt; expect_rc 3
+  err_has "noisy.uff"; err_has "--map" ;;
+fit_usage)
+  printf '# kind = inertance\n# rpm = 10000\nfreq_hz,C.A.x/DA.x re,C.A.x/DA.x im\n200,1,2\n300,1,3\n' >"$W/m.csv"
+  run fit "$MODEL" "$W/m.csv" --params coupling.C.kt,coupling.C.zz; expect_rc 3
+  err_has "coupling.C.zz"; out_empty
+  run fit "$MODEL" "$W/m.csv" --params coupling.C.kt:1e5:1e6; expect_rc 2
+  err_has "coupling.C.kt"; err_has "outside the bounds"
+  usage fit "$MODEL" "$W/m.csv"; err_has "option --params is required"
+  usage fit "$MODEL" --params coupling.C.kt; err_has "missing the measurement file"
+  usage fit "$MODEL" "$W/m.csv" --params coupling.C.kt:5; err_has "NAME:LO:HI"
+  usage fit "$MODEL" "$W/m.csv" --params bearing.B1.kxy; err_has "give bounds as bearing.B1.kxy:LO:HI"
+  usage fit "$MODEL" "$W/m.csv" --params coupling.C.kt --method simplex; err_has "paper or nlopt:ALG"
+  usage fit "$MODEL" "$W/m.csv" --params coupling.C.kt --scale ln; err_has "linear | log10 | db | complex"
+  usage fit "$MODEL" "$W/m.txt" --params coupling.C.kt; err_has "unknown file type"
+  run fit "$MODEL" "$W/none.csv" --params coupling.C.kt; expect_rc 3; err_has "none.csv"
+  run fit --help; expect_rc 0; out_has "usage: rcbtool fit MODEL.ini"
+  run help sensitivity; expect_rc 0; out_has "usage: rcbtool sensitivity MODEL.ini" ;;
+sensitivity_rank)
+  # unbalance responses 300-18300 rpm (the paper's FRD set-up): the four coupling
+  # DOFs come out as the most sensitive to kt, kr, ct, as in the paper's Fig. 7
+  run sensitivity "$MODEL" --params coupling.C.kt,coupling.C.kr,coupling.C.ct --unbalance \
+    --rpm-min 300 --rpm-max 18300 --points 61 --json
+  expect_rc 0; json_ok
+  python3 - "$W/out" <<'EOF' || fail "sensitivity ranking wrong"
+import json, sys
+d = json.load(open(sys.argv[1]))
+ch = d["channels"]
+assert d["params"] == ["coupling.C.kt", "coupling.C.kr", "coupling.C.ct"]
+assert [c["rank"] for c in ch] == list(range(1, len(ch) + 1))
+assert all(a["score"] >= b["score"] for a, b in zip(ch, ch[1:]))
+assert len(ch) == 2 * 22, len(ch)                   # x, y at each of 22 nodes, once
+assert len({c["channel"] for c in ch}) == len(ch)
+top = {(c["node"], c["channel"][-1]) for c in ch[:4]}
+assert top == {(10, "x"), (10, "y"), (11, "x"), (11, "y")}, ch[:4]   # the coupling
+# score: geometric mean of sensitivity / best channel's, recomputed
+best = [max(c["sensitivity"][k] for c in ch) for k in range(3)]
+for c in ch:
+    g = 1.0
+    for k in range(3):
+        g *= c["sensitivity"][k] / best[k]
+    assert abs(g ** (1 / 3) - c["score"]) <= 1e-12 + 1e-9 * c["score"], c
+EOF
+  run sensitivity "$MODEL" --params coupling.C.kt,coupling.C.kr --frf --in DA.x --fmin 200 \
+    --fmax 400 --points 21 --rpm 10000 --kind inertance --top 4
+  expect_rc 0
+  [ "$(grep -c '^[1-4] ' "$W/out")" -eq 4 ] || fail "--top 4 should print 4 channels"
+  grep -q '^--out [^,]*,[^,]*,[^,]*,[^,]*$' "$W/out" || fail "no ready-to-paste --out list"
+  usage sensitivity "$MODEL" --params coupling.C.kt --rpm-max 100; err_has "exactly one of --frf"
+  run sensitivity "$MODEL" --params coupling.C.zz --unbalance --rpm-max 100; expect_rc 3
+  err_has "coupling.C.zz" ;;
+# ==== end of rcbtool fit / sensitivity ====
+
 *) echo "unknown test case '$CASE'"; exit 1 ;;
 esac
 exit 0

@@ -165,6 +165,50 @@ void cli_progress_start(cli_progress *p, const cli_args *a, const char *label,
 void cli_progress_step(cli_progress *p, size_t done);
 void cli_progress_end(cli_progress *p);
 
+/* ---- measurements (cmd_convert.c; used by simulate) ---- */
+
+/** UFF node map from --map NODE=STATION,... (stations added by cli_uff_automap). */
+typedef struct cli_uff_map {
+  rcb_uff_node *nodes;
+  size_t n;
+  char *buf;     /**< the option's text, split in place */
+  char **owned;  /**< station names added by cli_uff_automap */
+  size_t nowned;
+} cli_uff_map;
+/** Parse option @p opt (absent = empty map); usage error (2) when malformed. */
+int cli_uff_map_parse(const cli_args *a, const char *opt, cli_uff_map *mp);
+void cli_uff_map_free(cli_uff_map *mp);
+/** Give every station of @p ms without a map entry the next free node number
+ * (printed on stderr). */
+int cli_uff_automap(const char *cmd, const rcb_meas *ms, cli_uff_map *mp);
+/** *is_uff from the file name's extension (.uff/.unv/.uf or .csv); else usage error. */
+int cli_meas_format(const char *cmd, const char *path, int *is_uff);
+/** Write @p ms to @p path as UFF (binary 58b if @p binary) or CSV by extension;
+ * exit code 0, 2, 3 or 5. */
+int cli_meas_write(const char *cmd, const rcb_meas *ms, const char *path, int binary,
+                   cli_uff_map *mp);
+
+/* ---- fitted parameters (cmd_fit.c; used by sensitivity) ---- */
+
+/** One --params item "NAME" or "NAME:LO:HI" (parameter units). */
+typedef struct cli_param_spec {
+  const char *name;
+  double lo, hi;
+  int has_bounds;
+} cli_param_spec;
+typedef struct cli_params {
+  char *buf; /**< the option's text, split in place */
+  cli_param_spec *items;
+  size_t n;
+} cli_params;
+/** Parse option @p opt (required; usage error 2 when absent or malformed). */
+int cli_params_parse(const cli_args *a, const char *opt, cli_params *ps);
+void cli_params_free(cli_params *ps);
+/** Add the parameters to @p f: unknown name exit 3, bad bounds exit 2; without
+ * bounds [start/1000, start*1000] (start > 0), or any bounds if @p any_bounds. */
+int cli_params_add(const cli_args *a, rcb_fit *f, const rcb_model *m, const cli_params *ps,
+                   int log_all, int any_bounds);
+
 /* ---- subcommands (one file each) ---- */
 
 int cmd_check(int argc, char **argv);
@@ -173,6 +217,10 @@ int cmd_frf(int argc, char **argv);
 int cmd_unbalance(int argc, char **argv);
 int cmd_modes(int argc, char **argv);
 int cmd_campbell(int argc, char **argv);
+int cmd_simulate(int argc, char **argv);
+int cmd_convert(int argc, char **argv);
+int cmd_fit(int argc, char **argv);
+int cmd_sensitivity(int argc, char **argv);
 
 extern const char cli_help_check[];
 extern const char cli_help_matrices[];
@@ -180,6 +228,10 @@ extern const char cli_help_frf[];
 extern const char cli_help_unbalance[];
 extern const char cli_help_modes[];
 extern const char cli_help_campbell[];
+extern const char cli_help_simulate[];
+extern const char cli_help_convert[];
+extern const char cli_help_fit[];
+extern const char cli_help_sensitivity[];
 
 /** Print a command's help text to stdout; returns 0 (or 5 if stdout fails). */
 int cli_print_help(const char *text);

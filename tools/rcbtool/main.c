@@ -16,6 +16,14 @@ static const cli_command commands[] = {
      cmd_modes},
     {"campbell", "Campbell diagram data and 1X critical speeds", cli_help_campbell,
      cmd_campbell},
+    {"simulate", "synthetic measurements (FRF or unbalance, eq. 19 noise) as UFF58/CSV",
+     cli_help_simulate, cmd_simulate},
+    {"convert", "measurements between UFF58 (ASCII/binary) and CSV, and between kinds",
+     cli_help_convert, cmd_convert},
+    {"fit", "fit model parameters to a measurement, with uncertainty", cli_help_fit,
+     cmd_fit},
+    {"sensitivity", "rank measurement channels by sensitivity to parameters",
+     cli_help_sensitivity, cmd_sensitivity},
 };
 #define N_COMMANDS (sizeof commands / sizeof commands[0])
 
@@ -34,7 +42,7 @@ static void print_usage(FILE *fp) {
         "Commands:\n",
         fp);
   for (i = 0; i < N_COMMANDS; i++)
-    fprintf(fp, "  %-10s %s\n", commands[i].name, commands[i].summary);
+    fprintf(fp, "  %-12s %s\n", commands[i].name, commands[i].summary);
   fputs("\nCommon options: --json (JSON instead of CSV), -o FILE (write FILE atomically),\n"
         "--progress (progress line on stderr), --help.\n"
         "Speeds are in rpm and frequencies in Hz on the command line.\n"
@@ -71,8 +79,12 @@ int main(int argc, char **argv) {
       strcmp(argv[1], "-h") == 0)
     return cmd_help(argc - 1, argv + 1);
   c = find_command(argv[1]);
-  if (!c) return cli_usage(NULL, "unknown command '%s'; expected one of check, matrices, "
-                                 "frf, unbalance, modes, campbell, help",
-                           argv[1]);
+  if (!c) {
+    char list[256] = "";
+    size_t i, n = 0;
+    for (i = 0; i < N_COMMANDS && n < sizeof list; i++)
+      n += (size_t)snprintf(list + n, sizeof list - n, "%s, ", commands[i].name);
+    return cli_usage(NULL, "unknown command '%s'; expected one of %shelp", argv[1], list);
+  }
   return c->run(argc - 1, argv + 1);
 }

@@ -1,0 +1,304 @@
+/* rcbtool convert: measurements between UFF dataset 58 (ASCII/binary) and CSV,
+ * and between receptance, mobility and inertance. Also the UFF node-map and
+ * file-format helpers shared with rcbtool simulate. */
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+
+const char cli_help_convert[] =
+    "usage: rcbtool convert IN OUT [--map NODE=STATION,...] [--kind K] [--binary]\n"
+    "\n"
+    "Reads a measurement (UFF dataset 58 / 58b, or CSV) and writes it again in the\n"
+    "format given by OUT's extension: .uff, .unv or .uf for UFF dataset 58 (ASCII,\n"
+    "or binary 58b with --binary), .csv for CSV. The output is written atomically.\n"
+    "  --map LIST   UFF node number <-> model station, e.g. 10=DA,20=C.A; a UFF node\n"
+    "               without an entry reads as model node \"#N\" (0-based node N);\n"
+    "               writing UFF, a station without an entry gets the next free\n"
+    "               number (the numbers used are printed on stderr)\n"
+    "  --kind K     convert FRFs to receptance (m/N), mobility (m/(N s)) or\n"
+    "               inertance (m/(N s^2)) before writing\n"
+    "  --binary     write binary 58b instead of ASCII 58\n"
+    "\n"
+    "UFF: function type 4 (FRF; ordinate displacement, velocity or acceleration\n"
+    "over excitation force decides the kind) or 1 with reference node 0 (unbalance\n"
+    "response); complex data (types 5, 6); abscissa in Hz (type 18) or rpm (19);\n"
+    "the rotor speed of an FRF test is the z-axis value (type 19, rpm; negative =\n"
+    "synchronous); directions 1, 2, 4, 5 = x, y, rx, ry (negative flips the sign).\n"
+    "CSV: '# kind = K' and '# rpm = R' comment lines, then freq_hz (FRF) or rpm\n"
+    "(unbalance) and per channel 'RESP/REF re','RESP/REF im' (or mag/amp and\n"
+    "phase_deg columns), as rcbtool frf and rcbtool unbalance write.\n"
+    "Exit codes: 2 usage, 3 unreadable or bad input data, 5 output not written.\n";
+
+static const char *const kind_names[] = {"receptance", "mobility", "inertance"};
+
+void cli_uff_map_free(cli_uff_map *mp) {
+  size_t i;
+  for (i = 0; i < mp->nowned; i++) free(mp->owned[i]);
+  free(mp->buf);
+  free(mp->nodes);
+  free(mp->owned);
+  memset(mp, 0, sizeof *mp);
+}
+
+/* One "NODE=STATION" item. */
+static int map_item(const cli_args *a, const char *opt, char *item, rcb_uff_node *out) {
+  char *eq = strchr(item, '='), *end;
+  long node;
+  if (!eq || eq == item || eq[1] == '\0')
+    return cli_usage(a->cmd, "option %s: item '%s': expected NODE=STATION (e.g. 10=DA)", opt,
+                     item);
+  *eq = '\0';
+  errno = 0;
+  node = strtol(item, &end, 10);
+  if (*end || errno || node < 0) {
+    *eq = '=';
+    return cli_usage(a->cmd, "option %s: item '%s': the UFF node must be a whole number >= 0",
+                     opt, item);
+  }
+  out->node = node;
+  out->station = eq + 1;
+  return 0;
+}
+
+int cli_uff_map_parse(const cli_args *a, const char *opt, cli_uff_map *mp) {
+  const char *list = cli_opt_value(a, opt);
+  size_t n = 1, i, j;
+  char *p;
+  int rc;
+  memset(mp, 0, sizeof *mp);
+  if (!list) return 0;
+  mp->buf = malloc(strlen(list) + 1);
+  if (!mp->buf) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  strcpy(mp->buf, list);
+  for (p = mp->buf; *p; p++) n += (*p == ',');
+  mp->nodes = malloc(n * sizeof *mp->nodes);
+  if (!mp->nodes) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  p = mp->buf;
+  for (i = 0; i < n; i++) {
+    char *comma = strchr(p, ',');
+    if (comma) *comma = '\0';
+    if ((rc = map_item(a, opt, p, &mp->nodes[i]))) return rc;
+    for (j = 0; j < i; j++)
+      if (mp->nodes[j].node == mp->nodes[i].node ||
+          strcmp(mp->nodes[j].station, mp->nodes[i].station) == 0)
+        return cli_usage(a->cmd, "option %s: node %ld or station '%s' appears twice", opt,
+                         mp->nodes[i].node, mp->nodes[i].station);
+    mp->n++;
+    if (comma) p = comma + 1;
+  }
+  return 0;
+}
+
+static int map_has_station(const cli_uff_map *mp, const char *st, size_t len) {
+  size_t i;
+  for (i = 0; i < mp->n; i++)
+    if (strlen(mp->nodes[i].station) == len && strncmp(mp->nodes[i].station, st, len) == 0)
+      return 1;
+  return 0;
+}
+
+static int map_has_node(const cli_uff_map *mp, long node) {
+  size_t i;
+  for (i = 0; i < mp->n; i++)
+    if (mp->nodes[i].node == node) return 1;
+  return 0;
+}
+
+/* Add station (first len chars of ch) with the next free node number. */
+static int map_add(cli_uff_map *mp, const char *ch, size_t len, long *next) {
+  rcb_uff_node *nn = realloc(mp->nodes, (mp->n + 1) * sizeof *nn);
+  char **no;
+  char *s;
+  if (!nn) return -1;
+  mp->nodes = nn;
+  no = realloc(mp->owned, (mp->nowned + 1) * sizeof *no);
+  if (!no) return -1;
+  mp->owned = no;
+  s = malloc(len + 1);
+  if (!s) return -1;
+  memcpy(s, ch, len);
+  s[len] = '\0';
+  mp->owned[mp->nowned++] = s;
+  while (map_has_node(mp, *next)) ++*next;
+  mp->nodes[mp->n].node = (*next)++;
+  mp->nodes[mp->n].station = s;
+  mp->n++;
+  return 0;
+}
+
+/* Station part of channel "STATION.DIR" (length in *len). */
+static void station_part(const char *ch, size_t *len) {
+  const char *dot = strrchr(ch, '.');
+  *len = dot ? (size_t)(dot - ch) : strlen(ch);
+}
+
+static int automap_one(cli_uff_map *mp, const char *ch, long *next, int *added) {
+  size_t len;
+  if (!ch) return 0;
+  station_part(ch, &len);
+  if ((ch[0] == '#' && len > 1) || map_has_station(mp, ch, len)) return 0;
+  if (map_add(mp, ch, len, next)) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  *added = 1;
+  return 0;
+}
+
+int cli_uff_automap(const char *cmd, const rcb_meas *ms, cli_uff_map *mp) {
+  size_t c, i, base = mp->n;
+  long next = 1;
+  int added = 0, rc;
+  for (c = 0; c < rcb_meas_channel_count(ms); c++) {
+    rcb_meas_channel_info info;
+    rcb_meas_channel(ms, c, &info);
+    if ((rc = automap_one(mp, info.response, &next, &added)) ||
+        (rc = automap_one(mp, info.reference, &next, &added)))
+      return rc;
+  }
+  if (added) {
+    fprintf(stderr, "rcbtool: %s: UFF node numbers given to stations: ", cmd);
+    for (i = base; i < mp->n; i++)
+      fprintf(stderr, "%s%ld=%s", i > base ? "," : "", mp->nodes[i].node, mp->nodes[i].station);
+    fputs(" (pass --map with these when reading the file back)\n", stderr);
+  }
+  return 0;
+}
+
+int cli_meas_format(const char *cmd, const char *path, int *is_uff) {
+  const char *dot = strrchr(path, '.');
+  const char *slash = strrchr(path, '/');
+  if (dot && (!slash || dot > slash)) {
+    if (strcmp(dot, ".csv") == 0 || strcmp(dot, ".CSV") == 0) {
+      *is_uff = 0;
+      return 0;
+    }
+    if (strcmp(dot, ".uff") == 0 || strcmp(dot, ".unv") == 0 || strcmp(dot, ".uf") == 0 ||
+        strcmp(dot, ".UFF") == 0 || strcmp(dot, ".UNV") == 0) {
+      *is_uff = 1;
+      return 0;
+    }
+  }
+  return cli_usage(cmd, "'%s': unknown file type; expected a name ending in .uff, .unv, .uf "
+                   "(UFF dataset 58) or .csv", path);
+}
+
+int cli_meas_write(const char *cmd, const rcb_meas *ms, const char *path, int binary,
+                   cli_uff_map *mp) {
+  int is_uff, rc;
+  rcb_status st;
+  if ((rc = cli_meas_format(cmd, path, &is_uff))) return rc;
+  if (is_uff) {
+    if ((rc = cli_uff_automap(cmd, ms, mp))) return rc;
+    st = rcb_meas_write_uff(ms, path, binary, mp->n, mp->nodes);
+  } else {
+    st = rcb_meas_write_csv(ms, path);
+  }
+  if (st)
+    return cli_fail(st == RCB_ERR_IO ? CLI_EXIT_IO : st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC
+                                                                         : CLI_EXIT_INPUT,
+                    "%s", cli_msg(rcb_meas_errmsg(ms), st));
+  return 0;
+}
+
+/* ---- convert ---- */
+
+/* Options that take a value, for finding the positional arguments. */
+static int takes_value(const char *arg) {
+  static const char *const withval[] = {"-o", "--output", "--map", "--kind"};
+  size_t i;
+  if (strchr(arg, '=')) return 0;
+  for (i = 0; i < sizeof withval / sizeof withval[0]; i++)
+    if (strcmp(arg, withval[i]) == 0) return 1;
+  return 0;
+}
+
+/* Take the second positional argument (OUT) out of argv: cli_parse knows one. */
+static int split_out(int argc, char **argv, char **args, int *nargs, const char **out) {
+  int k, npos = 0, only_pos = 0, n = 0;
+  *out = NULL;
+  for (k = 0; k < argc; k++) {
+    const char *arg = argv[k];
+    int pos = k > 0 && (only_pos || arg[0] != '-' || arg[1] == '\0');
+    if (k > 0 && !only_pos && strcmp(arg, "--") == 0) only_pos = 1;
+    if (pos && ++npos == 2) {
+      *out = arg;
+      continue;
+    }
+    args[n++] = argv[k];
+    if (k > 0 && !pos && !only_pos && takes_value(arg) && k + 1 < argc) args[n++] = argv[++k];
+  }
+  *nargs = n;
+  return npos;
+}
+
+static int read_input(const cli_args *a, rcb_meas *ms, const cli_uff_map *mp) {
+  int is_uff, rc;
+  rcb_status st;
+  if ((rc = cli_meas_format(a->cmd, a->model, &is_uff))) return rc;
+  st = is_uff ? rcb_meas_read_uff(ms, a->model, mp->n, mp->nodes)
+              : rcb_meas_read_csv(ms, a->model);
+  if (st)
+    return cli_fail(st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC : CLI_EXIT_INPUT, "%s",
+                    cli_msg(rcb_meas_errmsg(ms), st));
+  return 0;
+}
+
+static int convert(const cli_args *a, const char *out) {
+  cli_uff_map mp;
+  rcb_meas *ms = NULL;
+  int rc, kind = -1, is_uff;
+  if ((rc = cli_opt_choice(a, "--kind", kind_names, 3, -1, &kind)) ||
+      (rc = cli_meas_format(a->cmd, out, &is_uff)))
+    return rc;
+  if (cli_opt_value(a, "--binary") && !is_uff)
+    return cli_usage(a->cmd, "--binary applies to UFF output only ('%s' is CSV)", out);
+  if ((rc = cli_uff_map_parse(a, "--map", &mp))) {
+    cli_uff_map_free(&mp);
+    return rc;
+  }
+  if (rcb_meas_create(&ms, NULL)) {
+    cli_uff_map_free(&mp);
+    return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  }
+  rc = read_input(a, ms, &mp);
+  if (!rc && kind >= 0) {
+    rcb_status st = rcb_meas_convert(ms, (rcb_frf_kind)kind);
+    if (st) rc = cli_fail(CLI_EXIT_INPUT, "%s: %s", a->model, cli_msg(rcb_meas_errmsg(ms), st));
+  }
+  if (!rc) rc = cli_meas_write(a->cmd, ms, out, cli_opt_value(a, "--binary") != NULL, &mp);
+  rcb_meas_destroy(ms);
+  cli_uff_map_free(&mp);
+  return rc;
+}
+
+int cmd_convert(int argc, char **argv) {
+  cli_opt opts[] = {{"--map", "NODE=STATION,...", NULL},
+                    {"--kind", "KIND", NULL},
+                    {"--binary", NULL, NULL}};
+  cli_args a;
+  const char *out = NULL;
+  char **args = malloc(((size_t)argc + 1) * sizeof *args);
+  int nargs = 0, npos, rc, k;
+  if (!args) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  npos = split_out(argc, argv, args, &nargs, &out);
+  for (k = 1; k < argc; k++)
+    if (strcmp(argv[k], "--help") == 0 || strcmp(argv[k], "-h") == 0) {
+      free(args);
+      return cli_print_help(cli_help_convert);
+    }
+  if (npos == 0) {
+    free(args);
+    return cli_usage(argv[0], "missing the input file: expected 'rcbtool convert IN OUT'");
+  }
+  rc = cli_parse(nargs, args, opts, sizeof opts / sizeof opts[0], &a);
+  if (!rc && out && a.output)
+    rc = cli_usage(a.cmd, "give the output once: as OUT or as -o FILE, not both");
+  if (!rc && !out) out = a.output;
+  if (!rc && !out) rc = cli_usage(a.cmd, "missing the output file: expected 'rcbtool convert "
+                                         "IN OUT' (OUT ending in .uff, .unv or .csv)");
+  if (!rc && a.json) rc = cli_usage(a.cmd, "--json does not apply: the output format follows "
+                                           "OUT's extension");
+  if (!rc) rc = convert(&a, out);
+  free(args);
+  return rc;
+}

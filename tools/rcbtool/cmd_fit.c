@@ -1,0 +1,647 @@
+/* rcbtool fit: fit model parameters to a measurement (FRFs or unbalance
+ * responses) with the paper's algorithm or NLopt, print the fitted values with
+ * their uncertainty, and write the fitted model. Also the --params list
+ * helpers shared with rcbtool sensitivity. */
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "cli.h"
+
+const char cli_help_fit[] =
+    "usage: rcbtool fit MODEL.ini MEAS.uff|MEAS.unv|MEAS.csv --params NAME[:LO:HI][,...]\n"
+    "                   [--log] [--method paper|nlopt:ALG]\n"
+    "                   [--scale linear|log10|db|complex] [--band LO:HI]\n"
+    "                   [--noise BETA_A,BETA_S] [--fd] [--max-iter N]\n"
+    "                   [--map NODE=STATION,...] [-o FITTED.ini] [--json] [--progress]\n"
+    "\n"
+    "Fits model parameters so that the model reproduces the measurement (paper\n"
+    "eq. 12: least squares over every channel and point), starting from the values\n"
+    "in MODEL.ini. MODEL.ini itself is never changed.\n"
+    "  --params LIST  parameters to fit, by name (coupling.C.kt, bearing.B2.kxx,\n"
+    "                 disk.DA.mass, shaft.A.damping_stiffness, unbalance.UA.phase,\n"
+    "                 ...; SI units of the INI keys), each with optional bounds\n"
+    "                 NAME:LO:HI; without bounds [start/1000, start*1000] (a start\n"
+    "                 <= 0 needs explicit bounds)\n"
+    "  --log          optimise log(p) for every parameter (needs LO > 0)\n"
+    "  --method M     paper (default: Gauss-Newton by pseudo-inverse, Coggins line\n"
+    "                 search, lambda-Q damping, exterior penalty; eqs. 14-18) or\n"
+    "                 nlopt:ALG with an NLopt algorithm name (LN_BOBYQA, LN_SBPLX,\n"
+    "                 LD_LBFGS, LD_MMA, GN_DIRECT_L, GN_CRS2_LM, G_MLSL_LDS, ...)\n"
+    "  --scale S      residuals on |H| (linear), log10 |H| (log10, default: FRF\n"
+    "                 magnitudes span decades), 20 log10 |H| (db) or Re/Im (complex)\n"
+    "  --band LO:HI   fit only points with LO <= abscissa <= HI: Hz for FRFs, rpm\n"
+    "                 for unbalance responses\n"
+    "  --noise A,S    noise-aware weights from the paper's eq. 19 noise model (random\n"
+    "                 factor A %, systematic factor S %); points at the noise floor\n"
+    "                 are left out\n"
+    "  --fd           sensitivities by finite differences (eq. 11) instead of the\n"
+    "                 analytic ones (eq. 9)\n"
+    "  --max-iter N   iteration limit (default 100)\n"
+    "  --map LIST     UFF node number <-> model station, e.g. 10=DA,20=C.A (UFF\n"
+    "                 nodes without an entry read as model node \"#N\")\n"
+    "  -o FILE        write the fitted model as INI to FILE (atomically; never over\n"
+    "                 MODEL.ini)\n"
+    "\n"
+    "Prints per parameter: start, fitted value, standard error, 95 % confidence\n"
+    "interval and whether the data determine it (SVD test); then the paper's error\n"
+    "in % at the start (E0) and the end (E1), iterations, model evaluations,\n"
+    "residuals used, convergence and the parameter correlation matrix. Progress per\n"
+    "iteration goes to stderr (on a terminal, or with --progress).\n"
+    "JSON: {\"params\": [{\"name\", \"start\", \"fitted\", \"stderr\", \"ci95\": [lo, hi],\n"
+    "\"lo\", \"hi\", \"log\", \"identifiable\"}], \"error0_pct\", \"error_pct\",\n"
+    "\"iterations\", \"evaluations\", \"residuals\", \"converged\", \"objective0\",\n"
+    "\"objective\", \"sigma\", \"correlation\": [[...]], \"notes\": [...], \"output\"}\n"
+    "Exit codes: 2 usage, 3 bad model, measurement or parameter name, 4 numerical\n"
+    "failure, 5 output not written.\n";
+
+static const char *const scale_names[] = {"linear", "log10", "db", "complex"};
+
+#define NOT_IDENTIFIABLE "not identifiable from these data: its value is arbitrary"
+
+/* ---- --params NAME[:LO:HI],... (shared with rcbtool sensitivity) ---- */
+
+void cli_params_free(cli_params *ps) {
+  free(ps->buf);
+  free(ps->items);
+  memset(ps, 0, sizeof *ps);
+}
+
+static int parse_bound(const cli_args *a, const char *item, const char *s, double *out) {
+  char *end;
+  errno = 0;
+  *out = strtod(s, &end);
+  if (end == s || *end != '\0' || errno == ERANGE || !isfinite(*out))
+    return cli_usage(a->cmd, "option --params: item '%s': bound '%s' is not a finite number; "
+                     "expected NAME or NAME:LO:HI",
+                     item, s);
+  return 0;
+}
+
+/* One "NAME" or "NAME:LO:HI" item, split in place. */
+static int param_item(const cli_args *a, char *item, cli_param_spec *p) {
+  char *c1 = strchr(item, ':'), *c2 = c1 ? strchr(c1 + 1, ':') : NULL;
+  int rc;
+  memset(p, 0, sizeof *p);
+  p->name = item;
+  if (*item == '\0' || item[0] == ':')
+    return cli_usage(a->cmd, "option --params has an empty parameter name; expected "
+                     "NAME[:LO:HI][,...] (e.g. coupling.C.kt:1e3:1e6,coupling.C.kr)");
+  if (!c1) return 0;
+  if (!c2 || strchr(c2 + 1, ':'))
+    return cli_usage(a->cmd, "option --params: item '%s': expected NAME or NAME:LO:HI (two "
+                     "bounds)", item);
+  *c1 = *c2 = '\0';
+  if ((rc = parse_bound(a, item, c1 + 1, &p->lo)) || (rc = parse_bound(a, item, c2 + 1, &p->hi)))
+    return rc;
+  if (!(p->lo < p->hi))
+    return cli_usage(a->cmd, "option --params: parameter '%s': bounds %g:%g, expected LO < HI",
+                     item, p->lo, p->hi);
+  p->has_bounds = 1;
+  return 0;
+}
+
+int cli_params_parse(const cli_args *a, const char *opt, cli_params *ps) {
+  const char *list = cli_opt_value(a, opt);
+  size_t n = 1, i;
+  char *p;
+  int rc;
+  memset(ps, 0, sizeof *ps);
+  if (!list)
+    return cli_usage(a->cmd, "option %s is required: the parameters, e.g. "
+                     "coupling.C.kt,coupling.C.kr:1:1e5",
+                     opt);
+  ps->buf = malloc(strlen(list) + 1);
+  if (!ps->buf) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  strcpy(ps->buf, list);
+  for (p = ps->buf; *p; p++) n += (*p == ',');
+  ps->items = malloc(n * sizeof *ps->items);
+  if (!ps->items) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  p = ps->buf;
+  for (i = 0; i < n; i++) {
+    char *comma = strchr(p, ',');
+    if (comma) *comma = '\0';
+    if ((rc = param_item(a, p, &ps->items[i]))) return rc;
+    ps->n++;
+    if (comma) p = comma + 1;
+  }
+  return 0;
+}
+
+/* Bounds of one parameter: given, or [start/1000, start*1000]; @p any makes up
+ * bounds around any start (for sensitivities, where they do not matter). */
+static int param_bounds(const cli_args *a, const cli_param_spec *p, double start, int any,
+                        double *lo, double *hi) {
+  if (p->has_bounds) {
+    *lo = p->lo;
+    *hi = p->hi;
+  } else if (start > 0) {
+    *lo = start / 1000;
+    *hi = start * 1000;
+  } else if (any) {
+    *lo = start - 1000 * fabs(start) - 1;
+    *hi = start + 1000 * fabs(start) + 1;
+  } else {
+    return cli_usage(a->cmd, "parameter '%s' starts at %g: default bounds [start/1000, "
+                     "start*1000] need a start > 0; give bounds as %s:LO:HI",
+                     p->name, start, p->name);
+  }
+  return 0;
+}
+
+int cli_params_add(const cli_args *a, rcb_fit *f, const rcb_model *m, const cli_params *ps,
+                   int log_all, int any_bounds) {
+  size_t k;
+  for (k = 0; k < ps->n; k++) {
+    const cli_param_spec *p = &ps->items[k];
+    double start, lo, hi;
+    rcb_status st = rcb_model_get_param(m, p->name, &start);
+    int rc;
+    if (st)
+      return cli_fail(st == RCB_ERR_NOT_FOUND ? CLI_EXIT_INPUT : CLI_EXIT_NUMERIC, "%s: %s",
+                      a->cmd, cli_msg(rcb_model_errmsg(m), st));
+    if ((rc = param_bounds(a, p, start, any_bounds, &lo, &hi))) return rc;
+    st = rcb_fit_add_param(f, p->name, lo, hi, log_all);
+    if (st)
+      return st == RCB_ERR_ARG ? cli_usage(a->cmd, "%s", cli_msg(rcb_fit_errmsg(f), st))
+                               : cli_fail(cli_status_exit(st), "%s: %s", a->cmd,
+                                          cli_msg(rcb_fit_errmsg(f), st));
+  }
+  return 0;
+}
+
+/* ---- the fit job ---- */
+
+typedef struct fit_job {
+  const char *meas_path;
+  cli_params params;
+  int log_all, scale, method_nlopt;
+  const char *algorithm; /* after "nlopt:" */
+  int have_band, have_noise;
+  double band_lo, band_hi; /* Hz (FRF) or rpm (unbalance) */
+  double beta_a, beta_s;   /* % */
+  size_t max_iter;
+  int is_uff; /* the measurement is a UFF file (set by read_meas) */
+} fit_job;
+
+/* "A<sep>B": two finite numbers. */
+static int parse_pair(const cli_args *a, const char *opt, char sep, const char *what,
+                      double *x, double *y) {
+  const char *s = cli_opt_value(a, opt), *t;
+  char *end;
+  errno = 0;
+  *x = strtod(s, &end);
+  if (end != s && *end == sep) {
+    t = end + 1;
+    *y = strtod(t, &end);
+    if (end != t && *end == '\0' && !errno && isfinite(*x) && isfinite(*y)) return 0;
+  }
+  return cli_usage(a->cmd, "option %s expects %s, got '%s'", opt, what, s);
+}
+
+static int parse_method(const cli_args *a, fit_job *j) {
+  const char *s = cli_opt_value(a, "--method");
+  if (!s || strcmp(s, "paper") == 0) return 0;
+  if (strncmp(s, "nlopt:", 6) == 0 && s[6] != '\0') {
+    j->method_nlopt = 1;
+    j->algorithm = s + 6;
+    return 0;
+  }
+  return cli_usage(a->cmd, "option --method expects paper or nlopt:ALG (e.g. nlopt:LN_BOBYQA), "
+                   "got '%s'", s);
+}
+
+static int parse_job(const cli_args *a, fit_job *j) {
+  int rc;
+  j->log_all = cli_opt_value(a, "--log") != NULL;
+  if ((rc = cli_opt_choice(a, "--scale", scale_names, 4, RCB_SCALE_LOG10, &j->scale)) ||
+      (rc = parse_method(a, j)) || (rc = cli_opt_count(a, "--max-iter", 100, &j->max_iter)))
+    return rc;
+  if (cli_opt_value(a, "--band")) {
+    if ((rc = parse_pair(a, "--band", ':', "LO:HI (Hz for FRFs, rpm for unbalance data)",
+                         &j->band_lo, &j->band_hi)))
+      return rc;
+    if (!(j->band_lo >= 0 && j->band_lo < j->band_hi))
+      return cli_usage(a->cmd, "option --band %g:%g: expected 0 <= LO < HI", j->band_lo,
+                       j->band_hi);
+    j->have_band = 1;
+  }
+  if (cli_opt_value(a, "--noise")) {
+    if ((rc = parse_pair(a, "--noise", ',', "BETA_A,BETA_S: two percentages >= 0 (e.g. 10,1)",
+                         &j->beta_a, &j->beta_s)))
+      return rc;
+    if (j->beta_a < 0 || j->beta_s < 0)
+      return cli_usage(a->cmd, "option --noise expects percentages >= 0, got %g,%g", j->beta_a,
+                       j->beta_s);
+    j->have_noise = 1;
+  }
+  if (a->output && strcmp(a->output, "-") == 0)
+    return cli_usage(a->cmd, "-o - is not supported: the report goes to standard output; give "
+                     "a file for the fitted model");
+  return cli_params_parse(a, "--params", &j->params);
+}
+
+/* Do two paths name the same existing file? */
+static int same_file(const char *p, const char *q) {
+  struct stat sp, sq;
+  if (!p || !q || stat(p, &sp) != 0 || stat(q, &sq) != 0) return 0;
+  return sp.st_dev == sq.st_dev && sp.st_ino == sq.st_ino;
+}
+
+/* Refuse -o onto an input before spending time on the fit. */
+static int check_output(const cli_args *a, const fit_job *j) {
+  if (same_file(a->output, a->model))
+    return cli_fail(CLI_EXIT_IO, "refusing to write the output over the model file '%s'",
+                    a->model);
+  if (same_file(a->output, j->meas_path))
+    return cli_fail(CLI_EXIT_IO, "refusing to write the output over the measurement file '%s'",
+                    j->meas_path);
+  return 0;
+}
+
+static int read_meas(const cli_args *a, fit_job *j, rcb_meas **out) {
+  const char *path = j->meas_path;
+  cli_uff_map mp;
+  rcb_meas *ms = NULL;
+  rcb_status st;
+  int is_uff, rc;
+  *out = NULL;
+  if ((rc = cli_meas_format(a->cmd, path, &is_uff))) return rc;
+  j->is_uff = is_uff;
+  if ((rc = cli_uff_map_parse(a, "--map", &mp))) {
+    cli_uff_map_free(&mp);
+    return rc;
+  }
+  if (!is_uff && mp.n > 0) {
+    cli_uff_map_free(&mp);
+    return cli_usage(a->cmd, "--map applies to UFF measurements only ('%s' is CSV)", path);
+  }
+  if (rcb_meas_create(&ms, NULL)) {
+    cli_uff_map_free(&mp);
+    return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  }
+  st = is_uff ? rcb_meas_read_uff(ms, path, mp.n, mp.nodes) : rcb_meas_read_csv(ms, path);
+  cli_uff_map_free(&mp);
+  if (st) {
+    const char *msg = cli_msg(rcb_meas_errmsg(ms), st);
+    rc = cli_fail(st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC : CLI_EXIT_INPUT, "%s", msg);
+    if (!strstr(msg, path)) fprintf(stderr, "rcbtool: (while reading measurement '%s')\n", path);
+    rcb_meas_destroy(ms);
+    return rc;
+  }
+  *out = ms;
+  return 0;
+}
+
+/* Progress per iteration on stderr. */
+typedef struct fit_progress {
+  int on, tty, shown;
+} fit_progress;
+
+static int progress_cb(void *user, size_t iter, size_t evals, double objective) {
+  fit_progress *p = user;
+  if (!p->on) return 0;
+  fprintf(stderr, "%sfit: iteration %zu, %zu model evaluations, objective %.6g%s",
+          p->tty ? "\r" : "", iter, evals, objective, p->tty ? "   " : "\n");
+  fflush(stderr);
+  p->shown = 1;
+  return 0;
+}
+
+/* The fit's message without the library's own "fit: " prefix (we add the
+ * command name). */
+static const char *fit_msg(const rcb_fit *f, rcb_status st) {
+  const char *msg = cli_msg(rcb_fit_errmsg(f), st);
+  return strncmp(msg, "fit: ", 5) == 0 ? msg + 5 : msg;
+}
+
+/* The library's status for a setting or the run, as an exit code: settings the
+ * data cannot satisfy (empty band, unknown algorithm, NLopt missing) are usage. */
+static int fit_exit(rcb_status st) {
+  if (st == RCB_ERR_ARG || st == RCB_ERR_UNSUPPORTED) return CLI_EXIT_USAGE;
+  return cli_status_exit(st);
+}
+
+static int settings(const cli_args *a, const fit_job *j, rcb_fit *f, const rcb_meas *ms) {
+  double unit = rcb_meas_get_type(ms) == RCB_MEAS_FRF ? CLI_HZ_TO_RAD_S : CLI_RPM_TO_RAD_S;
+  rcb_status st = rcb_fit_set_scale(f, (rcb_fit_scale)j->scale);
+  if (!st && j->have_band) st = rcb_fit_set_band(f, j->band_lo * unit, j->band_hi * unit);
+  if (!st && j->have_noise) st = rcb_fit_set_noise_model(f, j->beta_a, j->beta_s);
+  if (!st)
+    st = rcb_fit_set_method(f, j->method_nlopt ? RCB_FIT_NLOPT : RCB_FIT_PAPER, j->algorithm);
+  if (!st) st = rcb_fit_set_analytic(f, cli_opt_value(a, "--fd") == NULL);
+  /* the library's default tolerances (rcb_fit_create), only the limit changes */
+  if (!st) st = rcb_fit_set_limits(f, j->max_iter, 1e-10, 1e-8);
+  if (st)
+    return cli_fail(fit_exit(st), "%s: %s", a->cmd, fit_msg(f, st));
+  return 0;
+}
+
+static int make_fit(const cli_args *a, const fit_job *j, rcb_model *m, const rcb_meas *ms,
+                    rcb_fit **out) {
+  rcb_status st = rcb_fit_create(out, m, ms, NULL);
+  int rc;
+  if (st) {
+    int code = st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC : CLI_EXIT_INPUT;
+    cli_fail(code, "%s: measurement '%s' against model '%s': %s", a->cmd, j->meas_path,
+             a->model, *out ? fit_msg(*out, st) : rcb_status_str(st));
+    if (st == RCB_ERR_NOT_FOUND && j->is_uff && !cli_opt_value(a, "--map"))
+      fputs("rcbtool: (UFF node numbers name model nodes \"#N\" unless mapped to stations "
+            "with --map NODE=STATION,...)\n",
+            stderr);
+    return code;
+  }
+  if ((rc = cli_params_add(a, *out, m, &j->params, j->log_all, 0))) return rc;
+  return settings(a, j, *out, ms);
+}
+
+static int run_fit(const cli_args *a, rcb_fit *f) {
+  fit_progress pr;
+  rcb_status st;
+  pr.tty = isatty(fileno(stderr));
+  pr.on = a->progress || pr.tty;
+  pr.shown = 0;
+  rcb_fit_set_progress(f, progress_cb, &pr);
+  st = rcb_fit_run(f);
+  if (pr.shown && pr.tty) fputc('\n', stderr);
+  if (st) return cli_fail(fit_exit(st), "%s: %s", a->cmd, fit_msg(f, st));
+  return 0;
+}
+
+/* ---- report ---- */
+
+typedef struct fit_result {
+  rcb_fit_report rep;
+  rcb_fit_param *par;
+  double *corr; /* np x np column-major */
+  size_t np;
+} fit_result;
+
+static int collect(rcb_fit *f, fit_result *r) {
+  size_t k;
+  r->np = rcb_fit_param_count(f);
+  r->par = calloc(r->np, sizeof *r->par);
+  r->corr = calloc(r->np * r->np, sizeof *r->corr);
+  if (!r->par || !r->corr) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  rcb_fit_get_report(f, &r->rep);
+  for (k = 0; k < r->np; k++) rcb_fit_get_param(f, k, &r->par[k]);
+  if (rcb_fit_correlation(f, r->corr))
+    for (k = 0; k < r->np * r->np; k++) r->corr[k] = NAN;
+  return 0;
+}
+
+static void text_num(FILE *fp, int width, double x) {
+  if (isfinite(x))
+    fprintf(fp, "%-*.10g", width, x);
+  else
+    fprintf(fp, "%-*s", width, "-");
+}
+
+static void write_text_params(FILE *fp, const fit_result *r) {
+  size_t k;
+  int w = 9;
+  for (k = 0; k < r->np; k++)
+    if ((int)strlen(r->par[k].name) > w) w = (int)strlen(r->par[k].name);
+  fprintf(fp, "%-*s  %-17s %-17s %-17s %-37s %s\n", w, "parameter", "start", "fitted",
+          "std error", "95 % CI", "identifiable");
+  for (k = 0; k < r->np; k++) {
+    const rcb_fit_param *p = &r->par[k];
+    char ci[80];
+    if (isfinite(p->ci_lo) && isfinite(p->ci_hi))
+      snprintf(ci, sizeof ci, "[%.10g, %.10g]", p->ci_lo, p->ci_hi);
+    else
+      snprintf(ci, sizeof ci, "-");
+    fprintf(fp, "%-*s  ", w, p->name);
+    text_num(fp, 18, p->start);
+    text_num(fp, 18, p->value);
+    text_num(fp, 18, p->stderr_);
+    fprintf(fp, "%-37s %s\n", ci, p->identifiable ? "yes" : "NO");
+  }
+  for (k = 0; k < r->np; k++)
+    if (!r->par[k].identifiable)
+      fprintf(fp, "note: %s is " NOT_IDENTIFIABLE "\n", r->par[k].name);
+}
+
+static void write_text(FILE *fp, const fit_result *r) {
+  size_t k, l;
+  write_text_params(fp, r);
+  fprintf(fp, "\nerror at start (E0): %.6g %%\nerror at end (E1):   %.6g %%\n",
+          r->rep.error0_pct, r->rep.error_pct);
+  fprintf(fp, "iterations: %zu\nmodel evaluations: %zu\nresiduals: %zu\nconverged: %s\n",
+          r->rep.iterations, r->rep.evaluations, r->rep.residuals,
+          r->rep.converged ? "yes" : "no");
+  fputs("\ncorrelation matrix:\n    ", fp);
+  for (l = 0; l < r->np; l++) fprintf(fp, " %7s(%zu)", "", l + 1);
+  fputc('\n', fp);
+  for (k = 0; k < r->np; k++) {
+    fprintf(fp, "(%zu) ", k + 1);
+    for (l = 0; l < r->np; l++) {
+      double c = r->corr[k + r->np * l];
+      if (isfinite(c))
+        fprintf(fp, " %+9.5f ", c);
+      else
+        fprintf(fp, " %9s ", "-");
+    }
+    fprintf(fp, " %s\n", r->par[k].name);
+  }
+}
+
+static void json_param(FILE *fp, const rcb_fit_param *p, const cli_param_spec *s,
+                       int log_all) {
+  fputs("{\"name\": ", fp);
+  cli_json_str(fp, p->name);
+  fputs(", \"start\": ", fp);
+  cli_json_num(fp, p->start);
+  fputs(", \"fitted\": ", fp);
+  cli_json_num(fp, p->value);
+  fputs(", \"stderr\": ", fp);
+  cli_json_num(fp, p->stderr_);
+  fputs(", \"ci95\": [", fp);
+  cli_json_num(fp, p->ci_lo);
+  fputs(", ", fp);
+  cli_json_num(fp, p->ci_hi);
+  fputs("], ", fp);
+  if (s->has_bounds) {
+    fputs("\"lo\": ", fp);
+    cli_json_num(fp, s->lo);
+    fputs(", \"hi\": ", fp);
+    cli_json_num(fp, s->hi);
+  } else {
+    fputs("\"lo\": ", fp);
+    cli_json_num(fp, p->start / 1000);
+    fputs(", \"hi\": ", fp);
+    cli_json_num(fp, p->start * 1000);
+  }
+  fprintf(fp, ", \"log\": %s, \"identifiable\": %s}", log_all ? "true" : "false",
+          p->identifiable ? "true" : "false");
+}
+
+static void write_json(FILE *fp, const fit_result *r, const fit_job *j, const cli_args *a) {
+  size_t k, n = 0;
+  fputs("{\"model\": ", fp);
+  cli_json_str(fp, a->model);
+  fputs(", \"measurement\": ", fp);
+  cli_json_str(fp, j->meas_path);
+  fprintf(fp, ", \"method\": \"%s%s\", \"scale\": \"%s\",\n\"params\": [",
+          j->method_nlopt ? "nlopt:" : "paper", j->method_nlopt ? j->algorithm : "",
+          scale_names[j->scale]);
+  for (k = 0; k < r->np; k++) {
+    fputs(k ? ",\n  " : "\n  ", fp);
+    json_param(fp, &r->par[k], &j->params.items[k], j->log_all);
+  }
+  fputs("],\n\"error0_pct\": ", fp);
+  cli_json_num(fp, r->rep.error0_pct);
+  fputs(", \"error_pct\": ", fp);
+  cli_json_num(fp, r->rep.error_pct);
+  fprintf(fp, ", \"iterations\": %zu, \"evaluations\": %zu, \"residuals\": %zu, "
+          "\"converged\": %s,\n\"objective0\": ",
+          r->rep.iterations, r->rep.evaluations, r->rep.residuals,
+          r->rep.converged ? "true" : "false");
+  cli_json_num(fp, r->rep.objective0);
+  fputs(", \"objective\": ", fp);
+  cli_json_num(fp, r->rep.objective);
+  fputs(", \"sigma\": ", fp);
+  cli_json_num(fp, r->rep.sigma);
+  fputs(",\n\"correlation\": [", fp);
+  for (k = 0; k < r->np; k++) {
+    fputs(k ? ", " : "", fp);
+    cli_json_nums(fp, r->corr + k, r->np, r->np); /* row k of a symmetric matrix */
+  }
+  fputs("],\n\"notes\": [", fp);
+  for (k = 0; k < r->np; k++)
+    if (!r->par[k].identifiable) {
+      fprintf(fp, "%s\"%s is " NOT_IDENTIFIABLE "\"", n++ ? ", " : "", r->par[k].name);
+    }
+  fputs("], \"output\": ", fp);
+  if (a->output)
+    cli_json_str(fp, a->output);
+  else
+    fputs("null", fp);
+  fputs("}\n", fp);
+}
+
+/* The fitted model as INI, written atomically to -o FILE. */
+static int write_model(const cli_args *a, const rcb_model *m) {
+  size_t need = 0;
+  char *buf;
+  cli_out o;
+  int rc;
+  rcb_status st = rcb_model_write_ini(m, NULL, 0, &need);
+  if (st != RCB_OK && st != RCB_ERR_WORKSPACE)
+    return cli_fail(cli_status_exit(st), "%s: writing the fitted model: %s", a->cmd,
+                    cli_msg(rcb_model_errmsg(m), st));
+  buf = malloc(need);
+  if (!buf) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  st = rcb_model_write_ini(m, buf, need, &need);
+  if (st) {
+    free(buf);
+    return cli_fail(cli_status_exit(st), "%s: writing the fitted model: %s", a->cmd,
+                    cli_msg(rcb_model_errmsg(m), st));
+  }
+  if ((rc = cli_out_open(&o, a))) {
+    free(buf);
+    return rc;
+  }
+  fputs(buf, o.fp);
+  free(buf);
+  return cli_out_close(&o);
+}
+
+static int report(const cli_args *a, const fit_job *j, rcb_fit *f, const rcb_model *m) {
+  fit_result r;
+  int rc;
+  memset(&r, 0, sizeof r);
+  if (!(rc = collect(f, &r))) {
+    if (a->json)
+      write_json(stdout, &r, j, a);
+    else
+      write_text(stdout, &r);
+    if (fflush(stdout) != 0 || ferror(stdout))
+      rc = cli_fail(CLI_EXIT_IO, "cannot write to standard output");
+  }
+  free(r.par);
+  free(r.corr);
+  if (!rc && a->output) rc = write_model(a, m);
+  return rc;
+}
+
+static int run(const cli_args *a, fit_job *j) {
+  rcb_model *m = NULL;
+  rcb_meas *ms = NULL;
+  rcb_fit *f = NULL;
+  int rc;
+  if ((rc = check_output(a, j)) || (rc = cli_load_model(a, &m))) return rc;
+  if (!(rc = read_meas(a, j, &ms)) && !(rc = make_fit(a, j, m, ms, &f)) &&
+      !(rc = run_fit(a, f)))
+    rc = report(a, j, f, m);
+  rcb_fit_destroy(f);
+  rcb_meas_destroy(ms);
+  rcb_model_destroy(m);
+  return rc;
+}
+
+/* ---- command line: MODEL and MEAS are both positional ---- */
+
+static int takes_value(const char *arg, const cli_opt *opts, size_t nopts) {
+  size_t i;
+  if (strchr(arg, '=')) return 0;
+  if (strcmp(arg, "-o") == 0 || strcmp(arg, "--output") == 0) return 1;
+  for (i = 0; i < nopts; i++)
+    if (opts[i].metavar && strcmp(arg, opts[i].name) == 0) return 1;
+  return 0;
+}
+
+/* cli_parse knows one positional argument (the model): take the second one
+ * (the measurement) out of argv; returns the number of positionals. */
+static int split_meas(int argc, char **argv, const cli_opt *opts, size_t nopts, char **args,
+                      int *nargs, const char **meas) {
+  int k, npos = 0, only_pos = 0, n = 0;
+  *meas = NULL;
+  for (k = 0; k < argc; k++) {
+    const char *arg = argv[k];
+    int pos = k > 0 && (only_pos || arg[0] != '-' || arg[1] == '\0');
+    if (k > 0 && !only_pos && strcmp(arg, "--") == 0) only_pos = 1;
+    if (pos && ++npos == 2) {
+      *meas = arg;
+      continue;
+    }
+    args[n++] = argv[k];
+    if (k > 0 && !pos && !only_pos && takes_value(arg, opts, nopts) && k + 1 < argc)
+      args[n++] = argv[++k];
+  }
+  *nargs = n;
+  return npos;
+}
+
+int cmd_fit(int argc, char **argv) {
+  cli_opt opts[] = {{"--params", "NAME[:LO:HI],...", NULL},
+                    {"--log", NULL, NULL},
+                    {"--method", "paper|nlopt:ALG", NULL},
+                    {"--scale", "SCALE", NULL},
+                    {"--band", "LO:HI", NULL},
+                    {"--noise", "BETA_A,BETA_S", NULL},
+                    {"--fd", NULL, NULL},
+                    {"--max-iter", "N", NULL},
+                    {"--map", "NODE=STATION,...", NULL}};
+  size_t nopts = sizeof opts / sizeof opts[0];
+  fit_job j;
+  cli_args a;
+  char **args = malloc(((size_t)argc + 1) * sizeof *args);
+  int nargs = 0, rc;
+  if (!args) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  memset(&j, 0, sizeof j);
+  split_meas(argc, argv, opts, nopts, args, &nargs, &j.meas_path);
+  rc = cli_parse(nargs, args, opts, nopts, &a);
+  if (!rc && a.help) rc = cli_print_help(cli_help_fit);
+  else if (!rc && !j.meas_path)
+    rc = cli_usage(a.cmd, "missing the measurement file: expected 'rcbtool fit MODEL.ini "
+                          "MEAS.uff|MEAS.csv --params ...'");
+  else if (!rc && !(rc = parse_job(&a, &j)))
+    rc = run(&a, &j);
+  cli_params_free(&j.params);
+  free(args);
+  return rc;
+}
