@@ -8,6 +8,9 @@
  *    coupling parameters of the paper system from 1/10 of the true values;
  *  - with eq. 19 noise over 20 seeds it reaches the noise floor every time,
  *    with honest standard errors, and flags cR as not identifiable;
+ *  - a fit that stays above the noise floor (a missing effect, or a local
+ *    minimum of a local NLopt method) is reported as unsure, and restarts
+ *    from random starts within the bounds reach the floor;
  *  - bad settings give clear errors.
  */
 #include <complex.h>
@@ -15,11 +18,13 @@
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <cmocka.h>
 
 #include "core/rcb_internal.h"
+#include "rcb/rcb_config.h"
 #include "rcb_test_util.h"
 
 #define RPM (RCB_PI / 30.0)
@@ -287,6 +292,98 @@ static void test_paper_fit_noisy_seeds(void **state) {
   rcb_model_destroy(truth);
 }
 
+/* One noisy Table 3 data set and a start model at 1/10 of kt, kr, ct, cr
+ * (coupling model 'model': the truth is nelson_crandall_2). */
+static rcb_fit *noisy_setup(rcb_model **mp, rcb_meas **msp, const char *model) {
+  rcb_model *truth = rcb_test_model_from_example("paper_system.ini"), *m;
+  const char *outs[] = {"C.A.x", "C.A.y", "C.B.x", "C.B.y"}, *ins[] = {"DA.x"};
+  const char *names[] = {"coupling.C.kt", "coupling.C.kr", "coupling.C.ct", "coupling.C.cr"};
+  rcb_fit *f = NULL;
+  size_t k, np = strcmp(model, "nelson_crandall_1") == 0 ? 2 : 4;
+  char ini[4096];
+  *msp = frf_meas(truth, outs, 4, ins, 1, 200, 400, 101, 10000, RCB_INERTANCE);
+  assert_int_equal(rcb_meas_add_noise(*msp, 10.0, 1.0, 5u), RCB_OK);
+  snprintf(ini, sizeof ini,
+           "[material steel]\ndensity = 7759.255\nyoung = 1.936e11\npoisson = 0.3\n"
+           "[shaft A]\nmaterial = steel\nshear_factor = 0.9\ndamping_mass = 15.691\n"
+           "damping_stiffness = 22.989e-6\nsegment = 0.5 0.017 0 10\n"
+           "[shaft B]\nmaterial = steel\nstart = 0.52\nshear_factor = 0.9\n"
+           "damping_mass = 15.691\ndamping_stiffness = 22.989e-6\nsegment = 0.5 0.017 0 10\n"
+           "[bearing B1]\nat = A 0.05\nkxx = 5e7\nkyy = 7e7\ncxx = 500\ncyy = 700\n"
+           "[bearing B2]\nat = A 0.35\nkxx = 7e7\nkyy = 9e7\ncxx = 300\ncyy = 500\n"
+           "[bearing B3]\nat = B 0.67\nkxx = 5e7\nkyy = 7e7\ncxx = 500\ncyy = 700\n"
+           "[bearing B4]\nat = B 0.97\nkxx = 7e7\nkyy = 9e7\ncxx = 300\ncyy = 500\n"
+           "[disk DA]\nat = A 0.2\ndensity = 6303.235\nouter_diameter = 0.09\n"
+           "inner_diameter = 0.017\nwidth = 0.025\n"
+           "[disk DB]\nat = B 0.82\ndensity = 6303.235\nouter_diameter = 0.09\n"
+           "inner_diameter = 0.017\nwidth = 0.025\n"
+           "[coupling C]\nmodel = %s\nbetween = A end, B start\nkt = 4609.5\nkr = 22.076\n"
+           "%shub_density = 2758.219\nhub_inner_radius = 0.006\nhub_outer_radius = 0.017\n"
+           "hub_thickness = 0.043115\n",
+           model, np == 4 ? "ct = 1.0949\ncr = 1.0949e-6\n" : "");
+  m = rcb_test_model_from_string(ini);
+  assert_int_equal(rcb_fit_create(&f, m, *msp, NULL), RCB_OK);
+  for (k = 0; k < np; k++) {
+    double v;
+    assert_int_equal(rcb_model_get_param(truth, names[k], &v), RCB_OK);
+    assert_int_equal(rcb_fit_add_param(f, names[k], v / 1000, v * 1000, 1), RCB_OK);
+  }
+  assert_int_equal(rcb_fit_set_scale(f, RCB_SCALE_LOG10), RCB_OK);
+  assert_int_equal(rcb_fit_set_noise_model(f, 10.0, 1.0), RCB_OK);
+  rcb_model_destroy(truth);
+  *mp = m;
+  return f;
+}
+
+/* A model without the coupling damping cannot reach the noise floor of data
+ * that has it: the fit says it is unsure instead of reporting success. */
+static void test_unsure_missing_effect(void **state) {
+  rcb_model *m;
+  rcb_meas *ms;
+  rcb_fit *f = noisy_setup(&m, &ms, "nelson_crandall_1");
+  rcb_fit_report rep;
+  (void)state;
+  if (rcb_fit_run(f)) fail_msg("%s", rcb_fit_errmsg(f));
+  assert_int_equal(rcb_fit_get_report(f, &rep), RCB_OK);
+  /* eq. 19 with beta_a = 10 %: uniform noise, floor 10/sqrt(3) = 5.8 % */
+  assert_true(rep.floor_pct > 5.0 && rep.floor_pct < 6.5);
+  assert_true(rep.error_pct > 2 * rep.floor_pct);
+  assert_int_equal(rep.unsure, 1);
+  rcb_fit_destroy(f);
+  rcb_meas_destroy(ms);
+  rcb_model_destroy(m);
+}
+
+#if RCB_WITH_NLOPT
+/* BOBYQA from 1/10 stops in a local minimum and says so; with restarts it
+ * reaches the noise floor. */
+static void test_multistart_local_minimum(void **state) {
+  rcb_fit_report one, many;
+  size_t n;
+  (void)state;
+  for (n = 1; n <= 8; n += 7) {
+    rcb_model *m;
+    rcb_meas *ms;
+    rcb_fit *f = noisy_setup(&m, &ms, "nelson_crandall_2");
+    assert_int_equal(rcb_fit_set_method(f, RCB_FIT_NLOPT, "bobyqa"), RCB_OK);
+    assert_int_equal(rcb_fit_set_starts(f, n, 3), RCB_OK);
+    if (rcb_fit_run(f)) fail_msg("%s", rcb_fit_errmsg(f));
+    assert_int_equal(rcb_fit_get_report(f, n == 1 ? &one : &many), RCB_OK);
+    rcb_fit_destroy(f);
+    rcb_meas_destroy(ms);
+    rcb_model_destroy(m);
+  }
+  print_message("bobyqa: 1 start error %.3g %% (unsure %d); %zu starts error %.3g %% "
+                "(floor %.3g %%)\n",
+                one.error_pct, one.unsure, many.starts, many.error_pct, many.floor_pct);
+  assert_int_equal(one.unsure, 1);
+  assert_true(one.error_pct > 2 * one.floor_pct);
+  assert_int_equal(many.unsure, 0);
+  assert_true(many.starts > 1);
+  assert_true(many.error_pct < 1.05 * many.floor_pct);
+}
+#endif
+
 static void test_bad_settings(void **state) {
   rcb_model *m = rcb_test_model_from_example("paper_system.ini");
   const char *outs[] = {"C.A.x"}, *ins[] = {"DA.x"};
@@ -317,6 +414,10 @@ int main(void) {
       cmocka_unit_test(test_sensitivities_unbalance),
       cmocka_unit_test(test_paper_fit_noise_free),
       cmocka_unit_test(test_paper_fit_noisy_seeds),
+      cmocka_unit_test(test_unsure_missing_effect),
+#if RCB_WITH_NLOPT
+      cmocka_unit_test(test_multistart_local_minimum),
+#endif
       cmocka_unit_test(test_bad_settings),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -85,6 +85,15 @@ RCB_API rcb_status rcb_fit_set_progress(rcb_fit *f,
                                                   double objective),
                                         void *user);
 
+/**
+ * @brief Guard against local minima: when a fit ends unsure (above the noise
+ * floor of the noise model, or not converged), try up to n - 1 further
+ * starting points, drawn log-uniformly (uniformly for linear parameters)
+ * within the bounds from a PRNG seeded by @p seed, and keep the best result.
+ * n = 1 (default) tries only the model's own start.
+ */
+RCB_API rcb_status rcb_fit_set_starts(rcb_fit *f, size_t n, unsigned long seed);
+
 /** @brief Run the fit; on success the model holds the fitted values. */
 RCB_API rcb_status rcb_fit_run(rcb_fit *f);
 
@@ -99,6 +108,10 @@ typedef struct rcb_fit_report {
   double error_pct;    /**< the same at the end */
   double sigma;        /**< residual standard deviation sqrt(F / (N - np)) */
   int converged;       /**< 1 when a convergence criterion was met */
+  double floor_pct;    /**< error % the noise model alone explains (NaN without one) */
+  int unsure;          /**< 1 when the fit did not converge, or ends above 1.5 times
+                            floor_pct: a local minimum, or an effect the model lacks */
+  size_t starts;       /**< starting points tried (see rcb_fit_set_starts) */
 } rcb_fit_report;
 RCB_API rcb_status rcb_fit_get_report(const rcb_fit *f, rcb_fit_report *out);
 

@@ -268,9 +268,78 @@ rcb_status rcb_fit_set_progress(rcb_fit *f,
 
 /* ---- run and results ---- */
 
+rcb_status rcb_fit_set_starts(rcb_fit *f, size_t n, unsigned long seed) {
+  if (!f || n == 0) return RCB_ERR_ARG;
+  f->nstarts = n;
+  f->rng = (unsigned long long)seed * 0x9E3779B97F4A7C15ull + 1ull;
+  return RCB_OK;
+}
+
+/* Uniform in [0, 1) from a splitmix64 step. */
+static double uniform(rcb_fit *f) {
+  unsigned long long z = (f->rng += 0x9E3779B97F4A7C15ull);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  z ^= z >> 31;
+  return (double)(z >> 11) * (1.0 / 9007199254740992.0);
+}
+
+/* A random start within the bounds, in internal coordinates. */
+static void random_start(rcb_fit *f, double *x) {
+  size_t k;
+  for (k = 0; k < f->np; k++) {
+    const rcb_fit_par *p = &f->par[k];
+    double u = uniform(f);
+    x[k] = p->log_param ? log(p->lo) + u * (log(p->hi) - log(p->lo))
+                        : (p->lo + u * (p->hi - p->lo)) / p->scale;
+  }
+}
+
+static int is_unsure(const rcb_fit *f, double err) {
+  double floor_pct = rcb_fit_floor_pct(f);
+  return !f->converged || (isfinite(floor_pct) && err > 1.5 * floor_pct);
+}
+
+/* Run the optimiser from the model's start, then from further random starts
+ * while the result is unsure; keep the best point in x_best. */
+static rcb_status multistart(rcb_fit *f, double *x, double *x_best) {
+  size_t s, it = 0, ev = 0, n = f->nstarts ? f->nstarts : 1;
+  double best = HUGE_VAL;
+  int conv = 0;
+  rcb_status st = RCB_OK, first = RCB_OK;
+  for (s = 0; s < n; s++) {
+    double F;
+    if (s > 0) {
+      random_start(f, x);
+      if ((st = rcb_fit_set_x(f, x))) break;
+    }
+    f->evaluations = 0;
+    st = f->method == RCB_FIT_NLOPT ? rcb_fit_run_nlopt(f) : rcb_fit_run_paper(f);
+    it += f->iterations, ev += f->evaluations;
+    f->starts_used = s + 1;
+    if (st) {
+      if (s == 0) first = st;
+      continue;
+    }
+    if ((st = rcb_fit_eval(f, f->r))) break;
+    ev++;
+    F = rcb_fit_sumsq(f->r, f->nres);
+    if (F < best) {
+      best = F;
+      conv = f->converged;
+      rcb_fit_get_x(f, x_best);
+    }
+    if (!is_unsure(f, rcb_fit_error_pct(f))) break;
+  }
+  f->iterations = it, f->evaluations = ev, f->converged = conv;
+  if (best == HUGE_VAL) return st ? st : first;
+  return rcb_fit_set_x(f, x_best);
+}
+
 rcb_status rcb_fit_run(rcb_fit *f) {
   rcb_status st;
   size_t k;
+  double *x;
   if (!f) return RCB_ERR_ARG;
   if (f->np == 0)
     return rcb_fit_fail(f, RCB_ERR_ARG, "no parameter to fit (add one with --params)");
@@ -285,7 +354,10 @@ rcb_status rcb_fit_run(rcb_fit *f) {
   if ((st = rcb_fit_eval(f, f->r))) return st;
   f->obj0 = rcb_fit_sumsq(f->r, f->nres);
   f->err0 = rcb_fit_error_pct(f);
-  st = f->method == RCB_FIT_NLOPT ? rcb_fit_run_nlopt(f) : rcb_fit_run_paper(f);
+  if (!(x = rcb_alloc(&f->alloc, 2 * f->np * sizeof *x)))
+    return rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory");
+  st = multistart(f, x, x + f->np);
+  rcb_free(&f->alloc, x);
   if (st) return st;
   for (k = 0; k < f->np; k++) rcb_model_get_param(f->m, f->par[k].name, &f->par[k].value);
   if ((st = rcb_fit_eval(f, f->r))) return st;
@@ -305,6 +377,9 @@ rcb_status rcb_fit_get_report(const rcb_fit *f, rcb_fit_report *out) {
   out->error_pct = f->err;
   out->sigma = f->nres > f->np ? sqrt(f->obj / (double)(f->nres - f->np)) : (double)NAN;
   out->converged = f->converged;
+  out->floor_pct = rcb_fit_floor_pct(f);
+  out->unsure = is_unsure(f, f->err);
+  out->starts = f->starts_used;
   return RCB_OK;
 }
 

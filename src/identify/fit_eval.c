@@ -216,6 +216,29 @@ double rcb_fit_error_pct(const rcb_fit *f) {
   return den > 0 ? 100.0 * sqrt(num / den) : (double)NAN;
 }
 
+double rcb_fit_floor_pct(const rcb_fit *f) {
+  double num = 0.0, den = 0.0, ba = f->beta_a / 100.0;
+  size_t j, c, i;
+  if (!(f->beta_a > 0 || f->beta_s > 0)) return (double)NAN;
+  for (c = 0; c < f->nch; c++) {
+    rcb_meas_channel_info ci;
+    double s2 = 0.0, a;
+    rcb_meas_channel(f->meas, c, &ci);
+    for (i = 0; i < f->npts; i++) s2 += creal(ci.data[i] * conj(ci.data[i]));
+    a = f->beta_s / 100.0 * sqrt(s2) / (double)f->npts;
+    for (j = 0; j < f->nres; j++) {
+      double em;
+      if (f->res_part[j] || f->res_ch[j] != c) continue;
+      em = cabs(ci.data[f->res_pt[j]]);
+      /* magnitude variance: proportional part uniform (1/3), additive part
+       * of random phase (1/6) */
+      num += ba * ba * em * em / 3.0 + a * a / 6.0;
+      den += em * em;
+    }
+  }
+  return den > 0 ? 100.0 * sqrt(num / den) : (double)NAN;
+}
+
 /* ---- sensitivities ---- */
 
 static double dpdx(const rcb_fit *f, size_t k) {

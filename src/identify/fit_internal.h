@@ -76,6 +76,8 @@ struct rcb_fit {
   size_t iterations, evaluations;
   double obj0, obj, err0, err;
   int converged;
+  size_t nstarts, starts_used;
+  unsigned long long rng;
   double *cov, *corr;    /* np x np */
 };
 
@@ -102,8 +104,10 @@ rcb_status rcb_fit_eval_jac(rcb_fit *f, double *r, double *Jx);
 /* F = r^T r at x (sets the model), and its gradient d F / d x when grad is
  * not NULL. */
 rcb_status rcb_fit_objective(rcb_fit *f, const double *x, double *F, double *grad);
-/* Paper's error % of residual vector r (unweighted distance on the scale). */
+/* Paper's error % of the current model values over the fit's points. */
 double rcb_fit_error_pct(const rcb_fit *f);
+/* Error % the eq. 19 noise model alone explains (NaN without a noise model). */
+double rcb_fit_floor_pct(const rcb_fit *f);
 
 /* Optimisers: each leaves the best point in the model and fills
  * iterations/evaluations/converged. */

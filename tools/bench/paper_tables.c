@@ -4,7 +4,7 @@
  * values, for all five coupling models. Public API only.
  *
  *   paper_tables examples/paper_system.ini [--seeds N] [--table 2|3]
- *                [--method paper|nlopt:NAME]
+ *                [--method paper|nlopt:NAME] [--starts N]
  *
  * Table 2: unbalance responses at the four coupling DOFs (C.A.x, C.A.y, C.B.x,
  * C.B.y), 300-18300 rpm (every 60 rpm). Table 3: inertances at the same DOFs
@@ -145,12 +145,15 @@ typedef struct run_stats {
   int unident[MAXP], reached, failed;
 } run_stats;
 
+static size_t g_starts = 1;
+
 static void configure(rcb_fit *f, const variant *v, const double *tv, const char *method) {
   int k;
   for (k = 0; k < MAXP; k++)
     if (v->uses[k]) rcb_fit_add_param(f, pnames[k], tv[k] / 1000, tv[k] * 1000, 1);
   rcb_fit_set_scale(f, RCB_SCALE_LOG10);
   rcb_fit_set_noise_model(f, 10.0, 1.0);
+  rcb_fit_set_starts(f, g_starts, 1);
   if (method && strncmp(method, "nlopt:", 6) == 0)
     rcb_fit_set_method(f, RCB_FIT_NLOPT, method + 6);
 }
@@ -263,13 +266,14 @@ int main(int argc, char **argv) {
   rcb_model *truth = NULL;
   if (argc < 2) {
     fprintf(stderr, "usage: paper_tables examples/paper_system.ini [--seeds N] [--table 2|3]"
-                    " [--method paper|nlopt:NAME]\n");
+                    " [--method paper|nlopt:NAME] [--starts N]\n");
     return 2;
   }
   for (i = 2; i + 1 < argc; i += 2) {
     if (strcmp(argv[i], "--seeds") == 0) seeds = (unsigned)atoi(argv[i + 1]);
     if (strcmp(argv[i], "--table") == 0) which = atoi(argv[i + 1]);
     if (strcmp(argv[i], "--method") == 0) method = argv[i + 1];
+    if (strcmp(argv[i], "--starts") == 0) g_starts = (size_t)atoi(argv[i + 1]);
   }
   if (seeds < 1 || seeds > MAXSEED) seeds = 20;
   if (method && strcmp(method, "paper") == 0) method = NULL;
