@@ -15,7 +15,7 @@ const char cli_help_fit[] =
     "usage: rcbtool fit MODEL.ini MEAS.uff|MEAS.unv|MEAS.csv --params NAME[:LO:HI][,...]\n"
     "                   [--log] [--method paper|nlopt:ALG]\n"
     "                   [--scale linear|log10|db|complex] [--band LO:HI]\n"
-    "                   [--noise BETA_A,BETA_S] [--fd] [--max-iter N]\n"
+    "                   [--noise BETA_A,BETA_S] [--fd] [--max-iter N] [--starts N]\n"
     "                   [--map NODE=STATION,...] [-o FITTED.ini] [--json] [--progress]\n"
     "\n"
     "Fits model parameters so that the model reproduces the measurement (paper\n"
@@ -41,6 +41,10 @@ const char cli_help_fit[] =
     "  --fd           sensitivities by finite differences (eq. 11) instead of the\n"
     "                 analytic ones (eq. 9)\n"
     "  --max-iter N   iteration limit (default 100)\n"
+    "  --starts N     when the fit ends unsure (above 1.5 x the noise floor that\n"
+    "                 --noise predicts, or not converged: a local minimum or a\n"
+    "                 missing effect), retry from up to N - 1 random starts within\n"
+    "                 the bounds and keep the best (default 1)\n"
     "  --map LIST     UFF node number <-> model station, e.g. 10=DA,20=C.A (UFF\n"
     "                 nodes without an entry read as model node \"#N\")\n"
     "  -o FILE        write the fitted model as INI to FILE (atomically; never over\n"
@@ -183,7 +187,7 @@ typedef struct fit_job {
   int have_band, have_noise;
   double band_lo, band_hi; /* Hz (FRF) or rpm (unbalance) */
   double beta_a, beta_s;   /* % */
-  size_t max_iter;
+  size_t max_iter, starts;
   int is_uff; /* the measurement is a UFF file (set by read_meas) */
 } fit_job;
 
@@ -218,7 +222,8 @@ static int parse_job(const cli_args *a, fit_job *j) {
   int rc;
   j->log_all = cli_opt_value(a, "--log") != NULL;
   if ((rc = cli_opt_choice(a, "--scale", scale_names, 4, RCB_SCALE_LOG10, &j->scale)) ||
-      (rc = parse_method(a, j)) || (rc = cli_opt_count(a, "--max-iter", 100, &j->max_iter)))
+      (rc = parse_method(a, j)) || (rc = cli_opt_count(a, "--max-iter", 100, &j->max_iter)) ||
+      (rc = cli_opt_count(a, "--starts", 1, &j->starts)))
     return rc;
   if (cli_opt_value(a, "--band")) {
     if ((rc = parse_pair(a, "--band", ':', "LO:HI (Hz for FRFs, rpm for unbalance data)",
@@ -335,6 +340,7 @@ static int settings(const cli_args *a, const fit_job *j, rcb_fit *f, const rcb_m
   if (!st) st = rcb_fit_set_analytic(f, cli_opt_value(a, "--fd") == NULL);
   /* the library's default tolerances (rcb_fit_create), only the limit changes */
   if (!st) st = rcb_fit_set_limits(f, j->max_iter, 1e-10, 1e-8);
+  if (!st) st = rcb_fit_set_starts(f, j->starts, 1);
   if (st)
     return cli_fail(fit_exit(st), "%s: %s", a->cmd, fit_msg(f, st));
   return 0;
@@ -430,9 +436,17 @@ static void write_text(FILE *fp, const fit_result *r) {
   write_text_params(fp, r);
   fprintf(fp, "\nerror at start (E0): %.6g %%\nerror at end (E1):   %.6g %%\n",
           r->rep.error0_pct, r->rep.error_pct);
-  fprintf(fp, "iterations: %zu\nmodel evaluations: %zu\nresiduals: %zu\nconverged: %s\n",
-          r->rep.iterations, r->rep.evaluations, r->rep.residuals,
+  if (isfinite(r->rep.floor_pct))
+    fprintf(fp, "noise floor (from --noise): %.6g %%\n", r->rep.floor_pct);
+  fprintf(fp, "iterations: %zu\nmodel evaluations: %zu\nstarting points: %zu\n"
+          "residuals: %zu\nconverged: %s\n",
+          r->rep.iterations, r->rep.evaluations, r->rep.starts, r->rep.residuals,
           r->rep.converged ? "yes" : "no");
+  if (r->rep.unsure)
+    fputs("UNSURE: the fit did not converge or ends well above the noise floor: a local "
+          "minimum (try --starts 8 or --method nlopt:direct-l+bobyqa) or a physical effect "
+          "the model lacks (rcbtool diagnose)\n",
+          fp);
   fputs("\ncorrelation matrix:\n    ", fp);
   for (l = 0; l < r->np; l++) fprintf(fp, " %7s(%zu)", "", l + 1);
   fputc('\n', fp);
@@ -496,10 +510,12 @@ static void write_json(FILE *fp, const fit_result *r, const fit_job *j, const cl
   cli_json_num(fp, r->rep.error0_pct);
   fputs(", \"error_pct\": ", fp);
   cli_json_num(fp, r->rep.error_pct);
-  fprintf(fp, ", \"iterations\": %zu, \"evaluations\": %zu, \"residuals\": %zu, "
-          "\"converged\": %s,\n\"objective0\": ",
-          r->rep.iterations, r->rep.evaluations, r->rep.residuals,
-          r->rep.converged ? "true" : "false");
+  fputs(", \"floor_pct\": ", fp);
+  cli_json_num(fp, r->rep.floor_pct);
+  fprintf(fp, ", \"iterations\": %zu, \"evaluations\": %zu, \"starts\": %zu, "
+          "\"residuals\": %zu, \"converged\": %s, \"unsure\": %s,\n\"objective0\": ",
+          r->rep.iterations, r->rep.evaluations, r->rep.starts, r->rep.residuals,
+          r->rep.converged ? "true" : "false", r->rep.unsure ? "true" : "false");
   cli_json_num(fp, r->rep.objective0);
   fputs(", \"objective\": ", fp);
   cli_json_num(fp, r->rep.objective);
@@ -625,6 +641,7 @@ int cmd_fit(int argc, char **argv) {
                     {"--noise", "BETA_A,BETA_S", NULL},
                     {"--fd", NULL, NULL},
                     {"--max-iter", "N", NULL},
+                    {"--starts", "N", NULL},
                     {"--map", "NODE=STATION,...", NULL}};
   size_t nopts = sizeof opts / sizeof opts[0];
   fit_job j;
