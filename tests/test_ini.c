@@ -530,6 +530,37 @@ static void test_err_file(void **state) {
   rcb_model_destroy(m);
 }
 
+/* [uff] map: UFF node numbers to stations; written back by the INI writer. */
+static void test_uff_map(void **state) {
+  char text[4096], out[8192];
+  rcb_model *m, *m2;
+  long node;
+  const char *st;
+  size_t need;
+  (void)state;
+  snprintf(text, sizeof text, "%s[disk D]\nat = A 0.5\nmass = 1\nId = 0.01\nIp = 0.02\n"
+           "[uff]\nmap = 7 D, 12 #3\n", BASE);
+  m = rcb_test_model_from_string(text);
+  assert_int_equal(rcb_model_uff_node_count(m), 2);
+  assert_int_equal(rcb_model_uff_node(m, 1, &node, &st), RCB_OK);
+  assert_int_equal(node, 12);
+  assert_string_equal(st, "#3");
+  assert_int_equal(rcb_model_write_ini(m, out, sizeof out, &need), RCB_OK);
+  m2 = rcb_test_model_from_string(out);
+  assert_int_equal(rcb_model_uff_node_count(m2), 2);
+  assert_int_equal(rcb_model_uff_node(m2, 0, &node, &st), RCB_OK);
+  assert_int_equal(node, 7);
+  assert_string_equal(st, "D");
+  rcb_model_destroy(m);
+  rcb_model_destroy(m2);
+  expect_error(1, "[uff]\nmap = 7 NOPE\n", RCB_ERR_NOT_FOUND, "node 7 maps to 'NOPE'",
+               "not a station");
+  expect_error(1, "[uff]\nmap = 7\n", RCB_ERR_PARSE, "t.ini:10: [uff] map",
+               "NODE STATION pairs");
+  expect_error(1, "[uff]\nmap = 7 #1, 7 #2\n", RCB_ERR_PARSE, "mapped twice", NULL);
+  expect_error(1, "[uff x]\n", RCB_ERR_PARSE, "takes no name", NULL);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_paper_system),
@@ -554,6 +585,7 @@ int main(void) {
       cmocka_unit_test(test_err_disk_both),
       cmocka_unit_test(test_err_syntax),
       cmocka_unit_test(test_err_file),
+      cmocka_unit_test(test_uff_map),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -160,6 +160,18 @@ RCB_API rcb_status rcb_model_add_unbalance(rcb_model *m, const char *name, const
 /** @brief A named measurement station (probe position) at (shaft, z). */
 RCB_API rcb_status rcb_model_add_station(rcb_model *m, const char *name, const char *shaft,
                                          double z);
+/**
+ * @brief Map a UFF (universal file) node number to a station name ("DA",
+ * "C.B", "#12"), so measurement files written with the test's own node
+ * numbers read without a command-line map. Checked by finalize.
+ */
+RCB_API rcb_status rcb_model_add_uff_node(rcb_model *m, long node, const char *station);
+/** @brief Number of UFF node map entries. */
+RCB_API size_t rcb_model_uff_node_count(const rcb_model *m);
+/** @brief UFF map entry i: node number and station name (owned by the model). */
+RCB_API rcb_status rcb_model_uff_node(const rcb_model *m, size_t i, long *node,
+                                      const char **station);
+
 /** @brief Build the mesh and the DOF map, check consistency. */
 RCB_API rcb_status rcb_model_finalize(rcb_model *m);
 

@@ -101,6 +101,12 @@ typedef struct rcb_station_s {
   size_t node;
 } rcb_station_t;
 
+/* UFF node number -> station name (INI [uff] map). */
+typedef struct rcb_uffmap_s {
+  long node;
+  char station[2 * RCB_NAME_MAX + 2];
+} rcb_uffmap_t;
+
 typedef struct rcb_node_s {
   size_t shaft;
   double z;     /* m */
@@ -127,6 +133,7 @@ struct rcb_model {
   RCB_ARRAY(rcb_coupling_t, couplings);
   RCB_ARRAY(rcb_unbalance_t, unbalances);
   RCB_ARRAY(rcb_probe_t, probes);
+  RCB_ARRAY(rcb_uffmap_t, uffmap);
   /* built by finalize */
   RCB_ARRAY(rcb_station_t, stations);
   RCB_ARRAY(rcb_node_t, nodes);

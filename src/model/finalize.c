@@ -212,6 +212,27 @@ static rcb_status build_stations(rcb_model *m) {
   return st;
 }
 
+/* Every UFF map entry names an existing station or node. */
+static rcb_status check_uffmap(rcb_model *m) {
+  size_t i, k;
+  for (i = 0; i < m->n_uffmap; i++) {
+    const char *st = m->uffmap[i].station;
+    int ok = 0;
+    if (st[0] == '#') {
+      char *end;
+      long n = strtol(st + 1, &end, 10);
+      ok = !*end && end != st + 1 && n >= 0 && (size_t)n < m->n_nodes;
+    }
+    for (k = 0; k < m->n_stations && !ok; k++) ok = strcmp(m->stations[k].name, st) == 0;
+    if (!ok)
+      return rcb_model_fail(m, RCB_ERR_NOT_FOUND,
+                            "uff map: node %ld maps to '%s', which is not a station of the "
+                            "model (see 'rcbtool check' for the station table)",
+                            m->uffmap[i].node, st);
+  }
+  return RCB_OK;
+}
+
 rcb_status rcb_model_finalize(rcb_model *m) {
   rcb_status st;
   if (!m) return RCB_ERR_ARG;
@@ -221,7 +242,7 @@ rcb_status rcb_model_finalize(rcb_model *m) {
   m->n_nodes = 0;
   m->n_elements = 0;
   if ((st = mesh_shafts(m)) || (st = resolve_all(m)) || (st = number_dofs(m)) ||
-      (st = build_stations(m)))
+      (st = build_stations(m)) || (st = check_uffmap(m)))
     return st;
   m->finalized = 1;
   m->errmsg[0] = '\0';

@@ -367,11 +367,38 @@ static const ini_section *section_of_message(const ini_ctx *c, const char *msg) 
   return NULL;
 }
 
+/* [uff] map = NODE STATION, NODE STATION, ... */
+static rcb_status build_uff(ini_ctx *c, const ini_section *s) {
+  const ini_entry *e = rcb_ini_get(s, "map");
+  const char *p, *q;
+  if (!e) return RCB_OK;
+  for (p = e->val; p && *p;) {
+    char item[2 * RCB_NAME_MAX + 40], station[2 * RCB_NAME_MAX + 2], extra[8];
+    long node;
+    size_t len;
+    q = strchr(p, ',');
+    len = q ? (size_t)(q - p) : strlen(p);
+    if (len >= sizeof item) len = sizeof item - 1;
+    memcpy(item, p, len);
+    item[len] = '\0';
+    if (sscanf(item, "%ld %97s %7s", &node, station, extra) != 2)
+      return rcb_ini_error(c, RCB_ERR_PARSE, e->line, s, "map",
+                           "'%s': expected NODE STATION pairs separated by commas, e.g. "
+                           "map = 10 DA, 20 C.B",
+                           item);
+    if (rcb_model_add_uff_node(c->m, node, station))
+      return rcb_ini_error(c, RCB_ERR_PARSE, e->line, s, "map", "%s",
+                           rcb_model_errmsg(c->m));
+    p = q ? q + 1 : NULL;
+  }
+  return RCB_OK;
+}
+
 rcb_status rcb_ini_build(ini_ctx *c) {
   /* dependency order: what is placed on a shaft comes after the shafts */
   static const ini_sec_type order[] = {INI_SEC_MATERIAL,  INI_SEC_SHAFT,    INI_SEC_DISK,
                                        INI_SEC_BEARING,   INI_SEC_COUPLING, INI_SEC_UNBALANCE,
-                                       INI_SEC_STATION};
+                                       INI_SEC_STATION,   INI_SEC_UFF};
   size_t k, i;
   rcb_status st = RCB_OK;
   for (k = 0; k < sizeof order / sizeof order[0] && !st; k++)
@@ -386,6 +413,7 @@ rcb_status rcb_ini_build(ini_ctx *c) {
         case INI_SEC_COUPLING: st = build_coupling(c, s); break;
         case INI_SEC_UNBALANCE: st = build_unbalance(c, s); break;
         case INI_SEC_STATION: st = build_station(c, s); break;
+        case INI_SEC_UFF: st = build_uff(c, s); break;
         default: break;
       }
     }

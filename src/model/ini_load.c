@@ -26,7 +26,7 @@
 #define INI_MAX_FILE (16u * 1024u * 1024u)
 
 static const char *const type_names[INI_SEC_COUNT] = {
-    "model", "material", "shaft", "disk", "bearing", "coupling", "unbalance", "station"};
+    "model", "material", "shaft", "disk", "bearing", "coupling", "unbalance", "station", "uff"};
 
 /* Keys of each section type, in the order the format documents them. */
 static const char *const keys_model[] = {"name", "description"};
@@ -45,6 +45,7 @@ static const char *const keys_coupling[] = {
     "hub_thickness"};
 static const char *const keys_unbalance[] = {"at", "amount", "phase_deg"};
 static const char *const keys_station[] = {"at"};
+static const char *const keys_uff[] = {"map"};
 
 typedef struct key_table {
   const char *const *keys;
@@ -54,7 +55,8 @@ typedef struct key_table {
 #define KT(a) {a, sizeof a / sizeof a[0]}
 static const key_table key_tables[INI_SEC_COUNT] = {
     KT(keys_model),    KT(keys_material), KT(keys_shaft),     KT(keys_disk),
-    KT(keys_bearing),  KT(keys_coupling), KT(keys_unbalance), KT(keys_station)};
+    KT(keys_bearing),  KT(keys_coupling), KT(keys_unbalance), KT(keys_station),
+    KT(keys_uff)};
 #undef KT
 
 const char *rcb_ini_type_name(ini_sec_type t) {
@@ -71,8 +73,8 @@ rcb_status rcb_ini_error(ini_ctx *c, rcb_status st, int line, const ini_section 
   va_start(ap, fmt);
   vsnprintf(what, sizeof what, fmt, ap);
   va_end(ap);
-  if (s && s->type == INI_SEC_MODEL)
-    snprintf(where, sizeof where, " [model]");
+  if (s && (s->type == INI_SEC_MODEL || s->type == INI_SEC_UFF))
+    snprintf(where, sizeof where, " [%s]", type_names[s->type]);
   else if (s)
     snprintf(where, sizeof where, " [%s %s]", type_names[s->type], s->name);
   else
@@ -183,11 +185,11 @@ static rcb_status check_duplicate(ini_ctx *c, ini_sec_type t, const char *name) 
   for (i = 0; i < c->n_sec; i++) {
     const ini_section *o = &c->sec[i];
     if (o->type == t && strcmp(o->name, name) == 0) {
-      if (t == INI_SEC_MODEL)
+      if (t == INI_SEC_MODEL || t == INI_SEC_UFF)
         return rcb_ini_error(c, RCB_ERR_PARSE, c->line, NULL, NULL,
-                             "duplicate section [model] (first at line %d); expected at most "
-                             "one [model] section",
-                             o->line);
+                             "duplicate section [%s] (first at line %d); expected at most "
+                             "one [%s] section",
+                             type_names[t], o->line, type_names[t]);
       return rcb_ini_error(c, RCB_ERR_PARSE, c->line, NULL, NULL,
                            "duplicate section [%s %s] (first defined at line %d); expected "
                            "unique names",
@@ -239,12 +241,11 @@ static rcb_status open_section(ini_ctx *c, const char *p) {
     return rcb_ini_error(c, RCB_ERR_PARSE, c->line, NULL, NULL,
                          "unknown section type [%s]; expected one of: %s", type, all);
   }
-  if (t == INI_SEC_MODEL && nf > 1)
+  if ((t == INI_SEC_MODEL || t == INI_SEC_UFF) && nf > 1)
     return rcb_ini_error(c, RCB_ERR_PARSE, c->line, NULL, NULL,
-                         "[model %s]: the [model] section takes no name; expected [model] "
-                         "(set name = ... inside it)",
-                         name);
-  if (t != INI_SEC_MODEL && nf < 2)
+                         "[%s %s]: the [%s] section takes no name; expected [%s]", type, name,
+                         type, type);
+  if (t != INI_SEC_MODEL && t != INI_SEC_UFF && nf < 2)
     return rcb_ini_error(c, RCB_ERR_PARSE, c->line, NULL, NULL,
                          "[%s] needs a name; expected [%s NAME], e.g. [%s %s]", type, type,
                          type, t == INI_SEC_SHAFT ? "A" : "X1");

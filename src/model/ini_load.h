@@ -22,6 +22,7 @@ typedef enum ini_sec_type {
   INI_SEC_COUPLING,
   INI_SEC_UNBALANCE,
   INI_SEC_STATION,
+  INI_SEC_UFF,
   INI_SEC_COUNT
 } ini_sec_type;
 

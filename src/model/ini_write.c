@@ -288,6 +288,12 @@ static void write_rest(wbuf *w, const rcb_model *m) {
     kv(w, "at", place_txt(m, &m->probes[i].at, at, sizeof at), "shaft, z m");
     wr(w, "\n");
   }
+  if (m->n_uffmap) {
+    wr(w, "[uff]\n; UFF node number -> station, for measurement files\nmap = ");
+    for (i = 0; i < m->n_uffmap; i++)
+      wr(w, "%s%ld %s", i ? ", " : "", m->uffmap[i].node, m->uffmap[i].station);
+    wr(w, "\n");
+  }
 }
 
 rcb_status rcb_model_write_ini(const rcb_model *m, char *buf, size_t size, size_t *needed) {

@@ -39,6 +39,7 @@ void rcb_model_destroy(rcb_model *m) {
   rcb_free(&a, m->couplings);
   rcb_free(&a, m->unbalances);
   rcb_free(&a, m->probes);
+  rcb_free(&a, m->uffmap);
   rcb_free(&a, m->stations);
   rcb_free(&a, m->nodes);
   rcb_free(&a, m->elements);
@@ -474,5 +475,36 @@ rcb_status rcb_model_add_station(rcb_model *m, const char *name, const char *sha
   p = &m->probes[m->n_probes++];
   snprintf(p->name, sizeof p->name, "%s", name);
   p->at = at;
+  return RCB_OK;
+}
+
+rcb_status rcb_model_add_uff_node(rcb_model *m, long node, const char *station) {
+  rcb_uffmap_t *u;
+  size_t i;
+  rcb_status st = check_editable(m, "uff map");
+  if (st) return st;
+  if (!station || !station[0] || strlen(station) >= sizeof u->station)
+    return rcb_model_fail(m, RCB_ERR_ARG, "uff map: node %ld: a station name is required",
+                          node);
+  if (node <= 0)
+    return rcb_model_fail(m, RCB_ERR_ARG, "uff map: node %ld, expected a positive UFF node "
+                          "number", node);
+  for (i = 0; i < m->n_uffmap; i++)
+    if (m->uffmap[i].node == node)
+      return rcb_model_fail(m, RCB_ERR_MODEL, "uff map: node %ld is mapped twice (%s, %s)",
+                            node, m->uffmap[i].station, station);
+  GROW(uffmap);
+  u = &m->uffmap[m->n_uffmap++];
+  u->node = node;
+  snprintf(u->station, sizeof u->station, "%s", station);
+  return RCB_OK;
+}
+
+size_t rcb_model_uff_node_count(const rcb_model *m) { return m ? m->n_uffmap : 0; }
+
+rcb_status rcb_model_uff_node(const rcb_model *m, size_t i, long *node, const char **station) {
+  if (!m || i >= m->n_uffmap || !node || !station) return RCB_ERR_ARG;
+  *node = m->uffmap[i].node;
+  *station = m->uffmap[i].station;
   return RCB_OK;
 }

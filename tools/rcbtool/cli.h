@@ -175,8 +175,10 @@ typedef struct cli_uff_map {
   char **owned;  /**< station names added by cli_uff_automap */
   size_t nowned;
 } cli_uff_map;
-/** Parse option @p opt (absent = empty map); usage error (2) when malformed. */
-int cli_uff_map_parse(const cli_args *a, const char *opt, cli_uff_map *mp);
+/** Parse option @p opt (absent: the model's [uff] map when @p m is given, else an
+ * empty map); usage error (2) when malformed. */
+int cli_uff_map_parse(const cli_args *a, const char *opt, const rcb_model *m,
+                      cli_uff_map *mp);
 void cli_uff_map_free(cli_uff_map *mp);
 /** Give every station of @p ms without a map entry the next free node number
  * (printed on stderr). */

@@ -62,13 +62,25 @@ static int map_item(const cli_args *a, const char *opt, char *item, rcb_uff_node
   return 0;
 }
 
-int cli_uff_map_parse(const cli_args *a, const char *opt, cli_uff_map *mp) {
+/* The model's own [uff] map (station names stay owned by the model). */
+static int map_from_model(const rcb_model *m, cli_uff_map *mp) {
+  size_t i, n = rcb_model_uff_node_count(m);
+  if (n == 0) return 0;
+  mp->nodes = malloc(n * sizeof *mp->nodes);
+  if (!mp->nodes) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  for (i = 0; i < n; i++) rcb_model_uff_node(m, i, &mp->nodes[i].node, &mp->nodes[i].station);
+  mp->n = n;
+  return 0;
+}
+
+int cli_uff_map_parse(const cli_args *a, const char *opt, const rcb_model *m,
+                      cli_uff_map *mp) {
   const char *list = cli_opt_value(a, opt);
   size_t n = 1, i, j;
   char *p;
   int rc;
   memset(mp, 0, sizeof *mp);
-  if (!list) return 0;
+  if (!list) return m ? map_from_model(m, mp) : 0;
   mp->buf = malloc(strlen(list) + 1);
   if (!mp->buf) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   strcpy(mp->buf, list);
@@ -252,7 +264,7 @@ static int convert(const cli_args *a, const char *out) {
     return rc;
   if (cli_opt_value(a, "--binary") && !is_uff)
     return cli_usage(a->cmd, "--binary applies to UFF output only ('%s' is CSV)", out);
-  if ((rc = cli_uff_map_parse(a, "--map", &mp))) {
+  if ((rc = cli_uff_map_parse(a, "--map", NULL, &mp))) {
     cli_uff_map_free(&mp);
     return rc;
   }

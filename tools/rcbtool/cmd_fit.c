@@ -267,7 +267,7 @@ static int check_output(const cli_args *a, const fit_job *j) {
   return 0;
 }
 
-static int read_meas(const cli_args *a, fit_job *j, rcb_meas **out) {
+static int read_meas(const cli_args *a, fit_job *j, const rcb_model *m, rcb_meas **out) {
   const char *path = j->meas_path;
   cli_uff_map mp;
   rcb_meas *ms = NULL;
@@ -276,11 +276,11 @@ static int read_meas(const cli_args *a, fit_job *j, rcb_meas **out) {
   *out = NULL;
   if ((rc = cli_meas_format(a->cmd, path, &is_uff))) return rc;
   j->is_uff = is_uff;
-  if ((rc = cli_uff_map_parse(a, "--map", &mp))) {
+  if ((rc = cli_uff_map_parse(a, "--map", m, &mp))) {
     cli_uff_map_free(&mp);
     return rc;
   }
-  if (!is_uff && mp.n > 0) {
+  if (!is_uff && cli_opt_value(a, "--map")) {
     cli_uff_map_free(&mp);
     return cli_usage(a->cmd, "--map applies to UFF measurements only ('%s' is CSV)", path);
   }
@@ -590,7 +590,7 @@ static int run(const cli_args *a, fit_job *j) {
   rcb_fit *f = NULL;
   int rc;
   if ((rc = check_output(a, j)) || (rc = cli_load_model(a, &m))) return rc;
-  if (!(rc = read_meas(a, j, &ms)) && !(rc = make_fit(a, j, m, ms, &f)) &&
+  if (!(rc = read_meas(a, j, m, &ms)) && !(rc = make_fit(a, j, m, ms, &f)) &&
       !(rc = run_fit(a, f)))
     rc = report(a, j, f, m);
   rcb_fit_destroy(f);

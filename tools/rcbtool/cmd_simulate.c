@@ -199,7 +199,7 @@ static int run(const cli_args *a, sim_job *j, rcb_model *m) {
   rcb_complex *data = NULL;
   size_t nch, p;
   int rc;
-  if ((rc = cli_uff_map_parse(a, "--map", &mp)) ||
+  if ((rc = cli_uff_map_parse(a, "--map", m, &mp)) ||
       (rc = cli_channels_parse(a, m, "--out", &j->out)) ||
       (j->frf && (rc = cli_channels_parse(a, m, "--in", &j->in)))) {
     cli_uff_map_free(&mp);
