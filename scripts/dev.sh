@@ -10,6 +10,9 @@
 #   ./scripts/dev.sh core       build + ctest with every optional backend OFF (build-core/)
 #   ./scripts/dev.sh sanitize   AddressSanitizer + UBSan build and ctest (build-asan/)
 #   ./scripts/dev.sh bench      FRF sweep benchmark (C dense/banded; SciPy and ROSS if .venv)
+#   ./scripts/dev.sh bench-fit  identification benchmark (issue #3, Table 3 data, 20 seeds):
+#                               rcbtool fit per method vs SciPy least_squares (needs .venv);
+#                               extra arguments go to tools/bench/bench_fit.py
 #
 # Environment: CI=true turns warnings into errors; RCB_BUILD_DIR (default build)
 # and RCB_VENV (default .venv) move the build tree and the venv;
@@ -171,8 +174,24 @@ EOF
     END { for (j = 2; j in n; j += 2)
             printf "  %-6s max amplitude %.3e m at %.0f rpm\n", n[j], pk[j], r[j] }' \
     "$out/unbalance.csv"
+
+  say "identification (paper section 8): fit the coupling to noisy measured FRFs"
+  # Measured inertances (eq. 19 noise 10 %, 1 %) from the true system, written
+  # as UFF58 with the test's node numbers; a model whose coupling starts at
+  # 1/10 of the truth, with the same node map in its [uff] section.
+  rcbtool simulate "$MODEL" --frf --out C.A.x,C.A.y,C.B.x,C.B.y --in DA.x --fmin 200 \
+    --fmax 400 --points 201 --rpm 10000 --kind inertance --noise 10,1 --seed 1 \
+    --map 10=C.A,11=C.B,4=DA -o "$out/measured.uff"
+  sed -e 's/^kt = 46.095e3/kt = 4609.5/' -e 's/^kr = 220.76 /kr = 22.076 /' \
+    -e 's/^ct = 10.949 /ct = 1.0949 /' -e 's/^cr = 10.949e-6/cr = 1.0949e-6/' "$MODEL" \
+    > "$out/start.ini"
+  printf '\n[uff]\nmap = 10 C.A, 11 C.B, 4 DA\n' >> "$out/start.ini"
+  rcbtool fit "$out/start.ini" "$out/measured.uff" --log --noise 10,1 \
+    --params coupling.C.kt,coupling.C.kr,coupling.C.ct,coupling.C.cr -o "$out/fitted.ini" |
+    sed -n '1,/^converged/p' | sed 's/^/  /'
+  echo "  (true values: kt 46095 N/m, kr 220.76 N m/rad, ct 10.949 N s/m, cr 1.0949e-05 N m s/rad)"
   echo
-  echo "full tables (CSV, JSON) in $out/"
+  echo "full tables (CSV, JSON, UFF, fitted model) in $out/"
 }
 
 python_for_summary() {
@@ -260,6 +279,18 @@ cmd_bench() {
   fi
 }
 
+cmd_bench_fit() {
+  cmd_build
+  [[ -x $(rcbtool_exe) && -f $(rcbtool_exe) ]] || die "rcbtool was not built"
+  [[ -x $VENV/bin/python ]] || die "no $VENV: run ./scripts/dev.sh deps (NumPy, SciPy)"
+  say "machine"
+  lscpu | grep -E '^(Model name|CPU\(s\)|Thread\(s\) per core)' || true
+  echo "load average (1, 5, 15 min): $(cut -d' ' -f1-3 /proc/loadavg 2> /dev/null)"
+  say "identification: librcb (rcbtool fit) vs SciPy least_squares (one core)"
+  OPENBLAS_NUM_THREADS=1 "$VENV/bin/python" tools/bench/bench_fit.py \
+    --rcbtool "$(rcbtool_exe)" --model "$MODEL" "$@"
+}
+
 usage() { awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$ROOT/scripts/dev.sh"; }
 
 case ${1:-} in
@@ -270,6 +301,7 @@ case ${1:-} in
   core) cmd_core ;;
   sanitize) cmd_sanitize ;;
   bench) cmd_bench ;;
+  bench-fit) shift; cmd_bench_fit "$@" ;;
   -h | --help | help) usage ;;
   *) usage >&2; exit 2 ;;
 esac

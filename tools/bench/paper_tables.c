@@ -4,7 +4,7 @@
  * values, for all five coupling models. Public API only.
  *
  *   paper_tables examples/paper_system.ini [--seeds N] [--table 2|3]
- *                [--method paper|nlopt:NAME] [--starts N]
+ *                [--method paper|nlopt:NAME] [--starts N] [--channels C1,C2,C3,C4]
  *
  * Table 2: unbalance responses at the four coupling DOFs (C.A.x, C.A.y, C.B.x,
  * C.B.y), 300-18300 rpm (every 60 rpm). Table 3: inertances at the same DOFs
@@ -29,7 +29,7 @@
 #define MAXP 4
 #define MAXSEED 100
 
-static const char *const chans[4] = {"C.A.x", "C.A.y", "C.B.x", "C.B.y"};
+static const char *chans[4] = {"C.A.x", "C.A.y", "C.B.x", "C.B.y"};
 static const char *const pnames[MAXP] = {"coupling.C.kt", "coupling.C.kr", "coupling.C.ct",
                                          "coupling.C.cr"};
 
@@ -240,10 +240,10 @@ static void table(const char *ini, const rcb_model *truth, int t, unsigned seeds
   rcb_meas *clean = simulate(truth, t);
   int vi, k;
   for (k = 0; k < MAXP; k++) rcb_model_get_param(truth, pnames[k], &tv[k]);
-  printf("Table %d (%s), %u seeds, eq. 19 noise 10 %% / 1 %%, start at 1/10, method %s\n", t,
-         t == 2 ? "FRD: unbalance responses at C.A.x C.A.y C.B.x C.B.y, 300-18300 rpm"
-                : "FRF: inertances C.*/DA.x, 200-400 Hz at 10000 rpm",
-         seeds, method ? method : "paper");
+  printf("Table %d (%s) at %s %s %s %s, %u seeds, eq. 19 noise 10 %% / 1 %%, start at 1/10, method %s\n", t,
+         t == 2 ? "FRD: unbalance responses, 300-18300 rpm"
+                : "FRF: inertances per force at DA.x, 200-400 Hz at 10000 rpm",
+         chans[0], chans[1], chans[2], chans[3], seeds, method ? method : "paper");
   for (vi = 0; vi < 5; vi++) {
     run_stats *rs = calloc(1, sizeof *rs);
     unsigned s;
@@ -266,7 +266,7 @@ int main(int argc, char **argv) {
   rcb_model *truth = NULL;
   if (argc < 2) {
     fprintf(stderr, "usage: paper_tables examples/paper_system.ini [--seeds N] [--table 2|3]"
-                    " [--method paper|nlopt:NAME] [--starts N]\n");
+                    " [--method paper|nlopt:NAME] [--starts N] [--channels C1,C2,C3,C4]\n");
     return 2;
   }
   for (i = 2; i + 1 < argc; i += 2) {
@@ -274,6 +274,15 @@ int main(int argc, char **argv) {
     if (strcmp(argv[i], "--table") == 0) which = atoi(argv[i + 1]);
     if (strcmp(argv[i], "--method") == 0) method = argv[i + 1];
     if (strcmp(argv[i], "--starts") == 0) g_starts = (size_t)atoi(argv[i + 1]);
+    if (strcmp(argv[i], "--channels") == 0) { /* four channels, e.g. from rcbtool sensitivity */
+      char *p = argv[i + 1];
+      int k;
+      for (k = 0; k < 4 && p; k++) {
+        chans[k] = p;
+        p = strchr(p, ',');
+        if (p) *p++ = '\0';
+      }
+    }
   }
   if (seeds < 1 || seeds > MAXSEED) seeds = 20;
   if (method && strcmp(method, "paper") == 0) method = NULL;
