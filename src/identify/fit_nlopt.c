@@ -294,10 +294,10 @@ static rcb_status nl_run(rcb_fit *f, double *work) {
   size_t np = f->np, k;
   double *x = work, *lb = work + np, *ub = work + 2 * np;
   nl_ctx c;
-  nlopt_algorithm a;
+  nlopt_algorithm a = NLOPT_LN_BOBYQA;
   nlopt_opt o = NULL, lo = NULL;
   nlopt_result res;
-  int local, global, polish;
+  int local = -1, global, polish;
   rcb_status st = nl_parse(f, &a, &local), st2;
   if (st != RCB_OK) return st;
   global = !nl_is_local(a);

@@ -456,7 +456,7 @@ static rcb_status accept(uff_reader *R, uff_set *S, uff_rec *r) {
   const char *rd = NULL, *fd = NULL;
   char st_r[RCB_MEAS_CH_MAX], st_f[RCB_MEAS_CH_MAX];
   double scale, speed = 0.0;
-  rcb_frf_kind kind;
+  rcb_frf_kind kind = RCB_RECEPTANCE;
   rcb_status st;
   struct uff_chan *c;
   size_t i;

@@ -29,7 +29,9 @@ error), median |error| % of kt, kr, ct, seeds reaching the floor
 A benchmark: it prints figures and never fails on a time.
 
 usage: bench_fit.py [--rcbtool PATH] [--model INI] [--seeds N]
-                    [--methods paper,nlopt:lbfgs,...] [--no-scipy] [--uff]
+                    [--methods paper,nlopt:lbfgs@4,...] [--no-scipy] [--uff]
+                    [--verbose]
+(METHOD@N: rcbtool fit --starts N, restarts from random points while unsure)
 """
 
 import argparse
@@ -58,7 +60,7 @@ PNAMES = ["coupling.C." + k for k in KEYS]
 UFF_MAP = "1=C.A,2=C.B,3=DA"  # UFF node numbers of the stations (simulate and fit)
 DIRS = {"x": 0, "y": 1, "rx": 2, "ry": 3}
 DEFAULT_METHODS = ("paper,nlopt:lbfgs,nlopt:mma,nlopt:bobyqa,nlopt:sbplx,"
-                   "nlopt:direct-l+bobyqa")
+                   "nlopt:direct-l+bobyqa,nlopt:lbfgs@8,nlopt:bobyqa@8")
 # The paper's Table 3 (Nelson-Crandall 2, FRF fit) and the SciPy figure of issue #3.
 PAPER_REF = "paper Table 3: kt 0.50 %, kr 0.06 %, ct 0.20 %, 202 evaluations"
 ISSUE_SCIPY_REF = ("issue #3, SciPy least_squares with a noise-floor mask: "
@@ -113,7 +115,8 @@ def coupling_values(ini):
     for k in KEYS:
         m = re.search(rf"^\s*{k}\s*=\s*([^\s;]+)", sec.group(1), re.M)
         if not m:
-            raise BenchError(f"[coupling C] has no '{k}' (a nelson_crandall_2 coupling is expected)")
+            raise BenchError(f"[coupling C] has no '{k}' "
+                             "(a nelson_crandall_2 coupling is expected)")
         vals.append(float(m.group(1)))
     return vals
 
@@ -287,6 +290,9 @@ def scipy_fit(model, obj, start, lo, hi, analytic):
 def librcb_fit(exe, start_ini, meas, method, lo, hi):
     params = ",".join(f"{n}:{a!r}:{b!r}" for n, a, b in zip(PNAMES, lo, hi))
     extra = ["--map", UFF_MAP] if meas.endswith(".uff") else []
+    method, _, starts = method.partition("@")  # "ALG@N": --starts N (restarts while unsure)
+    if starts:
+        extra += ["--starts", starts]
     t0 = time.perf_counter()
     res = run(exe, "fit", start_ini, meas, *extra, "--params", params, "--log", "--scale", "log10",
               "--noise", f"{BETA_A:g},{BETA_S:g}", "--method", method, "--json", check=False)
@@ -299,7 +305,8 @@ def librcb_fit(exe, start_ini, meas, method, lo, hi):
     out.update(p=np.array([by[n]["fitted"] for n in PNAMES]), evals=d["evaluations"],
                error=d["error_pct"], error0=d["error0_pct"], objective0=d["objective0"],
                residuals=d["residuals"], cr_flag=not by[PNAMES[3]]["identifiable"],
-               others_flagged=sum(not by[n]["identifiable"] for n in PNAMES[:3]))
+               others_flagged=sum(not by[n]["identifiable"] for n in PNAMES[:3]),
+               unsure=d.get("unsure"))
     if "time_s" in d:  # library time, if a later rcbtool reports it
         out["lib_secs"] = d["time_s"]
     return out
@@ -312,7 +319,15 @@ def med(v):
     return statistics.median(v) if v else float("nan")
 
 
+def timed(fn, *args):
+    t0 = time.perf_counter()
+    fn(*args)
+    return time.perf_counter() - t0
+
+
 def fmt_time(s):
+    if s < 0.01:
+        return f"{1e3 * s:.1f} ms"
     return f"{1e3 * s:.0f} ms" if s < 10 else f"{s:.1f} s"
 
 
@@ -329,16 +344,22 @@ def summarise(name, runs, floors, truth, librcb):
         "reached": sum(r["error"] <= 1.05 * fl for r, fl in ok),
         "n": len(runs), "failed": len(runs) - len(ok),
         "cr": (f"{sum(r['cr_flag'] for r, _ in ok)}/{len(ok)}" if librcb else "-"),
+        "unsure": (f"{sum(bool(r['unsure']) for r, _ in ok)}/{len(ok)}"
+                   if librcb and all(r.get("unsure") is not None for r, _ in ok) else "-"),
     }
+    ev = [r["evals"] for r, _ in ok]
+    row["evals_range"] = (min(ev), max(ev)) if ev else (0, 0)
+    row["per_eval"] = med([r["secs"] / r["evals"] for r, _ in ok if r["evals"] > 0])
     if librcb and any("lib_secs" in r for r, _ in ok):
         row["lib_secs"] = med([r.get("lib_secs") for r, _ in ok])
     return row
 
 
 def print_table(rows):
-    head = ["method", "median evaluations", "median wall time per fit", "median error %",
+    head = ["method", "median evaluations (min-max)", "median wall time per fit",
+            "per evaluation", "median error %",
             "median floor %", "median |err| kt %", "kr %", "ct %", "seeds at floor",
-            "cR flagged"]
+            "cR flagged", "unsure"]
     lines = ["| " + " | ".join(head) + " |",
              "| --- |" + " ---: |" * (len(head) - 1)]
     for r in rows:
@@ -346,9 +367,11 @@ def print_table(rows):
         if "lib_secs" in r:
             t += f" (library {fmt_time(r['lib_secs'])})"
         fail = f", {r['failed']} failed" if r["failed"] else ""
-        lines.append(f"| {r['method']} | {r['evals']:.0f} | {t} | {r['error']:.3f} | "
+        ev = f"{r['evals']:.0f} ({r['evals_range'][0]}-{r['evals_range'][1]})"
+        lines.append(f"| {r['method']} | {ev} | {t} | {1e3 * r['per_eval']:.1f} ms | "
+                     f"{r['error']:.3f} | "
                      f"{r['floor']:.3f} | {r['kt']:.3f} | {r['kr']:.3f} | {r['ct']:.3f} | "
-                     f"{r['reached']}/{r['n']}{fail} | {r['cr']} |")
+                     f"{r['reached']}/{r['n']}{fail} | {r['cr']} | {r['unsure']} |")
     print("\n".join(lines))
 
 
@@ -358,7 +381,8 @@ def main():
     ap.add_argument("--model", default=os.path.join(ROOT, "examples", "paper_system.ini"))
     ap.add_argument("--seeds", type=int, default=20, help="noise seeds 0..N-1 (default 20)")
     ap.add_argument("--methods", default=DEFAULT_METHODS,
-                    help=f"librcb methods, comma-separated (default {DEFAULT_METHODS})")
+                    help="librcb methods, comma-separated; METHOD@N adds --starts N "
+                    f"(default {DEFAULT_METHODS})")
     ap.add_argument("--no-scipy", action="store_true", help="librcb methods only")
     ap.add_argument("--uff", action="store_true", help="measurements as UFF58 (default CSV; "
                     "SciPy then reads a CSV twin written by the same seed)")
@@ -407,6 +431,17 @@ def main():
             raise BenchError("the Python model does not reproduce rcbtool's "
                              f"(affinity {model.affine_dev:.1e}, FRF {dev:.1e}); "
                              "the SciPy figures would not be comparable")
+
+        # one model sweep on each side (best of 5): what the evaluations cost
+        t_frf = min(timed(run, exe, "frf", start_ini, "--out", ",".join(OUTS), "--in", INP,
+                          "--fmin", FMIN, "--fmax", FMAX, "--points", NPTS, "--rpm", RPM,
+                          "--kind", "inertance") for _ in range(5))
+        p0 = np.array(start)
+        t_py = min(timed(model.inertance, p0, w) for _ in range(5))
+        t_pyj = min(timed(model.dlog, p0, w) for _ in range(5))
+        print(f"one sweep of {NPTS} frequencies: `rcbtool frf` process {fmt_time(t_frf)} "
+              f"(start, load, sweep, output); Python model {fmt_time(t_py)}, with the eq. 9 "
+              f"Jacobian {fmt_time(t_pyj)}")
 
         res = {m: [] for m in methods}
         sp = {"fd": [], "an": []}
@@ -469,6 +504,9 @@ def main():
               "uncertainty, JSON); SciPy = the least_squares call alone (in-process).")
         print("floor: error % of the true model on the same data and points; "
               "'seeds at floor': error <= 1.05 floor.")
+        print("cR flagged / unsure: librcb's SVD identifiability flag on cr, and its "
+              "'unsure' verdict (above 1.5 x its predicted floor, or not converged); "
+              "METHOD@N = --starts N.")
         print("reference: " + PAPER_REF)
         print("reference: " + ISSUE_SCIPY_REF)
     finally:

@@ -196,7 +196,7 @@ int cli_meas_format(const char *cmd, const char *path, int *is_uff) {
 
 int cli_meas_write(const char *cmd, const rcb_meas *ms, const char *path, int binary,
                    cli_uff_map *mp) {
-  int is_uff, rc;
+  int is_uff = 0, rc;
   rcb_status st;
   if ((rc = cli_meas_format(cmd, path, &is_uff))) return rc;
   if (is_uff) {
@@ -244,7 +244,7 @@ static int split_out(int argc, char **argv, char **args, int *nargs, const char 
 }
 
 static int read_input(const cli_args *a, rcb_meas *ms, const cli_uff_map *mp) {
-  int is_uff, rc;
+  int is_uff = 0, rc;
   rcb_status st;
   if ((rc = cli_meas_format(a->cmd, a->model, &is_uff))) return rc;
   st = is_uff ? rcb_meas_read_uff(ms, a->model, mp->n, mp->nodes)

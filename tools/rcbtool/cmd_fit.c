@@ -161,7 +161,7 @@ int cli_params_add(const cli_args *a, rcb_fit *f, const rcb_model *m, const cli_
   size_t k;
   for (k = 0; k < ps->n; k++) {
     const cli_param_spec *p = &ps->items[k];
-    double start, lo, hi;
+    double start, lo = 0.0, hi = 0.0;
     rcb_status st = rcb_model_get_param(m, p->name, &start);
     int rc;
     if (st)
@@ -272,7 +272,7 @@ static int read_meas(const cli_args *a, fit_job *j, const rcb_model *m, rcb_meas
   cli_uff_map mp;
   rcb_meas *ms = NULL;
   rcb_status st;
-  int is_uff, rc;
+  int is_uff = 0, rc;
   *out = NULL;
   if ((rc = cli_meas_format(a->cmd, path, &is_uff))) return rc;
   j->is_uff = is_uff;
