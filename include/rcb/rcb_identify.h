@@ -25,7 +25,9 @@ typedef enum rcb_fit_scale {
   RCB_SCALE_LINEAR = 0, /**< |H| */
   RCB_SCALE_LOG10 = 1,  /**< log10 |H| */
   RCB_SCALE_DB = 2,     /**< 20 log10 |H| */
-  RCB_SCALE_COMPLEX = 3 /**< Re H, Im H */
+  RCB_SCALE_COMPLEX = 3 /**< Re H, Im H; uses the phase. The fit first converges on
+                             log10 |H| (continuation: the complex objective has local
+                             minima a phase period apart), then on Re, Im */
 } rcb_fit_scale;
 
 typedef enum rcb_fit_method {

@@ -336,9 +336,28 @@ static rcb_status multistart(rcb_fit *f, double *x, double *x_best) {
   return rcb_fit_set_x(f, x_best);
 }
 
+/* A complex-valued objective has local minima where the model's phase is a
+ * period away from the measured one; a first stage on log magnitudes brings
+ * the parameters into the right basin (continuation). */
+static rcb_status log_magnitude_stage(rcb_fit *f, double *x, size_t *it, size_t *ev) {
+  rcb_status st;
+  double ftol = f->ftol_rel;
+  f->scale = RCB_SCALE_LOG10;
+  f->prepared = 0;
+  f->ftol_rel = ftol > 1e-4 ? ftol : 1e-4; /* the basin is enough here */
+  st = rcb_fit_prepare(f);
+  if (!st) st = multistart(f, x, x + f->np);
+  f->ftol_rel = ftol;
+  *it = f->iterations, *ev = f->evaluations;
+  f->scale = RCB_SCALE_COMPLEX;
+  f->prepared = 0;
+  if (!st) st = rcb_fit_prepare(f);
+  return st;
+}
+
 rcb_status rcb_fit_run(rcb_fit *f) {
   rcb_status st;
-  size_t k;
+  size_t k, it0 = 0, ev0 = 0;
   double *x;
   if (!f) return RCB_ERR_ARG;
   if (f->np == 0)
@@ -356,7 +375,9 @@ rcb_status rcb_fit_run(rcb_fit *f) {
   f->err0 = rcb_fit_error_pct(f);
   if (!(x = rcb_alloc(&f->alloc, 2 * f->np * sizeof *x)))
     return rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory");
-  st = multistart(f, x, x + f->np);
+  st = f->scale == RCB_SCALE_COMPLEX ? log_magnitude_stage(f, x, &it0, &ev0) : RCB_OK;
+  if (!st) st = multistart(f, x, x + f->np);
+  f->iterations += it0, f->evaluations += ev0 + 1;
   rcb_free(&f->alloc, x);
   if (st) return st;
   for (k = 0; k < f->np; k++) rcb_model_get_param(f->m, f->par[k].name, &f->par[k].value);

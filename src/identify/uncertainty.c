@@ -4,7 +4,8 @@
  * units), sigma^2 = F / (N - np); 95 % intervals p +/- 1.96 se (N large);
  * correlation; and an SVD test on the column-scaled Jacobian: a parameter is
  * not identifiable when it loads on a singular value below 1e-6 of the
- * largest (the data cannot tell it apart), or when the data cannot tell the
+ * largest (the data cannot tell it apart), when its 95 % interval reaches
+ * zero, or when the data cannot tell the
  * fitted value from half or twice of it: F(2p) and F(p/2) both stay within
  * the 95 % chi-square(1) level (3.84 sigma^2) of F(p) (the paper's "infinite"
  * cR error). These evaluations are not counted in the fit's evaluations.
@@ -33,7 +34,8 @@ static void flag_and_fill(rcb_fit *f, const double *s, const double *Vt, const d
     p->se = sqrt(f->cov[i + np * i]);
     p->ci_lo = p->value - RCB_Z95 * p->se;
     p->ci_hi = p->value + RCB_Z95 * p->se;
-    p->identifiable = !(p->se > fabs(p->value)) && isfinite(p->se);
+    /* a 95 % interval that reaches zero: the data do not determine it */
+    p->identifiable = !(RCB_Z95 * p->se >= fabs(p->value)) && isfinite(p->se);
     for (k = 0; k < np; k++)
       if (s[k] < RCB_SVD_RTOL * s[0] && fabs(Vt[k + np * i]) > 0.5) p->identifiable = 0;
   }

@@ -5,11 +5,12 @@
  *
  *   paper_tables examples/paper_system.ini [--seeds N] [--table 2|3]
  *                [--method paper|nlopt:NAME] [--starts N] [--channels C1,C2,C3,C4]
+ *                [--scale log10|linear|complex]
  *
  * Table 2: unbalance responses at the four coupling DOFs (C.A.x, C.A.y, C.B.x,
  * C.B.y), 300-18300 rpm (every 60 rpm). Table 3: inertances at the same DOFs
  * for a force at disk A (DA.x), 200-400 Hz (1 Hz steps) at 10000 rpm.
- * Fit: log10 magnitudes, noise-aware weights (rcb_fit_set_noise_model),
+ * Fit: log10 magnitudes (or --scale), noise-aware weights (rcb_fit_set_noise_model),
  * log parameters bounded to [true/1000, 1000 true]. Printed per model: the
  * median fitted values and their median |error| %, the median final error %
  * against the noise floor (the true model's error on the same noisy data),
@@ -146,12 +147,13 @@ typedef struct run_stats {
 } run_stats;
 
 static size_t g_starts = 1;
+static rcb_fit_scale g_scale = RCB_SCALE_LOG10;
 
 static void configure(rcb_fit *f, const variant *v, const double *tv, const char *method) {
   int k;
   for (k = 0; k < MAXP; k++)
     if (v->uses[k]) rcb_fit_add_param(f, pnames[k], tv[k] / 1000, tv[k] * 1000, 1);
-  rcb_fit_set_scale(f, RCB_SCALE_LOG10);
+  rcb_fit_set_scale(f, g_scale);
   rcb_fit_set_noise_model(f, 10.0, 1.0);
   rcb_fit_set_starts(f, g_starts, 1);
   if (method && strncmp(method, "nlopt:", 6) == 0)
@@ -207,6 +209,9 @@ static void one_seed(const char *ini, const rcb_model *truth, const rcb_meas *cl
         rs->err[j][s] = 100 * fabs(p.value - tv[j]) / tv[j];
         rs->se[j][s] = 100 * p.stderr_ / fabs(p.value);
         if (!p.identifiable) rs->unident[j]++;
+        if (getenv("RCB_TABLES_VERBOSE"))
+          fprintf(stderr, "    %s = %.5g (se %.3g)%s\n", p.name, p.value, p.stderr_,
+                  p.identifiable ? "" : " not identifiable");
       }
   }
   rcb_fit_destroy(f);
@@ -240,10 +245,15 @@ static void table(const char *ini, const rcb_model *truth, int t, unsigned seeds
   rcb_meas *clean = simulate(truth, t);
   int vi, k;
   for (k = 0; k < MAXP; k++) rcb_model_get_param(truth, pnames[k], &tv[k]);
-  printf("Table %d (%s) at %s %s %s %s, %u seeds, eq. 19 noise 10 %% / 1 %%, start at 1/10, method %s\n", t,
+  printf("Table %d (%s) at %s %s %s %s, %u seeds, eq. 19 noise 10 %% / 1 %%, start at 1/10, "
+         "scale %s, method %s\n", t,
          t == 2 ? "FRD: unbalance responses, 300-18300 rpm"
                 : "FRF: inertances per force at DA.x, 200-400 Hz at 10000 rpm",
-         chans[0], chans[1], chans[2], chans[3], seeds, method ? method : "paper");
+         chans[0], chans[1], chans[2], chans[3], seeds,
+         g_scale == RCB_SCALE_COMPLEX  ? "complex"
+         : g_scale == RCB_SCALE_LINEAR ? "linear"
+                                       : "log10",
+         method ? method : "paper");
   for (vi = 0; vi < 5; vi++) {
     run_stats *rs = calloc(1, sizeof *rs);
     unsigned s;
@@ -266,7 +276,8 @@ int main(int argc, char **argv) {
   rcb_model *truth = NULL;
   if (argc < 2) {
     fprintf(stderr, "usage: paper_tables examples/paper_system.ini [--seeds N] [--table 2|3]"
-                    " [--method paper|nlopt:NAME] [--starts N] [--channels C1,C2,C3,C4]\n");
+                    " [--method paper|nlopt:NAME] [--starts N] [--channels C1,C2,C3,C4]"
+                    " [--scale log10|linear|complex]\n");
     return 2;
   }
   for (i = 2; i + 1 < argc; i += 2) {
@@ -274,6 +285,10 @@ int main(int argc, char **argv) {
     if (strcmp(argv[i], "--table") == 0) which = atoi(argv[i + 1]);
     if (strcmp(argv[i], "--method") == 0) method = argv[i + 1];
     if (strcmp(argv[i], "--starts") == 0) g_starts = (size_t)atoi(argv[i + 1]);
+    if (strcmp(argv[i], "--scale") == 0)
+      g_scale = strcmp(argv[i + 1], "complex") == 0 ? RCB_SCALE_COMPLEX
+                : strcmp(argv[i + 1], "linear") == 0 ? RCB_SCALE_LINEAR
+                                                      : RCB_SCALE_LOG10;
     if (strcmp(argv[i], "--channels") == 0) { /* four channels, e.g. from rcbtool sensitivity */
       char *p = argv[i + 1];
       int k;
