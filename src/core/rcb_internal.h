@@ -32,6 +32,11 @@ rcb_status rcb_set_error(char *buf, rcb_status st, const char *fmt, ...)
 #endif
     ;
 
+/* ---- core/text.c ---- */
+/* Case-insensitive Levenshtein distance of two names ((size_t)-1 beyond 160
+ * characters), for "did you mean" suggestions. */
+size_t rcb_edit_distance(const char *a, const char *b);
+
 /* ---- model/ ---- */
 typedef struct rcb_material_s {
   char name[RCB_NAME_MAX];

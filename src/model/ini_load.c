@@ -93,32 +93,12 @@ rcb_status rcb_ini_error(ini_ctx *c, rcb_status st, int line, const ini_section 
   return st;
 }
 
-/* Case-insensitive Levenshtein distance of two short words (SIZE_MAX if too long). */
-static size_t edit_distance(const char *a, const char *b) {
-  size_t row[65], la = strlen(a), lb = strlen(b), i, j;
-  if (la > 64 || lb > 64) return (size_t)-1;
-  for (j = 0; j <= lb; j++) row[j] = j;
-  for (i = 1; i <= la; i++) {
-    size_t diag = row[0];
-    row[0] = i;
-    for (j = 1; j <= lb; j++) {
-      size_t up = row[j];
-      size_t cost = tolower((unsigned char)a[i - 1]) == tolower((unsigned char)b[j - 1]) ? 0 : 1;
-      size_t best = diag + cost;
-      if (up + 1 < best) best = up + 1;
-      if (row[j - 1] + 1 < best) best = row[j - 1] + 1;
-      row[j] = best;
-      diag = up;
-    }
-  }
-  return row[lb];
-}
 
 const char *rcb_ini_closest(const char *word, const char *const *cand, size_t n) {
   size_t i, best_d = (size_t)-1, limit = strlen(word) >= 4 ? 2 : 1;
   const char *best = NULL;
   for (i = 0; i < n; i++) {
-    size_t d = edit_distance(word, cand[i]);
+    size_t d = rcb_edit_distance(word, cand[i]);
     if (d < best_d) {
       best_d = d;
       best = cand[i];

@@ -210,26 +210,6 @@ rcb_status rcb_model_param_name(const rcb_model *m, size_t i, char *buf, size_t 
 
 #define NAME_CMP_MAX 160
 
-/* Case-insensitive Levenshtein distance (SIZE_MAX if a word is too long). */
-static size_t edit_distance(const char *a, const char *b) {
-  size_t row[NAME_CMP_MAX + 1], la = strlen(a), lb = strlen(b), i, j;
-  if (la > NAME_CMP_MAX || lb > NAME_CMP_MAX) return (size_t)-1;
-  for (j = 0; j <= lb; j++) row[j] = j;
-  for (i = 1; i <= la; i++) {
-    size_t diag = row[0];
-    row[0] = i;
-    for (j = 1; j <= lb; j++) {
-      size_t up = row[j];
-      size_t cost = tolower((unsigned char)a[i - 1]) == tolower((unsigned char)b[j - 1]) ? 0 : 1;
-      size_t best = diag + cost;
-      if (up + 1 < best) best = up + 1;
-      if (row[j - 1] + 1 < best) best = row[j - 1] + 1;
-      row[j] = best;
-      diag = up;
-    }
-  }
-  return row[lb];
-}
 
 /* "; the closest valid name is 'X'" (or that there is none) into buf. */
 static void closest_hint(const rcb_model *m, const char *word, char *buf, size_t size) {
@@ -248,7 +228,7 @@ static void closest_hint(const rcb_model *m, const char *word, char *buf, size_t
         r.j = j;
         n++;
         format_name(m, &r, cand, sizeof cand);
-        d = edit_distance(word, cand);
+        d = rcb_edit_distance(word, cand);
         if (d < best_d) {
           best_d = d;
           snprintf(best, sizeof best, "%s", cand);
