@@ -12,5 +12,7 @@
 #include "rcb/rcb_analysis.h"
 #include "rcb/rcb_measure.h"
 #include "rcb/rcb_identify.h"
+#include "rcb/rcb_compare.h"
+#include "rcb/rcb_diagnose.h"
 
 #endif /* RCB_H */

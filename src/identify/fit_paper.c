@@ -20,6 +20,7 @@ typedef struct paper_ws {
   size_t n, np, m;  /* residuals, parameters, rows of the damped system */
   double wpen;      /* penalty weight (x units) */
   double pred;      /* reduction of Phi the linear model predicts for the step */
+  double pred_full; /* the same for the unclipped Gauss-Newton step */
   int capped;       /* the step was shortened to one unit of x */
   double *R, *JA;   /* augmented residuals (n + np) and Jacobian ((n + np) x np) */
   double *A, *b;    /* least-squares copy: (m x np), (m) */
@@ -98,12 +99,18 @@ static rcb_status gn_step(rcb_fit *f, paper_ws *ws, double lambda) {
       if (ws->dx[k] != ws->b[k]) ws->capped = 1;
     }
   }
-  /* Phi - ||R + JA dx||^2: what the linearised model promises */
-  ws->pred = 0.0;
+  /* Phi - ||R + JA dx||^2: what the linearised model promises, for the
+   * Gauss-Newton step itself (pred_full: is anything left to gain?) and for
+   * the clipped step that is tried */
+  ws->pred = ws->pred_full = 0.0;
   for (i = 0; i < rows; i++) {
-    double lin = ws->R[i];
-    for (k = 0; k < ws->np; k++) lin += ws->JA[i + rows * k] * ws->dx[k];
+    double lin = ws->R[i], lin_full = ws->R[i];
+    for (k = 0; k < ws->np; k++) {
+      lin += ws->JA[i + rows * k] * ws->dx[k];
+      lin_full += ws->JA[i + rows * k] * ws->b[k];
+    }
     ws->pred += ws->R[i] * ws->R[i] - lin * lin;
+    ws->pred_full += ws->R[i] * ws->R[i] - lin_full * lin_full;
   }
   return RCB_OK;
 }
@@ -213,7 +220,7 @@ static rcb_status iterate(rcb_fit *f, paper_ws *ws, double *phi, int *moved) {
   int ok;
   rcb_status st;
   if ((st = linearise(f, ws, ws->x, &phi0)) || (st = gn_step(f, ws, 0.0))) return st;
-  if (ws->pred <= f->ftol_rel * phi0) { /* nothing left to gain: at a minimum */
+  if (ws->pred_full <= f->ftol_rel * phi0) { /* nothing left to gain: at a minimum */
     *moved = 0;
     *phi = phi0;
     return RCB_OK;
@@ -263,7 +270,11 @@ rcb_status rcb_fit_run_paper(rcb_fit *f) {
       break;
     }
     for (k = 0; k < ws.np; k++) step += ws.dx[k] * ws.dx[k], xn += ws.x[k] * ws.x[k];
+    /* with noise-aware weights Phi is a chi-square: a gain below a
+     * thousandth of one unit is no information (an unidentifiable parameter
+     * drifting along a flat valley) */
     if (phi_old - phi <= f->ftol_rel * phi_old ||
+        ((f->beta_a > 0 || f->beta_s > 0) && phi_old - phi < 1e-3) ||
         sqrt(step) <= f->xtol_rel * (sqrt(xn) + f->xtol_rel)) {
       f->converged = 1;
       break;

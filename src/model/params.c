@@ -46,7 +46,13 @@ static const pkey disk_keys[] = {
 static const pkey bearing_keys[] = {
     {"kxx", "kxx (N/m)", -1},   {"kxy", "kxy (N/m)", -1},   {"kyx", "kyx (N/m)", -1},
     {"kyy", "kyy (N/m)", -1},   {"cxx", "cxx (N s/m)", -1}, {"cxy", "cxy (N s/m)", -1},
-    {"cyx", "cyx (N s/m)", -1}, {"cyy", "cyy (N s/m)", -1}};
+    {"cyx", "cyx (N s/m)", -1}, {"cyy", "cyy (N s/m)", -1},
+    /* views for the diagnosis: a skew-symmetric (circulatory) pair, setting
+     * kxy = v and kyx = -v; not enumerated (they alias kxy/kyx) */
+    {"kcross", "kcross = kxy = -kyx (N/m)", -1}, {"ccross", "ccross = cxy = -cyx (N s/m)", -1}};
+
+/* The first keys of the bearing table are its own; the rest are views. */
+#define BEARING_OWN_KEYS 8
 static const pkey coupling_keys[] = {{"kt", "kt (N/m)", 0},
                                      {"kr", "kr (N m/rad)", 0},
                                      {"ct", "ct (N s/m)", 0},
@@ -98,6 +104,9 @@ static const char *item_name(const rcb_model *m, pkind k, size_t i) {
   }
 }
 
+/* Is (k, j) listed by rcb_model_param_count/_name (views are not)? */
+static int enumerated(pkind k, size_t j) { return !(k == PK_BEARING && j >= BEARING_OWN_KEYS); }
+
 /* Does item i of kind k have key j as a fittable parameter? */
 static int key_usable(const rcb_model *m, pkind k, size_t i, size_t j) {
   if (k == PK_BEARING) return m->bearings[i].n == 1;
@@ -120,7 +129,16 @@ static int slots(rcb_model *m, pkind k, size_t i, size_t j, double *v[2]) {
       v[0] = j == 0 ? &d->m : j == 1 ? &d->Id : &d->Ip;
       return 1;
     }
-    case PK_BEARING: v[0] = &(&m->bearings[i].c[0].kxx)[j]; return 1;
+    case PK_BEARING: {
+      rcb_bearing_coefs *c = &m->bearings[i].c[0];
+      if (j < BEARING_OWN_KEYS) {
+        v[0] = &(&c->kxx)[j];
+        return 1;
+      }
+      v[0] = j == BEARING_OWN_KEYS ? &c->kxy : &c->cxy; /* the pair's second slot */
+      v[1] = j == BEARING_OWN_KEYS ? &c->kyx : &c->cyx; /* gets the opposite sign */
+      return 2;
+    }
     case PK_COUPLING: {
       rcb_coupling_params *p = &m->couplings[i].p;
       double *four[4];
@@ -157,7 +175,7 @@ static int nth_param(const rcb_model *m, size_t idx, pref *out) {
   for (k = 0; k < PK_COUNT; k++)
     for (i = 0; i < item_count(m, (pkind)k); i++)
       for (j = 0; j < kinds[k].nkeys; j++) {
-        if (!key_usable(m, (pkind)k, i, j)) continue;
+        if (!enumerated((pkind)k, j) || !key_usable(m, (pkind)k, i, j)) continue;
         if (n++ == idx) {
           out->k = (pkind)k;
           out->i = i;
@@ -174,7 +192,8 @@ size_t rcb_model_param_count(const rcb_model *m) {
   if (!m) return 0;
   for (k = 0; k < PK_COUNT; k++)
     for (i = 0; i < item_count(m, (pkind)k); i++)
-      for (j = 0; j < kinds[k].nkeys; j++) n += (size_t)key_usable(m, (pkind)k, i, j);
+      for (j = 0; j < kinds[k].nkeys; j++)
+        n += (size_t)(enumerated((pkind)k, j) && key_usable(m, (pkind)k, i, j));
   return n;
 }
 
@@ -351,6 +370,6 @@ rcb_status rcb_model_set_param(rcb_model *m, const char *name, double value) {
                              key->sign);
   if (st) return st;
   n = slots(m, r.k, r.i, r.j, v);
-  for (s = 0; s < n; s++) *v[s] = value;
+  for (s = 0; s < n; s++) *v[s] = (r.k == PK_BEARING && s == 1) ? -value : value;
   return RCB_OK;
 }

@@ -1,0 +1,165 @@
+/**
+ * @file rcb_compare.h
+ * @brief Where does the model fail? Correlation of a model with a
+ * measurement: per-channel error measures, per-frequency cross-signature
+ * criteria, a channel x frequency-band residual map, and a peak table pairing
+ * the measured resonances with the model's modes.
+ *
+ * The model is evaluated on the measurement's abscissa (FRFs at the test's
+ * rotor speed, or synchronous; unbalance responses at each speed) and
+ * converted to each channel's kind, so e = measured and m = model values of
+ * the same quantity. Abscissa values (frequencies or speeds) in rad/s.
+ */
+#ifndef RCB_COMPARE_H
+#define RCB_COMPARE_H
+
+#include "rcb/rcb_analysis.h"
+#include "rcb/rcb_core.h"
+#include "rcb/rcb_measure.h"
+#include "rcb/rcb_model.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct rcb_compare rcb_compare;
+
+RCB_API rcb_status rcb_compare_create(rcb_compare **out, const rcb_allocator *alloc);
+RCB_API void rcb_compare_destroy(rcb_compare *c);
+/** @brief Last error message (names the channel, point or setting at fault). */
+RCB_API const char *rcb_compare_errmsg(const rcb_compare *c);
+
+/**
+ * @brief Number of frequency bands of the residual map (default 10): the grid
+ * points are split into @p nbands contiguous runs of (nearly) equal count.
+ * Fewer bands are used when the measurement has fewer points.
+ * @return RCB_ERR_ARG unless 1 <= nbands <= 1000
+ */
+RCB_API rcb_status rcb_compare_set_bands(rcb_compare *c, size_t nbands);
+
+/**
+ * @brief Peak detection and pairing settings.
+ * @param prominence_db a measured resonance is a local maximum of the
+ * channel-summed magnitude standing at least this much above the higher of
+ * its two bounding minima, dB (default 2 dB, > 0: 3 dB misses shoulders, 1 dB takes
+ * 10 % noise for peaks)
+ * @param freq_tol a measured peak and a model mode pair when their
+ * frequencies differ by at most freq_tol times the measured frequency
+ * (default 0.1, in (0, 1])
+ */
+RCB_API rcb_status rcb_compare_set_peaks(rcb_compare *c, double prominence_db, double freq_tol);
+
+/**
+ * @brief Compare model @p m (finalized) with measurement @p ms: evaluates the
+ * model at every point (a point where the model matrix is singular, e.g. a
+ * free rotor at 0 Hz, is left out as NaN), computes every result below.
+ * Errors: RCB_ERR_NOT_FOUND when a channel names no model station (the
+ * message names it), RCB_ERR_ARG for an empty measurement, RCB_ERR_NOMEM,
+ * RCB_ERR_LAPACK from the eigensolver. Results stay valid until the next run
+ * or destroy (they do not point into @p m or @p ms).
+ */
+RCB_API rcb_status rcb_compare_run(rcb_compare *c, const rcb_model *m, const rcb_meas *ms);
+
+/** @brief Results for one channel (e measured, m model, over the finite points). */
+typedef struct rcb_compare_channel {
+  const char *response;   /**< "DA.x" */
+  const char *reference;  /**< "C.B.y", NULL for unbalance responses */
+  rcb_frf_kind kind;      /**< kind of both value arrays */
+  double error_pct;       /**< paper's error: 100 ||(|m| - |e|)|| / || |e| ||, % */
+  double frac;            /**< FRAC |sum conj(e) m|^2 / (sum|e|^2 sum|m|^2), 0..1 */
+  double log_rms;         /**< RMS of log10|m| - log10|e| (decades; 0.1 ~ 26 %) */
+  double phase_rms_deg;   /**< RMS of arg(m) - arg(e) wrapped to (-180, 180], deg */
+  const rcb_complex *meas;  /**< measured values, rcb_compare_point_count of them */
+  const rcb_complex *model; /**< model values, same kind and units (NaN where left out) */
+} rcb_compare_channel;
+
+/** @brief Totals over every channel and point. */
+typedef struct rcb_compare_summary {
+  double error_pct;     /**< paper's error % over all channels (as rcb_fit_error) */
+  double frac_mean;     /**< mean FRAC over channels */
+  double log_rms;       /**< RMS log10 error over all points, decades */
+  double phase_rms_deg; /**< RMS phase error over all points, deg */
+  double csac_mean;     /**< mean CSAC over frequencies */
+  double csf_mean;      /**< mean CSF over frequencies */
+} rcb_compare_summary;
+
+RCB_API size_t rcb_compare_channel_count(const rcb_compare *c);
+RCB_API rcb_status rcb_compare_get_channel(const rcb_compare *c, size_t i,
+                                           rcb_compare_channel *out);
+RCB_API rcb_status rcb_compare_get_summary(const rcb_compare *c, rcb_compare_summary *out);
+/** @brief What the abscissa is (FRF: frequency; unbalance: rotor speed). */
+RCB_API rcb_meas_type rcb_compare_type(const rcb_compare *c);
+RCB_API size_t rcb_compare_point_count(const rcb_compare *c);
+/** @brief The abscissa, rad/s. */
+RCB_API const double *rcb_compare_grid(const rcb_compare *c);
+/**
+ * @brief Cross-signature assurance criterion at each point, across channels
+ * (Allemang/Pascual): CSAC = |e^H m|^2 / ((e^H e)(m^H m)), 0..1 (NaN where
+ * no channel is finite).
+ */
+RCB_API const double *rcb_compare_csac(const rcb_compare *c);
+/** @brief Cross-signature scale factor CSF = 2|e^H m| / (e^H e + m^H m), 0..1. */
+RCB_API const double *rcb_compare_csf(const rcb_compare *c);
+
+/** @brief Number of bands of the residual map. */
+RCB_API size_t rcb_compare_band_count(const rcb_compare *c);
+/**
+ * @brief One band: grid points first .. first + count - 1, abscissa lo .. hi
+ * (rad/s, the band's first and last points).
+ */
+RCB_API rcb_status rcb_compare_band(const rcb_compare *c, size_t b, double *lo, double *hi,
+                                    size_t *first, size_t *count);
+/**
+ * @brief Residual map: RMS of log10|m| - log10|e| (decades) per channel and
+ * band, map[ch + nch * b] (NaN where a cell has no finite point).
+ */
+RCB_API const double *rcb_compare_residual_map(const rcb_compare *c);
+
+/** @brief How a row of the peak table is paired. */
+typedef enum rcb_peak_match {
+  RCB_PEAK_MATCHED = 0,       /**< measured peak with a model mode */
+  RCB_PEAK_MEASURED_ONLY = 1, /**< measured peak, no model mode within the tolerance */
+  RCB_PEAK_MODEL_ONLY = 2     /**< model mode in the measured range, no measured peak */
+} rcb_peak_match;
+
+/**
+ * @brief One row of the peak table. Measured peaks: local maxima of the sum
+ * over channels of |e|/rms(e) (each channel scaled by its own RMS so no
+ * channel dominates by its units), frequency and height by parabolic
+ * interpolation through the three points at the top, damping ratio from the
+ * half-power width zeta = (w2 - w1)/(2 w_peak) (one side doubled when the
+ * other does not fall to half power). Model modes: for FRFs at a fixed speed,
+ * the damped modes (rcb_modes_compute at the test speed, damping ratio
+ * < 0.99) with wd in the measured range; for unbalance responses and
+ * synchronous FRFs, the 1X critical speeds (Campbell crossings) in the range,
+ * with the damping ratio of the crossing mode there. Rows are sorted by
+ * frequency.
+ */
+typedef struct rcb_compare_peak {
+  rcb_peak_match match;
+  double meas_freq;    /**< measured peak abscissa, rad/s (NaN for MODEL_ONLY) */
+  double meas_zeta;    /**< half-power damping ratio (NaN: no half-power point) */
+  size_t channel;      /**< channel with the largest |e|/rms(e) at the peak */
+  double meas_amp;     /**< |e| of that channel at the peak (channel units) */
+  double model_amp;    /**< |m| of that channel at meas_freq (channel units) */
+  double amp_ratio;    /**< meas_amp / model_amp */
+  double model_freq;   /**< mode wd or critical speed, rad/s (NaN for MEASURED_ONLY) */
+  double model_zeta;   /**< the mode's damping ratio */
+  int model_visible;   /**< the model's own response shows a peak near model_freq */
+  double model_peak;   /**< that peak of the model's response (same detection as the
+                            measured one), rad/s; NaN when not visible */
+  double freq_err_pct; /**< 100 (model_freq - meas_freq) / meas_freq, % */
+  double peak_err_pct; /**< 100 (model_peak - meas_freq) / meas_freq, %: like for like,
+                            free of the O(zeta^2) offset between a mode's wd and the
+                            top of its resonance */
+  double zeta_err_pct; /**< 100 (model_zeta - meas_zeta) / meas_zeta, % */
+} rcb_compare_peak;
+
+RCB_API size_t rcb_compare_peak_count(const rcb_compare *c);
+RCB_API rcb_status rcb_compare_get_peak(const rcb_compare *c, size_t i, rcb_compare_peak *out);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* RCB_COMPARE_H */

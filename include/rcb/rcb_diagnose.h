@@ -1,0 +1,115 @@
+/**
+ * @file rcb_diagnose.h
+ * @brief Diagnosis: which physical effect is missing from a model, and where
+ * (issue #4).
+ *
+ * A catalogue of physical effects, each a parametrised addition to the model
+ * with a neutral value where it is absent, is laid out at every place it can
+ * occur. Every candidate is scored by the error reduction it can explain: the
+ * score test on the fit's own (noise-aware) objective, with the candidate's
+ * sensitivity columns orthogonalised against the parameters already fitted.
+ * The best candidates (and the alternative coupling models, which have no
+ * neutral value) are then refitted; a candidate is significant when its
+ * information criterion (BIC) falls by more than 10 and the error itself
+ * falls.
+ */
+#ifndef RCB_DIAGNOSE_H
+#define RCB_DIAGNOSE_H
+
+#include "rcb/rcb_core.h"
+#include "rcb/rcb_identify.h"
+#include "rcb/rcb_measure.h"
+#include "rcb/rcb_model.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** @brief The catalogue of physical effects. */
+typedef enum rcb_effect {
+  RCB_EFFECT_COUPLING_TRANSLATIONAL_DAMPING = 0, /**< coupling ct */
+  RCB_EFFECT_COUPLING_ROTATIONAL_STIFFNESS = 1,  /**< coupling kr */
+  RCB_EFFECT_COUPLING_ROTATIONAL_DAMPING = 2,    /**< coupling cr */
+  RCB_EFFECT_COUPLING_MODEL = 3,                 /**< another coupling model */
+  RCB_EFFECT_COUPLING_HUB = 4,                   /**< coupling hub mass and inertia */
+  RCB_EFFECT_BEARING_STIFFNESS = 5,              /**< one direction: anisotropy */
+  RCB_EFFECT_BEARING_CROSS_COUPLING = 6,         /**< kxy = -kyx */
+  RCB_EFFECT_BEARING_DAMPING = 7,                /**< cxx, cyy */
+  RCB_EFFECT_SHAFT_DAMPING = 8,                  /**< stiffness-proportional */
+  RCB_EFFECT_ADDED_MASS = 9,                     /**< mass and inertia at a station */
+  RCB_EFFECT_COUNT = 10
+} rcb_effect;
+
+/** @brief Short English name of an effect. */
+RCB_API const char *rcb_effect_name(rcb_effect e);
+
+typedef struct rcb_diag rcb_diag;
+
+/**
+ * @brief Prepare a diagnosis of model @p m (not modified) against @p meas.
+ * On failure *out may hold an object carrying the message; destroy it.
+ */
+RCB_API rcb_status rcb_diag_create(rcb_diag **out, const rcb_model *m, const rcb_meas *meas,
+                                   const rcb_allocator *alloc);
+RCB_API void rcb_diag_destroy(rcb_diag *d);
+RCB_API const char *rcb_diag_errmsg(const rcb_diag *d);
+
+/**
+ * @brief A parameter of the model as it is, fitted before the candidates are
+ * scored and refitted with each of them (e.g. the coupling's kt, kr).
+ */
+RCB_API rcb_status rcb_diag_add_fitted_param(rcb_diag *d, const char *name, double lo,
+                                             double hi, int log_param);
+/** @brief Objective settings, as rcb_fit_set_scale / _set_noise_model / _set_band. */
+RCB_API rcb_status rcb_diag_set_scale(rcb_diag *d, rcb_fit_scale scale);
+RCB_API rcb_status rcb_diag_set_noise_model(rcb_diag *d, double beta_a, double beta_s);
+RCB_API rcb_status rcb_diag_set_band(rcb_diag *d, double lo, double hi);
+/** @brief How many of the best-scored candidates to refit (default 8). */
+RCB_API rcb_status rcb_diag_set_refits(rcb_diag *d, size_t n);
+/** @brief Progress callback: called after each candidate is scored or refitted. */
+RCB_API rcb_status rcb_diag_set_progress(rcb_diag *d,
+                                         int (*cb)(void *user, size_t done, size_t total),
+                                         void *user);
+
+/** @brief Fit the model as it is, score every candidate, refit the best. */
+RCB_API rcb_status rcb_diag_run(rcb_diag *d);
+
+/** @brief One candidate, in rank order (0 = the best). */
+typedef struct rcb_diag_candidate {
+  rcb_effect effect;
+  const char *place;        /**< "bearing B2", "coupling C", "station #7", ... */
+  const char *description;  /**< an engineer's sentence for the effect */
+  const char *params;       /**< the parameter names it adds, comma separated */
+  double predicted_pct;     /**< error-reduction ratio of the score test, % of F */
+  int refitted;             /**< 1 when actually refitted */
+  double error_pct;         /**< error % after the refit (NaN if not refitted) */
+  double objective_drop_pct; /**< real reduction of F, % (NaN if not refitted) */
+  double delta_bic;         /**< BIC change (negative is better; NaN if not refitted) */
+  int significant;          /**< refitted, BIC falls by > 10 and the error falls */
+  const char *fitted;       /**< "name = value, ..." of the refit (candidate's params) */
+} rcb_diag_candidate;
+
+RCB_API size_t rcb_diag_candidate_count(const rcb_diag *d);
+RCB_API rcb_status rcb_diag_candidate_get(const rcb_diag *d, size_t rank,
+                                          rcb_diag_candidate *out);
+/** @brief Error % and objective of the model as it is, after fitting its own parameters. */
+RCB_API rcb_status rcb_diag_baseline(const rcb_diag *d, double *error_pct, double *objective,
+                                     double *floor_pct);
+/**
+ * @brief The model with candidate @p rank added and fitted, as INI text
+ * (two-call sizing as rcb_model_write_ini).
+ */
+RCB_API rcb_status rcb_diag_apply_ini(const rcb_diag *d, size_t rank, char *buf, size_t size,
+                                      size_t *needed);
+/**
+ * @brief An explanation in an engineer's words, with its evidence (two-call
+ * sizing). Names the best significant candidate, or says that no candidate is
+ * significant.
+ */
+RCB_API rcb_status rcb_diag_explain(const rcb_diag *d, char *buf, size_t size, size_t *needed);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* RCB_DIAGNOSE_H */

@@ -1,0 +1,54 @@
+/* Model-measurement comparison: the object and the helpers shared by
+ * compare.c (metrics, bands) and compare_peaks.c (peak table). Not installed. */
+#ifndef RCB_COMPARE_INTERNAL_H
+#define RCB_COMPARE_INTERNAL_H
+
+#include "core/rcb_internal.h"
+#include "rcb/rcb_compare.h"
+
+struct rcb_compare {
+  rcb_allocator alloc;
+  char errmsg[RCB_ERRMSG_MAX];
+  size_t nbands_req;   /* requested bands */
+  double prom_db;      /* peak prominence, dB */
+  double tol;          /* relative frequency tolerance of the pairing */
+  /* results */
+  int done;
+  rcb_meas_type type;
+  double speed;        /* FRF test speed rad/s, < 0 synchronous */
+  size_t nch, npts, nbands, npeaks;
+  double *grid;                /* npts, rad/s */
+  rcb_complex *meas, *model;   /* nch * npts, channel-major */
+  char *names;                 /* response and reference strings */
+  const char **resp, **ref;    /* nch each, into names (ref NULL for unbalance) */
+  rcb_frf_kind *kind;          /* nch */
+  double *err, *frac, *lrms, *prms; /* nch */
+  double *csac, *csf;          /* npts */
+  size_t *band_first, *band_count; /* nbands */
+  double *map;                 /* nch * nbands */
+  rcb_compare_peak *peaks;     /* npeaks */
+  rcb_compare_summary sum;
+};
+
+/* The model side during a run: channel -> FRF output/input slots. */
+typedef struct rcb_cmp_eval {
+  const rcb_model *m;
+  rcb_frf *frf;
+  size_t nout, nin;
+  size_t *ch_out, *ch_in;
+  rcb_complex *H; /* nout * max(nin, 1) */
+} rcb_cmp_eval;
+
+rcb_status rcb_cmp_fail(rcb_compare *c, rcb_status st, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+/* Model values of every channel at abscissa w (rad/s) into out[nch]. */
+rcb_status rcb_cmp_model_at(rcb_compare *c, rcb_cmp_eval *ev, double w, rcb_complex *out);
+
+/* Build the peak table (compare_peaks.c). */
+rcb_status rcb_cmp_peaks(rcb_compare *c, rcb_cmp_eval *ev);
+
+#endif /* RCB_COMPARE_INTERNAL_H */

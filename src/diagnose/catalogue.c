@@ -1,0 +1,310 @@
+/*
+ * The catalogue of physical effects (issue #4), laid out at every place each
+ * can occur in a given model, each with the parameters it adds, their neutral
+ * value (the model as it is) and refit bounds; and the INI edits that build a
+ * candidate's model.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "diagnose/diag_internal.h"
+
+static const char *const effect_names[RCB_EFFECT_COUNT] = {
+    "coupling translational damping", "coupling rotational stiffness",
+    "coupling rotational damping",    "coupling model",
+    "coupling hub mass and inertia",  "bearing stiffness (anisotropy)",
+    "bearing cross-coupled stiffness", "bearing damping",
+    "shaft material damping",         "added mass and inertia"};
+
+const char *rcb_effect_name(rcb_effect e) {
+  return (int)e >= 0 && e < RCB_EFFECT_COUNT ? effect_names[e] : "?";
+}
+
+static diag_cand *new_cand(rcb_diag *d, rcb_effect e, const char *place) {
+  diag_cand *c;
+  if (rcb_grow(&d->alloc, (void **)&d->cand, &d->cap_cand, d->ncand + 1, sizeof *d->cand))
+    return NULL;
+  c = &d->cand[d->ncand++];
+  memset(c, 0, sizeof *c);
+  c->effect = e;
+  snprintf(c->place, sizeof c->place, "%s", place);
+  c->F = c->err = c->dbic = NAN;
+  return c;
+}
+
+static void add_par(diag_cand *c, const char *fmt, const char *item, double lo, double hi,
+                    int logp) {
+  size_t k = c->np++;
+  snprintf(c->pname[k], sizeof c->pname[k], fmt, item);
+  c->lo[k] = lo;
+  c->hi[k] = hi;
+  c->logp[k] = logp;
+  snprintf(c->params + strlen(c->params), sizeof c->params - strlen(c->params), "%s%s",
+           k ? ", " : "", c->pname[k]);
+}
+
+/* Is name among the parameters already fitted? */
+static int is_base(const rcb_diag *d, const char *name) {
+  size_t i;
+  for (i = 0; i < d->nbase; i++)
+    if (strcmp(d->base[i].name, name) == 0) return 1;
+  return 0;
+}
+
+/* Bounds for a parameter starting at v: four decades either way (log) when
+ * positive, else linear from 0 to hi0. */
+static void bounds(double v, double hi0, double *lo, double *hi, int *logp) {
+  *logp = v > 0;
+  *lo = v > 0 ? v / 1e4 : 0.0;
+  *hi = v > 0 ? v * 1e4 : hi0;
+}
+
+static rcb_status couplings(rcb_diag *d, const rcb_model *m) {
+  size_t i;
+  for (i = 0; i < m->n_couplings; i++) {
+    const rcb_coupling_t *cp = &m->couplings[i];
+    const rcb_coupling_params *p = &cp->p;
+    char place[RCB_DIAG_NAME], nm[RCB_DIAG_NAME];
+    double kref = p->kt > 0 ? p->kt : 1e6, krr = p->kr > 0 ? p->kr : 1e3;
+    int t;
+    diag_cand *c;
+    snprintf(place, sizeof place, "coupling %s", cp->name);
+    /* damping and rotational stiffness: NC2 has them; NC1/K1 need a model
+     * change with the new parameters at 0 (the same physics) */
+    for (t = 0; t < 3; t++) {
+      static const char *const keys[3] = {"ct", "kr", "cr"};
+      static const rcb_effect eff[3] = {RCB_EFFECT_COUPLING_TRANSLATIONAL_DAMPING,
+                                        RCB_EFFECT_COUPLING_ROTATIONAL_STIFFNESS,
+                                        RCB_EFFECT_COUPLING_ROTATIONAL_DAMPING};
+      static const char *const what[3] = {"translational damping", "rotational stiffness",
+                                          "rotational damping"};
+      double v = t == 0 ? p->ct : t == 1 ? p->kr : p->cr, lo, hi;
+      double hi0 = t == 0 ? 1e-2 * kref : t == 1 ? 1e3 * (p->kt > 0 ? 1e-2 * p->kt : 1e3)
+                                        : 1e-2 * krr;
+      int logp;
+      rcb_coupling_model to = cp->type;
+      snprintf(nm, sizeof nm, "coupling.%s.%s", cp->name, keys[t]);
+      if (is_base(d, nm) || cp->type == RCB_COUPLING_RIGID) continue;
+      if (t != 1 && cp->type == RCB_COUPLING_NELSON_CRANDALL_1) to = RCB_COUPLING_NELSON_CRANDALL_2;
+      if (cp->type == RCB_COUPLING_KRAMER_1) to = RCB_COUPLING_KRAMER_2;
+      if (t == 0 && (cp->type == RCB_COUPLING_KRAMER_1 || cp->type == RCB_COUPLING_KRAMER_2))
+        continue; /* tied translations have no translational damping */
+      if (!(c = new_cand(d, eff[t], place))) return RCB_ERR_NOMEM;
+      snprintf(c->desc, sizeof c->desc, "%s in coupling %s", what[t], cp->name);
+      if (to != cp->type) {
+        c->edit = EDIT_COUPLING_MODEL;
+        snprintf(c->target, sizeof c->target, "%s", cp->name);
+        c->new_type = to;
+        c->kt0 = p->kt, c->kr0 = p->kr, c->ct0 = p->ct, c->cr0 = p->cr;
+      }
+      bounds(v, hi0, &lo, &hi, &logp);
+      add_par(c, "%s", nm, lo, hi, logp);
+    }
+    for (t = 0; t < 5; t++) { /* another coupling model: refitted */
+      if (t == (int)cp->type || (cp->type == RCB_COUPLING_NELSON_CRANDALL_1 &&
+                                 t == RCB_COUPLING_NELSON_CRANDALL_2))
+        continue; /* NC1 -> NC2 is covered by the damping candidates above */
+      if (!(c = new_cand(d, RCB_EFFECT_COUPLING_MODEL, place))) return RCB_ERR_NOMEM;
+      snprintf(c->desc, sizeof c->desc, "coupling %s as %s instead of %s", cp->name,
+               rcb_coupling_model_name((rcb_coupling_model)t),
+               rcb_coupling_model_name(cp->type));
+      c->refit_only = 1;
+      c->edit = EDIT_COUPLING_MODEL;
+      snprintf(c->target, sizeof c->target, "%s", cp->name);
+      c->new_type = (rcb_coupling_model)t;
+      c->kt0 = kref, c->kr0 = krr, c->ct0 = p->ct, c->cr0 = p->cr;
+      if (t == RCB_COUPLING_NELSON_CRANDALL_1 || t == RCB_COUPLING_NELSON_CRANDALL_2) {
+        snprintf(nm, sizeof nm, "coupling.%s.kt", cp->name);
+        add_par(c, "%s", nm, kref / 1000, kref * 1000, 1);
+      }
+      if (t != RCB_COUPLING_KRAMER_1 && t != RCB_COUPLING_RIGID) {
+        snprintf(nm, sizeof nm, "coupling.%s.kr", cp->name);
+        add_par(c, "%s", nm, krr / 1000, krr * 1000, 1);
+      }
+    }
+    {
+      double lo, hi;
+      int logp;
+      if (!(c = new_cand(d, RCB_EFFECT_COUPLING_HUB, place))) return RCB_ERR_NOMEM;
+      snprintf(c->desc, sizeof c->desc, "mass of coupling %s's hubs", cp->name);
+      bounds(p->mass[0], 10.0, &lo, &hi, &logp);
+      add_par(c, "coupling.%s.hub_mass", cp->name, lo, hi, logp);
+      if (!(c = new_cand(d, RCB_EFFECT_COUPLING_HUB, place))) return RCB_ERR_NOMEM;
+      snprintf(c->desc, sizeof c->desc, "diametral inertia of coupling %s's hubs", cp->name);
+      bounds(p->Id[0], 0.1, &lo, &hi, &logp);
+      add_par(c, "coupling.%s.hub_Id", cp->name, lo, hi, logp);
+    }
+  }
+  return RCB_OK;
+}
+
+static rcb_status bearings(rcb_diag *d, const rcb_model *m) {
+  size_t i;
+  int a;
+  for (i = 0; i < m->n_bearings; i++) {
+    const rcb_bearing_t *b = &m->bearings[i];
+    const rcb_bearing_coefs *k = &b->c[0];
+    double kb = fmax(fabs(k->kxx), fabs(k->kyy)), lo, hi;
+    char place[RCB_DIAG_NAME];
+    int logp;
+    diag_cand *c;
+    if (b->n != 1) continue; /* speed-dependent: not fittable */
+    if (kb == 0) kb = 1e6;
+    snprintf(place, sizeof place, "bearing %s", b->name);
+    for (a = 0; a < 2; a++) {
+      double v = a ? k->kyy : k->kxx;
+      if (!(c = new_cand(d, RCB_EFFECT_BEARING_STIFFNESS, place))) return RCB_ERR_NOMEM;
+      snprintf(c->desc, sizeof c->desc, "stiffness in %s at bearing %s (anisotropy)",
+               a ? "y" : "x", b->name);
+      bounds(v, 10 * kb, &lo, &hi, &logp);
+      add_par(c, a ? "bearing.%s.kyy" : "bearing.%s.kxx", b->name, lo, hi, logp);
+    }
+    if (!(c = new_cand(d, RCB_EFFECT_BEARING_CROSS_COUPLING, place))) return RCB_ERR_NOMEM;
+    snprintf(c->desc, sizeof c->desc, "cross-coupled stiffness kxy = -kyx at bearing %s",
+             b->name);
+    add_par(c, "bearing.%s.kcross", b->name, -kb, kb, 0);
+    if (!(c = new_cand(d, RCB_EFFECT_BEARING_DAMPING, place))) return RCB_ERR_NOMEM;
+    snprintf(c->desc, sizeof c->desc, "damping at bearing %s", b->name);
+    bounds(k->cxx, 1e-2 * kb, &lo, &hi, &logp);
+    add_par(c, "bearing.%s.cxx", b->name, lo, hi, logp);
+    bounds(k->cyy, 1e-2 * kb, &lo, &hi, &logp);
+    add_par(c, "bearing.%s.cyy", b->name, lo, hi, logp);
+  }
+  return RCB_OK;
+}
+
+static rcb_status shafts(rcb_diag *d, const rcb_model *m) {
+  size_t i;
+  for (i = 0; i < m->n_shafts; i++) {
+    const rcb_shaft_t *s = &m->shafts[i];
+    char place[RCB_DIAG_NAME];
+    double lo, hi;
+    int logp;
+    diag_cand *c;
+    snprintf(place, sizeof place, "shaft %s", s->name);
+    if (!(c = new_cand(d, RCB_EFFECT_SHAFT_DAMPING, place))) return RCB_ERR_NOMEM;
+    snprintf(c->desc, sizeof c->desc, "material (stiffness-proportional) damping of shaft %s",
+             s->name);
+    bounds(s->qz_k, 1e-3, &lo, &hi, &logp);
+    add_par(c, "shaft.%s.damping_stiffness", s->name, lo, hi, logp);
+  }
+  return RCB_OK;
+}
+
+/* A mass at every disk, and a new (massless) disk at every other node. */
+static rcb_status added_masses(rcb_diag *d, const rcb_model *m) {
+  double mtot = 0.0;
+  size_t i, k;
+  for (i = 0; i < m->n_disks; i++) mtot += m->disks[i].m;
+  if (mtot <= 0) mtot = 1.0;
+  for (i = 0; i < m->n_nodes; i++) {
+    const rcb_node_t *nd = &m->nodes[i];
+    const rcb_disk_t *disk = NULL;
+    char place[RCB_DIAG_NAME];
+    diag_cand *c;
+    for (k = 0; k < m->n_disks; k++)
+      if (m->disks[k].at.node == i) disk = &m->disks[k];
+    if (disk)
+      snprintf(place, sizeof place, "disk %s", disk->name);
+    else
+      snprintf(place, sizeof place, "node #%zu (shaft %s, z = %g m)", i,
+               m->shafts[nd->shaft].name, nd->z);
+    for (k = 0; k < 2; k++) { /* a mass, or a diametral inertia */
+      if (!(c = new_cand(d, RCB_EFFECT_ADDED_MASS, place))) return RCB_ERR_NOMEM;
+      snprintf(c->desc, sizeof c->desc, "an added %s at %s", k ? "diametral inertia" : "mass",
+               place);
+      if (disk) {
+        double lo, hi;
+        int logp;
+        if (k == 0) bounds(disk->m, 10 * mtot, &lo, &hi, &logp);
+        else bounds(disk->Id, 0.01 * mtot, &lo, &hi, &logp);
+        add_par(c, k ? "disk.%s.Id" : "disk.%s.mass", disk->name, lo, hi, logp);
+        continue;
+      }
+      c->edit = EDIT_ADD_DISK;
+      snprintf(c->target, sizeof c->target, "ADDED_%zu", i);
+      snprintf(c->at, sizeof c->at, "%s %.17g", m->shafts[nd->shaft].name, nd->z);
+      add_par(c, k ? "disk.%s.Id" : "disk.%s.mass", c->target, 0.0, k ? 0.01 * mtot : mtot,
+              0);
+    }
+  }
+  return RCB_OK;
+}
+
+rcb_status rcb_diag_catalogue(rcb_diag *d, const rcb_model *m) {
+  rcb_status st;
+  if ((st = couplings(d, m)) || (st = bearings(d, m)) || (st = shafts(d, m)) ||
+      (st = added_masses(d, m)))
+    return rcb_diag_fail(d, st, "out of memory laying out the candidates");
+  return RCB_OK;
+}
+
+/* ---- candidate models: edits of the base INI text ---- */
+
+/* Text of the coupling section of c->target, with its model line and the
+ * kt/kr/ct/cr lines replaced by those of the new model. */
+static size_t edit_coupling(const char *ini, const diag_cand *c, char *out, size_t size) {
+  char head[RCB_NAME_MAX + 16];
+  const char *s, *e, *line;
+  size_t n = 0;
+  unsigned uses[5] = {0x0u, 0xAu, 0x3u, 0xFu, 0x0u}; /* kt kr ct cr bits */
+  double v[4];
+  int k;
+  static const char *const keys[4] = {"kt", "kr", "ct", "cr"};
+  v[0] = c->kt0, v[1] = c->kr0, v[2] = c->ct0, v[3] = c->cr0;
+  snprintf(head, sizeof head, "[coupling %s]", c->target);
+  s = strstr(ini, head);
+  if (!s) return 0;
+  e = strstr(s + 1, "\n[");
+  e = e ? e + 1 : ini + strlen(ini);
+#define PUT(...) n += (size_t)snprintf(out + (n < size ? n : size), n < size ? size - n : 0, __VA_ARGS__)
+  PUT("%.*s", (int)(s - ini), ini);
+  for (line = s; line < e;) {
+    const char *nl = memchr(line, '\n', (size_t)(e - line));
+    size_t len = nl ? (size_t)(nl - line) + 1 : (size_t)(e - line);
+    int drop = strncmp(line, "model ", 6) == 0 || strncmp(line, "model=", 6) == 0;
+    for (k = 0; k < 4; k++)
+      if (strncmp(line, keys[k], 2) == 0 && (line[2] == ' ' || line[2] == '=')) drop = 1;
+    if (!drop) PUT("%.*s", (int)len, line);
+    if (line == s) {
+      PUT("model = %s\n", rcb_coupling_model_name(c->new_type));
+      for (k = 0; k < 4; k++)
+        if (uses[c->new_type] & (1u << k)) PUT("%s = %.17g\n", keys[k], v[k]);
+    }
+    line += len;
+  }
+  PUT("%s", e);
+#undef PUT
+  return n;
+}
+
+rcb_status rcb_diag_candidate_model(rcb_diag *d, const diag_cand *c, rcb_model **out) {
+  size_t len = strlen(d->base_ini), size = len + 4096, n;
+  char *txt = rcb_alloc(&d->alloc, size);
+  rcb_model *m = NULL;
+  rcb_status st;
+  *out = NULL;
+  if (!txt) return rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
+  if (c->edit == EDIT_COUPLING_MODEL)
+    n = edit_coupling(d->base_ini, c, txt, size);
+  else if (c->edit == EDIT_ADD_DISK)
+    n = (size_t)snprintf(txt, size, "%s\n[disk %s]\nat = %s\nmass = 0\nId = 0\nIp = 0\n",
+                         d->base_ini, c->target, c->at);
+  else
+    n = (size_t)snprintf(txt, size, "%s", d->base_ini);
+  if (n == 0 || n >= size) {
+    rcb_free(&d->alloc, txt);
+    return rcb_diag_fail(d, RCB_ERR_MODEL, "%s: cannot edit the model text", c->desc);
+  }
+  st = rcb_model_create(&m, &d->alloc);
+  if (!st) st = rcb_model_load_string(m, txt, "<candidate>");
+  if (st) {
+    rcb_diag_fail(d, st, "%s: %s", c->desc, m ? rcb_model_errmsg(m) : "out of memory");
+    rcb_model_destroy(m);
+    m = NULL;
+  }
+  rcb_free(&d->alloc, txt);
+  *out = m;
+  return st;
+}

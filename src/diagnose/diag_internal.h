@@ -1,0 +1,81 @@
+/*
+ * The diagnosis object, shared by catalogue.c (the candidate effects of a
+ * model) and diagnose.c (scoring, refitting, ranking, explaining).
+ * Candidates are expressed as an edit of the model's INI text (none, a
+ * coupling model change, an added disk) plus the parameters the effect adds,
+ * so every candidate model is built through the public loader.
+ */
+#ifndef RCB_DIAG_INTERNAL_H
+#define RCB_DIAG_INTERNAL_H
+
+#include "core/rcb_internal.h"
+
+#define RCB_DIAG_MAXP 3
+#define RCB_DIAG_NAME 128
+
+typedef enum diag_edit { EDIT_NONE = 0, EDIT_COUPLING_MODEL = 1, EDIT_ADD_DISK = 2 } diag_edit;
+
+typedef struct diag_cand {
+  rcb_effect effect;
+  char place[RCB_DIAG_NAME];
+  char desc[2 * RCB_DIAG_NAME];
+  diag_edit edit;
+  char target[RCB_NAME_MAX];        /* coupling name, or the new disk's name */
+  rcb_coupling_model new_type;      /* EDIT_COUPLING_MODEL */
+  double kt0, kr0, ct0, cr0;        /* its starting values */
+  char at[RCB_DIAG_NAME];           /* EDIT_ADD_DISK: "SHAFT z" */
+  int refit_only;                   /* no neutral value: refitted, not scored */
+  size_t np;
+  char pname[RCB_DIAG_MAXP][RCB_DIAG_NAME];
+  double lo[RCB_DIAG_MAXP], hi[RCB_DIAG_MAXP];
+  int logp[RCB_DIAG_MAXP];
+  char params[RCB_DIAG_MAXP * RCB_DIAG_NAME];
+  /* results */
+  double predicted;                 /* score-test reduction of F */
+  int refitted, significant;
+  double F, err, dbic;
+  char fitted[RCB_DIAG_MAXP * (RCB_DIAG_NAME + 32)];
+  char *ini;                        /* refitted model as INI (owned) */
+} diag_cand;
+
+typedef struct diag_base_par {
+  char name[RCB_DIAG_NAME];
+  double lo, hi;
+  int logp;
+} diag_base_par;
+
+struct rcb_diag {
+  rcb_allocator alloc;
+  char errmsg[RCB_ERRMSG_MAX];
+  const rcb_model *m;
+  const rcb_meas *meas;
+  rcb_fit_scale scale;
+  double beta_a, beta_s, band_lo, band_hi;
+  int have_band;
+  size_t nrefit;
+  int (*progress)(void *user, size_t done, size_t total);
+  void *progress_user;
+  diag_base_par *base;
+  size_t nbase, cap_base;
+  /* results */
+  char *base_ini;                   /* the model with its own parameters fitted */
+  double F0, err0, floor0;
+  size_t nres;
+  diag_cand *cand;
+  size_t ncand, cap_cand;
+  size_t *order;                    /* rank -> candidate */
+  int ran;
+};
+
+rcb_status rcb_diag_fail(rcb_diag *d, rcb_status st, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+/* Lay out every candidate effect of the (fitted) model m. */
+rcb_status rcb_diag_catalogue(rcb_diag *d, const rcb_model *m);
+/* The candidate's model: the base INI text edited, loaded (caller destroys). */
+rcb_status rcb_diag_candidate_model(rcb_diag *d, const diag_cand *c, rcb_model **out);
+
+#endif

@@ -1,0 +1,476 @@
+/*
+ * Diagnosis (issue #4): fit the model as it is, score every candidate effect
+ * of the catalogue by the error reduction it can explain (score test: the
+ * candidate's sensitivity columns orthogonalised against the parameters
+ * already fitted, projected on the weighted residual of the fit's own
+ * objective), refit the best and the alternative coupling models, and rank by
+ * the change of BIC, requiring the error itself to fall.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "diagnose/diag_internal.h"
+
+#define RCB_DIAG_BIC_MIN (-10.0) /* "strong" evidence (Kass & Raftery) */
+#define RCB_DIAG_ERR_FALL 0.98   /* the error must fall by at least 2 % of itself */
+
+rcb_status rcb_diag_fail(rcb_diag *d, rcb_status st, const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(d->errmsg, sizeof d->errmsg, fmt, ap);
+  va_end(ap);
+  return st;
+}
+
+rcb_status rcb_diag_create(rcb_diag **out, const rcb_model *m, const rcb_meas *meas,
+                           const rcb_allocator *alloc) {
+  rcb_allocator a;
+  rcb_diag *d;
+  if (!out) return RCB_ERR_ARG;
+  *out = NULL;
+  if (!m || !meas) return RCB_ERR_ARG;
+  rcb_allocator_init(&a, alloc);
+  if (!(d = rcb_alloc(&a, sizeof *d))) return RCB_ERR_NOMEM;
+  d->alloc = a;
+  d->m = m;
+  d->meas = meas;
+  d->scale = RCB_SCALE_LOG10;
+  d->nrefit = 8;
+  *out = d;
+  if (rcb_model_dof_count(m) == 0) return rcb_diag_fail(d, RCB_ERR_STATE, "model not finalized");
+  return RCB_OK;
+}
+
+static void free_results(rcb_diag *d) {
+  size_t i;
+  for (i = 0; i < d->ncand; i++) rcb_free(&d->alloc, d->cand[i].ini);
+  rcb_free(&d->alloc, d->cand);
+  rcb_free(&d->alloc, d->order);
+  rcb_free(&d->alloc, d->base_ini);
+  d->cand = NULL, d->order = NULL, d->base_ini = NULL;
+  d->ncand = d->cap_cand = 0;
+  d->ran = 0;
+}
+
+void rcb_diag_destroy(rcb_diag *d) {
+  rcb_allocator a;
+  if (!d) return;
+  a = d->alloc;
+  free_results(d);
+  rcb_free(&a, d->base);
+  rcb_free(&a, d);
+}
+
+const char *rcb_diag_errmsg(const rcb_diag *d) { return d ? d->errmsg : "no diagnosis"; }
+
+rcb_status rcb_diag_add_fitted_param(rcb_diag *d, const char *name, double lo, double hi,
+                                     int log_param) {
+  diag_base_par *p;
+  if (!d || !name || strlen(name) >= RCB_DIAG_NAME) return RCB_ERR_ARG;
+  if (rcb_grow(&d->alloc, (void **)&d->base, &d->cap_base, d->nbase + 1, sizeof *d->base))
+    return rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
+  p = &d->base[d->nbase++];
+  snprintf(p->name, sizeof p->name, "%s", name);
+  p->lo = lo, p->hi = hi, p->logp = log_param;
+  return RCB_OK;
+}
+
+rcb_status rcb_diag_set_scale(rcb_diag *d, rcb_fit_scale scale) {
+  if (!d) return RCB_ERR_ARG;
+  d->scale = scale;
+  return RCB_OK;
+}
+
+rcb_status rcb_diag_set_noise_model(rcb_diag *d, double beta_a, double beta_s) {
+  if (!d || !(beta_a >= 0) || !(beta_s >= 0)) return RCB_ERR_ARG;
+  d->beta_a = beta_a, d->beta_s = beta_s;
+  return RCB_OK;
+}
+
+rcb_status rcb_diag_set_band(rcb_diag *d, double lo, double hi) {
+  if (!d || !(lo >= 0) || !(hi > lo)) return RCB_ERR_ARG;
+  d->band_lo = lo, d->band_hi = hi, d->have_band = 1;
+  return RCB_OK;
+}
+
+rcb_status rcb_diag_set_refits(rcb_diag *d, size_t n) {
+  if (!d) return RCB_ERR_ARG;
+  d->nrefit = n;
+  return RCB_OK;
+}
+
+rcb_status rcb_diag_set_progress(rcb_diag *d, int (*cb)(void *user, size_t done, size_t total),
+                                 void *user) {
+  if (!d) return RCB_ERR_ARG;
+  d->progress = cb, d->progress_user = user;
+  return RCB_OK;
+}
+
+/* ---- fits ---- */
+
+/* A fit of m with the diagnosis settings, the base parameters (with_base)
+ * and the candidate's parameters (c, may be NULL). */
+static rcb_status make_fit(rcb_diag *d, rcb_model *m, int with_base, const diag_cand *c,
+                           rcb_fit **out) {
+  rcb_fit *f = NULL;
+  rcb_status st = rcb_fit_create(&f, m, d->meas, &d->alloc);
+  size_t k;
+  if (!st) st = rcb_fit_set_scale(f, d->scale);
+  if (!st && (d->beta_a > 0 || d->beta_s > 0))
+    st = rcb_fit_set_noise_model(f, d->beta_a, d->beta_s);
+  if (!st && d->have_band) st = rcb_fit_set_band(f, d->band_lo, d->band_hi);
+  for (k = 0; !st && with_base && k < d->nbase; k++) {
+    double v;
+    size_t j;
+    int dup = 0;
+    for (j = 0; c && j < c->np; j++) dup |= strcmp(c->pname[j], d->base[k].name) == 0;
+    /* another coupling model may not have the parameter (kramer_1: no kt) */
+    if (dup || rcb_model_get_param(m, d->base[k].name, &v)) continue;
+    st = rcb_fit_add_param(f, d->base[k].name, d->base[k].lo, d->base[k].hi, d->base[k].logp);
+  }
+  for (k = 0; !st && c && k < c->np; k++)
+    st = rcb_fit_add_param(f, c->pname[k], c->lo[k], c->hi[k], c->logp[k]);
+  if (st) {
+    rcb_diag_fail(d, st, "%s", f ? rcb_fit_errmsg(f) : "out of memory");
+    rcb_fit_destroy(f);
+    return st;
+  }
+  *out = f;
+  return RCB_OK;
+}
+
+static rcb_status model_text(rcb_diag *d, const rcb_model *m, char **out) {
+  size_t need = 0;
+  char *t;
+  rcb_model_write_ini(m, NULL, 0, &need);
+  if (!(t = rcb_alloc(&d->alloc, need + 1))) return rcb_diag_fail(d, RCB_ERR_NOMEM, "no memory");
+  if (rcb_model_write_ini(m, t, need + 1, &need)) {
+    rcb_free(&d->alloc, t);
+    return rcb_diag_fail(d, RCB_ERR_MODEL, "the model cannot be written as INI");
+  }
+  *out = t;
+  return RCB_OK;
+}
+
+/* F = r^T r with the fit's weights. */
+static rcb_status objective(rcb_diag *d, rcb_fit *f, double *r, double *F) {
+  rcb_status st = rcb_fit_residuals(f, r);
+  size_t i;
+  if (st) return rcb_diag_fail(d, st, "%s", rcb_fit_errmsg(f));
+  *F = 0;
+  for (i = 0; i < d->nres; i++) *F += r[i] * r[i];
+  return RCB_OK;
+}
+
+/* Fit the model as it is: base INI text, F0, error, floor, residual count. */
+static rcb_status baseline(rcb_diag *d) {
+  rcb_model *m = NULL;
+  rcb_fit *f = NULL;
+  rcb_fit_report rep;
+  char *txt = NULL;
+  rcb_status st = model_text(d, d->m, &txt);
+  if (!st) st = rcb_model_create(&m, &d->alloc);
+  if (!st) st = rcb_model_load_string(m, txt, "<model>");
+  if (!st) st = make_fit(d, m, 1, NULL, &f);
+  if (!st && d->nbase) {
+    st = rcb_fit_run(f);
+    if (st) rcb_diag_fail(d, st, "fitting the model as it is: %s", rcb_fit_errmsg(f));
+  }
+  if (!st) {
+    d->nres = rcb_fit_residual_count(f);
+    rcb_fit_error(f, &d->err0);
+    rcb_fit_get_report(f, &rep);
+    d->floor0 = rep.floor_pct;
+    rcb_free(&d->alloc, txt);
+    txt = NULL;
+    st = model_text(d, m, &d->base_ini);
+  }
+  if (!st) {
+    double *r = rcb_alloc(&d->alloc, d->nres * sizeof *r);
+    st = r ? objective(d, f, r, &d->F0) : RCB_ERR_NOMEM;
+    rcb_free(&d->alloc, r);
+  }
+  rcb_free(&d->alloc, txt);
+  rcb_fit_destroy(f);
+  rcb_model_destroy(m);
+  return st;
+}
+
+/* ---- the score test ---- */
+
+/* Orthonormalise the columns of A (n x k) in place (modified Gram-Schmidt,
+ * two passes), also against the q columns of Q; returns the rank kept. */
+static size_t orthonormalise(double *A, size_t n, size_t k, const double *Q, size_t q) {
+  size_t j, i, l, kept = 0;
+  int pass;
+  for (j = 0; j < k; j++) {
+    double *a = A + n * j, norm0 = 0, norm = 0;
+    for (i = 0; i < n; i++) norm0 += a[i] * a[i];
+    for (pass = 0; pass < 2; pass++) {
+      for (l = 0; l < q + kept; l++) {
+        const double *b = l < q ? Q + n * l : A + n * (l - q);
+        double dot = 0;
+        for (i = 0; i < n; i++) dot += a[i] * b[i];
+        for (i = 0; i < n; i++) a[i] -= dot * b[i];
+      }
+    }
+    for (i = 0; i < n; i++) norm += a[i] * a[i];
+    if (!(norm > 1e-20 * norm0) || norm == 0) continue; /* explained by what is fitted */
+    norm = sqrt(norm);
+    for (i = 0; i < n; i++) A[n * kept + i] = a[i] / norm;
+    kept++;
+  }
+  return kept;
+}
+
+/* Predicted reduction of F: || Q_c^T r ||^2 with Q_c the candidate's columns
+ * made orthonormal to the fitted parameters' (Q0). */
+static rcb_status score(rcb_diag *d, diag_cand *c, const double *r, const double *Q0,
+                        size_t q0, double *J) {
+  rcb_model *m = NULL;
+  rcb_fit *f = NULL;
+  size_t k, i, kept;
+  rcb_status st = rcb_diag_candidate_model(d, c, &m);
+  if (!st) st = make_fit(d, m, 0, c, &f);
+  if (!st && rcb_fit_residual_count(f) != d->nres)
+    st = rcb_diag_fail(d, RCB_ERR_STATE, "%s: residual layout differs", c->desc);
+  if (!st && (st = rcb_fit_jacobian(f, 1, J)))
+    rcb_diag_fail(d, st, "%s: %s", c->desc, rcb_fit_errmsg(f));
+  if (!st) {
+    kept = orthonormalise(J, d->nres, c->np, Q0, q0);
+    c->predicted = 0;
+    for (k = 0; k < kept; k++) {
+      double dot = 0;
+      for (i = 0; i < d->nres; i++) dot += J[d->nres * k + i] * r[i];
+      c->predicted += dot * dot;
+    }
+  }
+  rcb_fit_destroy(f);
+  rcb_model_destroy(m);
+  return st;
+}
+
+static rcb_status score_all(rcb_diag *d) {
+  rcb_model *m = NULL;
+  rcb_fit *f = NULL;
+  size_t n = d->nres, k, q0 = 0;
+  double *r = rcb_alloc(&d->alloc, n * sizeof *r);
+  double *Q0 = rcb_alloc(&d->alloc, n * (d->nbase + 1) * sizeof *Q0);
+  double *J = rcb_alloc(&d->alloc, n * RCB_DIAG_MAXP * sizeof *J);
+  rcb_status st = (r && Q0 && J) ? RCB_OK : rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
+  if (!st) st = rcb_model_create(&m, &d->alloc);
+  if (!st) st = rcb_model_load_string(m, d->base_ini, "<model>");
+  if (!st) st = make_fit(d, m, 1, NULL, &f);
+  if (!st) st = rcb_fit_residuals(f, r);
+  if (!st && d->nbase && !(st = rcb_fit_jacobian(f, 1, Q0)))
+    q0 = orthonormalise(Q0, n, d->nbase, NULL, 0);
+  for (k = 0; !st && k < d->ncand; k++) {
+    if (d->cand[k].refit_only) continue;
+    st = score(d, &d->cand[k], r, Q0, q0, J);
+    if (!st && d->progress && d->progress(d->progress_user, k + 1, d->ncand + d->nrefit))
+      st = rcb_diag_fail(d, RCB_ERR_STATE, "stopped by the caller");
+  }
+  rcb_fit_destroy(f);
+  rcb_model_destroy(m);
+  rcb_free(&d->alloc, r);
+  rcb_free(&d->alloc, Q0);
+  rcb_free(&d->alloc, J);
+  return st;
+}
+
+/* ---- refits ---- */
+
+static void record_fit(diag_cand *c, rcb_fit *f) {
+  size_t k, n = 0;
+  c->fitted[0] = '\0';
+  for (k = rcb_fit_param_count(f) - c->np; k < rcb_fit_param_count(f); k++) {
+    rcb_fit_param p;
+    rcb_fit_get_param(f, k, &p);
+    n += (size_t)snprintf(c->fitted + n, n < sizeof c->fitted ? sizeof c->fitted - n : 0,
+                          "%s%s = %.6g", n ? ", " : "", p.name, p.value);
+  }
+}
+
+static rcb_status refit(rcb_diag *d, diag_cand *c) {
+  rcb_model *m = NULL;
+  rcb_fit *f = NULL;
+  rcb_fit_report rep;
+  double N = (double)d->nres, dk = (double)c->np;
+  rcb_status st = rcb_diag_candidate_model(d, c, &m);
+  if (!st) st = make_fit(d, m, 1, c, &f);
+  if (!st) st = rcb_fit_set_starts(f, 3, 1);
+  if (st) { /* a candidate that cannot be built is reported, not fatal */
+    snprintf(c->fitted, sizeof c->fitted, "not fitted: %.300s", d->errmsg);
+    st = RCB_OK;
+  } else if (rcb_fit_param_count(f) == 0) { /* nothing to fit: evaluate (kramer_1, rigid) */
+    double *r = rcb_alloc(&d->alloc, d->nres * sizeof *r);
+    st = r ? objective(d, f, r, &c->F) : RCB_ERR_NOMEM;
+    if (!st) st = rcb_fit_error(f, &c->err);
+    rcb_free(&d->alloc, r);
+    if (!st) {
+      c->refitted = 1;
+      c->dbic = (d->beta_a > 0 || d->beta_s > 0) ? c->F - d->F0
+                                                 : (double)d->nres * log(c->F / d->F0);
+      c->significant = c->dbic < RCB_DIAG_BIC_MIN && c->err < RCB_DIAG_ERR_FALL * d->err0;
+      snprintf(c->fitted, sizeof c->fitted, "no parameter");
+      st = model_text(d, m, &c->ini);
+    }
+  } else if ((st = rcb_fit_run(f)) != RCB_OK) {
+    /* a candidate that cannot be fitted is reported, not fatal */
+    snprintf(c->fitted, sizeof c->fitted, "refit failed: %.300s", rcb_fit_errmsg(f));
+    st = RCB_OK;
+  } else if (!st) {
+    rcb_fit_get_report(f, &rep);
+    c->refitted = 1;
+    c->F = rep.objective;
+    c->err = rep.error_pct;
+    /* with noise-aware weights F is a chi-square: BIC = F + k ln N; else
+     * the Gaussian likelihood with the variance estimated */
+    c->dbic = (d->beta_a > 0 || d->beta_s > 0) ? (c->F - d->F0) + dk * log(N)
+                                               : N * log(c->F / d->F0) + dk * log(N);
+    c->significant = c->dbic < RCB_DIAG_BIC_MIN && c->err < RCB_DIAG_ERR_FALL * d->err0;
+    record_fit(c, f);
+    st = model_text(d, m, &c->ini);
+  }
+  rcb_fit_destroy(f);
+  rcb_model_destroy(m);
+  return st;
+}
+
+/* Rank: refitted by BIC change, then the rest by predicted reduction. */
+static int better(const diag_cand *a, const diag_cand *b) {
+  if (a->refitted != b->refitted) return a->refitted;
+  if (a->refitted) return a->dbic < b->dbic;
+  return a->predicted > b->predicted;
+}
+
+static void sort_order(rcb_diag *d) {
+  size_t i, j;
+  for (i = 0; i < d->ncand; i++) d->order[i] = i;
+  for (i = 1; i < d->ncand; i++)
+    for (j = i; j > 0 && better(&d->cand[d->order[j]], &d->cand[d->order[j - 1]]); j--) {
+      size_t t = d->order[j];
+      d->order[j] = d->order[j - 1];
+      d->order[j - 1] = t;
+    }
+}
+
+static rcb_status refit_best(rcb_diag *d) {
+  size_t k, done = 0;
+  rcb_status st = RCB_OK;
+  sort_order(d); /* by predicted reduction (nothing refitted yet) */
+  for (k = 0; !st && k < d->ncand; k++) {
+    diag_cand *c = &d->cand[d->order[k]];
+    if (c->refit_only || done >= d->nrefit || !(c->predicted > 0)) continue;
+    st = refit(d, c);
+    done++;
+    if (!st && d->progress &&
+        d->progress(d->progress_user, d->ncand + done, d->ncand + d->nrefit))
+      st = rcb_diag_fail(d, RCB_ERR_STATE, "stopped by the caller");
+  }
+  for (k = 0; !st && k < d->ncand; k++)
+    if (d->cand[k].refit_only) st = refit(d, &d->cand[k]);
+  if (!st) sort_order(d);
+  return st;
+}
+
+rcb_status rcb_diag_run(rcb_diag *d) {
+  rcb_model *fitted = NULL;
+  rcb_status st;
+  if (!d) return RCB_ERR_ARG;
+  free_results(d);
+  if ((st = baseline(d))) return st;
+  st = rcb_model_create(&fitted, &d->alloc);
+  if (!st) st = rcb_model_load_string(fitted, d->base_ini, "<model>");
+  if (!st) st = rcb_diag_catalogue(d, fitted);
+  rcb_model_destroy(fitted);
+  if (!st && !(d->order = rcb_alloc(&d->alloc, (d->ncand ? d->ncand : 1) * sizeof *d->order)))
+    st = rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
+  if (!st) st = score_all(d);
+  if (!st) st = refit_best(d);
+  d->ran = !st;
+  return st;
+}
+
+/* ---- results ---- */
+
+size_t rcb_diag_candidate_count(const rcb_diag *d) { return d && d->ran ? d->ncand : 0; }
+
+rcb_status rcb_diag_candidate_get(const rcb_diag *d, size_t rank, rcb_diag_candidate *out) {
+  const diag_cand *c;
+  if (!d || !out || !d->ran || rank >= d->ncand) return RCB_ERR_ARG;
+  c = &d->cand[d->order[rank]];
+  out->effect = c->effect;
+  out->place = c->place;
+  out->description = c->desc;
+  out->params = c->params;
+  out->predicted_pct = d->F0 > 0 ? 100.0 * c->predicted / d->F0 : (double)NAN;
+  out->refitted = c->refitted;
+  out->error_pct = c->err;
+  out->objective_drop_pct = c->refitted ? 100.0 * (d->F0 - c->F) / d->F0 : (double)NAN;
+  out->delta_bic = c->dbic;
+  out->significant = c->significant;
+  out->fitted = c->fitted;
+  return RCB_OK;
+}
+
+rcb_status rcb_diag_baseline(const rcb_diag *d, double *error_pct, double *objective,
+                             double *floor_pct) {
+  if (!d || !d->ran) return RCB_ERR_STATE;
+  if (error_pct) *error_pct = d->err0;
+  if (objective) *objective = d->F0;
+  if (floor_pct) *floor_pct = d->floor0;
+  return RCB_OK;
+}
+
+static rcb_status put_text(const char *text, char *buf, size_t size, size_t *needed) {
+  size_t n = strlen(text) + 1;
+  if (needed) *needed = n;
+  if (!buf || size < n) {
+    if (buf && size) buf[0] = '\0';
+    return RCB_ERR_WORKSPACE;
+  }
+  memcpy(buf, text, n);
+  return RCB_OK;
+}
+
+rcb_status rcb_diag_apply_ini(const rcb_diag *d, size_t rank, char *buf, size_t size,
+                              size_t *needed) {
+  const diag_cand *c;
+  if (!d || !d->ran || rank >= d->ncand) return RCB_ERR_ARG;
+  c = &d->cand[d->order[rank]];
+  if (!c->ini)
+    return rcb_diag_fail((rcb_diag *)d, RCB_ERR_STATE,
+                         "candidate %zu (%s) was not refitted: nothing to apply", rank + 1,
+                         c->desc);
+  return put_text(c->ini, buf, size, needed);
+}
+
+rcb_status rcb_diag_explain(const rcb_diag *d, char *buf, size_t size, size_t *needed) {
+  char text[1024];
+  const diag_cand *c;
+  if (!d || !d->ran) return RCB_ERR_STATE;
+  c = d->ncand ? &d->cand[d->order[0]] : NULL;
+  if (!c || !c->significant) {
+    snprintf(text, sizeof text,
+             "No candidate is significant: the model as it is leaves an error of %.3g %%%s; "
+             "no effect of the catalogue lowers BIC by more than %g while lowering the error.",
+             d->err0,
+             isfinite(d->floor0) ? (d->err0 < 1.5 * d->floor0
+                                        ? " (at the noise floor)"
+                                        : " (above the noise floor: the missing effect may "
+                                          "not be in the catalogue)")
+                                 : "",
+             -RCB_DIAG_BIC_MIN);
+  } else {
+    char floor_txt[64] = "";
+    if (isfinite(d->floor0)) snprintf(floor_txt, sizeof floor_txt, " (noise floor %.3g %%)", d->floor0);
+    snprintf(text, sizeof text,
+             "Missing: %s. Adding it (%s) explains %.1f %% of the remaining misfit: the error "
+             "falls from %.3g %% to %.3g %%%s, BIC %+.1f.",
+             c->desc, c->fitted, 100.0 * (d->F0 - c->F) / d->F0, d->err0, c->err, floor_txt,
+             c->dbic);
+  }
+  return put_text(text, buf, size, needed);
+}

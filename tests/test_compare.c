@@ -1,0 +1,404 @@
+/*
+ * Model-measurement comparison:
+ *  - a model compared with its own simulated data: error 0, FRAC 1, CSAC 1,
+ *    CSF 1, zero log and phase errors, an empty residual map (FRFs of every
+ *    kind, unbalance responses); every measured peak paired;
+ *  - a pure frequency scaling (every stiffness x a, every damper x sqrt(a),
+ *    mass unchanged, at rest: every eigenvalue x sqrt(a)) gives a peak
+ *    frequency error of 100 (1/sqrt(a) - 1) % on every paired peak;
+ *  - the half-power damping of a simulated resonance matches the eigenvalue's
+ *    damping ratio within 5 %;
+ *  - a resonance added to the data that the model lacks is listed as a
+ *    measured peak without counterpart, at its frequency and damping;
+ *  - known values of FRAC / CSF for a scaled measurement, channel errors,
+ *    allocator balance.
+ */
+#include <complex.h>
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <cmocka.h>
+
+#include "core/rcb_internal.h"
+#include "rcb_test_util.h"
+
+#define RPM (RCB_PI / 30.0)
+#define TWO_PI (2.0 * RCB_PI)
+
+/* A shaft (0.8 m, d 30 mm) with a 20 kg disk in the middle on two isotropic
+ * bearings; %g placeholders: young (Pa), bearing k (N/m), bearing c (N s/m). */
+static const char ROTOR_FMT[] =
+    "[material steel]\ndensity = 7800\nyoung = %.17g\npoisson = 0.3\n"
+    "[shaft A]\nmaterial = steel\nshear_factor = 0.9\nsegment = 0.8 0.03 0.0 8\n"
+    "[disk D]\nat = A 0.40\nmass = 20\nId = 0.1\nIp = 0.2\n"
+    "[bearing B1]\nat = A 0.0\nkxx = %.17g\nkyy = %.17g\ncxx = %.17g\ncyy = %.17g\n"
+    "[bearing B2]\nat = A 0.8\nkxx = %.17g\nkyy = %.17g\ncxx = %.17g\ncyy = %.17g\n"
+    "[unbalance U]\nat = D\namount = 1e-4\nphase_deg = 0\n";
+
+static rcb_model *rotor(double young, double k, double c) {
+  char ini[2048];
+  rcb_model *m;
+  snprintf(ini, sizeof ini, ROTOR_FMT, young, k, k, c, c, k, k, c, c);
+  m = rcb_test_model_from_string(ini);
+  if (rcb_model_dof_count(m) == 0) assert_int_equal(rcb_model_finalize(m), RCB_OK);
+  return m;
+}
+
+static rcb_model *paper(void) {
+  rcb_model *m = rcb_test_model_from_example("paper_system.ini");
+  if (rcb_model_dof_count(m) == 0) assert_int_equal(rcb_model_finalize(m), RCB_OK);
+  return m;
+}
+
+/* Synthetic FRF measurement: channels outs[o]/ins[o] (pairs), n points on
+ * [f0, f1] Hz at speed rpm, of the given kind. */
+static rcb_meas *frf_meas(const rcb_model *m, const char *const *outs, const char *const *ins,
+                          size_t nch, double f0, double f1, size_t n, double rpm,
+                          rcb_frf_kind kind) {
+  rcb_meas *ms = NULL;
+  double *x = calloc(n, sizeof *x);
+  rcb_complex *col = calloc(n, sizeof *col);
+  size_t i, k;
+  for (i = 0; i < n; i++) x[i] = TWO_PI * (f0 + (f1 - f0) * (double)i / (double)(n - 1));
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, n, x, rpm * RPM), RCB_OK);
+  for (k = 0; k < nch; k++) {
+    rcb_frf *fr = NULL;
+    rcb_dof od, id;
+    assert_int_equal(rcb_model_find_dof(m, outs[k], &od), RCB_OK);
+    assert_int_equal(rcb_model_find_dof(m, ins[k], &id), RCB_OK);
+    assert_int_equal(rcb_frf_create(&fr, m, 1, &od, 1, &id, RCB_SOLVER_AUTO, NULL), RCB_OK);
+    for (i = 0; i < n; i++)
+      assert_int_equal(rcb_frf_eval(fr, x[i], rpm * RPM, kind, &col[i]), RCB_OK);
+    assert_int_equal(rcb_meas_add_channel(ms, outs[k], ins[k], kind, col), RCB_OK);
+    rcb_frf_destroy(fr);
+  }
+  free(x);
+  free(col);
+  return ms;
+}
+
+static rcb_meas *unb_meas(const rcb_model *m, const char *const *outs, size_t no, double r0,
+                          double r1, size_t n) {
+  rcb_meas *ms = NULL;
+  rcb_frf *fr = NULL;
+  rcb_dof od[8];
+  double *x = calloc(n, sizeof *x);
+  rcb_complex *Q = calloc(n * no, sizeof *Q), *col = calloc(n, sizeof *col);
+  size_t i, o;
+  for (o = 0; o < no; o++) assert_int_equal(rcb_model_find_dof(m, outs[o], &od[o]), RCB_OK);
+  assert_int_equal(rcb_frf_create(&fr, m, no, od, 0, NULL, RCB_SOLVER_AUTO, NULL), RCB_OK);
+  for (i = 0; i < n; i++) {
+    x[i] = RPM * (r0 + (r1 - r0) * (double)i / (double)(n - 1));
+    assert_int_equal(rcb_frf_unbalance(fr, x[i], Q + i * no), RCB_OK);
+  }
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_UNBALANCE, n, x, 0.0), RCB_OK);
+  for (o = 0; o < no; o++) {
+    for (i = 0; i < n; i++) col[i] = Q[i * no + o];
+    assert_int_equal(rcb_meas_add_channel(ms, outs[o], NULL, RCB_RECEPTANCE, col), RCB_OK);
+  }
+  rcb_frf_destroy(fr);
+  free(x);
+  free(Q);
+  free(col);
+  return ms;
+}
+
+static rcb_compare *run(const rcb_model *m, const rcb_meas *ms) {
+  rcb_compare *c = NULL;
+  rcb_status st;
+  assert_int_equal(rcb_compare_create(&c, NULL), RCB_OK);
+  st = rcb_compare_run(c, m, ms);
+  if (st) fail_msg("compare: %s", rcb_compare_errmsg(c));
+  return c;
+}
+
+/* Every measure says "identical". */
+static void assert_identical(const rcb_compare *c) {
+  rcb_compare_summary s;
+  size_t k, i, nch = rcb_compare_channel_count(c), n = rcb_compare_point_count(c);
+  const double *csac = rcb_compare_csac(c), *csf = rcb_compare_csf(c);
+  const double *map = rcb_compare_residual_map(c);
+  assert_true(nch > 0 && n > 0);
+  for (k = 0; k < nch; k++) {
+    rcb_compare_channel ch;
+    assert_int_equal(rcb_compare_get_channel(c, k, &ch), RCB_OK);
+    assert_true(ch.error_pct < 1e-9);
+    assert_true(fabs(ch.frac - 1.0) < 1e-12);
+    assert_true(ch.log_rms < 1e-12);
+    assert_true(ch.phase_rms_deg < 1e-9);
+  }
+  for (i = 0; i < n; i++) {
+    assert_true(fabs(csac[i] - 1.0) < 1e-12);
+    assert_true(fabs(csf[i] - 1.0) < 1e-12);
+  }
+  for (k = 0; k < nch * rcb_compare_band_count(c); k++) assert_true(map[k] < 1e-12);
+  assert_int_equal(rcb_compare_get_summary(c, &s), RCB_OK);
+  assert_true(s.error_pct < 1e-9 && fabs(s.frac_mean - 1) < 1e-12);
+  assert_true(fabs(s.csac_mean - 1) < 1e-12 && fabs(s.csf_mean - 1) < 1e-12);
+}
+
+static void test_self_frf(void **state) {
+  static const char *const outs[] = {"DA.x", "C.A.y", "DB.x", "DA.ry"};
+  static const char *const ins[] = {"DA.x", "DA.x", "C.B.y", "DA.x"};
+  rcb_frf_kind kinds[] = {RCB_RECEPTANCE, RCB_MOBILITY, RCB_INERTANCE};
+  rcb_model *m = paper();
+  size_t q, p;
+  (void)state;
+  for (q = 0; q < 3; q++) {
+    rcb_meas *ms = frf_meas(m, outs, ins, 4, 5.0, 500.0, 400, 3000.0, kinds[q]);
+    rcb_compare *c = run(m, ms);
+    assert_identical(c);
+    assert_int_equal(rcb_compare_band_count(c), 10);
+    /* measured peaks all pair, with the model's own modes nearby */
+    for (p = 0; p < rcb_compare_peak_count(c); p++) {
+      rcb_compare_peak r;
+      assert_int_equal(rcb_compare_get_peak(c, p, &r), RCB_OK);
+      assert_int_not_equal(r.match, RCB_PEAK_MEASURED_ONLY);
+      if (r.match == RCB_PEAK_MATCHED) {
+        assert_true(fabs(r.freq_err_pct) < 2.0);
+        assert_true(fabs(r.amp_ratio - 1.0) < 1e-9);
+      }
+    }
+    rcb_compare_destroy(c);
+    rcb_meas_destroy(ms);
+  }
+  rcb_model_destroy(m);
+}
+
+static void test_self_unbalance(void **state) {
+  static const char *const outs[] = {"DA.x", "DA.y", "DB.x", "DB.y"};
+  rcb_model *m = paper();
+  rcb_meas *ms = unb_meas(m, outs, 4, 300.0, 18300.0, 301);
+  rcb_compare *c = run(m, ms);
+  size_t p, matched = 0;
+  (void)state;
+  assert_identical(c);
+  for (p = 0; p < rcb_compare_peak_count(c); p++) {
+    rcb_compare_peak r;
+    assert_int_equal(rcb_compare_get_peak(c, p, &r), RCB_OK);
+    assert_int_not_equal(r.match, RCB_PEAK_MEASURED_ONLY);
+    if (r.match != RCB_PEAK_MATCHED) continue;
+    matched++;
+    /* the 1X resonance of a critical speed lies at it, to the damping's effect */
+    assert_true(fabs(r.freq_err_pct) < 3.0);
+  }
+  assert_true(matched >= 1);
+  rcb_compare_destroy(c);
+  rcb_meas_destroy(ms);
+  rcb_model_destroy(m);
+}
+
+/* Stiffness x 1.21, dampers x 1.1, at rest: every eigenvalue x 1.1. */
+static void test_frequency_scaling(void **state) {
+  static const char *const outs[] = {"D.x", "#2.x"};
+  static const char *const ins[] = {"#2.x", "#2.x"}; /* off centre: the rocking mode too */
+  rcb_model *truth = rotor(2.1e11 * 1.21, 2e6 * 1.21, 1500.0 * 1.1);
+  rcb_model *m = rotor(2.1e11, 2e6, 1500.0);
+  rcb_meas *ms = frf_meas(truth, outs, ins, 2, 5.0, 200.0, 4000, 0.0, RCB_RECEPTANCE);
+  rcb_compare *c = NULL;
+  size_t p, matched = 0;
+  double expect = 100.0 * (1.0 / 1.1 - 1.0);
+  (void)state;
+  assert_int_equal(rcb_compare_create(&c, NULL), RCB_OK);
+  assert_int_equal(rcb_compare_set_peaks(c, 3.0, 0.15), RCB_OK);
+  assert_int_equal(rcb_compare_run(c, m, ms), RCB_OK);
+  for (p = 0; p < rcb_compare_peak_count(c); p++) {
+    rcb_compare_peak r;
+    assert_int_equal(rcb_compare_get_peak(c, p, &r), RCB_OK);
+    assert_int_not_equal(r.match, RCB_PEAK_MEASURED_ONLY);
+    if (r.match != RCB_PEAK_MATCHED) continue;
+    matched++;
+    /* like for like (the model's own peak): the scaling exactly */
+    if (fabs(r.peak_err_pct - expect) > 0.02)
+      fail_msg("peak at %g Hz: peak frequency error %g %%, expected %g %%",
+               r.meas_freq / TWO_PI, r.peak_err_pct, expect);
+    /* against the mode's wd: the same, to the O(zeta^2) offset of a peak */
+    if (fabs(r.freq_err_pct - expect) > 200.0 * r.model_zeta * r.model_zeta + 0.02)
+      fail_msg("peak at %g Hz: frequency error %g %%, expected %g %%", r.meas_freq / TWO_PI,
+               r.freq_err_pct, expect);
+  }
+  assert_true(matched >= 2);
+  rcb_compare_destroy(c);
+  rcb_meas_destroy(ms);
+  rcb_model_destroy(m);
+  rcb_model_destroy(truth);
+}
+
+/* Half-power damping of the first resonance vs the eigenvalue's zeta. */
+static void test_half_power_damping(void **state) {
+  static const char *const outs[] = {"D.x"};
+  static const char *const ins[] = {"D.x"};
+  rcb_model *m = rotor(2.1e11, 2e6, 1500.0);
+  rcb_modes *me = NULL;
+  rcb_mode modes[8];
+  size_t nm = 0, p, found = 0;
+  rcb_meas *ms;
+  rcb_compare *c;
+  (void)state;
+  assert_int_equal(rcb_modes_create(&me, m, NULL), RCB_OK);
+  assert_int_equal(rcb_modes_compute(me, 0.0, 8, modes, &nm, NULL), RCB_OK);
+  assert_true(nm >= 2 && modes[0].zeta > 0.005 && modes[0].zeta < 0.2);
+  /* the first bending mode alone in the band */
+  ms = frf_meas(m, outs, ins, 1, 0.5 * modes[0].wd / TWO_PI, 1.6 * modes[0].wd / TWO_PI, 3000,
+                0.0, RCB_RECEPTANCE);
+  c = run(m, ms);
+  for (p = 0; p < rcb_compare_peak_count(c); p++) {
+    rcb_compare_peak r;
+    assert_int_equal(rcb_compare_get_peak(c, p, &r), RCB_OK);
+    if (r.match != RCB_PEAK_MATCHED) continue;
+    found++;
+    if (!rcb_test_close(r.meas_zeta, modes[0].zeta, 0.05, 0.0))
+      fail_msg("half-power zeta %g, eigenvalue zeta %g", r.meas_zeta, modes[0].zeta);
+    assert_true(rcb_test_close(r.model_zeta, modes[0].zeta, 1e-9, 0.0));
+    assert_true(fabs(r.zeta_err_pct) < 5.0);
+  }
+  assert_int_equal(found, 1);
+  rcb_compare_destroy(c);
+  rcb_meas_destroy(ms);
+  rcb_modes_destroy(me);
+  rcb_model_destroy(m);
+}
+
+/* A resonance in the data that the model lacks (a single-DOF term added to
+ * the simulated receptance): listed as measured only, at its frequency. */
+static void test_unmatched_peak(void **state) {
+  static const char *const outs[] = {"D.x"};
+  static const char *const ins[] = {"D.x"};
+  rcb_model *m = rotor(2.1e11, 2e6, 400.0);
+  rcb_meas *ms0 = frf_meas(m, outs, ins, 1, 5.0, 400.0, 4000, 0.0, RCB_RECEPTANCE), *ms = NULL;
+  rcb_modes *me = NULL;
+  rcb_mode modes[16];
+  rcb_meas_channel_info ci;
+  rcb_complex *v = calloc(4000, sizeof *v);
+  const double *x = rcb_meas_grid(ms0);
+  double wr = TWO_PI * 60.0, zr = 0.02, a, hmax = 0.0;
+  size_t i, nm = 0, p, extra = 0;
+  rcb_compare *c;
+  (void)state;
+  assert_int_equal(rcb_modes_create(&me, m, NULL), RCB_OK);
+  assert_int_equal(rcb_modes_compute(me, 0.0, 16, modes, &nm, NULL), RCB_OK);
+  for (i = 0; i < nm; i++) assert_true(fabs(modes[i].wd / wr - 1.0) > 0.2);
+  assert_int_equal(rcb_meas_channel(ms0, 0, &ci), RCB_OK);
+  for (i = 0; i < 4000; i++) hmax = fmax(hmax, cabs(ci.data[i]));
+  a = 0.3 * hmax * 2.0 * zr * wr * wr; /* a peak 0.3 times the largest one */
+  for (i = 0; i < 4000; i++)
+    v[i] = ci.data[i] + a / (wr * wr - x[i] * x[i] + RCB_J * 2.0 * zr * wr * x[i]);
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, 4000, x, 0.0), RCB_OK);
+  assert_int_equal(rcb_meas_add_channel(ms, "D.x", "D.x", RCB_RECEPTANCE, v), RCB_OK);
+  c = run(m, ms);
+  for (p = 0; p < rcb_compare_peak_count(c); p++) {
+    rcb_compare_peak r;
+    assert_int_equal(rcb_compare_get_peak(c, p, &r), RCB_OK);
+    if (r.match != RCB_PEAK_MEASURED_ONLY) continue;
+    extra++;
+    assert_true(rcb_test_close(r.meas_freq, wr, 5e-3, 0.0));
+    assert_true(rcb_test_close(r.meas_zeta, zr, 0.15, 0.0));
+    assert_true(isnan(r.model_freq));
+    assert_true(r.amp_ratio > 3.0); /* the model has nothing there */
+  }
+  assert_int_equal(extra, 1);
+  rcb_compare_destroy(c);
+  rcb_meas_destroy(ms);
+  rcb_meas_destroy(ms0);
+  rcb_modes_destroy(me);
+  rcb_model_destroy(m);
+  free(v);
+}
+
+/* A measurement that is the model times a constant s on one channel and
+ * exact on the other: error |s - 1| 100 % there, FRAC 1 (shape only), log
+ * error |log10 s|; CSF across both channels = 2 s' / (1 + s'^2) in the
+ * single-channel limit is checked on a one-channel measurement. */
+static void test_known_values(void **state) {
+  static const char *const outs[] = {"D.x"};
+  static const char *const ins[] = {"D.x"};
+  rcb_model *m = rotor(2.1e11, 2e6, 400.0);
+  rcb_meas *ms0 = frf_meas(m, outs, ins, 1, 5.0, 100.0, 200, 0.0, RCB_MOBILITY), *ms = NULL;
+  rcb_meas_channel_info ci;
+  rcb_complex v[200];
+  double s = 1.25;
+  size_t i;
+  rcb_compare *c;
+  rcb_compare_channel ch;
+  (void)state;
+  assert_int_equal(rcb_meas_channel(ms0, 0, &ci), RCB_OK);
+  for (i = 0; i < 200; i++) v[i] = s * ci.data[i];
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, 200, rcb_meas_grid(ms0), 0.0), RCB_OK);
+  assert_int_equal(rcb_meas_add_channel(ms, "D.x", "D.x", RCB_MOBILITY, v), RCB_OK);
+  c = run(m, ms);
+  assert_int_equal(rcb_compare_get_channel(c, 0, &ch), RCB_OK);
+  /* e = s m: ||(|m| - s|m|)|| / ||s|m||| = (s - 1)/s */
+  assert_true(rcb_test_close(ch.error_pct, 100.0 * (s - 1.0) / s, 1e-12, 0.0));
+  assert_true(fabs(ch.frac - 1.0) < 1e-12);
+  assert_true(rcb_test_close(ch.log_rms, log10(s), 1e-12, 0.0));
+  assert_true(ch.phase_rms_deg < 1e-9);
+  for (i = 0; i < 200; i++) {
+    assert_true(fabs(rcb_compare_csac(c)[i] - 1.0) < 1e-12);
+    assert_true(rcb_test_close(rcb_compare_csf(c)[i], 2.0 * s / (1.0 + s * s), 1e-12, 0.0));
+  }
+  rcb_compare_destroy(c);
+  rcb_meas_destroy(ms);
+  rcb_meas_destroy(ms0);
+  rcb_model_destroy(m);
+}
+
+static void test_errors_and_allocator(void **state) {
+  static const char *const outs[] = {"D.x"};
+  static const char *const ins[] = {"D.x"};
+  rcb_test_counter cnt = {0, 0};
+  rcb_allocator al = rcb_test_counting_allocator(&cnt);
+  rcb_model *m = rotor(2.1e11, 2e6, 400.0);
+  rcb_meas *ms = frf_meas(m, outs, ins, 1, 5.0, 100.0, 50, 0.0, RCB_RECEPTANCE), *bad = NULL;
+  rcb_complex v[50];
+  rcb_compare *c = NULL;
+  size_t b, first, count, total = 0;
+  (void)state;
+  assert_int_equal(rcb_compare_create(&c, &al), RCB_OK);
+  assert_int_equal(rcb_compare_set_bands(c, 0), RCB_ERR_ARG);
+  assert_non_null(strstr(rcb_compare_errmsg(c), "expected 1 to 1000"));
+  assert_int_equal(rcb_compare_set_peaks(c, 3.0, 2.0), RCB_ERR_ARG);
+  assert_int_equal(rcb_compare_set_bands(c, 7), RCB_OK);
+  assert_int_equal(rcb_compare_run(c, m, ms), RCB_OK);
+  assert_int_equal(rcb_compare_band_count(c), 7);
+  for (b = 0; b < 7; b++) {
+    assert_int_equal(rcb_compare_band(c, b, NULL, NULL, &first, &count), RCB_OK);
+    assert_int_equal(first, total);
+    total += count;
+  }
+  assert_int_equal(total, 50);
+  /* a channel the model does not know: named in the message */
+  memset(v, 0, sizeof v);
+  assert_int_equal(rcb_meas_create(&bad, NULL), RCB_OK);
+  assert_int_equal(rcb_meas_set_grid(bad, RCB_MEAS_FRF, 50, rcb_meas_grid(ms), 0.0), RCB_OK);
+  assert_int_equal(rcb_meas_add_channel(bad, "NOPE.x", "D.x", RCB_RECEPTANCE, v), RCB_OK);
+  assert_int_equal(rcb_compare_run(c, m, bad), RCB_ERR_NOT_FOUND);
+  assert_non_null(strstr(rcb_compare_errmsg(c), "NOPE"));
+  assert_int_equal(rcb_compare_channel_count(c), 0);
+  rcb_compare_destroy(c);
+  assert_true(cnt.allocs > 0);
+  assert_int_equal(cnt.allocs, cnt.frees);
+  rcb_meas_destroy(bad);
+  rcb_meas_destroy(ms);
+  rcb_model_destroy(m);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_self_frf),
+      cmocka_unit_test(test_self_unbalance),
+      cmocka_unit_test(test_frequency_scaling),
+      cmocka_unit_test(test_half_power_damping),
+      cmocka_unit_test(test_unmatched_peak),
+      cmocka_unit_test(test_known_values),
+      cmocka_unit_test(test_errors_and_allocator),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

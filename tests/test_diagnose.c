@@ -1,0 +1,195 @@
+/*
+ * Diagnosis on data whose generating model holds an effect the user's model
+ * lacks (eq. 19 noise, 10 %, 1 %): the hidden effect, at the right place,
+ * ranks first and is significant, and applying it brings the error to the
+ * noise floor; with nothing hidden, no candidate is significant.
+ */
+#include <complex.h>
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <cmocka.h>
+
+#include "core/rcb_internal.h"
+#include "rcb_test_util.h"
+
+#define RPM (RCB_PI / 30.0)
+
+static const char *const outs[] = {"DA.x", "DA.y", "C.A.x", "C.A.y",
+                                   "C.B.x", "C.B.y", "DB.x", "DB.y"};
+
+/* Inertances outs / DA.x, 100-400 Hz at 10000 rpm, with eq. 19 noise. */
+static rcb_meas *measure(const rcb_model *truth, unsigned seed) {
+  rcb_meas *ms = NULL;
+  rcb_frf *fr = NULL;
+  rcb_dof od[8], in;
+  size_t n = 151, i, o;
+  double *x = calloc(n, sizeof *x);
+  rcb_complex *H = calloc(8 * n, sizeof *H), *col = calloc(n, sizeof *col);
+  for (o = 0; o < 8; o++) assert_int_equal(rcb_model_find_dof(truth, outs[o], &od[o]), 0);
+  assert_int_equal(rcb_model_find_dof(truth, "DA.x", &in), RCB_OK);
+  assert_int_equal(rcb_frf_create(&fr, truth, 8, od, 1, &in, RCB_SOLVER_AUTO, NULL), RCB_OK);
+  for (i = 0; i < n; i++) {
+    x[i] = 2 * RCB_PI * (100.0 + 2.0 * (double)i);
+    assert_int_equal(rcb_frf_eval(fr, x[i], 10000 * RPM, RCB_INERTANCE, H + 8 * i), RCB_OK);
+  }
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, n, x, 10000 * RPM), RCB_OK);
+  for (o = 0; o < 8; o++) {
+    for (i = 0; i < n; i++) col[i] = H[8 * i + o];
+    assert_int_equal(rcb_meas_add_channel(ms, outs[o], "DA.x", RCB_INERTANCE, col), RCB_OK);
+  }
+  assert_int_equal(rcb_meas_add_noise(ms, 10.0, 1.0, seed), RCB_OK);
+  rcb_frf_destroy(fr);
+  free(x);
+  free(H);
+  free(col);
+  return ms;
+}
+
+/* Diagnose the paper model (its coupling kt, kr, ct fitted) against data
+ * from a truth with one extra effect; return the best candidate. */
+static void diagnose(rcb_model *truth, unsigned seed, rcb_diag_candidate *best,
+                     double *err0, double *floor0, rcb_diag **out) {
+  rcb_model *m = rcb_test_model_from_example("paper_system.ini");
+  rcb_meas *ms = measure(truth, seed);
+  rcb_diag *d = NULL;
+  char text[1024];
+  size_t need;
+  assert_int_equal(rcb_diag_create(&d, m, ms, NULL), RCB_OK);
+  assert_int_equal(rcb_diag_set_noise_model(d, 10.0, 1.0), RCB_OK);
+  assert_int_equal(rcb_diag_add_fitted_param(d, "coupling.C.kt", 46.095, 46.095e6, 1), 0);
+  assert_int_equal(rcb_diag_add_fitted_param(d, "coupling.C.kr", 0.22076, 220760, 1), 0);
+  assert_int_equal(rcb_diag_add_fitted_param(d, "coupling.C.ct", 0.010949, 10949, 1), 0);
+  if (rcb_diag_run(d)) fail_msg("%s", rcb_diag_errmsg(d));
+  assert_true(rcb_diag_candidate_count(d) > 30);
+  assert_int_equal(rcb_diag_candidate_get(d, 0, best), RCB_OK);
+  assert_int_equal(rcb_diag_baseline(d, err0, NULL, floor0), RCB_OK);
+  assert_int_equal(rcb_diag_explain(d, text, sizeof text, &need), RCB_OK);
+  print_message("  %s\n", text);
+  if (getenv("RCB_DIAG_VERBOSE")) {
+    size_t k;
+    for (k = 0; k < rcb_diag_candidate_count(d) &&
+                k < (getenv("RCB_DIAG_ROWS") ? (size_t)atoi(getenv("RCB_DIAG_ROWS")) : 12u);
+         k++) {
+      rcb_diag_candidate c;
+      rcb_diag_candidate_get(d, k, &c);
+      print_message("    %2zu %-60s pred %6.2f%% refit %d err %.3g bic %+.1f %s\n", k + 1,
+                    c.description, c.predicted_pct, c.refitted, c.error_pct, c.delta_bic,
+                    c.fitted);
+    }
+  }
+  *out = d;
+  rcb_meas_destroy(ms);
+  rcb_model_destroy(m);
+}
+
+/* Apply the best candidate: its model reaches the noise floor. */
+static void apply_reaches_floor(rcb_diag *d, double floor0) {
+  char *ini;
+  size_t need = 0;
+  rcb_model *m2;
+  assert_int_equal(rcb_diag_apply_ini(d, 0, NULL, 0, &need), RCB_ERR_WORKSPACE);
+  ini = malloc(need);
+  assert_int_equal(rcb_diag_apply_ini(d, 0, ini, need, &need), RCB_OK);
+  m2 = rcb_test_model_from_string(ini); /* the applied model loads */
+  rcb_model_destroy(m2);
+  free(ini);
+  {
+    rcb_diag_candidate c;
+    assert_int_equal(rcb_diag_candidate_get(d, 0, &c), RCB_OK);
+    if (!(c.error_pct < 1.1 * floor0))
+      fail_msg("applied: error %g %%, floor %g %%", c.error_pct, floor0);
+  }
+}
+
+static void hidden(const char *param, double value, rcb_effect want, const char *place) {
+  rcb_model *truth = rcb_test_model_from_example("paper_system.ini");
+  rcb_diag_candidate best;
+  rcb_diag *d;
+  double err0, floor0;
+  unsigned seed;
+  for (seed = 1; seed <= (getenv("RCB_DIAG_SEEDS") ? (unsigned)atoi(getenv("RCB_DIAG_SEEDS")) : 2u); seed++) {
+    assert_int_equal(rcb_model_set_param(truth, param, value), RCB_OK);
+    diagnose(truth, seed, &best, &err0, &floor0, &d);
+    print_message("  hidden %s = %g: first '%s' (%s), predicted %.1f %%, error %.3g -> %.3g "
+                  "%% (floor %.3g), BIC %+.1f\n",
+                  param, value, best.description, best.place, best.predicted_pct, err0,
+                  best.error_pct, floor0, best.delta_bic);
+    assert_int_equal(best.effect, want);
+    assert_non_null(strstr(best.place, place));
+    assert_true(best.significant);
+    apply_reaches_floor(d, floor0);
+    rcb_diag_destroy(d);
+  }
+  rcb_model_destroy(truth);
+}
+
+static void test_hidden_cross_coupling(void **state) {
+  (void)state;
+  hidden("bearing.B2.kcross", 2e7, RCB_EFFECT_BEARING_CROSS_COUPLING, "bearing B2");
+}
+
+static void test_hidden_bearing_damping(void **state) {
+  (void)state;
+  hidden("bearing.B2.cxx", 2e4, RCB_EFFECT_BEARING_DAMPING, "bearing B2");
+}
+
+static void test_hidden_anisotropy(void **state) {
+  (void)state;
+  hidden("bearing.B1.kyy", 2.5e7, RCB_EFFECT_BEARING_STIFFNESS, "bearing B1");
+}
+
+static void test_hidden_hub(void **state) {
+  (void)state;
+  hidden("coupling.C.hub_mass", 0.07, RCB_EFFECT_COUPLING_HUB, "coupling C");
+}
+
+static void test_hidden_shaft_damping(void **state) {
+  (void)state;
+  hidden("shaft.B.damping_stiffness", 1e-4, RCB_EFFECT_SHAFT_DAMPING, "shaft B");
+}
+
+static void test_hidden_disk_mass(void **state) {
+  (void)state;
+  hidden("disk.DB.mass", 1.3, RCB_EFFECT_ADDED_MASS, "disk DB");
+}
+
+static void test_hidden_coupling_rotational_damping(void **state) {
+  (void)state;
+  hidden("coupling.C.cr", 0.02, RCB_EFFECT_COUPLING_ROTATIONAL_DAMPING, "coupling C");
+}
+
+/* Nothing hidden: no candidate is significant. */
+static void test_null(void **state) {
+  rcb_model *truth = rcb_test_model_from_example("paper_system.ini");
+  rcb_diag_candidate best;
+  rcb_diag *d;
+  double err0, floor0;
+  (void)state;
+  diagnose(truth, 3, &best, &err0, &floor0, &d);
+  print_message("  null: first '%s', BIC %+.1f, error %.3g %% (floor %.3g)\n",
+                best.description, best.delta_bic, err0, floor0);
+  assert_false(best.significant);
+  assert_true(err0 < 1.1 * floor0);
+  rcb_diag_destroy(d);
+  rcb_model_destroy(truth);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_hidden_cross_coupling),
+      cmocka_unit_test(test_hidden_bearing_damping),
+      cmocka_unit_test(test_hidden_anisotropy),
+      cmocka_unit_test(test_hidden_hub),
+      cmocka_unit_test(test_hidden_shaft_damping),
+      cmocka_unit_test(test_hidden_disk_mass),
+      cmocka_unit_test(test_hidden_coupling_rotational_damping),
+      cmocka_unit_test(test_null),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
