@@ -29,9 +29,12 @@ typedef enum rcb_frf_kind {
 
 /** @brief Linear solver used for the dynamic stiffness. */
 typedef enum rcb_solver_kind {
-  RCB_SOLVER_AUTO = 0,   /**< banded when it pays, dense otherwise */
+  RCB_SOLVER_AUTO = 0,   /**< sparse from 1000 DOF when built with KLU, else
+                              banded when the band is narrow, else dense */
   RCB_SOLVER_DENSE = 1,  /**< LAPACK zgesv */
-  RCB_SOLVER_BANDED = 2  /**< LAPACK zgbsv */
+  RCB_SOLVER_BANDED = 2, /**< LAPACK zgbsv */
+  RCB_SOLVER_SPARSE = 3  /**< SuiteSparse KLU (complex); RCB_ERR_UNSUPPORTED
+                              when built without RCB_WITH_SUITESPARSE */
 } rcb_solver_kind;
 
 typedef struct rcb_frf rcb_frf;
@@ -41,7 +44,7 @@ typedef struct rcb_frf rcb_frf;
  * @param nout number of output DOFs @param outputs output DOFs
  * @param nin number of input (force) DOFs, may be 0 for unbalance-only use
  * @param inputs input DOFs
- * @param solver RCB_SOLVER_AUTO, _DENSE or _BANDED
+ * @param solver RCB_SOLVER_AUTO, _DENSE, _BANDED or _SPARSE
  * @param alloc allocator hooks, NULL for malloc
  */
 RCB_API rcb_status rcb_frf_create(rcb_frf **out, const rcb_model *m, size_t nout,
@@ -54,9 +57,10 @@ RCB_API void rcb_frf_destroy(rcb_frf *f);
  */
 RCB_API rcb_status rcb_frf_refresh(rcb_frf *f);
 RCB_API const char *rcb_frf_errmsg(const rcb_frf *f);
-/** @brief Solver actually chosen (dense or banded). */
+/** @brief Solver actually chosen (dense, banded or sparse). */
 RCB_API rcb_solver_kind rcb_frf_solver(const rcb_frf *f);
-/** @brief Bytes held by the object (its whole workspace). */
+/** @brief Bytes held by the object (its whole workspace; with the sparse
+ * solver, plus KLU's peak usage, which KLU allocates itself with malloc). */
 RCB_API size_t rcb_frf_memory(const rcb_frf *f);
 
 /**

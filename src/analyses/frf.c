@@ -12,11 +12,53 @@
 #include "analyses/frf_internal.h"
 
 
-/* Banded storage pays once the band is well below the order. */
-static const rcb_zsolver_ops *choose_solver(rcb_solver_kind kind, size_t n, size_t bw) {
-  if (kind == RCB_SOLVER_DENSE) return rcb_zsolver_dense();
-  if (kind == RCB_SOLVER_BANDED) return rcb_zsolver_banded();
-  return (n >= 32 && 4 * bw < n) ? rcb_zsolver_banded() : rcb_zsolver_dense();
+/* Automatic choice: KLU from this many DOF on (when built with it), banded
+ * storage once the band is well below the order, dense otherwise. The
+ * threshold comes from tools/bench/bench_scale (docs/benchmarks.md). */
+#define SPARSE_MIN_DOF 1000
+
+static rcb_status choose_solver(rcb_frf *f, rcb_solver_kind kind, size_t n, size_t bw) {
+  const rcb_zsolver_ops *sparse = rcb_zsolver_sparse();
+  switch (kind) {
+    case RCB_SOLVER_DENSE: f->ops = rcb_zsolver_dense(); return RCB_OK;
+    case RCB_SOLVER_BANDED: f->ops = rcb_zsolver_banded(); return RCB_OK;
+    case RCB_SOLVER_SPARSE:
+      if (!sparse)
+        return rcb_set_error(f->errmsg, RCB_ERR_UNSUPPORTED,
+                             "solver 'sparse' needs librcb built with RCB_WITH_SUITESPARSE=ON "
+                             "(use dense, banded or auto)");
+      f->ops = sparse;
+      return RCB_OK;
+    case RCB_SOLVER_AUTO: break;
+    default:
+      return rcb_set_error(f->errmsg, RCB_ERR_ARG,
+                           "solver kind %d: expected auto, dense, banded or sparse", (int)kind);
+  }
+  if (sparse && n >= SPARSE_MIN_DOF)
+    f->ops = sparse;
+  else
+    f->ops = (n >= 32 && 4 * bw < n) ? rcb_zsolver_banded() : rcb_zsolver_dense();
+  return RCB_OK;
+}
+
+/* Sparse layout: the model's structural pattern, then KLU's symbolic
+ * analysis, once for the life of the object. */
+static rcb_status sparse_layout(rcb_frf *f) {
+  const rcb_model *m = f->m;
+  int *colp, *rowi;
+  size_t nnz;
+  rcb_status st = rcb_csc_pattern(m, &f->alloc, &colp, &rowi, &nnz);
+  if (st == RCB_ERR_NOMEM)
+    return rcb_set_error(f->errmsg, st, "out of memory building the sparsity pattern");
+  if (st)
+    return rcb_set_error(f->errmsg, st, "model of %zu DOF too large for KLU's int indices",
+                         m->ndof);
+  f->bytes += (m->ndof + 1 + nnz) * sizeof(int);
+  rcb_layout_csc(&f->L, m->ndof, m->bandwidth, colp, rowi);
+  if ((st = f->ops->prepare(&f->L, &f->alloc)))
+    return rcb_set_error(f->errmsg, st, "KLU symbolic analysis of %zu DOF, %zu entries failed",
+                         m->ndof, nnz);
+  return RCB_OK;
 }
 
 static void *frf_alloc(rcb_frf *f, size_t size) {
@@ -39,8 +81,11 @@ static rcb_status frf_setup(rcb_frf *f, size_t nout, const rcb_dof *outputs, siz
   const rcb_model *m = f->m;
   size_t n = m->ndof, sz, ncol = nin ? nin : 1;
   rcb_status st;
-  f->ops = choose_solver(solver, n, m->bandwidth);
-  f->ops->layout(&f->L, n, m->bandwidth);
+  if ((st = choose_solver(f, solver, n, m->bandwidth))) return st;
+  if (f->ops->layout)
+    f->ops->layout(&f->L, n, m->bandwidth);
+  else if ((st = sparse_layout(f)))
+    return st;
   sz = rcb_layout_size(&f->L);
   f->M = frf_alloc(f, sz * sizeof *f->M);
   f->C = frf_alloc(f, sz * sizeof *f->C);
@@ -91,6 +136,11 @@ void rcb_frf_destroy(rcb_frf *f) {
   rcb_allocator a;
   if (!f) return;
   a = f->alloc;
+  if (f->ops && f->ops->release) f->ops->release(&f->L, &a);
+  if (f->L.sparse) {
+    rcb_free(&a, f->L.colp);
+    rcb_free(&a, f->L.rowi);
+  }
   rcb_free(&a, f->M);
   rcb_free(&a, f->C);
   rcb_free(&a, f->G);
@@ -112,10 +162,14 @@ rcb_status rcb_frf_refresh(rcb_frf *f) {
 const char *rcb_frf_errmsg(const rcb_frf *f) { return f ? f->errmsg : "no FRF object"; }
 
 rcb_solver_kind rcb_frf_solver(const rcb_frf *f) {
+  if (f && f->L.sparse) return RCB_SOLVER_SPARSE;
   return (f && f->L.banded) ? RCB_SOLVER_BANDED : RCB_SOLVER_DENSE;
 }
 
-size_t rcb_frf_memory(const rcb_frf *f) { return f ? f->bytes : 0; }
+size_t rcb_frf_memory(const rcb_frf *f) {
+  if (!f) return 0;
+  return f->bytes + (f->ops && f->ops->memory ? f->ops->memory(&f->L) : 0);
+}
 
 /* Z = K - w^2 M + i w (C + W G) + bearings at speed W, then factor and solve
  * Z X = B in place. */
@@ -139,6 +193,9 @@ rcb_status rcb_frf_factor_solve(rcb_frf *f, double omega, double speed, size_t n
                          "dynamic stiffness singular at %g rad/s, speed %g rad/s (a free-free "
                          "model at omega = 0, or an undamped resonance hit exactly)",
                          omega, speed);
+  if (st == RCB_ERR_NOMEM)
+    return rcb_set_error(f->errmsg, st, "%s solver out of memory at %g rad/s", f->ops->name,
+                         omega);
   if (st) return rcb_set_error(f->errmsg, st, "%s solver failed at %g rad/s", f->ops->name,
                                omega);
   return RCB_OK;

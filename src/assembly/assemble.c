@@ -10,6 +10,7 @@
 #include "assembly/assembly.h"
 
 void rcb_layout_dense(rcb_layout *L, size_t n) {
+  memset(L, 0, sizeof *L);
   L->banded = 0;
   L->n = n;
   L->kl = L->ku = n ? n - 1 : 0;
@@ -17,13 +18,14 @@ void rcb_layout_dense(rcb_layout *L, size_t n) {
 }
 
 void rcb_layout_banded(rcb_layout *L, size_t n, size_t bandwidth) {
+  memset(L, 0, sizeof *L);
   L->banded = 1;
   L->n = n;
   L->kl = L->ku = bandwidth;
   L->ld = 2 * bandwidth + bandwidth + 1;
 }
 
-size_t rcb_layout_size(const rcb_layout *L) { return L->ld * L->n; }
+size_t rcb_layout_size(const rcb_layout *L) { return L->sparse ? L->nnz : L->ld * L->n; }
 
 /* Add an nd x nd column-major block, scaled by f, on the given matrix rows. */
 static void scatter(const rcb_layout *L, double *A, const long *rows, int nd, const double *blk,

@@ -329,6 +329,18 @@ static void dz_times(const rcb_layout *L, const double *d, double w, double W,
                      const rcb_complex *x, rcb_complex *y) {
   size_t sz = rcb_layout_size(L), i, j, n = L->n;
   memset(y, 0, n * sizeof *y);
+  if (L->sparse) { /* CSC: entry a of column j is on row rowi[a] */
+    for (j = 0; j < n; j++) {
+      size_t a;
+      if (x[j] == 0.0) continue;
+      for (a = (size_t)L->colp[j]; a < (size_t)L->colp[j + 1]; a++) {
+        double complex z =
+            CMPLX(d[3 * sz + a] - w * w * d[a], w * (d[sz + a] + W * d[2 * sz + a]));
+        y[L->rowi[a]] += z * x[j];
+      }
+    }
+    return;
+  }
   for (j = 0; j < n; j++) {
     size_t i0 = j > L->ku ? j - L->ku : 0, i1 = j + L->kl < n ? j + L->kl : n - 1;
     if (x[j] == 0.0) continue;

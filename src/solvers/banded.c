@@ -28,6 +28,6 @@ static rcb_status banded_resolve(const rcb_layout *L, const rcb_complex *Z, cons
 }
 
 static const rcb_zsolver_ops banded_ops = {"banded", rcb_layout_banded, banded_solve,
-                                           banded_resolve};
+                                           banded_resolve, NULL, NULL, NULL};
 
 const rcb_zsolver_ops *rcb_zsolver_banded(void) { return &banded_ops; }

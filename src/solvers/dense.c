@@ -32,6 +32,7 @@ static rcb_status dense_resolve(const rcb_layout *L, const rcb_complex *Z, const
   return info ? RCB_ERR_LAPACK : RCB_OK;
 }
 
-static const rcb_zsolver_ops dense_ops = {"dense", dense_layout, dense_solve, dense_resolve};
+static const rcb_zsolver_ops dense_ops = {"dense", dense_layout, dense_solve, dense_resolve,
+                                          NULL, NULL, NULL};
 
 const rcb_zsolver_ops *rcb_zsolver_dense(void) { return &dense_ops; }

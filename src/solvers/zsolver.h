@@ -1,7 +1,9 @@
 /*
  * Complex linear solvers for the dynamic stiffness Z(w) X = B, behind a small
  * table of function pointers (one file per backend): dense LAPACK zgesv,
- * banded LAPACK zgbsv. Each factors Z in place and overwrites B with X.
+ * banded LAPACK zgbsv, sparse KLU (klu_z_*). Each overwrites B with X; the
+ * LAPACK ones factor Z in place, KLU keeps its factors in the layout's
+ * solver state.
  */
 #ifndef RCB_ZSOLVER_H
 #define RCB_ZSOLVER_H
@@ -10,7 +12,9 @@
 
 typedef struct rcb_zsolver_ops_s {
   const char *name;
-  /* Layout this backend factors, for a model of order n and half-bandwidth bw. */
+  /* Layout this backend factors, for a model of order n and half-bandwidth bw;
+   * NULL for the sparse backend (the caller sets a CSC layout on the model's
+   * pattern, rcb_csc_pattern, then calls prepare). */
   void (*layout)(rcb_layout *L, size_t n, size_t bw);
   /* Solve in place; ipiv has n entries. RCB_ERR_SINGULAR when a pivot is 0. */
   rcb_status (*solve)(const rcb_layout *L, rcb_complex *Z, int *ipiv, rcb_complex *B,
@@ -18,9 +22,21 @@ typedef struct rcb_zsolver_ops_s {
   /* Solve again with the factors left by solve: op(Z) X = B, trans 'N' or 'T'. */
   rcb_status (*resolve)(const rcb_layout *L, const rcb_complex *Z, const int *ipiv,
                         rcb_complex *B, size_t nrhs, char trans);
+  /* Optional (NULL for LAPACK): analyse the pattern once (KLU symbolic
+   * ordering) and keep the state in L->solver; release frees it. The state
+   * struct comes from a; KLU's own factors come from SuiteSparse's malloc. */
+  rcb_status (*prepare)(rcb_layout *L, const rcb_allocator *a);
+  void (*release)(rcb_layout *L, const rcb_allocator *a);
+  /* Optional: bytes held by the backend state (KLU's peak usage), 0 if none. */
+  size_t (*memory)(const rcb_layout *L);
 } rcb_zsolver_ops;
 
 const rcb_zsolver_ops *rcb_zsolver_dense(void);
 const rcb_zsolver_ops *rcb_zsolver_banded(void);
+/* NULL when librcb was built without RCB_WITH_SUITESPARSE. */
+const rcb_zsolver_ops *rcb_zsolver_sparse(void);
+/* Full factorisations and kept-pivot refactorisations done so far by the
+ * sparse backend on layout L (0, 0 for the other backends). */
+void rcb_zsolver_sparse_counts(const rcb_layout *L, size_t *factors, size_t *refactors);
 
 #endif
