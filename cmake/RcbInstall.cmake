@@ -64,6 +64,10 @@ endif()
 if(RCB_WITH_NLOPT)
   string(APPEND RCB_PC_REQUIRES_PRIVATE " nlopt")
 endif()
+if(RCB_WITH_SUNDIALS)
+  string(APPEND RCB_PC_LIBS_PRIVATE
+    " -lsundials_cvode -lsundials_sunmatrixdense -lsundials_nvecserial")
+endif()
 string(APPEND RCB_PC_LIBS_PRIVATE " -lm")
 # prefix is found from the .pc file's own place (${pcfiledir}), so the package
 # stays right when installed with `cmake --install --prefix DIR` or moved.

@@ -13,6 +13,11 @@
 #   ./scripts/dev.sh bench-fit  identification benchmark (issue #3, Table 3 data, 20 seeds):
 #                               rcbtool fit per method vs SciPy least_squares (needs .venv);
 #                               extra arguments go to tools/bench/bench_fit.py
+#   ./scripts/dev.sh fuzz       libFuzzer smoke (issue #7): build fuzz/ with clang (ASan+UBSan),
+#                               replay the seed corpora, then fuzz each harness FUZZ_SECONDS
+#                               (default 30) s; needs clang and libclang-rt-dev (not in `test`)
+#   ./scripts/dev.sh embedded   the "embedded" CMake preset (static, -Os, no optional backend,
+#                               build-embedded/): build and print the library size
 #
 # Environment: CI=true turns warnings into errors; RCB_BUILD_DIR (default build)
 # and RCB_VENV (default .venv) move the build tree and the venv;
@@ -190,8 +195,28 @@ EOF
     --params coupling.C.kt,coupling.C.kr,coupling.C.ct,coupling.C.cr -o "$out/fitted.ini" |
     sed -n '1,/^converged/p' | sed 's/^/  /'
   echo "  (true values: kt 46095 N/m, kr 220.76 N m/rad, ct 10.949 N s/m, cr 1.0949e-05 N m s/rad)"
+
+  say "diagnosis (issue #4): examples/walkthrough, a model that does not match its machine"
+  local wk=examples/walkthrough P=coupling.C.kt,coupling.C.kr,coupling.C.ct
+  rm -f "$out/history.jsonl"
+  echo "-- rcbtool compare: where does the model fail?"
+  rcbtool compare "$wk/model.ini" "$wk/measured.uff" | sed -n '3,12p' | sed 's/^/  /'
+  echo "-- rcbtool fit: the best the model can do as it is"
+  rcbtool fit "$wk/model.ini" "$wk/measured.uff" --params "$P" --log --noise 10,1 \
+    --history "$out/history.jsonl" | grep -E '^(error|noise|UNSURE)' | sed 's/^/  /'
+  echo "-- rcbtool diagnose: which physical effect is missing, and where?"
+  rcbtool diagnose "$wk/model.ini" "$wk/measured.uff" --params "$P" --log --noise 10,1 \
+    --top 5 --apply 1 -o "$out/model2.ini" --history "$out/history.jsonl" | sed 's/^/  /'
+  echo "-- rcbtool fit on the model with the effect added"
+  rcbtool fit "$out/model2.ini" "$wk/measured.uff" --params "$P,bearing.B2.kcross:-7e7:7e7" \
+    --noise 10,1 --history "$out/history.jsonl" | grep -E '^(bearing|error|noise)' |
+    sed 's/^/  /'
+  echo "-- rcbtool history: the error falling"
+  rcbtool history "$out/history.jsonl" | sed 's/^/  /'
+  echo "  (the data were made with bearing B2 cross-coupled: kxy = 2e7, kyx = -2e7 N/m;"
+  echo "   see examples/walkthrough/README.md)"
   echo
-  echo "full tables (CSV, JSON, UFF, fitted model) in $out/"
+  echo "full tables (CSV, JSON, UFF, fitted models, history) in $out/"
 }
 
 python_for_summary() {
@@ -294,6 +319,49 @@ cmd_bench_fit() {
     --rcbtool "$(rcbtool_exe)" --model "$MODEL" "$@"
 }
 
+# libFuzzer smoke: every seed replayed, then FUZZ_SECONDS of fuzzing per
+# harness on a scratch copy of the corpus (fuzz/corpus stays as committed).
+# Not part of `test`: it needs clang with its runtime (Debian: clang,
+# libclang-rt-14-dev) and takes FUZZ_SECONDS x 3 plus a build.
+cmd_fuzz() {
+  local dir=$BUILD_DIR-fuzz secs=${FUZZ_SECONDS:-30} t rc=0
+  command -v clang > /dev/null ||
+    die "fuzz needs clang and its runtime (Debian: apt-get install clang libclang-rt-14-dev)"
+  say "libFuzzer build ($dir, clang, ASan+UBSan)"
+  mkdir -p "$dir"
+  CC=clang cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRCB_BUILD_FUZZERS=ON \
+    -DRCB_BUILD_TESTS=OFF -DRCB_BUILD_TOOLS=OFF -DRCB_BUILD_SHARED=OFF \
+    -DRCB_WITH_SUITESPARSE=OFF -DRCB_WITH_NLOPT=OFF -DRCB_WITH_SUNDIALS=OFF \
+    > "$dir/configure.log" 2>&1 || { cat "$dir/configure.log"; die "cmake configure failed in $dir"; }
+  cmake --build "$dir" -j "$JOBS"
+  mkdir -p "$dir/crashes"
+  for t in ini csv uff; do
+    say "fuzz_$t: replay fuzz/corpus/$t, then ${secs} s"
+    rm -rf "$dir/work_$t"
+    cp -r "fuzz/corpus/$t" "$dir/work_$t"
+    UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 "$dir/fuzz/fuzz_$t" -runs=0 \
+      "fuzz/corpus/$t" 2>&1 | tail -n 1 || rc=1
+    UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 "$dir/fuzz/fuzz_$t" "$dir/work_$t" \
+      -max_total_time="$secs" -max_len=8192 -timeout=10 -rss_limit_mb=2048 \
+      -artifact_prefix="$dir/crashes/fuzz_${t}-" -print_final_stats=1 > "$dir/fuzz_$t.log" 2>&1 || rc=1
+    grep -E '^stat::number_of_executed_units|^SUMMARY' "$dir/fuzz_$t.log" || true
+  done
+  ((rc == 0)) || die "a fuzzer failed: see $dir/fuzz_*.log and $dir/crashes/ (reproduce: $dir/fuzz/fuzz_NAME FILE)"
+  say "fuzz smoke passed (crash-free, ${secs} s per harness)"
+}
+
+# The embedded preset (CMakePresets.json): static, MinSizeRel, no backend.
+cmd_embedded() {
+  say "embedded preset (build-embedded: static, -Os, no SuiteSparse/NLopt/SUNDIALS)"
+  cmake --preset embedded > /dev/null
+  cmake --build --preset embedded -j "$JOBS"
+  local lib=build-embedded/src/librcb.a
+  [[ -f $lib ]] || die "$lib was not built"
+  say "library size"
+  ls -l "$lib" | awk '{ printf "  %s: %d bytes on disk\n", $NF, $5 }'
+  size -t "$lib" | awk 'END { printf "  code (text) %d bytes, data %d, bss %d: total %d bytes\n", $1, $2, $3, $4 }'
+}
+
 usage() { awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$ROOT/scripts/dev.sh"; }
 
 case ${1:-} in
@@ -305,6 +373,8 @@ case ${1:-} in
   sanitize) cmd_sanitize ;;
   bench) cmd_bench ;;
   bench-fit) shift; cmd_bench_fit "$@" ;;
+  fuzz) cmd_fuzz ;;
+  embedded) cmd_embedded ;;
   -h | --help | help) usage ;;
   *) usage >&2; exit 2 ;;
 esac

@@ -14,5 +14,6 @@
 #include "rcb/rcb_identify.h"
 #include "rcb/rcb_compare.h"
 #include "rcb/rcb_diagnose.h"
+#include "rcb/rcb_transient.h"
 
 #endif /* RCB_H */

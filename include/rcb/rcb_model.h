@@ -177,6 +177,23 @@ RCB_API rcb_status rcb_model_finalize(rcb_model *m);
 
 /* ---- queries (after finalize) ---- */
 
+/**
+ * @brief Warnings found by rcb_model_finalize: values that are valid but
+ * implausible for a machine in SI units, most often a unit slip (mm where m
+ * is meant, g/cm^3, MPa or GPa where Pa is meant), and shafts that no chain
+ * of couplings joins (separate rotors). A warning never stops the load; show
+ * them to the user (rcbtool check prints them on stderr). Checked: shaft
+ * outer diameters outside 1 mm to 5 m, shaft lengths outside 1 mm to 100 m,
+ * densities outside 100 to 30000 kg/m^3, Young's moduli outside 1e8 to 1e13
+ * Pa, disks heavier than 1e6 kg. The list is made by finalize and kept as is
+ * by rcb_model_set_param. Texts start "KIND 'NAME': " (after "FILE:LINE: "
+ * when the model came from an INI file).
+ * @return number of warnings (0 before finalize)
+ */
+RCB_API size_t rcb_model_warning_count(const rcb_model *m);
+/** @brief Warning i (0-based), owned by the model; NULL when i is out of range. */
+RCB_API const char *rcb_model_warning(const rcb_model *m, size_t i);
+
 /** @brief Number of nodes (4 DOFs each before coupling constraints). */
 RCB_API size_t rcb_model_node_count(const rcb_model *m);
 /** @brief Number of independent DOFs (matrix size) after constraint elimination. */

@@ -12,6 +12,12 @@
 
 #include "rcb/rcb.h"
 
+/* glibc defines CMPLX only for GCC >= 4.7, so clang (which reports itself
+ * as GCC 4.2) lacks it; clang has the same builtin. */
+#if !defined(CMPLX) && defined(__clang__)
+#define CMPLX(x, y) __builtin_complex((double)(x), (double)(y))
+#endif
+
 #define RCB_ERRMSG_MAX 512
 #define RCB_PI 3.14159265358979323846
 /* The imaginary unit as double complex (complex.h's I is a float complex). */
@@ -112,6 +118,13 @@ typedef struct rcb_uffmap_s {
   char station[2 * RCB_NAME_MAX + 2];
 } rcb_uffmap_t;
 
+/* A finalize warning (implausible value, unconnected shafts): the text starts
+ * "KIND 'NAME'" so the INI loader can prefix the item's file:line. */
+#define RCB_WARNING_MAX 384
+typedef struct rcb_warning_s {
+  char text[RCB_WARNING_MAX];
+} rcb_warning_t;
+
 typedef struct rcb_node_s {
   size_t shaft;
   double z;     /* m */
@@ -143,9 +156,14 @@ struct rcb_model {
   RCB_ARRAY(rcb_station_t, stations);
   RCB_ARRAY(rcb_node_t, nodes);
   RCB_ARRAY(rcb_element_t, elements);
+  RCB_ARRAY(rcb_warning_t, warnings); /* model/warnings.c */
   size_t ndof;      /* independent DOFs */
   size_t bandwidth; /* max |row - col| of any nonzero (kl = ku) */
 };
+
+/* model/warnings.c: rebuild m->warnings (called by finalize once the mesh
+ * exists); RCB_ERR_NOMEM only. */
+rcb_status rcb_model_collect_warnings(rcb_model *m);
 
 /* Bearing coefficients at a rotor speed (linear interpolation, clamped). */
 void rcb_bearing_eval(const rcb_bearing_t *b, double speed, rcb_bearing_coefs *out);

@@ -29,7 +29,7 @@ static diag_cand *new_cand(rcb_diag *d, rcb_effect e, const char *place) {
   memset(c, 0, sizeof *c);
   c->effect = e;
   snprintf(c->place, sizeof c->place, "%s", place);
-  c->F = c->err = c->dbic = NAN;
+  c->F = c->err = c->dbic = (double)NAN;
   return c;
 }
 

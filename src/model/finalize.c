@@ -242,7 +242,8 @@ rcb_status rcb_model_finalize(rcb_model *m) {
   m->n_nodes = 0;
   m->n_elements = 0;
   if ((st = mesh_shafts(m)) || (st = resolve_all(m)) || (st = number_dofs(m)) ||
-      (st = build_stations(m)) || (st = check_uffmap(m)))
+      (st = build_stations(m)) || (st = check_uffmap(m)) ||
+      (st = rcb_model_collect_warnings(m)))
     return st;
   m->finalized = 1;
   m->errmsg[0] = '\0';

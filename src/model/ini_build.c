@@ -367,6 +367,21 @@ static const ini_section *section_of_message(const ini_ctx *c, const char *msg) 
   return NULL;
 }
 
+/* Finalize warnings start "KIND 'NAME'" like its errors: prefix each with the
+ * file and the line of that item's section header. */
+static void prefix_warnings(ini_ctx *c) {
+  size_t i;
+  rcb_model *m = c->m;
+  for (i = 0; i < m->n_warnings; i++) {
+    char buf[RCB_WARNING_MAX];
+    const ini_section *s = section_of_message(c, m->warnings[i].text);
+    int k = s ? snprintf(buf, sizeof buf, "%s:%d: %s", c->src, s->line, m->warnings[i].text)
+              : snprintf(buf, sizeof buf, "%s: %s", c->src, m->warnings[i].text);
+    if (k < 0) continue;
+    memcpy(m->warnings[i].text, buf, sizeof buf);
+  }
+}
+
 /* [uff] map = NODE STATION, NODE STATION, ... */
 static rcb_status build_uff(ini_ctx *c, const ini_section *s) {
   const ini_entry *e = rcb_ini_get(s, "map");
@@ -423,5 +438,6 @@ rcb_status rcb_ini_build(ini_ctx *c) {
     const ini_section *s = section_of_message(c, rcb_model_errmsg(c->m));
     return builder_fail(c, s, s ? s->line : 0, st);
   }
+  prefix_warnings(c);
   return RCB_OK;
 }

@@ -189,6 +189,7 @@ static rcb_status check_duplicate(ini_ctx *c, ini_sec_type t, const char *name) 
 static rcb_status open_section(ini_ctx *c, const char *p) {
   char head[256], type[64], name[256], extra[8];
   const char *end = p + 1;
+  const unsigned char *q;
   int nf, t;
   ini_section *s;
   /* inih: ']' ends the header unless an inline comment (" ;") comes first */
@@ -239,6 +240,14 @@ static rcb_status open_section(ini_ctx *c, const char *p) {
     return rcb_ini_error(c, RCB_ERR_PARSE, c->line, NULL, NULL,
                          "[%s %s]: name longer than %d characters; expected a shorter name",
                          type, name, RCB_NAME_MAX - 1);
+  /* a name the INI writer could not write back ([kind NAME], KEY = NAME,
+   * "NAME z, NAME z"); bytes >= 0x80 (UTF-8) pass */
+  for (q = (const unsigned char *)name; *q; q++)
+    if (*q < 0x20 || *q == 0x7f || strchr("[];,=:", *q))
+      return rcb_ini_error(c, RCB_ERR_PARSE, c->line, NULL, NULL,
+                           "[%s ...]: byte 0x%02x cannot be used in a name; expected letters, "
+                           "digits, '_' or '-' (no control characters or [ ] ; , = :)",
+                           type, *q);
   if (check_duplicate(c, (ini_sec_type)t, name)) return c->st;
   if (rcb_grow(&c->m->alloc, (void **)&c->sec, &c->cap_sec, c->n_sec + 1, sizeof *c->sec))
     return rcb_ini_error(c, RCB_ERR_NOMEM, c->line, NULL, NULL, "out of memory");
@@ -417,6 +426,7 @@ static void model_reset(rcb_model *m) {
   }
   m->n_materials = m->n_shafts = m->n_disks = m->n_bearings = 0;
   m->n_couplings = m->n_unbalances = m->n_probes = 0;
+  m->n_uffmap = m->n_warnings = 0;
   m->n_stations = m->n_nodes = m->n_elements = 0;
   m->ndof = m->bandwidth = 0;
   m->finalized = 0;

@@ -116,7 +116,8 @@ static int ini_safe(const char *name) {
   const char *p;
   if (!name[0]) return 0;
   for (p = name; *p; p++)
-    if (!isgraph((unsigned char)*p) || strchr("[];,=:#", *p)) return 0;
+    if ((!isgraph((unsigned char)*p) && (unsigned char)*p < 0x80) || strchr("[];,=:#", *p))
+      return 0; /* bytes >= 0x80 (UTF-8 names) pass, as the builder lets them */
   return 1;
 }
 

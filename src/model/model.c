@@ -43,6 +43,7 @@ void rcb_model_destroy(rcb_model *m) {
   rcb_free(&a, m->stations);
   rcb_free(&a, m->nodes);
   rcb_free(&a, m->elements);
+  rcb_free(&a, m->warnings);
   rcb_free(&a, m);
 }
 

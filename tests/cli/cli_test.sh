@@ -444,6 +444,239 @@ EOF
   err_has "coupling.C.zz" ;;
 # ==== end of rcbtool fit / sensitivity ====
 
+# ==== bad-input catalogue (issue #7): exit code, message, no output file
+# created or overwritten, the input files unchanged (cmp) ====
+bad_ini_catalogue)
+  # one wrong line of the paper model per row: sed expression | exit | phrase
+  echo old >"$W/old"
+  while IFS='|' read -r expr code phrase; do
+    [ -n "$expr" ] || continue
+    sed -e "$expr" "$MODEL" >"$W/m.ini"; cp "$W/m.ini" "$W/m.orig"; cp "$W/old" "$W/o.csv"
+    cmp -s "$MODEL" "$W/m.ini" && fail "sed '$expr' changed nothing"
+    run check "$W/m.ini" -o "$W/o.csv"; expect_rc "$code"; out_empty
+    err_has "$phrase"
+    grep -q 'm\.ini:[0-9]' "$W/err" || fail "[$expr] message does not name m.ini:LINE"
+    cmp -s "$W/o.csv" "$W/old" || fail "[$expr] the existing output file was overwritten"
+    cmp -s "$W/m.ini" "$W/m.orig" || fail "[$expr] the model file was modified"
+    rm -f "$W/o.csv"
+    run check "$W/m.ini" -o "$W/new.csv"; expect_rc "$code"
+    [ ! -e "$W/new.csv" ] || fail "[$expr] an output file was created"
+  done <<'CASES'
+s/^\[disk DA\]/[disc DA]/|3|did you mean [disk]?
+s/^\[station P1\]/[gizmo P1]/|3|unknown section type [gizmo]
+s/^kxx = 5e7 /kxz = 5e7 /|3|did you mean kxx?
+s/^phase_deg = 90/phase = 90/|3|phase_deg
+s/^shear_factor = 0.9 .*//|3|missing key 'shear_factor'
+s/^material = steel//|3|missing key 'material'
+s/^segment = 0.50 0.017 0.0 10 /segment = -0.50 0.017 0.0 10 /|3|segment length (m) = -0.5, expected a positive value
+s/^segment = 0.50 0.017 0.0 10 /segment = 0 0.017 0.0 10 /|3|segment length (m) = 0
+s/^segment = 0.50 0.017 0.0 10 /segment = 0.50 0.017 0.017 10 /|3|inner diameter 0.017 m >= outer diameter 0.017 m
+s/^segment = 0.50 0.017 0.0 10 /segment = 0.50 0.017 0.0 0 /|3|0 elements
+s/^young = 1.936e11 /young = nan /|3|'nan' is not a finite number
+s/^kxx = 5e7 /kxx = inf /|3|'inf' is not a finite number
+s/^density = 7759.255 /density = -7759.255 /|3|expected a positive value
+s/^at = A 0.05 /at = A 0.60 /|3|is outside shaft 'A'
+s/^at = A 0.05 /at = A 0.06 /|3|is not on a node of shaft 'A'
+s/^between = A end, B start/between = A end, Q start/|3|shaft 'Q' is not defined
+s/^between = A end, B start/between = A end, A start/|3|both stations are on shaft 'A'
+s/^model = nelson_crandall_2/model = nelson_crandall_3/|3|unknown coupling model
+CASES
+  ;;
+bad_unit_slip_warnings)
+  # implausible magnitudes load (exit 0) with a warning naming file:line
+  sed -e 's/^density = 7759.255 /density = 7.759255 /' "$MODEL" >"$W/m.ini"
+  run check "$W/m.ini"; expect_rc 0
+  err_has "warning: $W/m.ini:17: material 'steel': density = 7.75925 kg/m^3"; err_has "g/cm^3"
+  sed -e 's/^young = 1.936e11 /young = 193.6e3 /' "$MODEL" >"$W/m.ini"
+  run check "$W/m.ini"; expect_rc 0; err_has "young = 193600 Pa"; err_has "MPa or GPa"
+  sed -e 's/^segment = 0.50 0.017 0.0 10 /segment = 0.50 17 0.0 10 /' "$MODEL" >"$W/m.ini"
+  run check "$W/m.ini"; expect_rc 0; err_has "outer diameter = 17 m"; err_has "mm where m is meant"
+  run check "$MODEL"; expect_rc 0; [ ! -s "$W/err" ] || fail "warnings on the paper model" ;;
+bad_unconnected_shafts)
+  awk '/^\[coupling C\]/ { skip = 1; next } /^\[/ { skip = 0 } !skip' "$MODEL" >"$W/m.ini"
+  run check "$W/m.ini"; expect_rc 0
+  err_has "shaft 'B': not joined to shaft 'A'"; err_has "2 separate rotors" ;;
+bad_free_free_zero)
+  echo old >"$W/o.csv"
+  run frf "$EX/paper_freefree.ini" --out DA.x --in DA.x --fmin 0 --fmax 100 --points 3 -o "$W/o.csv"
+  expect_rc 4; err_has "singular at 0 rad/s"; err_has "free-free"
+  [ "$(cat "$W/o.csv")" = old ] || fail "the existing output file was overwritten"
+  run frf "$EX/paper_freefree.ini" --out DA.x --in DA.x --fmin 0 --fmax 100 --points 3 -o "$W/n.csv"
+  expect_rc 4; [ ! -e "$W/n.csv" ] || fail "an output file was created" ;;
+bad_uff_truncated)
+  run simulate "$MODEL" --frf --out DA.x,DB.y --in DA.x --fmin 10 --fmax 100 --points 9 \
+    --map 1=DA,2=DB -o "$W/s.uff"; expect_rc 0
+  sz=$(wc -c <"$W/s.uff")
+  head -c $((sz - 300)) "$W/s.uff" >"$W/cut.uff"; cp "$W/cut.uff" "$W/cut.orig"
+  run convert "$W/cut.uff" "$W/o.csv" --map 1=DA,2=DB; expect_rc 3; err_has "cut.uff:"; err_has "truncated"
+  [ ! -e "$W/o.csv" ] || fail "output written from a truncated file"
+  cmp -s "$W/cut.uff" "$W/cut.orig" || fail "the input file was modified"
+  run fit "$MODEL" "$W/cut.uff" --map 1=DA,2=DB --params coupling.C.kt -o "$W/f.ini"
+  expect_rc 3; err_has "truncated"; [ ! -e "$W/f.ini" ] || fail "fit wrote a model" ;;
+bad_uff_mislabelled)
+  run simulate "$MODEL" --frf --out DA.x --in DA.x --fmin 10 --fmax 100 --points 5 \
+    --map 1=DA -o "$W/s.uff"; expect_rc 0
+  # ordinate data type 8 (displacement) relabelled 99; dataset 58 relabelled 5x
+  sed -e 's/^         8    0    0    0 Displacement/        99    0    0    0 Displacement/' \
+    "$W/s.uff" >"$W/u.uff"
+  cmp -s "$W/s.uff" "$W/u.uff" && fail "sed changed nothing"
+  run convert "$W/u.uff" "$W/o.csv" --map 1=DA; expect_rc 3; err_has "ordinate data type 99"
+  sed -e 's/^    58 /    5x /' "$W/s.uff" >"$W/u.uff"
+  run convert "$W/u.uff" "$W/o.csv" --map 1=DA; expect_rc 3; err_has "u.uff:2:"; err_has "not a number"
+  [ ! -e "$W/o.csv" ] || fail "output written from a mislabelled file" ;;
+bad_csv_missing_columns)
+  printf 'freq_hz\n10\n20\n' >"$W/a.csv"
+  run convert "$W/a.csv" "$W/o.uff"; expect_rc 3; err_has "no channel columns"
+  printf 'freq_hz,DA.x/DA.x re\n10,1\n' >"$W/a.csv"
+  run convert "$W/a.csv" "$W/o.uff"; expect_rc 3; err_has "a.csv:1:"; err_has "pair"
+  printf 'freq_hz,DA.x/DA.x re,DA.x/DA.x im\n10,1,2\n20,1\n' >"$W/a.csv"; cp "$W/a.csv" "$W/a.orig"
+  run convert "$W/a.csv" "$W/o.uff"; expect_rc 3; err_has "a.csv:3:"; err_has "2 fields, the header has 3"
+  [ ! -e "$W/o.uff" ] || fail "output written from a bad CSV"
+  cmp -s "$W/a.csv" "$W/a.orig" || fail "the input CSV was modified" ;;
+bad_fit_params)
+  run simulate "$MODEL" --frf --out C.A.x --in DA.x --fmin 200 --fmax 400 --points 11 \
+    --rpm 10000 -o "$W/m.csv"; expect_rc 0
+  cp "$MODEL" "$W/model.ini"; echo old >"$W/f.ini"
+  # no free parameter
+  usage fit "$W/model.ini" "$W/m.csv" --params "" -o "$W/f.ini"; err_has "--params"
+  # bounds that exclude the start (46095 N/m)
+  usage fit "$W/model.ini" "$W/m.csv" --params coupling.C.kt:1e5:1e6 -o "$W/f.ini"
+  err_has "start value 46095 is outside the bounds [100000, 1e+06]"
+  usage fit "$W/model.ini" "$W/m.csv" --params coupling.C.kt:1e6:1e5 -o "$W/f.ini"; err_has "coupling.C.kt"
+  run fit "$W/model.ini" "$W/m.csv" --params coupling.C.nope -o "$W/f.ini"; expect_rc 3
+  err_has "coupling.C.nope"
+  [ "$(cat "$W/f.ini")" = old ] || fail "a refused fit overwrote the output"
+  cmp -s "$MODEL" "$W/model.ini" || fail "the model was modified" ;;
+# ==== end of the bad-input catalogue ====
+
+# ==== rcbtool compare ====
+compare_self)
+  # the model against its own simulated FRFs: error 0, FRAC/CSAC/CSF 1, every peak paired
+  run simulate "$MODEL" --frf --out C.A.x,C.A.y,DB.y --in DA.x --fmin 5 --fmax 400 --points 300 \
+    --rpm 3000 --kind inertance -o "$W/self.csv"
+  [ "$RC" -eq 0 ] || { [ "$RC" -eq 2 ] && grep -q "unknown command" "$W/err" && exit 77; fail "simulate failed"; }
+  run compare "$MODEL" "$W/self.csv" --json --bands 8; expect_rc 0; json_ok
+  python3 - "$W/out" <<'EOF2' || fail "self comparison wrong"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["type"] == "frf" and d["x_unit"] == "Hz" and abs(d["rpm"] - 3000) < 1e-6, d["rpm"]
+assert len(d["x"]) == 300 and abs(d["x"][0] - 5) < 1e-9 and abs(d["x"][-1] - 400) < 1e-9
+assert [c["response"] for c in d["channels"]] == ["C.A.x", "C.A.y", "DB.y"]
+for c in d["channels"]:
+    assert c["error_pct"] < 1e-6 and abs(c["frac"] - 1) < 1e-9 and c["kind"] == "inertance", c["error_pct"]
+    assert c["reference"] == "DA.x" and len(c["meas_re"]) == 300
+assert all(abs(v - 1) < 1e-9 for v in d["csac"] + d["csf"])
+assert len(d["bands"]) == 8 and len(d["residual_map"]) == 3 and len(d["residual_map"][0]) == 8
+assert sum(b["count"] for b in d["bands"]) == 300
+assert all(v < 1e-9 for row in d["residual_map"] for v in row)
+assert len(d["worst_bands"]) == 3
+assert d["peaks"] and all(p["match"] != "measured_only" for p in d["peaks"]), d["peaks"]
+EOF2
+  run compare "$MODEL" "$W/self.csv"; expect_rc 0
+  out_has "overall: error 0 %"; out_has "worst bands"; out_has "peaks (measured resonances vs model modes" ;;
+compare_shift)
+  # a model with the coupling's kt at 20e3 instead of 46.095e3 vs noisy data of the true
+  # system (UFF): errors show, the peak near 160 Hz (a shoulder of the 150 Hz one: found
+  # with --prominence 1.5) pairs with a model mode about 5 % low
+  run simulate "$MODEL" --frf --out C.A.x,C.A.y,C.B.x,C.B.y,DA.x,DB.y --in DA.x --fmin 5 \
+    --fmax 400 --points 800 --rpm 3000 --kind inertance --noise 10,1 --seed 3 \
+    --map 10=C.A,20=C.B,30=DA,40=DB -o "$W/noisy.uff"
+  [ "$RC" -eq 0 ] || { [ "$RC" -eq 2 ] && grep -q "unknown command" "$W/err" && exit 77; fail "simulate failed"; }
+  sed -e 's/^kt = 46.095e3 /kt = 20e3 /' "$MODEL" >"$W/soft.ini"
+  grep -q '^kt = 20e3 ' "$W/soft.ini" || fail "sed did not change kt"
+  run compare "$W/soft.ini" "$W/noisy.uff" --map 10=C.A,20=C.B,30=DA,40=DB --json -o "$W/c.json" \
+    --prominence 1.5
+  expect_rc 0; out_empty
+  python3 - "$W/c.json" <<'EOF2' || fail "shifted-model comparison wrong"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["summary"]["error_pct"] > 15, d["summary"]
+m = [p for p in d["peaks"] if p["match"] == "matched"]
+assert any(abs(p["meas_x"] - 162) < 3 and -8 < p["freq_err_pct"] < -3 for p in m), m
+assert any(abs(p["meas_x"] - 150.3) < 1 and abs(p["freq_err_pct"]) < 0.5 for p in m), m
+EOF2
+  # the channel the model does not know: exit 3, names it and --map
+  run compare "$W/soft.ini" "$W/noisy.uff"; expect_rc 3; err_has "#10"; err_has "--map" ;;
+compare_unbalance)
+  run simulate "$MODEL" --unbalance --out DA.x,DA.y,DB.x,DB.y --rpm-min 300 --rpm-max 18300 \
+    --points 301 -o "$W/unb.csv"
+  [ "$RC" -eq 0 ] || { [ "$RC" -eq 2 ] && grep -q "unknown command" "$W/err" && exit 77; fail "simulate failed"; }
+  run compare "$MODEL" "$W/unb.csv" --json; expect_rc 0; json_ok
+  python3 - "$W/out" <<'EOF2' || fail "unbalance comparison wrong"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["type"] == "unbalance" and d["x_unit"] == "rpm" and d["rpm"] is None
+assert d["summary"]["error_pct"] < 1e-6 and all(c["reference"] is None for c in d["channels"])
+m = [p for p in d["peaks"] if p["match"] == "matched"]
+assert m and all(abs(p["freq_err_pct"]) < 3 for p in m), d["peaks"]   # 1X critical speeds
+EOF2
+  run compare "$MODEL" "$W/unb.csv"; expect_rc 0; out_has "1X critical speeds"; out_has "rpm" ;;
+compare_usage)
+  printf '# kind = inertance\n# rpm = 10000\nfreq_hz,C.A.x/DA.x re,C.A.x/DA.x im\n200,1,2\n300,1,3\n' >"$W/m.csv"
+  usage compare "$MODEL"; err_has "missing the measurement file"
+  usage compare "$MODEL" "$W/m.csv" --bands 0; err_has "--bands"
+  usage compare "$MODEL" "$W/m.csv" --tol 0; err_has "percentage"
+  usage compare "$MODEL" "$W/m.csv" --prominence -1; err_has "--prominence"
+  usage compare "$MODEL" "$W/m.csv" --map 10=DA; err_has "UFF measurements only"
+  run compare "$MODEL" "$W/none.csv"; expect_rc 3; err_has "none.csv"
+  run compare "$MODEL" "$W/m.csv" --plot "$W/nodir/p"; expect_rc 5; err_has "nodir"
+  run compare --help; expect_rc 0; out_has "usage: rcbtool compare MODEL.ini"
+  run help; expect_rc 0; out_has "  compare " ;;
+# ==== end of rcbtool compare ====
+
+# ==== rcbtool diagnose / history: the issue #4 workflow ====
+diagnose_workflow)
+  # truth: the paper system with a cross-coupled stiffness at bearing B2
+  awk '{ print } /^\[bearing B2\]/ { print "kxy = 2e7"; print "kyx = -2e7" }' "$MODEL" >"$W/truth.ini"
+  cp "$MODEL" "$W/model.ini"
+  run simulate "$W/truth.ini" --frf --out DA.x,DA.y,C.A.x,C.A.y,C.B.x,C.B.y,DB.x,DB.y --in DA.x \
+    --fmin 100 --fmax 400 --points 101 --rpm 10000 --kind inertance --noise 10,1 --seed 7 \
+    -o "$W/meas.csv"
+  expect_rc 0
+  P=coupling.C.kt,coupling.C.kr,coupling.C.ct
+  run fit "$W/model.ini" "$W/meas.csv" --params $P --log --noise 10,1 --history "$W/h.jsonl"
+  expect_rc 0
+  run diagnose "$W/model.ini" "$W/meas.csv" --params $P --log --noise 10,1 --json \
+    --apply 1 -o "$W/model2.ini" --history "$W/h.jsonl"
+  expect_rc 0; json_ok
+  python3 - "$W/out" <<'PY' || fail "the hidden effect is not ranked first and significant"
+import json, sys
+d = json.load(open(sys.argv[1]))
+c = d["candidates"][0]
+assert c["place"] == "bearing B2" and "cross-coupled" in c["effect"], c
+assert c["significant"] and c["error_pct"] < 1.1 * d["floor_pct"], c
+assert "bearing B2" in d["explanation"]
+PY
+  cmp -s "$MODEL" "$W/model.ini" || fail "the input model was modified"
+  run check "$W/model2.ini"; expect_rc 0
+  run fit "$W/model2.ini" "$W/meas.csv" --params $P,bearing.B2.kcross:-7e7:7e7 --noise 10,1 \
+    --history "$W/h.jsonl"
+  expect_rc 0; out_has "bearing.B2.kcross"
+  run history "$W/h.jsonl"; expect_rc 0; out_has "apply"; out_has "error % by step"
+  [ "$(wc -l <"$W/h.jsonl")" -eq 3 ] || fail "history should hold 3 steps" ;;
+diagnose_usage)
+  printf '# kind = inertance\n# rpm = 10000\nfreq_hz,C.A.x/DA.x re,C.A.x/DA.x im\n200,1,2\n300,1,3\n' >"$W/m.csv"
+  usage diagnose "$MODEL"; err_has "missing the measurement"
+  usage diagnose "$MODEL" "$W/m.csv" --apply 1; err_has "-o MODEL2.ini"
+  run diagnose "$MODEL" "$W/m.csv" --params coupling.C.zz; expect_rc 3; err_has "coupling.C.zz"
+  run history "$W/none.jsonl"; expect_rc 3; err_has "none.jsonl" ;;
+# ---- time integration (SUNDIALS; skipped when librcb is built without it) ----
+transient_csv)
+  run transient "$MODEL" --out DA.x,DA.y --rpm 3000 --t-end 0.01 --dt 0.005
+  if [ "$RC" -eq 4 ] && grep -F -q "without SUNDIALS" "$W/err"; then exit 77; fi
+  expect_rc 0; out_has "t_s,rpm,angle_deg,DA.x,DA.y"
+  [ "$(wc -l <"$W/out")" -eq 4 ] || fail "expected a header and 3 samples" ;;
+transient_usage)
+  usage transient "$MODEL" --out DA.x --rpm 3000; err_has "expected --t-end"
+  usage transient "$MODEL" --out DA.x --rpm 3000 --rpm-end 6000; err_has "expected --accel > 0" ;;
+timecheck_json)
+  run timecheck "$MODEL" --out DA.x --rpm-min 3000 --rpm-max 3000 --points 1 --rtol 1e-6 \
+    --steady-tol 1e-3 --json
+  if [ "$RC" -eq 4 ] && grep -F -q "without SUNDIALS" "$W/err"; then exit 77; fi
+  expect_rc 0; json_ok
+  python3 -c 'import json,sys; c=json.load(open(sys.argv[1]))["channels"][0]
+a,b=c["amp_freq"][0],c["amp_time"][0]; assert abs(b/a-1)<5e-3, (a,b)' "$W/out" \
+    || fail "time and frequency domain amplitudes differ by more than 0.5 %" ;;
 *) echo "unknown test case '$CASE'"; exit 1 ;;
 esac
 exit 0

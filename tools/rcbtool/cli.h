@@ -190,6 +190,16 @@ int cli_meas_format(const char *cmd, const char *path, int *is_uff);
 int cli_meas_write(const char *cmd, const rcb_meas *ms, const char *path, int binary,
                    cli_uff_map *mp);
 
+/* ---- model + measurement commands (cli_meas.c) ---- */
+
+/** cli_parse knows one positional argument (the model): take the second one
+ * (the measurement) out of argv; returns the number of positionals. */
+int cli_split_meas(int argc, char **argv, const cli_opt *opts, size_t nopts, char **args,
+                   int *nargs, const char **meas);
+/** Read a measurement by extension (UFF with --map or the model's [uff] map,
+ * or CSV); exit code 0, 2, 3 or 4 with the message printed. */
+int cli_meas_read(const cli_args *a, const char *path, const rcb_model *m, rcb_meas **out);
+
 /* ---- fitted parameters (cmd_fit.c; used by sensitivity) ---- */
 
 /** One --params item "NAME" or "NAME:LO:HI" (parameter units). */
@@ -206,6 +216,15 @@ typedef struct cli_params {
 /** Parse option @p opt (required; usage error 2 when absent or malformed). */
 int cli_params_parse(const cli_args *a, const char *opt, cli_params *ps);
 void cli_params_free(cli_params *ps);
+/** Bounds of one parameter: given, or [start/1000, start*1000] (start > 0), or any
+ * bounds around the start if @p any; else a usage error (2). */
+int cli_param_bounds(const cli_args *a, const cli_param_spec *p, double start, int any,
+                     double *lo, double *hi);
+/** Append a step to a history file (JSON lines, rewritten atomically): the
+ * command, the model, its error % (and the noise floor, NaN if unknown), the
+ * number of parameters fitted so far, and a note; exit code 0 or 5. */
+int cli_history_append(const char *path, const char *command, const char *model,
+                       double error_pct, double floor_pct, size_t nparams, const char *note);
 /** Add the parameters to @p f: unknown name exit 3, bad bounds exit 2; without
  * bounds [start/1000, start*1000] (start > 0), or any bounds if @p any_bounds. */
 int cli_params_add(const cli_args *a, rcb_fit *f, const rcb_model *m, const cli_params *ps,
@@ -223,6 +242,11 @@ int cmd_simulate(int argc, char **argv);
 int cmd_convert(int argc, char **argv);
 int cmd_fit(int argc, char **argv);
 int cmd_sensitivity(int argc, char **argv);
+int cmd_transient(int argc, char **argv);
+int cmd_timecheck(int argc, char **argv);
+int cmd_compare(int argc, char **argv);
+int cmd_diagnose(int argc, char **argv);
+int cmd_history(int argc, char **argv);
 
 extern const char cli_help_check[];
 extern const char cli_help_matrices[];
@@ -234,6 +258,11 @@ extern const char cli_help_simulate[];
 extern const char cli_help_convert[];
 extern const char cli_help_fit[];
 extern const char cli_help_sensitivity[];
+extern const char cli_help_transient[];
+extern const char cli_help_timecheck[];
+extern const char cli_help_compare[];
+extern const char cli_help_diagnose[];
+extern const char cli_help_history[];
 
 /** Print a command's help text to stdout; returns 0 (or 5 if stdout fails). */
 int cli_print_help(const char *text);

@@ -41,6 +41,7 @@ const char cli_help_fit[] =
     "  --fd           sensitivities by finite differences (eq. 11) instead of the\n"
     "                 analytic ones (eq. 9)\n"
     "  --max-iter N   iteration limit (default 100)\n"
+    "  --history FILE record this fit as a step (rcbtool history FILE shows them)\n"
     "  --starts N     when the fit ends unsure (above 1.5 x the noise floor that\n"
     "                 --noise predicts, or not converged: a local minimum or a\n"
     "                 missing effect), retry from up to N - 1 random starts within\n"
@@ -137,8 +138,8 @@ int cli_params_parse(const cli_args *a, const char *opt, cli_params *ps) {
 
 /* Bounds of one parameter: given, or [start/1000, start*1000]; @p any makes up
  * bounds around any start (for sensitivities, where they do not matter). */
-static int param_bounds(const cli_args *a, const cli_param_spec *p, double start, int any,
-                        double *lo, double *hi) {
+int cli_param_bounds(const cli_args *a, const cli_param_spec *p, double start, int any,
+                     double *lo, double *hi) {
   if (p->has_bounds) {
     *lo = p->lo;
     *hi = p->hi;
@@ -167,7 +168,7 @@ int cli_params_add(const cli_args *a, rcb_fit *f, const rcb_model *m, const cli_
     if (st)
       return cli_fail(st == RCB_ERR_NOT_FOUND ? CLI_EXIT_INPUT : CLI_EXIT_NUMERIC, "%s: %s",
                       a->cmd, cli_msg(rcb_model_errmsg(m), st));
-    if ((rc = param_bounds(a, p, start, any_bounds, &lo, &hi))) return rc;
+    if ((rc = cli_param_bounds(a, p, start, any_bounds, &lo, &hi))) return rc;
     st = rcb_fit_add_param(f, p->name, lo, hi, log_all);
     if (st)
       return st == RCB_ERR_ARG ? cli_usage(a->cmd, "%s", cli_msg(rcb_fit_errmsg(f), st))
@@ -268,37 +269,8 @@ static int check_output(const cli_args *a, const fit_job *j) {
 }
 
 static int read_meas(const cli_args *a, fit_job *j, const rcb_model *m, rcb_meas **out) {
-  const char *path = j->meas_path;
-  cli_uff_map mp;
-  rcb_meas *ms = NULL;
-  rcb_status st;
-  int is_uff = 0, rc;
-  *out = NULL;
-  if ((rc = cli_meas_format(a->cmd, path, &is_uff))) return rc;
-  j->is_uff = is_uff;
-  if ((rc = cli_uff_map_parse(a, "--map", m, &mp))) {
-    cli_uff_map_free(&mp);
-    return rc;
-  }
-  if (!is_uff && cli_opt_value(a, "--map")) {
-    cli_uff_map_free(&mp);
-    return cli_usage(a->cmd, "--map applies to UFF measurements only ('%s' is CSV)", path);
-  }
-  if (rcb_meas_create(&ms, NULL)) {
-    cli_uff_map_free(&mp);
-    return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
-  }
-  st = is_uff ? rcb_meas_read_uff(ms, path, mp.n, mp.nodes) : rcb_meas_read_csv(ms, path);
-  cli_uff_map_free(&mp);
-  if (st) {
-    const char *msg = cli_msg(rcb_meas_errmsg(ms), st);
-    rc = cli_fail(st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC : CLI_EXIT_INPUT, "%s", msg);
-    if (!strstr(msg, path)) fprintf(stderr, "rcbtool: (while reading measurement '%s')\n", path);
-    rcb_meas_destroy(ms);
-    return rc;
-  }
-  *out = ms;
-  return 0;
+  int rc = cli_meas_format(a->cmd, j->meas_path, &j->is_uff);
+  return rc ? rc : cli_meas_read(a, j->meas_path, m, out);
 }
 
 /* Progress per iteration on stderr. */
@@ -578,6 +550,13 @@ static int report(const cli_args *a, const fit_job *j, rcb_fit *f, const rcb_mod
     if (fflush(stdout) != 0 || ferror(stdout))
       rc = cli_fail(CLI_EXIT_IO, "cannot write to standard output");
   }
+  if (!rc && cli_opt_value(a, "--history")) {
+    char note[160];
+    snprintf(note, sizeof note, "fit: error %.4g %% -> %.4g %%%s", r.rep.error0_pct,
+             r.rep.error_pct, r.rep.unsure ? " (unsure)" : "");
+    rc = cli_history_append(cli_opt_value(a, "--history"), "fit", a->model, r.rep.error_pct,
+                            r.rep.floor_pct, r.np, note);
+  }
   free(r.par);
   free(r.corr);
   if (!rc && a->output) rc = write_model(a, m);
@@ -599,39 +578,6 @@ static int run(const cli_args *a, fit_job *j) {
   return rc;
 }
 
-/* ---- command line: MODEL and MEAS are both positional ---- */
-
-static int takes_value(const char *arg, const cli_opt *opts, size_t nopts) {
-  size_t i;
-  if (strchr(arg, '=')) return 0;
-  if (strcmp(arg, "-o") == 0 || strcmp(arg, "--output") == 0) return 1;
-  for (i = 0; i < nopts; i++)
-    if (opts[i].metavar && strcmp(arg, opts[i].name) == 0) return 1;
-  return 0;
-}
-
-/* cli_parse knows one positional argument (the model): take the second one
- * (the measurement) out of argv; returns the number of positionals. */
-static int split_meas(int argc, char **argv, const cli_opt *opts, size_t nopts, char **args,
-                      int *nargs, const char **meas) {
-  int k, npos = 0, only_pos = 0, n = 0;
-  *meas = NULL;
-  for (k = 0; k < argc; k++) {
-    const char *arg = argv[k];
-    int pos = k > 0 && (only_pos || arg[0] != '-' || arg[1] == '\0');
-    if (k > 0 && !only_pos && strcmp(arg, "--") == 0) only_pos = 1;
-    if (pos && ++npos == 2) {
-      *meas = arg;
-      continue;
-    }
-    args[n++] = argv[k];
-    if (k > 0 && !pos && !only_pos && takes_value(arg, opts, nopts) && k + 1 < argc)
-      args[n++] = argv[++k];
-  }
-  *nargs = n;
-  return npos;
-}
-
 int cmd_fit(int argc, char **argv) {
   cli_opt opts[] = {{"--params", "NAME[:LO:HI],...", NULL},
                     {"--log", NULL, NULL},
@@ -642,6 +588,7 @@ int cmd_fit(int argc, char **argv) {
                     {"--fd", NULL, NULL},
                     {"--max-iter", "N", NULL},
                     {"--starts", "N", NULL},
+                    {"--history", "FILE", NULL},
                     {"--map", "NODE=STATION,...", NULL}};
   size_t nopts = sizeof opts / sizeof opts[0];
   fit_job j;
@@ -650,7 +597,7 @@ int cmd_fit(int argc, char **argv) {
   int nargs = 0, rc;
   if (!args) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   memset(&j, 0, sizeof j);
-  split_meas(argc, argv, opts, nopts, args, &nargs, &j.meas_path);
+  cli_split_meas(argc, argv, opts, nopts, args, &nargs, &j.meas_path);
   rc = cli_parse(nargs, args, opts, nopts, &a);
   if (!rc && a.help) rc = cli_print_help(cli_help_fit);
   else if (!rc && !j.meas_path)

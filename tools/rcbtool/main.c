@@ -24,6 +24,16 @@ static const cli_command commands[] = {
      cmd_fit},
     {"sensitivity", "rank measurement channels by sensitivity to parameters",
      cli_help_sensitivity, cmd_sensitivity},
+    {"compare", "where the model fails: errors per channel and band, peaks vs modes, plots",
+     cli_help_compare, cmd_compare},
+    {"diagnose", "which physical effect is missing, and where; --apply adds it (fitted)",
+     cli_help_diagnose, cmd_diagnose},
+    {"history", "the steps of a session (fit, diagnose, apply) and the error falling",
+     cli_help_history, cmd_history},
+    {"transient", "time histories: constant speed, run-up, coast-down (SUNDIALS)",
+     cli_help_transient, cmd_transient},
+    {"timecheck", "unbalance response: frequency domain vs time integration, per speed",
+     cli_help_timecheck, cmd_timecheck},
 };
 #define N_COMMANDS (sizeof commands / sizeof commands[0])
 

@@ -1,0 +1,65 @@
+/* The transient-analysis object, shared by transient.c (setup, equations of
+ * motion) and transient_run.c (runs, steady-state extraction). */
+#ifndef RCB_TRANSIENT_INTERNAL_H
+#define RCB_TRANSIENT_INTERNAL_H
+
+#include <lapacke.h>
+
+#include "assembly/assembly.h"
+#include "solvers/sundials_adapter.h"
+
+#if RCB_WITH_SUNDIALS
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_linearsolver.h>
+#include <sundials/sundials_matrix.h>
+#endif
+
+struct rcb_transient {
+  rcb_allocator alloc;
+  char errmsg[RCB_ERRMSG_MAX];
+  const rcb_model *m;
+  size_t n, nout, *out_row;
+  /* M^-1 times the speed-independent matrices (structure and constant
+   * bearings), n x n column-major: 1/s^2, 1/s, 1/s. */
+  double *MiK, *MiC, *MiG;
+  /* Tabulated (speed-dependent) bearings: their indices, and M^-1 e_r for
+   * the x and y rows r of each (n x 2 ntab), 1/kg. */
+  size_t ntab, *tab;
+  double *MiB;
+  double *Pr, *Pi; /* M^-1 F1 (unbalance phasor at unit speed), m/s^2 per (rad/s)^2 */
+  double *q, *v, *out; /* sample buffers: n, n, nout */
+  rcb_complex *Qa, *Qb; /* steady state: 1X phasors of two revolutions (nout) */
+  double rtol, atol_q, atol_v;
+  double ss_tol;
+  size_t ss_spp, ss_max_periods;
+  rcb_speed_profile prof; /* of the run in progress */
+  rcb_transient_stats stats;
+  size_t bytes;
+#if RCB_WITH_SUNDIALS
+  SUNContext ctx;
+  void *cvode;
+  N_Vector y, abstol;
+  SUNMatrix J;
+  SUNLinearSolver LS;
+  rcb_sun_route route;
+  double *S;      /* Schur complement of I - gamma J, n x n, LU-factored */
+  lapack_int *ipiv; /* its pivots */
+  char sunmsg[256]; /* last SUNDIALS message */
+  int started;      /* CVodeInit done */
+#endif
+};
+
+/* Omega (rad/s), alpha (rad/s^2) and phi (rad) of the profile at time t (s). */
+void rcb_profile_eval(const rcb_speed_profile *p, double t, double *speed, double *accel,
+                      double *angle);
+
+#if RCB_WITH_SUNDIALS
+/* CVODE callbacks (transient.c). */
+int rcb_transient_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void *user);
+/* The Schur-complement linear solver for CVODE (transient_linsol.c). */
+SUNLinearSolver rcb_transient_linsol(rcb_transient *t);
+int rcb_transient_jac(sunrealtype t, N_Vector y, N_Vector fy, SUNMatrix J, void *user,
+                      N_Vector tmp1, N_Vector tmp2, N_Vector tmp3);
+#endif
+
+#endif

@@ -1,0 +1,334 @@
+/*
+ * Allocation-failure injection (issue #7): an allocator hook that fails the
+ * k-th allocation, walked over k = 1, 2, ... until a run finishes without
+ * reaching k, for each of: loading a model from an INI string, creating an
+ * FRF object and sweeping it, a small fit (the paper's method, noise-free
+ * data, 2 parameters), and reading a CSV measurement. Every run must
+ *  - return an error status when the failing allocation was reached (never
+ *    RCB_OK with a silently missing piece), RCB_ERR_NOMEM or an error that
+ *    propagated from it, with a message;
+ *  - free everything it allocated (the hook counts allocations and frees;
+ *    the sanitizer build checks the same with LeakSanitizer);
+ *  - not crash.
+ * A final run with no failure checks the scenario's result, so the walk
+ * covers a path that really works.
+ */
+#define _POSIX_C_SOURCE 200809L /* mkdtemp */
+#include <complex.h>
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <cmocka.h>
+
+#include "core/rcb_internal.h"
+#include "rcb_test_util.h"
+
+typedef struct failing {
+  size_t fail_at; /* 1-based index of the allocation that fails, 0 = never */
+  size_t allocs;  /* allocation calls so far (the failing one included) */
+  size_t frees;   /* free calls on pointers we handed out */
+  size_t live;    /* allocated and not yet freed */
+  int hit;        /* the failing allocation was reached */
+} failing;
+
+static void *f_alloc(void *user, size_t size) {
+  failing *f = user;
+  f->allocs++;
+  if (f->fail_at && f->allocs == f->fail_at) {
+    f->hit = 1;
+    return NULL;
+  }
+  f->live++;
+  return malloc(size);
+}
+
+static void f_free(void *user, void *p) {
+  failing *f = user;
+  if (!p) return;
+  f->frees++;
+  f->live--;
+  free(p);
+}
+
+static rcb_allocator hooks(failing *f) {
+  rcb_allocator a;
+  a.alloc = f_alloc;
+  a.free = f_free;
+  a.user = f;
+  return a;
+}
+
+/* Two shafts, nelson_crandall_1 coupling, bearings, a disk, an unbalance,
+ * a probe and a UFF map: every kind of item the loader allocates for. */
+static const char MODEL[] =
+    "[model]\nname = alloc test\n"
+    "[material steel]\ndensity = 7800\nyoung = 2e11\npoisson = 0.3\n"
+    "[shaft A]\nmaterial = steel\nshear_factor = 0.9\nsegment = 0.3 0.02 0 3\n"
+    "segment = 0.2 0.03 0.01 2\n"
+    "[shaft B]\nmaterial = steel\nshear_factor = 0.9\nstart = 0.6\n"
+    "damping_stiffness = 1e-5\nsegment = 0.5 0.02 0.0 5\n"
+    "[bearing B1]\nat = A 0.1\nkxx = 1e7\nkyy = 2e7\ncxx = 100\ncyy = 100\n"
+    "[bearing B2]\nat = B 1.0\nspeed_rpm = 0 3000 6000\nkxx = 1e7 2e7 3e7\nkyy = 1e7\n"
+    "[disk D]\nat = A 0.2\ndensity = 7800\nouter_diameter = 0.1\ninner_diameter = 0.02\n"
+    "width = 0.02\n"
+    "[coupling C]\nmodel = nelson_crandall_1\nbetween = A end, B start\nkt = 1e5\n"
+    "kr = 1e3\nhub_mass = 0.1\nhub_Id = 1e-4\nhub_Ip = 2e-4\n"
+    "[unbalance U]\nat = D\namount = 1e-4\nphase_deg = 30\n"
+    "[station P]\nat = B 0.8\n"
+    "[uff]\nmap = 1 D, 2 P\n";
+
+typedef rcb_status (*scenario)(const rcb_allocator *a, int check);
+
+/* Walk k = 1.. until the scenario runs without reaching k; returns the
+ * number of allocations of the complete run. */
+static size_t walk(const char *name, scenario run) {
+  size_t k;
+  for (k = 1;; k++) {
+    failing f = {k, 0, 0, 0, 0};
+    rcb_allocator a = hooks(&f);
+    rcb_status st = run(&a, 0);
+    if (f.live != 0)
+      fail_msg("%s: failing allocation %zu: %zu blocks leaked (status %s)", name, k, f.live,
+               rcb_status_str(st));
+    if (f.hit && st == RCB_OK)
+      fail_msg("%s: allocation %zu failed but the run returned RCB_OK", name, k);
+    if (!f.hit) {
+      failing g = {0, 0, 0, 0, 0};
+      rcb_allocator b = hooks(&g);
+      assert_int_equal(st, RCB_OK);
+      assert_int_equal(run(&b, 1), RCB_OK); /* and its result is right */
+      assert_int_equal(g.live, 0);
+      assert_int_equal(g.allocs, k - 1);
+      return k - 1;
+    }
+    if (k > 100000) fail_msg("%s: no end to the walk", name);
+  }
+}
+
+/* ---- scenarios; each frees everything before returning ---- */
+
+static rcb_status load(const rcb_allocator *a, rcb_model **out) {
+  rcb_model *m = NULL;
+  rcb_status st = rcb_model_create(&m, a);
+  *out = NULL;
+  if (st) {
+    assert_null(m);
+    assert_int_equal(st, RCB_ERR_NOMEM);
+    return st;
+  }
+  st = rcb_model_load_string(m, MODEL, "<alloc>");
+  if (st) {
+    assert_true(rcb_model_errmsg(m)[0] != '\0');
+    rcb_model_destroy(m);
+    return st;
+  }
+  *out = m;
+  return RCB_OK;
+}
+
+static rcb_status sc_load(const rcb_allocator *a, int check) {
+  rcb_model *m = NULL;
+  rcb_status st = load(a, &m);
+  if (st) return st;
+  if (check) {
+    long node;
+    const char *station;
+    assert_int_equal(rcb_model_node_count(m), 5 + 1 + 5 + 1);
+    assert_int_equal(rcb_model_uff_node_count(m), 2);
+    assert_int_equal(rcb_model_uff_node(m, 1, &node, &station), RCB_OK);
+    assert_int_equal(node, 2);
+    assert_string_equal(station, "P");
+  }
+  rcb_model_destroy(m);
+  return RCB_OK;
+}
+
+static rcb_status sc_frf(const rcb_allocator *a, int check) {
+  rcb_model *m = NULL;
+  rcb_frf *f = NULL;
+  rcb_dof d[2];
+  rcb_complex H[4], Q[2];
+  rcb_status st = load(a, &m);
+  int i, s;
+  if (st) return st;
+  assert_int_equal(rcb_model_find_dof(m, "D.x", &d[0]), RCB_OK);
+  assert_int_equal(rcb_model_find_dof(m, "P.y", &d[1]), RCB_OK);
+  for (s = 1; s <= 2 && !st; s++) { /* dense and banded workspaces */
+    st = rcb_frf_create(&f, m, 2, d, 2, d, (rcb_solver_kind)s, a);
+    if (st) {
+      assert_null(f);
+      break;
+    }
+    for (i = 0; i < 5 && !st; i++) st = rcb_frf_eval(f, 50.0 * i + 10.0, 300.0, RCB_RECEPTANCE, H);
+    if (!st) st = rcb_frf_unbalance(f, 300.0, Q);
+    if (!st && check) {
+      /* reciprocity without rotation-dependent terms is broken by G; at
+       * speed 0 and no cross-coupled bearings H is symmetric */
+      assert_int_equal(rcb_frf_eval(f, 100.0, 0.0, RCB_RECEPTANCE, H), RCB_OK);
+      assert_true(cabs(H[1] - H[2]) <= 1e-9 * cabs(H[1]) + 1e-30);
+      assert_true(cabs(Q[0]) > 0.0);
+    }
+    rcb_frf_destroy(f);
+    f = NULL;
+  }
+  rcb_model_destroy(m);
+  return st;
+}
+
+static char tmpdir[256];
+
+static const char *csv_path(void) {
+  static char p[300];
+  snprintf(p, sizeof p, "%s/meas.csv", tmpdir);
+  return p;
+}
+
+static rcb_status sc_csv(const rcb_allocator *a, int check) {
+  rcb_meas *ms = NULL;
+  rcb_status st = rcb_meas_create(&ms, a);
+  if (st) {
+    assert_null(ms);
+    return st;
+  }
+  st = rcb_meas_read_csv(ms, csv_path());
+  if (st) assert_true(rcb_meas_errmsg(ms)[0] != '\0');
+  if (!st && check) {
+    rcb_meas_channel_info ci;
+    assert_int_equal(rcb_meas_point_count(ms), 3);
+    assert_int_equal(rcb_meas_channel_count(ms), 2);
+    assert_int_equal(rcb_meas_channel(ms, 1, &ci), RCB_OK);
+    assert_string_equal(ci.response, "P.y");
+    assert_true(creal(ci.data[2]) == 7.0 && cimag(ci.data[2]) == -8.0);
+    assert_true(rcb_test_close(rcb_meas_grid(ms)[1], 2.0 * RCB_PI * 20.0, 1e-15, 0.0));
+  }
+  rcb_meas_destroy(ms);
+  return st;
+}
+
+/* Noise-free FRF "measurement" of the model (plain malloc: not walked). */
+static rcb_meas *truth_meas(void) {
+  rcb_model *m = rcb_test_model_from_string(MODEL);
+  rcb_meas *ms = NULL;
+  rcb_frf *f = NULL;
+  rcb_dof d[4];
+  double x[12];
+  rcb_complex H[4 * 12], col[12];
+  size_t i, o;
+  static const char *const outs[4] = {"C.A.x", "C.B.x", "C.A.ry", "C.B.ry"};
+  for (o = 0; o < 4; o++) assert_int_equal(rcb_model_find_dof(m, outs[o], &d[o]), RCB_OK);
+  assert_int_equal(rcb_frf_create(&f, m, 4, d, 1, d, RCB_SOLVER_AUTO, NULL), RCB_OK);
+  for (i = 0; i < 12; i++) {
+    x[i] = 2.0 * RCB_PI * (50.0 + 40.0 * (double)i);
+    assert_int_equal(rcb_frf_eval(f, x[i], 0.0, RCB_RECEPTANCE, H + 4 * i), RCB_OK);
+  }
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, 12, x, 0.0), RCB_OK);
+  for (o = 0; o < 4; o++) {
+    for (i = 0; i < 12; i++) col[i] = H[4 * i + o];
+    assert_int_equal(rcb_meas_add_channel(ms, outs[o], "C.A.x", RCB_RECEPTANCE, col), RCB_OK);
+  }
+  rcb_frf_destroy(f);
+  rcb_model_destroy(m);
+  return ms;
+}
+
+static rcb_meas *g_truth;
+
+static rcb_status sc_fit(const rcb_allocator *a, int check) {
+  rcb_model *m = NULL;
+  rcb_fit *f = NULL;
+  rcb_status st = load(a, &m);
+  if (st) return st;
+  /* start a factor 2 away from the truth (kt 1e5 N/m, kr 1e3 N m/rad) */
+  assert_int_equal(rcb_model_set_param(m, "coupling.C.kt", 2e5), RCB_OK);
+  assert_int_equal(rcb_model_set_param(m, "coupling.C.kr", 5e2), RCB_OK);
+  st = rcb_fit_create(&f, m, g_truth, a);
+  if (!st) st = rcb_fit_add_param(f, "coupling.C.kt", 1e3, 1e7, 1);
+  if (!st) st = rcb_fit_add_param(f, "coupling.C.kr", 1e1, 1e5, 1);
+  if (!st) st = rcb_fit_set_scale(f, RCB_SCALE_LOG10);
+  if (!st) st = rcb_fit_run(f);
+  if (st && f) assert_true(rcb_fit_errmsg(f)[0] != '\0');
+  if (!st && check) {
+    double kt, kr;
+    rcb_fit_report r;
+    assert_int_equal(rcb_model_get_param(m, "coupling.C.kt", &kt), RCB_OK);
+    assert_int_equal(rcb_model_get_param(m, "coupling.C.kr", &kr), RCB_OK);
+    print_message("fit: kt %.9g kr %.9g\n", kt, kr);
+    assert_true(rcb_test_close(kt, 1e5, 1e-5, 0.0));
+    assert_true(rcb_test_close(kr, 1e3, 1e-5, 0.0));
+    assert_int_equal(rcb_fit_get_report(f, &r), RCB_OK);
+    assert_true(r.converged);
+  }
+  rcb_fit_destroy(f);
+  rcb_model_destroy(m);
+  return st;
+}
+
+/* ---- tests ---- */
+
+static void test_load(void **state) {
+  size_t n;
+  (void)state;
+  n = walk("model load", sc_load);
+  print_message("model load: %zu allocation sites walked\n", n);
+  assert_true(n > 10);
+}
+
+static void test_frf(void **state) {
+  size_t n;
+  (void)state;
+  n = walk("FRF create + sweep", sc_frf);
+  print_message("FRF: %zu allocation sites walked\n", n);
+}
+
+static void test_csv(void **state) {
+  size_t n;
+  FILE *fp;
+  (void)state;
+  fp = fopen(csv_path(), "w");
+  assert_non_null(fp);
+  fputs("# kind = receptance\n# rpm = 0\nfreq_hz,D.x/D.x re,D.x/D.x im,P.y/D.x re,P.y/D.x im\n"
+        "10,1,2,3,4\n20,5,6,7,8\n30,1e-9,-2e-9,7,-8\n",
+        fp);
+  fclose(fp);
+  n = walk("CSV read", sc_csv);
+  print_message("CSV read: %zu allocation sites walked\n", n);
+  assert_true(n > 1);
+}
+
+static void test_fit(void **state) {
+  size_t n;
+  (void)state;
+  g_truth = truth_meas();
+  n = walk("fit (paper method)", sc_fit);
+  print_message("fit: %zu allocation sites walked\n", n);
+  rcb_meas_destroy(g_truth);
+  g_truth = NULL;
+}
+
+static int setup_dir(void **state) {
+  (void)state;
+  snprintf(tmpdir, sizeof tmpdir, "/tmp/rcb_test_alloc_XXXXXX");
+  return mkdtemp(tmpdir) ? 0 : -1;
+}
+
+static int teardown_dir(void **state) {
+  char cmd[300];
+  (void)state;
+  snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
+  return system(cmd) == 0 ? 0 : -1;
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_load),
+      cmocka_unit_test(test_frf),
+      cmocka_unit_test(test_csv),
+      cmocka_unit_test(test_fit),
+  };
+  return cmocka_run_group_tests(tests, setup_dir, teardown_dir);
+}

@@ -1,0 +1,279 @@
+/* rcbtool diagnose: which physical effect is the model missing, and where?
+ * With --apply K, write the model with candidate K added and fitted. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+
+const char cli_help_diagnose[] =
+    "usage: rcbtool diagnose MODEL.ini MEAS.uff|MEAS.csv [--params NAME[:LO:HI],...]\n"
+    "                        [--log] [--scale linear|log10|db|complex] [--noise A,S]\n"
+    "                        [--band LO:HI] [--map NODE=STATION,...] [--refits N]\n"
+    "                        [--top N] [--apply K -o MODEL2.ini] [--history FILE]\n"
+    "                        [--json] [--progress]\n"
+    "\n"
+    "Fits the model as it is (the --params, e.g. the coupling's kt and kr), then\n"
+    "scores every effect of the catalogue at every place it can occur: coupling\n"
+    "damping and rotational stiffness, another coupling model, coupling hub mass\n"
+    "and inertia, bearing stiffness in each direction (anisotropy), bearing\n"
+    "cross-coupled stiffness kxy = -kyx, bearing damping, shaft material damping,\n"
+    "an added mass or inertia at each node. The score is the error reduction the\n"
+    "effect can explain (score test on the weighted objective, orthogonal to the\n"
+    "fitted parameters); the best N (--refits, default 8) and the other coupling\n"
+    "models are refitted, and ranked by the change of BIC. A candidate is\n"
+    "significant when BIC falls by more than 10 and the error itself falls.\n"
+    "  --noise A,S    the eq. 19 noise model (random A %, systematic S %): weights\n"
+    "                 and the noise floor (strongly recommended)\n"
+    "  --top N        candidates to print (default 10)\n"
+    "  --apply K      with -o FILE: write the model with candidate K (1 = best)\n"
+    "                 added and fitted, atomically; the input model is untouched\n"
+    "  --history FILE record this step (rcbtool history FILE shows the steps)\n"
+    "Other options as for rcbtool fit. Exit codes: 0 ok, 2 usage, 3 bad input,\n"
+    "4 numerical failure, 5 output error.\n";
+
+static const char *const scale_names[] = {"linear", "log10", "db", "complex"};
+
+typedef struct diag_job {
+  const char *meas_path;
+  cli_params params;
+  int have_params, log_all, scale, have_noise, have_band;
+  double beta_a, beta_s, band_lo, band_hi;
+  size_t refits, top, apply;
+  const char *history;
+} diag_job;
+
+static int pair(const cli_args *a, const char *opt, char sep, double *x, double *y) {
+  const char *s = cli_opt_value(a, opt), *t = s ? strchr(s, sep) : NULL;
+  char *e1, *e2;
+  if (!t) return cli_usage(a->cmd, "option %s expects two numbers separated by '%c'", opt, sep);
+  *x = strtod(s, &e1);
+  *y = strtod(t + 1, &e2);
+  if (e1 != t || *e2 || !isfinite(*x) || !isfinite(*y))
+    return cli_usage(a->cmd, "option %s expects two numbers separated by '%c', got '%s'", opt,
+                     sep, s);
+  return 0;
+}
+
+static int parse_job(const cli_args *a, diag_job *j) {
+  int rc;
+  j->log_all = cli_opt_value(a, "--log") != NULL;
+  j->history = cli_opt_value(a, "--history");
+  if ((rc = cli_opt_choice(a, "--scale", scale_names, 4, RCB_SCALE_LOG10, &j->scale)) ||
+      (rc = cli_opt_count(a, "--refits", 8, &j->refits)) ||
+      (rc = cli_opt_count(a, "--top", 10, &j->top)) ||
+      (rc = cli_opt_count(a, "--apply", 0, &j->apply)))
+    return rc;
+  if ((j->have_noise = cli_opt_value(a, "--noise") != NULL) &&
+      (rc = pair(a, "--noise", ',', &j->beta_a, &j->beta_s)))
+    return rc;
+  if ((j->have_band = cli_opt_value(a, "--band") != NULL) &&
+      (rc = pair(a, "--band", ':', &j->band_lo, &j->band_hi)))
+    return rc;
+  if (j->apply && !a->output)
+    return cli_usage(a->cmd, "--apply K writes a model: give -o MODEL2.ini");
+  if ((j->have_params = cli_opt_value(a, "--params") != NULL) &&
+      (rc = cli_params_parse(a, "--params", &j->params)))
+    return rc;
+  return 0;
+}
+
+static int setup(const cli_args *a, const diag_job *j, const rcb_model *m, const rcb_meas *ms,
+                 rcb_diag *d) {
+  double unit = rcb_meas_get_type(ms) == RCB_MEAS_FRF ? CLI_HZ_TO_RAD_S : CLI_RPM_TO_RAD_S;
+  rcb_status st = rcb_diag_set_scale(d, (rcb_fit_scale)j->scale);
+  size_t k;
+  if (!st && j->have_noise) st = rcb_diag_set_noise_model(d, j->beta_a, j->beta_s);
+  if (!st && j->have_band) st = rcb_diag_set_band(d, j->band_lo * unit, j->band_hi * unit);
+  if (!st) st = rcb_diag_set_refits(d, j->refits);
+  if (st) return cli_usage(a->cmd, "invalid --noise, --band or --refits value");
+  for (k = 0; j->have_params && k < j->params.n; k++) {
+    const cli_param_spec *p = &j->params.items[k];
+    double v, lo = 0, hi = 0;
+    int rc;
+    if (rcb_model_get_param(m, p->name, &v))
+      return cli_fail(CLI_EXIT_INPUT, "%s: %s", a->cmd, rcb_model_errmsg(m));
+    if ((rc = cli_param_bounds(a, p, v, 0, &lo, &hi))) return rc;
+    if (rcb_diag_add_fitted_param(d, p->name, lo, hi, j->log_all))
+      return cli_fail(CLI_EXIT_NUMERIC, "%s: %s", a->cmd, rcb_diag_errmsg(d));
+  }
+  return 0;
+}
+
+typedef struct prog_ctx {
+  cli_progress p;
+  const cli_args *a;
+  int started;
+} prog_ctx;
+
+static int progress_cb(void *user, size_t done, size_t total) {
+  prog_ctx *c = user;
+  if (!c->started) {
+    cli_progress_start(&c->p, c->a, "diagnose", "steps", total);
+    c->started = 1;
+  }
+  cli_progress_step(&c->p, done);
+  return 0;
+}
+
+static void print_text(FILE *fp, const diag_job *j, const rcb_diag *d, const char *explain) {
+  double e0, floor_pct;
+  size_t k, n = rcb_diag_candidate_count(d);
+  rcb_diag_baseline(d, &e0, NULL, &floor_pct);
+  fprintf(fp, "the model as it is: error %.4g %%", e0);
+  if (isfinite(floor_pct)) fprintf(fp, " (noise floor %.4g %%)", floor_pct);
+  fprintf(fp, "; %zu candidates scored\n\n", n);
+  fprintf(fp, "%-4s %-5s %-58s %9s %9s %10s  %s\n", "rank", "sig", "candidate", "score %",
+          "error %", "dBIC", "fitted");
+  for (k = 0; k < n && k < j->top; k++) {
+    rcb_diag_candidate c;
+    rcb_diag_candidate_get(d, k, &c);
+    fprintf(fp, "%-4zu %-5s %-58.58s %9.3g ", k + 1, c.significant ? "YES" : "no",
+            c.description, c.predicted_pct);
+    if (c.refitted)
+      fprintf(fp, "%9.4g %+10.1f  %s\n", c.error_pct, c.delta_bic, c.fitted);
+    else
+      fprintf(fp, "%9s %10s  %s\n", "-", "-", c.fitted[0] ? c.fitted : "(not refitted)");
+  }
+  fprintf(fp, "\n%s\n", explain);
+}
+
+static void print_json(FILE *fp, const diag_job *j, const rcb_diag *d, const char *explain) {
+  double e0, floor_pct;
+  size_t k, n = rcb_diag_candidate_count(d);
+  rcb_diag_baseline(d, &e0, NULL, &floor_pct);
+  fputs("{\"error0_pct\": ", fp);
+  cli_json_num(fp, e0);
+  fputs(", \"floor_pct\": ", fp);
+  cli_json_num(fp, floor_pct);
+  fputs(", \"explanation\": ", fp);
+  cli_json_str(fp, explain);
+  fputs(",\n\"candidates\": [", fp);
+  for (k = 0; k < n && k < j->top; k++) {
+    rcb_diag_candidate c;
+    rcb_diag_candidate_get(d, k, &c);
+    fprintf(fp, "%s\n  {\"rank\": %zu, \"effect\": ", k ? "," : "", k + 1);
+    cli_json_str(fp, rcb_effect_name(c.effect));
+    fputs(", \"place\": ", fp);
+    cli_json_str(fp, c.place);
+    fputs(", \"description\": ", fp);
+    cli_json_str(fp, c.description);
+    fputs(", \"params\": ", fp);
+    cli_json_str(fp, c.params);
+    fputs(", \"score_pct\": ", fp);
+    cli_json_num(fp, c.predicted_pct);
+    fprintf(fp, ", \"refitted\": %s, \"error_pct\": ", c.refitted ? "true" : "false");
+    cli_json_num(fp, c.error_pct);
+    fputs(", \"delta_bic\": ", fp);
+    cli_json_num(fp, c.delta_bic);
+    fprintf(fp, ", \"significant\": %s, \"fitted\": ", c.significant ? "true" : "false");
+    cli_json_str(fp, c.fitted);
+    fputs("}", fp);
+  }
+  fputs("]}\n", fp);
+}
+
+/* --apply K: the candidate's fitted model to -o, the report to stdout. */
+static int apply(const cli_args *a, const diag_job *j, const rcb_diag *d) {
+  size_t need = 0;
+  char *buf;
+  cli_out o;
+  int rc;
+  if (j->apply > rcb_diag_candidate_count(d))
+    return cli_usage(a->cmd, "--apply %zu: there are %zu candidates", j->apply,
+                     rcb_diag_candidate_count(d));
+  if (rcb_diag_apply_ini(d, j->apply - 1, NULL, 0, &need) != RCB_ERR_WORKSPACE)
+    return cli_fail(CLI_EXIT_INPUT, "%s: %s", a->cmd, rcb_diag_errmsg(d));
+  if (!(buf = malloc(need))) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  rcb_diag_apply_ini(d, j->apply - 1, buf, need, &need);
+  if ((rc = cli_out_open(&o, a))) {
+    free(buf);
+    return rc;
+  }
+  fputs(buf, o.fp);
+  free(buf);
+  return cli_out_close(&o);
+}
+
+static int record(const cli_args *a, const diag_job *j, const rcb_diag *d, const char *text) {
+  double e0, floor_pct;
+  rcb_diag_candidate c;
+  char note[700];
+  rcb_diag_baseline(d, &e0, NULL, &floor_pct);
+  if (j->apply && !rcb_diag_candidate_get(d, j->apply - 1, &c)) {
+    snprintf(note, sizeof note, "applied: %s (%s)", c.description, c.fitted);
+    return cli_history_append(j->history, "apply", a->output, c.error_pct, floor_pct,
+                              (j->have_params ? j->params.n : 0) +
+                                  (size_t)(strchr(c.params, ',') ? 2 : 1),
+                              note);
+  }
+  return cli_history_append(j->history, "diagnose", a->model, e0, floor_pct,
+                            j->have_params ? j->params.n : 0, text);
+}
+
+static int run(const cli_args *a, diag_job *j) {
+  rcb_model *m = NULL;
+  rcb_meas *ms = NULL;
+  rcb_diag *d = NULL;
+  char text[1200];
+  size_t need;
+  rcb_status st;
+  prog_ctx pc;
+  int rc;
+  memset(&pc, 0, sizeof pc);
+  pc.a = a;
+  if ((rc = cli_load_model(a, &m))) return rc;
+  if ((rc = cli_meas_read(a, j->meas_path, m, &ms))) goto done;
+  if ((st = rcb_diag_create(&d, m, ms, NULL))) {
+    rc = cli_fail(cli_status_exit(st), "%s: %s", a->cmd, cli_msg(rcb_diag_errmsg(d), st));
+    goto done;
+  }
+  if ((rc = setup(a, j, m, ms, d))) goto done;
+  rcb_diag_set_progress(d, progress_cb, &pc);
+  if ((st = rcb_diag_run(d))) {
+    rc = cli_fail(cli_status_exit(st), "%s: %s", a->cmd, cli_msg(rcb_diag_errmsg(d), st));
+    goto done;
+  }
+  if (pc.started) cli_progress_end(&pc.p);
+  rcb_diag_explain(d, text, sizeof text, &need);
+  (a->json ? print_json : print_text)(stdout, j, d, text);
+  if (j->apply && (rc = apply(a, j, d))) goto done;
+  if (j->history) rc = record(a, j, d, text);
+done:
+  rcb_diag_destroy(d);
+  rcb_meas_destroy(ms);
+  rcb_model_destroy(m);
+  return rc;
+}
+
+int cmd_diagnose(int argc, char **argv) {
+  cli_opt opts[] = {{"--params", "NAME[:LO:HI],...", NULL},
+                    {"--log", NULL, NULL},
+                    {"--scale", "SCALE", NULL},
+                    {"--noise", "BETA_A,BETA_S", NULL},
+                    {"--band", "LO:HI", NULL},
+                    {"--map", "NODE=STATION,...", NULL},
+                    {"--refits", "N", NULL},
+                    {"--top", "N", NULL},
+                    {"--apply", "K", NULL},
+                    {"--history", "FILE", NULL}};
+  size_t nopts = sizeof opts / sizeof opts[0];
+  diag_job j;
+  cli_args a;
+  char **args = malloc(((size_t)argc + 1) * sizeof *args);
+  int nargs = 0, rc;
+  if (!args) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  memset(&j, 0, sizeof j);
+  cli_split_meas(argc, argv, opts, nopts, args, &nargs, &j.meas_path);
+  rc = cli_parse(nargs, args, opts, nopts, &a);
+  if (!rc && a.help) rc = cli_print_help(cli_help_diagnose);
+  else if (!rc && !j.meas_path)
+    rc = cli_usage(a.cmd, "missing the measurement; expected rcbtool diagnose MODEL.ini "
+                          "MEAS.uff|MEAS.csv");
+  else if (!rc && !(rc = parse_job(&a, &j)))
+    rc = run(&a, &j);
+  if (j.have_params) cli_params_free(&j.params);
+  free(args);
+  return rc;
+}

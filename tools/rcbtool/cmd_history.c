@@ -1,0 +1,192 @@
+/* rcbtool history: the steps of a model-improvement session (fit, diagnose,
+ * apply), their errors and parameter counts, and the error falling. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+
+const char cli_help_history[] =
+    "usage: rcbtool history FILE [--json]\n"
+    "\n"
+    "Prints the steps recorded in FILE by 'rcbtool fit --history FILE' and 'rcbtool\n"
+    "diagnose --history FILE': command, model, error %, noise floor %, number of\n"
+    "parameters, note; then draws the error falling, one bar per step.\n"
+    "FILE holds one JSON object per line; --json prints them as one JSON array.\n";
+
+/* Escape a string for JSON (quotes, backslashes, control characters). */
+static void json_str(FILE *fp, const char *s) {
+  fputc('"', fp);
+  for (; s && *s; s++) {
+    if (*s == '"' || *s == '\\')
+      fprintf(fp, "\\%c", *s);
+    else if ((unsigned char)*s < 0x20)
+      fprintf(fp, "\\u%04x", (unsigned)(unsigned char)*s);
+    else
+      fputc(*s, fp);
+  }
+  fputc('"', fp);
+}
+
+static char *slurp(const char *path, size_t *len) {
+  FILE *fp = fopen(path, "rb");
+  char *buf = NULL;
+  size_t cap = 0, n = 0, r;
+  *len = 0;
+  if (!fp) return NULL;
+  do {
+    if (n + 4096 + 1 > cap) {
+      char *nb = realloc(buf, cap = 2 * cap + 8192);
+      if (!nb) break;
+      buf = nb;
+    }
+    r = fread(buf + n, 1, cap - n - 1, fp);
+    n += r;
+  } while (r > 0);
+  fclose(fp);
+  if (buf) buf[n] = '\0';
+  *len = n;
+  return buf;
+}
+
+int cli_history_append(const char *path, const char *command, const char *model,
+                       double error_pct, double floor_pct, size_t nparams, const char *note) {
+  size_t len = 0;
+  char *old = slurp(path, &len);
+  char *tmp = malloc(strlen(path) + 16);
+  FILE *fp;
+  int ok;
+  if (!tmp) return cli_fail(CLI_EXIT_IO, "out of memory");
+  sprintf(tmp, "%s.tmpXXXXXX", path);
+  {
+    int fd = mkstemp(tmp);
+    fp = fd >= 0 ? fdopen(fd, "w") : NULL;
+  }
+  if (!fp) {
+    free(old);
+    free(tmp);
+    return cli_fail(CLI_EXIT_IO, "history '%s': cannot write next to it", path);
+  }
+  if (old) fwrite(old, 1, len, fp);
+  fputs("{\"command\": ", fp);
+  json_str(fp, command);
+  fputs(", \"model\": ", fp);
+  json_str(fp, model);
+  fputs(", \"error_pct\": ", fp);
+  cli_json_num(fp, error_pct);
+  fputs(", \"floor_pct\": ", fp);
+  cli_json_num(fp, floor_pct);
+  fprintf(fp, ", \"params\": %zu, \"note\": ", nparams);
+  json_str(fp, note);
+  fputs("}\n", fp);
+  ok = !ferror(fp);
+  ok = (fclose(fp) == 0) && ok;
+  if (ok) ok = rename(tmp, path) == 0;
+  if (!ok) remove(tmp);
+  free(old);
+  free(tmp);
+  return ok ? 0 : cli_fail(CLI_EXIT_IO, "history '%s': write failed", path);
+}
+
+/* The value of "key": in a JSON line (a string or a number), copied to out. */
+static int field(const char *line, const char *key, char *out, size_t size) {
+  char pat[64];
+  const char *p;
+  size_t n = 0;
+  snprintf(pat, sizeof pat, "\"%s\": ", key);
+  if (!(p = strstr(line, pat))) return 0;
+  p += strlen(pat);
+  if (*p == '"') {
+    for (p++; *p && *p != '"' && n + 1 < size; p++) {
+      if (*p == '\\' && p[1]) p++;
+      out[n++] = *p;
+    }
+  } else {
+    while (*p && *p != ',' && *p != '}' && n + 1 < size) out[n++] = *p++;
+  }
+  out[n] = '\0';
+  return 1;
+}
+
+static void print_steps(char *text) {
+  char *line, *save = NULL;
+  double emax = 0;
+  int step = 0, pass;
+  for (pass = 0; pass < 2; pass++) {
+    char *copy = strdup(text);
+    if (!copy) return;
+    step = 0;
+    if (pass == 1) {
+      printf("%-4s %-10s %-28s %10s %10s %6s  %s\n", "step", "command", "model", "error %",
+             "floor %", "params", "note");
+    }
+    for (line = strtok_r(copy, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
+      char cmd[32] = "", model[256] = "", err[64] = "", flo[64] = "", np[16] = "",
+           note[512] = "";
+      double e;
+      field(line, "command", cmd, sizeof cmd);
+      field(line, "model", model, sizeof model);
+      field(line, "error_pct", err, sizeof err);
+      field(line, "floor_pct", flo, sizeof flo);
+      field(line, "params", np, sizeof np);
+      field(line, "note", note, sizeof note);
+      e = atof(err);
+      step++;
+      if (pass == 0) {
+        if (e > emax) emax = e;
+        continue;
+      }
+      if (strcmp(flo, "null") && flo[0])
+        printf("%-4d %-10s %-28.28s %10.4g %10.4g %6s  %s\n", step, cmd, model, e, atof(flo),
+               np, note);
+      else
+        printf("%-4d %-10s %-28.28s %10.4g %10s %6s  %s\n", step, cmd, model, e, "-", np, note);
+    }
+    free(copy);
+  }
+  if (step == 0) return;
+  printf("\nerror %% by step (each # is %.3g %%):\n", emax / 50);
+  {
+    char *copy = strdup(text);
+    int k = 0;
+    if (!copy) return;
+    for (line = strtok_r(copy, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
+      char err[64] = "";
+      int bars, b;
+      field(line, "error_pct", err, sizeof err);
+      bars = emax > 0 ? (int)lround(50.0 * atof(err) / emax) : 0;
+      printf("%4d |", ++k);
+      for (b = 0; b < bars; b++) putchar('#');
+      printf(" %.4g %%\n", atof(err));
+    }
+    free(copy);
+  }
+}
+
+int cmd_history(int argc, char **argv) {
+  cli_args a;
+  size_t len;
+  char *text;
+  int rc = cli_parse(argc, argv, NULL, 0, &a);
+  if (rc) return rc;
+  if (a.help) return cli_print_help(cli_help_history);
+  if (!a.model)
+    return cli_usage(a.cmd, "missing the history file; expected rcbtool history FILE");
+  if (!(text = slurp(a.model, &len)))
+    return cli_fail(CLI_EXIT_INPUT, "history '%s': cannot read it", a.model);
+  if (a.json) {
+    char *line, *save = NULL;
+    int first = 1;
+    fputs("[", stdout);
+    for (line = strtok_r(text, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
+      printf("%s\n%s", first ? "" : ",", line);
+      first = 0;
+    }
+    fputs("]\n", stdout);
+  } else {
+    print_steps(text);
+  }
+  free(text);
+  return 0;
+}
