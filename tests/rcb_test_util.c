@@ -49,3 +49,31 @@ rcb_allocator rcb_test_counting_allocator(rcb_test_counter *c) {
   a.user = c;
   return a;
 }
+
+/* Noise-free unbalance responses of m at outs over r0..r1 rpm, n speeds. */
+rcb_meas *rcb_test_unbalance_meas(const rcb_model *m, const char *const *outs, size_t no,
+                                  double r0, double r1, size_t n) {
+  rcb_meas *ms = NULL;
+  rcb_frf *fr = NULL;
+  rcb_dof od[8];
+  double *x = calloc(n, sizeof *x);
+  rcb_complex *Q = calloc(n * no, sizeof *Q), *col = calloc(n, sizeof *col);
+  size_t i, o;
+  for (o = 0; o < no; o++) assert_int_equal(rcb_model_find_dof(m, outs[o], &od[o]), RCB_OK);
+  assert_int_equal(rcb_frf_create(&fr, m, no, od, 0, NULL, RCB_SOLVER_AUTO, NULL), RCB_OK);
+  for (i = 0; i < n; i++) {
+    x[i] = (3.14159265358979323846 / 30.0) * (r0 + (r1 - r0) * (double)i / (double)(n - 1));
+    assert_int_equal(rcb_frf_unbalance(fr, x[i], Q + i * no), RCB_OK);
+  }
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_UNBALANCE, n, x, 0.0), RCB_OK);
+  for (o = 0; o < no; o++) {
+    for (i = 0; i < n; i++) col[i] = Q[i * no + o];
+    assert_int_equal(rcb_meas_add_channel(ms, outs[o], NULL, RCB_RECEPTANCE, col), RCB_OK);
+  }
+  rcb_frf_destroy(fr);
+  free(x);
+  free(Q);
+  free(col);
+  return ms;
+}

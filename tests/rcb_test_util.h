@@ -17,4 +17,8 @@ typedef struct rcb_test_counter {
 } rcb_test_counter;
 /* Allocator hooks (malloc/free) that count every call into *c. */
 rcb_allocator rcb_test_counting_allocator(rcb_test_counter *c);
+/* Noise-free unbalance responses of m at channels outs (no of them), n speeds
+ * evenly from r0 to r1 rpm, as a measurement (aborts the test on failure). */
+rcb_meas *rcb_test_unbalance_meas(const rcb_model *m, const char *const *outs, size_t no,
+                                  double r0, double r1, size_t n);
 #endif

@@ -82,32 +82,6 @@ static rcb_meas *frf_meas(const rcb_model *m, const char *const *outs, const cha
   return ms;
 }
 
-static rcb_meas *unb_meas(const rcb_model *m, const char *const *outs, size_t no, double r0,
-                          double r1, size_t n) {
-  rcb_meas *ms = NULL;
-  rcb_frf *fr = NULL;
-  rcb_dof od[8];
-  double *x = calloc(n, sizeof *x);
-  rcb_complex *Q = calloc(n * no, sizeof *Q), *col = calloc(n, sizeof *col);
-  size_t i, o;
-  for (o = 0; o < no; o++) assert_int_equal(rcb_model_find_dof(m, outs[o], &od[o]), RCB_OK);
-  assert_int_equal(rcb_frf_create(&fr, m, no, od, 0, NULL, RCB_SOLVER_AUTO, NULL), RCB_OK);
-  for (i = 0; i < n; i++) {
-    x[i] = RPM * (r0 + (r1 - r0) * (double)i / (double)(n - 1));
-    assert_int_equal(rcb_frf_unbalance(fr, x[i], Q + i * no), RCB_OK);
-  }
-  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
-  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_UNBALANCE, n, x, 0.0), RCB_OK);
-  for (o = 0; o < no; o++) {
-    for (i = 0; i < n; i++) col[i] = Q[i * no + o];
-    assert_int_equal(rcb_meas_add_channel(ms, outs[o], NULL, RCB_RECEPTANCE, col), RCB_OK);
-  }
-  rcb_frf_destroy(fr);
-  free(x);
-  free(Q);
-  free(col);
-  return ms;
-}
 
 static rcb_compare *run(const rcb_model *m, const rcb_meas *ms) {
   rcb_compare *c = NULL;
@@ -174,7 +148,7 @@ static void test_self_frf(void **state) {
 static void test_self_unbalance(void **state) {
   static const char *const outs[] = {"DA.x", "DA.y", "DB.x", "DB.y"};
   rcb_model *m = paper();
-  rcb_meas *ms = unb_meas(m, outs, 4, 300.0, 18300.0, 301);
+  rcb_meas *ms = rcb_test_unbalance_meas(m, outs, 4, 300.0, 18300.0, 301);
   rcb_compare *c = run(m, ms);
   size_t p, matched = 0;
   (void)state;

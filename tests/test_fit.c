@@ -62,32 +62,6 @@ static rcb_meas *frf_meas(const rcb_model *m, const char *const *outs, size_t no
   return ms;
 }
 
-static rcb_meas *unb_meas(const rcb_model *m, const char *const *outs, size_t no, double r0,
-                          double r1, size_t n) {
-  rcb_meas *ms = NULL;
-  rcb_frf *fr = NULL;
-  rcb_dof od[8];
-  double *x = calloc(n, sizeof *x);
-  rcb_complex *Q = calloc(n * no, sizeof *Q), *col = calloc(n, sizeof *col);
-  size_t i, o;
-  for (o = 0; o < no; o++) assert_int_equal(rcb_model_find_dof(m, outs[o], &od[o]), RCB_OK);
-  assert_int_equal(rcb_frf_create(&fr, m, no, od, 0, NULL, RCB_SOLVER_AUTO, NULL), RCB_OK);
-  for (i = 0; i < n; i++) {
-    x[i] = RPM * (r0 + (r1 - r0) * (double)i / (double)(n - 1));
-    assert_int_equal(rcb_frf_unbalance(fr, x[i], Q + i * no), RCB_OK);
-  }
-  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
-  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_UNBALANCE, n, x, 0.0), RCB_OK);
-  for (o = 0; o < no; o++) {
-    for (i = 0; i < n; i++) col[i] = Q[i * no + o];
-    assert_int_equal(rcb_meas_add_channel(ms, outs[o], NULL, RCB_RECEPTANCE, col), RCB_OK);
-  }
-  rcb_frf_destroy(fr);
-  free(x);
-  free(Q);
-  free(col);
-  return ms;
-}
 
 /* Central difference of the residuals along parameter name, step h. */
 static void central(rcb_model *m, rcb_fit *f, const char *name, double p, double h, size_t n,
@@ -168,7 +142,7 @@ static void test_sensitivities_unbalance(void **state) {
   const char *outs[] = {"C.A.x", "C.A.y", "C.B.x", "C.B.y"};
   const char *names[] = {"coupling.C.kt", "coupling.C.kr", "coupling.C.ct",
                          "unbalance.UB.phase", "unbalance.UA.amount"};
-  rcb_meas *ms = unb_meas(m, outs, 4, 300, 18300, 25);
+  rcb_meas *ms = rcb_test_unbalance_meas(m, outs, 4, 300, 18300, 25);
   rcb_fit *f = NULL;
   size_t k;
   (void)state;
