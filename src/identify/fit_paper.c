@@ -68,6 +68,19 @@ static rcb_status linearise(rcb_fit *f, paper_ws *ws, const double *x, double *p
   return RCB_OK;
 }
 
+/* Phi - ||R + JA d||^2: the reduction the linearised model promises for the
+ * step d (x units). */
+static double promise(const paper_ws *ws, const double *d) {
+  size_t rows = ws->n + ws->np, i, k;
+  double gain = 0.0;
+  for (i = 0; i < rows; i++) {
+    double lin = ws->R[i];
+    for (k = 0; k < ws->np; k++) lin += ws->JA[i + rows * k] * d[k];
+    gain += ws->R[i] * ws->R[i] - lin * lin;
+  }
+  return gain;
+}
+
 /* Step dx minimising ||[JA; lambda Q] dx + [R; 0]|| by SVD (pseudo-inverse,
  * eq. 16; eq. 18 when lambda > 0). */
 static rcb_status gn_step(rcb_fit *f, paper_ws *ws, double lambda) {
@@ -99,18 +112,16 @@ static rcb_status gn_step(rcb_fit *f, paper_ws *ws, double lambda) {
       if (ws->dx[k] != ws->b[k]) ws->capped = 1;
     }
   }
-  /* Phi - ||R + JA dx||^2: what the linearised model promises, for the
-   * Gauss-Newton step itself (pred_full: is anything left to gain?) and for
-   * the clipped step that is tried */
-  ws->pred = ws->pred_full = 0.0;
-  for (i = 0; i < rows; i++) {
-    double lin = ws->R[i], lin_full = ws->R[i];
-    for (k = 0; k < ws->np; k++) {
-      lin += ws->JA[i + rows * k] * ws->dx[k];
-      lin_full += ws->JA[i + rows * k] * ws->b[k];
-    }
-    ws->pred += ws->R[i] * ws->R[i] - lin * lin;
-    ws->pred_full += ws->R[i] * ws->R[i] - lin_full * lin_full;
+  /* what the linearised model promises, for the Gauss-Newton step itself
+   * (pred_full: is anything left to gain?) and for the clipped step tried */
+  ws->pred_full = promise(ws, ws->b);
+  ws->pred = promise(ws, ws->dx);
+  if (ws->capped && !(ws->pred > 0)) {
+    /* clipping turned the step away from descent: scale it as a whole instead */
+    double big = 0.0;
+    for (k = 0; k < ws->np; k++) big = fmax(big, fabs(ws->b[k]));
+    for (k = 0; k < ws->np; k++) ws->dx[k] = ws->b[k] / big;
+    ws->pred = promise(ws, ws->dx);
   }
   return RCB_OK;
 }
@@ -216,11 +227,19 @@ static void ws_free(rcb_fit *f, paper_ws *ws) {
 
 /* One iteration: Gauss-Newton + line search, then damped steps (eq. 18). */
 static rcb_status iterate(rcb_fit *f, paper_ws *ws, double *phi, int *moved) {
-  double phi0 = *phi, lambda;
-  int ok;
+  double phi0 = *phi, lambda, lim;
+  int ok, noisy;
   rcb_status st;
   if ((st = linearise(f, ws, ws->x, &phi0)) || (st = gn_step(f, ws, 0.0))) return st;
-  if (ws->pred_full <= f->ftol_rel * phi0) { /* nothing left to gain: at a minimum */
+  /* Nothing left to gain: at a minimum. With noise-aware weights Phi is a
+   * chi-square, and a step promising less than 0.01 of one unit moves every
+   * parameter combination by under 0.1 of its standard error: stop without
+   * spending evaluations on it. The same when the step that can be tried
+   * (clipped) promises that little: what is left is an unidentifiable
+   * parameter's drift along a flat valley. */
+  noisy = f->beta_a > 0 || f->beta_s > 0;
+  lim = noisy ? fmax(f->ftol_rel * phi0, 1e-2) : f->ftol_rel * phi0;
+  if (ws->pred_full <= lim || (noisy && ws->pred <= lim)) {
     *moved = 0;
     *phi = phi0;
     return RCB_OK;

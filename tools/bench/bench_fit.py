@@ -30,7 +30,7 @@ A benchmark: it prints figures and never fails on a time.
 
 usage: bench_fit.py [--rcbtool PATH] [--model INI] [--seeds N]
                     [--methods paper,nlopt:lbfgs@4,...] [--no-scipy] [--uff]
-                    [--verbose]
+                    [--scale log10|complex] [--verbose]
 (METHOD@N: rcbtool fit --starts N, restarts from random points while unsure)
 """
 
@@ -233,26 +233,48 @@ def read_csv(path):
 
 
 class Objective:
-    """librcb's residuals (fit_eval.c layout/noise_var) on log10 magnitudes."""
+    """librcb's residuals (fit_eval.c layout/noise_var): log10 magnitudes, or
+    real and imaginary parts (scale "complex", two residuals per point)."""
 
-    def __init__(self, f_hz, e):
+    def __init__(self, f_hz, e, scale="log10"):
         npts = e.shape[1]
         ba = BETA_A / 100.0
         a = BETA_S / 100.0 * np.sqrt(np.sum(np.abs(e) ** 2, axis=1)) / npts  # per channel
         mag = np.abs(e)
         keep = np.isfinite(e) & (mag > 0) & (mag >= 2.0 * a[:, None])
-        var = (ba * ba * mag ** 2 / 3.0 + (a * a / 6.0)[:, None]) / (mag * np.log(10.0)) ** 2
         self.ch, self.pt = np.nonzero(keep)
         self.used = np.unique(self.pt)
         self.w = 2.0 * math.pi * f_hz[self.used]  # rad/s
         self.col = np.searchsorted(self.used, self.pt)
-        self.sqrtw = 1.0 / np.sqrt(var[self.ch, self.pt])
         self.emag = mag[self.ch, self.pt]
-        self.meas = np.log10(self.emag)
-        self.nres = len(self.ch)
+        self.complex = scale == "complex"
+        ev = e[self.ch, self.pt]
+        a2 = (a * a / 6.0)[self.ch]
+        if self.complex:  # per component: ba^2 c^2 / 3 + a^2 / 6
+            var = np.concatenate([ba * ba * ev.real ** 2 / 3.0 + a2,
+                                  ba * ba * ev.imag ** 2 / 3.0 + a2])
+            self.meas = np.concatenate([ev.real, ev.imag])
+        else:
+            var = (ba * ba * self.emag ** 2 / 3.0 + a2) / (self.emag * np.log(10.0)) ** 2
+            self.meas = np.log10(self.emag)
+        self.sqrtw = 1.0 / np.sqrt(var)
+        self.nres = len(self.meas)
+
+    def on_scale(self, H):
+        h = H[self.ch, self.col]
+        return np.concatenate([h.real, h.imag]) if self.complex else np.log10(np.abs(h))
+
+    def on_scale_d(self, H, dlog, p):
+        """Jacobian of on_scale in log parameters, from dH/dp / H (eq. 9)."""
+        h = H[self.ch, self.col]
+        d = dlog[self.ch, self.col, :] * p[None, :]  # d H / d log p, over H
+        if self.complex:
+            dh = h[:, None] * d
+            return np.concatenate([dh.real, dh.imag])
+        return np.real(d) / math.log(10.0)
 
     def residuals(self, H):
-        return self.sqrtw * (np.log10(np.abs(H[self.ch, self.col])) - self.meas)
+        return self.sqrtw * (self.on_scale(H) - self.meas)
 
     def error_pct(self, H):
         m = np.abs(H[self.ch, self.col])
@@ -271,9 +293,8 @@ def scipy_fit(model, obj, start, lo, hi, analytic):
     def jac(x):
         sweeps[0] += 1
         p = np.exp(x)
-        _, dlog = model.dlog(p, obj.w)  # (channels, used points, 4)
-        g = np.real(dlog[obj.ch, obj.col, :]) / math.log(10.0)  # d log10|H| / dp
-        return obj.sqrtw[:, None] * g * p[None, :]
+        H, dlog = model.dlog(p, obj.w)  # (channels, used points), (..., 4)
+        return obj.sqrtw[:, None] * obj.on_scale_d(H, dlog, p)
 
     t0 = time.perf_counter()
     res = least_squares(fun, np.log(start), jac=jac if analytic else "2-point",
@@ -287,14 +308,14 @@ def scipy_fit(model, obj, start, lo, hi, analytic):
 
 # ---------------------------------------------------------------- librcb
 
-def librcb_fit(exe, start_ini, meas, method, lo, hi):
+def librcb_fit(exe, start_ini, meas, method, lo, hi, scale):
     params = ",".join(f"{n}:{a!r}:{b!r}" for n, a, b in zip(PNAMES, lo, hi))
     extra = ["--map", UFF_MAP] if meas.endswith(".uff") else []
     method, _, starts = method.partition("@")  # "ALG@N": --starts N (restarts while unsure)
     if starts:
         extra += ["--starts", starts]
     t0 = time.perf_counter()
-    res = run(exe, "fit", start_ini, meas, *extra, "--params", params, "--log", "--scale", "log10",
+    res = run(exe, "fit", start_ini, meas, *extra, "--params", params, "--log", "--scale", scale,
               "--noise", f"{BETA_A:g},{BETA_S:g}", "--method", method, "--json", check=False)
     secs = time.perf_counter() - t0
     out = {"secs": secs, "rc": res.returncode, "stderr": res.stderr.strip()}
@@ -386,6 +407,9 @@ def main():
     ap.add_argument("--no-scipy", action="store_true", help="librcb methods only")
     ap.add_argument("--uff", action="store_true", help="measurements as UFF58 (default CSV; "
                     "SciPy then reads a CSV twin written by the same seed)")
+    ap.add_argument("--scale", choices=("log10", "complex"), default="log10",
+                    help="objective: log10 magnitudes (the paper's like-for-like, default) or "
+                    "complex values (real and imaginary parts)")
     ap.add_argument("--verbose", action="store_true", help="one line per seed and method")
     a = ap.parse_args()
     if a.seeds < 1:
@@ -409,7 +433,9 @@ def main():
         print(f"data: inertance {','.join(OUTS)} / {INP}, {FMIN:g}-{FMAX:g} Hz, {NPTS} points, "
               f"{RPM:g} rpm, eq. 19 noise {BETA_A:g} %, {BETA_S:g} %; seeds 0..{a.seeds - 1}")
         print("fit: kt, kr, ct, cr from 1/10 of the truth, log parameters in "
-              "[truth/1000, 1000 truth], log10 magnitudes, noise-aware weights and floor mask")
+              "[truth/1000, 1000 truth], "
+              f"{'log10 magnitudes' if a.scale == 'log10' else 'complex values'}, "
+              "noise-aware weights and floor mask")
 
         if not a.no_scipy:
             import scipy  # noqa: F401  (fail early with a clear message)
@@ -457,10 +483,10 @@ def main():
                 csv = os.path.join(tmp, f"meas{s}.csv")
                 run(exe, *sim, "-o", csv)
             f_hz, e = read_csv(csv)
-            obj = Objective(f_hz, e)
+            obj = Objective(f_hz, e, a.scale)
             floors.append(obj.error_pct(model.inertance(np.array(truth), obj.w)))
             for m in methods:
-                r = librcb_fit(exe, start_ini, meas, m, lo, hi)
+                r = librcb_fit(exe, start_ini, meas, m, lo, hi, a.scale)
                 res[m].append(r)
                 if "p" not in r:
                     print(f"  seed {s} {m}: rcbtool fit exit {r['rc']}: {r['stderr']}",

@@ -267,4 +267,17 @@ extern const char cli_help_history[];
 /** Print a command's help text to stdout; returns 0 (or 5 if stdout fails). */
 int cli_print_help(const char *text);
 
+/* ---- sweep options shared by simulate and sensitivity (cli_sweep.c) ---- */
+
+/** "receptance", "mobility", "inertance", in rcb_frf_kind order. */
+extern const char *const cli_kind_names[3];
+/** --frf options: --in (required, described by in_what), --fmin/--fmax (Hz),
+ * --rpm (rpm), --kind; rejects --rpm-min/--rpm-max. 0 or an exit code. */
+int cli_sweep_frf(const cli_args *a, const char *in_what, double *fmin_hz, double *fmax_hz,
+                  double *rpm, int *kind);
+/** --unbalance options: --rpm-min/--rpm-max (rpm); rejects the FRF options
+ * with the message frf_only. 0 or an exit code. */
+int cli_sweep_unbalance(const cli_args *a, const char *frf_only, double *rpm_min,
+                        double *rpm_max);
+
 #endif /* RCBTOOL_CLI_H */

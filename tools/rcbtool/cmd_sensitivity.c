@@ -46,7 +46,6 @@ const char cli_help_sensitivity[] =
     "Exit codes: 2 usage, 3 bad model or parameter name, 4 numerical failure,\n"
     "5 output not written.\n";
 
-static const char *const kind_names[] = {"receptance", "mobility", "inertance"};
 static const char *const scale_names[] = {"linear", "log10", "db", "complex"};
 static const char *const dir_names[] = {"x", "y"};
 
@@ -150,32 +149,16 @@ static int cand_parse(const cli_args *a, const rcb_model *m, cand_list *cl) {
 /* ---- options ---- */
 
 static int parse_frf(const cli_args *a, sens_job *j) {
-  int rc;
-  if (cli_opt_value(a, "--rpm-min") || cli_opt_value(a, "--rpm-max"))
-    return cli_usage(a->cmd, "--rpm-min/--rpm-max belong to --unbalance; for --frf give "
-                     "--fmin/--fmax (Hz) and --rpm");
-  if ((rc = cli_opt_require(a, "--in", "the force channel STATION.DIR of the FRFs")) ||
-      (rc = cli_opt_require(a, "--fmax", "the last frequency in Hz")) ||
-      (rc = cli_opt_nonneg(a, "--fmin", "Hz", 0.0, &j->lo)) ||
-      (rc = cli_opt_nonneg(a, "--fmax", "Hz", 0.0, &j->hi)) ||
-      (rc = cli_opt_nonneg(a, "--rpm", "rotor speed, rpm", 0.0, &j->rpm)) ||
-      (rc = cli_opt_choice(a, "--kind", kind_names, 3, RCB_RECEPTANCE, &j->kind)))
-    return rc;
-  return 0;
+  return cli_sweep_frf(a, "the force channel STATION.DIR of the FRFs", &j->lo, &j->hi, &j->rpm,
+                       &j->kind);
 }
 
 static int parse_unbalance(const cli_args *a, sens_job *j) {
-  int rc;
-  if (cli_opt_value(a, "--in") || cli_opt_value(a, "--fmin") || cli_opt_value(a, "--fmax") ||
-      cli_opt_value(a, "--rpm") || cli_opt_value(a, "--kind"))
-    return cli_usage(a->cmd, "--in, --fmin, --fmax, --rpm and --kind belong to --frf; "
-                     "--unbalance takes --rpm-min, --rpm-max, --points");
-  if ((rc = cli_opt_require(a, "--rpm-max", "the highest rotor speed in rpm")) ||
-      (rc = cli_opt_nonneg(a, "--rpm-min", "rpm", 0.0, &j->lo)) ||
-      (rc = cli_opt_nonneg(a, "--rpm-max", "rpm", 0.0, &j->hi)))
-    return rc;
   j->kind = RCB_RECEPTANCE;
-  return 0;
+  return cli_sweep_unbalance(a,
+                             "--in, --fmin, --fmax, --rpm and --kind belong to --frf; "
+                             "--unbalance takes --rpm-min, --rpm-max, --points",
+                             &j->lo, &j->hi);
 }
 
 static int parse_job(const cli_args *a, sens_job *j) {

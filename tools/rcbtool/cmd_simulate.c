@@ -38,7 +38,6 @@ const char cli_help_simulate[] =
     "complex data, abscissa in Hz, rotor speed of an FRF test as the z-axis value\n"
     "(rpm). CSV: '# kind' and '# rpm' lines, then as rcbtool frf writes it (re/im).\n";
 
-static const char *const kind_names[] = {"receptance", "mobility", "inertance"};
 static const char *const solver_names[] = {"auto", "dense", "banded"};
 
 typedef struct sim_job {
@@ -78,36 +77,19 @@ static int parse_noise(const cli_args *a, sim_job *j) {
 }
 
 static int parse_frf(const cli_args *a, sim_job *j) {
-  int rc;
   j->sync = cli_opt_value(a, "--synchronous") != NULL;
   if (j->sync && cli_opt_value(a, "--rpm"))
     return cli_usage(a->cmd, "--rpm and --synchronous exclude each other; give one");
-  if (cli_opt_value(a, "--rpm-min") || cli_opt_value(a, "--rpm-max"))
-    return cli_usage(a->cmd, "--rpm-min/--rpm-max belong to --unbalance; for --frf give "
-                     "--fmin/--fmax (Hz) and --rpm");
-  if ((rc = cli_opt_require(a, "--in", "input (force) channels STATION.DIR[,...]")) ||
-      (rc = cli_opt_require(a, "--fmax", "the last frequency in Hz")) ||
-      (rc = cli_opt_nonneg(a, "--fmin", "Hz", 0.0, &j->lo)) ||
-      (rc = cli_opt_nonneg(a, "--fmax", "Hz", 0.0, &j->hi)) ||
-      (rc = cli_opt_nonneg(a, "--rpm", "rotor speed, rpm", 0.0, &j->rpm)) ||
-      (rc = cli_opt_choice(a, "--kind", kind_names, 3, RCB_RECEPTANCE, &j->kind)))
-    return rc;
-  return 0;
+  return cli_sweep_frf(a, "input (force) channels STATION.DIR[,...]", &j->lo, &j->hi, &j->rpm,
+                       &j->kind);
 }
 
 static int parse_unbalance(const cli_args *a, sim_job *j) {
-  int rc;
-  if (cli_opt_value(a, "--in") || cli_opt_value(a, "--fmin") || cli_opt_value(a, "--fmax") ||
-      cli_opt_value(a, "--rpm") || cli_opt_value(a, "--synchronous") ||
-      cli_opt_value(a, "--kind"))
-    return cli_usage(a->cmd, "--in, --fmin, --fmax, --rpm, --synchronous and --kind belong to "
-                     "--frf; --unbalance takes --out, --rpm-min, --rpm-max, --points");
-  if ((rc = cli_opt_require(a, "--rpm-max", "the highest rotor speed in rpm")) ||
-      (rc = cli_opt_nonneg(a, "--rpm-min", "rpm", 0.0, &j->lo)) ||
-      (rc = cli_opt_nonneg(a, "--rpm-max", "rpm", 0.0, &j->hi)))
-    return rc;
   j->kind = RCB_RECEPTANCE;
-  return 0;
+  return cli_sweep_unbalance(a,
+                             "--in, --fmin, --fmax, --rpm, --synchronous and --kind belong to --frf; "
+                             "--unbalance takes --out, --rpm-min, --rpm-max, --points",
+                             &j->lo, &j->hi);
 }
 
 static int parse_job(const cli_args *a, sim_job *j) {
