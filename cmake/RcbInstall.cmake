@@ -68,7 +68,7 @@ if(RCB_WITH_SUNDIALS)
   string(APPEND RCB_PC_LIBS_PRIVATE
     " -lsundials_cvode -lsundials_sunmatrixdense -lsundials_nvecserial")
 endif()
-string(APPEND RCB_PC_LIBS_PRIVATE " -lm")
+string(APPEND RCB_PC_LIBS_PRIVATE " -lpthread -lm")
 # prefix is found from the .pc file's own place (${pcfiledir}), so the package
 # stays right when installed with `cmake --install --prefix DIR` or moved.
 file(RELATIVE_PATH _rcb_pc_to_prefix ${CMAKE_INSTALL_FULL_LIBDIR}/pkgconfig

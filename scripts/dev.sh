@@ -13,9 +13,24 @@
 #   ./scripts/dev.sh bench-fit  identification benchmark (issue #3, Table 3 data, 20 seeds):
 #                               rcbtool fit per method vs SciPy least_squares (needs .venv);
 #                               extra arguments go to tools/bench/bench_fit.py
+#   ./scripts/dev.sh bench-suite  the benchmark suite (issue #6) in one run: the paper sweep
+#                               (librcb paths vs SciPy and ROSS), trains of 1e2-1e5 DOF, one fit,
+#                               one diagnosis, the targets (needs .venv; about 2 min); writes
+#                               out/bench-suite.md, and with --docs docs/benchmarks.md the
+#                               published table; extra arguments go to tools/bench/suite.py
+#   ./scripts/dev.sh diag-success  diagnosis success rate (issue #4): every hidden-effect case
+#                               (truth by ROSS and by rcbtool simulate, a two-effect and a null
+#                               case) x SEEDS (default 5) noise seeds, as a table (needs .venv;
+#                               several minutes); extra arguments go to tools/bench/diag_success.py
 #   ./scripts/dev.sh fuzz       libFuzzer smoke (issue #7): build fuzz/ with clang (ASan+UBSan),
 #                               replay the seed corpora, then fuzz each harness FUZZ_SECONDS
 #                               (default 30) s; needs clang and libclang-rt-dev (not in `test`)
+#   ./scripts/dev.sh valgrind   memcheck on the CLI runs of the examples (check, frf, unbalance,
+#                               modes, fit, compare, diagnose on examples/walkthrough): no error,
+#                               no definite leak (part of `test`)
+#   ./scripts/dev.sh lint       cppcheck (warning, portability, performance) and clang-tidy
+#                               (.clang-tidy) on src/ and tools/rcbtool/; `test` runs it when
+#                               RCB_LINT=1 (not yet clean: see docs/reliability.md)
 #   ./scripts/dev.sh embedded   the "embedded" CMake preset (static, -Os, no optional backend,
 #                               build-embedded/): build and print the library size
 #
@@ -37,7 +52,8 @@ MODEL=examples/paper_system.ini
 
 DEB_PACKAGES=(build-essential cmake pkg-config libopenblas-dev liblapacke-dev
   libsuitesparse-dev libnlopt-dev libsundials-dev libcmocka-dev libinih-dev
-  python3-venv python3-pip)
+  python3-venv python3-pip
+  clang libclang-rt-14-dev valgrind cppcheck clang-tidy)
 
 say() { printf '\n==> %s\n' "$*"; }
 die() { printf 'dev.sh: %s\n' "$*" >&2; exit 1; }
@@ -246,10 +262,24 @@ cmd_sanitize() {
     UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 run_ctest "$dir" -LE slow
 }
 
+# The librcb Python package (tools/python) into the venv, built from a copy in
+# the build tree (setuptools writes build/ and egg-info beside its sources);
+# its tests load the shared library of this build through LIBRCB_PATH.
+install_python_package() {
+  local src=$BUILD_DIR/python-pkg
+  rm -rf "$src"
+  mkdir -p "$src"
+  cp -r tools/python/pyproject.toml tools/python/README.md tools/python/librcb "$src/"
+  "$VENV/bin/python" -m pip install --quiet --no-build-isolation --no-index --no-deps \
+    --force-reinstall "$src"
+}
+
 cmd_pytest() {
-  say "Python cross-validation (tests/python, against ROSS)"
+  say "Python cross-validation (tests/python, against ROSS) and the librcb package"
   local rc=0
-  RCBTOOL=$(rcbtool_exe) OPENBLAS_NUM_THREADS=1 \
+  [[ -f $BUILD_DIR/src/librcb.so ]] || die "$BUILD_DIR/src/librcb.so was not built (RCB_BUILD_SHARED=ON)"
+  install_python_package || die "pip install ./tools/python failed"
+  RCBTOOL=$(rcbtool_exe) LIBRCB_PATH=$BUILD_DIR/src/librcb.so OPENBLAS_NUM_THREADS=1 \
     "$VENV/bin/python" -m pytest tests/python -q || rc=$?
   if ((rc == 5)); then
     echo "dev.sh: WARNING: pytest collected no test in tests/python" >&2
@@ -271,6 +301,9 @@ cmd_test() {
   cmd_build
   local stages=(ctest pytest core)
   [[ ${RCB_SKIP_SANITIZE:-0} == 1 ]] || stages+=(sanitize)
+  # issue #7: valgrind on the CLI, a libFuzzer smoke (FUZZ_SECONDS per harness)
+  stages+=(valgrind fuzz_smoke)
+  [[ ${RCB_LINT:-0} == 1 ]] && stages+=(lint)
   for stage in "${stages[@]}"; do
     set +e
     (
@@ -319,6 +352,27 @@ cmd_bench_fit() {
     --rcbtool "$(rcbtool_exe)" --model "$MODEL" "$@"
 }
 
+# The benchmark suite (issue #6): tools/bench/suite.py prints the machine, the
+# versions, the commit and every figure as Markdown; never fails on a time.
+cmd_bench_suite() {
+  cmd_build
+  [[ -x $(rcbtool_exe) && -f $(rcbtool_exe) ]] || die "rcbtool was not built"
+  [[ -x $VENV/bin/python ]] || die "no $VENV: run ./scripts/dev.sh deps (NumPy, SciPy, ROSS)"
+  say "benchmark suite: librcb vs SciPy and ROSS, trains, fit, diagnosis (one core)"
+  OPENBLAS_NUM_THREADS=1 "$VENV/bin/python" tools/bench/suite.py --build "$BUILD_DIR" "$@"
+}
+
+# Diagnosis success rate (issue #4): tools/bench/diag_success.py prints the table
+# that docs/diagnosis.md quotes; never fails on a miss (the tests assert).
+cmd_diag_success() {
+  cmd_build
+  [[ -x $(rcbtool_exe) && -f $(rcbtool_exe) ]] || die "rcbtool was not built"
+  [[ -x $VENV/bin/python ]] || die "no $VENV: run ./scripts/dev.sh deps (NumPy, ROSS, pyuff)"
+  say "diagnosis success rate: hidden effects x ${SEEDS:-5} seeds (one core)"
+  OPENBLAS_NUM_THREADS=1 "$VENV/bin/python" tools/bench/diag_success.py \
+    --rcbtool "$(rcbtool_exe)" --seeds "${SEEDS:-5}" "$@"
+}
+
 # libFuzzer smoke: every seed replayed, then FUZZ_SECONDS of fuzzing per
 # harness on a scratch copy of the corpus (fuzz/corpus stays as committed).
 # Not part of `test`: it needs clang with its runtime (Debian: clang,
@@ -350,6 +404,69 @@ cmd_fuzz() {
   say "fuzz smoke passed (crash-free, ${secs} s per harness)"
 }
 
+# The fuzz stage of `test`: shorter runs (FUZZ_SECONDS, default 20 s each).
+cmd_fuzz_smoke() { FUZZ_SECONDS=${FUZZ_SECONDS:-20} cmd_fuzz; }
+
+# valgrind memcheck on small CLI runs of the examples, in the Release build.
+# Exit 99 on any memcheck error or definite leak (OpenBLAS on one thread:
+# its thread pool's buffers are "possibly lost" by design).
+cmd_valgrind() {
+  local exe W=examples/walkthrough P=coupling.C.kt,coupling.C.kr,coupling.C.ct t0=$SECONDS
+  local out=$BUILD_DIR/valgrind rc=0
+  command -v valgrind > /dev/null || die "valgrind missing (Debian: apt-get install valgrind)"
+  exe=$(rcbtool_exe)
+  [[ -x $exe && -f $exe ]] || die "rcbtool was not built: run ./scripts/dev.sh build"
+  mkdir -p "$out"
+  say "valgrind memcheck on the CLI ($exe)"
+  vg() {
+    local name=$1
+    shift
+    if OPENBLAS_NUM_THREADS=1 valgrind -q --error-exitcode=99 --leak-check=full \
+      --errors-for-leak-kinds=definite --show-leak-kinds=definite \
+      --log-file="$out/$name.log" "$exe" "$@" > "$out/$name.out" 2>&1; then
+      printf '  %-10s clean\n' "$name"
+    else
+      printf '  %-10s FAILED (exit %d): see %s\n' "$name" "$?" "$out/$name.log"
+      rc=1
+    fi
+  }
+  vg check check "$MODEL"
+  vg frf frf "$W/model.ini" --out DA.x,DB.y --in DA.x --fmax 500 --points 50 --rpm 10000 \
+    -o "$out/frf.csv"
+  vg unbalance unbalance "$W/model.ini" --out DA.x,DB.y --rpm-max 20000 --points 50 \
+    -o "$out/unbalance.csv"
+  vg modes modes "$W/model.ini" --rpm 10000 --modes 6 -o "$out/modes.csv"
+  vg compare compare "$W/model.ini" "$W/measured.uff"
+  vg fit fit "$W/model.ini" "$W/measured.uff" --params "$P" --log --noise 10,1 --max-iter 5
+  vg diagnose diagnose "$W/model.ini" "$W/measured.uff" --params "$P" --log --noise 10,1 \
+    --band 200:400 --refits 1 --top 3
+  ((rc == 0)) || die "valgrind found errors or leaks ($((SECONDS - t0)) s)"
+  say "valgrind: no error, no definite leak ($((SECONDS - t0)) s)"
+}
+
+# Static analysis: cppcheck and clang-tidy on the library and the CLI, from
+# a configure-only tree's compile_commands.json. Suppressions with their
+# reasons: .cppcheck-suppressions and .clang-tidy.
+cmd_lint() {
+  local dir=$BUILD_DIR-lint t0=$SECONDS rc=0
+  command -v cppcheck > /dev/null && command -v clang-tidy > /dev/null ||
+    die "lint needs cppcheck and clang-tidy (Debian: apt-get install cppcheck clang-tidy)"
+  mkdir -p "$dir"
+  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Release -DCMAKE_EXPORT_COMPILE_COMMANDS=ON \
+    > "$dir/configure.log" 2>&1 || { cat "$dir/configure.log"; die "cmake configure failed in $dir"; }
+  say "cppcheck (warning, portability, performance)"
+  cppcheck --project="$dir/compile_commands.json" --enable=warning,portability,performance \
+    --inline-suppr --suppressions-list=.cppcheck-suppressions --error-exitcode=1 -q \
+    -j "$JOBS" --file-filter="$ROOT/src/*" --file-filter="$ROOT/tools/rcbtool/*" \
+    --template='{file}:{line}: {severity}: {message} [{id}]' || rc=1
+  say "clang-tidy (.clang-tidy)"
+  find src tools/rcbtool -name '*.c' -print0 | sort -z |
+    xargs -0 -P "$JOBS" -n 8 clang-tidy -p "$dir" --quiet > "$dir/clang-tidy.log" 2>&1 || rc=1
+  grep -E ': (warning|error):' "$dir/clang-tidy.log" || true
+  ((rc == 0)) || die "lint found problems ($((SECONDS - t0)) s; clang-tidy: $dir/clang-tidy.log)"
+  say "lint clean ($((SECONDS - t0)) s)"
+}
+
 # The embedded preset (CMakePresets.json): static, MinSizeRel, no backend.
 cmd_embedded() {
   say "embedded preset (build-embedded: static, -Os, no SuiteSparse/NLopt/SUNDIALS)"
@@ -373,7 +490,12 @@ case ${1:-} in
   sanitize) cmd_sanitize ;;
   bench) cmd_bench ;;
   bench-fit) shift; cmd_bench_fit "$@" ;;
+  bench-suite) shift; cmd_bench_suite "$@" ;;
+  diag-success) shift; cmd_diag_success "$@" ;;
   fuzz) cmd_fuzz ;;
+  fuzz-smoke) cmd_fuzz_smoke ;;
+  valgrind) cmd_valgrind ;;
+  lint) cmd_lint ;;
   embedded) cmd_embedded ;;
   -h | --help | help) usage ;;
   *) usage >&2; exit 2 ;;

@@ -5,6 +5,7 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <cmocka.h>
 
 int rcb_test_close(double a, double b, double rtol, double atol) {
@@ -29,6 +30,36 @@ rcb_model *rcb_test_model_from_example(const char *name) {
   assert_int_equal(rcb_model_create(&m, NULL), RCB_OK);
   st = rcb_model_load_file(m, path);
   if (st != RCB_OK) fail_msg("model load failed: %s", rcb_model_errmsg(m));
+  return m;
+}
+
+rcb_model *rcb_test_model_edited(const char *name, const char *after, const char *extra) {
+  char path[1024], *txt, *out;
+  const char *at;
+  FILE *fp;
+  long len;
+  size_t pre;
+  rcb_model *m;
+  snprintf(path, sizeof path, "%s/%s", RCB_EXAMPLES_DIR, name);
+  fp = fopen(path, "rb");
+  assert_non_null(fp);
+  fseek(fp, 0, SEEK_END);
+  len = ftell(fp);
+  fseek(fp, 0, SEEK_SET);
+  assert_true(len > 0);
+  txt = calloc((size_t)len + 1, 1);
+  out = calloc((size_t)len + strlen(extra) + 4, 1);
+  assert_int_equal(fread(txt, 1, (size_t)len, fp), (size_t)len);
+  fclose(fp);
+  at = strstr(txt, after);
+  if (!at || !(at = strchr(at, '\n'))) fail_msg("%s: no line '%s'", name, after);
+  pre = (size_t)(at + 1 - txt);
+  memcpy(out, txt, pre);
+  snprintf(out + pre, strlen(extra) + 2, "%s\n", extra);
+  strcat(out, txt + pre);
+  m = rcb_test_model_from_string(out);
+  free(txt);
+  free(out);
   return m;
 }
 

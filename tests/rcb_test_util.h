@@ -11,6 +11,9 @@ int rcb_test_close(double a, double b, double rtol, double atol);
 rcb_model *rcb_test_model_from_string(const char *ini);
 /* Load examples/<name> or abort. */
 rcb_model *rcb_test_model_from_example(const char *name);
+/* examples/<name> with the lines `extra` put right after the line `after`
+ * (e.g. "[bearing B2]"), loaded, or abort. */
+rcb_model *rcb_test_model_edited(const char *name, const char *after, const char *extra);
 /* Allocation counts seen through rcb_test_counting_allocator's hooks. */
 typedef struct rcb_test_counter {
   size_t allocs, frees;

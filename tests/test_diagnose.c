@@ -107,19 +107,19 @@ static void apply_reaches_floor(rcb_diag *d, double floor0) {
   }
 }
 
-static void hidden(const char *param, double value, rcb_effect want, const char *place) {
-  rcb_model *truth = rcb_test_model_from_example("paper_system.ini");
+/* Diagnose data from truth (which holds the hidden effect `what`) over the
+ * seeds; destroys truth. */
+static void hidden_in(rcb_model *truth, const char *what, rcb_effect want, const char *place) {
   rcb_diag_candidate best;
   rcb_diag *d;
   double err0, floor0;
   unsigned seed;
   for (seed = 1; seed <= (getenv("RCB_DIAG_SEEDS") ? (unsigned)atoi(getenv("RCB_DIAG_SEEDS")) : 2u); seed++) {
-    assert_int_equal(rcb_model_set_param(truth, param, value), RCB_OK);
     diagnose(truth, seed, &best, &err0, &floor0, &d);
-    print_message("  hidden %s = %g: first '%s' (%s), predicted %.1f %%, error %.3g -> %.3g "
-                  "%% (floor %.3g), BIC %+.1f\n",
-                  param, value, best.description, best.place, best.predicted_pct, err0,
-                  best.error_pct, floor0, best.delta_bic);
+    print_message("  hidden %s: first '%s' (%s), predicted %.1f %%, error %.3g -> %.3g "
+                  "%% (floor %.3g), BIC %+.1f, %s\n",
+                  what, best.description, best.place, best.predicted_pct, err0,
+                  best.error_pct, floor0, best.delta_bic, best.fitted);
     assert_int_equal(best.effect, want);
     assert_non_null(strstr(best.place, place));
     assert_true(best.significant);
@@ -127,6 +127,14 @@ static void hidden(const char *param, double value, rcb_effect want, const char 
     rcb_diag_destroy(d);
   }
   rcb_model_destroy(truth);
+}
+
+static void hidden(const char *param, double value, rcb_effect want, const char *place) {
+  rcb_model *truth = rcb_test_model_from_example("paper_system.ini");
+  char what[160];
+  assert_int_equal(rcb_model_set_param(truth, param, value), RCB_OK);
+  snprintf(what, sizeof what, "%s = %g", param, value);
+  hidden_in(truth, what, want, place);
 }
 
 static void test_hidden_cross_coupling(void **state) {
@@ -164,6 +172,25 @@ static void test_hidden_coupling_rotational_damping(void **state) {
   hidden("coupling.C.cr", 0.02, RCB_EFFECT_COUPLING_ROTATIONAL_DAMPING, "coupling C");
 }
 
+/* A pedestal under bearing B2 (its mode in the band), and one under B3. */
+static void test_hidden_pedestal(void **state) {
+  (void)state;
+  hidden_in(rcb_test_model_edited("paper_system.ini", "[bearing B2]",
+                                  "pedestal_mass = 10\npedestal_kxx = 3e7\npedestal_kyy = 3e7\n"
+                                  "pedestal_cxx = 500\npedestal_cyy = 500"),
+            "pedestal under B2 (10 kg on 3e7 N/m)", RCB_EFFECT_FLEXIBLE_SUPPORT, "bearing B2");
+  hidden_in(rcb_test_model_edited("paper_system.ini", "[bearing B3]",
+                                  "pedestal_mass = 6\npedestal_kxx = 4e7\npedestal_kyy = 4e7\n"
+                                  "pedestal_cxx = 300\npedestal_cyy = 300"),
+            "pedestal under B3 (6 kg on 4e7 N/m)", RCB_EFFECT_FLEXIBLE_SUPPORT, "bearing B3");
+}
+
+/* The rotor turns 20 % faster than the measurement says. */
+static void test_hidden_speed(void **state) {
+  (void)state;
+  hidden("speed.factor", 1.2, RCB_EFFECT_SPEED, "operating speed");
+}
+
 /* Nothing hidden: no candidate is significant. */
 static void test_null(void **state) {
   rcb_model *truth = rcb_test_model_from_example("paper_system.ini");
@@ -189,6 +216,8 @@ int main(void) {
       cmocka_unit_test(test_hidden_shaft_damping),
       cmocka_unit_test(test_hidden_disk_mass),
       cmocka_unit_test(test_hidden_coupling_rotational_damping),
+      cmocka_unit_test(test_hidden_pedestal),
+      cmocka_unit_test(test_hidden_speed),
       cmocka_unit_test(test_null),
   };
   if (getenv("RCB_DIAG_ONLY")) cmocka_set_test_filter(getenv("RCB_DIAG_ONLY"));

@@ -33,9 +33,19 @@ typedef enum rcb_solver_kind {
                               banded when the band is narrow, else dense */
   RCB_SOLVER_DENSE = 1,  /**< LAPACK zgesv */
   RCB_SOLVER_BANDED = 2, /**< LAPACK zgbsv */
-  RCB_SOLVER_SPARSE = 3  /**< SuiteSparse KLU (complex); RCB_ERR_UNSUPPORTED
+  RCB_SOLVER_SPARSE = 3, /**< SuiteSparse KLU (complex); RCB_ERR_UNSUPPORTED
                               when built without RCB_WITH_SUITESPARSE */
+  RCB_SOLVER_MODAL = 4   /**< modal superposition (paper eq. 7) on the
+                              state-space eigenvectors at one speed, O(modes)
+                              per output per frequency; a direct solver (as
+                              for auto) serves the unbalance response, the
+                              sensitivities and the checks. Dense
+                              eigenproblem: up to RCB_MODAL_MAX_DOF DOF */
 } rcb_solver_kind;
+
+/** @brief Largest model (DOF) the modal solver accepts (its eigenproblem is
+ * dense, 2n x 2n). */
+#define RCB_MODAL_MAX_DOF 2000
 
 typedef struct rcb_frf rcb_frf;
 
@@ -80,6 +90,139 @@ RCB_API rcb_status rcb_frf_eval(rcb_frf *f, double omega, double speed, rcb_frf_
  * @param Q output displacement phasors at the nout outputs, m (rad for rotations)
  */
 RCB_API rcb_status rcb_frf_unbalance(rcb_frf *f, double speed, rcb_complex *Q);
+
+/**
+ * @brief Frequency sweep, optionally on threads: H(omegas[p]) at rotor speed
+ * speeds[p] for p = 0..nfreq-1. Each thread works on its own copy of the
+ * workspace (sized here, freed on return); the model is only read. The
+ * result is bit-identical whatever @p nthreads is: every frequency goes
+ * through the same operations (the sparse solver starts a fresh
+ * factorisation every RCB_SWEEP_BLOCK frequencies, so its kept-pivot history
+ * does not depend on how the sweep is split). With the modal solver and one
+ * speed, the threads share the basis computed once.
+ * @param omegas excitation frequencies, rad/s (>= 0)
+ * @param speeds rotor speed at each frequency, rad/s (pass omegas for a
+ * synchronous sweep)
+ * @param H output, nout x nin per frequency, column-major, frequency p at
+ * H + p * nout * nin
+ * @param nthreads threads to use (0 or 1: the calling thread only; at most
+ * RCB_SWEEP_MAX_THREADS, and no more than there are blocks)
+ * @return the first failing part's status (message in rcb_frf_errmsg);
+ * RCB_ERR_NOMEM if a thread cannot be started. The condition record
+ * (rcb_frf_get_condition) covers the solves of all threads.
+ */
+RCB_API rcb_status rcb_frf_sweep(rcb_frf *f, size_t nfreq, const double *omegas,
+                                 const double *speeds, rcb_frf_kind kind, rcb_complex *H,
+                                 size_t nthreads);
+
+/** @brief Frequencies per block of rcb_frf_sweep (see there). */
+#define RCB_SWEEP_BLOCK 64
+/** @brief Most threads rcb_frf_sweep accepts. */
+#define RCB_SWEEP_MAX_THREADS 64
+
+/** @brief State of the modal basis of an FRF object (RCB_SOLVER_MODAL). */
+typedef struct rcb_modal_info {
+  size_t nroots;      /**< eigenvalues of the state-space form, 2n */
+  size_t nkept;       /**< roots kept in the modal sum (a conjugate pair counts 2) */
+  size_t nmodes;      /**< kept modes (a conjugate pair counts 1, a real root 1) */
+  double speed;       /**< rotor speed of the basis, rad/s */
+  double max_kept_wn; /**< largest |lambda| kept, rad/s */
+  int residual_used;  /**< 1: static residual-flexibility term added (truncated set) */
+  double residual;    /**< max |residual term| / max |H(0)| (-), 0 if all kept */
+  double rcond_v;     /**< reciprocal condition number of the eigenvector matrix
+                           (-); near 0: nearly defective, modal sum unreliable */
+} rcb_modal_info;
+
+/**
+ * @brief Truncate the modal sum (RCB_SOLVER_MODAL): keep the roots with
+ * |lambda| <= @p max_freq (rad/s, 0: no limit) and at most @p max_modes modes
+ * (0: no limit), lowest |lambda| first; conjugate roots stay together. The
+ * dropped modes are replaced by a static residual term: the direct solution
+ * at omega = 0 minus the kept modes' contribution there (exact at omega = 0;
+ * left out, and residual_used = 0, when the dynamic stiffness is singular at
+ * 0, as for a free rotor). Default: all modes, no residual. The basis is
+ * recomputed at the next evaluation. @return RCB_ERR_STATE if @p f does not
+ * use the modal solver, RCB_ERR_ARG for max_freq < 0 or not finite.
+ */
+RCB_API rcb_status rcb_frf_set_modal(rcb_frf *f, size_t max_modes, double max_freq);
+
+/** @brief Modal basis at rotor speed @p speed (rad/s), computed if needed,
+ * and its description. @return RCB_ERR_STATE if @p f is not modal. */
+RCB_API rcb_status rcb_frf_modal_info(rcb_frf *f, double speed, rcb_modal_info *info);
+
+/**
+ * @brief Truncation error estimate: one direct solve at @p omega (rad/s;
+ * use the top of the band of interest) compared with the modal sum there.
+ * @param err output max |H_modal - H_direct| / max |H_direct| over the
+ * outputs x inputs (-); ~1e-12 with all modes kept
+ */
+RCB_API rcb_status rcb_frf_modal_error(rcb_frf *f, double omega, double speed, double *err);
+
+/* ------------------------------------------- FRF: numerical guard -- */
+
+/** @brief Default threshold below which a solve counts as ill-conditioned:
+ * with rcond = 1e-12 about 4 of the 16 significant digits of the response
+ * are left (relative error ~ machine eps / rcond). */
+#define RCB_RCOND_WARN 1e-12
+
+/** @brief Modes of the condition check (rcb_frf_set_condition_check). */
+enum {
+  RCB_COND_OFF = 0,    /**< no check */
+  RCB_COND_SCREEN = 1, /**< default: the pivot ratio min|U_ii| / max|U_ii| of every
+                            factorisation (O(n), read off the factors); the full
+                            estimate only where it falls below RCB_PIVOT_SCREEN */
+  RCB_COND_ALWAYS = 2  /**< the full estimate after every factorisation */
+};
+
+/** @brief Pivot ratio below which RCB_COND_SCREEN computes the full estimate
+ * (-). Six decades above RCB_RCOND_WARN: the LU of a matrix with rcond
+ * 1e-12 and every pivot within 1e-6 of the largest would need an element
+ * growth of 1e6, which partial pivoting does not produce on dynamic
+ * stiffness matrices (a heuristic: RCB_COND_ALWAYS removes it). The full
+ * estimate costs several triangular solves, and LAPACK's zgbcon, through
+ * zlatbs's careful scaled solves, O(n^2) on a long train: screened, a
+ * sweep costs what it cost without the check. */
+#define RCB_PIVOT_SCREEN 1e-6
+
+/**
+ * @brief Condition of the dynamic-stiffness solves since the last reset.
+ *
+ * rcond is the reciprocal condition number in the 1-norm,
+ * 1 / (||Z||_1 ||Z^-1||_1), estimated from the factors (LAPACK zgecon /
+ * zgbcon, KLU klu_z_condest: the Hager-Higham estimator, which never
+ * overestimates ||Z^-1||_1 and is in practice within a factor 3 of it).
+ * A solve is ill-conditioned when rcond < threshold: an all-free model at
+ * omega = 0 (rigid-body modes: Z = K is singular up to round-off), or an
+ * undamped resonance hit almost exactly. The results are then dominated by
+ * round-off and must not be trusted.
+ */
+typedef struct rcb_frf_condition {
+  double rcond_min;  /**< smallest estimate since the reset (-); NaN before any
+                          estimated solve or when an estimate failed */
+  double omega;      /**< excitation frequency of that solve, rad/s */
+  double speed;      /**< rotor speed of that solve, rad/s */
+  double rcond_last; /**< estimate of the last solve (-), NaN if screened */
+  size_t checked;    /**< solves checked since the reset */
+  size_t estimated;  /**< of which had the full estimate (RCB_COND_SCREEN: those
+                          whose pivot ratio fell below RCB_PIVOT_SCREEN) */
+  size_t ill;        /**< of which ill-conditioned (rcond < threshold or NaN) */
+  double threshold;  /**< the threshold in use (-) */
+} rcb_frf_condition;
+
+/**
+ * @brief Set the condition check of every factorisation and its threshold
+ * (default RCB_COND_SCREEN with RCB_RCOND_WARN). Resets the record.
+ * @param mode RCB_COND_OFF, RCB_COND_SCREEN or RCB_COND_ALWAYS
+ * @param threshold 0 < threshold < 1 (-)
+ */
+RCB_API rcb_status rcb_frf_set_condition_check(rcb_frf *f, int mode, double threshold);
+/** @brief Forget the record (before a new sweep). */
+RCB_API void rcb_frf_reset_condition(rcb_frf *f);
+/** @brief The record since the last reset (see rcb_frf_condition). */
+RCB_API rcb_status rcb_frf_get_condition(const rcb_frf *f, rcb_frf_condition *out);
+/** @brief Smallest reciprocal condition estimate since the last reset (-), NaN if
+ * none. */
+RCB_API double rcb_frf_rcond(const rcb_frf *f);
 
 /* -------------------------------------------------------------- modes -- */
 

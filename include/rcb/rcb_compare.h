@@ -126,7 +126,10 @@ typedef enum rcb_peak_match {
  * @brief One row of the peak table. Measured peaks: local maxima of the sum
  * over channels of |e|/rms(e) (each channel scaled by its own RMS so no
  * channel dominates by its units), frequency and height by parabolic
- * interpolation through the three points at the top, damping ratio from the
+ * interpolation through the three points at the top; damping ratio from a
+ * local modal fit on the complex FRF of the peak's dominant channel (a
+ * single-DOF rational fraction with a residual, over the points within 3.5
+ * half-power half-widths of the top, 5 to 250 each side), and from the
  * half-power width zeta = (w2 - w1)/(2 w_peak) (one side doubled when the
  * other does not fall to half power). Model modes: for FRFs at a fixed speed,
  * the damped modes (rcb_modes_compute at the test speed, damping ratio
@@ -138,7 +141,8 @@ typedef enum rcb_peak_match {
 typedef struct rcb_compare_peak {
   rcb_peak_match match;
   double meas_freq;    /**< measured peak abscissa, rad/s (NaN for MODEL_ONLY) */
-  double meas_zeta;    /**< half-power damping ratio (NaN: no half-power point) */
+  double meas_zeta;    /**< damping ratio of the local modal fit (meas_zeta_hp when the
+                            fit fails; NaN when both do) */
   size_t channel;      /**< channel with the largest |e|/rms(e) at the peak */
   double meas_amp;     /**< |e| of that channel at the peak (channel units) */
   double model_amp;    /**< |m| of that channel at meas_freq (channel units) */
@@ -153,6 +157,9 @@ typedef struct rcb_compare_peak {
                             free of the O(zeta^2) offset between a mode's wd and the
                             top of its resonance */
   double zeta_err_pct; /**< 100 (model_zeta - meas_zeta) / meas_zeta, % */
+  double meas_zeta_hp; /**< half-power damping ratio (NaN: no half-power point) */
+  double meas_wd;      /**< damped natural frequency wn sqrt(1 - zeta^2) of the local modal
+                            fit, rad/s (NaN: no fit) */
 } rcb_compare_peak;
 
 RCB_API size_t rcb_compare_peak_count(const rcb_compare *c);

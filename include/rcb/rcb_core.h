@@ -48,9 +48,10 @@ RCB_API const char *rcb_version_string(void);
   X(RCB_ERR_LAPACK, -8, "LAPACK routine failed")                            \
   X(RCB_ERR_IO, -9, "input/output error")                                   \
   X(RCB_ERR_UNSUPPORTED, -10, "feature not built into this library")        \
-  X(RCB_ERR_WORKSPACE, -11, "caller workspace too small")
+  X(RCB_ERR_WORKSPACE, -11, "caller workspace too small")                  \
+  X(RCB_ERR_NOT_CONVERGED, -12, "iteration did not converge")
 
-#define RCB_STATUS_ENUM_(name, value, text) name = value,
+#define RCB_STATUS_ENUM_(name, value, text) name = (value),
 typedef enum rcb_status { RCB_STATUS_LIST(RCB_STATUS_ENUM_) } rcb_status;
 #undef RCB_STATUS_ENUM_
 

@@ -37,7 +37,9 @@ typedef enum rcb_effect {
   RCB_EFFECT_BEARING_DAMPING = 7,                /**< cxx, cyy */
   RCB_EFFECT_SHAFT_DAMPING = 8,                  /**< stiffness-proportional */
   RCB_EFFECT_ADDED_MASS = 9,                     /**< mass and inertia at a station */
-  RCB_EFFECT_COUNT = 10
+  RCB_EFFECT_FLEXIBLE_SUPPORT = 10,              /**< a pedestal under a bearing */
+  RCB_EFFECT_SPEED = 11,                         /**< operating speed (speed.factor) */
+  RCB_EFFECT_COUNT = 12
 } rcb_effect;
 
 /** @brief Short English name of an effect. */
@@ -95,6 +97,13 @@ RCB_API rcb_status rcb_diag_candidate_get(const rcb_diag *d, size_t rank,
 /** @brief Error % and objective of the model as it is, after fitting its own parameters. */
 RCB_API rcb_status rcb_diag_baseline(const rcb_diag *d, double *error_pct, double *objective,
                                      double *floor_pct);
+/** @brief Work done by the last rcb_diag_run (for benchmarks and progress reports). */
+typedef struct rcb_diag_stats {
+  size_t evaluations; /**< model sweeps over the measured points (a Jacobian counts one) */
+  size_t scored;      /**< candidates scored by the score test */
+  size_t refits;      /**< candidates refitted (or evaluated, with nothing to fit) */
+} rcb_diag_stats;
+RCB_API rcb_status rcb_diag_get_stats(const rcb_diag *d, rcb_diag_stats *out);
 /**
  * @brief The model with candidate @p rank added and fitted, as INI text
  * (two-call sizing as rcb_model_write_ini).

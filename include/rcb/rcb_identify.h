@@ -111,11 +111,45 @@ typedef struct rcb_fit_report {
   double sigma;        /**< residual standard deviation sqrt(F / (N - np)) */
   int converged;       /**< 1 when a convergence criterion was met */
   double floor_pct;    /**< error % the noise model alone explains (NaN without one) */
-  int unsure;          /**< 1 when the fit did not converge, or ends above 1.5 times
-                            floor_pct: a local minimum, or an effect the model lacks */
+  int unsure;          /**< 1 when the fit did not converge (see rcb_fit_stop_reason),
+                            or ends above 1.5 times floor_pct: a local minimum, or an
+                            effect the model lacks */
   size_t starts;       /**< starting points tried (see rcb_fit_set_starts) */
 } rcb_fit_report;
 RCB_API rcb_status rcb_fit_get_report(const rcb_fit *f, rcb_fit_report *out);
+
+/**
+ * @brief Why the last run stopped. Anything but RCB_FIT_STOP_CONVERGED makes
+ * the report unsure. (A non-finite objective is not a stop reason: rcb_fit_run
+ * fails with RCB_ERR_NOT_CONVERGED, naming where it appeared.)
+ */
+typedef enum rcb_fit_stop {
+  RCB_FIT_STOP_NONE = 0,      /**< not run yet */
+  RCB_FIT_STOP_CONVERGED = 1, /**< a convergence test was met */
+  RCB_FIT_STOP_AT_BOUND = 2,  /**< converged with a parameter at (or past) a bound that
+                                   the objective pushes against (moving past it would
+                                   lower F by more than 0.1 %): the minimum lies outside
+                                   the bounds */
+  RCB_FIT_STOP_STALLED = 3,   /**< no step reduced the objective although the local
+                                   model promised a reduction (or NLopt ended
+                                   round-off limited): a wrong or noisy gradient, or a
+                                   kink */
+  RCB_FIT_STOP_MAX_ITER = 4   /**< the iteration or evaluation budget ran out first */
+} rcb_fit_stop;
+/**
+ * @brief Stop reason of the last run. @param param if not NULL, receives the
+ * index of the parameter at its bound (RCB_FIT_STOP_AT_BOUND), else np.
+ */
+RCB_API rcb_fit_stop rcb_fit_stop_reason(const rcb_fit *f, size_t *param);
+/** @brief Short English text for a stop reason (never NULL). */
+RCB_API const char *rcb_fit_stop_str(rcb_fit_stop s);
+/**
+ * @brief Condition of the linear solves in the final evaluation of the last run
+ * (see rcb_frf_condition; only that sweep is checked, the iterations run
+ * without the estimate). ill > 0 means the fitted model is near-singular at
+ * some point of the band (omega there): its residuals are not to be trusted.
+ */
+RCB_API rcb_status rcb_fit_get_condition(const rcb_fit *f, rcb_frf_condition *out);
 
 /** @brief One fitted parameter with its uncertainty. */
 typedef struct rcb_fit_param {

@@ -104,6 +104,26 @@ RCB_API rcb_status rcb_model_add_bearing_table(rcb_model *m, const char *name,
                                                const double *speeds,
                                                const rcb_bearing_coefs *c);
 
+/**
+ * @brief Flexible support under a bearing: a pedestal mass on springs and
+ * dampers to ground. The bearing's coefficients then join the shaft node to
+ * the pedestal (station "BEARING.ped", directions x and y) instead of ground.
+ */
+typedef struct rcb_pedestal {
+  double mass;     /**< kg, moving in x and y (>= 0) */
+  double kxx, kyy; /**< pedestal to ground, N/m (>= 0) */
+  double cxx, cyy; /**< pedestal to ground, N s/m (>= 0) */
+} rcb_pedestal;
+
+/**
+ * @brief Put bearing @p bearing (already added) on a pedestal, before
+ * finalize. All zero (or @p p NULL) removes it: the bearing goes to ground.
+ * INI keys pedestal_mass, pedestal_kxx, pedestal_kyy, pedestal_cxx,
+ * pedestal_cyy; parameters bearing.B.pedestal_mass, ... (see below).
+ */
+RCB_API rcb_status rcb_model_set_pedestal(rcb_model *m, const char *bearing,
+                                          const rcb_pedestal *p);
+
 /** @brief The five coupling models of Tapia & Cavalca (paper section 3). */
 typedef enum rcb_coupling_model {
   RCB_COUPLING_KRAMER_1 = 0,         /**< translations tied (DOF elimination) */
@@ -215,7 +235,9 @@ typedef enum rcb_station_kind {
   RCB_STATION_BEARING = 1,
   RCB_STATION_COUPLING = 2,
   RCB_STATION_UNBALANCE = 3,
-  RCB_STATION_PROBE = 4
+  RCB_STATION_PROBE = 4,
+  RCB_STATION_PEDESTAL = 5 /**< "BEARING.ped": x, y only; its node is virtual
+                                (>= rcb_model_node_count) */
 } rcb_station_kind;
 
 /** @brief Named stations, in definition order. */
@@ -241,7 +263,8 @@ RCB_API rcb_status rcb_model_dof_index(const rcb_model *m, rcb_dof dof, size_t *
  * coefficients of speed-dependent bearings). Each output is n x n column-major,
  * n = rcb_model_dof_count(); any pointer may be NULL.
  * M kg, C N s/m (shaft proportional damping, bearings, couplings), G (multiplied
- * by Omega in the equation of motion), K N/m.
+ * by Omega in the equation of motion; it includes speed.factor), K N/m.
+ * Pedestals of bearings add two DOFs each (rcb_model_find_dof "B2.ped.x").
  */
 RCB_API rcb_status rcb_model_matrices(const rcb_model *m, double speed, double *M, double *C,
                                       double *G, double *K);
@@ -263,6 +286,13 @@ RCB_API rcb_status rcb_model_unbalance_force(const rcb_model *m, double speed,
  *  - coupling.C.kt | kr | ct | cr (those its model uses), coupling.C.hub_mass,
  *    hub_Id, hub_Ip (both stations together)
  *  - bearing.B2.kxx ... cyy (constant bearings; tabulated ones are not fittable)
+ *  - bearing.B2.pedestal_mass | pedestal_kxx | pedestal_kyy | pedestal_cxx |
+ *    pedestal_cyy (bearings on a pedestal), and the views pedestal_k,
+ *    pedestal_c setting x and y together
+ *  - speed.factor: real rotor speed / stated speed in the gyroscopic and bearing
+ *    terms of FRFs, modes and Campbell diagrams (1 = as stated; > 0). The
+ *    unbalance response ignores it: there the speed is the measured
+ *    once-per-revolution frequency. INI: [model] speed_factor.
  *  - disk.DA.mass | Id | Ip
  *  - shaft.A.damping_mass | damping_stiffness
  *  - material.steel.density | young

@@ -29,10 +29,12 @@ static rcb_status choose_solver(rcb_frf *f, rcb_solver_kind kind, size_t n, size
                              "(use dense, banded or auto)");
       f->ops = sparse;
       return RCB_OK;
-    case RCB_SOLVER_AUTO: break;
+    case RCB_SOLVER_AUTO:
+    case RCB_SOLVER_MODAL: break; /* modal: the direct solver behind it, as auto */
     default:
       return rcb_set_error(f->errmsg, RCB_ERR_ARG,
-                           "solver kind %d: expected auto, dense, banded or sparse", (int)kind);
+                           "solver kind %d: expected auto, dense, banded, sparse or modal",
+                           (int)kind);
   }
   if (sparse && n >= SPARSE_MIN_DOF)
     f->ops = sparse;
@@ -99,6 +101,7 @@ static rcb_status frf_setup(rcb_frf *f, size_t nout, const rcb_dof *outputs, siz
   if (!f->M || !f->C || !f->G || !f->K || !f->Z || !f->B || !f->ipiv || !f->out_row ||
       !f->in_row)
     return rcb_set_error(f->errmsg, RCB_ERR_NOMEM, "out of memory sizing the FRF workspace");
+  if ((st = rcb_frf_cond_setup(f))) return st;
   f->nout = nout;
   f->nin = nin;
   if ((st = map_dofs(f, nout, outputs, f->out_row, "output"))) return st;
@@ -124,6 +127,7 @@ rcb_status rcb_frf_create(rcb_frf **out, const rcb_model *m, size_t nout,
   f->m = m;
   f->bytes = sizeof *f;
   st = frf_setup(f, nout, outputs, nin, inputs, solver);
+  if (!st && solver == RCB_SOLVER_MODAL) st = rcb_frf_modal_create(f, NULL);
   if (st) {
     rcb_frf_destroy(f);
     return st;
@@ -136,6 +140,7 @@ void rcb_frf_destroy(rcb_frf *f) {
   rcb_allocator a;
   if (!f) return;
   a = f->alloc;
+  rcb_frf_modal_destroy(f);
   if (f->ops && f->ops->release) f->ops->release(&f->L, &a);
   if (f->L.sparse) {
     rcb_free(&a, f->L.colp);
@@ -150,25 +155,29 @@ void rcb_frf_destroy(rcb_frf *f) {
   rcb_free(&a, f->ipiv);
   rcb_free(&a, f->out_row);
   rcb_free(&a, f->in_row);
+  rcb_frf_cond_free(f);
   rcb_free(&a, f);
 }
 
 rcb_status rcb_frf_refresh(rcb_frf *f) {
   if (!f) return RCB_ERR_ARG;
   rcb_assemble_structure(f->m, &f->L, f->M, f->C, f->G, f->K);
+  rcb_frf_modal_invalidate(f);
   return RCB_OK;
 }
 
 const char *rcb_frf_errmsg(const rcb_frf *f) { return f ? f->errmsg : "no FRF object"; }
 
 rcb_solver_kind rcb_frf_solver(const rcb_frf *f) {
+  if (f && f->modal) return RCB_SOLVER_MODAL;
   if (f && f->L.sparse) return RCB_SOLVER_SPARSE;
   return (f && f->L.banded) ? RCB_SOLVER_BANDED : RCB_SOLVER_DENSE;
 }
 
 size_t rcb_frf_memory(const rcb_frf *f) {
   if (!f) return 0;
-  return f->bytes + (f->ops && f->ops->memory ? f->ops->memory(&f->L) : 0);
+  return f->bytes + (f->ops && f->ops->memory ? f->ops->memory(&f->L) : 0) +
+         rcb_frf_modal_memory(f);
 }
 
 /* Z = K - w^2 M + i w (C + W G) + bearings at speed W, then factor and solve
@@ -181,13 +190,14 @@ rcb_status rcb_frf_factor_solve(rcb_frf *f, double omega, double speed, size_t n
   for (k = 0; k < sz; k++)
     f->Z[k] = CMPLX(f->K[k] - w2 * f->M[k], omega * (f->C[k] + speed * f->G[k]));
   for (b = 0; b < m->n_bearings; b++) {
-    rcb_entry e[4];
-    int j;
-    rcb_bearing_entries(m, b, speed, e);
-    for (j = 0; j < 4; j++) f->Z[rcb_layout_at(&f->L, e[j].row, e[j].col)] +=
+    rcb_entry e[RCB_BEARING_ENTRIES_MAX];
+    size_t j, ne = rcb_bearing_entries(m, b, speed, e);
+    for (j = 0; j < ne; j++) f->Z[rcb_layout_at(&f->L, e[j].row, e[j].col)] +=
         CMPLX(e[j].k, omega * e[j].c);
   }
+  rcb_frf_cond_before(f);
   st = f->ops->solve(&f->L, f->Z, f->ipiv, f->B, nrhs);
+  if (!st) rcb_frf_cond_after(f, omega, speed);
   if (st == RCB_ERR_SINGULAR)
     return rcb_set_error(f->errmsg, st,
                          "dynamic stiffness singular at %g rad/s, speed %g rad/s (a free-free "
@@ -207,6 +217,12 @@ static int bad_speed(double omega, double speed) {
 
 rcb_status rcb_frf_eval(rcb_frf *f, double omega, double speed, rcb_frf_kind kind,
                         rcb_complex *H) {
+  if (f && f->modal) return rcb_frf_modal_eval(f, omega, speed, kind, H);
+  return rcb_frf_eval_direct(f, omega, speed, kind, H);
+}
+
+rcb_status rcb_frf_eval_direct(rcb_frf *f, double omega, double speed, rcb_frf_kind kind,
+                               rcb_complex *H) {
   size_t n, i, o;
   double complex scale;
   rcb_status st;
@@ -239,7 +255,9 @@ rcb_status rcb_frf_unbalance(rcb_frf *f, double speed, rcb_complex *Q) {
     return rcb_set_error(f->errmsg, RCB_ERR_ARG,
                          "speed %g rad/s: expected a finite value >= 0", speed);
   rcb_model_unbalance_force(f->m, speed, f->B);
-  if ((st = rcb_frf_factor_solve(f, speed, speed, 1))) return st;
+  /* the speed factor does not apply: the speed is the measured excitation
+   * frequency (G and the bearings carry the factor, so divide it out) */
+  if ((st = rcb_frf_factor_solve(f, speed, speed / f->m->speed_factor, 1))) return st;
   for (o = 0; o < f->nout; o++) Q[o] = f->B[f->out_row[o]];
   return RCB_OK;
 }

@@ -68,16 +68,16 @@ static rcb_status solve_all(rcb_transient *t, const double *Lm, double *B, size_
 /* Add the constant bearings to K, C (dense n x n); list the tabulated ones. */
 static void split_bearings(rcb_transient *t, double *K, double *C) {
   const rcb_model *m = t->m;
-  size_t b, k, n = t->n;
-  rcb_entry e[4];
+  size_t b, k, n = t->n, ne;
+  rcb_entry e[RCB_BEARING_ENTRIES_MAX];
   t->ntab = 0;
   for (b = 0; b < m->n_bearings; b++) {
     if (m->bearings[b].n > 1) {
       t->tab[t->ntab++] = b;
       continue;
     }
-    rcb_bearing_entries(m, b, 0.0, e);
-    for (k = 0; k < 4; k++) {
+    ne = rcb_bearing_entries(m, b, 0.0, e);
+    for (k = 0; k < ne; k++) {
       K[e[k].row + n * e[k].col] += e[k].k;
       C[e[k].row + n * e[k].col] += e[k].c;
     }
@@ -189,7 +189,7 @@ static void accel(const rcb_transient *t, double tt, const double *q, const doub
     for (i = 0; i < n; i++) a[i] -= kc[i] * qj + cc[i] * vj + gc[i] * wv;
   }
   for (b = 0; b < t->ntab; b++) {
-    rcb_entry e[4];
+    rcb_entry e[RCB_BEARING_ENTRIES_MAX];
     double r[2] = {0.0, 0.0};
     const double *bx = t->MiB + n * (2 * b), *by = t->MiB + n * (2 * b + 1);
     rcb_bearing_entries(m, t->tab[b], W, e);
@@ -211,7 +211,7 @@ int rcb_transient_rhs(sunrealtype tt, N_Vector y, N_Vector ydot, void *user) {
 static void jac_bearings(const rcb_transient *t, double W, SUNMatrix J) {
   size_t b, i, k, n = t->n;
   for (b = 0; b < t->ntab; b++) {
-    rcb_entry e[4];
+    rcb_entry e[RCB_BEARING_ENTRIES_MAX];
     rcb_bearing_entries(t->m, t->tab[b], W, e);
     for (k = 0; k < 4; k++) {
       const double *bc = t->MiB + n * (2 * b + k / 2);
@@ -293,6 +293,26 @@ static void free_cvode(rcb_transient *t) {
 }
 #endif /* RCB_WITH_SUNDIALS */
 
+/* Not integrated (yet): a speed factor (the unbalance would drive at the
+ * stated speed while G and the bearings run at the factored one), and a
+ * speed-dependent bearing on a pedestal (the tabulated-bearing force path
+ * acts on the shaft rows only). */
+static rcb_status transient_supported(rcb_transient *t) {
+  size_t b;
+  if (t->m->speed_factor != 1.0)
+    return rcb_set_error(t->errmsg, RCB_ERR_UNSUPPORTED,
+                         "transient: speed factor %g; the time integration runs at the stated "
+                         "speed (set [model] speed_factor = 1)",
+                         t->m->speed_factor);
+  for (b = 0; b < t->m->n_bearings; b++)
+    if (t->m->bearings[b].has_ped && t->m->bearings[b].n > 1)
+      return rcb_set_error(t->errmsg, RCB_ERR_UNSUPPORTED,
+                           "transient: bearing '%s' is speed-dependent and on a pedestal; not "
+                           "supported by the time integration",
+                           t->m->bearings[b].name);
+  return RCB_OK;
+}
+
 rcb_status rcb_transient_create(rcb_transient **out, const rcb_model *m, size_t nout,
                                 const rcb_dof *outputs, const rcb_allocator *alloc) {
   rcb_allocator a;
@@ -316,6 +336,7 @@ rcb_status rcb_transient_create(rcb_transient **out, const rcb_model *m, size_t 
   t->ss_spp = 32;
   t->ss_max_periods = 20000;
   *out = t;
+  if ((st = transient_supported(t))) return st;
 #if RCB_WITH_SUNDIALS
   if ((st = alloc_arrays(t, nout, outputs)) || (st = setup_matrices(t)) ||
       (st = setup_cvode(t)))

@@ -63,7 +63,7 @@ static void add_shafts(const rcb_model *m, const rcb_layout *L, double *M, doubl
       rows[4 + k] = m->nodes[el->node0 + 1].dof[k];
     }
     scatter(L, M, rows, 8, Me, 1.0);
-    scatter(L, G, rows, 8, Ge, 1.0);
+    scatter(L, G, rows, 8, Ge, m->speed_factor);
     scatter(L, K, rows, 8, Ke, 1.0);
     scatter(L, C, rows, 8, Me, sh->qz_m);
     scatter(L, C, rows, 8, Ke, sh->qz_k);
@@ -75,7 +75,24 @@ static void add_disk(const rcb_model *m, const rcb_layout *L, size_t node, doubl
   double Md[16], Gd[16];
   rcb_disk_element(mass, Id, Ip, Md, Gd);
   scatter(L, M, m->nodes[node].dof, 4, Md, 1.0);
-  scatter(L, G, m->nodes[node].dof, 4, Gd, 1.0);
+  scatter(L, G, m->nodes[node].dof, 4, Gd, m->speed_factor);
+}
+
+/* Pedestals: mass on x and y, springs and dampers to ground (diagonal). */
+static void add_pedestals(const rcb_model *m, const rcb_layout *L, double *M, double *C,
+                          double *K) {
+  size_t b;
+  int k;
+  for (b = 0; b < m->n_bearings; b++) {
+    const rcb_bearing_t *br = &m->bearings[b];
+    if (!br->has_ped) continue;
+    for (k = 0; k < 2; k++) {
+      size_t at = rcb_layout_at(L, (size_t)br->ped_dof[k], (size_t)br->ped_dof[k]);
+      if (M) M[at] += br->ped_m;
+      if (C) C[at] += br->ped_c[k];
+      if (K) K[at] += br->ped_k[k];
+    }
+  }
 }
 
 /* Translational and rotational spring (or damper) between the two coupling
@@ -143,21 +160,34 @@ void rcb_assemble_structure(const rcb_model *m, const rcb_layout *L, double *M, 
   for (i = 0; i < m->n_disks; i++)
     add_disk(m, L, m->disks[i].at.node, m->disks[i].m, m->disks[i].Id, m->disks[i].Ip, M, G);
   add_couplings(m, L, M, C, G, K);
+  add_pedestals(m, L, M, C, K);
 }
 
-void rcb_bearing_entries(const rcb_model *m, size_t b, double speed, rcb_entry out[4]) {
+/* The bearing force -K (q_shaft - q_ped) acts on the shaft and, reversed,
+ * on the pedestal: blocks [+B -B; -B +B] on (shaft, pedestal). */
+size_t rcb_bearing_entries(const rcb_model *m, size_t b, double speed,
+                           rcb_entry out[RCB_BEARING_ENTRIES_MAX]) {
   const rcb_bearing_t *br = &m->bearings[b];
   const rcb_node_t *nd = &m->nodes[br->at.node];
+  const long *dof[2];
   rcb_bearing_coefs c;
   const double *kv = &c.kxx, *cv = &c.cxx;
-  int r, s;
-  rcb_bearing_eval(br, speed, &c);
-  for (r = 0; r < 2; r++)
-    for (s = 0; s < 2; s++) {
-      rcb_entry *e = &out[2 * r + s];
-      e->row = (size_t)nd->dof[r];
-      e->col = (size_t)nd->dof[s];
-      e->k = kv[2 * r + s]; /* kxx kxy kyx kyy */
-      e->c = cv[2 * r + s];
+  size_t n = 0;
+  int r, s, bi, bj, nb = br->has_ped ? 2 : 1;
+  dof[0] = nd->dof;
+  dof[1] = br->ped_dof;
+  rcb_bearing_eval(br, speed * m->speed_factor, &c);
+  for (bj = 0; bj < nb; bj++)
+    for (bi = 0; bi < nb; bi++) {
+      double sign = bi == bj ? 1.0 : -1.0;
+      for (r = 0; r < 2; r++)
+        for (s = 0; s < 2; s++) {
+          rcb_entry *e = &out[n++];
+          e->row = (size_t)dof[bi][r];
+          e->col = (size_t)dof[bj][s];
+          e->k = sign * kv[2 * r + s]; /* kxx kxy kyx kyy */
+          e->c = sign * cv[2 * r + s];
+        }
     }
+  return n;
 }

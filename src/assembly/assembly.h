@@ -61,7 +61,8 @@ rcb_status rcb_csc_pattern(const rcb_model *m, const rcb_allocator *a, int **col
                            size_t *nnz);
 
 /* Speed-independent parts: M, G, and C, K of shafts (with proportional
- * damping) and couplings, bearings left out. Arrays of rcb_layout_size()
+ * damping), couplings and bearing pedestals (mass, springs and dampers to
+ * ground), bearings left out. G includes the model's speed factor. Arrays of rcb_layout_size()
  * entries are overwritten; any may be NULL. */
 void rcb_assemble_structure(const rcb_model *m, const rcb_layout *L, double *M, double *C,
                             double *G, double *K);
@@ -73,7 +74,16 @@ typedef struct rcb_entry_s {
   double k, c; /* N/m, N s/m */
 } rcb_entry;
 
-/* The 4 entries (x/y rows and columns) of bearing b at rotor speed (rad/s). */
-void rcb_bearing_entries(const rcb_model *m, size_t b, double speed, rcb_entry out[4]);
+/* Most entries one bearing contributes: its 2x2 block between the shaft
+ * node and ground (4), or between the shaft node and its pedestal (16). */
+#define RCB_BEARING_ENTRIES_MAX 16
+
+/* The entries of bearing b at rotor speed (rad/s; times the model's speed
+ * factor): the shaft block first (x/y rows and columns of the shaft node),
+ * then with a pedestal the shaft-pedestal, pedestal-shaft and pedestal
+ * blocks. Returns the count (4 or 16). The pedestal's own mass, springs and
+ * dampers are speed-independent and in rcb_assemble_structure. */
+size_t rcb_bearing_entries(const rcb_model *m, size_t b, double speed,
+                           rcb_entry out[RCB_BEARING_ENTRIES_MAX]);
 
 #endif

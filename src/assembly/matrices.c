@@ -7,15 +7,15 @@
 rcb_status rcb_model_matrices(const rcb_model *m, double speed, double *M, double *C, double *G,
                               double *K) {
   rcb_layout L;
-  rcb_entry e[4];
-  size_t b, k;
+  rcb_entry e[RCB_BEARING_ENTRIES_MAX];
+  size_t b, k, ne;
   if (!m || !isfinite(speed)) return RCB_ERR_ARG;
   if (!m->finalized) return RCB_ERR_STATE;
   rcb_layout_dense(&L, m->ndof);
   rcb_assemble_structure(m, &L, M, C, G, K);
   for (b = 0; b < m->n_bearings; b++) {
-    rcb_bearing_entries(m, b, speed, e);
-    for (k = 0; k < 4; k++) {
+    ne = rcb_bearing_entries(m, b, speed, e);
+    for (k = 0; k < ne; k++) {
       if (K) K[rcb_layout_at(&L, e[k].row, e[k].col)] += e[k].k;
       if (C) C[rcb_layout_at(&L, e[k].row, e[k].col)] += e[k].c;
     }

@@ -4,7 +4,8 @@
  * write couples the DOFs of one node or of two nodes (a shaft element's two
  * ends, a coupling's two stations), so the pattern is the union of full
  * node blocks: 8 x 8 for elements and couplings, 4 x 4 for disks and
- * bearings, plus the diagonal. Full blocks (not the current nonzeros) keep
+ * bearings (and a bearing's shaft x, y with its pedestal's x, y), plus the
+ * diagonal. Full blocks (not the current nonzeros) keep
  * the pattern valid when rcb_model_set_param turns a zero coefficient on.
  */
 #include <limits.h>
@@ -18,14 +19,9 @@ typedef struct pat_s {
   int *rows;    /* slots */
 } pat;
 
-/* Add the DOFs of nodes a and b (b may equal a) as a full block. */
-static void node_block(const rcb_model *m, pat *p, size_t a, size_t b, int count_only) {
-  long d[8];
-  int k, r, c, nd = a == b ? 4 : 8;
-  for (k = 0; k < 4; k++) {
-    d[k] = m->nodes[a].dof[k];
-    d[4 + k] = m->nodes[b].dof[k];
-  }
+/* Add the nd DOFs d as a full block. */
+static void dof_block(pat *p, const long *d, int nd, int count_only) {
+  int r, c;
   for (c = 0; c < nd; c++) {
     size_t col = (size_t)d[c];
     if (count_only) {
@@ -36,6 +32,27 @@ static void node_block(const rcb_model *m, pat *p, size_t a, size_t b, int count
   }
 }
 
+/* Add the DOFs of nodes a and b (b may equal a) as a full block. */
+static void node_block(const rcb_model *m, pat *p, size_t a, size_t b, int count_only) {
+  long d[8];
+  int k;
+  for (k = 0; k < 4; k++) {
+    d[k] = m->nodes[a].dof[k];
+    d[4 + k] = m->nodes[b].dof[k];
+  }
+  dof_block(p, d, a == b ? 4 : 8, count_only);
+}
+
+/* A bearing on a pedestal: shaft x, y and pedestal x, y as one block. */
+static void pedestal_block(const rcb_model *m, pat *p, const rcb_bearing_t *b, int count_only) {
+  long d[4];
+  d[0] = m->nodes[b->at.node].dof[0];
+  d[1] = m->nodes[b->at.node].dof[1];
+  d[2] = b->ped_dof[0];
+  d[3] = b->ped_dof[1];
+  dof_block(p, d, 4, count_only);
+}
+
 static void all_blocks(const rcb_model *m, pat *p, int count_only) {
   size_t i;
   for (i = 0; i < m->n_elements; i++)
@@ -44,8 +61,10 @@ static void all_blocks(const rcb_model *m, pat *p, int count_only) {
     node_block(m, p, m->couplings[i].at[0].node, m->couplings[i].at[1].node, count_only);
   for (i = 0; i < m->n_disks; i++) node_block(m, p, m->disks[i].at.node, m->disks[i].at.node,
                                                count_only);
-  for (i = 0; i < m->n_bearings; i++)
+  for (i = 0; i < m->n_bearings; i++) {
     node_block(m, p, m->bearings[i].at.node, m->bearings[i].at.node, count_only);
+    if (m->bearings[i].has_ped) pedestal_block(m, p, &m->bearings[i], count_only);
+  }
 }
 
 static void sort_unique(int *v, size_t *len) {

@@ -11,7 +11,7 @@
 
 #include "compare/compare_internal.h"
 
-rcb_status rcb_cmp_fail(rcb_compare *c, rcb_status st, const char *fmt, ...) {
+rcb_status (rcb_cmp_fail)(rcb_compare *c, rcb_status st, const char *fmt, ...) {
   va_list ap;
   va_start(ap, fmt);
   vsnprintf(c->errmsg, sizeof c->errmsg, fmt, ap);

@@ -44,9 +44,19 @@ rcb_status rcb_cmp_fail(rcb_compare *c, rcb_status st, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
+#ifdef __clang_analyzer__ /* returns st: see rcb_set_error in core/rcb_internal.h */
+#define rcb_cmp_fail(o, st, ...) ((void)(rcb_cmp_fail)((o), (st), __VA_ARGS__), (st))
+#endif
 
 /* Model values of every channel at abscissa w (rad/s) into out[nch]. */
 rcb_status rcb_cmp_model_at(rcb_compare *c, rcb_cmp_eval *ev, double w, rcb_complex *out);
+
+/* Local modal fit of one resonance on n points (w rad/s, h complex, one
+ * channel; wref: the peak's frequency, for scaling): natural frequency wn
+ * (rad/s) and damping ratio zeta, both NaN when the fit fails
+ * (compare_modal.c). */
+rcb_status rcb_cmp_modal_fit(rcb_compare *c, const double *w, const rcb_complex *h, size_t n,
+                             double wref, double *wn, double *zeta);
 
 /* Build the peak table (compare_peaks.c). */
 rcb_status rcb_cmp_peaks(rcb_compare *c, rcb_cmp_eval *ev);

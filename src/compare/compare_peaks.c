@@ -1,6 +1,7 @@
 /*
  * The peak table: measured resonances (prominent local maxima of the
- * channel-summed magnitude, parabolic top, half-power damping) paired with
+ * channel-summed magnitude, parabolic top, damping from a local modal fit,
+ * compare_modal.c, and from the half-power width) paired with
  * the model's modes (damped modes at the test speed for FRFs; 1X critical
  * speeds for unbalance responses and synchronous FRFs) by nearest frequency.
  */
@@ -293,6 +294,42 @@ static void measured_row(const rcb_compare *c, const peak *p, const double *wt,
   r->amp_ratio = r->model_amp > 0 ? r->meas_amp / r->model_amp : (double)NAN;
 }
 
+/* The local modal fit of a measured peak on its dominant channel: the
+ * points within 3.5 half-power half-widths (zeta w) of the top, at least 5
+ * and at most 250 on each side. A window of about one half-width leaves
+ * the fit's residual terms free to take up the noise: under eq. 19 noise
+ * the damping then comes out 25 % low, as the half-power width's does. */
+static rcb_status modal_row(rcb_compare *c, const peak *p, rcb_compare_peak *r) {
+  const rcb_complex *e = c->meas + r->channel * c->npts;
+  double half = 3.5 * (isfinite(p->zeta) ? p->zeta : 0.01) * p->freq, wn, zeta;
+  size_t lo = p->idx, hi = p->idx, i, n = 0;
+  rcb_status st;
+  double *w = rcb_alloc(&c->alloc, c->npts * sizeof *w);
+  rcb_complex *h = rcb_alloc(&c->alloc, c->npts * sizeof *h);
+  r->meas_zeta_hp = p->zeta;
+  r->meas_wd = (double)NAN;
+  if (!w || !h) {
+    rcb_free(&c->alloc, w);
+    rcb_free(&c->alloc, h);
+    return rcb_cmp_fail(c, RCB_ERR_NOMEM, "out of memory (modal fit)");
+  }
+  while (lo > 0 && p->idx - lo < 250 && (p->idx - lo < 5 || c->grid[lo - 1] >= p->freq - half))
+    lo--;
+  while (hi + 1 < c->npts && hi - p->idx < 250 &&
+         (hi - p->idx < 5 || c->grid[hi + 1] <= p->freq + half))
+    hi++;
+  for (i = lo; i <= hi; i++)
+    if (isfinite(creal(e[i])) && isfinite(cimag(e[i]))) w[n] = c->grid[i], h[n++] = e[i];
+  st = rcb_cmp_modal_fit(c, w, h, n, p->freq, &wn, &zeta);
+  if (!st && isfinite(zeta) && zeta < 1.0) {
+    r->meas_zeta = zeta;
+    r->meas_wd = wn * sqrt(1.0 - zeta * zeta);
+  }
+  rcb_free(&c->alloc, w);
+  rcb_free(&c->alloc, h);
+  return st;
+}
+
 static void model_side(rcb_compare_peak *r, const mref *q) {
   r->model_freq = q->freq;
   r->model_zeta = q->zeta;
@@ -303,6 +340,7 @@ static void model_side(rcb_compare_peak *r, const mref *q) {
 static rcb_status build_rows(rcb_compare *c, const peak *pk, size_t np, const size_t *pk_pair,
                              const mref *refs, size_t nref, const double *wt) {
   size_t i, j, n = 0, unpaired = 0;
+  rcb_status st;
   for (j = 0; j < nref; j++) unpaired += refs[j].pair == NONE;
   c->peaks = rcb_alloc(&c->alloc, (np + unpaired + 1) * sizeof *c->peaks);
   if (!c->peaks) return rcb_cmp_fail(c, RCB_ERR_NOMEM, "out of memory");
@@ -311,6 +349,7 @@ static rcb_status build_rows(rcb_compare *c, const peak *pk, size_t np, const si
     r->model_freq = r->model_zeta = r->model_peak = (double)NAN;
     r->freq_err_pct = r->zeta_err_pct = r->peak_err_pct = (double)NAN;
     measured_row(c, &pk[i], wt, r);
+    if ((st = modal_row(c, &pk[i], r))) return st;
     r->match = RCB_PEAK_MEASURED_ONLY;
     if (pk_pair[i] == NONE) continue;
     r->match = RCB_PEAK_MATCHED;
@@ -325,6 +364,7 @@ static rcb_status build_rows(rcb_compare *c, const peak *pk, size_t np, const si
     r = &c->peaks[n++];
     r->match = RCB_PEAK_MODEL_ONLY;
     r->meas_freq = r->meas_zeta = r->meas_amp = r->model_amp = r->amp_ratio = (double)NAN;
+    r->meas_zeta_hp = r->meas_wd = (double)NAN;
     r->freq_err_pct = r->zeta_err_pct = r->peak_err_pct = (double)NAN;
     r->channel = 0;
     model_side(r, &refs[j]);

@@ -3,7 +3,7 @@
 
 #include "core/rcb_internal.h"
 
-rcb_status rcb_set_error(char *buf, rcb_status st, const char *fmt, ...) {
+rcb_status (rcb_set_error)(char *buf, rcb_status st, const char *fmt, ...) {
   va_list ap;
   if (buf) {
     va_start(ap, fmt);

@@ -37,6 +37,14 @@ rcb_status rcb_set_error(char *buf, rcb_status st, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
+#ifdef __clang_analyzer__
+/* The clang static analyzer (clang-tidy, `dev.sh lint`) never follows a call
+ * into a variadic function, so it cannot see that this returns st and it
+ * explores "failed, yet returned RCB_OK" paths. This macro states the return
+ * value for the analysis only (a compiler never defines __clang_analyzer__);
+ * the other *_fail helpers do the same. */
+#define rcb_set_error(buf, st, ...) ((void)(rcb_set_error)((buf), (st), __VA_ARGS__), (st))
+#endif
 
 /* ---- core/text.c ---- */
 /* Case-insensitive Levenshtein distance of two names ((size_t)-1 beyond 160
@@ -84,6 +92,15 @@ typedef struct rcb_bearing_s {
   size_t n;             /* table rows (1 = constant) */
   double *speeds;       /* rad/s, n of them */
   rcb_bearing_coefs *c; /* n of them */
+  /* Flexible support: with has_ped the bearing joins the shaft node to a
+   * pedestal (x, y DOFs, mass ped_m) that springs/dampers hold to ground;
+   * without it the bearing goes to ground. ped_node is the pedestal's
+   * virtual node (n_nodes + k), ped_dof its matrix rows (after finalize). */
+  int has_ped;
+  double ped_m;              /* kg, on x and y */
+  double ped_k[2], ped_c[2]; /* N/m, N s/m: x, y, pedestal to ground */
+  size_t ped_node;
+  long ped_dof[2];
 } rcb_bearing_t;
 
 typedef struct rcb_coupling_s {
@@ -157,6 +174,9 @@ struct rcb_model {
   RCB_ARRAY(rcb_node_t, nodes);
   RCB_ARRAY(rcb_element_t, elements);
   RCB_ARRAY(rcb_warning_t, warnings); /* model/warnings.c */
+  size_t n_peds;    /* bearings with a pedestal (virtual nodes after n_nodes) */
+  double speed_factor; /* real rotor speed / stated speed in the gyroscopic and
+                          bearing terms (1: as stated; [model] speed_factor) */
   size_t ndof;      /* independent DOFs */
   size_t bandwidth; /* max |row - col| of any nonzero (kl = ku) */
 };

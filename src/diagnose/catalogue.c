@@ -15,7 +15,8 @@ static const char *const effect_names[RCB_EFFECT_COUNT] = {
     "coupling rotational damping",    "coupling model",
     "coupling hub mass and inertia",  "bearing stiffness (anisotropy)",
     "bearing cross-coupled stiffness", "bearing damping",
-    "shaft material damping",         "added mass and inertia"};
+    "shaft material damping",         "added mass and inertia",
+    "flexible support",               "operating speed"};
 
 const char *rcb_effect_name(rcb_effect e) {
   return (int)e >= 0 && e < RCB_EFFECT_COUNT ? effect_names[e] : "?";
@@ -232,10 +233,126 @@ static rcb_status added_masses(rcb_diag *d, const rcb_model *m) {
   return RCB_OK;
 }
 
+/* Mass of the rotor train, kg: shafts, disks, coupling hubs. */
+static double rotor_mass(const rcb_model *m) {
+  double mt = 0.0;
+  size_t i;
+  for (i = 0; i < m->n_elements; i++) {
+    const rcb_element_t *e = &m->elements[i];
+    mt += m->materials[m->shafts[e->shaft].material].rho * RCB_PI / 4 *
+          (e->od * e->od - e->id * e->id) * e->L;
+  }
+  for (i = 0; i < m->n_disks; i++) mt += m->disks[i].m;
+  for (i = 0; i < m->n_couplings; i++) mt += m->couplings[i].p.mass[0] + m->couplings[i].p.mass[1];
+  return mt > 0 ? mt : 1.0;
+}
+
+/* A pedestal under every bearing that has none. Its neutral point (no
+ * pedestal) has no DOFs, so the candidate starts as a very stiff, light
+ * pedestal (1000 x the bearing's stiffness, 1e-3 of the rotor mass per
+ * bearing, no damping): the model is the same to about 1e-3, and the score
+ * test sees the first terms of the pedestal's dynamic compliance,
+ * 1/(k - w^2 m + i w c) ~ 1/k + w^2 m/k^2 - i w c/k^2: a series compliance,
+ * its w^2-weighted and its w-weighted (damping) shapes. The refit then moves
+ * the pedestal into the band. */
+static rcb_status pedestals(rcb_diag *d, const rcb_model *m) {
+  double mref = rotor_mass(m) / (double)(m->n_bearings ? m->n_bearings : 1);
+  size_t i;
+  for (i = 0; i < m->n_bearings; i++) {
+    const rcb_bearing_t *b = &m->bearings[i];
+    double kb = fmax(fabs(b->c[0].kxx), fabs(b->c[0].kyy));
+    char place[RCB_DIAG_NAME];
+    diag_cand *c;
+    if (b->has_ped) continue;
+    if (kb == 0) kb = 1e6;
+    snprintf(place, sizeof place, "bearing %s", b->name);
+    if (!(c = new_cand(d, RCB_EFFECT_FLEXIBLE_SUPPORT, place))) return RCB_ERR_NOMEM;
+    snprintf(c->desc, sizeof c->desc,
+             "a flexible support (pedestal mass on a spring and damper) under bearing %s",
+             b->name);
+    c->edit = EDIT_ADD_PEDESTAL;
+    snprintf(c->target, sizeof c->target, "%s", b->name);
+    c->ped0[0] = 1e-3 * mref;
+    c->ped0[1] = 1e3 * kb;
+    c->ped0[2] = 0.0;
+    add_par(c, "bearing.%s.pedestal_mass", b->name, 1e-4 * mref, 20 * mref, 1);
+    add_par(c, "bearing.%s.pedestal_k", b->name, 1e-2 * kb, 1e4 * kb, 1);
+    add_par(c, "bearing.%s.pedestal_c", b->name, 0.0, 1e-2 * kb, 0);
+  }
+  return RCB_OK;
+}
+
+/* Weighted objective of f at the model's current values (NaN on failure). */
+static double objective_now(rcb_fit *f, double *r) {
+  size_t i, n = rcb_fit_residual_count(f);
+  double F = 0;
+  if (rcb_fit_residuals(f, r)) return (double)NAN;
+  for (i = 0; i < n; i++) F += r[i] * r[i];
+  return F;
+}
+
+static rcb_status set_pedestal(rcb_model *m, const char *bearing, double mass, double k,
+                               double c) {
+  char nm[RCB_DIAG_NAME];
+  rcb_status st;
+  snprintf(nm, sizeof nm, "bearing.%s.pedestal_mass", bearing);
+  if ((st = rcb_model_set_param(m, nm, mass))) return st;
+  snprintf(nm, sizeof nm, "bearing.%s.pedestal_k", bearing);
+  if ((st = rcb_model_set_param(m, nm, k))) return st;
+  snprintf(nm, sizeof nm, "bearing.%s.pedestal_c", bearing);
+  return rcb_model_set_param(m, nm, c);
+}
+
+/* The refit of a pedestal starts from the best point of a grid (68 model
+ * sweeps): masses 0.3, 1, 3 and 10 x the rotor mass per bearing, stiffnesses
+ * over the lower four decades of its bounds (4 per decade), 5 % of critical
+ * damping; or from the stiff light start when no grid point is better. The
+ * score test, taken at that start, only sees the pedestal's compliance,
+ * while a pedestal near the band adds a resonance that a local fit from
+ * there does not find. */
+rcb_status rcb_diag_refit_start(rcb_diag *d, const diag_cand *c, rcb_model *m, rcb_fit *f) {
+  static const double mass_f[4] = {0.3, 1.0, 3.0, 10.0};
+  double *r, best, bm = c->ped0[0], bk = c->ped0[1], bc = c->ped0[2], mref;
+  int a, j;
+  rcb_status st = RCB_OK;
+  if (c->edit != EDIT_ADD_PEDESTAL) return RCB_OK;
+  if (!(r = rcb_alloc(&d->alloc, (rcb_fit_residual_count(f) + 1) * sizeof *r)))
+    return rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
+  mref = rotor_mass(m) / (double)(m->n_bearings ? m->n_bearings : 1);
+  best = objective_now(f, r);
+  for (a = 0; a < 4 && !st; a++)
+    for (j = 0; j <= 16 && !st; j++) {
+      double mass = mass_f[a] * mref, k = c->lo[1] * pow(10.0, 0.25 * j);
+      double damp = fmin(0.1 * sqrt(k * mass), c->hi[2]), F;
+      if ((st = set_pedestal(m, c->target, mass, k, damp))) break;
+      F = objective_now(f, r);
+      if (F < best) best = F, bm = mass, bk = k, bc = damp;
+    }
+  if (!st) st = set_pedestal(m, c->target, bm, bk, bc);
+  rcb_free(&d->alloc, r);
+  if (st) return rcb_diag_fail(d, st, "%s: %s", c->desc, rcb_model_errmsg(m));
+  return RCB_OK;
+}
+
+/* The operating speed (FRF data taken on a spinning rotor only): a speed
+ * factor, neutral 1. Unbalance responses are left out: their abscissa is the
+ * measured once-per-revolution speed, and the factor does not apply there. */
+static rcb_status speed(rcb_diag *d) {
+  diag_cand *c;
+  if (rcb_meas_get_type(d->meas) != RCB_MEAS_FRF || rcb_meas_speed(d->meas) == 0 ||
+      is_base(d, "speed.factor"))
+    return RCB_OK;
+  if (!(c = new_cand(d, RCB_EFFECT_SPEED, "operating speed"))) return RCB_ERR_NOMEM;
+  snprintf(c->desc, sizeof c->desc,
+           "an operating speed other than the stated one (gyroscopic split)");
+  add_par(c, "%s", "speed.factor", 0.25, 4.0, 1);
+  return RCB_OK;
+}
+
 rcb_status rcb_diag_catalogue(rcb_diag *d, const rcb_model *m) {
   rcb_status st;
-  if ((st = couplings(d, m)) || (st = bearings(d, m)) || (st = shafts(d, m)) ||
-      (st = added_masses(d, m)))
+  if ((st = couplings(d, m)) || (st = bearings(d, m)) || (st = pedestals(d, m)) ||
+      (st = shafts(d, m)) || (st = added_masses(d, m)) || (st = speed(d)))
     return rcb_diag_fail(d, st, "out of memory laying out the candidates");
   return RCB_OK;
 }
@@ -279,6 +396,24 @@ static size_t edit_coupling(const char *ini, const diag_cand *c, char *out, size
   return n;
 }
 
+/* The base text with the pedestal keys put right after c->target's
+ * [bearing] header. */
+static size_t edit_pedestal(const char *ini, const diag_cand *c, char *out, size_t size) {
+  char head[RCB_NAME_MAX + 16];
+  const char *s;
+  size_t pre;
+  int n;
+  snprintf(head, sizeof head, "[bearing %s]\n", c->target);
+  if (!(s = strstr(ini, head))) return 0;
+  pre = (size_t)(s - ini) + strlen(head);
+  n = snprintf(out, size,
+               "%.*spedestal_mass = %.17g\npedestal_kxx = %.17g\npedestal_kyy = %.17g\n"
+               "pedestal_cxx = %.17g\npedestal_cyy = %.17g\n%s",
+               (int)pre, ini, c->ped0[0], c->ped0[1], c->ped0[1], c->ped0[2], c->ped0[2],
+               ini + pre);
+  return n < 0 ? 0 : (size_t)n;
+}
+
 rcb_status rcb_diag_candidate_model(rcb_diag *d, const diag_cand *c, rcb_model **out) {
   size_t len = strlen(d->base_ini), size = len + 4096, n;
   char *txt = rcb_alloc(&d->alloc, size);
@@ -288,6 +423,8 @@ rcb_status rcb_diag_candidate_model(rcb_diag *d, const diag_cand *c, rcb_model *
   if (!txt) return rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
   if (c->edit == EDIT_COUPLING_MODEL)
     n = edit_coupling(d->base_ini, c, txt, size);
+  else if (c->edit == EDIT_ADD_PEDESTAL)
+    n = edit_pedestal(d->base_ini, c, txt, size);
   else if (c->edit == EDIT_ADD_DISK)
     n = (size_t)snprintf(txt, size, "%s\n[disk %s]\nat = %s\nmass = 0\nId = 0\nIp = 0\n",
                          d->base_ini, c->target, c->at);

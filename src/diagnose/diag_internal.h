@@ -13,7 +13,12 @@
 #define RCB_DIAG_MAXP 3
 #define RCB_DIAG_NAME 128
 
-typedef enum diag_edit { EDIT_NONE = 0, EDIT_COUPLING_MODEL = 1, EDIT_ADD_DISK = 2 } diag_edit;
+typedef enum diag_edit {
+  EDIT_NONE = 0,
+  EDIT_COUPLING_MODEL = 1,
+  EDIT_ADD_DISK = 2,
+  EDIT_ADD_PEDESTAL = 3 /* target: the bearing; ped0: its starting values */
+} diag_edit;
 
 typedef struct diag_cand {
   rcb_effect effect;
@@ -24,6 +29,7 @@ typedef struct diag_cand {
   rcb_coupling_model new_type;      /* EDIT_COUPLING_MODEL */
   double kt0, kr0, ct0, cr0;        /* its starting values */
   char at[RCB_DIAG_NAME];           /* EDIT_ADD_DISK: "SHAFT z" */
+  double ped0[3];                   /* EDIT_ADD_PEDESTAL: kg, N/m, N s/m */
   int refit_only;                   /* no neutral value: refitted, not scored */
   size_t np;
   char pname[RCB_DIAG_MAXP][RCB_DIAG_NAME];
@@ -64,6 +70,7 @@ struct rcb_diag {
   diag_cand *cand;
   size_t ncand, cap_cand;
   size_t *order;                    /* rank -> candidate */
+  rcb_diag_stats stats;             /* work done by the last run */
   int ran;
 };
 
@@ -75,6 +82,10 @@ rcb_status rcb_diag_fail(rcb_diag *d, rcb_status st, const char *fmt, ...)
 
 /* Lay out every candidate effect of the (fitted) model m. */
 rcb_status rcb_diag_catalogue(rcb_diag *d, const rcb_model *m);
+/* Before a refit of candidate c on its model m (fit f, base parameters
+ * fitted): move the candidate's parameters to a better start where the
+ * neutral start sees nothing (a pedestal: a scan of its mass and stiffness). */
+rcb_status rcb_diag_refit_start(rcb_diag *d, const diag_cand *c, rcb_model *m, rcb_fit *f);
 /* The candidate's model: the base INI text edited, loaded (caller destroys). */
 rcb_status rcb_diag_candidate_model(rcb_diag *d, const diag_cand *c, rcb_model **out);
 

@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "diagnose/diag_internal.h"
+#include "identify/fit_internal.h"
 
 #define RCB_DIAG_BIC_MIN (-10.0) /* "strong" evidence (Kass & Raftery) */
 #define RCB_DIAG_ERR_FALL 0.98   /* the error must fall by at least 2 % of itself */
@@ -51,6 +52,7 @@ static void free_results(rcb_diag *d) {
   d->cand = NULL, d->order = NULL, d->base_ini = NULL;
   d->ncand = d->cap_cand = 0;
   d->ran = 0;
+  memset(&d->stats, 0, sizeof d->stats);
 }
 
 void rcb_diag_destroy(rcb_diag *d) {
@@ -116,6 +118,7 @@ static rcb_status make_fit(rcb_diag *d, rcb_model *m, int with_base, const diag_
   rcb_fit *f = NULL;
   rcb_status st = rcb_fit_create(&f, m, d->meas, &d->alloc);
   size_t k;
+  if (!st) f->no_uncertainty = 1; /* intervals are not part of a diagnosis */
   if (!st) st = rcb_fit_set_scale(f, d->scale);
   if (!st && (d->beta_a > 0 || d->beta_s > 0))
     st = rcb_fit_set_noise_model(f, d->beta_a, d->beta_s);
@@ -138,6 +141,12 @@ static rcb_status make_fit(rcb_diag *d, rcb_model *m, int with_base, const diag_
   }
   *out = f;
   return RCB_OK;
+}
+
+/* Destroy a fit, counting its model sweeps in the diagnosis' figures. */
+static void drop_fit(rcb_diag *d, rcb_fit *f) {
+  if (f) d->stats.evaluations += f->sweeps;
+  rcb_fit_destroy(f);
 }
 
 static rcb_status model_text(rcb_diag *d, const rcb_model *m, char **out) {
@@ -192,7 +201,7 @@ static rcb_status baseline(rcb_diag *d) {
     rcb_free(&d->alloc, r);
   }
   rcb_free(&d->alloc, txt);
-  rcb_fit_destroy(f);
+  drop_fit(d, f);
   rcb_model_destroy(m);
   return st;
 }
@@ -224,58 +233,137 @@ static size_t orthonormalise(double *A, size_t n, size_t k, const double *Q, siz
   return kept;
 }
 
-/* Predicted reduction of F: || Q_c^T r ||^2 with Q_c the candidate's columns
- * made orthonormal to the fitted parameters' (Q0). */
-static rcb_status score(rcb_diag *d, diag_cand *c, const double *r, const double *Q0,
-                        size_t q0, double *J) {
+/* Predicted reduction of F: || Q_c^T r ||^2 with Q_c the candidate's
+ * columns J (n x np, overwritten) made orthonormal to the fitted
+ * parameters' (Q0). */
+static double explained(double *J, size_t n, size_t np, const double *r, const double *Q0,
+                        size_t q0) {
+  size_t kept = orthonormalise(J, n, np, Q0, q0), k, i;
+  double pred = 0;
+  for (k = 0; k < kept; k++) {
+    double dot = 0;
+    for (i = 0; i < n; i++) dot += J[n * k + i] * r[i];
+    pred += dot * dot;
+  }
+  return pred;
+}
+
+/* The candidate's model and a fit of its own parameters (the base's
+ * residual layout); the caller destroys both. */
+static rcb_status candidate_fit(rcb_diag *d, const diag_cand *c, rcb_model **m, rcb_fit **f) {
+  rcb_status st = rcb_diag_candidate_model(d, c, m);
+  *f = NULL;
+  if (!st) st = make_fit(d, *m, 0, c, f);
+  if (!st && rcb_fit_residual_count(*f) != d->nres)
+    st = rcb_diag_fail(d, RCB_ERR_STATE, "%s: residual layout differs", c->desc);
+  return st;
+}
+
+/* A candidate whose model has other DOFs than the base: its own sweep. */
+static rcb_status score_alone(rcb_diag *d, diag_cand *c, const double *r, const double *Q0,
+                              size_t q0, double *J) {
   rcb_model *m = NULL;
   rcb_fit *f = NULL;
-  size_t k, i, kept;
-  rcb_status st = rcb_diag_candidate_model(d, c, &m);
-  if (!st) st = make_fit(d, m, 0, c, &f);
-  if (!st && rcb_fit_residual_count(f) != d->nres)
-    st = rcb_diag_fail(d, RCB_ERR_STATE, "%s: residual layout differs", c->desc);
+  rcb_status st = candidate_fit(d, c, &m, &f);
   if (!st && (st = rcb_fit_jacobian(f, 1, J)))
     rcb_diag_fail(d, st, "%s: %s", c->desc, rcb_fit_errmsg(f));
-  if (!st) {
-    kept = orthonormalise(J, d->nres, c->np, Q0, q0);
-    c->predicted = 0;
-    for (k = 0; k < kept; k++) {
-      double dot = 0;
-      for (i = 0; i < d->nres; i++) dot += J[d->nres * k + i] * r[i];
-      c->predicted += dot * dot;
-    }
-  }
-  rcb_fit_destroy(f);
+  if (!st) c->predicted = explained(J, d->nres, c->np, r, Q0, q0);
+  drop_fit(d, f);
   rcb_model_destroy(m);
+  return st;
+}
+
+/* The derivatives of the candidate's parameters, taken on its own model at
+ * the neutral value (the base model itself). *same = 0 when that model has
+ * other DOFs than the base (dz left empty). */
+static rcb_status candidate_dz(rcb_diag *d, const diag_cand *c, size_t ndof, rcb_fit_dz *dz,
+                               int *same) {
+  rcb_model *m = NULL;
+  rcb_fit *f = NULL;
+  rcb_status st = candidate_fit(d, c, &m, &f);
+  *same = !st && rcb_model_dof_count(m) == ndof;
+  if (*same && (st = rcb_fit_dz_get(f, &d->alloc, dz))) {
+    rcb_diag_fail(d, st, "%s: %s", c->desc, rcb_fit_errmsg(f));
+    *same = 0;
+  }
+  drop_fit(d, f);
+  rcb_model_destroy(m);
+  return st;
+}
+
+/* Candidates are scored in batches of up to this many parameters, whose
+ * columns share one sweep of the base model (fit_score.c). */
+#define RCB_DIAG_BATCH 32
+
+typedef struct score_ws {
+  rcb_fit *f;           /* the base model, fitted */
+  const double *r, *Q0; /* its weighted residual; the fitted parameters' columns */
+  size_t q0;
+  double *J;            /* nres x RCB_DIAG_BATCH */
+  rcb_fit_dz dz[RCB_DIAG_BATCH];
+  size_t which[RCB_DIAG_BATCH], ncand, npar; /* candidates of the batch, their parameters */
+} score_ws;
+
+static rcb_status progress(rcb_diag *d, size_t k) {
+  if (d->progress && d->progress(d->progress_user, k + 1, d->ncand + d->nrefit))
+    return rcb_diag_fail(d, RCB_ERR_STATE, "stopped by the caller");
+  return RCB_OK;
+}
+
+static rcb_status flush_batch(rcb_diag *d, score_ws *w) {
+  size_t b, off = 0;
+  rcb_status st = RCB_OK;
+  if (w->npar && (st = rcb_fit_jacobian_dz(w->f, w->dz, w->npar, w->J)))
+    rcb_diag_fail(d, st, "scoring the candidates: %s", rcb_fit_errmsg(w->f));
+  for (b = 0; !st && b < w->ncand; b++) {
+    diag_cand *c = &d->cand[w->which[b]];
+    c->predicted = explained(w->J + d->nres * off, d->nres, c->np, w->r, w->Q0, w->q0);
+    off += c->np;
+    st = progress(d, w->which[b]);
+  }
+  rcb_fit_dz_free(&d->alloc, w->dz, w->npar);
+  w->ncand = w->npar = 0;
   return st;
 }
 
 static rcb_status score_all(rcb_diag *d) {
   rcb_model *m = NULL;
-  rcb_fit *f = NULL;
-  size_t n = d->nres, k, q0 = 0;
+  score_ws w;
+  size_t n = d->nres, k, ndof = rcb_model_dof_count(d->m);
   double *r = rcb_alloc(&d->alloc, n * sizeof *r);
   double *Q0 = rcb_alloc(&d->alloc, n * (d->nbase + 1) * sizeof *Q0);
-  double *J = rcb_alloc(&d->alloc, n * RCB_DIAG_MAXP * sizeof *J);
-  rcb_status st = (r && Q0 && J) ? RCB_OK : rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
+  rcb_status st;
+  memset(&w, 0, sizeof w);
+  w.J = rcb_alloc(&d->alloc, n * RCB_DIAG_BATCH * sizeof *w.J);
+  w.r = r, w.Q0 = Q0;
+  st = (r && Q0 && w.J) ? RCB_OK : rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
   if (!st) st = rcb_model_create(&m, &d->alloc);
   if (!st) st = rcb_model_load_string(m, d->base_ini, "<model>");
-  if (!st) st = make_fit(d, m, 1, NULL, &f);
-  if (!st) st = rcb_fit_residuals(f, r);
-  if (!st && d->nbase && !(st = rcb_fit_jacobian(f, 1, Q0)))
-    q0 = orthonormalise(Q0, n, d->nbase, NULL, 0);
+  if (!st) ndof = rcb_model_dof_count(m);
+  if (!st) st = make_fit(d, m, 1, NULL, &w.f);
+  if (!st) st = rcb_fit_residuals(w.f, r);
+  if (!st && d->nbase && !(st = rcb_fit_jacobian(w.f, 1, Q0)))
+    w.q0 = orthonormalise(Q0, n, d->nbase, NULL, 0);
   for (k = 0; !st && k < d->ncand; k++) {
-    if (d->cand[k].refit_only) continue;
-    st = score(d, &d->cand[k], r, Q0, q0, J);
-    if (!st && d->progress && d->progress(d->progress_user, k + 1, d->ncand + d->nrefit))
-      st = rcb_diag_fail(d, RCB_ERR_STATE, "stopped by the caller");
+    diag_cand *c = &d->cand[k];
+    int same;
+    if (c->refit_only) continue;
+    d->stats.scored++;
+    if (w.npar + c->np > RCB_DIAG_BATCH && (st = flush_batch(d, &w))) break;
+    if ((st = candidate_dz(d, c, ndof, w.dz + w.npar, &same))) break;
+    if (same) {
+      w.which[w.ncand++] = k, w.npar += c->np;
+    } else if (!(st = score_alone(d, c, r, Q0, w.q0, w.J + n * w.npar))) {
+      st = progress(d, k);
+    }
   }
-  rcb_fit_destroy(f);
+  if (!st) st = flush_batch(d, &w);
+  rcb_fit_dz_free(&d->alloc, w.dz, w.npar);
+  drop_fit(d, w.f);
   rcb_model_destroy(m);
   rcb_free(&d->alloc, r);
   rcb_free(&d->alloc, Q0);
-  rcb_free(&d->alloc, J);
+  rcb_free(&d->alloc, w.J);
   return st;
 }
 
@@ -298,7 +386,9 @@ static rcb_status refit(rcb_diag *d, diag_cand *c) {
   rcb_fit_report rep;
   double N = (double)d->nres, dk = (double)c->np;
   rcb_status st = rcb_diag_candidate_model(d, c, &m);
+  d->stats.refits++;
   if (!st) st = make_fit(d, m, 1, c, &f);
+  if (!st) st = rcb_diag_refit_start(d, c, m, f);
   if (!st) st = rcb_fit_set_starts(f, 3, 1);
   if (st) { /* a candidate that cannot be built is reported, not fatal */
     snprintf(c->fitted, sizeof c->fitted, "not fitted: %.300s", d->errmsg);
@@ -333,7 +423,7 @@ static rcb_status refit(rcb_diag *d, diag_cand *c) {
     record_fit(c, f);
     st = model_text(d, m, &c->ini);
   }
-  rcb_fit_destroy(f);
+  drop_fit(d, f);
   rcb_model_destroy(m);
   return st;
 }
@@ -412,6 +502,12 @@ rcb_status rcb_diag_candidate_get(const rcb_diag *d, size_t rank, rcb_diag_candi
   out->delta_bic = c->dbic;
   out->significant = c->significant;
   out->fitted = c->fitted;
+  return RCB_OK;
+}
+
+rcb_status rcb_diag_get_stats(const rcb_diag *d, rcb_diag_stats *out) {
+  if (!d || !out) return RCB_ERR_ARG;
+  *out = d->stats;
   return RCB_OK;
 }
 

@@ -9,7 +9,7 @@
 
 #include "identify/fit_internal.h"
 
-rcb_status rcb_fit_fail(rcb_fit *f, rcb_status st, const char *fmt, ...) {
+rcb_status (rcb_fit_fail)(rcb_fit *f, rcb_status st, const char *fmt, ...) {
   va_list ap;
   va_start(ap, fmt);
   vsnprintf(f->errmsg, sizeof f->errmsg, fmt, ap);
@@ -61,6 +61,9 @@ static rcb_status fit_setup(rcb_fit *f) {
   else if (!(st = resolve_channels(f, outs, ins))) {
     st = rcb_frf_create(&f->frf, f->m, f->nout, outs, f->nin, ins, RCB_SOLVER_AUTO, &f->alloc);
     if (st) rcb_fit_fail(f, st, "FRF workspace: %s", rcb_status_str(st));
+    /* the iterations run without the condition check; the final
+     * evaluation has it (rcb_fit_run) */
+    if (!st) rcb_frf_set_condition_check(f->frf, RCB_COND_OFF, RCB_RCOND_WARN);
     f->Hwork = rcb_alloc(&f->alloc, f->nout * (f->nin ? f->nin : 1) * sizeof *f->Hwork);
     if (!st && !f->Hwork) st = rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory");
   }
@@ -118,6 +121,9 @@ void rcb_fit_free_layout(rcb_fit *f) {
   rcb_free(&f->alloc, f->dF);
   rcb_free(&f->alloc, f->cov);
   rcb_free(&f->alloc, f->corr);
+  rcb_free(&f->alloc, f->pt_first);
+  rcb_free(&f->alloc, f->pt_res);
+  f->pt_first = f->pt_res = NULL;
   f->res_ch = f->res_pt = NULL;
   f->res_part = f->pt_used = NULL;
   f->res_sqrtw = f->res_meas = f->J = f->r = f->dmat = f->cov = f->corr = NULL;
@@ -305,7 +311,7 @@ static int is_unsure(const rcb_fit *f, double err) {
 static rcb_status multistart(rcb_fit *f, double *x, double *x_best) {
   size_t s, it = 0, ev = 0, n = f->nstarts ? f->nstarts : 1;
   double best = HUGE_VAL;
-  int conv = 0;
+  int conv = 0, stall = 0;
   rcb_status st = RCB_OK, first = RCB_OK;
   for (s = 0; s < n; s++) {
     double F;
@@ -314,6 +320,7 @@ static rcb_status multistart(rcb_fit *f, double *x, double *x_best) {
       if ((st = rcb_fit_set_x(f, x))) break;
     }
     f->evaluations = 0;
+    f->stalled = 0;
     st = f->method == RCB_FIT_NLOPT ? rcb_fit_run_nlopt(f) : rcb_fit_run_paper(f);
     it += f->iterations, ev += f->evaluations;
     f->starts_used = s + 1;
@@ -327,11 +334,12 @@ static rcb_status multistart(rcb_fit *f, double *x, double *x_best) {
     if (F < best) {
       best = F;
       conv = f->converged;
+      stall = f->stalled;
       rcb_fit_get_x(f, x_best);
     }
     if (!is_unsure(f, rcb_fit_error_pct(f))) break;
   }
-  f->iterations = it, f->evaluations = ev, f->converged = conv;
+  f->iterations = it, f->evaluations = ev, f->converged = conv, f->stalled = stall;
   if (best == HUGE_VAL) return st ? st : first;
   return rcb_fit_set_x(f, x_best);
 }
@@ -370,8 +378,10 @@ rcb_status rcb_fit_run(rcb_fit *f) {
   rcb_frf_refresh(f->frf); /* the caller may have changed the model */
   f->iterations = f->evaluations = 0;
   f->converged = 0;
+  f->stop = RCB_FIT_STOP_NONE;
   if ((st = rcb_fit_eval(f, f->r))) return st;
   f->obj0 = rcb_fit_sumsq(f->r, f->nres);
+  if ((st = rcb_fit_check_finite(f, f->obj0, "at the start"))) return st;
   f->err0 = rcb_fit_error_pct(f);
   if (!(x = rcb_alloc(&f->alloc, 2 * f->np * sizeof *x)))
     return rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory");
@@ -381,10 +391,18 @@ rcb_status rcb_fit_run(rcb_fit *f) {
   rcb_free(&f->alloc, x);
   if (st) return st;
   for (k = 0; k < f->np; k++) rcb_model_get_param(f->m, f->par[k].name, &f->par[k].value);
-  if ((st = rcb_fit_eval(f, f->r))) return st;
+  /* the final evaluation, with the condition of every solve checked */
+  rcb_frf_set_condition_check(f->frf, RCB_COND_SCREEN, RCB_RCOND_WARN);
+  st = rcb_fit_eval(f, f->r);
+  rcb_frf_get_condition(f->frf, &f->cond);
+  rcb_frf_set_condition_check(f->frf, RCB_COND_OFF, RCB_RCOND_WARN);
+  if (st) return st;
   f->obj = rcb_fit_sumsq(f->r, f->nres);
+  if ((st = rcb_fit_check_finite(f, f->obj, "at the fitted point"))) return st;
   f->err = rcb_fit_error_pct(f);
-  return rcb_fit_uncertainty(f);
+  st = f->no_uncertainty ? RCB_OK : rcb_fit_uncertainty(f);
+  rcb_fit_classify_stop(f);
+  return st;
 }
 
 rcb_status rcb_fit_get_report(const rcb_fit *f, rcb_fit_report *out) {
@@ -399,7 +417,7 @@ rcb_status rcb_fit_get_report(const rcb_fit *f, rcb_fit_report *out) {
   out->sigma = f->nres > f->np ? sqrt(f->obj / (double)(f->nres - f->np)) : (double)NAN;
   out->converged = f->converged;
   out->floor_pct = rcb_fit_floor_pct(f);
-  out->unsure = is_unsure(f, f->err);
+  out->unsure = is_unsure(f, f->err) || f->stop == RCB_FIT_STOP_AT_BOUND;
   out->starts = f->starts_used;
   return RCB_OK;
 }

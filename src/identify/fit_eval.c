@@ -93,6 +93,19 @@ static size_t layout(rcb_fit *f, int fill) {
   return n;
 }
 
+/* The residuals of each point (counting sort of res_pt), so that a
+ * per-point pass touches only its own residuals. */
+static void index_points(rcb_fit *f) {
+  size_t i, j;
+  memset(f->pt_first, 0, (f->npts + 1) * sizeof *f->pt_first);
+  for (j = 0; j < f->nres; j++) f->pt_first[f->res_pt[j] + 1]++;
+  for (i = 0; i < f->npts; i++) f->pt_first[i + 1] += f->pt_first[i];
+  for (j = f->nres; j-- > 0;) f->pt_res[--f->pt_first[f->res_pt[j] + 1]] = j;
+  /* pt_first[i + 1] now holds the start of point i: shift back */
+  for (i = 0; i < f->npts; i++) f->pt_first[i] = f->pt_first[i + 1];
+  f->pt_first[f->npts] = f->nres;
+}
+
 rcb_status rcb_fit_prepare(rcb_fit *f) {
   size_t n, sz, ncol;
   if (f->prepared) return RCB_OK;
@@ -117,12 +130,16 @@ rcb_status rcb_fit_prepare(rcb_fit *f) {
   f->rhs = rcb_alloc(&f->alloc, f->m->ndof * (ncol ? ncol : 1) * sizeof *f->rhs);
   f->cov = rcb_alloc(&f->alloc, (f->np ? f->np * f->np : 1) * sizeof *f->cov);
   f->corr = rcb_alloc(&f->alloc, (f->np ? f->np * f->np : 1) * sizeof *f->corr);
+  f->pt_first = rcb_alloc(&f->alloc, (f->npts + 1) * sizeof *f->pt_first);
+  f->pt_res = rcb_alloc(&f->alloc, n * sizeof *f->pt_res);
   if (!f->res_ch || !f->res_pt || !f->res_part || !f->res_sqrtw || !f->res_meas ||
-      !f->pt_used || !f->r || !f->J || !f->dmat || !f->dF || !f->rhs || !f->cov || !f->corr) {
+      !f->pt_used || !f->r || !f->J || !f->dmat || !f->dF || !f->rhs || !f->cov || !f->corr ||
+      !f->pt_first || !f->pt_res) {
     rcb_fit_free_layout(f);
     return rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory sizing the fit");
   }
   f->nres = layout(f, 1);
+  index_points(f);
   f->prepared = 1;
   return RCB_OK;
 }
@@ -164,7 +181,7 @@ static double complex kind_factor(rcb_frf_kind kind, double w) {
 
 /* Solve the model at point i: leaves the factors in the FRF workspace and
  * the solution vectors in its B; fills Hmod for every channel. */
-static rcb_status solve_point(rcb_fit *f, size_t i) {
+rcb_status rcb_fit_solve_point(rcb_fit *f, size_t i) {
   double w = f->grid[i];
   size_t c;
   rcb_status st;
@@ -194,9 +211,10 @@ rcb_status rcb_fit_eval(rcb_fit *f, double *r) {
   size_t i;
   rcb_status st;
   for (i = 0; i < f->npts; i++)
-    if (f->pt_used[i] && (st = solve_point(f, i))) return st;
+    if (f->pt_used[i] && (st = rcb_fit_solve_point(f, i))) return st;
   residuals_from_model(f, r);
   f->evaluations++;
+  f->sweeps++;
   return RCB_OK;
 }
 
@@ -278,9 +296,9 @@ static void full_system(rcb_fit *f, double *A, rcb_complex *F1) {
   int e;
   rcb_assemble_structure(f->m, L, A, A + sz, A + 2 * sz, A + 3 * sz);
   for (b = 0; b < f->m->n_bearings; b++) {
-    rcb_entry en[4];
-    rcb_bearing_entries(f->m, b, 0.0, en);
-    for (e = 0; e < 4; e++) {
+    rcb_entry en[RCB_BEARING_ENTRIES_MAX];
+    int ne = (int)rcb_bearing_entries(f->m, b, 0.0, en);
+    for (e = 0; e < ne; e++) {
       A[sz + rcb_layout_at(L, en[e].row, en[e].col)] += en[e].c;
       A[3 * sz + rcb_layout_at(L, en[e].row, en[e].col)] += en[e].k;
     }
@@ -291,7 +309,7 @@ static void full_system(rcb_fit *f, double *A, rcb_complex *F1) {
 /* dM, dC, dG, dK and dF/dp per parameter: every fittable parameter enters the
  * matrices affinely, so a forward difference of any size is exact there; the
  * unbalance phase enters F through e^{i phase}, hence a small central step. */
-static rcb_status derivative_matrices(rcb_fit *f) {
+rcb_status rcb_fit_derivative_matrices(rcb_fit *f) {
   size_t sz = 4 * rcb_layout_size(&f->frf->L), n = f->m->ndof, k, i;
   double *base = f->dmat + f->np * sz;
   rcb_complex *F0 = f->dF + f->np * n, *Fk;
@@ -352,12 +370,23 @@ static void dz_times(const rcb_layout *L, const double *d, double w, double W,
   }
 }
 
+double rcb_fit_point_speed(const rcb_fit *f, double w) {
+  /* unbalance: the speed factor is divided out as in rcb_frf_unbalance */
+  return f->unbalance ? w / f->m->speed_factor : (f->speed < 0 ? w : f->speed);
+}
+
+double rcb_fit_res_deriv(const rcb_fit *f, size_t j, double complex dh) {
+  size_t c = f->res_ch[j], i = f->res_pt[j];
+  if (!f->unbalance) dh *= kind_factor(f->ch_kind[c], f->grid[i]);
+  return f->res_sqrtw[j] * on_scale_d(f->scale, f->Hmod[c * f->npts + i], dh, f->res_part[j]);
+}
+
 /* Analytic Jacobian, eq. 9, one point: X = Z^-1 B (kept by the solve), then
  * dX/dp_k = Z^-1 (dF_k - dZ_k X), all parameters and inputs in one re-solve. */
 static rcb_status jac_point(rcb_fit *f, size_t i, double *Jx) {
   const rcb_frf *fr = f->frf;
-  size_t n = f->m->ndof, nin = f->nin ? f->nin : 1, k, q, j, sz = 4 * rcb_layout_size(&fr->L);
-  double w = f->grid[i], W = f->unbalance ? w : (f->speed < 0 ? w : f->speed);
+  size_t n = f->m->ndof, nin = f->nin ? f->nin : 1, k, q, jj, sz = 4 * rcb_layout_size(&fr->L);
+  double w = f->grid[i], W = rcb_fit_point_speed(f, w);
   rcb_status st;
   for (k = 0; k < f->np; k++)
     for (q = 0; q < nin; q++) {
@@ -368,16 +397,11 @@ static rcb_status jac_point(rcb_fit *f, size_t i, double *Jx) {
     }
   st = fr->ops->resolve(&fr->L, fr->Z, fr->ipiv, f->rhs, f->np * nin, 'N');
   if (st) return rcb_fit_fail(f, st, "sensitivity solve at %g rad/s failed", w);
-  for (j = 0; j < f->nres; j++) {
-    size_t c = f->res_ch[j];
-    double complex h;
-    if (f->res_pt[j] != i) continue;
-    h = f->Hmod[c * f->npts + i];
+  for (jj = f->pt_first[i]; jj < f->pt_first[i + 1]; jj++) {
+    size_t j = f->pt_res[jj], c = f->res_ch[j];
     for (k = 0; k < f->np; k++) {
       size_t col = k * nin + (f->unbalance ? 0 : f->ch_in[c]);
-      double complex dh = f->rhs[n * col + fr->out_row[f->ch_out[c]]];
-      if (!f->unbalance) dh *= kind_factor(f->ch_kind[c], w);
-      Jx[j + f->nres * k] = f->res_sqrtw[j] * on_scale_d(f->scale, h, dh, f->res_part[j]);
+      Jx[j + f->nres * k] = rcb_fit_res_deriv(f, j, f->rhs[n * col + fr->out_row[f->ch_out[c]]]);
     }
   }
   return RCB_OK;
@@ -386,13 +410,18 @@ static rcb_status jac_point(rcb_fit *f, size_t i, double *Jx) {
 static rcb_status jac_analytic(rcb_fit *f, double *r, double *Jx) {
   size_t i, k, j;
   rcb_status st;
-  if ((st = derivative_matrices(f))) return st;
-  for (i = 0; i < f->npts; i++) {
-    if (!f->pt_used[i]) continue;
-    if ((st = solve_point(f, i)) || (st = jac_point(f, i, Jx))) return st;
+  if ((st = rcb_fit_derivative_matrices(f))) return st;
+  if (rcb_fit_adjoint_cheaper(f)) { /* many inputs: eq. 9 by the adjoint (fit_score.c) */
+    if ((st = rcb_fit_jac_adjoint(f, Jx))) return st;
+  } else {
+    for (i = 0; i < f->npts; i++) {
+      if (!f->pt_used[i]) continue;
+      if ((st = rcb_fit_solve_point(f, i)) || (st = jac_point(f, i, Jx))) return st;
+    }
   }
   residuals_from_model(f, r);
   f->evaluations++;
+  f->sweeps++;
   for (k = 0; k < f->np; k++) {
     double g = dpdx(f, k);
     for (j = 0; j < f->nres; j++) Jx[j + f->nres * k] *= g;

@@ -13,7 +13,7 @@
 #include "analyses/frf_internal.h"
 #include "core/rcb_internal.h"
 
-#define RCB_PARAM_NAME_MAX (3 * RCB_NAME_MAX)
+#define RCB_PARAM_NAME_MAX ((size_t)3 * RCB_NAME_MAX)
 
 typedef struct rcb_fit_par_s {
   char name[RCB_PARAM_NAME_MAX];
@@ -66,6 +66,7 @@ struct rcb_fit {
   rcb_complex *Hwork;    /* frf output buffer, nout * nin */
   size_t nout, nin;
   unsigned char *pt_used; /* npts: 1 when some residual needs the model there */
+  size_t *pt_first, *pt_res; /* residuals of point i: pt_res[pt_first[i] .. pt_first[i+1]) */
   double *J, *r;         /* nres x np, nres (workspace for optimisers) */
   double *dmat;          /* np x 4 x layout size: dM, dC, dG, dK per parameter */
   rcb_complex *rhs;      /* n x (np * max(nin, 1)): sensitivity right-hand sides */
@@ -74,8 +75,15 @@ struct rcb_fit {
 
   /* results */
   size_t iterations, evaluations;
+  int no_uncertainty;    /* rcb_fit_run skips the uncertainty step (the diagnosis' refits) */
+  size_t sweeps;         /* model sweeps since creation (never reset; the diagnosis counts them) */
   double obj0, obj, err0, err;
   int converged;
+  int stalled;           /* the optimiser stopped without meeting a convergence test
+                            though its model promised progress (fit_guard.c) */
+  int stop;              /* rcb_fit_stop of the last run */
+  size_t stop_param;     /* parameter at its bound (RCB_FIT_STOP_AT_BOUND) */
+  rcb_frf_condition cond; /* condition of the final evaluation's solves */
   size_t nstarts, starts_used;
   unsigned long long rng;
   double *cov, *corr;    /* np x np */
@@ -86,6 +94,9 @@ rcb_status rcb_fit_fail(rcb_fit *f, rcb_status st, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
+#ifdef __clang_analyzer__ /* returns st: see rcb_set_error in core/rcb_internal.h */
+#define rcb_fit_fail(o, st, ...) ((void)(rcb_fit_fail)((o), (st), __VA_ARGS__), (st))
+#endif
 double rcb_fit_sumsq(const double *r, size_t n);
 void rcb_fit_free_layout(rcb_fit *f);
 
@@ -109,8 +120,54 @@ double rcb_fit_error_pct(const rcb_fit *f);
 /* Error % the eq. 19 noise model alone explains (NaN without a noise model). */
 double rcb_fit_floor_pct(const rcb_fit *f);
 
+/* Pieces of the analytic Jacobian (fit_eval.c) for fit_score.c: the model
+ * solve at point i (factors and solutions left in the FRF workspace); the
+ * rotor speed of the gyroscopic and bearing terms there; dr_j/dp from
+ * dH/dp of residual j's channel (receptance for FRF channels); dM, dC, dG,
+ * dK and dF per parameter into f->dmat, f->dF. */
+rcb_status rcb_fit_solve_point(rcb_fit *f, size_t i);
+double rcb_fit_point_speed(const rcb_fit *f, double w);
+double rcb_fit_res_deriv(const rcb_fit *f, size_t j, double complex dh);
+rcb_status rcb_fit_derivative_matrices(rcb_fit *f);
+
+/* One parameter's derivatives at a model: dM, dC, dG, dK over their
+ * non-zero entries (DOF row, column) and dF/dp at unit speed (NULL when the
+ * force does not depend on it). */
+typedef struct rcb_fit_dz_entry {
+  size_t row, col;
+  double m, c, g, k;
+} rcb_fit_dz_entry;
+typedef struct rcb_fit_dz {
+  rcb_fit_dz_entry *e;
+  size_t ne;
+  rcb_complex *dF;
+} rcb_fit_dz;
+
+/* The derivatives of fit c's parameters at its current model, dz[0 .. np)
+ * allocated from a (rcb_fit_dz_free). */
+rcb_status rcb_fit_dz_get(rcb_fit *c, const rcb_allocator *a, rcb_fit_dz *dz);
+void rcb_fit_dz_free(const rcb_allocator *a, rcb_fit_dz *dz, size_t n);
+/* Columns d r / d p (parameter units, nres x ndz) of f's residuals for
+ * parameters dz[0 .. ndz) of models equal to f's at its current point, with
+ * the same DOFs (the score test of candidates at their neutral values): one
+ * factorisation per point for all of them (fit_score.c). One sweep. */
+rcb_status rcb_fit_jacobian_dz(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, double *J);
+/* The same from f->dmat, f->dF (after rcb_fit_derivative_matrices). */
+rcb_status rcb_fit_dz_collect(rcb_fit *f, const rcb_allocator *a, rcb_fit_dz *dz);
+/* f's own Jacobian d r / d p by the adjoint (models values into Hmod, no
+ * residuals), and whether that needs fewer solves per point than the direct
+ * re-solve of jac_point. */
+rcb_status rcb_fit_jac_adjoint(rcb_fit *f, double *Jp);
+int rcb_fit_adjoint_cheaper(const rcb_fit *f);
+
+/* fit_guard.c: after the run, why it stopped (converged, at a bound,
+ * stalled, out of iterations) into f->stop; a non-finite objective as
+ * RCB_ERR_NOT_CONVERGED with a message (RCB_OK when finite). */
+void rcb_fit_classify_stop(rcb_fit *f);
+rcb_status rcb_fit_check_finite(rcb_fit *f, double F, const char *where);
+
 /* Optimisers: each leaves the best point in the model and fills
- * iterations/evaluations/converged. */
+ * iterations/evaluations/converged (and stalled). */
 rcb_status rcb_fit_run_paper(rcb_fit *f);
 rcb_status rcb_fit_run_nlopt(rcb_fit *f);
 /* Standard errors, confidence intervals, correlation, identifiability at the

@@ -336,6 +336,7 @@ static rcb_status nl_run(rcb_fit *f, double *work) {
   res = nl_optimize(&c, o, x);
   st = nl_result(f, &c, res, a);
   f->converged = nl_converged(res);
+  f->stalled = res == NLOPT_ROUNDOFF_LIMITED || res == NLOPT_FAILURE;
   nlopt_destroy(o);
   c.opt = NULL;
 
@@ -346,6 +347,7 @@ static rcb_status nl_run(rcb_fit *f, double *work) {
     res = nl_optimize(&c, o, x);
     st = nl_result(f, &c, res, (nlopt_algorithm)local);
     f->converged = nl_converged(res);
+    f->stalled = res == NLOPT_ROUNDOFF_LIMITED || res == NLOPT_FAILURE;
     nlopt_destroy(o);
     c.opt = NULL;
   }

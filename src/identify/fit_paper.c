@@ -227,7 +227,9 @@ static void ws_free(rcb_fit *f, paper_ws *ws) {
 
 /* One iteration: Gauss-Newton + line search, then damped steps (eq. 18). */
 static rcb_status iterate(rcb_fit *f, paper_ws *ws, double *phi, int *moved) {
-  double phi0 = *phi, lambda, lim;
+  static const double lambdas[] = {1e-3, 1e-2, 1e-1, 1.0, 1e1, 1e2, 1e3};
+  double phi0 = *phi, lim;
+  size_t k;
   int ok, noisy;
   rcb_status st;
   if ((st = linearise(f, ws, ws->x, &phi0)) || (st = gn_step(f, ws, 0.0))) return st;
@@ -245,8 +247,10 @@ static rcb_status iterate(rcb_fit *f, paper_ws *ws, double *phi, int *moved) {
     return RCB_OK;
   }
   if ((st = line_search(f, ws, phi0, phi, &ok))) return st;
-  /* eq. 18: damped steps, one trial each, lambda growing tenfold */
-  for (lambda = 1e-3; !ok && lambda <= 1e3; lambda *= 10.0) {
+  /* eq. 18: damped steps, one trial each, lambda growing tenfold from 1e-3
+   * to 1e3 (a table, not a floating-point loop counter: cert-flp30-c) */
+  for (k = 0; !ok && k < sizeof lambdas / sizeof lambdas[0]; k++) {
+    const double lambda = lambdas[k];
     double p1;
     if ((st = gn_step(f, ws, lambda))) return st;
     along(ws, 1.0, ws->xt);
@@ -258,7 +262,12 @@ static rcb_status iterate(rcb_fit *f, paper_ws *ws, double *phi, int *moved) {
     }
   }
   *moved = ok;
-  if (!ok) *phi = phi0;
+  if (!ok) {
+    /* the linearisation promised more than 0.1 % and no step delivered any
+     * of it: a stall (a wrong or noisy gradient, a kink), not a minimum */
+    f->stalled = ws->pred_full > 1e-3 * phi0;
+    *phi = phi0;
+  }
   return RCB_OK;
 }
 
@@ -272,7 +281,8 @@ rcb_status rcb_fit_run_paper(rcb_fit *f) {
   if ((st = ws_alloc(f, &ws))) goto done;
   rcb_fit_get_x(f, ws.x);
   ws.wpen = 1e4 * (f->obj0 > 0 ? f->obj0 : 1.0);
-  if ((st = phi_at(f, &ws, ws.x, &phi))) goto done;
+  if ((st = phi_at(f, &ws, ws.x, &phi)) || (st = rcb_fit_check_finite(f, phi, "at the start")))
+    goto done;
   for (f->iterations = 0; f->iterations < f->max_iter;) {
     double step = 0.0, xn = 0.0;
     int moved;
@@ -285,7 +295,7 @@ rcb_status rcb_fit_run_paper(rcb_fit *f) {
       goto done;
     }
     if (!moved) { /* no descent left: a (local) minimum to working precision */
-      f->converged = 1;
+      f->converged = !f->stalled;
       break;
     }
     for (k = 0; k < ws.np; k++) step += ws.dx[k] * ws.dx[k], xn += ws.x[k] * ws.x[k];

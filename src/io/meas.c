@@ -12,7 +12,7 @@
 
 #define TWO_PI (2.0 * RCB_PI)
 
-rcb_status rcb_meas_fail(rcb_meas *ms, rcb_status st, const char *fmt, ...) {
+rcb_status (rcb_meas_fail)(rcb_meas *ms, rcb_status st, const char *fmt, ...) {
   va_list ap;
   if (!ms) return st;
   va_start(ap, fmt);

@@ -38,6 +38,9 @@ rcb_status rcb_meas_fail(rcb_meas *ms, rcb_status st, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
+#ifdef __clang_analyzer__ /* returns st: see rcb_set_error in core/rcb_internal.h */
+#define rcb_meas_fail(o, st, ...) ((void)(rcb_meas_fail)((o), (st), __VA_ARGS__), (st))
+#endif
 
 /* Drop grid and channels (the object stays usable). */
 void rcb_meas_clear(rcb_meas *ms);

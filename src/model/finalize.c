@@ -125,15 +125,35 @@ static void uf_union(size_t *parent, size_t a, size_t b) {
     parent[a] = b;
 }
 
-static void widen(rcb_model *m, size_t na, size_t nb) {
+/* Widen the band to hold every pair of the na DOFs a and nb DOFs b. */
+static void widen_dofs(rcb_model *m, const long *a, int na, const long *b, int nb) {
   int i, j;
-  for (i = 0; i < 4; i++)
-    for (j = 0; j < 4; j++) {
-      long d = m->nodes[na].dof[i] - m->nodes[nb].dof[j];
+  for (i = 0; i < na; i++)
+    for (j = 0; j < nb; j++) {
+      long d = a[i] - b[j];
       size_t w = (size_t)(d < 0 ? -d : d);
       if (w > m->bandwidth) m->bandwidth = w;
     }
 }
+
+static void widen(rcb_model *m, size_t na, size_t nb) {
+  widen_dofs(m, m->nodes[na].dof, 4, m->nodes[nb].dof, 4);
+}
+
+/* Pedestals of the bearings at node i get the two rows right after the
+ * node's own, so the band stays narrow (two rows wider at most). Virtual
+ * node numbers n_nodes + k in bearing order. */
+static size_t number_pedestals(rcb_model *m, size_t node, size_t next) {
+  size_t b;
+  for (b = 0; b < m->n_bearings; b++) {
+    rcb_bearing_t *br = &m->bearings[b];
+    if (!br->has_ped || br->at.node != node) continue;
+    br->ped_dof[0] = (long)next++;
+    br->ped_dof[1] = (long)next++;
+  }
+  return next;
+}
+
 
 static rcb_status number_dofs(rcb_model *m) {
   size_t nfull = 4 * m->n_nodes, d, i, next = 0;
@@ -157,6 +177,7 @@ static rcb_status number_dofs(rcb_model *m) {
   for (d = 0; d < nfull; d++) {
     size_t r = uf_find(parent, d);
     idx[d] = (r == d) ? (long)next++ : idx[r];
+    if (d % 4 == 3) next = number_pedestals(m, d / 4, next);
   }
   for (i = 0; i < m->n_nodes; i++)
     for (d = 0; d < 4; d++) m->nodes[i].dof[d] = idx[4 * i + d];
@@ -168,6 +189,9 @@ static rcb_status number_dofs(rcb_model *m) {
   for (i = 0; i < m->n_elements; i++) widen(m, m->elements[i].node0, m->elements[i].node0 + 1);
   for (i = 0; i < m->n_couplings; i++)
     widen(m, m->couplings[i].at[0].node, m->couplings[i].at[1].node);
+  for (i = 0; i < m->n_bearings; i++)
+    if (m->bearings[i].has_ped)
+      widen_dofs(m, m->nodes[m->bearings[i].at.node].dof, 2, m->bearings[i].ped_dof, 2);
   return RCB_OK;
 }
 
@@ -191,9 +215,14 @@ static rcb_status build_stations(rcb_model *m) {
   m->n_stations = 0;
   for (i = 0; i < m->n_disks && !st; i++)
     st = add_station(m, m->disks[i].name, NULL, RCB_STATION_DISK, i, m->disks[i].at.node);
-  for (i = 0; i < m->n_bearings && !st; i++)
-    st = add_station(m, m->bearings[i].name, NULL, RCB_STATION_BEARING, i,
-                     m->bearings[i].at.node);
+  for (i = 0; i < m->n_bearings && !st; i++) {
+    rcb_bearing_t *b = &m->bearings[i];
+    st = add_station(m, b->name, NULL, RCB_STATION_BEARING, i, b->at.node);
+    if (!st && b->has_ped) {
+      b->ped_node = m->n_nodes + m->n_peds++;
+      st = add_station(m, b->name, "ped", RCB_STATION_PEDESTAL, i, b->ped_node);
+    }
+  }
   for (i = 0; i < m->n_couplings && !st; i++) {
     const rcb_coupling_t *c = &m->couplings[i];
     st = add_station(m, c->name, NULL, RCB_STATION_COUPLING, i, c->at[0].node);
@@ -241,6 +270,7 @@ rcb_status rcb_model_finalize(rcb_model *m) {
     return rcb_model_fail(m, RCB_ERR_MODEL, "the model has no shaft (add a [shaft NAME])");
   m->n_nodes = 0;
   m->n_elements = 0;
+  m->n_peds = 0;
   if ((st = mesh_shafts(m)) || (st = resolve_all(m)) || (st = number_dofs(m)) ||
       (st = build_stations(m)) || (st = check_uffmap(m)) ||
       (st = rcb_model_collect_warnings(m)))
@@ -261,9 +291,28 @@ size_t rcb_model_station_count(const rcb_model *m) {
   return m && m->finalized ? m->n_stations : 0;
 }
 
+/* The bearing whose pedestal is virtual node `node` (>= n_nodes), or NULL. */
+static const rcb_bearing_t *pedestal_of(const rcb_model *m, size_t node) {
+  size_t b;
+  if (node < m->n_nodes) return NULL;
+  for (b = 0; b < m->n_bearings; b++)
+    if (m->bearings[b].has_ped && m->bearings[b].ped_node == node) return &m->bearings[b];
+  return NULL;
+}
+
 rcb_status rcb_model_node_info(const rcb_model *m, size_t node, rcb_node_info *out) {
+  const rcb_bearing_t *b;
   int k;
-  if (!m || !out || !m->finalized || node >= m->n_nodes) return RCB_ERR_ARG;
+  if (!m || !out || !m->finalized) return RCB_ERR_ARG;
+  if ((b = pedestal_of(m, node)) != NULL) { /* a pedestal: x, y only (-1: none) */
+    out->shaft = m->shafts[b->at.shaft].name;
+    out->z = b->at.z;
+    out->dof[0] = b->ped_dof[0];
+    out->dof[1] = b->ped_dof[1];
+    out->dof[2] = out->dof[3] = -1;
+    return RCB_OK;
+  }
+  if (node >= m->n_nodes) return RCB_ERR_ARG;
   out->shaft = m->shafts[m->nodes[node].shaft].name;
   out->z = m->nodes[node].z;
   for (k = 0; k < 4; k++) out->dof[k] = m->nodes[node].dof[k];
@@ -318,6 +367,9 @@ rcb_status rcb_model_find_dof(const rcb_model *m, const char *spec, rcb_dof *out
   for (i = 0; i < m->n_stations; i++)
     if (strcmp(m->stations[i].name, station) == 0) {
       out->node = m->stations[i].node;
+      if (m->stations[i].kind == RCB_STATION_PEDESTAL && d > 1)
+        return rcb_model_fail(mm, RCB_ERR_ARG,
+                              "channel '%s': a pedestal moves in x and y only", spec);
       return RCB_OK;
     }
   return rcb_model_fail(mm, RCB_ERR_NOT_FOUND,
@@ -327,9 +379,15 @@ rcb_status rcb_model_find_dof(const rcb_model *m, const char *spec, rcb_dof *out
 }
 
 rcb_status rcb_model_dof_index(const rcb_model *m, rcb_dof dof, size_t *index) {
-  if (!m || !index || !m->finalized || dof.node >= m->n_nodes || (int)dof.dir < 0 ||
-      (int)dof.dir > 3)
+  const rcb_bearing_t *b;
+  if (!m || !index || !m->finalized || (int)dof.dir < 0 || (int)dof.dir > 3)
     return RCB_ERR_ARG;
+  if ((b = pedestal_of(m, dof.node)) != NULL) {
+    if ((int)dof.dir > 1) return RCB_ERR_ARG;
+    *index = (size_t)b->ped_dof[dof.dir];
+    return RCB_OK;
+  }
+  if (dof.node >= m->n_nodes) return RCB_ERR_ARG;
   *index = (size_t)m->nodes[dof.node].dof[dof.dir];
   return RCB_OK;
 }

@@ -193,6 +193,28 @@ static rcb_status bearing_coef(ini_ctx *c, const ini_section *s, int k, const ch
   return RCB_OK;
 }
 
+/* The bearing's pedestal keys (all absent or 0: no pedestal). */
+static rcb_status build_pedestal(ini_ctx *c, const ini_section *s) {
+  rcb_pedestal p;
+  TRY(rcb_ini_get_num(c, s, "pedestal_mass", "pedestal mass in kg", 0, 0.0, &p.mass));
+  TRY(rcb_ini_get_num(c, s, "pedestal_kxx", "pedestal stiffness in N/m", 0, 0.0, &p.kxx));
+  TRY(rcb_ini_get_num(c, s, "pedestal_kyy", "pedestal stiffness in N/m", 0, 0.0, &p.kyy));
+  TRY(rcb_ini_get_num(c, s, "pedestal_cxx", "pedestal damping in N s/m", 0, 0.0, &p.cxx));
+  TRY(rcb_ini_get_num(c, s, "pedestal_cyy", "pedestal damping in N s/m", 0, 0.0, &p.cyy));
+  if (rcb_model_set_pedestal(c->m, s->name, &p)) return builder_fail(c, s, s->line, RCB_ERR_ARG);
+  return RCB_OK;
+}
+
+/* [model] speed_factor: real rotor speed / stated speed (default 1). */
+static rcb_status build_model_section(ini_ctx *c, const ini_section *s) {
+  double f;
+  TRY(rcb_ini_get_num(c, s, "speed_factor", "a speed factor > 0 (real / stated speed)", 0, 1.0,
+                      &f));
+  if (rcb_model_set_param(c->m, "speed.factor", f))
+    return builder_fail(c, s, s->line, RCB_ERR_ARG);
+  return RCB_OK;
+}
+
 static rcb_status build_bearing(ini_ctx *c, const ini_section *s) {
   const ini_entry *rpm = rcb_ini_get(s, "speed_rpm"), *rad = rcb_ini_get(s, "speed");
   const char *shaft, *speed_key = rpm ? "speed_rpm" : "speed";
@@ -226,6 +248,7 @@ static rcb_status build_bearing(ini_ctx *c, const ini_section *s) {
     st = rcb_model_add_bearing_table(c->m, s->name, shaft, z, nrows, speeds, rows);
     if (st) builder_fail(c, s, s->line, st);
   }
+  if (!st) st = build_pedestal(c, s);
   rcb_free(&c->m->alloc, rows);
   rcb_free(&c->m->alloc, speeds);
   return st;
@@ -411,7 +434,8 @@ static rcb_status build_uff(ini_ctx *c, const ini_section *s) {
 
 rcb_status rcb_ini_build(ini_ctx *c) {
   /* dependency order: what is placed on a shaft comes after the shafts */
-  static const ini_sec_type order[] = {INI_SEC_MATERIAL,  INI_SEC_SHAFT,    INI_SEC_DISK,
+  static const ini_sec_type order[] = {INI_SEC_MODEL,     INI_SEC_MATERIAL, INI_SEC_SHAFT,
+                                       INI_SEC_DISK,
                                        INI_SEC_BEARING,   INI_SEC_COUPLING, INI_SEC_UNBALANCE,
                                        INI_SEC_STATION,   INI_SEC_UFF};
   size_t k, i;
@@ -421,6 +445,7 @@ rcb_status rcb_ini_build(ini_ctx *c) {
       ini_section *s = &c->sec[i];
       if (s->type != order[k]) continue;
       switch (s->type) {
+        case INI_SEC_MODEL: st = build_model_section(c, s); break;
         case INI_SEC_MATERIAL: st = build_material(c, s); break;
         case INI_SEC_SHAFT: st = build_shaft(c, s); break;
         case INI_SEC_DISK: st = build_disk(c, s); break;

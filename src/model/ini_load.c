@@ -29,7 +29,7 @@ static const char *const type_names[INI_SEC_COUNT] = {
     "model", "material", "shaft", "disk", "bearing", "coupling", "unbalance", "station", "uff"};
 
 /* Keys of each section type, in the order the format documents them. */
-static const char *const keys_model[] = {"name", "description"};
+static const char *const keys_model[] = {"name", "description", "speed_factor"};
 static const char *const keys_material[] = {"density", "young", "poisson"};
 static const char *const keys_shaft[] = {"material",     "start",           "shear_factor",
                                          "damping_mass", "damping_stiffness", "segment"};
@@ -37,7 +37,9 @@ static const char *const keys_disk[] = {"at",      "mass",           "Id",
                                         "Ip",      "density",        "outer_diameter",
                                         "inner_diameter", "width"};
 static const char *const keys_bearing[] = {"at",  "kxx", "kxy", "kyx",       "kyy", "cxx",
-                                           "cxy", "cyx", "cyy", "speed_rpm", "speed"};
+                                           "cxy", "cyx", "cyy", "speed_rpm", "speed",
+                                           "pedestal_mass", "pedestal_kxx", "pedestal_kyy",
+                                           "pedestal_cxx", "pedestal_cyy"};
 static const char *const keys_coupling[] = {
     "model",       "between",      "kt",           "kr",
     "ct",          "cr",           "hub_mass",     "hub_Id",
@@ -429,6 +431,8 @@ static void model_reset(rcb_model *m) {
   m->n_uffmap = m->n_warnings = 0;
   m->n_stations = m->n_nodes = m->n_elements = 0;
   m->ndof = m->bandwidth = 0;
+  m->n_peds = 0;
+  m->speed_factor = 1.0;
   m->finalized = 0;
 }
 

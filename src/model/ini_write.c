@@ -236,6 +236,13 @@ static void write_bearings(wbuf *w, const rcb_model *m) {
       for (r = 1; r < b->n; r++) constant &= table_value(b, k, r) == table_value(b, k, 0);
       write_list(w, keys[k], b, k, constant ? 1 : b->n, k < 4 ? "N/m" : "N s/m");
     }
+    if (b->has_ped) {
+      kv_num(w, "pedestal_mass", b->ped_m, "kg (pedestal under the bearing)");
+      kv_num(w, "pedestal_kxx", b->ped_k[0], "N/m, pedestal to ground");
+      kv_num(w, "pedestal_kyy", b->ped_k[1], "N/m");
+      kv_num(w, "pedestal_cxx", b->ped_c[0], "N s/m");
+      kv_num(w, "pedestal_cyy", b->ped_c[1], "N s/m");
+    }
     wr(w, "\n");
   }
 }
@@ -311,6 +318,11 @@ rcb_status rcb_model_write_ini(const rcb_model *m, char *buf, size_t size, size_
   w.len = 0;
   wr(&w, "; librcb model (rcb_model_write_ini). SI units: m, kg, N/m, N s/m, N m/rad, Pa, s.\n"
          "; Positions are absolute axial coordinates z (m).\n\n");
+  if (m->speed_factor != 1.0) {
+    wr(&w, "[model]\n");
+    kv_num(&w, "speed_factor", m->speed_factor, "real / stated rotor speed");
+    wr(&w, "\n");
+  }
   write_materials(&w, m);
   write_shafts(&w, m);
   write_disks(&w, m);

@@ -18,6 +18,7 @@ rcb_status rcb_model_create(rcb_model **out, const rcb_allocator *alloc) {
   m = rcb_alloc(&a, sizeof *m);
   if (!m) return RCB_ERR_NOMEM;
   m->alloc = a;
+  m->speed_factor = 1.0;
   *out = m;
   return RCB_OK;
 }
@@ -342,7 +343,35 @@ rcb_status rcb_model_add_bearing_table(rcb_model *m, const char *name, const cha
   snprintf(b->name, sizeof b->name, "%s", name);
   b->at = at;
   b->n = n;
+  b->has_ped = 0;
+  b->ped_m = b->ped_k[0] = b->ped_k[1] = b->ped_c[0] = b->ped_c[1] = 0.0;
   m->n_bearings++;
+  return RCB_OK;
+}
+
+rcb_status rcb_model_set_pedestal(rcb_model *m, const char *bearing, const rcb_pedestal *p) {
+  static const rcb_pedestal none = {0, 0, 0, 0, 0};
+  rcb_bearing_t *b = NULL;
+  size_t i;
+  rcb_status st = check_editable(m, "pedestal");
+  if (st) return st;
+  for (i = 0; bearing && i < m->n_bearings; i++)
+    if (strcmp(m->bearings[i].name, bearing) == 0) b = &m->bearings[i];
+  if (!b)
+    return rcb_model_fail(m, RCB_ERR_NOT_FOUND, "pedestal: no bearing named '%s'",
+                          bearing ? bearing : "(null)");
+  if (!p) p = &none;
+  CHECK_VALUE("bearing", b->name, "pedestal_mass (kg)", p->mass, 0);
+  CHECK_VALUE("bearing", b->name, "pedestal_kxx (N/m)", p->kxx, 0);
+  CHECK_VALUE("bearing", b->name, "pedestal_kyy (N/m)", p->kyy, 0);
+  CHECK_VALUE("bearing", b->name, "pedestal_cxx (N s/m)", p->cxx, 0);
+  CHECK_VALUE("bearing", b->name, "pedestal_cyy (N s/m)", p->cyy, 0);
+  b->has_ped = p->mass != 0 || p->kxx != 0 || p->kyy != 0 || p->cxx != 0 || p->cyy != 0;
+  b->ped_m = p->mass;
+  b->ped_k[0] = p->kxx;
+  b->ped_k[1] = p->kyy;
+  b->ped_c[0] = p->cxx;
+  b->ped_c[1] = p->cyy;
   return RCB_OK;
 }
 

@@ -17,6 +17,8 @@
 #include "core/rcb_internal.h"
 #include "model/model_util.h"
 
+#define SPEED_FACTOR "speed.factor"
+
 typedef enum pkind {
   PK_MATERIAL = 0,
   PK_SHAFT,
@@ -49,10 +51,20 @@ static const pkey bearing_keys[] = {
     {"cyx", "cyx (N s/m)", -1}, {"cyy", "cyy (N s/m)", -1},
     /* views for the diagnosis: a skew-symmetric (circulatory) pair, setting
      * kxy = v and kyx = -v; not enumerated (they alias kxy/kyx) */
-    {"kcross", "kcross = kxy = -kyx (N/m)", -1}, {"ccross", "ccross = cxy = -cyx (N s/m)", -1}};
+    {"kcross", "kcross = kxy = -kyx (N/m)", -1}, {"ccross", "ccross = cxy = -cyx (N s/m)", -1},
+    /* the pedestal (flexible support) of a bearing that has one */
+    {"pedestal_mass", "pedestal_mass (kg)", 0}, {"pedestal_kxx", "pedestal_kxx (N/m)", 0},
+    {"pedestal_kyy", "pedestal_kyy (N/m)", 0},  {"pedestal_cxx", "pedestal_cxx (N s/m)", 0},
+    {"pedestal_cyy", "pedestal_cyy (N s/m)", 0},
+    /* views for the diagnosis: an isotropic pedestal, x and y together */
+    {"pedestal_k", "pedestal_k = pedestal_kxx = pedestal_kyy (N/m)", 0},
+    {"pedestal_c", "pedestal_c = pedestal_cxx = pedestal_cyy (N s/m)", 0}};
 
-/* The first keys of the bearing table are its own; the rest are views. */
+/* The first keys of the bearing table are its own; then the views kcross,
+ * ccross; the pedestal's own keys; its views. */
 #define BEARING_OWN_KEYS 8
+#define BEARING_PED_KEYS 10 /* first pedestal key */
+#define BEARING_PED_VIEWS 15 /* pedestal_k, pedestal_c */
 static const pkey coupling_keys[] = {{"kt", "kt (N/m)", 0},
                                      {"kr", "kr (N m/rad)", 0},
                                      {"ct", "ct (N s/m)", 0},
@@ -105,10 +117,14 @@ static const char *item_name(const rcb_model *m, pkind k, size_t i) {
 }
 
 /* Is (k, j) listed by rcb_model_param_count/_name (views are not)? */
-static int enumerated(pkind k, size_t j) { return !(k == PK_BEARING && j >= BEARING_OWN_KEYS); }
+static int enumerated(pkind k, size_t j) {
+  return !(k == PK_BEARING && j >= BEARING_OWN_KEYS &&
+           (j < BEARING_PED_KEYS || j >= BEARING_PED_VIEWS));
+}
 
 /* Does item i of kind k have key j as a fittable parameter? */
 static int key_usable(const rcb_model *m, pkind k, size_t i, size_t j) {
+  if (k == PK_BEARING && j >= BEARING_PED_KEYS) return m->bearings[i].has_ped;
   if (k == PK_BEARING) return m->bearings[i].n == 1;
   if (k == PK_COUPLING && j < 4) {
     int t = (int)m->couplings[i].type;
@@ -130,7 +146,23 @@ static int slots(rcb_model *m, pkind k, size_t i, size_t j, double *v[2]) {
       return 1;
     }
     case PK_BEARING: {
-      rcb_bearing_coefs *c = &m->bearings[i].c[0];
+      rcb_bearing_t *b = &m->bearings[i];
+      rcb_bearing_coefs *c = &b->c[0];
+      if (j >= BEARING_PED_VIEWS) { /* x and y together */
+        v[0] = j == BEARING_PED_VIEWS ? &b->ped_k[0] : &b->ped_c[0];
+        v[1] = j == BEARING_PED_VIEWS ? &b->ped_k[1] : &b->ped_c[1];
+        return 2;
+      }
+      if (j >= BEARING_PED_KEYS) {
+        double *ped[5];
+        ped[0] = &b->ped_m;
+        ped[1] = &b->ped_k[0];
+        ped[2] = &b->ped_k[1];
+        ped[3] = &b->ped_c[0];
+        ped[4] = &b->ped_c[1];
+        v[0] = ped[j - BEARING_PED_KEYS];
+        return 1;
+      }
       if (j < BEARING_OWN_KEYS) {
         v[0] = &(&c->kxx)[j];
         return 1;
@@ -276,6 +308,10 @@ static void usable_keys(const rcb_model *m, pkind k, size_t i, char *buf, size_t
 
 /* ---- name lookup ---- */
 
+/* "speed.factor": the model's speed factor, outside the KIND.ITEM.KEY table
+ * (not enumerated). */
+static int is_speed_factor(const char *name) { return name && strcmp(name, SPEED_FACTOR) == 0; }
+
 static rcb_status lookup(rcb_model *m, const char *name, pref *out) {
   char item[RCB_NAME_MAX], keys[200], hint[NAME_CMP_MAX + 64];
   const char *d1, *d2, *key;
@@ -326,6 +362,12 @@ static rcb_status lookup(rcb_model *m, const char *name, pref *out) {
                           keys[0] ? keys : "none", hint);
   }
   if (!key_usable(m, (pkind)k, i, j)) {
+    if (k == PK_BEARING && j >= BEARING_PED_KEYS)
+      return rcb_model_fail(m, RCB_ERR_NOT_FOUND,
+                            "parameter '%s': bearing '%s' has no pedestal; give it one in the "
+                            "model (pedestal_mass, pedestal_kxx, pedestal_kyy, ... in its "
+                            "[bearing] section) before fitting it",
+                            name, m->bearings[i].name);
     if (k == PK_BEARING)
       return rcb_model_fail(m, RCB_ERR_NOT_FOUND,
                             "parameter '%s': bearing '%s' is speed-dependent (a table of %zu "
@@ -351,10 +393,19 @@ rcb_status rcb_model_get_param(const rcb_model *m, const char *name, double *val
   rcb_status st;
   if (!m) return RCB_ERR_ARG;
   if (!value) return rcb_model_fail(mm, RCB_ERR_ARG, "rcb_model_get_param: value is NULL");
+  if (is_speed_factor(name)) {
+    *value = m->speed_factor;
+    return RCB_OK;
+  }
   if ((st = lookup(mm, name, &r))) return st;
   slots(mm, r.k, r.i, r.j, v);
   *value = *v[0]; /* hubs: station a */
   return RCB_OK;
+}
+
+/* kcross, ccross: the second slot gets the opposite sign. */
+static int cross_pair(pkind k, size_t j) {
+  return k == PK_BEARING && j >= BEARING_OWN_KEYS && j < BEARING_PED_KEYS;
 }
 
 rcb_status rcb_model_set_param(rcb_model *m, const char *name, double value) {
@@ -364,12 +415,17 @@ rcb_status rcb_model_set_param(rcb_model *m, const char *name, double value) {
   const pkey *key;
   int n, s;
   if (!m) return RCB_ERR_ARG;
+  if (is_speed_factor(name)) {
+    if ((st = rcb_model_check_value(m, "model", "speed", "factor (-)", value, 1))) return st;
+    m->speed_factor = value;
+    return RCB_OK;
+  }
   if ((st = lookup(m, name, &r))) return st;
   key = &kinds[r.k].keys[r.j];
   st = rcb_model_check_value(m, kinds[r.k].name, item_name(m, r.k, r.i), key->what, value,
                              key->sign);
   if (st) return st;
   n = slots(m, r.k, r.i, r.j, v);
-  for (s = 0; s < n; s++) *v[s] = (r.k == PK_BEARING && s == 1) ? -value : value;
+  for (s = 0; s < n; s++) *v[s] = (cross_pair(r.k, r.j) && s == 1) ? -value : value;
   return RCB_OK;
 }

@@ -32,7 +32,18 @@ static rcb_status dense_resolve(const rcb_layout *L, const rcb_complex *Z, const
   return info ? RCB_ERR_LAPACK : RCB_OK;
 }
 
+/* zgecon: Hager-Higham estimate of ||Z^-1||_1 from the LU factors, O(n^2). */
+static rcb_status dense_rcond(const rcb_layout *L, const rcb_complex *Z, const int *ipiv,
+                              double anorm, rcb_complex *work, double *rwork, double *rcond) {
+  lapack_int info;
+  (void)ipiv;
+  info = LAPACKE_zgecon_work(LAPACK_COL_MAJOR, '1', (lapack_int)L->n,
+                             (const lapack_complex_double *)Z, (lapack_int)L->ld, anorm, rcond,
+                             (lapack_complex_double *)work, rwork);
+  return info ? RCB_ERR_LAPACK : RCB_OK;
+}
+
 static const rcb_zsolver_ops dense_ops = {"dense", dense_layout, dense_solve, dense_resolve,
-                                          NULL, NULL, NULL};
+                                          NULL,    NULL,         NULL,        dense_rcond};
 
 const rcb_zsolver_ops *rcb_zsolver_dense(void) { return &dense_ops; }

@@ -17,6 +17,8 @@
  * per-object hooks): only the state struct comes from the caller's
  * allocator; KLU's bytes are reported by klu_memory (Common.mempeak).
  */
+#include <math.h>
+
 #include "rcb/rcb_config.h"
 #include "solvers/zsolver.h"
 
@@ -24,6 +26,7 @@
 
 #include <klu.h>
 #include <limits.h>
+#include <stdint.h>
 
 /* Accept a refactorisation whose pivot ratio is at least this fraction of
  * the last full factorisation's (-). */
@@ -135,8 +138,24 @@ static size_t klu_memory(const rcb_layout *L) {
   return s ? s->common.mempeak : 0;
 }
 
+/* klu_z_condest: Hager-Higham 1-norm estimate from KLU's factors and the
+ * matrix values (still in Z: KLU does not factor in place); a few solves.
+ * klu_z_rcond is only the pivot ratio min|U_ii| / max|U_ii|, not a
+ * condition number. */
+static rcb_status klu_rcond_(const rcb_layout *L, const rcb_complex *Z, const int *ipiv,
+                             double anorm, rcb_complex *work, double *rwork, double *rcond) {
+  klu_state *s = L->solver;
+  (void)ipiv, (void)anorm, (void)work, (void)rwork;
+  if (!s || !s->num) return RCB_ERR_STATE;
+  /* klu_z_condest takes non-const arrays but only reads them */
+  if (!klu_z_condest(L->colp, (double *)(uintptr_t)Z, s->sym, s->num, &s->common))
+    return klu_status(&s->common) ? klu_status(&s->common) : RCB_ERR_ARG;
+  *rcond = s->common.condest > 0 ? 1.0 / s->common.condest : (double)NAN;
+  return RCB_OK;
+}
+
 static const rcb_zsolver_ops klu_ops = {"sparse",    NULL,        klu_solve_, klu_resolve,
-                                        klu_prepare, klu_release, klu_memory};
+                                        klu_prepare, klu_release, klu_memory, klu_rcond_};
 
 const rcb_zsolver_ops *rcb_zsolver_sparse(void) { return &klu_ops; }
 
@@ -146,7 +165,18 @@ void rcb_zsolver_sparse_counts(const rcb_layout *L, size_t *factors, size_t *ref
   *refactors = s ? s->refactors : 0;
 }
 
+/* klu_z_rcond of the last factorisation (full or kept-pivot): both compute it. */
+double rcb_zsolver_sparse_pivot_ratio(const rcb_layout *L) {
+  const klu_state *s = L->solver;
+  return s ? s->common.rcond : (double)NAN;
+}
+
 #else /* !RCB_WITH_SUITESPARSE */
+
+double rcb_zsolver_sparse_pivot_ratio(const rcb_layout *L) {
+  (void)L;
+  return (double)NAN;
+}
 
 const rcb_zsolver_ops *rcb_zsolver_sparse(void) { return NULL; }
 

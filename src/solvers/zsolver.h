@@ -29,6 +29,13 @@ typedef struct rcb_zsolver_ops_s {
   void (*release)(rcb_layout *L, const rcb_allocator *a);
   /* Optional: bytes held by the backend state (KLU's peak usage), 0 if none. */
   size_t (*memory)(const rcb_layout *L);
+  /* Reciprocal condition number (1-norm) of the matrix the last solve
+   * factored: LAPACK zgecon / zgbcon on the factors in Z (anorm: the 1-norm
+   * of Z before the factorisation, rcb_layout_norm1), KLU klu_z_condest on
+   * its own factors and the values still in Z (anorm unused). O(n^2) dense,
+   * O(n bw) banded, a few sparse solves; work 2n, rwork 2n entries. */
+  rcb_status (*rcond)(const rcb_layout *L, const rcb_complex *Z, const int *ipiv, double anorm,
+                      rcb_complex *work, double *rwork, double *rcond);
 } rcb_zsolver_ops;
 
 const rcb_zsolver_ops *rcb_zsolver_dense(void);
@@ -37,6 +44,13 @@ const rcb_zsolver_ops *rcb_zsolver_banded(void);
 const rcb_zsolver_ops *rcb_zsolver_sparse(void);
 /* Full factorisations and kept-pivot refactorisations done so far by the
  * sparse backend on layout L (0, 0 for the other backends). */
+/* 1-norm (largest column sum of |Z_ij|) of a matrix in any layout; NaN if
+ * an entry is NaN (solvers/condition.c). */
+double rcb_layout_norm1(const rcb_layout *L, const rcb_complex *Z);
+/* min|U_ii| / max|U_ii| of the factors left by the last solve (-): read off
+ * the LAPACK factors in Z, or KLU's klu_z_rcond of its own; NaN if unknown. */
+double rcb_layout_pivot_ratio(const rcb_layout *L, const rcb_complex *Z);
+double rcb_zsolver_sparse_pivot_ratio(const rcb_layout *L);
 void rcb_zsolver_sparse_counts(const rcb_layout *L, size_t *factors, size_t *refactors);
 
 #endif

@@ -677,6 +677,46 @@ timecheck_json)
   python3 -c 'import json,sys; c=json.load(open(sys.argv[1]))["channels"][0]
 a,b=c["amp_freq"][0],c["amp_time"][0]; assert abs(b/a-1)<5e-3, (a,b)' "$W/out" \
     || fail "time and frequency domain amplitudes differ by more than 0.5 %" ;;
+# ---- solvers: modal (eq. 7) and threads give the direct numbers ----
+frf_modal_matches_direct)
+  run frf "$MODEL" --out C.A.x,C.B.y --in DA.x,DA.y --fmax 500 --points 101 --rpm 10000 --json
+  expect_rc 0; cp "$W/out" "$W/direct.json"
+  run frf "$MODEL" --out C.A.x,C.B.y --in DA.x,DA.y --fmax 500 --points 101 --rpm 10000 --json \
+    --solver modal --threads 2
+  expect_rc 0; json_ok; err_has "truncation error estimate at 500 Hz"
+  python3 - "$W/direct.json" "$W/out" <<'EOF' || fail "modal FRF differs from the direct one"
+import json, sys
+a, b = (json.load(open(p)) for p in sys.argv[1:3])
+assert b["solver"] == "modal" and b["modal"]["roots_kept"] == b["modal"]["roots"]
+assert b["modal"]["truncation_error"] < 1e-8 and b["modal"]["residual_used"] is False
+for i in range(101):
+    ha = [complex(c["re"][i], c["im"][i]) for c in a["channels"]]
+    hb = [complex(c["re"][i], c["im"][i]) for c in b["channels"]]
+    assert max(abs(x - y) for x, y in zip(ha, hb)) <= 1e-8 * max(abs(x) for x in ha)
+EOF
+  ;;
+frf_modal_truncated)
+  run frf "$MODEL" --out C.A.x --in DA.x --fmax 300 --points 11 --rpm 10000 --solver modal --modes 10 --json
+  expect_rc 0; json_ok; err_has "10 modes"; err_has "residual term added"
+  python3 -c 'import json,sys; m=json.load(open(sys.argv[1]))["modal"]; assert m["modes_kept"]==10 and m["residual_used"] and 0<m["truncation_error"]<0.1' "$W/out" ||
+    fail "modal truncation report" ;;
+frf_threads_identical)
+  run frf "$MODEL" --out DA.x,C.A.y --in DA.x --fmax 400 --points 300 --rpm 3000 --solver banded
+  expect_rc 0; cp "$W/out" "$W/one.csv"
+  run frf "$MODEL" --out DA.x,C.A.y --in DA.x --fmax 400 --points 300 --rpm 3000 --solver banded --threads 3
+  expect_rc 0; cmp -s "$W/one.csv" "$W/out" || fail "--threads 3 changed the numbers" ;;
+usage_frf_modes_without_modal)
+  usage frf "$MODEL" --out DA.x --in DA.x --fmax 100 --modes 4; err_has "need --solver modal" ;;
+check_pedestal)
+  # a pedestal under B2: its station, its two DOFs after B2's node, its FRF channel
+  sed 's/^\[bearing B2\]$/[bearing B2]\npedestal_mass = 10\npedestal_kxx = 3e7\npedestal_kyy = 3e7/' \
+    "$MODEL" >"$W/ped.ini"
+  run check "$W/ped.ini"; expect_rc 0
+  out_has "B2.ped,pedestal,"; out_has "90 DOFs"
+  run frf "$W/ped.ini" --out B2.ped.x,DA.x --in B2.ped.x --fmax 300 --points 4 --rpm 3000
+  expect_rc 0
+  run frf "$W/ped.ini" --out B2.ped.rx --in DA.x --fmax 300 --points 4
+  expect_rc 2; err_has "pedestal moves in x and y only" ;;
 *) echo "unknown test case '$CASE'"; exit 1 ;;
 esac
 exit 0

@@ -1,343 +1,47 @@
 """Build the same rotor models in ROSS (ross-rotordynamics 2.3) as librcb.
 
-The model is read from librcb's INI format (the contract in the README /
-issue #2) by a small parser written here, independently of the C loader, and
-turned into ROSS elements:
+The INI parser (independent of the C loader) and the ROSS builder live in the
+package's ROSS bridge, ``librcb.ross_bridge`` (tools/python/librcb); this
+module keeps the names the cross-validation tests use, the INI variants the
+examples do not cover, and the ROSS-side damped-mode helpers.
 
 * each shaft segment -> ``n`` ShaftElements of length L/n, with shear,
-  rotary inertia and gyroscopics on; ROSS computes its own (Cowper) shear
-  factor, so ``kappa`` and ``phi = 12 E Ie / (G_s kappa A L^2)`` are
-  overwritten with the INI ``shear_factor`` exactly as ROSS's ``__init__``
-  computes them (``shear_factor = 0`` -> ``shear_effects=False``, phi = 0);
-  proportional damping ``alpha = damping_mass`` (1/s) and
-  ``beta = damping_stiffness`` (s): ROSS's element C = alpha M + beta K;
-* disks -> DiskElement(n, m, Id, Ip) (explicit or annulus from geometry);
-* bearings -> BearingElement(n, kxx, cxx, kyy, cyy, kxy, kyx, cxy, cyx);
-  speed tables are interpolated linearly here, at the requested speed, and
-  the ROSS rotor is built for that speed (ROSS itself would fit a spline);
-* nelson_crandall_1/2 couplings -> CouplingElement placed in the shaft
-  element list between the two shafts (the coupling must join the end of
-  one shaft to the start of the next shaft in INI order).
+  rotary inertia and gyroscopics on, ROSS's phi overwritten with the INI
+  ``shear_factor``; proportional damping alpha = damping_mass (1/s),
+  beta = damping_stiffness (s);
+* disks -> DiskElement; bearings -> BearingElement, speed tables interpolated
+  linearly here at the requested speed (the ROSS rotor is built per speed);
+* nelson_crandall_1/2 couplings -> CouplingElement.
 
 ROSS is 6 DOF/node [x, y, z, alpha, beta, theta]; the lateral DOFs of ROSS
-node n are 6 n + (0, 1, 3, 4). The ROSS nodes are numbered along the shaft
-element list: shaft 1's nodes, then (through the coupling element) shaft 2's.
-``RossModel.node_keys`` gives (shaft name, z) of every ROSS node so that it
-can be matched with the node table printed by ``rcbtool matrices``.
-
-Units are SI throughout (m, kg, N/m, N s/m, rad/s).
+node n are 6 n + (0, 1, 3, 4). ``RossModel.node_keys`` gives (shaft name, z)
+of every ROSS node. Units are SI throughout (m, kg, N/m, N s/m, rad/s).
 """
 
 import math
-import re
+import sys
+from pathlib import Path
 
 import numpy as np
 
-LATERAL = (0, 1, 3, 4)  # ROSS local indices of x, y, alpha (rot_x), beta (rot_y)
+try:
+    from librcb import ross_bridge
+except ImportError:  # package not installed: use the repository's source
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tools" / "python"))
+    from librcb import ross_bridge
+
+LATERAL = ross_bridge.LATERAL
+Model = ross_bridge.Model
+parse_ini = ross_bridge.parse_ini
+annulus = ross_bridge.annulus
 
 
-# --------------------------------------------------------------------------
-# INI parsing (independent of the C loader)
-# --------------------------------------------------------------------------
-
-
-def parse_ini(text):
-    """Return a list of (kind, name, {key: [values...]}) in file order.
-
-    Comments start with ';' or '#' (at line start or after whitespace);
-    repeated keys accumulate (``segment``).
-    """
-    sections = []
-    cur = None
-    for raw in text.splitlines():
-        line = re.split(r"(?:^|\s)[;#]", raw, maxsplit=1)[0].strip()
-        if not line:
-            continue
-        if line.startswith("["):
-            head = line.strip("[]").strip()
-            parts = head.split(None, 1)
-            kind = parts[0].lower()
-            name = parts[1].strip() if len(parts) > 1 else ""
-            cur = {}
-            sections.append((kind, name, cur))
-            continue
-        key, _, val = line.partition("=")
-        cur.setdefault(key.strip().lower(), []).append(val.strip())
-    return sections
-
-
-def _f(d, key, default=None):
-    if key not in d:
-        if default is None:
-            raise KeyError(key)
-        return default
-    return float(d[key][-1])
-
-
-def _floats(s):
-    return [float(t) for t in s.replace(",", " ").split()]
-
-
-def annulus(density, outer_d, inner_d, width):
-    """Mass (kg), Id (kg m^2, about a diameter through the centre), Ip (kg m^2)."""
-    ro, ri = outer_d / 2.0, inner_d / 2.0
-    m = density * math.pi * (ro**2 - ri**2) * width
-    ip = 0.5 * m * (ro**2 + ri**2)
-    idd = m * (3.0 * (ro**2 + ri**2) + width**2) / 12.0
-    return m, idd, ip
-
-
-class Shaft:
-    def __init__(self, name, d):
-        self.name = name
-        self.material = d["material"][-1]
-        self.start = _f(d, "start", 0.0)
-        self.kappa = _f(d, "shear_factor", 0.0)
-        self.alpha = _f(d, "damping_mass", 0.0)
-        self.beta = _f(d, "damping_stiffness", 0.0)
-        self.elements = []  # (L, od, id)
-        for seg in d.get("segment", []):
-            length, od, idd, n = _floats(seg)
-            n = int(n)
-            for _ in range(n):
-                self.elements.append((length / n, od, idd))
-        z = [self.start]
-        for el in self.elements:
-            z.append(z[-1] + el[0])
-        self.z = z
-
-    def node_at(self, where):
-        """Local node index of 'start' | 'end' | z (m)."""
-        if where == "start":
-            return 0
-        if where == "end":
-            return len(self.z) - 1
-        zz = float(where)
-        for i, z in enumerate(self.z):
-            if abs(z - zz) < 1e-9:
-                return i
-        raise ValueError(f"z = {zz} m is not a node of shaft {self.name}")
-
-
-class Model:
-    """The INI model, in plain Python."""
-
-    def __init__(self, text):
-        self.materials = {}
-        self.shafts = []
-        self.disks = []
-        self.bearings = []
-        self.couplings = []
-        self.unbalances = []
-        self.stations = {}
-        secs = parse_ini(text)
-        for kind, name, d in secs:
-            if kind == "material":
-                self.materials[name] = (
-                    _f(d, "density"),
-                    _f(d, "young"),
-                    _f(d, "poisson"),
-                )
-            elif kind == "shaft":
-                self.shafts.append(Shaft(name, d))
-        self._shaft = {s.name: s for s in self.shafts}
-        for kind, name, d in secs:
-            if kind == "disk":
-                at = self.place(d["at"][-1])
-                if "mass" in d:
-                    m, idd, ip = _f(d, "mass"), _f(d, "id"), _f(d, "ip")
-                else:
-                    m, idd, ip = annulus(
-                        _f(d, "density"),
-                        _f(d, "outer_diameter"),
-                        _f(d, "inner_diameter", 0.0),
-                        _f(d, "width"),
-                    )
-                self.disks.append((name, at, m, idd, ip))
-                self.stations[name] = at
-            elif kind == "bearing":
-                self.bearings.append((name, self.place(d["at"][-1]), d))
-                self.stations[name] = self.place(d["at"][-1])
-            elif kind == "coupling":
-                a, b = [s.strip() for s in d["between"][-1].split(",")]
-                self.couplings.append((name, self.place(a), self.place(b), d))
-                self.stations[name] = self.place(a)
-                self.stations[name + "." + self.place(a)[0]] = self.place(a)
-                self.stations[name + "." + self.place(b)[0]] = self.place(b)
-            elif kind == "station":
-                self.stations[name] = self.place(d["at"][-1])
-        for kind, name, d in secs:
-            if kind == "unbalance":
-                at = d["at"][-1]
-                place = self.stations[at] if at in self.stations else self.place(at)
-                self.unbalances.append(
-                    (name, place, _f(d, "amount"), math.radians(_f(d, "phase_deg", 0.0)))
-                )
-                self.stations.setdefault(name, place)
-
-    def place(self, spec):
-        """'A 0.20' | 'A start' | 'A end' -> (shaft name, local node index)."""
-        sname, where = spec.split()
-        return (sname, self._shaft[sname].node_at(where))
-
-    @staticmethod
-    def bearing_coefs(d, speed):
-        """Coefficients (dict) at rotor speed (rad/s), linear interpolation, clamped."""
-        table = None
-        if "speed_rpm" in d:
-            table = np.array(_floats(d["speed_rpm"][-1])) * math.pi / 30.0
-        elif "speed" in d:
-            table = np.array(_floats(d["speed"][-1]))
-        out = {}
-        for k in ("kxx", "kxy", "kyx", "kyy", "cxx", "cxy", "cyx", "cyy"):
-            vals = _floats(d[k][-1]) if k in d else [0.0]
-            if len(vals) == 1 or table is None:
-                out[k] = vals[0]
-            else:
-                out[k] = float(np.interp(speed, table, vals))
-        return out
-
-
-class RossModel:
-    """A ROSS rotor built from a Model, with the node map."""
-
-    def __init__(self, model, speed=0.0, override_shear=True):
-        """override_shear=False keeps ROSS's own (Cowper) shear factor: only
-        to show that the comparison would notice it."""
-        import ross as rs
-
-        self.model = model
-        mats = {}
-        for name, (rho, E, nu) in model.materials.items():
-            mats[name] = rs.Material(
-                name="rcb_" + re.sub(r"\W", "_", name), rho=rho, E=E, Poisson=nu
-            )
-        elements = []
-        self.node_keys = []  # ROSS node -> (shaft name, z)
-        self.first_node = {}  # shaft name -> ROSS node of its local node 0
-        couplings = {c[1][0]: c for c in model.couplings}  # keyed by side-a shaft
-        for si, sh in enumerate(model.shafts):
-            self.first_node[sh.name] = len(self.node_keys)
-            self.node_keys.extend((sh.name, z) for z in sh.z)
-            mat = mats[sh.material]
-            for L, od, idd in sh.elements:
-                el = rs.ShaftElement(
-                    L=L,
-                    idl=idd,
-                    odl=od,
-                    material=mat,
-                    shear_effects=sh.kappa > 0,
-                    rotary_inertia=True,
-                    gyroscopic=True,
-                    alpha=sh.alpha,
-                    beta=sh.beta,
-                )
-                if sh.kappa > 0 and override_shear:
-                    el.kappa = sh.kappa
-                    el.phi = (
-                        12 * mat.E * el.Ie / (mat.G_s * sh.kappa * el.A * el.L**2)
-                    )
-                elements.append(el)
-            if si + 1 < len(model.shafts):
-                c = couplings.get(sh.name)
-                nxt = model.shafts[si + 1]
-                if (
-                    c is None
-                    or c[1][1] != len(sh.z) - 1
-                    or c[2] != (nxt.name, 0)
-                ):
-                    raise ValueError(
-                        "ROSS builder: shafts must be chained end -> start by couplings"
-                    )
-                elements.append(self._coupling(c, nxt.start - sh.z[-1]))
-        disks = []
-        for name, (sname, i), m, idd, ip in model.disks:
-            disks.append(rs.DiskElement(n=self.first_node[sname] + i, m=m, Id=idd, Ip=ip, tag=name))
-        bearings = []
-        for name, (sname, i), d in model.bearings:
-            k = model.bearing_coefs(d, speed)
-            bearings.append(
-                rs.BearingElement(
-                    n=self.first_node[sname] + i,
-                    kxx=k["kxx"],
-                    kyy=k["kyy"],
-                    kxy=k["kxy"],
-                    kyx=k["kyx"],
-                    cxx=k["cxx"],
-                    cyy=k["cyy"],
-                    cxy=k["cxy"],
-                    cyx=k["cyx"],
-                    tag=name,
-                )
-            )
-        self.rotor = rs.Rotor(elements, disks, bearings)
-        assert self.rotor.ndof == 6 * len(self.node_keys)
-
-    @staticmethod
-    def _coupling(c, gap):
-        import ross as rs
-
-        name, _, _, d = c
-        typ = d["model"][-1].strip()
-        if typ not in ("nelson_crandall_1", "nelson_crandall_2"):
-            raise ValueError(f"ROSS builder: coupling model {typ} has no ROSS element")
-        if "hub_density" in d:
-            m, idd, ip = annulus(
-                _f(d, "hub_density"),
-                2 * _f(d, "hub_outer_radius"),
-                2 * _f(d, "hub_inner_radius"),
-                0.5 * _f(d, "hub_thickness"),
-            )
-        else:
-            m, idd, ip = _f(d, "hub_mass", 0.0), _f(d, "hub_id", 0.0), _f(d, "hub_ip", 0.0)
-        kt, kr = _f(d, "kt", 0.0), _f(d, "kr", 0.0)
-        ct, cr = (_f(d, "ct", 0.0), _f(d, "cr", 0.0)) if typ == "nelson_crandall_2" else (0.0, 0.0)
-        # ROSS replaces Id = 0 by Ip/2; only matters for massless hubs.
-        return rs.CouplingElement(
-            m_l=m, m_r=m, Ip_l=ip, Ip_r=ip, Id_l=idd, Id_r=idd,
-            kt_x=kt, kt_y=kt, kr_x=kr, kr_y=kr,
-            ct_x=ct, ct_y=ct, cr_x=cr, cr_y=cr,
-            L=gap, tag=name,
-        )
-
-    # ---- helpers -------------------------------------------------------
-
-    def ross_node(self, shaft, z):
-        for i, (s, zz) in enumerate(self.node_keys):
-            if s == shaft and abs(zz - z) < 1e-9:
-                return i
-        raise KeyError((shaft, z))
-
-    def lateral_map(self, nodes_table):
-        """Pairs (ours, ross) of DOF indices from rcbtool's "nodes" table."""
-        ours, ross = [], []
-        for nd in nodes_table:
-            n = self.ross_node(nd["shaft"], nd["z"])
-            for k in range(4):
-                ours.append(nd["dof"][k])
-                ross.append(6 * n + LATERAL[k])
-        return np.array(ours), np.array(ross)
-
-    def lateral_dofs(self):
-        """ROSS indices of all lateral DOFs, node by node."""
-        return np.array([6 * n + k for n in range(len(self.node_keys)) for k in LATERAL])
-
-    def station_dof(self, spec):
-        """ROSS global index of a channel 'STATION.DIR' or '#N.DIR' (N = ROSS node)."""
-        st, _, direction = spec.rpartition(".")
-        k = {"x": 0, "y": 1, "rx": 3, "ry": 4}[direction]
-        if st.startswith("#"):
-            return 6 * int(st[1:]) + k
-        sname, i = self.model.stations[st]
-        return 6 * (self.first_node[sname] + i) + k
-
-    def unbalance_args(self):
-        nodes, mags, phases = [], [], []
-        for _, (sname, i), amount, phase in self.model.unbalances:
-            nodes.append(self.first_node[sname] + i)
-            mags.append(amount)
-            phases.append(phase)
-        return nodes, mags, phases
+def RossModel(model, speed=0.0, override_shear=True):
+    """A ROSS rotor built from a Model for one rotor speed (rad/s; it selects
+    tabulated bearings), with the node map (ross_bridge.IniRotor).
+    override_shear=False keeps ROSS's own (Cowper) shear factor: only to show
+    that the comparison would notice it."""
+    return ross_bridge.IniRotor(model, speed=speed, override_shear=override_shear)
 
 
 # --------------------------------------------------------------------------

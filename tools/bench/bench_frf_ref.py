@@ -15,6 +15,9 @@ outputs C.A.x, C.A.y, C.B.x, C.B.y, inputs DA.x, DA.y, rotor at 10000 rpm.
    the matrices at every call) is timed on a subset and compared with
    librcb's values.
 
+The pieces are functions (PaperSweep, import_ross_quietly, ross_fixed_loop,
+ross_freq_response) that tools/bench/suite.py reuses.
+
 usage: bench_frf_ref.py --rcbtool build/tools/rcbtool/rcbtool MODEL.ini
 Run it with OPENBLAS_NUM_THREADS=1 for one-core figures.
 """
@@ -71,72 +74,67 @@ def best_of(fn, repeats):
     return best, out
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("model")
-    ap.add_argument("--rcbtool", required=True)
-    ap.add_argument("--points", type=int, default=2000)
-    ap.add_argument("--fmax", type=float, default=500.0, help="Hz")
-    ap.add_argument("--rpm", type=float, default=10000.0)
-    ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--ross-fixed-points", type=int, default=100,
-                    help="frequencies for the ROSS fixed-speed loop (0: skip)")
-    ap.add_argument("--no-ross", action="store_true")
-    a = ap.parse_args()
+def frf_channels(doc):
+    """(points, outputs, inputs) complex array from ``rcbtool frf --json``."""
+    H = np.empty((len(doc["freq_hz"]), len(OUTS), len(INS)), dtype=complex)
+    for ch in doc["channels"]:
+        H[:, OUTS.index(ch["output"]), INS.index(ch["input"])] = (
+            np.array(ch["re"]) + 1j * np.array(ch["im"]))
+    return H
 
-    import ross_models
 
-    speed = a.rpm * math.pi / 30.0  # rad/s
-    f_hz = np.linspace(0.0, a.fmax, a.points)
-    w = 2.0 * math.pi * f_hz
+def rel_dev(H, ref):
+    """max |H - ref| / max |ref| over all entries."""
+    return float(np.max(np.abs(H - ref)) / np.max(np.abs(ref)))
 
-    mats = rcbtool_json(a.rcbtool, "matrices", a.model, "--rpm", a.rpm)
-    M, C, G, K = (np.array(mats[k], dtype=float) for k in ("M", "C", "G", "K"))
-    n = M.shape[0]
-    with open(a.model) as fh:
-        model = ross_models.Model(fh.read())
-    out_rows = [our_row(model, mats["nodes"], s) for s in OUTS]
-    in_rows = [our_row(model, mats["nodes"], s) for s in INS]
-    B = np.zeros((n, len(INS)), dtype=complex)
-    for j, r in enumerate(in_rows):
-        B[r, j] = 1.0
-    D = C + speed * G
 
-    def scipy_sweep():
-        H = np.empty((a.points, len(OUTS), len(INS)), dtype=complex)
-        for i, wi in enumerate(w):
-            X = scipy.linalg.solve(K - wi * wi * M + 1j * wi * D, B,
+class PaperSweep:
+    """The benchmark problem on rcbtool's assembled matrices (M, C, G, K)."""
+
+    def __init__(self, exe, path, points=2000, fmax=500.0, rpm=10000.0):
+        import ross_models
+
+        self.exe, self.path, self.points, self.fmax, self.rpm = exe, path, points, fmax, rpm
+        self.speed = rpm * math.pi / 30.0  # rad/s
+        self.f_hz = np.linspace(0.0, fmax, points)
+        self.w = 2.0 * math.pi * self.f_hz  # rad/s
+        mats = rcbtool_json(exe, "matrices", path, "--rpm", rpm)
+        self.M, C, G, self.K = (np.array(mats[k], dtype=float) for k in ("M", "C", "G", "K"))
+        self.n = self.M.shape[0]
+        with open(path) as fh:
+            self.model = ross_models.Model(fh.read())
+        self.out_rows = [our_row(self.model, mats["nodes"], s) for s in OUTS]
+        in_rows = [our_row(self.model, mats["nodes"], s) for s in INS]
+        self.B = np.zeros((self.n, len(INS)), dtype=complex)
+        for j, r in enumerate(in_rows):
+            self.B[r, j] = 1.0
+        self.D = C + self.speed * G
+
+    def scipy_sweep(self):
+        """(points, outputs, inputs): one scipy.linalg.solve per frequency."""
+        H = np.empty((self.points, len(OUTS), len(INS)), dtype=complex)
+        for i, wi in enumerate(self.w):
+            X = scipy.linalg.solve(self.K - wi * wi * self.M + 1j * wi * self.D, self.B,
                                    check_finite=False)
-            H[i] = X[out_rows, :]
+            H[i] = X[self.out_rows, :]
         return H
 
-    print(f"model {a.model}: {n} DOFs; {a.points} frequencies 0-{a.fmax:g} Hz, "
-          f"{len(OUTS)} outputs x {len(INS)} inputs, {a.rpm:g} rpm")
-    t_scipy, H = best_of(scipy_sweep, a.repeats)
-    print(f"SciPy solve loop:        {1e3 * t_scipy:9.1f} ms/sweep "
-          f"{1e6 * t_scipy / a.points:9.1f} us/frequency (best of {a.repeats})")
+    def rcbtool_frf(self, *extra):
+        """``rcbtool frf --json`` on the same grid: (seconds of the whole run, H)."""
+        t0 = time.perf_counter()
+        doc = rcbtool_json(self.exe, "frf", self.path, "--out", ",".join(OUTS),
+                           "--in", ",".join(INS), "--fmin", 0, "--fmax", self.fmax,
+                           "--points", self.points, *extra)
+        return time.perf_counter() - t0, frf_channels(doc)
 
-    # The same sweep through rcbtool (process start, parsing and JSON output included).
-    t0 = time.perf_counter()
-    frf = rcbtool_json(a.rcbtool, "frf", a.model, "--out", ",".join(OUTS),
-                       "--in", ",".join(INS), "--fmin", 0, "--fmax", a.fmax,
-                       "--points", a.points, "--rpm", a.rpm)
-    t_tool = time.perf_counter() - t0
-    peak = np.abs(H).max()
-    worst = 0.0
-    for ch in frf["channels"]:
-        h = np.array(ch["re"]) + 1j * np.array(ch["im"])
-        ref = H[:, OUTS.index(ch["output"]), INS.index(ch["input"])]
-        worst = max(worst, float(np.max(np.abs(h - ref)) / peak))
-    print(f"rcbtool frf (whole run): {1e3 * t_tool:9.1f} ms; "
-          f"max |H_rcb - H_scipy| / max|H| = {worst:.1e}")
 
-    if a.no_ross:
-        return 0
+def import_ross_quietly():
+    """Import ROSS outside any timing; its ccp dependency talks about REFPROP
+    on import (from Python and from C), so file descriptors 1 and 2 are
+    silenced meanwhile. Also silences LinAlgWarning (ROSS's matrix is singular
+    at 0 Hz through its axial and torsional DOFs)."""
     import warnings
 
-    # Import outside the timings; ROSS's ccp dependency talks about REFPROP on
-    # import (from Python and from C), so silence file descriptors 1 and 2.
     sys.stdout.flush()
     sys.stderr.flush()
     saved = [os.dup(1), os.dup(2)]
@@ -154,28 +152,79 @@ def main():
         os.dup2(saved[1], 2)
         for fd in (*saved, devnull):
             os.close(fd)
-    # ROSS warns that its matrix is singular at 0 Hz (axial/torsional DOFs).
     warnings.simplefilter("ignore", scipy.linalg.LinAlgWarning)
 
-    rm = ross_models.RossModel(model, speed=speed)
+
+def ross_rotor(model, speed):
+    """The model as a ROSS rotor (tests/python/ross_models.py), speed rad/s."""
+    import ross_models
+
+    return ross_models.RossModel(model, speed=speed)
+
+
+def ross_fixed_loop(rm, speed, w):
+    """ROSS ``transfer_matrix(speed, frequency)`` at each w (rad/s): seconds per
+    frequency and H (len(w), outputs, inputs)."""
+    rows = [rm.station_dof(s) for s in OUTS]
+    cols = [rm.station_dof(s) for s in INS]
+    H = np.empty((len(w), len(OUTS), len(INS)), dtype=complex)
+    t0 = time.perf_counter()
+    for i, wi in enumerate(w):
+        H[i] = rm.rotor.transfer_matrix(speed=speed, frequency=wi)[np.ix_(rows, cols)]
+    return (time.perf_counter() - t0) / len(w), H
+
+
+def ross_freq_response(rm, w):
+    """ROSS ``run_freq_response`` (Omega = omega, all DOFs; run once: ROSS caches
+    it): seconds, H (len(w), outputs, inputs), peak RSS before and after, MB."""
+    rows = [rm.station_dof(s) for s in OUTS]
+    cols = [rm.station_dof(s) for s in INS]
     rss0 = rss_mb()
     t0 = time.perf_counter()
-    rm.rotor.run_freq_response(speed_range=w)
-    t_ross = time.perf_counter() - t0
+    res = rm.rotor.run_freq_response(speed_range=w)
+    secs = time.perf_counter() - t0
+    H = np.transpose(res.freq_resp[np.ix_(rows, cols)], (2, 0, 1))
+    return secs, H, rss0, rss_mb()
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("model")
+    ap.add_argument("--rcbtool", required=True)
+    ap.add_argument("--points", type=int, default=2000)
+    ap.add_argument("--fmax", type=float, default=500.0, help="Hz")
+    ap.add_argument("--rpm", type=float, default=10000.0)
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--ross-fixed-points", type=int, default=100,
+                    help="frequencies for the ROSS fixed-speed loop (0: skip)")
+    ap.add_argument("--no-ross", action="store_true")
+    a = ap.parse_args()
+
+    p = PaperSweep(a.rcbtool, a.model, a.points, a.fmax, a.rpm)
+    print(f"model {a.model}: {p.n} DOFs; {a.points} frequencies 0-{a.fmax:g} Hz, "
+          f"{len(OUTS)} outputs x {len(INS)} inputs, {a.rpm:g} rpm")
+    t_scipy, H = best_of(p.scipy_sweep, a.repeats)
+    print(f"SciPy solve loop:        {1e3 * t_scipy:9.1f} ms/sweep "
+          f"{1e6 * t_scipy / a.points:9.1f} us/frequency (best of {a.repeats})")
+
+    # The same sweep through rcbtool (process start, parsing and JSON output included).
+    t_tool, Hr = p.rcbtool_frf("--rpm", a.rpm)
+    print(f"rcbtool frf (whole run): {1e3 * t_tool:9.1f} ms; "
+          f"max |H_rcb - H_scipy| / max|H| = {rel_dev(Hr, H):.1e}")
+
+    if a.no_ross:
+        return 0
+    import_ross_quietly()
+    rm = ross_rotor(p.model, p.speed)
+    t_ross, _, rss0, rss1 = ross_freq_response(rm, p.w)
     print(f"ROSS run_freq_response:  {1e3 * t_ross:9.1f} ms/sweep "
-          f"(Omega = omega, all DOFs); peak RSS {rss0:.0f} -> {rss_mb():.0f} MB")
+          f"(Omega = omega, all DOFs); peak RSS {rss0:.0f} -> {rss1:.0f} MB")
 
     if a.ross_fixed_points > 0:
         # Not at 0 Hz: ROSS's axial and torsional DOFs make its matrix singular there.
         idx = np.linspace(1, a.points - 1, a.ross_fixed_points).astype(int)
-        rows = [rm.station_dof(s) for s in OUTS]
-        cols = [rm.station_dof(s) for s in INS]
-        t0 = time.perf_counter()
-        worst = 0.0
-        for i in idx:
-            Hr = rm.rotor.transfer_matrix(speed=speed, frequency=w[i])
-            worst = max(worst, float(np.max(np.abs(Hr[np.ix_(rows, cols)] - H[i]))) / peak)
-        t_fixed = (time.perf_counter() - t0) / len(idx)
+        t_fixed, Hf = ross_fixed_loop(rm, p.speed, p.w[idx])
+        worst = float(np.max(np.abs(Hf - H[idx]))) / np.max(np.abs(H))
         print(f"ROSS transfer_matrix loop (fixed speed): {1e3 * t_fixed:.1f} ms/frequency "
               f"-> {t_fixed * a.points:.1f} s per {a.points}-point sweep "
               f"(timed on {len(idx)}); max |H_ross - H_scipy| / max|H| = {worst:.1e}")

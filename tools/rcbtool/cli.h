@@ -61,16 +61,28 @@ int cli_fail(int code, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)))
 #endif
     ;
+#ifdef __clang_analyzer__ /* returns code: see rcb_set_error in src/core/rcb_internal.h */
+#define cli_fail(code, ...) ((void)(cli_fail)((code), __VA_ARGS__), (code))
+#endif
 /** A usage error: message plus a pointer to --help; returns CLI_EXIT_USAGE. */
 int cli_usage(const char *cmd, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 2, 3)))
 #endif
     ;
+#ifdef __clang_analyzer__ /* as cli_fail */
+#define cli_usage(cmd, ...) ((void)(cli_usage)((cmd), __VA_ARGS__), CLI_EXIT_USAGE)
+#endif
 /** @p msg if it says something, else the status text. */
 const char *cli_msg(const char *msg, rcb_status st);
 /** Exit code for a failed analysis call (numerical failure unless it is the input). */
 int cli_status_exit(rcb_status st);
+/**
+ * Print "rcbtool: warning: CMD: ill-conditioned ..." to stderr when a sweep had
+ * solves below the condition threshold, naming where the worst one was (in rpm
+ * when @p by_speed, else in Hz and rpm); nothing otherwise.
+ */
+void cli_warn_condition(const char *cmd, const rcb_frf_condition *c, int by_speed);
 
 /* ---- options (cli_args.c) ---- */
 

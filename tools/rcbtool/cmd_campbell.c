@@ -39,11 +39,12 @@ static int alloc_job(camp_job *j) {
   size_t t = j->ns * j->nm;
   j->rpm = malloc(j->ns * sizeof *j->rpm);
   j->speed = malloc(j->ns * sizeof *j->speed);
-  j->wd = malloc(t * sizeof *j->wd);
-  j->logdec = malloc(t * sizeof *j->logdec);
-  j->whirl = malloc(t * sizeof *j->whirl);
-  j->crit = malloc(t * sizeof *j->crit);
-  j->crit_mode = malloc(t * sizeof *j->crit_mode);
+  /* calloc: the static analyzer cannot see rcb_campbell fill them */
+  j->wd = calloc(t, sizeof *j->wd);
+  j->logdec = calloc(t, sizeof *j->logdec);
+  j->whirl = calloc(t, sizeof *j->whirl);
+  j->crit = calloc(t, sizeof *j->crit);
+  j->crit_mode = calloc(t, sizeof *j->crit_mode);
   if (!j->rpm || !j->speed || !j->wd || !j->logdec || !j->whirl || !j->crit || !j->crit_mode)
     return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   return 0;
@@ -62,7 +63,7 @@ static void free_job(camp_job *j) {
 /* One rcb_campbell call per speed (the library sorts modes per speed), so the
  * progress line can follow the sweep. */
 static int sweep(const cli_args *a, camp_job *j, rcb_modes *e) {
-  size_t i, off;
+  size_t i, off, ncrit = 0;
   rcb_status st = RCB_OK;
   cli_progress pr;
   cli_progress_start(&pr, a, "campbell", "speeds", j->ns);
@@ -78,8 +79,10 @@ static int sweep(const cli_args *a, camp_job *j, rcb_modes *e) {
     return cli_fail(cli_status_exit(st), "campbell at %.17g rpm: %s", j->rpm[i],
                     cli_msg(rcb_modes_errmsg(e), st));
   if (j->ns < 2) return 0; /* one speed: no crossing can be located */
+  /* a local count: &j->ncrit would let the analyzer forget j's other pointers */
   st = rcb_critical_speeds(j->ns, j->speed, j->nm, j->wd, 1.0, j->ns * j->nm, j->crit,
-                           j->crit_mode, &j->ncrit);
+                           j->crit_mode, &ncrit);
+  j->ncrit = ncrit;
   if (st) return cli_fail(cli_status_exit(st), "critical speeds: %s", rcb_status_str(st));
   return 0;
 }
@@ -127,7 +130,7 @@ static void write_csv(FILE *fp, const camp_job *j) {
   }
 }
 
-/* A per-speed list of per-mode values: [[...], [...]]; scale 0 writes whirl names. */
+/* A per-speed list of per-mode values: [[...], [...]]; x NULL writes whirl names. */
 static void json_table(FILE *fp, const char *key, const camp_job *j, const double *x,
                        double scale) {
   size_t i, k;
@@ -139,7 +142,7 @@ static void json_table(FILE *fp, const char *key, const camp_job *j, const doubl
       fputs(k ? ", " : "", fp);
       if (isnan(j->wd[c]))
         fputs("null", fp); /* fewer modes than asked at this speed */
-      else if (scale != 0.0)
+      else if (x)
         cli_json_num(fp, x[c] * scale);
       else
         fprintf(fp, "\"%s\"", cli_whirl_name(j->whirl[c]));

@@ -24,6 +24,8 @@ static const char *kind_name(rcb_station_kind k) {
       return "coupling";
     case RCB_STATION_UNBALANCE:
       return "unbalance";
+    case RCB_STATION_PEDESTAL:
+      return "pedestal";
     default:
       return "station";
   }

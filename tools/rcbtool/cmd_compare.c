@@ -316,6 +316,7 @@ static void json_peaks(FILE *fp, const rcb_compare *c, const cmp_job *j) {
     fprintf(fp, "%s{\"match\": \"%s\"", p ? ",\n " : "\n ", match_name(r.match));
     json_key_num(fp, "meas_x", r.meas_freq * j->xscale, 1);
     json_key_num(fp, "meas_zeta", r.meas_zeta, 1);
+    json_key_num(fp, "meas_zeta_hp", r.meas_zeta_hp, 1);
     if (r.match == RCB_PEAK_MODEL_ONLY)
       fputs(", \"channel\": null", fp);
     else
@@ -496,7 +497,8 @@ static int run(const cli_args *a, cmp_job *j) {
     rc = compare_fail(c, st, j->meas_path);
     goto done;
   }
-  ord = malloc((rcb_compare_band_count(c) + 1) * sizeof *ord);
+  /* calloc: the analyzer cannot tell that band_order and the printers see one count */
+  ord = calloc(rcb_compare_band_count(c) + 1, sizeof *ord);
   if (!ord) {
     rc = cli_fail(CLI_EXIT_NUMERIC, "out of memory");
     goto done;

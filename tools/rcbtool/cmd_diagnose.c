@@ -141,12 +141,16 @@ static void print_text(FILE *fp, const diag_job *j, const rcb_diag *d, const cha
 
 static void print_json(FILE *fp, const diag_job *j, const rcb_diag *d, const char *explain) {
   double e0, floor_pct;
+  rcb_diag_stats stats;
   size_t k, n = rcb_diag_candidate_count(d);
   rcb_diag_baseline(d, &e0, NULL, &floor_pct);
   fputs("{\"error0_pct\": ", fp);
   cli_json_num(fp, e0);
   fputs(", \"floor_pct\": ", fp);
   cli_json_num(fp, floor_pct);
+  if (rcb_diag_get_stats(d, &stats) == RCB_OK) /* the work done: model sweeps, candidates */
+    fprintf(fp, ", \"evaluations\": %zu, \"scored\": %zu, \"refits\": %zu", stats.evaluations,
+            stats.scored, stats.refits);
   fputs(", \"explanation\": ", fp);
   cli_json_str(fp, explain);
   fputs(",\n\"candidates\": [", fp);

@@ -356,6 +356,9 @@ typedef struct fit_result {
   rcb_fit_param *par;
   double *corr; /* np x np column-major */
   size_t np;
+  rcb_fit_stop stop;      /* why the run stopped */
+  size_t stop_param;      /* the parameter at its bound (RCB_FIT_STOP_AT_BOUND) */
+  rcb_frf_condition cond; /* condition of the final evaluation's solves */
 } fit_result;
 
 static int collect(rcb_fit *f, fit_result *r) {
@@ -365,6 +368,8 @@ static int collect(rcb_fit *f, fit_result *r) {
   r->corr = calloc(r->np * r->np, sizeof *r->corr);
   if (!r->par || !r->corr) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   rcb_fit_get_report(f, &r->rep);
+  r->stop = rcb_fit_stop_reason(f, &r->stop_param);
+  if (rcb_fit_get_condition(f, &r->cond)) r->cond.ill = 0;
   for (k = 0; k < r->np; k++) rcb_fit_get_param(f, k, &r->par[k]);
   if (rcb_fit_correlation(f, r->corr))
     for (k = 0; k < r->np * r->np; k++) r->corr[k] = NAN;
@@ -414,7 +419,19 @@ static void write_text(FILE *fp, const fit_result *r) {
           "residuals: %zu\nconverged: %s\n",
           r->rep.iterations, r->rep.evaluations, r->rep.starts, r->rep.residuals,
           r->rep.converged ? "yes" : "no");
-  if (r->rep.unsure)
+  fprintf(fp, "stopped: %s\n", rcb_fit_stop_str(r->stop));
+  if (r->stop == RCB_FIT_STOP_AT_BOUND && r->stop_param < r->np) {
+    const rcb_fit_param *p = &r->par[r->stop_param];
+    fprintf(fp, "UNSURE: %s ended at its bound (%.10g): the best fit may lie outside the "
+            "bounds (widen them with --params NAME:LO:HI) or the model lacks an effect\n",
+            p->name, p->value);
+  } else if (r->stop == RCB_FIT_STOP_STALLED || r->stop == RCB_FIT_STOP_MAX_ITER)
+    fprintf(fp, "UNSURE: the fit %s (%s)\n",
+            r->stop == RCB_FIT_STOP_STALLED ? "stalled: no step reduced the objective"
+                                            : "used its iterations before converging",
+            r->stop == RCB_FIT_STOP_STALLED ? "try --fd or another --method"
+                                            : "raise --max-iter, or try --starts 8");
+  else if (r->rep.unsure)
     fputs("UNSURE: the fit did not converge or ends well above the noise floor: a local "
           "minimum (try --starts 8 or --method nlopt:direct-l+bobyqa) or a physical effect "
           "the model lacks (rcbtool diagnose)\n",
@@ -485,9 +502,11 @@ static void write_json(FILE *fp, const fit_result *r, const fit_job *j, const cl
   fputs(", \"floor_pct\": ", fp);
   cli_json_num(fp, r->rep.floor_pct);
   fprintf(fp, ", \"iterations\": %zu, \"evaluations\": %zu, \"starts\": %zu, "
-          "\"residuals\": %zu, \"converged\": %s, \"unsure\": %s,\n\"objective0\": ",
+          "\"residuals\": %zu, \"converged\": %s, \"unsure\": %s, \"stop\": \"%s\",\n"
+          "\"objective0\": ",
           r->rep.iterations, r->rep.evaluations, r->rep.starts, r->rep.residuals,
-          r->rep.converged ? "true" : "false", r->rep.unsure ? "true" : "false");
+          r->rep.converged ? "true" : "false", r->rep.unsure ? "true" : "false",
+          rcb_fit_stop_str(r->stop));
   cli_json_num(fp, r->rep.objective0);
   fputs(", \"objective\": ", fp);
   cli_json_num(fp, r->rep.objective);
@@ -543,6 +562,7 @@ static int report(const cli_args *a, const fit_job *j, rcb_fit *f, const rcb_mod
   int rc;
   memset(&r, 0, sizeof r);
   if (!(rc = collect(f, &r))) {
+    cli_warn_condition(a->cmd, &r.cond, 0);
     if (a->json)
       write_json(stdout, &r, j, a);
     else

@@ -8,7 +8,9 @@ const char cli_help_frf[] =
     "usage: rcbtool frf MODEL.ini --out CH[,CH...] --in CH[,CH...] --fmax HZ\n"
     "                   [--fmin HZ] [--points N] [--rpm R | --synchronous]\n"
     "                   [--kind receptance|mobility|inertance]\n"
-    "                   [--solver auto|dense|banded] [--json] [-o FILE] [--progress]\n"
+    "                   [--solver auto|dense|banded|sparse|modal]\n"
+    "                   [--modes N | --modes-fmax HZ] [--threads N]\n"
+    "                   [--json] [-o FILE] [--progress]\n"
     "\n"
     "H(w) = [K - w^2 M + i w (C + Omega G)]^-1 between force inputs and response\n"
     "outputs, at frequencies f_i = fmin + i (fmax - fmin)/(N - 1), i = 0..N-1.\n"
@@ -21,7 +23,18 @@ const char cli_help_frf[] =
     "  --synchronous  rotor speed equal to the excitation frequency (Omega = w)\n"
     "  --kind K       receptance m/N (default), mobility m/(N s), inertance m/(N s^2)\n"
     "                 (rad instead of m for rotations)\n"
-    "  --solver S     linear solver: auto (default), dense (zgesv), banded (zgbsv)\n"
+    "  --solver S     auto (default), dense (zgesv), banded (zgbsv), sparse (KLU),\n"
+    "                 modal (eq. 7: eigenvectors once per speed, then a sum over\n"
+    "                 modes per frequency; best for many frequencies at one speed)\n"
+    "  --modes N      modal: keep the N lowest modes (|lambda|) plus a static\n"
+    "                 residual term; default all modes\n"
+    "  --modes-fmax HZ  modal: keep the modes with |lambda| <= 2 pi HZ, plus the\n"
+    "                 residual term\n"
+    "  --threads N    sweep on N threads (default 1); same numbers bit for bit\n"
+    "\n"
+    "With --solver modal, stderr gets the modes kept and a truncation error\n"
+    "estimate: max |H_modal - H_direct| / max |H_direct| at fmax (one direct\n"
+    "solve); JSON adds them as \"modal\".\n"
     "\n"
     "CSV: freq_hz,<out>/<in> re,<out>/<in> im,... (outputs outer, inputs inner).\n"
     "JSON: {\"freq_hz\": [...], \"rpm\": R (null if synchronous), \"synchronous\",\n"
@@ -29,7 +42,7 @@ const char cli_help_frf[] =
     "\"im\": [...]}]}\n";
 
 static const char *const kind_names[] = {"receptance", "mobility", "inertance"};
-static const char *const solver_names[] = {"auto", "dense", "banded"};
+static const char *const solver_names[] = {"auto", "dense", "banded", "sparse", "modal"};
 
 typedef struct frf_job {
   cli_channels out, in;
@@ -38,6 +51,11 @@ typedef struct frf_job {
   double *re, *im;      /* [point * nch + o * nin + i] */
   double rpm;           /* fixed speed, rpm */
   int sync, kind, solver;
+  size_t modes, threads; /* modal truncation (0: all); sweep threads */
+  double modes_fmax;     /* modal truncation, Hz (0: none) */
+  int modal_ok;          /* modal report below is filled */
+  rcb_modal_info modal;
+  double modal_err;      /* truncation error estimate at fmax (-) */
 } frf_job;
 
 static int parse_grid(const cli_args *a, frf_job *j, double *fmin, double *fmax) {
@@ -63,16 +81,26 @@ static int parse_job(const cli_args *a, frf_job *j, double *fmin, double *fmax) 
       (rc = parse_grid(a, j, fmin, fmax)) ||
       (rc = cli_opt_nonneg(a, "--rpm", "rotor speed, rpm", 0.0, &j->rpm)) ||
       (rc = cli_opt_choice(a, "--kind", kind_names, 3, RCB_RECEPTANCE, &j->kind)) ||
-      (rc = cli_opt_choice(a, "--solver", solver_names, 3, RCB_SOLVER_AUTO, &j->solver)))
+      (rc = cli_opt_choice(a, "--solver", solver_names, 5, RCB_SOLVER_AUTO, &j->solver)) ||
+      (rc = cli_opt_count(a, "--modes", 0, &j->modes)) ||
+      (rc = cli_opt_nonneg(a, "--modes-fmax", "Hz", 0.0, &j->modes_fmax)) ||
+      (rc = cli_opt_count(a, "--threads", 1, &j->threads)))
     return rc;
+  if ((j->modes || j->modes_fmax > 0.0) && j->solver != RCB_SOLVER_MODAL)
+    return cli_usage(a->cmd, "--modes and --modes-fmax need --solver modal");
+  if (j->modes && j->modes_fmax > 0.0)
+    return cli_usage(a->cmd, "--modes and --modes-fmax exclude each other; give one");
+  if (j->threads > RCB_SWEEP_MAX_THREADS)
+    return cli_usage(a->cmd, "--threads %zu: at most %d", j->threads, RCB_SWEEP_MAX_THREADS);
   return 0;
 }
 
 static int alloc_job(frf_job *j) {
   j->nch = j->out.n * j->in.n;
   j->freq = malloc(j->npts * sizeof *j->freq);
-  j->re = malloc(j->npts * j->nch * sizeof *j->re);
-  j->im = malloc(j->npts * j->nch * sizeof *j->im);
+  /* calloc: the static analyzer cannot see the sweep fill them */
+  j->re = calloc(j->npts * j->nch, sizeof *j->re);
+  j->im = calloc(j->npts * j->nch, sizeof *j->im);
   if (!j->freq || !j->re || !j->im) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   return 0;
 }
@@ -85,28 +113,77 @@ static void free_job(frf_job *j) {
   free(j->im);
 }
 
-/* The sweep: one rcb_frf_eval (one factorisation) per frequency. */
+/* Modes kept and the truncation error estimate at the last frequency, on
+ * stderr (and in JSON). */
+static rcb_status modal_report(const cli_args *a, frf_job *j, rcb_frf *f, double w,
+                               double speed) {
+  rcb_status st = rcb_frf_modal_info(f, speed, &j->modal);
+  if (!st) st = rcb_frf_modal_error(f, w, speed, &j->modal_err);
+  if (st) return st;
+  j->modal_ok = 1;
+  fprintf(stderr,
+          "rcbtool: %s: modal: %zu of %zu roots kept (%zu modes, |lambda| <= %.6g Hz) at "
+          "%.6g rpm; residual term %s (%.3g of |H(0)|); truncation error estimate at "
+          "%.6g Hz: %.3g (max |H_modal - H_direct| / max |H_direct|)\n",
+          a->cmd, j->modal.nkept, j->modal.nroots, j->modal.nmodes,
+          j->modal.max_kept_wn / CLI_HZ_TO_RAD_S, speed / CLI_RPM_TO_RAD_S,
+          j->modal.residual_used ? "added" : "none", j->modal.residual, w / CLI_HZ_TO_RAD_S,
+          j->modal_err);
+  return RCB_OK;
+}
+
+/* The sweep: rcb_frf_sweep on chunks of whole RCB_SWEEP_BLOCK blocks (so
+ * the numbers do not depend on the chunking or on --threads), progress
+ * between chunks. H holds nch entries per frequency. */
+static rcb_status sweep_chunks(frf_job *j, rcb_frf *f, const double *w, const double *sp,
+                               rcb_complex *H, cli_progress *pr) {
+  size_t p, chunk = RCB_SWEEP_BLOCK * j->threads * 4;
+  for (p = 0; p < j->npts; p += chunk) {
+    size_t np = j->npts - p < chunk ? j->npts - p : chunk;
+    rcb_status st = rcb_frf_sweep(f, np, w + p, sp + p, (rcb_frf_kind)j->kind, H + p * j->nch,
+                                  j->threads);
+    if (st) return st;
+    cli_progress_step(pr, p + np);
+  }
+  return RCB_OK;
+}
+
 static int sweep(const cli_args *a, frf_job *j, rcb_frf *f, rcb_complex *H) {
   size_t p, o, i, nout = j->out.n, nin = j->in.n;
+  double *w = malloc(2 * j->npts * sizeof *w), *sp;
   cli_progress pr;
-  cli_progress_start(&pr, a, "frf", "frequencies", j->npts);
+  rcb_status st;
+  if (!w) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  sp = w + j->npts;
   for (p = 0; p < j->npts; p++) {
-    double w = j->freq[p] * CLI_HZ_TO_RAD_S;
-    double speed = j->sync ? w : j->rpm * CLI_RPM_TO_RAD_S;
-    rcb_status st = rcb_frf_eval(f, w, speed, (rcb_frf_kind)j->kind, H);
-    if (st) {
-      cli_progress_end(&pr);
-      return cli_fail(cli_status_exit(st), "frf at %.17g Hz: %s", j->freq[p],
-                      cli_msg(rcb_frf_errmsg(f), st));
-    }
+    w[p] = j->freq[p] * CLI_HZ_TO_RAD_S;
+    sp[p] = j->sync ? w[p] : j->rpm * CLI_RPM_TO_RAD_S;
+  }
+  cli_progress_start(&pr, a, "frf", "frequencies", j->npts);
+  st = sweep_chunks(j, f, w, sp, H, &pr);
+  if (st) {
+    cli_progress_end(&pr);
+    free(w);
+    return cli_fail(cli_status_exit(st), "frf: %s", cli_msg(rcb_frf_errmsg(f), st));
+  }
+  for (p = 0; p < j->npts; p++)
     for (o = 0; o < nout; o++)
       for (i = 0; i < nin; i++) {
-        j->re[p * j->nch + o * nin + i] = creal(H[o + nout * i]);
-        j->im[p * j->nch + o * nin + i] = cimag(H[o + nout * i]);
+        j->re[p * j->nch + o * nin + i] = creal(H[p * j->nch + o + nout * i]);
+        j->im[p * j->nch + o * nin + i] = cimag(H[p * j->nch + o + nout * i]);
       }
-    cli_progress_step(&pr, p + 1);
+  if (j->solver == RCB_SOLVER_MODAL && j->npts)
+    st = modal_report(a, j, f, w[j->npts - 1], sp[j->npts - 1]);
+  free(w);
+  if (st) {
+    cli_progress_end(&pr);
+    return cli_fail(cli_status_exit(st), "frf: modal check: %s", cli_msg(rcb_frf_errmsg(f), st));
   }
   cli_progress_end(&pr);
+  {
+    rcb_frf_condition c;
+    if (!rcb_frf_get_condition(f, &c)) cli_warn_condition(a->cmd, &c, 0);
+  }
   return 0;
 }
 
@@ -123,7 +200,13 @@ static int compute(const cli_args *a, const rcb_model *m, frf_job *j) {
     return rc;
   }
   j->solver = (int)rcb_frf_solver(f);
-  H = malloc(j->nch * sizeof *H);
+  if (j->solver == RCB_SOLVER_MODAL &&
+      (st = rcb_frf_set_modal(f, j->modes, j->modes_fmax * CLI_HZ_TO_RAD_S))) {
+    rc = cli_fail(cli_status_exit(st), "frf: %s", cli_msg(rcb_frf_errmsg(f), st));
+    rcb_frf_destroy(f);
+    return rc;
+  }
+  H = malloc((j->npts ? j->npts : 1) * j->nch * sizeof *H);
   rc = H ? sweep(a, j, f, H) : cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   free(H);
   rcb_frf_destroy(f);
@@ -159,8 +242,23 @@ static void write_json(FILE *fp, const frf_job *j) {
     fputs("null", fp);
   else
     cli_json_num(fp, j->rpm);
-  fprintf(fp, ", \"synchronous\": %s, \"kind\": \"%s\", \"solver\": \"%s\",\n\"channels\": [",
+  fprintf(fp, ", \"synchronous\": %s, \"kind\": \"%s\", \"solver\": \"%s\",\n",
           j->sync ? "true" : "false", kind_names[j->kind], solver_names[j->solver]);
+  if (j->modal_ok) {
+    fprintf(fp, "\"modal\": {\"roots\": %zu, \"roots_kept\": %zu, \"modes_kept\": %zu, ",
+            j->modal.nroots, j->modal.nkept, j->modal.nmodes);
+    fputs("\"max_kept_hz\": ", fp);
+    cli_json_num(fp, j->modal.max_kept_wn / CLI_HZ_TO_RAD_S);
+    fprintf(fp, ", \"residual_used\": %s, \"residual\": ",
+            j->modal.residual_used ? "true" : "false");
+    cli_json_num(fp, j->modal.residual);
+    fputs(", \"check_hz\": ", fp);
+    cli_json_num(fp, j->freq[j->npts - 1]);
+    fputs(", \"truncation_error\": ", fp);
+    cli_json_num(fp, j->modal_err);
+    fputs("},\n", fp);
+  }
+  fputs("\"channels\": [", fp);
   for (o = 0; o < j->out.n; o++)
     for (i = 0; i < j->in.n; i++) {
       size_t c = o * j->in.n + i;
@@ -194,7 +292,8 @@ int cmd_frf(int argc, char **argv) {
                     {"--fmin", "HZ", NULL},     {"--fmax", "HZ", NULL},
                     {"--points", "N", NULL},    {"--rpm", "R", NULL},
                     {"--synchronous", NULL, NULL}, {"--kind", "KIND", NULL},
-                    {"--solver", "SOLVER", NULL}};
+                    {"--solver", "SOLVER", NULL}, {"--modes", "N", NULL},
+                    {"--modes-fmax", "HZ", NULL}, {"--threads", "N", NULL}};
   frf_job j = {0};
   cli_args a;
   rcb_model *m = NULL;

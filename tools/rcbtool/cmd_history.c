@@ -109,6 +109,14 @@ static int field(const char *line, const char *key, char *out, size_t size) {
   return 1;
 }
 
+/* A number field of a record (0 when it holds none, e.g. null), with the
+ * conversion checked (cert-err34-c) instead of atof's silent 0. */
+static double num_field(const char *s) {
+  char *end;
+  double v = strtod(s, &end);
+  return end == s ? 0.0 : v;
+}
+
 static void print_steps(char *text) {
   char *line, *save = NULL;
   double emax = 0;
@@ -131,15 +139,15 @@ static void print_steps(char *text) {
       field(line, "floor_pct", flo, sizeof flo);
       field(line, "params", np, sizeof np);
       field(line, "note", note, sizeof note);
-      e = atof(err);
+      e = num_field(err);
       step++;
       if (pass == 0) {
         if (e > emax) emax = e;
         continue;
       }
-      if (strcmp(flo, "null") && flo[0])
-        printf("%-4d %-10s %-28.28s %10.4g %10.4g %6s  %s\n", step, cmd, model, e, atof(flo),
-               np, note);
+      if (strcmp(flo, "null") != 0 && flo[0])
+        printf("%-4d %-10s %-28.28s %10.4g %10.4g %6s  %s\n", step, cmd, model, e,
+               num_field(flo), np, note);
       else
         printf("%-4d %-10s %-28.28s %10.4g %10s %6s  %s\n", step, cmd, model, e, "-", np, note);
     }
@@ -155,10 +163,10 @@ static void print_steps(char *text) {
       char err[64] = "";
       int bars, b;
       field(line, "error_pct", err, sizeof err);
-      bars = emax > 0 ? (int)lround(50.0 * atof(err) / emax) : 0;
+      bars = emax > 0 ? (int)lround(50.0 * num_field(err) / emax) : 0;
       printf("%4d |", ++k);
       for (b = 0; b < bars; b++) putchar('#');
-      printf(" %.4g %%\n", atof(err));
+      printf(" %.4g %%\n", num_field(err));
     }
     free(copy);
   }

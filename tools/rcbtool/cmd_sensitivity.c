@@ -219,8 +219,10 @@ static int fill_meas(const sens_job *j, const cand_list *cl, const double *x,
 static int simulate(const cli_args *a, const sens_job *j, const rcb_model *m,
                     const cand_list *cl, rcb_meas *ms) {
   rcb_frf *fr = NULL;
-  double *x = malloc(j->npts * sizeof *x);
-  rcb_complex *H = malloc(cl->n * sizeof *H), *data = malloc(cl->n * j->npts * sizeof *data);
+  /* at least one item each: malloc(0) may return NULL, read as out of memory */
+  size_t nc = cl->n ? cl->n : 1, npts = j->npts ? j->npts : 1;
+  double *x = malloc(npts * sizeof *x);
+  rcb_complex *H = malloc(nc * sizeof *H), *data = malloc(nc * npts * sizeof *data);
   size_t p;
   int rc;
   rcb_status st;
@@ -339,7 +341,7 @@ static void write_json(FILE *fp, const sens_job *j, const cand_list *cl, const d
 }
 
 static int output(const cli_args *a, const sens_job *j, const cand_list *cl, const double *S) {
-  ranked *rk = malloc(cl->n * sizeof *rk);
+  ranked *rk = malloc((cl->n ? cl->n : 1) * sizeof *rk);
   size_t nshow = j->top && j->top < cl->n ? j->top : cl->n;
   cli_out o;
   int rc;
@@ -358,7 +360,8 @@ static int output(const cli_args *a, const sens_job *j, const cand_list *cl, con
 static int sensitivities(const cli_args *a, const sens_job *j, rcb_model *m,
                          const cand_list *cl, const rcb_meas *ms) {
   rcb_fit *f = NULL;
-  double *S = malloc(cl->n * j->params.n * sizeof *S);
+  /* calloc of at least one: the analyzer cannot see rcb_fit fill S */
+  double *S = calloc(cl->n && j->params.n ? cl->n * j->params.n : 1, sizeof *S);
   int rc = 0;
   rcb_status st = S ? rcb_fit_create(&f, m, ms, NULL) : RCB_ERR_NOMEM;
   if (st) {

@@ -75,6 +75,10 @@ static int sweep(const cli_args *a, unb_job *j, rcb_frf *f, rcb_complex *Q) {
     cli_progress_step(&pr, p + 1);
   }
   cli_progress_end(&pr);
+  {
+    rcb_frf_condition c;
+    if (!rcb_frf_get_condition(f, &c)) cli_warn_condition(a->cmd, &c, 1);
+  }
   return 0;
 }
 
@@ -157,8 +161,9 @@ static int run(const cli_args *a, rcb_model *m, unb_job *j, double lo, double hi
   int rc;
   if ((rc = cli_channels_parse(a, m, "--out", &j->out))) return rc;
   j->rpm = malloc(j->npts * sizeof *j->rpm);
-  j->re = malloc(j->npts * j->out.n * sizeof *j->re);
-  j->im = malloc(j->npts * j->out.n * sizeof *j->im);
+  /* calloc: the static analyzer cannot see compute fill them */
+  j->re = calloc(j->npts * j->out.n, sizeof *j->re);
+  j->im = calloc(j->npts * j->out.n, sizeof *j->im);
   if (!j->rpm || !j->re || !j->im) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   cli_linspace(lo, hi, j->npts, j->rpm);
   if ((rc = compute(a, m, j)) || (rc = cli_out_open(&o, a))) return rc;

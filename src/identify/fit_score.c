@@ -1,0 +1,155 @@
+/*
+ * Sensitivities of many parameters at one model, for the diagnosis' score
+ * test: eq. 9 by the adjoint. With the factorisation of Z at each point, the
+ * solutions X = Z^-1 B (kept by the model solve) and Y = Z^-T E_out (one
+ * transposed re-solve for the outputs), every parameter's
+ *   dH_oq/dp = Y_o^T (dF/dp - dZ/dp X_q)
+ * costs a sum over the few non-zero entries of dZ/dp: no solve per
+ * parameter, and one factorisation per point for all the candidates.
+ */
+#include <string.h>
+
+#include "identify/fit_internal.h"
+
+/* The non-zero entries (i, j) of dM, dC, dG, dK (d: four matrices in the
+ * layout), column by column over the stored pattern; count only when e is
+ * NULL. */
+static void collect(const rcb_layout *L, const double *d, rcb_fit_dz_entry *e, size_t *ne) {
+  size_t sz = rcb_layout_size(L), n = L->n, i, j, a, k = 0;
+  for (j = 0; j < n; j++) {
+    size_t i0 = j > L->ku ? j - L->ku : 0, i1 = j + L->kl < n ? j + L->kl : n - 1;
+    size_t a0 = L->sparse ? (size_t)L->colp[j] : i0, a1 = L->sparse ? (size_t)L->colp[j + 1] : i1 + 1;
+    for (a = a0; a < a1; a++) {
+      size_t s;
+      i = L->sparse ? (size_t)L->rowi[a] : a;
+      s = L->sparse ? a : rcb_layout_at(L, i, j);
+      if (d[s] == 0.0 && d[sz + s] == 0.0 && d[2 * sz + s] == 0.0 && d[3 * sz + s] == 0.0)
+        continue;
+      if (e) {
+        e[k].row = i, e[k].col = j;
+        e[k].m = d[s], e[k].c = d[sz + s], e[k].g = d[2 * sz + s], e[k].k = d[3 * sz + s];
+      }
+      k++;
+    }
+  }
+  *ne = k;
+}
+
+void rcb_fit_dz_free(const rcb_allocator *a, rcb_fit_dz *dz, size_t n) {
+  size_t k;
+  for (k = 0; dz && k < n; k++) {
+    rcb_free(a, dz[k].e);
+    rcb_free(a, dz[k].dF);
+    dz[k].e = NULL, dz[k].dF = NULL, dz[k].ne = 0;
+  }
+}
+
+rcb_status rcb_fit_dz_collect(rcb_fit *f, const rcb_allocator *a, rcb_fit_dz *dz) {
+  size_t k, ndof = f->m->ndof, sz = 4 * rcb_layout_size(&f->frf->L), d;
+  for (k = 0; k < f->np; k++) dz[k].e = NULL, dz[k].dF = NULL, dz[k].ne = 0;
+  for (k = 0; k < f->np; k++) {
+    const double *dm = f->dmat + k * sz;
+    const rcb_complex *F = f->dF + k * ndof;
+    size_t ne;
+    collect(&f->frf->L, dm, NULL, &ne);
+    dz[k].e = rcb_alloc(a, (ne ? ne : 1) * sizeof *dz[k].e);
+    if (!dz[k].e) goto nomem;
+    collect(&f->frf->L, dm, dz[k].e, &dz[k].ne);
+    for (d = 0; d < ndof && F[d] == 0.0; d++) continue;
+    if (d == ndof) continue; /* the force does not depend on it */
+    if (!(dz[k].dF = rcb_alloc(a, ndof * sizeof *dz[k].dF))) goto nomem;
+    memcpy(dz[k].dF, F, ndof * sizeof *F);
+  }
+  return RCB_OK;
+nomem:
+  rcb_fit_dz_free(a, dz, f->np);
+  return rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory (parameter derivatives)");
+}
+
+rcb_status rcb_fit_dz_get(rcb_fit *c, const rcb_allocator *a, rcb_fit_dz *dz) {
+  size_t k;
+  rcb_status st;
+  for (k = 0; k < c->np; k++) dz[k].e = NULL, dz[k].dF = NULL, dz[k].ne = 0;
+  if ((st = rcb_fit_prepare(c)) || (st = rcb_fit_derivative_matrices(c))) return st;
+  return rcb_fit_dz_collect(c, a, dz);
+}
+
+/* dH_oq/dp of one parameter: Y_o^T (w^2 dF - dZ X_q) (unbalance: the force
+ * term, at unit speed as in jac_point). */
+static double complex dh_adjoint(const rcb_fit_dz *p, const rcb_complex *y,
+                                 const rcb_complex *x, double w, double W, int unbalance,
+                                 size_t n) {
+  double complex s = 0.0;
+  size_t a;
+  for (a = 0; a < p->ne; a++) {
+    const rcb_fit_dz_entry *e = &p->e[a];
+    double complex z = CMPLX(e->k - w * w * e->m, w * (e->c + W * e->g));
+    s -= y[e->row] * z * x[e->col];
+  }
+  if (unbalance && p->dF)
+    for (a = 0; a < n; a++) s += y[a] * (w * w) * p->dF[a];
+  return s;
+}
+
+/* One point: the model solve, the adjoint solutions, then every column. */
+static rcb_status score_point(rcb_fit *f, size_t i, const rcb_fit_dz *dz, size_t ndz,
+                              rcb_complex *Y, rcb_complex *dH, double *J) {
+  const rcb_frf *fr = f->frf;
+  size_t n = f->m->ndof, o, k, c, jj;
+  double w = f->grid[i], W = rcb_fit_point_speed(f, w);
+  rcb_status st;
+  if ((st = rcb_fit_solve_point(f, i))) return st;
+  memset(Y, 0, n * f->nout * sizeof *Y);
+  for (o = 0; o < f->nout; o++) Y[fr->out_row[o] + n * o] = 1.0;
+  if ((st = fr->ops->resolve(&fr->L, fr->Z, fr->ipiv, Y, f->nout, 'T')))
+    return rcb_fit_fail(f, st, "adjoint solve at %g rad/s failed", w);
+  for (k = 0; k < ndz; k++) {
+    for (c = 0; c < f->nch; c++) {
+      size_t q = f->unbalance ? 0 : f->ch_in[c];
+      dH[c] = dh_adjoint(&dz[k], Y + n * f->ch_out[c], fr->B + n * q, w, W, f->unbalance, n);
+    }
+    for (jj = f->pt_first[i]; jj < f->pt_first[i + 1]; jj++) {
+      size_t j = f->pt_res[jj];
+      J[j + f->nres * k] = rcb_fit_res_deriv(f, j, dH[f->res_ch[j]]);
+    }
+  }
+  return RCB_OK;
+}
+
+/* Every point: columns d r / d p of dz[0 .. ndz) into J, the model values
+ * into Hmod. */
+static rcb_status sweep_adjoint(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, double *J) {
+  size_t i, n = f->m->ndof;
+  rcb_complex *Y = rcb_alloc(&f->alloc, n * (f->nout ? f->nout : 1) * sizeof *Y);
+  rcb_complex *dH = rcb_alloc(&f->alloc, (f->nch ? f->nch : 1) * sizeof *dH);
+  rcb_status st = (Y && dH) ? RCB_OK : rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory (adjoint)");
+  for (i = 0; !st && i < f->npts; i++)
+    if (f->pt_used[i]) st = score_point(f, i, dz, ndz, Y, dH, J);
+  rcb_free(&f->alloc, Y);
+  rcb_free(&f->alloc, dH);
+  return st;
+}
+
+rcb_status rcb_fit_jacobian_dz(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, double *J) {
+  rcb_status st;
+  if (!f || (!dz && ndz) || !J) return RCB_ERR_ARG;
+  if ((st = rcb_fit_prepare(f))) return st;
+  rcb_frf_refresh(f->frf);
+  if (!(st = sweep_adjoint(f, dz, ndz, J))) f->sweeps++;
+  return st;
+}
+
+int rcb_fit_adjoint_cheaper(const rcb_fit *f) {
+  /* right-hand sides per point: nout transposed vs np per input direct */
+  return f->nout < f->np * (f->unbalance || !f->nin ? 1 : f->nin);
+}
+
+rcb_status rcb_fit_jac_adjoint(rcb_fit *f, double *Jp) {
+  rcb_fit_dz *dz = rcb_alloc(&f->alloc, (f->np ? f->np : 1) * sizeof *dz);
+  rcb_status st = dz ? rcb_fit_dz_collect(f, &f->alloc, dz)
+                     : rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory (adjoint)");
+  if (!st) st = sweep_adjoint(f, dz, f->np, Jp);
+  if (dz) rcb_fit_dz_free(&f->alloc, dz, f->np);
+  rcb_free(&f->alloc, dz);
+  return st;
+}
