@@ -172,6 +172,7 @@ rcb_status rcb_frf_sweep(rcb_frf *f, size_t nfreq, const double *omegas, const d
     return rcb_set_error(f->errmsg, RCB_ERR_ARG, "sweep: %zu threads: at most %d", nthreads,
                          RCB_SWEEP_MAX_THREADS);
   if ((st = check_grid(f, nfreq, omegas, speeds, &one_speed))) return st;
+  if (nfreq == 0) return RCB_OK; /* nothing to evaluate (and no part to run) */
   memset(workers, 0, sizeof workers);
   nt = nthreads < 1 ? 1 : nthreads;
   if (nt > nblocks) nt = nblocks ? nblocks : 1;

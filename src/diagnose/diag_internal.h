@@ -79,6 +79,9 @@ rcb_status rcb_diag_fail(rcb_diag *d, rcb_status st, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
+#ifdef __clang_analyzer__ /* returns st: see rcb_set_error in core/rcb_internal.h */
+#define rcb_diag_fail(o, st, ...) ((void)(rcb_diag_fail)((o), (st), __VA_ARGS__), (st))
+#endif
 
 /* Lay out every candidate effect of the (fitted) model m. */
 rcb_status rcb_diag_catalogue(rcb_diag *d, const rcb_model *m);

@@ -5,6 +5,7 @@
  * finalize message is prefixed with the file and the line of the section
  * header of the item concerned.
  */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -413,13 +414,17 @@ static rcb_status build_uff(ini_ctx *c, const ini_section *s) {
   for (p = e->val; p && *p;) {
     char item[2 * RCB_NAME_MAX + 40], station[2 * RCB_NAME_MAX + 2], extra[8];
     long node;
+    char *end;
     size_t len;
     q = strchr(p, ',');
     len = q ? (size_t)(q - p) : strlen(p);
     if (len >= sizeof item) len = sizeof item - 1;
     memcpy(item, p, len);
     item[len] = '\0';
-    if (sscanf(item, "%ld %97s %7s", &node, station, extra) != 2)
+    /* strtol, not sscanf's %ld: an out-of-range node is an error (cert-err34-c) */
+    errno = 0;
+    node = strtol(item, &end, 10);
+    if (end == item || errno == ERANGE || sscanf(end, "%97s %7s", station, extra) != 1)
       return rcb_ini_error(c, RCB_ERR_PARSE, e->line, s, "map",
                            "'%s': expected NODE STATION pairs separated by commas, e.g. "
                            "map = 10 DA, 20 C.B",

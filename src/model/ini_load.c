@@ -23,7 +23,7 @@
 
 /* Longest file accepted, bytes: a model is a few kB; this only guards against
  * reading a wrong (binary, huge) file into memory. */
-#define INI_MAX_FILE (16u * 1024u * 1024u)
+#define INI_MAX_FILE ((size_t)16 * 1024 * 1024)
 
 static const char *const type_names[INI_SEC_COUNT] = {
     "model", "material", "shaft", "disk", "bearing", "coupling", "unbalance", "station", "uff"};
@@ -54,7 +54,7 @@ typedef struct key_table {
   size_t n;
 } key_table;
 
-#define KT(a) {a, sizeof a / sizeof a[0]}
+#define KT(a) {(a), sizeof(a) / sizeof((a)[0])}
 static const key_table key_tables[INI_SEC_COUNT] = {
     KT(keys_model),    KT(keys_material), KT(keys_shaft),     KT(keys_disk),
     KT(keys_bearing),  KT(keys_coupling), KT(keys_unbalance), KT(keys_station),
@@ -67,8 +67,8 @@ const char *rcb_ini_type_name(ini_sec_type t) {
 
 /* ---- messages ---- */
 
-rcb_status rcb_ini_error(ini_ctx *c, rcb_status st, int line, const ini_section *s,
-                         const char *key, const char *fmt, ...) {
+rcb_status (rcb_ini_error)(ini_ctx *c, rcb_status st, int line, const ini_section *s,
+                           const char *key, const char *fmt, ...) {
   char what[RCB_ERRMSG_MAX], where[2 * RCB_NAME_MAX + 80], pos[24];
   va_list ap;
   if (c->st) return c->st;
@@ -510,7 +510,7 @@ rcb_status rcb_model_load_file(rcb_model *m, const char *path) {
     rcb_free(&m->alloc, buf);
     if (toolong)
       return rcb_model_fail(m, RCB_ERR_IO,
-                            "%s: file larger than %u bytes; expected an INI model file", path,
+                            "%s: file larger than %zu bytes; expected an INI model file", path,
                             INI_MAX_FILE);
     return rcb_model_fail(m, RCB_ERR_IO, "%s: read error", path);
   }

@@ -73,6 +73,9 @@ rcb_status rcb_ini_error(ini_ctx *c, rcb_status st, int line, const ini_section 
     __attribute__((format(printf, 6, 7)))
 #endif
     ;
+#ifdef __clang_analyzer__ /* returns st: see rcb_set_error in core/rcb_internal.h */
+#define rcb_ini_error(o, st, ...) ((void)(rcb_ini_error)((o), (st), __VA_ARGS__), (st))
+#endif
 
 /* Closest of n candidate strings to word (case-insensitive edit distance),
  * NULL if none is close enough to be a plausible typo. */

@@ -52,7 +52,7 @@ const char *rcb_model_errmsg(const rcb_model *m) { return m ? m->errmsg : "no mo
 
 /* ---- small helpers shared by the builder ---- */
 
-rcb_status rcb_model_fail(rcb_model *m, rcb_status st, const char *fmt, ...) {
+rcb_status (rcb_model_fail)(rcb_model *m, rcb_status st, const char *fmt, ...) {
   va_list ap;
   va_start(ap, fmt);
   vsnprintf(m->errmsg, sizeof m->errmsg, fmt, ap);

@@ -10,6 +10,9 @@ rcb_status rcb_model_fail(rcb_model *m, rcb_status st, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
+#ifdef __clang_analyzer__ /* returns st: see rcb_set_error in core/rcb_internal.h */
+#define rcb_model_fail(o, st, ...) ((void)(rcb_model_fail)((o), (st), __VA_ARGS__), (st))
+#endif
 
 /* Check a numeric input: finite always; sign > 0 requires v > 0, sign == 0
  * requires v >= 0, sign < 0 accepts any finite value. */

@@ -81,7 +81,7 @@ typedef struct pkind_info {
   size_t nkeys;
 } pkind_info;
 
-#define PK(n, a) {n, a, sizeof a / sizeof a[0]}
+#define PK(n, a) {(n), (a), sizeof(a) / sizeof((a)[0])}
 static const pkind_info kinds[PK_COUNT] = {
     PK("material", material_keys), PK("shaft", shaft_keys),
     PK("disk", disk_keys),         PK("bearing", bearing_keys),

@@ -1,0 +1,484 @@
+"""Hidden-effect cases for the diagnosis (issue #4), shared by
+test_diag_ross.py and tools/bench/diag_success.py.
+
+A case is a truth rotor: the paper system (examples/paper_system.ini) with one
+or two physical effects the user's model lacks. Two sources of truth data:
+
+* ROSS (ross-rotordynamics 2.3), an implementation that is not ours: the
+  model is read by the independent INI parser of the ROSS bridge (ross_models.py,
+  tools/python/librcb/ross_bridge.py), the effect is added to the parsed model
+  (bearing coefficients, the CouplingElement's hub masses or damping, an extra
+  DiskElement, a pedestal: the bridge builds a BearingElement
+  with n_link to a PointMass held by a second BearingElement to ground), and
+  the FRFs are ROSS's M, C, G, K at the test speed, H = [K - w^2 M + i w (C +
+  Omega G)]^-1 as ROSS's Rotor.transfer_matrix computes it (checked against
+  transfer_matrix at one frequency; solved for the one input column here
+  because transfer_matrix reassembles the matrices and inverts the whole
+  matrix at every frequency, 0.3 s each).
+* rcbtool simulate on a truth INI (the seven cases of tests/test_diagnose.c),
+  for the success-rate report.
+
+The test: inertances of DA, C.A, C.B, DB in x and y per a force at DA in x,
+100-400 Hz (151 points) at 10000 rpm, with the paper's eq. 19 noise (10 %
+random, 1 % systematic), written as UFF 58 with pyuff; the model's [uff]
+section maps the test's node numbers to its stations.
+
+The noise is eq. 19 exactly as src/io/noise.c draws it (xoshiro256** seeded
+by splitmix64, channel by channel, point by point, r1, r2, phi), so that a
+seed means the same noise here and in `rcbtool simulate --seed`
+(test_diag_ross.py checks this against rcbtool).
+
+SI units: m, kg, N/m, N s/m, rad/s; frequencies in Hz and speeds in rpm only
+where the files and the CLI use them.
+"""
+
+import json
+import math
+import re
+import subprocess
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+import ross_models as rm
+
+REPO = Path(__file__).resolve().parent.parent.parent
+BASE_INI = (REPO / "examples" / "paper_system.ini").read_text()
+
+RPM = 10000.0  # test speed, rpm
+FREQ_HZ = 100.0 + 2.0 * np.arange(151)  # Hz; exact in UFF's E13.5 min/increment
+OUTS = ["DA.x", "DA.y", "C.A.x", "C.A.y", "C.B.x", "C.B.y", "DB.x", "DB.y"]
+IN = "DA.x"
+NOISE = (10.0, 1.0)  # eq. 19 beta_a, beta_s in %
+UFF_NODES = {"DA": 3, "C.A": 10, "C.B": 11, "DB": 16}  # the test's node numbers
+UFF_DIRS = {"x": 1, "y": 2, "rx": 4, "ry": 5}
+FIT_PARAMS = "coupling.C.kt,coupling.C.kr,coupling.C.ct"  # what the user fits anyway
+AT_FLOOR = 1.1  # "at the noise floor": error below 1.1 x the floor
+
+# --------------------------------------------------------------------------
+# INI text edits (a truth INI for rcbtool simulate; the model with [uff])
+# --------------------------------------------------------------------------
+
+
+def set_keys(text, section, drop=(), **keys):
+    """INI text with keys of [section] set (replaced, or added after the
+    header) and the keys in drop removed."""
+    lines = text.splitlines()
+    head = next(
+        i for i, ln in enumerate(lines) if ln.strip().lower() == f"[{section}]".lower()
+    )
+    end = next(
+        (i for i in range(head + 1, len(lines)) if lines[i].lstrip().startswith("[")),
+        len(lines),
+    )
+    body = []
+    for ln in lines[head + 1 : end]:
+        key = ln.split("=", 1)[0].strip().lower() if "=" in ln else None
+        if key in (k.lower() for k in drop) or key in (k.lower() for k in keys):
+            continue
+        body.append(ln)
+    new = [f"{k} = {v!r}" if isinstance(v, float) else f"{k} = {v}" for k, v in keys.items()]
+    return "\n".join(lines[: head + 1] + new + body + lines[end:]) + "\n"
+
+
+def model_ini(text=BASE_INI):
+    """The user's model: the INI with the test's UFF node table."""
+    nodes = ", ".join(f"{n} {st}" for st, n in UFF_NODES.items())
+    return text.rstrip("\n") + f"\n\n[uff]\nmap = {nodes}\n"
+
+
+HUB_GEOMETRY = ("hub_density", "hub_inner_radius", "hub_outer_radius", "hub_thickness")
+
+
+def _hub(model):
+    _, _, _, d = model.couplings[0]
+    return rm.annulus(
+        float(d["hub_density"][-1]),
+        2 * float(d["hub_outer_radius"][-1]),
+        2 * float(d["hub_inner_radius"][-1]),
+        0.5 * float(d["hub_thickness"][-1]),
+    )
+
+
+def _disk(model, name):
+    return next(d for d in model.disks if d[0] == name)
+
+
+def hub_mass_ini(text, mass):
+    """Coupling C's hubs as explicit mass (kg, per station), Id, Ip of the geometry."""
+    _, idd, ip = _hub(rm.Model(text))
+    return set_keys(text, "coupling C", drop=HUB_GEOMETRY, hub_mass=mass, hub_Id=idd, hub_Ip=ip)
+
+
+def disk_mass_ini(text, name, mass):
+    """Disk NAME with mass (kg), its geometry's Id and Ip kept."""
+    _, _, _, idd, ip = _disk(rm.Model(text), name)
+    geo = ("density", "outer_diameter", "inner_diameter", "width")
+    return set_keys(text, f"disk {name}", drop=geo, mass=mass, Id=idd, Ip=ip)
+
+
+# --------------------------------------------------------------------------
+# eq. 19 noise, drawn as src/io/noise.c draws it
+# --------------------------------------------------------------------------
+
+_M64 = (1 << 64) - 1
+
+
+class Xoshiro256ss:
+    """xoshiro256** (Blackman & Vigna), seeded through splitmix64."""
+
+    def __init__(self, seed):
+        x = seed & _M64
+        self.s = []
+        for _ in range(4):
+            x = (x + 0x9E3779B97F4A7C15) & _M64
+            z = x
+            z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & _M64
+            z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & _M64
+            self.s.append(z ^ (z >> 31))
+
+    @staticmethod
+    def _rotl(x, k):
+        return ((x << k) | (x >> (64 - k))) & _M64
+
+    def next(self):
+        s = self.s
+        result = (self._rotl((s[1] * 5) & _M64, 7) * 9) & _M64
+        t = (s[1] << 17) & _M64
+        s[2] ^= s[0]
+        s[3] ^= s[1]
+        s[1] ^= s[2]
+        s[0] ^= s[3]
+        s[2] ^= t
+        s[3] = self._rotl(s[3], 45)
+        return result
+
+    def uniform01(self):
+        """[0, 1): the top 53 bits."""
+        return (self.next() >> 11) * 2.0**-53
+
+    def uniform_pm1(self):
+        """[-1, 1]: 2^53 + 1 equally spaced values including both ends."""
+        k = (self.next() >> 10) % ((1 << 53) + 1)
+        return k * 2.0**-52 - 1.0
+
+
+def add_noise(data, beta_a, beta_s, seed):
+    """Eq. 19 on channels data[c, i] (complex):
+    f_e = f_s (1 + beta_a/100 r1) + (||f_s||_2 / n)(beta_s/100) r2 e^{i phi}."""
+    data = np.asarray(data, dtype=complex)
+    out = np.empty_like(data)
+    r = Xoshiro256ss(seed)
+    n = data.shape[1]
+    for c in range(data.shape[0]):
+        level = math.sqrt(float(np.sum(np.abs(data[c]) ** 2))) / n * (beta_s / 100.0)
+        for i in range(n):
+            r1, r2 = r.uniform_pm1(), r.uniform_pm1()
+            phi = 2.0 * math.pi * r.uniform01()
+            out[c, i] = data[c, i] * (1.0 + beta_a / 100.0 * r1) + level * r2 * complex(
+                math.cos(phi), math.sin(phi)
+            )
+    return out
+
+
+# --------------------------------------------------------------------------
+# Truth FRFs from ROSS
+# --------------------------------------------------------------------------
+
+
+def _speed():
+    return RPM * math.pi / 30.0
+
+
+def ross_inertance(text, model_edit=None, check=True):
+    """Inertances (len(OUTS) x len(FREQ_HZ), m/s^2/N) of the ROSS rotor built
+    from INI text; model_edit(model) changes the parsed Python model first."""
+    model = rm.Model(text)
+    if model_edit:
+        model_edit(model)
+    speed = _speed()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rmod = rm.RossModel(model, speed=speed)
+        rot = rmod.rotor
+        M, C, K, G = rot.M(frequency=speed), rot.C(frequency=speed), rot.K(frequency=speed), rot.G()
+    jin = rmod.station_dof(IN)
+    rows = [rmod.station_dof(o) for o in OUTS]
+    e = np.zeros(M.shape[0])
+    e[jin] = 1.0
+    H = np.empty((len(OUTS), len(FREQ_HZ)), dtype=complex)
+    for i, f in enumerate(FREQ_HZ):
+        w = 2.0 * math.pi * f
+        col = np.linalg.solve(K - w * w * M + 1j * w * (C + speed * G), e)
+        H[:, i] = -w * w * col[rows]
+    if check:  # the same as ROSS's own transfer matrix
+        w = 2.0 * math.pi * FREQ_HZ[len(FREQ_HZ) // 2]
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            T = rot.transfer_matrix(speed=speed, frequency=w)
+        ref = -w * w * T[rows, jin]
+        got = H[:, len(FREQ_HZ) // 2]
+        assert np.max(np.abs(got - ref)) <= 1e-9 * np.max(np.abs(ref)), (got, ref)
+    return H
+
+
+def _bearing(model, name):
+    return next(d for n, _, d in model.bearings if n == name)
+
+
+def bearing_keys(name, **keys):
+    """model_edit: bearing NAME's coefficients (N/m, N s/m) set."""
+
+    def edit(model):
+        d = _bearing(model, name)
+        for k, v in keys.items():
+            d[k] = [repr(float(v))]
+
+    return edit
+
+
+def coupling_keys(drop=(), **keys):
+    """model_edit: coupling C's keys set (the ROSS builder reads them)."""
+
+    def edit(model):
+        d = model.couplings[0][3]
+        for k in drop:
+            d.pop(k, None)
+        for k, v in keys.items():
+            d[k] = [repr(float(v))]
+
+    return edit
+
+
+def hub_mass_edit(mass):
+    """model_edit: hub mass (kg per station) of coupling C, Id and Ip of its geometry."""
+
+    def edit(model):
+        _, idd, ip = _hub(model)
+        coupling_keys(drop=HUB_GEOMETRY, hub_mass=mass, hub_id=idd, hub_ip=ip)(model)
+
+    return edit
+
+
+def point_mass_edit(station_spec, mass):
+    """model_edit: a point mass (kg; no inertia) at 'SHAFT z', a ROSS DiskElement."""
+
+    def edit(model):
+        model.disks.append((f"added_{len(model.disks)}", model.place(station_spec), mass, 0.0, 0.0))
+
+    return edit
+
+
+def both(*edits):
+    def edit(model):
+        for e in edits:
+            e(model)
+
+    return edit
+
+
+# --------------------------------------------------------------------------
+# The cases
+# --------------------------------------------------------------------------
+
+
+class Case:
+    """A hidden-effect case. expect: [(effect name, place substring)] in the
+    order two rounds of diagnose-apply may find them (any order accepted)."""
+
+    def __init__(self, name, what, expect, source, model_edit=None, truth_ini=None,
+                 needs=None):
+        self.name = name
+        self.what = what  # the hidden effect, in words
+        self.expect = expect
+        self.source = source  # "ross" | "rcbtool"
+        self.model_edit = model_edit
+        self.truth_ini = truth_ini  # for source "rcbtool": INI text -> truth INI text
+        self.needs = needs  # INI keys the model loader must accept ("pedestal")
+
+    def __repr__(self):
+        return self.name
+
+
+CROSS = "bearing cross-coupled stiffness"
+STIFF = "bearing stiffness (anisotropy)"
+DAMP = "bearing damping"
+HUB = "coupling hub mass and inertia"
+CR = "coupling rotational damping"
+MASS = "added mass and inertia"
+SHAFT = "shaft material damping"
+PEDESTAL = "flexible support"
+
+# B4 on a pedestal (kg, N/m, N s/m): the INI keys of the loader's contract; the
+# ROSS bridge builds a BearingElement with n_link to a PointMass held to ground
+# by a second BearingElement.
+PEDESTAL_B4 = dict(pedestal_mass=2.0, pedestal_kxx=5e6, pedestal_kyy=5e6, pedestal_cxx=500.0,
+                   pedestal_cyy=500.0)
+
+ROSS_CASES = [
+    Case("ross_cross_B3", "kxy = -kyx = 1.5e7 N/m at B3", [(CROSS, "bearing B3")], "ross",
+         model_edit=bearing_keys("B3", kxy=1.5e7, kyx=-1.5e7)),
+    Case("ross_hub_C", "coupling C hub mass 0.07 kg per station", [(HUB, "coupling C")],
+         "ross", model_edit=hub_mass_edit(0.07)),
+    Case("ross_cr_C", "coupling C rotational damping 0.02 N m s/rad", [(CR, "coupling C")],
+         "ross", model_edit=coupling_keys(cr=0.02)),
+    Case("ross_mass_P1", "0.5 kg point mass at A 0.30 (P1)", [(MASS, "shaft A, z = 0.3 m")],
+         "ross", model_edit=point_mass_edit("A 0.30", 0.5)),
+    Case("ross_aniso_B4", "B4 kyy 9e7 -> 1e7 N/m", [(STIFF, "bearing B4")], "ross",
+         model_edit=bearing_keys("B4", kyy=1e7)),
+    Case("ross_damp_B3", "B3 cxx = cyy = 1.5e4 N s/m", [(DAMP, "bearing B3")], "ross",
+         model_edit=bearing_keys("B3", cxx=1.5e4, cyy=1.5e4)),
+    Case("ross_pedestal_B4", "B4 on a 2 kg pedestal, 5e6 N/m, 500 N s/m",
+         [(PEDESTAL, "B4")], "ross", model_edit=bearing_keys("B4", **PEDESTAL_B4),
+         needs="pedestal"),
+]
+
+TWO_EFFECT = Case(
+    "ross_two_B2cross_DBmass", "kxy = -kyx = 2e7 N/m at B2 and 0.35 kg at DB",
+    [(CROSS, "bearing B2"), (MASS, "disk DB")], "ross",
+    model_edit=both(bearing_keys("B2", kxy=2e7, kyx=-2e7), point_mass_edit("B 0.82", 0.35)),
+)
+
+# The seven cases of tests/test_diagnose.c, as truth INIs for rcbtool simulate.
+SIM_CASES = [
+    Case("sim_cross_B2", "kcross 2e7 N/m at B2", [(CROSS, "bearing B2")], "rcbtool",
+         truth_ini=lambda t: set_keys(t, "bearing B2", kxy=2e7, kyx=-2e7)),
+    Case("sim_damp_B2", "B2 cxx 2e4 N s/m", [(DAMP, "bearing B2")], "rcbtool",
+         truth_ini=lambda t: set_keys(t, "bearing B2", cxx=2e4)),
+    Case("sim_aniso_B1", "B1 kyy 1.2e7 N/m", [(STIFF, "bearing B1")], "rcbtool",
+         truth_ini=lambda t: set_keys(t, "bearing B1", kyy=1.2e7)),
+    Case("sim_hub_C", "coupling C hub mass 0.07 kg", [(HUB, "coupling C")], "rcbtool",
+         truth_ini=lambda t: hub_mass_ini(t, 0.07)),
+    Case("sim_shaft_B", "shaft B damping_stiffness 1e-4 s", [(SHAFT, "shaft B")], "rcbtool",
+         truth_ini=lambda t: set_keys(t, "shaft B", damping_stiffness=1e-4)),
+    Case("sim_mass_DB", "disk DB mass 1.3 kg", [(MASS, "disk DB")], "rcbtool",
+         truth_ini=lambda t: disk_mass_ini(t, "DB", 1.3)),
+    Case("sim_cr_C", "coupling C cr 0.02 N m s/rad", [(CR, "coupling C")], "rcbtool",
+         truth_ini=lambda t: set_keys(t, "coupling C", cr=0.02)),
+]
+
+NULL_CASE = Case("null", "nothing hidden", [], "rcbtool", truth_ini=lambda t: t)
+
+
+# --------------------------------------------------------------------------
+# Running rcbtool
+# --------------------------------------------------------------------------
+
+
+class Rcbtool:
+    def __init__(self, exe):
+        self.exe = str(exe)
+
+    def run(self, *args, check=True):
+        res = subprocess.run([self.exe, *map(str, args)], capture_output=True, text=True,
+                             timeout=600)
+        if check and res.returncode != 0:
+            raise RuntimeError(f"rcbtool {' '.join(map(str, args))}: exit {res.returncode}\n"
+                               f"{res.stderr.strip()}")
+        return res
+
+    def json(self, *args):
+        return json.loads(self.run(*args, "--json").stdout)
+
+    def accepts(self, ini_text, tmp):
+        """Whether `rcbtool check` loads this INI."""
+        p = Path(tmp) / "accepts.ini"
+        p.write_text(ini_text)
+        return self.run("check", p, check=False).returncode == 0
+
+
+def pedestal_probe_ini():
+    """The model with the pedestal keys of the loader's contract under B4."""
+    return set_keys(BASE_INI, "bearing B4", **PEDESTAL_B4)
+
+
+def truth_clean(case, tool=None, workdir=None):
+    """Noise-free truth inertances (len(OUTS) x len(FREQ_HZ))."""
+    if case.source == "ross":
+        return ross_inertance(BASE_INI, case.model_edit)
+    ini = Path(workdir) / f"{case.name}_truth.ini"
+    ini.write_text(case.truth_ini(BASE_INI))
+    res = tool.json("frf", ini, "--out", ",".join(OUTS), "--in", IN, "--fmin", FREQ_HZ[0],
+                    "--fmax", FREQ_HZ[-1], "--points", len(FREQ_HZ), "--rpm", RPM,
+                    "--kind", "inertance")
+    return np.array([np.array(c["re"]) + 1j * np.array(c["im"]) for c in res["channels"]])
+
+
+def write_uff(path, data):
+    """Inertance channels OUTS / IN as UFF 58 (ASCII, pyuff), rpm on the z axis."""
+    import pyuff
+
+    path = Path(path)
+    if path.exists():
+        path.unlink()
+    u = pyuff.UFF(str(path))
+    rn, _, rd = IN.rpartition(".")
+    for c, out in enumerate(OUTS):
+        st, _, d = out.rpartition(".")
+        u._write_set(
+            pyuff.prepare_58(
+                binary=0, func_type=4, rsp_node=UFF_NODES[st], rsp_dir=UFF_DIRS[d],
+                ref_node=UFF_NODES[rn], ref_dir=UFF_DIRS[rd], data=data[c], x=FREQ_HZ,
+                id1=f"{out}/{IN}", abscissa_spacing=1, abscissa_spec_data_type=18,
+                ordinate_spec_data_type=12, orddenom_spec_data_type=13,
+                z_axis_spec_data_type=19, z_axis_value=RPM,
+            ),
+            "add",
+        )
+
+
+_FITTED = re.compile(r"([A-Za-z_][\w.]*)\s*=\s*([-+0-9.eE]+)")
+
+
+def _bounded(fitted):
+    """'name = v, ...' -> 'name:lo:hi,...' bounds a factor of 100 around v."""
+    out = []
+    for name, v in _FITTED.findall(fitted):
+        v = float(v)
+        lo, hi = sorted((v / 100.0, v * 100.0))
+        out.append(f"{name}:{lo:.17g}:{hi:.17g}")
+    return ",".join(out)
+
+
+def diagnose_rounds(tool, workdir, meas, rounds, params=FIT_PARAMS):
+    """Rounds of `diagnose --apply 1` then `fit` of the applied model, each
+    round on the previous round's model. Returns a list of dicts: the first
+    candidate (effect, place, significant, fitted), E0, the fitted error and
+    the floor."""
+    workdir = Path(workdir)
+    model = workdir / "model.ini"
+    model.write_text(model_ini())
+    noise = f"{NOISE[0]:g},{NOISE[1]:g}"
+    out = []
+    for r in range(rounds):
+        nxt = workdir / f"model{r + 2}.ini"
+        log = ["--log"] if not re.search(r":-", params) else []  # --log needs bounds > 0
+        d = tool.json("diagnose", model, meas, "--params", params, *log, "--noise", noise,
+                      "--top", 3, "--apply", 1, "-o", nxt)
+        best = d["candidates"][0]
+        params = params + "," + _bounded(best["fitted"])
+        f = tool.json("fit", nxt, meas, "--params", params, "--noise", noise)
+        out.append({"effect": best["effect"], "place": best["place"],
+                    "description": best["description"],
+                    "significant": best["significant"], "fitted": best["fitted"],
+                    "error0_pct": d["error0_pct"], "error_pct": f["error_pct"],
+                    "floor_pct": f["floor_pct"], "explanation": d["explanation"]})
+        model = nxt
+    return out
+
+
+def found(step, want):
+    """The first candidate is significant, of the wanted effect, at the place.
+    (The flexible support is matched in the effect's name or description: its
+    catalogue entry is being added.)"""
+    effect, place = want
+    if effect == PEDESTAL:
+        ok = effect in (step["effect"] + " " + step["description"]).lower()
+    else:
+        ok = step["effect"] == effect
+    return step["significant"] and ok and place in step["place"]
+
+
+def at_floor(step):
+    return step["error_pct"] < AT_FLOOR * step["floor_pct"]
