@@ -26,6 +26,7 @@
 #include <string.h>
 
 #include "analyses/frf_internal.h"
+#include "analyses/state_space.h"
 
 typedef struct rcb_frf_modal rcb_frf_modal;
 
@@ -136,29 +137,17 @@ size_t rcb_frf_modal_memory(const rcb_frf *f) {
 /* A = [0, I; -M^-1 K, -M^-1 D] and Y = [0; M^-1 e_k] at rotor speed (rad/s). */
 static rcb_status state_form(rcb_frf *f, double speed) {
   rcb_frf_modal *md = f->modal;
-  const size_t n = md->n, N = md->N, nn = n * n;
-  double *K = md->KD, *D = md->KD + nn;
-  lapack_int ni = (lapack_int)n, info;
-  size_t i, j;
-  rcb_status st = rcb_model_matrices(f->m, speed, md->M, D, md->G, K);
-  if (st) return rcb_set_error(f->errmsg, st, "modal: matrices at %g rad/s", speed);
-  for (i = 0; i < nn; i++) D[i] += speed * md->G[i];
-  info = LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'L', ni, md->M, ni);
-  if (info)
-    return rcb_set_error(f->errmsg, info > 0 ? RCB_ERR_MODEL : RCB_ERR_LAPACK,
-                         "modal: mass matrix not positive definite (dpotrf info %d); every "
-                         "DOF needs mass or inertia", (int)info);
+  const size_t n = md->n, N = md->N;
+  lapack_int info = 0;
+  size_t j;
+  rcb_status st = rcb_state_matrix(f->m, speed, md->M, md->KD, md->G, md->A, f->errmsg, "modal");
+  if (st) return st;
   memset(md->Y, 0, N * f->nin * sizeof *md->Y);
   for (j = 0; j < f->nin; j++) md->Y[n + f->in_row[j] + N * j] = 1.0;
-  info = LAPACKE_dpotrs_work(LAPACK_COL_MAJOR, 'L', ni, 2 * ni, md->M, ni, md->KD, ni);
-  if (!info && f->nin)
-    info = LAPACKE_dpotrs_work(LAPACK_COL_MAJOR, 'L', ni, (lapack_int)f->nin, md->M, ni,
-                               md->Y + n, (lapack_int)N);
+  if (f->nin)
+    info = LAPACKE_dpotrs_work(LAPACK_COL_MAJOR, 'L', (lapack_int)n, (lapack_int)f->nin, md->M,
+                               (lapack_int)n, md->Y + n, (lapack_int)N);
   if (info) return rcb_set_error(f->errmsg, RCB_ERR_LAPACK, "modal: dpotrs info %d", (int)info);
-  memset(md->A, 0, N * N * sizeof *md->A);
-  for (j = 0; j < n; j++) md->A[j + N * (n + j)] = 1.0;
-  for (j = 0; j < 2 * n; j++)
-    for (i = 0; i < n; i++) md->A[n + i + N * j] = -md->KD[i + n * j];
   return RCB_OK;
 }
 

@@ -20,7 +20,7 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "core/rcb_internal.h"
+#include "analyses/state_space.h"
 
 /* A root is kept as an oscillating mode when Im(lambda) > RCB_MODES_IM_TOL *
  * max |lambda|. The rigid-body roots of a free rotor are exact double zeros
@@ -189,33 +189,7 @@ rcb_status rcb_modes_set_max_zeta(rcb_modes *e, double max_zeta) {
 
 /* A = [0, I; -M^-1 K, -M^-1 (C + Omega G)] at rotor speed Omega (rad/s). */
 static rcb_status build_state_matrix(rcb_modes *e, double speed) {
-  const size_t n = e->n, N = e->N;
-  double *K = e->KC, *C = e->KC + n * n;
-  size_t i, j;
-  lapack_int info, ni = (lapack_int)n;
-  rcb_status st = rcb_model_matrices(e->model, speed, e->M, C, e->G, K);
-  if (st != RCB_OK)
-    return rcb_set_error(e->errmsg, st, "modes: assembling the matrices at %g rad/s: %s",
-                         speed, rcb_status_str(st));
-  for (i = 0; i < n * n; i++) C[i] += speed * e->G[i];
-  info = LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'L', ni, e->M, ni);
-  if (info > 0)
-    return rcb_set_error(e->errmsg, RCB_ERR_MODEL,
-                         "modes: the mass matrix is not positive definite (leading minor %d "
-                         "of %zu); every DOF needs mass or inertia (shaft elements give both)",
-                         (int)info, n);
-  if (info < 0)
-    return rcb_set_error(e->errmsg, RCB_ERR_LAPACK, "modes: dpotrf argument %d invalid",
-                         (int)-info);
-  info = LAPACKE_dpotrs_work(LAPACK_COL_MAJOR, 'L', ni, 2 * ni, e->M, ni, e->KC, ni);
-  if (info != 0)
-    return rcb_set_error(e->errmsg, RCB_ERR_LAPACK, "modes: dpotrs failed (info %d)",
-                         (int)info);
-  memset(e->A, 0, N * N * sizeof *e->A);
-  for (i = 0; i < n; i++) e->A[i + N * (n + i)] = 1.0;
-  for (j = 0; j < 2 * n; j++)
-    for (i = 0; i < n; i++) e->A[n + i + N * j] = -e->KC[i + n * j];
-  return RCB_OK;
+  return rcb_state_matrix(e->model, speed, e->M, e->KC, e->G, e->A, e->errmsg, "modes");
 }
 
 static rcb_status solve_eigen(rcb_modes *e, double speed) {
