@@ -28,14 +28,6 @@
 #define TWO_PI 6.283185307179586
 #define RPM (TWO_PI / 60.0) /* rad/s per rpm */
 
-static rcb_frf *frf_at(const rcb_model *m, const char *ch, rcb_solver_kind s) {
-  rcb_frf *f = NULL;
-  rcb_dof d;
-  assert_int_equal(rcb_model_find_dof(m, ch, &d), RCB_OK);
-  assert_int_equal(rcb_frf_create(&f, m, 1, &d, 1, &d, s, NULL), RCB_OK);
-  return f;
-}
-
 /* The paper's system, 0-500 Hz at 10000 rpm: a normal sweep, no warning. */
 static void test_normal_sweep(void **state) {
   rcb_model *m = rcb_test_model_from_example("paper_system.ini");
@@ -90,8 +82,15 @@ static void test_free_rotor_near_zero(void **state) {
   int s;
   (void)state;
   w[0] = TWO_PI * 50.0, w[1] = w_bad, w[2] = TWO_PI * 100.0;
-  for (s = RCB_SOLVER_DENSE; s <= RCB_SOLVER_BANDED; s++) {
-    rcb_frf *f = frf_at(m, "DA.x", (rcb_solver_kind)s);
+  for (s = RCB_SOLVER_DENSE; s <= RCB_SOLVER_SPARSE; s++) {
+    rcb_frf *f = NULL;
+    rcb_dof dof;
+    assert_int_equal(rcb_model_find_dof(m, "DA.x", &dof), RCB_OK);
+    if (rcb_frf_create(&f, m, 1, &dof, 1, &dof, (rcb_solver_kind)s, NULL) ==
+        RCB_ERR_UNSUPPORTED) {
+      rcb_frf_destroy(f); /* built without KLU */
+      continue;
+    }
     rcb_frf_condition c;
     rcb_complex H[1];
     size_t p;
