@@ -18,8 +18,10 @@ const char cli_help_diagnose[] =
     "scores every effect of the catalogue at every place it can occur: coupling\n"
     "damping and rotational stiffness, another coupling model, coupling hub mass\n"
     "and inertia, bearing stiffness in each direction (anisotropy), bearing\n"
-    "cross-coupled stiffness kxy = -kyx, bearing damping, shaft material damping,\n"
-    "an added mass or inertia at each node. The score is the error reduction the\n"
+    "cross-coupled stiffness kxy = -kyx, bearing damping, a flexible support (a\n"
+    "pedestal mass on a spring and damper) under each bearing, shaft material\n"
+    "damping, an added mass or inertia at each node, and (FRF data) an operating\n"
+    "speed other than the stated one. The score is the error reduction the\n"
     "effect can explain (score test on the weighted objective, orthogonal to the\n"
     "fitted parameters); the best N (--refits, default 8) and the other coupling\n"
     "models are refitted, and ranked by the change of BIC. A candidate is\n"
@@ -30,6 +32,8 @@ const char cli_help_diagnose[] =
     "  --apply K      with -o FILE: write the model with candidate K (1 = best)\n"
     "                 added and fitted, atomically; the input model is untouched\n"
     "  --history FILE record this step (rcbtool history FILE shows the steps)\n"
+    "  --json         the ranking as JSON, with \"evaluations\" (model sweeps, a\n"
+    "                 Jacobian counting one), \"scored\" and \"refits\"\n"
     "Other options as for rcbtool fit. Exit codes: 0 ok, 2 usage, 3 bad input,\n"
     "4 numerical failure, 5 output error.\n";
 
