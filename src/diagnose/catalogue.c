@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "diagnose/diag_internal.h"
+#include "identify/fit_internal.h"
 
 static const char *const effect_names[RCB_EFFECT_COUNT] = {
     "coupling translational damping", "coupling rotational stiffness",
@@ -363,8 +364,10 @@ rcb_status rcb_diag_refit_start(rcb_diag *d, const diag_cand *c, rcb_model *m, r
   rcb_status st = RCB_OK;
   if (c->edit != EDIT_ADD_PEDESTAL) return RCB_OK;
   if ((w = grid_weights(d)) && (st = rcb_fit_set_weights(f, w)) == RCB_OK &&
-      rcb_fit_residual_count(f) == 0)
+      (st = rcb_fit_prepare(f)) != RCB_OK && st != RCB_ERR_NOMEM) {
     rcb_fit_set_weights(f, NULL); /* no point left there: all points */
+    st = RCB_OK;
+  }
   if (!w || st || !(r = rcb_alloc(&d->alloc, (rcb_fit_residual_count(f) + 1) * sizeof *r))) {
     rcb_free(&d->alloc, w);
     return rcb_diag_fail(d, st ? st : RCB_ERR_NOMEM, "%s",

@@ -431,7 +431,9 @@ static rcb_status refit(rcb_diag *d, diag_cand *c) {
   if (!st) st = rcb_diag_refit_start(d, c, m, f);
   if (!st) st = rcb_fit_set_starts(f, refit_starts(c), 1);
   if (!st) st = refit_tolerance(d, c, f);
-  if (st) { /* a candidate that cannot be built is reported, not fatal */
+  if (st == RCB_ERR_NOMEM) {
+    /* out of memory is the caller's to know, not a property of the candidate */
+  } else if (st) { /* a candidate that cannot be built is reported, not fatal */
     snprintf(c->fitted, sizeof c->fitted, "not fitted: %.300s", d->errmsg);
     st = RCB_OK;
   } else if (rcb_fit_param_count(f) == 0) { /* nothing to fit: evaluate (kramer_1, rigid) */
@@ -447,9 +449,14 @@ static rcb_status refit(rcb_diag *d, diag_cand *c) {
       st = model_text(d, m, &c->ini);
     }
   } else if ((st = rcb_fit_run(f)) != RCB_OK) {
-    /* a candidate that cannot be fitted is reported, not fatal */
-    snprintf(c->fitted, sizeof c->fitted, "refit failed: %.300s", rcb_fit_errmsg(f));
-    st = RCB_OK;
+    /* a candidate that cannot be fitted is reported, not fatal (unless the
+     * memory ran out) */
+    if (st == RCB_ERR_NOMEM)
+      rcb_diag_fail(d, st, "refitting %s: %s", c->desc, rcb_fit_errmsg(f));
+    else {
+      snprintf(c->fitted, sizeof c->fitted, "refit failed: %.300s", rcb_fit_errmsg(f));
+      st = RCB_OK;
+    }
   } else if (!st) {
     rcb_fit_get_report(f, &rep);
     c->refitted = 1;
@@ -505,20 +512,31 @@ static rcb_status refit_best(rcb_diag *d) {
   return st;
 }
 
-rcb_status rcb_diag_run(rcb_diag *d) {
+static rcb_status run_steps(rcb_diag *d) {
   rcb_model *fitted = NULL;
   rcb_status st;
-  if (!d) return RCB_ERR_ARG;
-  free_results(d);
   if ((st = baseline(d))) return st;
   st = rcb_model_create(&fitted, &d->alloc);
   if (!st) st = rcb_model_load_string(fitted, d->base_ini, "<model>");
-  if (!st) st = rcb_diag_catalogue(d, fitted);
+  if (!st && (st = rcb_diag_catalogue(d, fitted)))
+    rcb_diag_fail(d, st, "laying out the catalogue of effects: %s", rcb_status_str(st));
   rcb_model_destroy(fitted);
   if (!st && !(d->order = rcb_alloc(&d->alloc, (d->ncand ? d->ncand : 1) * sizeof *d->order)))
     st = rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
   if (!st) st = score_all(d);
   if (!st) st = refit_best(d);
+  return st;
+}
+
+rcb_status rcb_diag_run(rcb_diag *d) {
+  rcb_status st;
+  if (!d) return RCB_ERR_ARG;
+  free_results(d);
+  d->errmsg[0] = '\0';
+  st = run_steps(d);
+  /* every failure carries a message, even one from a step that set none */
+  if (st && d->errmsg[0] == '\0')
+    rcb_diag_fail(d, st, "diagnosis failed: %s", rcb_status_str(st));
   d->ran = !st;
   return st;
 }

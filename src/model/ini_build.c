@@ -197,12 +197,15 @@ static rcb_status bearing_coef(ini_ctx *c, const ini_section *s, int k, const ch
 /* The bearing's pedestal keys (all absent or 0: no pedestal). */
 static rcb_status build_pedestal(ini_ctx *c, const ini_section *s) {
   rcb_pedestal p;
+  rcb_status st;
   TRY(rcb_ini_get_num(c, s, "pedestal_mass", "pedestal mass in kg", 0, 0.0, &p.mass));
   TRY(rcb_ini_get_num(c, s, "pedestal_kxx", "pedestal stiffness in N/m", 0, 0.0, &p.kxx));
   TRY(rcb_ini_get_num(c, s, "pedestal_kyy", "pedestal stiffness in N/m", 0, 0.0, &p.kyy));
   TRY(rcb_ini_get_num(c, s, "pedestal_cxx", "pedestal damping in N s/m", 0, 0.0, &p.cxx));
   TRY(rcb_ini_get_num(c, s, "pedestal_cyy", "pedestal damping in N s/m", 0, 0.0, &p.cyy));
-  if (rcb_model_set_pedestal(c->m, s->name, &p)) return builder_fail(c, s, s->line, RCB_ERR_ARG);
+  st = rcb_model_set_pedestal(c->m, s->name, &p);
+  /* out of memory stays what it is: the caller must not read it as bad input */
+  if (st) return builder_fail(c, s, s->line, st == RCB_ERR_NOMEM ? st : RCB_ERR_ARG);
   return RCB_OK;
 }
 
@@ -410,6 +413,7 @@ static void prefix_warnings(ini_ctx *c) {
 static rcb_status build_uff(ini_ctx *c, const ini_section *s) {
   const ini_entry *e = rcb_ini_get(s, "map");
   const char *p, *q;
+  rcb_status st;
   if (!e) return RCB_OK;
   for (p = e->val; p && *p;) {
     char item[2 * RCB_NAME_MAX + 40], station[2 * RCB_NAME_MAX + 2], extra[8];
@@ -429,9 +433,9 @@ static rcb_status build_uff(ini_ctx *c, const ini_section *s) {
                            "'%s': expected NODE STATION pairs separated by commas, e.g. "
                            "map = 10 DA, 20 C.B",
                            item);
-    if (rcb_model_add_uff_node(c->m, node, station))
-      return rcb_ini_error(c, RCB_ERR_PARSE, e->line, s, "map", "%s",
-                           rcb_model_errmsg(c->m));
+    if ((st = rcb_model_add_uff_node(c->m, node, station)))
+      return rcb_ini_error(c, st == RCB_ERR_NOMEM ? st : RCB_ERR_PARSE, e->line, s, "map",
+                           "%s", rcb_model_errmsg(c->m));
     p = q ? q + 1 : NULL;
   }
   return RCB_OK;
