@@ -404,9 +404,9 @@ static void test_uff(void **state) {
 }
 
 static void test_fit_nlopt(void **state) {
+  (void)state;
 #if RCB_WITH_NLOPT
   size_t n;
-  (void)state;
   g_truth = truth_meas();
   g_method = "LN_BOBYQA"; /* NLopt's own allocations do not go through the hooks */
   n = walk("fit (NLopt BOBYQA)", sc_fit);
