@@ -13,6 +13,11 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include <complex.h>
+#include <math.h>
+
+#include "rcb/rcb.h"
+
 /* Write data to a fresh memfd; path receives its /proc/self/fd name.
  * Returns the descriptor (close it after use) or aborts: a harness that
  * cannot set up must not report "no crash". */
@@ -27,6 +32,27 @@ static int rcb_fuzz_memfile(const uint8_t *data, size_t size, char *path, size_t
   }
   snprintf(path, psize, "/proc/self/fd/%d", fd);
   return fd;
+}
+
+/* A read that succeeded: a consistent container (points, an increasing
+ * non-negative grid, finite data) or abort. One that failed: a message and
+ * no channel, or abort. */
+static void rcb_fuzz_check_meas(const rcb_meas *ms, rcb_status st) {
+  size_t n = rcb_meas_point_count(ms), c, i;
+  const double *x = rcb_meas_grid(ms);
+  if (st != RCB_OK) {
+    if (rcb_meas_errmsg(ms)[0] == '\0' || rcb_meas_channel_count(ms) != 0) abort();
+    return;
+  }
+  if (n == 0 || rcb_meas_channel_count(ms) == 0) abort();
+  for (i = 0; i < n; i++)
+    if (!isfinite(x[i]) || x[i] < 0 || (i && !(x[i] > x[i - 1]))) abort();
+  for (c = 0; c < rcb_meas_channel_count(ms); c++) {
+    rcb_meas_channel_info ci;
+    if (rcb_meas_channel(ms, c, &ci)) abort();
+    for (i = 0; i < n; i++)
+      if (!isfinite(creal(ci.data[i])) || !isfinite(cimag(ci.data[i]))) abort();
+  }
 }
 
 #endif

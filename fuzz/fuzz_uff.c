@@ -6,11 +6,6 @@
  */
 #include "fuzz_common.h" /* first: it defines _GNU_SOURCE */
 
-#include <complex.h>
-#include <math.h>
-
-#include "rcb/rcb.h"
-
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 static const rcb_uff_node MAP[] = {{1, "DA"}, {2, "DB"}, {10, "C.A"}, {11, "C.B"}};
@@ -18,21 +13,7 @@ static const rcb_uff_node MAP[] = {{1, "DA"}, {2, "DB"}, {10, "C.A"}, {11, "C.B"
 static void read_once(const char *path, size_t nmap) {
   rcb_meas *ms = NULL;
   if (rcb_meas_create(&ms, NULL)) abort();
-  if (rcb_meas_read_uff(ms, path, nmap, nmap ? MAP : NULL) == RCB_OK) {
-    size_t n = rcb_meas_point_count(ms), c, i;
-    const double *x = rcb_meas_grid(ms);
-    if (n == 0 || rcb_meas_channel_count(ms) == 0) abort();
-    for (i = 0; i < n; i++)
-      if (!isfinite(x[i]) || x[i] < 0 || (i && !(x[i] > x[i - 1]))) abort();
-    for (c = 0; c < rcb_meas_channel_count(ms); c++) {
-      rcb_meas_channel_info ci;
-      if (rcb_meas_channel(ms, c, &ci)) abort();
-      for (i = 0; i < n; i++)
-        if (!isfinite(creal(ci.data[i])) || !isfinite(cimag(ci.data[i]))) abort();
-    }
-  } else if (rcb_meas_errmsg(ms)[0] == '\0' || rcb_meas_channel_count(ms) != 0) {
-    abort();
-  }
+  rcb_fuzz_check_meas(ms, rcb_meas_read_uff(ms, path, nmap, nmap ? MAP : NULL));
   rcb_meas_destroy(ms);
 }
 

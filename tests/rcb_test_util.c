@@ -1,3 +1,4 @@
+#define _POSIX_C_SOURCE 200809L /* mkdtemp */
 #include "rcb_test_util.h"
 
 #include <math.h>
@@ -107,4 +108,29 @@ rcb_meas *rcb_test_unbalance_meas(const rcb_model *m, const char *const *outs, s
   free(Q);
   free(col);
   return ms;
+}
+
+static char tmpdir_[256];
+
+int rcb_test_setup_tmpdir(void **state) {
+  (void)state;
+  snprintf(tmpdir_, sizeof tmpdir_, "/tmp/rcb_test_XXXXXX");
+  return mkdtemp(tmpdir_) ? 0 : -1;
+}
+
+int rcb_test_teardown_tmpdir(void **state) {
+  char cmd[300];
+  (void)state;
+  snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir_);
+  return system(cmd) == 0 ? 0 : -1;
+}
+
+const char *rcb_test_tmpdir(void) { return tmpdir_; }
+
+const char *rcb_test_tmp_path(const char *name) {
+  static char buf[4][512];
+  static int k;
+  k = (k + 1) % 4;
+  snprintf(buf[k], sizeof buf[k], "%s/%s", tmpdir_, name);
+  return buf[k];
 }

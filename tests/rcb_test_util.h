@@ -24,4 +24,11 @@ rcb_allocator rcb_test_counting_allocator(rcb_test_counter *c);
  * evenly from r0 to r1 rpm, as a measurement (aborts the test on failure). */
 rcb_meas *rcb_test_unbalance_meas(const rcb_model *m, const char *const *outs, size_t no,
                                   double r0, double r1, size_t n);
+/* A scratch folder for a test group: cmocka group setup/teardown create
+ * /tmp/rcb_test_XXXXXX and remove it with its contents. */
+int rcb_test_setup_tmpdir(void **state);
+int rcb_test_teardown_tmpdir(void **state);
+const char *rcb_test_tmpdir(void);
+/* FOLDER/name in the scratch folder (4 rotating buffers: use it at once). */
+const char *rcb_test_tmp_path(const char *name);
 #endif

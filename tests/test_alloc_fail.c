@@ -191,12 +191,8 @@ static rcb_status sc_frf(const rcb_allocator *a, int check) {
   return st;
 }
 
-static char tmpdir[256];
-
 static const char *csv_path(void) {
-  static char p[300];
-  snprintf(p, sizeof p, "%s/meas.csv", tmpdir);
-  return p;
+  return rcb_test_tmp_path("meas.csv");
 }
 
 static rcb_status sc_csv(const rcb_allocator *a, int check) {
@@ -222,9 +218,7 @@ static rcb_status sc_csv(const rcb_allocator *a, int check) {
 }
 
 static const char *uff_path(void) {
-  static char p[300];
-  snprintf(p, sizeof p, "%s/meas.uff", tmpdir);
-  return p;
+  return rcb_test_tmp_path("meas.uff");
 }
 
 static const rcb_uff_node uff_map[2] = {{1, "D"}, {2, "P"}};
@@ -376,14 +370,23 @@ static void test_csv(void **state) {
   assert_true(n > 1);
 }
 
-static void test_fit(void **state) {
+/* A walk of a scenario that reads the noise-free measurement g_truth, with
+ * the NLopt algorithm method (NULL: the paper's method). */
+static size_t walk_on_truth(const char *name, scenario run, const char *method) {
   size_t n;
-  (void)state;
   g_truth = truth_meas();
-  n = walk("fit (paper method)", sc_fit);
-  print_message("fit: %zu allocation sites walked\n", n);
+  g_method = method;
+  n = walk(name, run);
+  g_method = NULL;
+  print_message("%s: %zu allocation sites walked\n", name, n);
   rcb_meas_destroy(g_truth);
   g_truth = NULL;
+  return n;
+}
+
+static void test_fit(void **state) {
+  (void)state;
+  walk_on_truth("fit (paper method)", sc_fit, NULL);
 }
 
 static void test_uff(void **state) {
@@ -406,40 +409,16 @@ static void test_uff(void **state) {
 static void test_fit_nlopt(void **state) {
   (void)state;
 #if RCB_WITH_NLOPT
-  size_t n;
-  g_truth = truth_meas();
-  g_method = "LN_BOBYQA"; /* NLopt's own allocations do not go through the hooks */
-  n = walk("fit (NLopt BOBYQA)", sc_fit);
-  g_method = NULL;
-  print_message("fit, NLopt: %zu allocation sites walked\n", n);
-  rcb_meas_destroy(g_truth);
-  g_truth = NULL;
+  /* NLopt's own allocations do not go through the hooks */
+  walk_on_truth("fit (NLopt BOBYQA)", sc_fit, "LN_BOBYQA");
 #else
   skip();
 #endif
 }
 
 static void test_diagnose(void **state) {
-  size_t n;
   (void)state;
-  g_truth = truth_meas();
-  n = walk("diagnosis", sc_diag);
-  print_message("diagnosis: %zu allocation sites walked\n", n);
-  rcb_meas_destroy(g_truth);
-  g_truth = NULL;
-}
-
-static int setup_dir(void **state) {
-  (void)state;
-  snprintf(tmpdir, sizeof tmpdir, "/tmp/rcb_test_alloc_XXXXXX");
-  return mkdtemp(tmpdir) ? 0 : -1;
-}
-
-static int teardown_dir(void **state) {
-  char cmd[300];
-  (void)state;
-  snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
-  return system(cmd) == 0 ? 0 : -1;
+  walk_on_truth("diagnosis", sc_diag, NULL);
 }
 
 int main(void) {
@@ -452,5 +431,5 @@ int main(void) {
       cmocka_unit_test(test_diagnose),
       cmocka_unit_test(test_fit),
   };
-  return cmocka_run_group_tests(tests, setup_dir, teardown_dir);
+  return cmocka_run_group_tests(tests, rcb_test_setup_tmpdir, rcb_test_teardown_tmpdir);
 }

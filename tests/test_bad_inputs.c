@@ -396,29 +396,6 @@ static void test_bad_frequencies(void **state) {
 
 /* ------------------------------------------------- measurement files -- */
 
-static char tmpdir[256];
-
-static int setup_dir(void **state) {
-  (void)state;
-  snprintf(tmpdir, sizeof tmpdir, "/tmp/rcb_test_bad_XXXXXX");
-  return mkdtemp(tmpdir) ? 0 : -1;
-}
-
-static int teardown_dir(void **state) {
-  char cmd[300];
-  (void)state;
-  snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
-  return system(cmd) == 0 ? 0 : -1;
-}
-
-static const char *tpath(const char *name) {
-  static char buf[4][512];
-  static int k;
-  k = (k + 1) % 4;
-  snprintf(buf[k], sizeof buf[k], "%s/%s", tmpdir, name);
-  return buf[k];
-}
-
 static void write_bytes(const char *path, const char *text, size_t n) {
   FILE *fp = fopen(path, "wb");
   assert_non_null(fp);
@@ -497,7 +474,7 @@ static void patch(char *buf, size_t after, const char *from, const char *to) {
 }
 
 static void test_bad_uff_files(void **state) {
-  const char *good = tpath("good.uff");
+  const char *good = rcb_test_tmp_path("good.uff");
   size_t n;
   char *buf;
   (void)state;
@@ -506,46 +483,46 @@ static void test_bad_uff_files(void **state) {
   buf = read_all(good, &n);
   /* truncated: cut in the middle of the second record's values, and inside
    * the first record's header lines */
-  write_bytes(tpath("cut.uff"), buf, n - 200);
-  expect_read(tpath("cut.uff"), 1, RCB_ERR_PARSE, "cut.uff:", "truncated");
-  write_bytes(tpath("cut2.uff"), buf, 150);
-  expect_read(tpath("cut2.uff"), 1, RCB_ERR_PARSE, "cut2.uff:", "truncated");
+  write_bytes(rcb_test_tmp_path("cut.uff"), buf, n - 200);
+  expect_read(rcb_test_tmp_path("cut.uff"), 1, RCB_ERR_PARSE, "cut.uff:", "truncated");
+  write_bytes(rcb_test_tmp_path("cut2.uff"), buf, 150);
+  expect_read(rcb_test_tmp_path("cut2.uff"), 1, RCB_ERR_PARSE, "cut2.uff:", "truncated");
   /* mislabelled: the dataset number is not a number */
   {
     char *b2 = malloc(n + 1);
     memcpy(b2, buf, n + 1);
     patch(b2, 0, "    -1\n    58", "    -1\n    5x");
-    write_bytes(tpath("label.uff"), b2, n);
-    expect_read(tpath("label.uff"), 1, RCB_ERR_PARSE, "label.uff:2:", "is not a number");
+    write_bytes(rcb_test_tmp_path("label.uff"), b2, n);
+    expect_read(rcb_test_tmp_path("label.uff"), 1, RCB_ERR_PARSE, "label.uff:2:", "is not a number");
     /* ordinate labelled with an unknown data type (record 9) */
     memcpy(b2, buf, n + 1);
     patch(b2, 0, "\n         8    0    0    0 Displacement",
           "\n        99    0    0    0 Displacement");
-    write_bytes(tpath("units.uff"), b2, n);
-    expect_read(tpath("units.uff"), 1, RCB_ERR_PARSE, "units.uff:", "ordinate data type 99");
+    write_bytes(rcb_test_tmp_path("units.uff"), b2, n);
+    expect_read(rcb_test_tmp_path("units.uff"), 1, RCB_ERR_PARSE, "units.uff:", "ordinate data type 99");
     /* response direction 3 (z, not a lateral DOF) in record 6 */
     memcpy(b2, buf, n + 1);
     patch(b2, 0, " D         1   1          D", " D         1   3          D");
-    write_bytes(tpath("dir.uff"), b2, n);
-    expect_read(tpath("dir.uff"), 1, RCB_ERR_PARSE, "dir.uff:8:", "direction code 3");
+    write_bytes(rcb_test_tmp_path("dir.uff"), b2, n);
+    expect_read(rcb_test_tmp_path("dir.uff"), 1, RCB_ERR_PARSE, "dir.uff:8:", "direction code 3");
     free(b2);
   }
   /* mislabelled: a dataset 58 with the block delimiter missing */
-  write_bytes(tpath("nodelim.uff"), buf + 7, n - 7);
-  expect_read(tpath("nodelim.uff"), 1, RCB_ERR_PARSE, "nodelim.uff:1:", "expected '    -1'");
+  write_bytes(rcb_test_tmp_path("nodelim.uff"), buf + 7, n - 7);
+  expect_read(rcb_test_tmp_path("nodelim.uff"), 1, RCB_ERR_PARSE, "nodelim.uff:1:", "expected '    -1'");
   /* no dataset 58 at all */
-  write_bytes(tpath("other.uff"), "    -1\n   151\nheader\n    -1\n", 28);
-  expect_read(tpath("other.uff"), 1, RCB_ERR_PARSE, "no dataset 58 record", NULL);
+  write_bytes(rcb_test_tmp_path("other.uff"), "    -1\n   151\nheader\n    -1\n", 28);
+  expect_read(rcb_test_tmp_path("other.uff"), 1, RCB_ERR_PARSE, "no dataset 58 record", NULL);
   /* empty and missing files */
-  write_bytes(tpath("empty.uff"), "", 0);
-  expect_read(tpath("empty.uff"), 1, RCB_ERR_PARSE, "empty.uff", NULL);
-  expect_read(tpath("missing.uff"), 1, RCB_ERR_IO, "missing.uff", NULL);
+  write_bytes(rcb_test_tmp_path("empty.uff"), "", 0);
+  expect_read(rcb_test_tmp_path("empty.uff"), 1, RCB_ERR_PARSE, "empty.uff", NULL);
+  expect_read(rcb_test_tmp_path("missing.uff"), 1, RCB_ERR_IO, "missing.uff", NULL);
   free(buf);
   /* binary 58b cut inside its data */
-  write_sample_uff(tpath("good.bin.uff"), 1);
-  buf = read_all(tpath("good.bin.uff"), &n);
-  write_bytes(tpath("cut.bin.uff"), buf, n - 40);
-  expect_read(tpath("cut.bin.uff"), 1, RCB_ERR_PARSE, "cut.bin.uff:", "truncated");
+  write_sample_uff(rcb_test_tmp_path("good.bin.uff"), 1);
+  buf = read_all(rcb_test_tmp_path("good.bin.uff"), &n);
+  write_bytes(rcb_test_tmp_path("cut.bin.uff"), buf, n - 40);
+  expect_read(rcb_test_tmp_path("cut.bin.uff"), 1, RCB_ERR_PARSE, "cut.bin.uff:", "truncated");
   free(buf);
 }
 
@@ -564,10 +541,10 @@ static void test_bad_csv_files(void **state) {
   size_t k;
   (void)state;
   for (k = 0; k < sizeof cases / sizeof cases[0]; k++) {
-    write_bytes(tpath("bad.csv"), cases[k].text, strlen(cases[k].text));
-    expect_read(tpath("bad.csv"), 0, RCB_ERR_PARSE, cases[k].p1, cases[k].p2);
+    write_bytes(rcb_test_tmp_path("bad.csv"), cases[k].text, strlen(cases[k].text));
+    expect_read(rcb_test_tmp_path("bad.csv"), 0, RCB_ERR_PARSE, cases[k].p1, cases[k].p2);
   }
-  expect_read(tpath("none.csv"), 0, RCB_ERR_IO, "none.csv", NULL);
+  expect_read(rcb_test_tmp_path("none.csv"), 0, RCB_ERR_IO, "none.csv", NULL);
 }
 
 /* ---------------------------------------------------------------- fits -- */
@@ -651,5 +628,5 @@ int main(void) {
       cmocka_unit_test(test_bad_csv_files),       cmocka_unit_test(test_bad_fits),
       cmocka_unit_test(test_fit_unknown_channel),
   };
-  return cmocka_run_group_tests(tests, setup_dir, teardown_dir);
+  return cmocka_run_group_tests(tests, rcb_test_setup_tmpdir, rcb_test_teardown_tmpdir);
 }

@@ -32,29 +32,6 @@
 #define TWO_PI (2.0 * RCB_PI)
 #define NPT 37
 
-static char tmpdir[256];
-
-static int setup_dir(void **state) {
-  (void)state;
-  snprintf(tmpdir, sizeof tmpdir, "/tmp/rcb_test_io_XXXXXX");
-  return mkdtemp(tmpdir) ? 0 : -1;
-}
-
-static int teardown_dir(void **state) {
-  char cmd[300];
-  (void)state;
-  snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
-  return system(cmd) == 0 ? 0 : -1;
-}
-
-static const char *tpath(const char *name) {
-  static char buf[4][512];
-  static int k;
-  k = (k + 1) % 4;
-  snprintf(buf[k], sizeof buf[k], "%s/%s", tmpdir, name);
-  return buf[k];
-}
-
 static void write_text(const char *path, const char *text) {
   FILE *fp = fopen(path, "wb");
   assert_non_null(fp);
@@ -117,7 +94,7 @@ static void assert_same(const rcb_meas *a, const rcb_meas *b, double xtol, doubl
 
 static void roundtrip_uff(int binary, int uneven, double speed, double xtol, double vtol) {
   rcb_meas *a = sample_frf(speed, uneven), *b = NULL;
-  const char *p = tpath(binary ? "rt.bin.uff" : "rt.uff");
+  const char *p = rcb_test_tmp_path(binary ? "rt.bin.uff" : "rt.uff");
   assert_int_equal(rcb_meas_write_uff(a, p, binary, 4, MAP), RCB_OK);
   assert_int_equal(rcb_meas_create(&b, NULL), RCB_OK);
   if (rcb_meas_read_uff(b, p, 4, MAP) != RCB_OK) fail_msg("%s", rcb_meas_errmsg(b));
@@ -142,7 +119,7 @@ static void test_uff_binary_roundtrip(void **state) {
 
 static void test_csv_roundtrip(void **state) {
   rcb_meas *a = sample_frf(4500.0 * RCB_PI / 30.0, 1), *b = NULL;
-  const char *p = tpath("rt.csv");
+  const char *p = rcb_test_tmp_path("rt.csv");
   (void)state;
   /* CSV has one kind line: mixed kinds are refused, nothing is written */
   assert_int_equal(rcb_meas_write_csv(a, p), RCB_ERR_ARG);
@@ -173,7 +150,7 @@ static void test_unbalance_roundtrip(void **state) {
   assert_int_equal(rcb_meas_add_channel(a, "C.B.ry", NULL, RCB_RECEPTANCE, d), RCB_OK);
   assert_int_equal(rcb_meas_add_channel(a, "DA.y", NULL, RCB_MOBILITY, d), RCB_ERR_ARG);
   for (f = 0; f < 3; f++) {
-    const char *p = tpath(f == 2 ? "unb.csv" : "unb.uff");
+    const char *p = rcb_test_tmp_path(f == 2 ? "unb.csv" : "unb.uff");
     assert_int_equal(f == 2 ? rcb_meas_write_csv(a, p) : rcb_meas_write_uff(a, p, (int)f, 4, MAP),
                      RCB_OK);
     assert_int_equal(rcb_meas_create(&b, NULL), RCB_OK);
@@ -210,7 +187,7 @@ static const char V3[] =
     "   5.00000000000e+00   6.00000000000e+00\n";
 
 static void test_uff_read_hand_written(void **state) {
-  const char *p = tpath("hand.uff");
+  const char *p = rcb_test_tmp_path("hand.uff");
   FILE *fp = fopen(p, "w");
   rcb_meas *ms = NULL;
   rcb_meas_channel_info c;
@@ -258,7 +235,7 @@ static void test_uff_read_hand_written(void **state) {
 }
 
 static void test_csv_read_rcbtool_output(void **state) {
-  const char *p = tpath("frf.csv"), *q = tpath("unb_amp.csv");
+  const char *p = rcb_test_tmp_path("frf.csv"), *q = rcb_test_tmp_path("unb_amp.csv");
   rcb_meas *ms = NULL;
   rcb_meas_channel_info c;
   (void)state;
@@ -292,7 +269,7 @@ static void test_csv_read_rcbtool_output(void **state) {
 
 /* "# kind" and "# rpm" comment lines. */
 static void test_csv_comments(void **state) {
-  const char *p = tpath("kind.csv");
+  const char *p = rcb_test_tmp_path("kind.csv");
   rcb_meas *ms = NULL;
   rcb_meas_channel_info c;
   (void)state;
@@ -330,7 +307,7 @@ static void be_float(FILE *fp, float v) {
 }
 
 static void test_uff_binary_big_endian(void **state) {
-  const char *p = tpath("be.uff");
+  const char *p = rcb_test_tmp_path("be.uff");
   FILE *fp = fopen(p, "wb");
   rcb_meas *ms = NULL;
   rcb_meas_channel_info c;
@@ -515,7 +492,7 @@ static void test_noise_stream(void **state) {
 /* Read @p text as UFF; expect RCB_ERR_PARSE and each of the NULL-ended
  * fragments in the message. */
 static void bad_uff(const char *text, ...) {
-  const char *p = tpath("bad.uff"), *frag;
+  const char *p = rcb_test_tmp_path("bad.uff"), *frag;
   rcb_meas *ms = NULL;
   va_list ap;
   write_text(p, text);
@@ -597,7 +574,7 @@ static void test_bad_uff(void **state) {
 
 static void test_bad_uff_binary(void **state) {
   rcb_meas *a = sample_frf(0.0, 0), *b = NULL;
-  const char *p = tpath("trunc.uff");
+  const char *p = rcb_test_tmp_path("trunc.uff");
   FILE *fp;
   long size;
   char *buf;
@@ -626,7 +603,7 @@ static void test_bad_uff_binary(void **state) {
 }
 
 static void bad_csv(const char *text, const char *f1, const char *f2) {
-  const char *p = tpath("bad.csv");
+  const char *p = rcb_test_tmp_path("bad.csv");
   rcb_meas *ms = NULL;
   write_text(p, text);
   assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
@@ -693,19 +670,19 @@ static void test_bad_api(void **state) {
 
 static void test_write_atomic(void **state) {
   rcb_meas *a = sample_frf(0.0, 0);
-  const char *p = tpath("nomap.uff");
+  const char *p = rcb_test_tmp_path("nomap.uff");
   char cmd[600];
   (void)state;
   /* station DA without a node number: refused, nothing left behind */
   assert_int_equal(rcb_meas_write_uff(a, p, 0, 0, NULL), RCB_ERR_ARG);
   assert_non_null(strstr(rcb_meas_errmsg(a), "no UFF node number"));
   assert_int_equal(access(p, F_OK), -1);
-  assert_int_equal(rcb_meas_write_uff(a, tpath("no/such/dir.uff"), 0, 4, MAP), RCB_ERR_IO);
+  assert_int_equal(rcb_meas_write_uff(a, rcb_test_tmp_path("no/such/dir.uff"), 0, 4, MAP), RCB_ERR_IO);
   assert_non_null(strstr(rcb_meas_errmsg(a), "no/such/dir.uff"));
   /* an existing file is replaced whole */
   write_text(p, "old");
   assert_int_equal(rcb_meas_write_uff(a, p, 1, 4, MAP), RCB_OK);
-  snprintf(cmd, sizeof cmd, "test $(ls '%s' | grep -c tmp) -eq 0", tmpdir);
+  snprintf(cmd, sizeof cmd, "test $(ls '%s' | grep -c tmp) -eq 0", rcb_test_tmpdir());
   assert_int_equal(system(cmd), 0);
   rcb_meas_destroy(a);
 }
@@ -714,17 +691,17 @@ static void test_allocator(void **state) {
   rcb_test_counter cnt = {0, 0};
   rcb_allocator al = rcb_test_counting_allocator(&cnt);
   rcb_meas *ms = NULL;
-  const char *p = tpath("alloc.uff");
+  const char *p = rcb_test_tmp_path("alloc.uff");
   rcb_meas *src = sample_frf(0.0, 0);
   (void)state;
   assert_int_equal(rcb_meas_write_uff(src, p, 1, 4, MAP), RCB_OK);
   rcb_meas_destroy(src);
   assert_int_equal(rcb_meas_create(&ms, &al), RCB_OK);
   assert_int_equal(rcb_meas_read_uff(ms, p, 4, MAP), RCB_OK);
-  assert_int_equal(rcb_meas_write_csv(ms, tpath("alloc.csv")), RCB_ERR_ARG); /* mixed kinds */
+  assert_int_equal(rcb_meas_write_csv(ms, rcb_test_tmp_path("alloc.csv")), RCB_ERR_ARG); /* mixed kinds */
   assert_int_equal(rcb_meas_convert(ms, RCB_RECEPTANCE), RCB_OK);
-  assert_int_equal(rcb_meas_write_csv(ms, tpath("alloc.csv")), RCB_OK);
-  assert_int_equal(rcb_meas_read_csv(ms, tpath("alloc.csv")), RCB_OK);
+  assert_int_equal(rcb_meas_write_csv(ms, rcb_test_tmp_path("alloc.csv")), RCB_OK);
+  assert_int_equal(rcb_meas_read_csv(ms, rcb_test_tmp_path("alloc.csv")), RCB_OK);
   rcb_meas_destroy(ms);
   assert_true(cnt.allocs > 5);
   assert_int_equal(cnt.allocs, cnt.frees);
@@ -743,5 +720,5 @@ int main(void) {
       cmocka_unit_test(test_write_atomic),          cmocka_unit_test(test_allocator),
       cmocka_unit_test(test_uff_binary_big_endian),
   };
-  return cmocka_run_group_tests(tests, setup_dir, teardown_dir);
+  return cmocka_run_group_tests(tests, rcb_test_setup_tmpdir, rcb_test_teardown_tmpdir);
 }

@@ -208,6 +208,13 @@ int cli_meas_write(const char *cmd, const rcb_meas *ms, const char *path, int bi
  * (the measurement) out of argv; returns the number of positionals. */
 int cli_split_meas(int argc, char **argv, const cli_opt *opts, size_t nopts, char **args,
                    int *nargs, const char **meas);
+/** The start of every MODEL MEAS command: take the measurement out of argv,
+ * parse the rest into a, print @p help when asked. Returns 0 to go on, -1
+ * when the help was printed, or an exit code (a missing measurement is a
+ * usage error saying @p expected). *args (free it after the command: a
+ * points into it) is set in every case, NULL when out of memory. */
+int cli_parse_meas_cmd(int argc, char **argv, cli_opt *opts, size_t nopts, const char *help,
+                       const char *expected, cli_args *a, const char **meas, char ***args);
 /** Read a measurement by extension (UFF with --map or the model's [uff] map,
  * or CSV); exit code 0, 2, 3 or 4 with the message printed. */
 int cli_meas_read(const cli_args *a, const char *path, const rcb_model *m, rcb_meas **out);

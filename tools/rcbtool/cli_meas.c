@@ -35,6 +35,19 @@ int cli_split_meas(int argc, char **argv, const cli_opt *opts, size_t nopts, cha
   return npos;
 }
 
+int cli_parse_meas_cmd(int argc, char **argv, cli_opt *opts, size_t nopts, const char *help,
+                       const char *expected, cli_args *a, const char **meas, char ***args) {
+  int nargs = 0, rc;
+  *meas = NULL;
+  if (!(*args = malloc(((size_t)argc + 1) * sizeof **args)))
+    return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  cli_split_meas(argc, argv, opts, nopts, *args, &nargs, meas);
+  if ((rc = cli_parse(nargs, *args, opts, nopts, a))) return rc;
+  if (a->help) return (rc = cli_print_help(help)) ? rc : -1;
+  if (!*meas) return cli_usage(a->cmd, "missing the measurement file: expected %s", expected);
+  return 0;
+}
+
 int cli_meas_read(const cli_args *a, const char *path, const rcb_model *m,
                      rcb_meas **out) {
   cli_uff_map mp;

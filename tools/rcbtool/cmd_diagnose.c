@@ -269,19 +269,15 @@ int cmd_diagnose(int argc, char **argv) {
   size_t nopts = sizeof opts / sizeof opts[0];
   diag_job j;
   cli_args a;
-  char **args = malloc(((size_t)argc + 1) * sizeof *args);
-  int nargs = 0, rc;
-  if (!args) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  char **args = NULL;
+  int rc;
   memset(&j, 0, sizeof j);
-  cli_split_meas(argc, argv, opts, nopts, args, &nargs, &j.meas_path);
-  rc = cli_parse(nargs, args, opts, nopts, &a);
-  if (!rc && a.help) rc = cli_print_help(cli_help_diagnose);
-  else if (!rc && !j.meas_path)
-    rc = cli_usage(a.cmd, "missing the measurement; expected rcbtool diagnose MODEL.ini "
-                          "MEAS.uff|MEAS.csv");
-  else if (!rc && !(rc = parse_job(&a, &j)))
+  if (!(rc = cli_parse_meas_cmd(argc, argv, opts, nopts, cli_help_diagnose,
+                                "'rcbtool diagnose MODEL.ini MEAS.uff|MEAS.csv'",
+                                &a, &j.meas_path, &args)) &&
+      !(rc = parse_job(&a, &j)))
     rc = run(&a, &j);
   if (j.have_params) cli_params_free(&j.params);
   free(args);
-  return rc;
+  return rc < 0 ? CLI_EXIT_OK : rc;
 }

@@ -613,19 +613,15 @@ int cmd_fit(int argc, char **argv) {
   size_t nopts = sizeof opts / sizeof opts[0];
   fit_job j;
   cli_args a;
-  char **args = malloc(((size_t)argc + 1) * sizeof *args);
-  int nargs = 0, rc;
-  if (!args) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  char **args = NULL;
+  int rc;
   memset(&j, 0, sizeof j);
-  cli_split_meas(argc, argv, opts, nopts, args, &nargs, &j.meas_path);
-  rc = cli_parse(nargs, args, opts, nopts, &a);
-  if (!rc && a.help) rc = cli_print_help(cli_help_fit);
-  else if (!rc && !j.meas_path)
-    rc = cli_usage(a.cmd, "missing the measurement file: expected 'rcbtool fit MODEL.ini "
-                          "MEAS.uff|MEAS.csv --params ...'");
-  else if (!rc && !(rc = parse_job(&a, &j)))
+  if (!(rc = cli_parse_meas_cmd(argc, argv, opts, nopts, cli_help_fit,
+                                "'rcbtool fit MODEL.ini MEAS.uff|MEAS.csv --params ...'",
+                                &a, &j.meas_path, &args)) &&
+      !(rc = parse_job(&a, &j)))
     rc = run(&a, &j);
   cli_params_free(&j.params);
   free(args);
-  return rc;
+  return rc < 0 ? CLI_EXIT_OK : rc;
 }
