@@ -6,13 +6,24 @@
  *    calls only change values, so they refactor with the same pivot order
  *    (klu_z_refactor, no allocation, no graph search). A frequency sweep can
  *    make a kept pivot poor (K - w^2 M changes sign along the diagonal), so
- *    each refactorisation's pivot ratio min|U_ii| / max|U_ii| (klu_z_rcond,
- *    O(n)) is compared with the last full factorisation's, and a full
+ *    each refactorisation's pivot ratio min|U_ii| / max|U_ii| (as
+ *    klu_z_rcond, O(n)) is compared with the last full factorisation's, and a full
  *    factorisation redone when it drops below REFACTOR_RCOND_RATIO of it.
  *    (The reciprocal pivot growth, klu_z_rgrowth, would be the sharper
  *    test but costs as much as the refactorisation itself: on a 1e5-DOF
  *    train it doubled the time per frequency. tests/test_sparse.c checks the
  *    kept pivots against zgesv across resonances.)
+ *  - row scaling: a full factorisation chooses its pivots on the row-scaled
+ *    matrix (KLU scale 2: each row by its largest |entry|, which balances
+ *    translational rows in N/m against rotational ones in N m/rad). A
+ *    refactorisation keeps those pivots and skips KLU's scaling pass, which
+ *    reads all of Z again (12 % of the time per frequency): with a fixed
+ *    pivot order, row scaling changes the factors only by rounding, and
+ *    klu_z_solve then applies no scale factors either. The pivot ratio is
+ *    still taken on the scaled diagonal, |U_kk| / Rs_k with the scale
+ *    factors Rs of the last full factorisation (pivot order), so that the
+ *    refactor test and the condition screen see the same, units-free,
+ *    figure as before.
  * KLU allocates through SuiteSparse's global malloc (KLU 1.3 has no
  * per-object hooks): only the state struct comes from the caller's
  * allocator; KLU's bytes are reported by klu_memory (Common.mempeak).
@@ -31,12 +42,17 @@
 /* Accept a refactorisation whose pivot ratio is at least this fraction of
  * the last full factorisation's (-). */
 #define REFACTOR_RCOND_RATIO 1e-3
+/* KLU row scaling for full factorisations: 2 = by the row's largest |entry| */
+#define KLU_SCALE_FULL 2
 
 typedef struct klu_state_s {
   klu_common common;
   klu_symbolic *sym;
   klu_numeric *num;
   double rcond0;             /* pivot ratio of the last full factorisation (-) */
+  double rcond;              /* pivot ratio of the last factorisation of either kind (-) */
+  double *irs;               /* n reciprocal row scale factors of the last full
+                              * factorisation, pivot order (1 / KLU Numeric->Rs) */
   size_t factors, refactors; /* counts of each kind, for tests and benchmarks */
 } klu_state;
 
@@ -55,7 +71,13 @@ static rcb_status klu_prepare(rcb_layout *L, const rcb_allocator *a) {
   if (L->n > (size_t)INT_MAX || L->nnz > (size_t)INT_MAX) return RCB_ERR_UNSUPPORTED;
   s = rcb_alloc(a, sizeof *s);
   if (!s) return RCB_ERR_NOMEM;
+  s->irs = rcb_alloc(a, L->n * sizeof *s->irs);
+  if (!s->irs) {
+    rcb_free(a, s);
+    return RCB_ERR_NOMEM;
+  }
   klu_defaults(&s->common);
+  s->common.scale = KLU_SCALE_FULL;
   /* COLAMD rather than AMD: on trains numbered along the shaft line it
    * keeps neighbouring columns together, and the memory-bound
    * refactorisation ran 1.5 to 2 times faster for the same fill
@@ -69,6 +91,7 @@ static rcb_status klu_prepare(rcb_layout *L, const rcb_allocator *a) {
   s->sym = klu_analyze((int)L->n, L->colp, L->rowi, &s->common);
   if (!s->sym) {
     rcb_status st = klu_status(&s->common);
+    rcb_free(a, s->irs);
     rcb_free(a, s);
     return st ? st : RCB_ERR_NOMEM;
   }
@@ -81,23 +104,57 @@ static void klu_release(rcb_layout *L, const rcb_allocator *a) {
   if (!s) return;
   if (s->num) klu_z_free_numeric(&s->num, &s->common);
   if (s->sym) klu_free_symbolic(&s->sym, &s->common);
+  rcb_free(a, s->irs);
   rcb_free(a, s);
   L->solver = NULL;
 }
 
-/* Refactor with the kept pivots; 1 if the result is acceptable. */
-static int try_refactor(const rcb_layout *L, klu_state *s, double *Ax) {
-  if (!klu_z_refactor(L->colp, L->rowi, Ax, s->sym, s->num, &s->common)) return 0;
-  if (!klu_z_rcond(s->sym, s->num, &s->common)) return 0;
-  return s->common.rcond >= REFACTOR_RCOND_RATIO * s->rcond0;
+/* Pivot ratio min |U_kk| / max |U_kk| of the row-scaled matrix (-); 0 if a
+ * pivot is zero or NaN (as klu_z_rcond, O(n), but on squared moduli: no
+ * hypot per pivot). After an unscaled refactorisation (unscaled = 1) U_kk
+ * is multiplied by the kept reciprocal scale factor of its pivot row, so
+ * the moduli are O(1) and their squares safe from overflow; a full
+ * factorisation's U is scaled already. */
+static double pivot_ratio(const klu_state *s, int unscaled) {
+  const double *u = s->num->Udiag; /* n complex entries, re/im interleaved */
+  double umin = (double)INFINITY, umax = 0;
+  size_t k, n = (size_t)s->num->n;
+  for (k = 0; k < n; k++) {
+    double r = unscaled ? s->irs[k] : 1.0, re = r * u[2 * k], im = r * u[2 * k + 1];
+    double d = re * re + im * im;
+    if (!(d > 0)) return 0.0;
+    if (d < umin) umin = d;
+    if (d > umax) umax = d;
+  }
+  return n && umax < (double)INFINITY ? sqrt(umin / umax) : 0.0;
 }
 
+/* Refactor with the kept pivots, without row scaling (KLU scale -1: no
+ * scaling pass and no pattern check; the pattern is the one analysed).
+ * Returns 1 if it succeeded, with its pivot ratio in s->rcond. */
+static int refactor_unscaled(const rcb_layout *L, klu_state *s, double *Ax) {
+  int ok;
+  s->common.scale = -1;
+  ok = klu_z_refactor(L->colp, L->rowi, Ax, s->sym, s->num, &s->common);
+  s->common.scale = KLU_SCALE_FULL;
+  if (ok) s->rcond = pivot_ratio(s, 1);
+  return ok;
+}
+
+/* Refactor with the kept pivots; 1 if the result is acceptable. */
+static int try_refactor(const rcb_layout *L, klu_state *s, double *Ax) {
+  return refactor_unscaled(L, s, Ax) && s->rcond >= REFACTOR_RCOND_RATIO * s->rcond0;
+}
+
+/* Full factorisation with row scaling; its scale factors are kept for the
+ * pivot ratios of the unscaled refactorisations that follow. */
 static rcb_status full_factor(const rcb_layout *L, klu_state *s, double *Ax) {
+  size_t k;
   if (s->num) klu_z_free_numeric(&s->num, &s->common);
   s->num = klu_z_factor(L->colp, L->rowi, Ax, s->sym, &s->common);
   if (!s->num) return klu_status(&s->common) ? klu_status(&s->common) : RCB_ERR_NOMEM;
-  if (!klu_z_rcond(s->sym, s->num, &s->common)) return klu_status(&s->common);
-  s->rcond0 = s->common.rcond;
+  for (k = 0; k < L->n; k++) s->irs[k] = s->num->Rs ? 1.0 / s->num->Rs[k] : 1.0;
+  s->rcond0 = s->rcond = pivot_ratio(s, 0);
   s->factors++;
   return RCB_OK;
 }
@@ -165,10 +222,11 @@ void rcb_zsolver_sparse_counts(const rcb_layout *L, size_t *factors, size_t *ref
   *refactors = s ? s->refactors : 0;
 }
 
-/* klu_z_rcond of the last factorisation (full or kept-pivot): both compute it. */
+/* Pivot ratio of the row-scaled matrix at the last factorisation (full or
+ * kept-pivot): both compute it. */
 double rcb_zsolver_sparse_pivot_ratio(const rcb_layout *L) {
   const klu_state *s = L->solver;
-  return s ? s->common.rcond : (double)NAN;
+  return s ? s->rcond : (double)NAN;
 }
 
 #else /* !RCB_WITH_SUITESPARSE */

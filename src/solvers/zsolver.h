@@ -48,7 +48,8 @@ const rcb_zsolver_ops *rcb_zsolver_sparse(void);
  * an entry is NaN (solvers/condition.c). */
 double rcb_layout_norm1(const rcb_layout *L, const rcb_complex *Z);
 /* min|U_ii| / max|U_ii| of the factors left by the last solve (-): read off
- * the LAPACK factors in Z, or KLU's klu_z_rcond of its own; NaN if unknown. */
+ * the LAPACK factors in Z, or KLU's, on the row-scaled pivots (as
+ * klu_z_rcond; see solvers/klu.c); NaN if unknown. */
 double rcb_layout_pivot_ratio(const rcb_layout *L, const rcb_complex *Z);
 double rcb_zsolver_sparse_pivot_ratio(const rcb_layout *L);
 void rcb_zsolver_sparse_counts(const rcb_layout *L, size_t *factors, size_t *refactors);

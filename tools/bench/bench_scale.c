@@ -12,7 +12,9 @@
  * other processes on a shared machine). Prints a Markdown table for
  * docs/benchmarks.md. Never a test: figures only.
  *
- * usage: bench_scale MODEL.ini...   (run with OPENBLAS_NUM_THREADS=1)
+ * usage: bench_scale [--solver banded|sparse|dense] MODEL.ini...
+ *        (run with OPENBLAS_NUM_THREADS=1; --solver times that solver only,
+ *        e.g. under perf)
  *   for n in 100 1000 10000 100000; do
  *     python3 tools/bench/gen_train.py --dof $n -o /tmp/train_$n.ini; done
  *   OPENBLAS_NUM_THREADS=1 build/tools/bench/bench_scale /tmp/train_{100,1000,10000,100000}.ini
@@ -162,11 +164,23 @@ int main(int argc, char **argv) {
   static const rcb_solver_kind kinds[3] = {RCB_SOLVER_BANDED, RCB_SOLVER_SPARSE,
                                            RCB_SOLVER_DENSE};
   static const char *const names[3] = {"banded (zgbsv)", "sparse (KLU)", "dense (zgesv)"};
+  static const char *const keys[3] = {"banded", "sparse", "dense"};
   result res[3][MAX_MODELS];
-  size_t nm = (size_t)argc - 1, i;
-  int s;
-  if (argc < 2 || nm > MAX_MODELS) {
-    fprintf(stderr, "usage: bench_scale MODEL.ini... (at most %d)\n", MAX_MODELS);
+  size_t nm, i;
+  int s, only = -1, first = 1;
+  if (argc > 2 && !strcmp(argv[1], "--solver")) {
+    for (s = 0; s < 3; s++)
+      if (!strcmp(argv[2], keys[s])) only = s;
+    if (only < 0) {
+      fprintf(stderr, "bench_scale: unknown solver '%s' (banded, sparse or dense)\n", argv[2]);
+      return 2;
+    }
+    first = 3;
+  }
+  nm = (size_t)(argc - first);
+  if (argc <= first || nm > MAX_MODELS) {
+    fprintf(stderr, "usage: bench_scale [--solver banded|sparse|dense] MODEL.ini... (at most %d)\n",
+            MAX_MODELS);
     return 2;
   }
   memset(res, 0, sizeof res);
@@ -175,13 +189,14 @@ int main(int argc, char **argv) {
   for (i = 0; i < nm; i++)
     for (s = 0; s < 3; s++) {
       result *r = &res[s][i];
-      if (s == 2) { /* dense only where it is feasible */
+      if (only >= 0 && s != only) continue;
+      if (s == 2 && only != 2) { /* dense only where it is feasible */
         result probe = res[0][i];
         if (!probe.ok || probe.ndof > DENSE_MAX_DOF) continue;
       }
-      *r = run_forked(argv[i + 1], kinds[s]);
+      *r = run_forked(argv[first + (int)i], kinds[s]);
       if (!r->ok) {
-        printf("| %s | %s | - | - | - | - | - | - |\n", argv[i + 1], names[s]);
+        printf("| %s | %s | - | - | - | - | - | - |\n", argv[first + (int)i], names[s]);
         continue;
       }
       printf("| %zu | %s | %.3f | %.4f | %.4f | %zu | %.2f | %.1f |\n", r->ndof, names[s],
@@ -190,7 +205,8 @@ int main(int argc, char **argv) {
       fflush(stdout);
     }
   printf("\nslope of log(median time per frequency) against log(DOF), DOF >= 1e3:");
-  for (s = 0; s < 2; s++) printf(" %s %.3f;", names[s], slope(res[s], nm));
+  for (s = 0; s < 2; s++)
+    if (only < 0 || s == only) printf(" %s %.3f;", names[s], slope(res[s], nm));
   printf("\n");
   return 0;
 }
