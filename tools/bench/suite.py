@@ -12,7 +12,8 @@
    ``rcbtool frf --solver S --json`` against the SciPy loop.
 2. Train scaling: gen_train.py trains of 1e2..1e5 DOF through bench_scale
    (median time and peak resident memory per frequency, each run in its own
-   process), with the slopes of log(time) against log(DOF).
+   process; the median of --train-runs runs), with the slopes of log(time)
+   against log(DOF) and their spread over the runs.
 3. One identification (the paper's Nelson-Crandall 2 case, Table 3 data, from
    1/10 of the true kt, kr, ct, cr; ``rcbtool simulate`` + ``rcbtool fit``)
    and one full diagnosis (``rcbtool diagnose`` on examples/walkthrough): wall
@@ -25,7 +26,8 @@ also replaces the block between the "bench-suite" markers in FILE
 (docs/benchmarks.md, section "The suite").
 
 usage: suite.py [--build DIR] [--docs docs/benchmarks.md] [--out FILE]
-                [--repeats N] [--no-ross] [--dofs 100,1000,10000,100000]
+                [--repeats N] [--no-ross] [--dofs 100,1000,3000,10000,30000,100000]
+                [--train-runs 3]
 (./scripts/dev.sh bench-suite runs it with the build tree and venv of dev.sh;
 run it with OPENBLAS_NUM_THREADS=1: every figure is one core.)
 """
@@ -294,20 +296,9 @@ def slope(pts):
     return float(np.polyfit(x, y, 1)[0])
 
 
-def trains(a, bench_scale_exe):
-    dofs = [int(x) for x in a.dofs.split(",")]
-    with tempfile.TemporaryDirectory(prefix="rcb-suite-") as tmp:
-        paths = []
-        for n in dofs:
-            path = os.path.join(tmp, f"train_{n}.ini")
-            sh(sys.executable, os.path.join(HERE, "gen_train.py"), "--dof", n, "-o", path,
-               check=True)
-            paths.append(path)
-        res = sh(bench_scale_exe, *paths, env=one_core_env())
-    if res.returncode != 0:
-        raise RuntimeError(f"bench_scale failed: {res.stderr.strip()}")
+def parse_scale(text):
     rows = []
-    for ln in res.stdout.splitlines():
+    for ln in text.splitlines():
         m = SCALE_RE.match(ln)
         if m:
             rows.append({"dof": int(m.group(1)), "solver": m.group(2), "setup_ms":
@@ -317,29 +308,72 @@ def trains(a, bench_scale_exe):
     return rows
 
 
-def render_trains(rows):
+def trains(a, bench_scale_exe):
+    """bench_scale over every train, a.train_runs times (each run goes through
+    all sizes, so the runs interleave in time); per (DOF, solver) the run with
+    the median time, plus every run's times for the spread of the slopes."""
+    dofs = [int(x) for x in a.dofs.split(",")]
+    runs = []
+    with tempfile.TemporaryDirectory(prefix="rcb-suite-") as tmp:
+        paths = []
+        for n in dofs:
+            path = os.path.join(tmp, f"train_{n}.ini")
+            sh(sys.executable, os.path.join(HERE, "gen_train.py"), "--dof", n, "-o", path,
+               check=True)
+            paths.append(path)
+        for _ in range(max(1, a.train_runs)):
+            res = sh(bench_scale_exe, *paths, env=one_core_env())
+            if res.returncode != 0:
+                raise RuntimeError(f"bench_scale failed: {res.stderr.strip()}")
+            runs.append(parse_scale(res.stdout))
+    rows = []
+    for r in runs[0]:
+        same = sorted((x for run in runs for x in run
+                       if x["dof"] == r["dof"] and x["solver"] == r["solver"]),
+                      key=lambda x: x["ms"])
+        pick = dict(same[(len(same) - 1) // 2])
+        pick["runs_ms"] = [x["ms"] for x in same]
+        rows.append(pick)
+    return rows, runs
+
+
+def endpoint_slope(pts, lo, hi):
+    """Slope between the points nearest lo and hi DOF (within 10 %), or None."""
+    a = [p for p in pts if abs(p[0] / lo - 1) < 0.1]
+    b = [p for p in pts if abs(p[0] / hi - 1) < 0.1]
+    return slope([a[0], b[0]]) if a and b else None
+
+
+def render_trains(rows, runs):
     L = ["### 2. Long machine trains: time and peak memory per frequency (one core)", "",
-         "| DOF | solver | ms / frequency (median) | (mean) | frequencies timed | "
-         "setup ms | FRF object MB | peak RSS MB |",
-         "| ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: |"]
+         f"Each figure is the median over {len(runs)} runs of `bench_scale` (the runs go "
+         "through all sizes in turn) of the median time per frequency within the run.", "",
+         "| DOF | solver | ms / frequency (median) | ns per DOF | runs (ms) | frequencies "
+         "timed | setup ms | FRF object MB | peak RSS MB |",
+         "| ---: | --- | ---: | ---: | --- | ---: | ---: | ---: | ---: |"]
     for r in rows:
-        L.append(f"| {r['dof']} | {r['solver']} | {r['ms']:.4g} | {r['mean_ms']:.4g} | "
+        spread = ", ".join(f"{t:.4g}" for t in r["runs_ms"])
+        L.append(f"| {r['dof']} | {r['solver']} | {r['ms']:.4g} | "
+                 f"{1e6 * r['ms'] / r['dof']:.1f} | {spread} | "
                  f"{r['nfreq']} | {r['setup_ms']:.3g} | {r['obj_mb']:.3g} | "
                  f"{r['rss_mb']:.1f} |")
-    L += ["", "Slopes of log(median time per frequency) against log(DOF):", "",
+    L += ["", "Slopes of log(median time per frequency) against log(DOF); the fit is over "
+          "every size >= 1e3, on the medians, and in brackets the range of the same fit "
+          "over the single runs:", "",
           "| solver | 1e2-1e3 | 1e3-1e4 | 1e4-1e5 | fit over >= 1e3 |",
           "| --- | ---: | ---: | ---: | ---: |"]
     slopes = {}
     for solver in dict.fromkeys(r["solver"] for r in rows):
         pts = sorted((r["dof"], r["ms"]) for r in rows if r["solver"] == solver)
-        pairs = []
-        for lo, hi in ((1e2, 1e3), (1e3, 1e4), (1e4, 1e5)):
-            sel = [p for p in pts if lo * 0.9 <= p[0] <= hi * 1.1]
-            pairs.append(slope(sel) if len(sel) == 2 else None)
+        pairs = [endpoint_slope(pts, lo, hi) for lo, hi in ((1e2, 1e3), (1e3, 1e4), (1e4, 1e5))]
         fit = slope([p for p in pts if p[0] >= 900])
-        slopes[solver] = fit
-        L.append(f"| {solver} | " + " | ".join("-" if s is None else f"{s:.2f}" for s in pairs)
-                 + f" | {'-' if fit is None else f'{fit:.2f}'} |")
+        each = [slope(sorted((x["dof"], x["ms"]) for x in run
+                             if x["solver"] == solver and x["dof"] >= 900)) for run in runs]
+        each = [e for e in each if e is not None]
+        slopes[solver] = (fit, min(each) if each else None, max(each) if each else None)
+        rng = f" ({min(each):.3f}-{max(each):.3f})" if len(each) > 1 else ""
+        L.append(f"| {solver} | " + " | ".join("-" if s is None else f"{s:.3f}" for s in pairs)
+                 + f" | {'-' if fit is None else f'{fit:.3f}'}{rng} |")
     return L, slopes
 
 
@@ -437,10 +471,11 @@ def render_targets(sweep, t_scipy, t_rfr, rows, slopes):
                  f"({b['solver']}, {b['dof']} DOF) | {met(b['ms'] < T_MS_1E5)} |")
         L.append(f"| 1e5 DOF < 1 GB | {b['rss_mb']:.0f} MB peak RSS | "
                  f"{met(b['rss_mb'] < T_MB_1E5)} |")
-        s = slopes.get(b["solver"])
+        s, lo, hi = slopes.get(b["solver"], (None, None, None))
         if s is not None:
+            rng = f", single runs {lo:.3f}-{hi:.3f}" if lo is not None and hi != lo else ""
             L.append(f"| time per frequency no faster than linear above 1e3 DOF (slope <= 1) | "
-                     f"{s:.2f} ({b['solver']}) | {met(s <= T_SLOPE)} |")
+                     f"{s:.3f} ({b['solver']}{rng}) | {met(s <= T_SLOPE)} |")
     return L
 
 
@@ -465,7 +500,10 @@ def main():
     ap.add_argument("--docs", help="replace the suite's block in this file "
                     "(docs/benchmarks.md)")
     ap.add_argument("--repeats", type=int, default=10, help="bench_frf sweeps (best of)")
-    ap.add_argument("--dofs", default="100,1000,10000,100000", help="train sizes")
+    ap.add_argument("--dofs", default="100,1000,3000,10000,30000,100000",
+                    help="train sizes (DOF)")
+    ap.add_argument("--train-runs", type=int, default=3,
+                    help="bench_scale runs over the trains (median of)")
     ap.add_argument("--no-ross", action="store_true")
     ap.add_argument("--quiet-load", type=float, default=0.0,
                     help="first wait (at most --wait s) for the 1-minute load average to "
@@ -491,7 +529,7 @@ def main():
     print("suite: 1/3 paper sweep (librcb, SciPy, ROSS) ...", file=sys.stderr, flush=True)
     sweep, t_scipy, t_rfr = paper_sweep(a, bench["bench_frf"], rcbtool)
     print("suite: 2/3 trains ...", file=sys.stderr, flush=True)
-    rows = trains(a, bench["bench_scale"])
+    rows, runs = trains(a, bench["bench_scale"])
     print("suite: 3/3 fit and diagnosis ...", file=sys.stderr, flush=True)
     fit = fit_case(rcbtool, a.model)
     diag = diagnosis_case(rcbtool)
@@ -503,7 +541,7 @@ def main():
          f"load average (1, 5, 15 min) {load0} at the start, {loadavg()} at the end; "
          f"the suite took {time.perf_counter() - t0:.0f} s.", ""]
     L += render_sweep(sweep, t_scipy, t_rfr) + [""]
-    Lt, slopes = render_trains(rows)
+    Lt, slopes = render_trains(rows, runs)
     L += Lt + [""] + render_id(fit, diag) + [""]
     L += render_targets(sweep, t_scipy, t_rfr, rows, slopes)
     block = "\n".join(L)
