@@ -99,9 +99,12 @@ static int init(monitor *mon, const rcb_allocator *al) {
   }
   for (i = 0; i < NOUT; i++)
     if (rcb_model_find_dof(mon->model, outs[i], &dof[i])) return 1;
-  /* unbalance-only FRF objects (no force input): all memory sized here */
-  if (rcb_frf_create(&mon->frf, mon->model, NOUT, dof, 0, NULL, RCB_SOLVER_AUTO, al) ||
-      rcb_frf_create(&mon->frf_machine, mon->machine, NOUT, dof, 0, NULL, RCB_SOLVER_AUTO,
+  /* unbalance-only FRF objects (no force input): all memory sized here. The
+   * banded LAPACK solver by name: RCB_SOLVER_AUTO would take KLU in a build
+   * with SuiteSparse, and KLU allocates its factors with malloc, not through
+   * this arena's hook. */
+  if (rcb_frf_create(&mon->frf, mon->model, NOUT, dof, 0, NULL, RCB_SOLVER_BANDED, al) ||
+      rcb_frf_create(&mon->frf_machine, mon->machine, NOUT, dof, 0, NULL, RCB_SOLVER_BANDED,
                      al)) {
     fprintf(stderr, "FRF workspace: out of arena memory\n");
     return 1;

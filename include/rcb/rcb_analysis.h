@@ -5,7 +5,12 @@
  *
  * Each analysis object is sized once at creation (all its memory comes from
  * the allocator hooks then); evaluations allocate nothing, so a sweep in a
- * loop is allocation-free. Objects keep a pointer to the model: the model
+ * loop is allocation-free. The one exception is the sparse solver (KLU,
+ * chosen by RCB_SOLVER_AUTO from 32 DOF when librcb is built with
+ * SuiteSparse): KLU allocates its LU factors itself, with SuiteSparse's
+ * malloc, at the first factorisation and whenever it pivots anew. A host
+ * that needs every byte through its hooks asks for RCB_SOLVER_DENSE or
+ * RCB_SOLVER_BANDED, or builds without SuiteSparse (the embedded preset). Objects keep a pointer to the model: the model
  * must outlive them. Two objects on two threads never share state.
  */
 #ifndef RCB_ANALYSIS_H
@@ -29,7 +34,7 @@ typedef enum rcb_frf_kind {
 
 /** @brief Linear solver used for the dynamic stiffness. */
 typedef enum rcb_solver_kind {
-  RCB_SOLVER_AUTO = 0,   /**< sparse from 1000 DOF when built with KLU, else
+  RCB_SOLVER_AUTO = 0,   /**< sparse from 32 DOF when built with KLU, else
                               banded when the band is narrow, else dense */
   RCB_SOLVER_DENSE = 1,  /**< LAPACK zgesv */
   RCB_SOLVER_BANDED = 2, /**< LAPACK zgbsv */
