@@ -43,6 +43,7 @@ install(EXPORT rcbTargets NAMESPACE rcb:: FILE rcbTargets.cmake
 set(RCB_CONFIG_WITH_SUITESPARSE ${RCB_WITH_SUITESPARSE})
 set(RCB_CONFIG_WITH_NLOPT ${RCB_WITH_NLOPT})
 set(RCB_CONFIG_WITH_SUNDIALS ${RCB_WITH_SUNDIALS})
+set(RCB_CONFIG_WITH_THREADS ${RCB_WITH_THREADS})
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/rcbConfig.cmake.in
   ${PROJECT_BINARY_DIR}/rcbConfig.cmake
   INSTALL_DESTINATION ${RCB_INSTALL_CMAKEDIR})
@@ -68,7 +69,10 @@ if(RCB_WITH_SUNDIALS)
   string(APPEND RCB_PC_LIBS_PRIVATE
     " -lsundials_cvode -lsundials_sunmatrixdense -lsundials_nvecserial")
 endif()
-string(APPEND RCB_PC_LIBS_PRIVATE " -lpthread -lm")
+if(RCB_WITH_THREADS)
+  string(APPEND RCB_PC_LIBS_PRIVATE " -lpthread")
+endif()
+string(APPEND RCB_PC_LIBS_PRIVATE " -lm")
 # prefix is found from the .pc file's own place (${pcfiledir}), so the package
 # stays right when installed with `cmake --install --prefix DIR` or moved.
 file(RELATIVE_PATH _rcb_pc_to_prefix ${CMAKE_INSTALL_FULL_LIBDIR}/pkgconfig

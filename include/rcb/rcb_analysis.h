@@ -111,7 +111,9 @@ RCB_API rcb_status rcb_frf_unbalance(rcb_frf *f, double speed, rcb_complex *Q);
  * @param H output, nout x nin per frequency, column-major, frequency p at
  * H + p * nout * nin
  * @param nthreads threads to use (0 or 1: the calling thread only; at most
- * RCB_SWEEP_MAX_THREADS, and no more than there are blocks)
+ * RCB_SWEEP_MAX_THREADS, and no more than there are blocks). A librcb built
+ * with RCB_WITH_THREADS=OFF (no pthreads, e.g. the embedded preset) takes
+ * the same values and runs every sweep on the calling thread.
  * @return the first failing part's status (message in rcb_frf_errmsg);
  * RCB_ERR_NOMEM if a thread cannot be started. The condition record
  * (rcb_frf_get_condition) covers the solves of all threads.

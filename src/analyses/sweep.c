@@ -1,6 +1,7 @@
 /*
- * Frequency sweep, serial or on POSIX threads, with results that do not
- * depend on the number of threads (bit for bit):
+ * Frequency sweep, serial or on POSIX threads (RCB_WITH_THREADS; built
+ * without them, every sweep runs on the calling thread), with results that
+ * do not depend on the number of threads (bit for bit):
  *  - every frequency runs the same code on a workspace of its own thread;
  *    the dense and banded solvers keep no state between frequencies;
  *  - the sparse solver (KLU) refactors with the pivots of an earlier
@@ -15,10 +16,14 @@
  * state and modal basis are its own.
  */
 #include <math.h>
-#include <pthread.h>
 #include <string.h>
 
 #include "analyses/frf_internal.h"
+#include "rcb/rcb_config.h"
+
+#if RCB_WITH_THREADS
+#include <pthread.h>
+#endif
 
 typedef struct sweep_part {
   rcb_frf *f;                         /* workspace of this part */
@@ -53,10 +58,12 @@ static void run_part(sweep_part *s) {
   }
 }
 
+#if RCB_WITH_THREADS
 static void *part_main(void *arg) {
   run_part(arg);
   return NULL;
 }
+#endif
 
 static void worker_destroy(rcb_frf *w) {
   if (!w) return;
@@ -102,6 +109,7 @@ static rcb_status worker_create(rcb_frf *f, rcb_frf **out) {
   return RCB_OK;
 }
 
+#if RCB_WITH_THREADS
 /* The worst condition estimate of a thread's solves joins the caller's
  * record (rcb_frf_get_condition), as if the solves had been its own. */
 static void merge_condition(rcb_frf_condition *dst, const rcb_frf_condition *src) {
@@ -117,6 +125,7 @@ static void merge_condition(rcb_frf_condition *dst, const rcb_frf_condition *src
   dst->ill += src->ill;
   dst->rcond_last = src->rcond_last;
 }
+#endif
 
 static rcb_status check_grid(rcb_frf *f, size_t nfreq, const double *omegas,
                              const double *speeds, int *one_speed) {
@@ -134,6 +143,7 @@ static rcb_status check_grid(rcb_frf *f, size_t nfreq, const double *omegas,
   return RCB_OK;
 }
 
+#if RCB_WITH_THREADS
 /* Threads over whole blocks; part 0 runs on the calling thread. */
 static rcb_status run_threads(rcb_frf *f, sweep_part *parts, size_t nt, rcb_frf **workers) {
   pthread_t tid[RCB_SWEEP_MAX_THREADS];
@@ -158,6 +168,14 @@ static rcb_status run_threads(rcb_frf *f, sweep_part *parts, size_t nt, rcb_frf 
     if (workers[t] != f) merge_condition(&f->cond, &workers[t]->cond);
   return st;
 }
+#else
+/* Built without threads: rcb_frf_sweep makes one part, run here. */
+static rcb_status run_threads(rcb_frf *f, sweep_part *parts, size_t nt, rcb_frf **workers) {
+  (void)f, (void)nt, (void)workers;
+  run_part(&parts[0]);
+  return parts[0].st;
+}
+#endif
 
 rcb_status rcb_frf_sweep(rcb_frf *f, size_t nfreq, const double *omegas, const double *speeds,
                          rcb_frf_kind kind, rcb_complex *H, size_t nthreads) {
@@ -174,7 +192,7 @@ rcb_status rcb_frf_sweep(rcb_frf *f, size_t nfreq, const double *omegas, const d
   if ((st = check_grid(f, nfreq, omegas, speeds, &one_speed))) return st;
   if (nfreq == 0) return RCB_OK; /* nothing to evaluate (and no part to run) */
   memset(workers, 0, sizeof workers);
-  nt = nthreads < 1 ? 1 : nthreads;
+  nt = nthreads < 1 || !RCB_WITH_THREADS ? 1 : nthreads;
   if (nt > nblocks) nt = nblocks ? nblocks : 1;
   if (f->modal && one_speed && nfreq && (st = rcb_frf_modal_basis(f, speeds[0]))) return st;
   for (t = 0; t < nt; t++) {
