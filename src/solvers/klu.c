@@ -171,13 +171,14 @@ static rcb_status klu_solve_(const rcb_layout *L, rcb_complex *Z, int *ipiv, rcb
   rcb_status st;
   (void)ipiv;
   if (!s || nrhs > (size_t)INT_MAX) return RCB_ERR_ARG;
-  if (s->num && try_refactor(L, s, Ax))
+  /* KLU stops only at an exactly zero pivot; a scaled pivot at rounding
+   * level of the largest is as singular (LAPACK finds an exactly zero pivot
+   * on the same matrix: a free-free model at 0 Hz), once fresh pivoting has
+   * been tried. */
+  if (s->num && try_refactor(L, s, Ax) && s->rcond >= SINGULAR_PIVOT_RATIO)
     s->refactors++;
   else if ((st = full_factor(L, s, Ax)))
     return st;
-  /* KLU stops only at an exactly zero pivot; a scaled pivot at rounding
-   * level of the largest is as singular (LAPACK finds an exactly zero pivot
-   * on the same matrix: a free-free model at 0 Hz). */
   if (s->rcond < SINGULAR_PIVOT_RATIO) return RCB_ERR_SINGULAR;
   if (!klu_z_solve(s->sym, s->num, (int)L->n, (int)nrhs, (double *)B, &s->common))
     return klu_status(&s->common) ? klu_status(&s->common) : RCB_ERR_ARG;
