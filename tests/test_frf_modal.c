@@ -193,6 +193,23 @@ static void sweep_identical(rcb_solver_kind kind, int sync, int eval_loop) {
   free(H2);
 }
 
+/* rcb_frf_pick_solver: modal from RCB_MODAL_PAYS x ndof^2 frequencies at
+ * one speed (88 DOF: 1548.8, so 1549); never over several speeds, for no
+ * model or for a model not finalized. */
+static void test_pick_solver(void **state) {
+  rcb_model *m = rcb_test_model_from_example("paper_system.ini"), *e = NULL;
+  (void)state;
+  assert_int_equal(rcb_model_dof_count(m), 88);
+  assert_int_equal(rcb_frf_pick_solver(m, 1549, 1), RCB_SOLVER_MODAL);
+  assert_int_equal(rcb_frf_pick_solver(m, 1548, 1), RCB_SOLVER_AUTO);
+  assert_int_equal(rcb_frf_pick_solver(m, 100000, 0), RCB_SOLVER_AUTO);
+  assert_int_equal(rcb_frf_pick_solver(NULL, 100000, 1), RCB_SOLVER_AUTO);
+  assert_int_equal(rcb_model_create(&e, NULL), RCB_OK);
+  assert_int_equal(rcb_frf_pick_solver(e, 100000, 1), RCB_SOLVER_AUTO);
+  rcb_model_destroy(e);
+  rcb_model_destroy(m);
+}
+
 static void test_sweep_threads(void **state) {
   rcb_model *m = rcb_test_model_from_example("paper_system.ini");
   rcb_frf *f = NULL;
@@ -214,6 +231,7 @@ int main(void) {
       cmocka_unit_test(test_cross_coupled_speeds),
       cmocka_unit_test(test_truncated),
       cmocka_unit_test(test_sweep_threads),
+      cmocka_unit_test(test_pick_solver),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -153,6 +153,20 @@ typedef struct rcb_modal_info {
  */
 RCB_API rcb_status rcb_frf_set_modal(rcb_frf *f, size_t max_modes, double max_freq);
 
+/**
+ * @brief The solver that pays for a sweep of @p nfreq frequencies:
+ * RCB_SOLVER_MODAL when every frequency has the same rotor speed
+ * (@p one_speed = 1), the model has at most RCB_MODAL_MAX_DOF DOF and
+ * nfreq >= RCB_MODAL_PAYS * ndof^2; RCB_SOLVER_AUTO (a direct solver) otherwise.
+ * The rule weighs the eigenvector basis, about 1.5e-9 s x (2 ndof)^3, against
+ * a direct solve per frequency, about 1.2e-7 s x ndof with KLU, with a factor 2
+ * of margin for the modal side (docs/benchmarks.md, "Modal path and threads").
+ */
+RCB_API rcb_solver_kind rcb_frf_pick_solver(const rcb_model *m, size_t nfreq, int one_speed);
+/** @brief Frequencies per DOF^2 from which the modal path pays (see
+ * rcb_frf_pick_solver): 2 x 1.5e-9 x 8 / 1.2e-7. */
+#define RCB_MODAL_PAYS 0.2
+
 /** @brief Modal basis at rotor speed @p speed (rad/s), computed if needed,
  * and its description. @return RCB_ERR_STATE if @p f is not modal. */
 RCB_API rcb_status rcb_frf_modal_info(rcb_frf *f, double speed, rcb_modal_info *info);

@@ -66,6 +66,13 @@ static rcb_status sparse_layout(rcb_frf *f) {
   return RCB_OK;
 }
 
+rcb_solver_kind rcb_frf_pick_solver(const rcb_model *m, size_t nfreq, int one_speed) {
+  double n;
+  if (!m || !m->finalized || !one_speed || m->ndof > RCB_MODAL_MAX_DOF) return RCB_SOLVER_AUTO;
+  n = (double)m->ndof;
+  return (double)nfreq >= RCB_MODAL_PAYS * n * n ? RCB_SOLVER_MODAL : RCB_SOLVER_AUTO;
+}
+
 static void *frf_alloc(rcb_frf *f, size_t size) {
   f->bytes += size;
   return rcb_alloc(&f->alloc, size);

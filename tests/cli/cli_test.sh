@@ -678,6 +678,30 @@ timecheck_json)
 a,b=c["amp_freq"][0],c["amp_time"][0]; assert abs(b/a-1)<5e-3, (a,b)' "$W/out" \
     || fail "time and frequency domain amplitudes differ by more than 0.5 %" ;;
 # ---- solvers: modal (eq. 7) and threads give the direct numbers ----
+frf_auto_modal)
+  # --solver auto: modal from 0.2 x DOF^2 frequencies at one speed (1549 on 88 DOF), else KLU
+  run frf "$MODEL" --out C.A.x,C.B.y --in DA.x --fmax 500 --points 1549 --rpm 10000 --json \
+    --solver sparse
+  expect_rc 0; cp "$W/out" "$W/direct.json"
+  run frf "$MODEL" --out C.A.x,C.B.y --in DA.x --fmax 500 --points 1549 --rpm 10000 --json
+  expect_rc 0; json_ok; err_has "truncation error estimate at 500 Hz"
+  cp "$W/out" "$W/auto.json"
+  run frf "$MODEL" --out C.A.x --in DA.x --fmax 500 --points 1548 --rpm 10000 --json
+  expect_rc 0; cp "$W/out" "$W/below.json"
+  run frf "$MODEL" --out C.A.x --in DA.x --fmax 500 --points 1549 --synchronous --json
+  expect_rc 0
+  python3 - "$W/direct.json" "$W/auto.json" "$W/below.json" "$W/out" <<'EOF' \
+    || fail "auto did not pick as documented, or its modal FRF differs from KLU's"
+import json, sys
+d, a, lo, sy = (json.load(open(p)) for p in sys.argv[1:5])
+assert a["solver"] == "modal" and a["modal"]["truncation_error"] < 1e-8, a["solver"]
+assert lo["solver"] == "sparse" and sy["solver"] == "sparse", (lo["solver"], sy["solver"])
+for i in range(1549):
+    hd = [complex(c["re"][i], c["im"][i]) for c in d["channels"]]
+    ha = [complex(c["re"][i], c["im"][i]) for c in a["channels"]]
+    assert max(abs(x - y) for x, y in zip(hd, ha)) <= 1e-8 * max(abs(x) for x in hd), i
+EOF
+  ;;
 frf_modal_matches_direct)
   run frf "$MODEL" --out C.A.x,C.B.y --in DA.x,DA.y --fmax 500 --points 101 --rpm 10000 --json
   expect_rc 0; cp "$W/out" "$W/direct.json"
