@@ -58,6 +58,15 @@ rcb_status rcb_cmp_model_at(rcb_compare *c, rcb_cmp_eval *ev, double w, rcb_comp
 rcb_status rcb_cmp_modal_fit(rcb_compare *c, const double *w, const rcb_complex *h, size_t n,
                              double wref, double *wn, double *zeta);
 
+/* Local modal fit of nmodes (1 to 4) resonances sharing their poles over
+ * nch channels of n points each (w rad/s; h channel-major, nch * n; wref
+ * rad/s, for scaling): the stable underdamped poles found, at most nmodes,
+ * as natural frequencies wn (rad/s, ascending) and damping ratios zeta;
+ * *nfound = 0 when the fit fails or n < 3 nmodes + 2 (compare_modal.c). */
+rcb_status rcb_cmp_modal_fit_multi(rcb_compare *c, const double *w, const rcb_complex *h,
+                                   size_t nch, size_t n, double wref, size_t nmodes,
+                                   double *wn, double *zeta, size_t *nfound);
+
 /* Build the peak table (compare_peaks.c). */
 rcb_status rcb_cmp_peaks(rcb_compare *c, rcb_cmp_eval *ev);
 
