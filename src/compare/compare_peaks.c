@@ -294,37 +294,117 @@ static void measured_row(const rcb_compare *c, const peak *p, const double *wt,
   r->amp_ratio = r->model_amp > 0 ? r->meas_amp / r->model_amp : (double)NAN;
 }
 
-/* The local modal fit of a measured peak on its dominant channel: the
- * points within 3.5 half-power half-widths (zeta w) of the top, at least 5
- * and at most 250 on each side. A window of about one half-width leaves
- * the fit's residual terms free to take up the noise: under eq. 19 noise
- * the damping then comes out 25 % low, as the half-power width's does. */
-static rcb_status modal_row(rcb_compare *c, const peak *p, rcb_compare_peak *r) {
-  const rcb_complex *e = c->meas + r->channel * c->npts;
-  double half = 3.5 * (isfinite(p->zeta) ? p->zeta : 0.01) * p->freq, wn, zeta;
-  size_t lo = p->idx, hi = p->idx, i, n = 0;
-  rcb_status st;
+/* The fit window of a peak: the grid points within half (rad/s) of its top,
+ * at least 5 and at most 250 on each side. */
+static void fit_window(const rcb_compare *c, const peak *p, double half, size_t *lo, size_t *hi) {
+  *lo = *hi = p->idx;
+  while (*lo > 0 && p->idx - *lo < 250 &&
+         (p->idx - *lo < 5 || c->grid[*lo - 1] >= p->freq - half))
+    (*lo)--;
+  while (*hi + 1 < c->npts && *hi - p->idx < 250 &&
+         (*hi - p->idx < 5 || c->grid[*hi + 1] <= p->freq + half))
+    (*hi)++;
+}
+
+/* How many modes the window [w0, w1] (rad/s) holds: the measured peaks in
+ * it, plus the model's modes in it that no measured peak claimed (a
+ * resonance the data show merged with a neighbour: the gyroscopic pair of a
+ * rotor, seen on the direct and the cross channels), at most 4. */
+static size_t window_modes(const peak *pk, size_t np, const mref *refs, size_t nref, double w0,
+                           double w1) {
+  size_t j, n = 0;
+  for (j = 0; j < np; j++) n += pk[j].freq >= w0 && pk[j].freq <= w1;
+  for (j = 0; j < nref; j++) n += refs[j].pair == NONE && refs[j].freq >= w0 && refs[j].freq <= w1;
+  return n < 1 ? 1 : n > 4 ? 4 : n;
+}
+
+/* The window's points into w (rad/s) and h (channel-major, stride
+ * hi - lo + 1): channel k0 alone (its finite points), or when k0 == nch
+ * every channel finite on the whole window. Returns the point count,
+ * *nused the channels. */
+static size_t gather(const rcb_compare *c, size_t lo, size_t hi, size_t k0, double *w,
+                     rcb_complex *h, size_t *nused) {
+  size_t i, k, n = 0, one = k0 < c->nch, kb = one ? k0 : 0, ke = one ? k0 + 1 : c->nch;
+  *nused = 0;
+  for (k = kb; k < ke; k++) {
+    const rcb_complex *e = c->meas + k * c->npts;
+    size_t m = 0;
+    for (i = lo; i <= hi; i++) {
+      int ok = isfinite(creal(e[i])) && isfinite(cimag(e[i]));
+      if (!ok && !one) break; /* several channels share the abscissae */
+      if (ok) w[m] = c->grid[i], h[*nused * (hi - lo + 1) + m++] = e[i];
+    }
+    if (!one && m < hi - lo + 1) continue;
+    n = m;
+    (*nused)++;
+  }
+  return n;
+}
+
+static double damped(double wn, double zeta) { return wn * sqrt(1.0 - zeta * zeta); }
+
+/* The fitted pole whose damped frequency is nearest the peak's, among those
+ * at least one grid step wide (half-power half-width zeta wn >= step, rad/s:
+ * a narrower one is fitted to the noise of a single point); NONE if none. */
+static size_t nearest_pole(const double *wn, const double *zeta, size_t nf, double w,
+                           double step) {
+  size_t j, best = NONE;
+  for (j = 0; j < nf; j++) {
+    if (zeta[j] * wn[j] < step) continue;
+    if (best == NONE || fabs(damped(wn[j], zeta[j]) - w) < fabs(damped(wn[best], zeta[best]) - w))
+      best = j;
+  }
+  return best;
+}
+
+/* The half-width (rad/s) of a window about w that holds 3.5 half-widths
+ * either side of every model mode no measured peak claimed in [w0, w1]. */
+static double merged_half(const mref *refs, size_t nref, double w, double w0, double w1,
+                          double half) {
+  size_t j;
+  for (j = 0; j < nref; j++) {
+    const mref *q = &refs[j];
+    if (q->pair != NONE || q->freq < w0 || q->freq > w1 || !isfinite(q->zeta)) continue;
+    half = fmax(half, fabs(q->freq - w) + 3.5 * q->zeta * q->freq);
+  }
+  return half;
+}
+
+/* The local modal fit of a measured peak (compare_modal.c) over 3.5
+ * half-power half-widths (zeta w) either side of the top: a window of about
+ * one half-width leaves the fit's residual terms free to take up the noise,
+ * and under eq. 19 noise the damping then comes out 25 % low, as the
+ * half-power width's does. Alone in its window: one mode on the peak's
+ * dominant channel. With several modes in the window (window_modes): as
+ * many modes sharing their poles on every channel finite there, the peak
+ * taking the pole nearest its frequency. The half-power width of modes
+ * merged into one peak says little (the cross channels of a gyroscopic pair
+ * show the two modes' difference, a narrower peak): the window then also
+ * holds 3.5 half-widths of each merged model mode (merged_half), and the
+ * mode count is taken again on it. */
+static rcb_status modal_row(rcb_compare *c, const peak *pk, size_t np, size_t ip,
+                            const mref *refs, size_t nref, rcb_compare_peak *r) {
+  const peak *p = &pk[ip];
+  double wn[4], zeta[4], half = 3.5 * (isfinite(p->zeta) ? p->zeta : 0.01) * p->freq;
+  size_t lo, hi, n = 0, nm, nch = 0, nf = 0, best = NONE;
+  rcb_status st = RCB_OK;
   double *w = rcb_alloc(&c->alloc, c->npts * sizeof *w);
-  rcb_complex *h = rcb_alloc(&c->alloc, c->npts * sizeof *h);
+  rcb_complex *h = rcb_alloc(&c->alloc, c->nch * c->npts * sizeof *h);
   r->meas_zeta_hp = p->zeta;
   r->meas_wd = (double)NAN;
-  if (!w || !h) {
-    rcb_free(&c->alloc, w);
-    rcb_free(&c->alloc, h);
-    return rcb_cmp_fail(c, RCB_ERR_NOMEM, "out of memory (modal fit)");
+  if (!w || !h) st = rcb_cmp_fail(c, RCB_ERR_NOMEM, "out of memory (modal fit)");
+  fit_window(c, p, half, &lo, &hi);
+  nm = window_modes(pk, np, refs, nref, c->grid[lo], c->grid[hi]);
+  if (nm > 1) {
+    fit_window(c, p, merged_half(refs, nref, p->freq, c->grid[lo], c->grid[hi], half), &lo, &hi);
+    nm = window_modes(pk, np, refs, nref, c->grid[lo], c->grid[hi]);
   }
-  while (lo > 0 && p->idx - lo < 250 && (p->idx - lo < 5 || c->grid[lo - 1] >= p->freq - half))
-    lo--;
-  while (hi + 1 < c->npts && hi - p->idx < 250 &&
-         (hi - p->idx < 5 || c->grid[hi + 1] <= p->freq + half))
-    hi++;
-  for (i = lo; i <= hi; i++)
-    if (isfinite(creal(e[i])) && isfinite(cimag(e[i]))) w[n] = c->grid[i], h[n++] = e[i];
-  st = rcb_cmp_modal_fit(c, w, h, n, p->freq, &wn, &zeta);
-  if (!st && isfinite(zeta) && zeta < 1.0) {
-    r->meas_zeta = zeta;
-    r->meas_wd = wn * sqrt(1.0 - zeta * zeta);
-  }
+  if (!st && nm > 1) n = gather(c, lo, hi, c->nch, w, h, &nch);
+  if (!st && nch == 0) /* alone, or no channel finite on the whole window */
+    nm = 1, n = gather(c, lo, hi, r->channel, w, h, &nch);
+  if (!st) st = rcb_cmp_modal_fit_multi(c, w, h, nch, n, p->freq, nm, wn, zeta, &nf);
+  if (!st && n > 1) best = nearest_pole(wn, zeta, nf, p->freq, (w[n - 1] - w[0]) / (double)(n - 1));
+  if (best != NONE) r->meas_zeta = zeta[best], r->meas_wd = damped(wn[best], zeta[best]);
   rcb_free(&c->alloc, w);
   rcb_free(&c->alloc, h);
   return st;
@@ -349,7 +429,7 @@ static rcb_status build_rows(rcb_compare *c, const peak *pk, size_t np, const si
     r->model_freq = r->model_zeta = r->model_peak = (double)NAN;
     r->freq_err_pct = r->zeta_err_pct = r->peak_err_pct = (double)NAN;
     measured_row(c, &pk[i], wt, r);
-    if ((st = modal_row(c, &pk[i], r))) return st;
+    if ((st = modal_row(c, pk, np, i, refs, nref, r))) return st;
     r->match = RCB_PEAK_MEASURED_ONLY;
     if (pk_pair[i] == NONE) continue;
     r->match = RCB_PEAK_MATCHED;
