@@ -23,6 +23,7 @@
 #include <string.h>
 #include <cmocka.h>
 
+#include "compare/compare_internal.h"
 #include "core/rcb_internal.h"
 #include "rcb_test_util.h"
 
@@ -400,6 +401,92 @@ static void test_modal_fit_paper(void **state) {
   rcb_model_destroy(m);
 }
 
+/* Two modes 1 % apart in frequency (different zetas, complex residues) plus
+ * a constant residual on two channels, noise-free: the shared-pole fit with
+ * N = 2 returns both poles to 1e-8 (rcb_cmp_modal_fit_multi directly). */
+static void test_modal_fit_two_modes(void **state) {
+  const double w1 = TWO_PI * 100.0, w2 = 1.01 * w1, z1 = 0.012, z2 = 0.02; /* rad/s, - */
+  const rcb_complex r[2][2] = {{CMPLX(3.0, 1.0), CMPLX(-1.0, 2.0)},
+                               {CMPLX(1.0, -2.0), CMPLX(2.5, 0.5)}}; /* [channel][mode] */
+  double x[301], wn[4], zeta[4];
+  rcb_complex v[2 * 301];
+  rcb_compare *c = NULL;
+  size_t i, k, nf = 0;
+  (void)state;
+  for (i = 0; i < 301; i++) {
+    double complex s = RCB_J * (x[i] = w1 * (0.94 + 0.13 * (double)i / 300.0));
+    for (k = 0; k < 2; k++) {
+      double complex p1 = CMPLX(-z1 * w1, w1 * sqrt(1 - z1 * z1));
+      double complex p2 = CMPLX(-z2 * w2, w2 * sqrt(1 - z2 * z2));
+      v[k * 301 + i] = w1 * (r[k][0] / (s - p1) + conj(r[k][0]) / (s - conj(p1)) +
+                             r[k][1] / (s - p2) + conj(r[k][1]) / (s - conj(p2))) +
+                       CMPLX(0.3, -0.1 * (double)k);
+    }
+  }
+  assert_int_equal(rcb_compare_create(&c, NULL), RCB_OK);
+  assert_int_equal(rcb_cmp_modal_fit_multi(c, x, v, 2, 301, w1, 2, wn, zeta, &nf), RCB_OK);
+  assert_int_equal(nf, 2);
+  if (!rcb_test_close(wn[0], w1, 1e-8, 0.0) || !rcb_test_close(wn[1], w2, 1e-8, 0.0) ||
+      !rcb_test_close(zeta[0], z1, 1e-8, 0.0) || !rcb_test_close(zeta[1], z2, 1e-8, 0.0))
+    fail_msg("wn %.12g %.12g zeta %.12g %.12g", wn[0], wn[1], zeta[0], zeta[1]);
+  rcb_compare_destroy(c);
+}
+
+/* The paper system at 10000 rpm, inertances DA.x, DA.y, DB.x, DB.y per a
+ * force at DA.x, 1-500 Hz on 2000 points, eq. 19 noise (10 %, 1 %), seeds 1
+ * to 10: the gyroscopic pair near 150 Hz (150.11 and 150.56 Hz, zeta 0.0131)
+ * shows as one peak, its cross channels as the modes' difference, a narrower
+ * peak. The single-mode fit gave 0.0054-0.0062 there (RMS error 56 %, worst
+ * 59 %); the shared-pole fit (two modes, four channels) is asserted below 25 %
+ * RMS and 30 % worst against the damped modes' zeta. The peak near 161 Hz
+ * (modes 161.5/161.9 Hz, zeta 0.031, weak in these channels, not a peak of
+ * the noise-free data) is reported only: docs/diagnosis.md. */
+static void test_modal_fit_gyroscopic(void **state) {
+  static const char *const outs[] = {"DA.x", "DA.y", "DB.x", "DB.y"};
+  static const char *const ins[] = {"DA.x", "DA.x", "DA.x", "DA.x"};
+  rcb_model *m = paper();
+  rcb_modes *me = NULL;
+  rcb_mode modes[64];
+  size_t nm = 0, p, j, n[2] = {0, 0};
+  double e2[2] = {0, 0}, worst[2] = {0, 0};
+  unsigned seed;
+  (void)state;
+  assert_int_equal(rcb_modes_create(&me, m, NULL), RCB_OK);
+  assert_int_equal(rcb_modes_set_max_zeta(me, 0.99), RCB_OK); /* as the peak table */
+  assert_int_equal(rcb_modes_compute(me, 10000 * RPM, 64, modes, &nm, NULL), RCB_OK);
+  for (seed = 1; seed <= 10; seed++) {
+    rcb_meas *ms = frf_meas(m, outs, ins, 4, 1.0, 500.0, 2000, 10000.0, RCB_INERTANCE);
+    rcb_compare *c;
+    assert_int_equal(rcb_meas_add_noise(ms, 10.0, 1.0, seed), RCB_OK);
+    c = run(m, ms);
+    for (p = 0; p < rcb_compare_peak_count(c); p++) {
+      rcb_compare_peak r;
+      size_t best = 0, g;
+      double e;
+      assert_int_equal(rcb_compare_get_peak(c, p, &r), RCB_OK);
+      if (r.match == RCB_PEAK_MODEL_ONLY || r.meas_freq < TWO_PI * 145.0 ||
+          r.meas_freq > TWO_PI * 170.0)
+        continue;
+      for (j = 1; j < nm; j++)
+        if (fabs(modes[j].wd - r.meas_wd) < fabs(modes[best].wd - r.meas_wd)) best = j;
+      g = r.meas_freq > TWO_PI * 155.0;
+      e = r.meas_zeta / modes[best].zeta - 1.0;
+      e2[g] += e * e, n[g]++, worst[g] = fmax(worst[g], fabs(e));
+    }
+    rcb_compare_destroy(c);
+    rcb_meas_destroy(ms);
+  }
+  assert_int_equal(n[0], 10);
+  for (j = 0; j < 2; j++)
+    if (n[j])
+      print_message("  peak near %s Hz: %zu peaks, zeta error RMS %.1f %% (worst %.1f %%)\n",
+                    j ? "161" : "150", n[j], 100 * sqrt(e2[j] / (double)n[j]), 100 * worst[j]);
+  assert_true(sqrt(e2[0] / 10.0) < 0.25);
+  assert_true(worst[0] < 0.30);
+  rcb_modes_destroy(me);
+  rcb_model_destroy(m);
+}
+
 /* A measurement that is the model times a constant s on one channel and
  * exact on the other: error |s - 1| 100 % there, FRAC 1 (shape only), log
  * error |log10 s|; CSF across both channels = 2 s' / (1 + s'^2) in the
@@ -488,6 +575,8 @@ int main(void) {
       cmocka_unit_test(test_modal_fit_exact),
       cmocka_unit_test(test_modal_fit_noise),
       cmocka_unit_test(test_modal_fit_paper),
+      cmocka_unit_test(test_modal_fit_two_modes),
+      cmocka_unit_test(test_modal_fit_gyroscopic),
       cmocka_unit_test(test_known_values),
       cmocka_unit_test(test_errors_and_allocator),
   };
