@@ -371,8 +371,8 @@ static void test_modal_fit_noise(void **state) {
  * 1-500 Hz on 2000 points, eq. 19 noise (10 %, 1 %): the matched peak (the
  * first bending pair near 150 Hz, two modes 0.1 Hz apart that the data show
  * as one, and the pair near 320 Hz) has a modal-fit damping within 25 % of
- * the model's own modal damping (the truth). (At 10000 rpm the gyroscopic split puts two peaks in one window
- * and a single-DOF fit does not apply: docs/diagnosis.md.) */
+ * the model's own modal damping (the truth); each pair is fitted as two
+ * modes sharing their poles on both channels (test_modal_fit_gyroscopic). */
 static void test_modal_fit_paper(void **state) {
   static const char *const outs[] = {"DA.x", "DB.x"};
   static const char *const ins[] = {"DA.x", "DA.x"};
