@@ -385,7 +385,7 @@ static double merged_half(const mref *refs, size_t nref, double w, double w0, do
 static rcb_status modal_row(rcb_compare *c, const peak *pk, size_t np, size_t ip,
                             const mref *refs, size_t nref, rcb_compare_peak *r) {
   const peak *p = &pk[ip];
-  double wn[4], zeta[4], half = 3.5 * (isfinite(p->zeta) ? p->zeta : 0.01) * p->freq;
+  double wn[4] = {0}, zeta[4] = {0}, half = 3.5 * (isfinite(p->zeta) ? p->zeta : 0.01) * p->freq;
   size_t lo, hi, n = 0, nm, nch = 0, nf = 0, best = NONE;
   rcb_status st = RCB_OK;
   double *w = rcb_alloc(&c->alloc, c->npts * sizeof *w);
