@@ -294,28 +294,66 @@ static void measured_row(const rcb_compare *c, const peak *p, const double *wt,
   r->amp_ratio = r->model_amp > 0 ? r->meas_amp / r->model_amp : (double)NAN;
 }
 
-/* The fit window of a peak: the grid points within half (rad/s) of its top,
- * at least 5 and at most 250 on each side. */
-static void fit_window(const rcb_compare *c, const peak *p, double half, size_t *lo, size_t *hi) {
+/* The fit window of a peak: the grid points within [w0, w1] (rad/s), at
+ * least 5 and at most 250 on each side of its top. */
+static void fit_window(const rcb_compare *c, const peak *p, double w0, double w1, size_t *lo,
+                       size_t *hi) {
   *lo = *hi = p->idx;
-  while (*lo > 0 && p->idx - *lo < 250 &&
-         (p->idx - *lo < 5 || c->grid[*lo - 1] >= p->freq - half))
-    (*lo)--;
-  while (*hi + 1 < c->npts && *hi - p->idx < 250 &&
-         (*hi - p->idx < 5 || c->grid[*hi + 1] <= p->freq + half))
+  while (*lo > 0 && p->idx - *lo < 250 && (p->idx - *lo < 5 || c->grid[*lo - 1] >= w0)) (*lo)--;
+  while (*hi + 1 < c->npts && *hi - p->idx < 250 && (*hi - p->idx < 5 || c->grid[*hi + 1] <= w1))
     (*hi)++;
 }
 
-/* How many modes the window [w0, w1] (rad/s) holds: the measured peaks in
- * it, plus the model's modes in it that no measured peak claimed (a
- * resonance the data show merged with a neighbour: the gyroscopic pair of a
- * rotor, seen on the direct and the cross channels), at most 4. */
-static size_t window_modes(const peak *pk, size_t np, const mref *refs, size_t nref, double w0,
-                           double w1) {
-  size_t j, n = 0;
-  for (j = 0; j < np; j++) n += pk[j].freq >= w0 && pk[j].freq <= w1;
-  for (j = 0; j < nref; j++) n += refs[j].pair == NONE && refs[j].freq >= w0 && refs[j].freq <= w1;
-  return n < 1 ? 1 : n > 4 ? 4 : n;
+/* A resonance that may share a fit window: frequency and half-power
+ * half-width zeta w, rad/s. */
+typedef struct reson {
+  double f, hw;
+} reson;
+
+/* Resonance i of the data: the measured peaks (i < np; zeta from the
+ * half-power width, 0.01 when none), then the model's modes no measured
+ * peak claimed (modes the data show merged with a neighbour: the gyroscopic
+ * pair of a rotor, one peak on the direct and the cross channels). 0 when i
+ * is a claimed mode. */
+static int resonance(const peak *pk, size_t np, const mref *refs, size_t i, reson *q) {
+  if (i < np) {
+    q->f = pk[i].freq;
+    q->hw = (isfinite(pk[i].zeta) ? pk[i].zeta : 0.01) * q->f;
+    return 1;
+  }
+  i -= np;
+  if (refs[i].pair != NONE || !isfinite(refs[i].zeta)) return 0;
+  q->f = refs[i].freq;
+  q->hw = refs[i].zeta * q->f;
+  return 1;
+}
+
+/* The resonances fitted with peak ip, at most 4, and their window [*w0,
+ * *w1] (rad/s): 3.5 half-widths either side of each. Grown from the peak
+ * alone by the nearest resonance whose half-power band [f - hw, f + hw]
+ * meets the window (its tail is not negligible there), until none does.
+ * Returns how many. */
+static size_t fit_group(const peak *pk, size_t np, const mref *refs, size_t nref, size_t ip,
+                        double *w0, double *w1) {
+  size_t grp[4] = {ip, 0, 0, 0}, ng = 1, i, j;
+  reson q;
+  resonance(pk, np, refs, ip, &q);
+  *w0 = q.f - 3.5 * q.hw, *w1 = q.f + 3.5 * q.hw;
+  while (ng < 4) {
+    size_t best = NONE;
+    double dbest = (double)INFINITY;
+    for (i = 0; i < np + nref; i++) {
+      for (j = 0; j < ng && grp[j] != i; j++) {}
+      if (j < ng || !resonance(pk, np, refs, i, &q)) continue;
+      if (q.f + q.hw < *w0 || q.f - q.hw > *w1 || fabs(q.f - pk[ip].freq) >= dbest) continue;
+      best = i, dbest = fabs(q.f - pk[ip].freq);
+    }
+    if (best == NONE) break;
+    resonance(pk, np, refs, best, &q);
+    grp[ng++] = best;
+    *w0 = fmin(*w0, q.f - 3.5 * q.hw), *w1 = fmax(*w1, q.f + 3.5 * q.hw);
+  }
+  return ng;
 }
 
 /* The window's points into w (rad/s) and h (channel-major, stride
@@ -357,35 +395,18 @@ static size_t nearest_pole(const double *wn, const double *zeta, size_t nf, doub
   return best;
 }
 
-/* The half-width (rad/s) of a window about w that holds 3.5 half-widths
- * either side of every model mode no measured peak claimed in [w0, w1]. */
-static double merged_half(const mref *refs, size_t nref, double w, double w0, double w1,
-                          double half) {
-  size_t j;
-  for (j = 0; j < nref; j++) {
-    const mref *q = &refs[j];
-    if (q->pair != NONE || q->freq < w0 || q->freq > w1 || !isfinite(q->zeta)) continue;
-    half = fmax(half, fabs(q->freq - w) + 3.5 * q->zeta * q->freq);
-  }
-  return half;
-}
-
 /* The local modal fit of a measured peak (compare_modal.c) over 3.5
  * half-power half-widths (zeta w) either side of the top: a window of about
  * one half-width leaves the fit's residual terms free to take up the noise,
  * and under eq. 19 noise the damping then comes out 25 % low, as the
- * half-power width's does. Alone in its window: one mode on the peak's
- * dominant channel. With several modes in the window (window_modes): as
- * many modes sharing their poles on every channel finite there, the peak
- * taking the pole nearest its frequency. The half-power width of modes
- * merged into one peak says little (the cross channels of a gyroscopic pair
- * show the two modes' difference, a narrower peak): the window then also
- * holds 3.5 half-widths of each merged model mode (merged_half), and the
- * mode count is taken again on it. */
+ * half-power width's does. Alone (fit_group): one mode on the peak's
+ * dominant channel. With neighbours: as many modes sharing their poles on
+ * every channel finite on the group's window, the peak taking the pole
+ * nearest its frequency. */
 static rcb_status modal_row(rcb_compare *c, const peak *pk, size_t np, size_t ip,
                             const mref *refs, size_t nref, rcb_compare_peak *r) {
   const peak *p = &pk[ip];
-  double wn[4] = {0}, zeta[4] = {0}, half = 3.5 * (isfinite(p->zeta) ? p->zeta : 0.01) * p->freq;
+  double wn[4] = {0}, zeta[4] = {0}, w0, w1;
   size_t lo, hi, n = 0, nm, nch = 0, nf = 0, best = NONE;
   rcb_status st = RCB_OK;
   double *w = rcb_alloc(&c->alloc, c->npts * sizeof *w);
@@ -393,12 +414,8 @@ static rcb_status modal_row(rcb_compare *c, const peak *pk, size_t np, size_t ip
   r->meas_zeta_hp = p->zeta;
   r->meas_wd = (double)NAN;
   if (!w || !h) st = rcb_cmp_fail(c, RCB_ERR_NOMEM, "out of memory (modal fit)");
-  fit_window(c, p, half, &lo, &hi);
-  nm = window_modes(pk, np, refs, nref, c->grid[lo], c->grid[hi]);
-  if (nm > 1) {
-    fit_window(c, p, merged_half(refs, nref, p->freq, c->grid[lo], c->grid[hi], half), &lo, &hi);
-    nm = window_modes(pk, np, refs, nref, c->grid[lo], c->grid[hi]);
-  }
+  nm = fit_group(pk, np, refs, nref, ip, &w0, &w1);
+  fit_window(c, p, w0, w1, &lo, &hi);
   if (!st && nm > 1) n = gather(c, lo, hi, c->nch, w, h, &nch);
   if (!st && nch == 0) /* alone, or no channel finite on the whole window */
     nm = 1, n = gather(c, lo, hi, r->channel, w, h, &nch);
