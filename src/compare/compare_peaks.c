@@ -336,7 +336,7 @@ static int resonance(const peak *pk, size_t np, const mref *refs, size_t i, reso
 static size_t fit_group(const peak *pk, size_t np, const mref *refs, size_t nref, size_t ip,
                         double *w0, double *w1) {
   size_t grp[4] = {ip, 0, 0, 0}, ng = 1, i, j;
-  reson q;
+  reson q = {0.0, 0.0};
   resonance(pk, np, refs, ip, &q);
   *w0 = q.f - 3.5 * q.hw, *w1 = q.f + 3.5 * q.hw;
   while (ng < 4) {
