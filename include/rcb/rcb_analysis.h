@@ -10,8 +10,9 @@
  * SuiteSparse): KLU allocates its LU factors itself, with SuiteSparse's
  * malloc, at the first factorisation and whenever it pivots anew. A host
  * that needs every byte through its hooks asks for RCB_SOLVER_DENSE or
- * RCB_SOLVER_BANDED, or builds without SuiteSparse (the embedded preset). Objects keep a pointer to the model: the model
- * must outlive them. Two objects on two threads never share state.
+ * RCB_SOLVER_BANDED, or builds without SuiteSparse (the embedded preset).
+ * Objects keep a pointer to the model: the model must outlive them. Two
+ * objects on two threads never share state.
  */
 #ifndef RCB_ANALYSIS_H
 #define RCB_ANALYSIS_H

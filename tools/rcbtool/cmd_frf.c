@@ -193,31 +193,35 @@ static int sweep(const cli_args *a, frf_job *j, rcb_frf *f, rcb_complex *H) {
 
 /* --solver auto at one speed: the modal path where it pays
  * (rcb_frf_pick_solver), if its basis passes the check against one direct
- * solve at fmax within AUTO_MODAL_TOL (-); a direct solver otherwise. */
+ * solve at fmax within AUTO_MODAL_TOL (-): then the checked object (basis
+ * computed) is returned and j->solver set; NULL for a direct solver. */
 #define AUTO_MODAL_TOL 1e-8
 
-static void pick_auto(const rcb_model *m, frf_job *j) {
+static rcb_frf *pick_auto(const rcb_model *m, frf_job *j) {
   rcb_frf *f = NULL;
   double w = j->npts ? j->freq[j->npts - 1] * CLI_HZ_TO_RAD_S : 0.0,
          speed = j->rpm * CLI_RPM_TO_RAD_S, err = (double)NAN;
   if (j->solver != RCB_SOLVER_AUTO ||
       rcb_frf_pick_solver(m, j->npts, !j->sync) != RCB_SOLVER_MODAL)
-    return;
+    return NULL;
   if (!rcb_frf_create(&f, m, j->out.n, j->out.dofs, j->in.n, j->in.dofs, RCB_SOLVER_MODAL,
                       NULL) &&
-      !rcb_frf_modal_error(f, w, speed, &err) && err <= AUTO_MODAL_TOL)
+      !rcb_frf_modal_error(f, w, speed, &err) && err <= AUTO_MODAL_TOL) {
     j->solver = RCB_SOLVER_MODAL;
+    return f;
+  }
   rcb_frf_destroy(f);
+  return NULL;
 }
 
 static int compute(const cli_args *a, const rcb_model *m, frf_job *j) {
-  rcb_frf *f = NULL;
+  rcb_frf *f = pick_auto(m, j);
   rcb_complex *H;
   int rc;
-  rcb_status st;
-  pick_auto(m, j);
-  st = rcb_frf_create(&f, m, j->out.n, j->out.dofs, j->in.n, j->in.dofs,
-                      (rcb_solver_kind)j->solver, NULL);
+  rcb_status st =
+      f ? RCB_OK
+        : rcb_frf_create(&f, m, j->out.n, j->out.dofs, j->in.n, j->in.dofs,
+                         (rcb_solver_kind)j->solver, NULL);
   if (st) {
     rc = cli_fail(cli_status_exit(st), "frf: %s",
                   cli_msg(f ? rcb_frf_errmsg(f) : rcb_model_errmsg(m), st));
@@ -225,7 +229,8 @@ static int compute(const cli_args *a, const rcb_model *m, frf_job *j) {
     return rc;
   }
   j->solver = (int)rcb_frf_solver(f);
-  if (j->solver == RCB_SOLVER_MODAL &&
+  /* the default (all modes) needs no call, which would drop pick_auto's basis */
+  if (j->solver == RCB_SOLVER_MODAL && (j->modes || j->modes_fmax > 0.0) &&
       (st = rcb_frf_set_modal(f, j->modes, j->modes_fmax * CLI_HZ_TO_RAD_S))) {
     rc = cli_fail(cli_status_exit(st), "frf: %s", cli_msg(rcb_frf_errmsg(f), st));
     rcb_frf_destroy(f);
