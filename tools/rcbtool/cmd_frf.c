@@ -60,6 +60,7 @@ typedef struct frf_job {
   int modal_ok;          /* modal report below is filled */
   rcb_modal_info modal;
   double modal_err;      /* truncation error estimate at fmax (-) */
+  int modal_err_set;     /* 1: modal_err already measured (by pick_auto) */
 } frf_job;
 
 static int parse_grid(const cli_args *a, frf_job *j, double *fmin, double *fmax) {
@@ -122,7 +123,7 @@ static void free_job(frf_job *j) {
 static rcb_status modal_report(const cli_args *a, frf_job *j, rcb_frf *f, double w,
                                double speed) {
   rcb_status st = rcb_frf_modal_info(f, speed, &j->modal);
-  if (!st) st = rcb_frf_modal_error(f, w, speed, &j->modal_err);
+  if (!st && !j->modal_err_set) st = rcb_frf_modal_error(f, w, speed, &j->modal_err);
   if (st) return st;
   j->modal_ok = 1;
   fprintf(stderr,
@@ -208,6 +209,7 @@ static rcb_frf *pick_auto(const rcb_model *m, frf_job *j) {
                       NULL) &&
       !rcb_frf_modal_error(f, w, speed, &err) && err <= AUTO_MODAL_TOL) {
     j->solver = RCB_SOLVER_MODAL;
+    j->modal_err = err, j->modal_err_set = 1; /* the same check modal_report makes */
     return f;
   }
   rcb_frf_destroy(f);
