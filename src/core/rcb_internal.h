@@ -31,6 +31,9 @@ void rcb_allocator_init(rcb_allocator *dst, const rcb_allocator *src);
 int rcb_grow(const rcb_allocator *a, void **items, size_t *cap, size_t need, size_t item_size);
 
 /* ---- core/errmsg.c ---- */
+/* Show control bytes (C0, DEL) of a message as \xNN, in place, truncated to
+ * @p size bytes with the NUL: a token echoed from a file cannot drive a terminal. */
+void rcb_escape_controls(char *buf, size_t size);
 /* printf into an object's error buffer, returns st for "return rcb_fail(...)" */
 rcb_status rcb_set_error(char *buf, rcb_status st, const char *fmt, ...)
 #if defined(__GNUC__)

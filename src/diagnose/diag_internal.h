@@ -61,6 +61,7 @@ struct rcb_diag {
   size_t nrefit;
   int (*progress)(void *user, size_t done, size_t total);
   void *progress_user;
+  size_t progress_done;             /* steps reported: a count that only rises */
   diag_base_par *base;
   size_t nbase, cap_base;
   /* results */

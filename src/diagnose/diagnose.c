@@ -53,6 +53,7 @@ static void free_results(rcb_diag *d) {
   d->ncand = d->cap_cand = 0;
   d->ran = 0;
   memset(&d->stats, 0, sizeof d->stats);
+  d->progress_done = 0;
 }
 
 void rcb_diag_destroy(rcb_diag *d) {
@@ -310,8 +311,11 @@ typedef struct score_ws {
   size_t which[RCB_DIAG_BATCH], ncand, npar; /* candidates of the batch, their parameters */
 } score_ws;
 
-static rcb_status progress(rcb_diag *d, size_t k) {
-  if (d->progress && d->progress(d->progress_user, k + 1, d->ncand + d->nrefit))
+/* One more candidate scored. Candidates finish out of index order (a batch of
+ * alike ones is swept together), so the count reported is the number done,
+ * not the index of the one just done. */
+static rcb_status progress(rcb_diag *d) {
+  if (d->progress && d->progress(d->progress_user, ++d->progress_done, d->ncand + d->nrefit))
     return rcb_diag_fail(d, RCB_ERR_STATE, "stopped by the caller");
   return RCB_OK;
 }
@@ -325,7 +329,7 @@ static rcb_status flush_batch(rcb_diag *d, score_ws *w) {
     diag_cand *c = &d->cand[w->which[b]];
     c->predicted = explained(w->J + d->nres * off, d->nres, c->np, w->r, w->Q0, w->q0);
     off += c->np;
-    st = progress(d, w->which[b]);
+    st = progress(d);
   }
   rcb_fit_dz_free(&d->alloc, w->dz, w->npar);
   w->ncand = w->npar = 0;
@@ -364,7 +368,7 @@ static rcb_status score_all(rcb_diag *d) {
     if (same) {
       w.which[w.ncand++] = k, w.npar += c->np;
     } else if (!(st = score_alone(d, c, r, Q0, w.q0, w.J + n * w.npar))) {
-      st = progress(d, k);
+      st = progress(d);
     }
   }
   if (!st) st = flush_batch(d, &w);
@@ -502,8 +506,9 @@ static rcb_status refit_best(rcb_diag *d) {
     if (c->refit_only || done >= d->nrefit || !(c->predicted > 0)) continue;
     st = refit(d, c);
     done++;
+    if (d->progress_done < d->ncand) d->progress_done = d->ncand; /* refit-only ones */
     if (!st && d->progress &&
-        d->progress(d->progress_user, d->ncand + done, d->ncand + d->nrefit))
+        d->progress(d->progress_user, ++d->progress_done, d->ncand + d->nrefit))
       st = rcb_diag_fail(d, RCB_ERR_STATE, "stopped by the caller");
   }
   for (k = 0; !st && k < d->ncand; k++)

@@ -18,6 +18,7 @@ rcb_status (rcb_meas_fail)(rcb_meas *ms, rcb_status st, const char *fmt, ...) {
   va_start(ap, fmt);
   vsnprintf(ms->errmsg, sizeof ms->errmsg, fmt, ap);
   va_end(ap);
+  rcb_escape_controls(ms->errmsg, sizeof ms->errmsg);
   return st;
 }
 

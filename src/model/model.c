@@ -57,6 +57,7 @@ rcb_status (rcb_model_fail)(rcb_model *m, rcb_status st, const char *fmt, ...) {
   va_start(ap, fmt);
   vsnprintf(m->errmsg, sizeof m->errmsg, fmt, ap);
   va_end(ap);
+  rcb_escape_controls(m->errmsg, sizeof m->errmsg);
   return st;
 }
 

@@ -40,6 +40,7 @@ typedef struct cli_args {
   const char *output; /**< -o FILE, NULL = stdout */
   int json;           /**< --json */
   int progress;       /**< --progress */
+  double max_output_mb; /**< --max-output MB: largest output accepted, MB (0: default) */
   int help;           /**< --help / -h */
   cli_opt *opts;
   size_t nopts;
@@ -55,7 +56,8 @@ typedef struct cli_command {
 
 /* ---- messages (cli_common.c) ---- */
 
-/** Print "rcbtool: <message>" to stderr and return @p code. */
+/** Print "rcbtool: <message>" to stderr (control bytes shown as \xNN) and
+ * return @p code. */
 int cli_fail(int code, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 2, 3)))
@@ -64,6 +66,13 @@ int cli_fail(int code, const char *fmt, ...)
 #ifdef __clang_analyzer__ /* returns code: see rcb_set_error in src/core/rcb_internal.h */
 #define cli_fail(code, ...) ((void)(cli_fail)((code), __VA_ARGS__), (code))
 #endif
+/** Print "rcbtool: warning: <message>" to stderr (control bytes escaped, as
+ * in every message of cli_fail and cli_usage). */
+void cli_warn(const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 1, 2)))
+#endif
+    ;
 /** A usage error: message plus a pointer to --help; returns CLI_EXIT_USAGE. */
 int cli_usage(const char *cmd, const char *fmt, ...)
 #if defined(__GNUC__)
@@ -75,6 +84,9 @@ int cli_usage(const char *cmd, const char *fmt, ...)
 #endif
 /** @p msg if it says something, else the status text. */
 const char *cli_msg(const char *msg, rcb_status st);
+/** All of standard input, NUL-terminated (*len bytes before the terminator);
+ * NULL after a printed message when it cannot be read. */
+char *cli_read_stdin(size_t *len);
 /** Exit code for a failed analysis call (numerical failure unless it is the input). */
 int cli_status_exit(rcb_status st);
 /**
@@ -133,19 +145,59 @@ void cli_channels_free(cli_channels *ch);
 
 /* ---- output (cli_output.c) ---- */
 
+/** Record @p path as an input of this run (@p what: "model", "measurement", ...);
+ * "-" and missing files are ignored. */
+void cli_input_add(const char *path, const char *what);
+/** Refuse (message, exit 5) an output path that is one of the inputs (same
+ * device and inode, so links and other spellings count); 0 otherwise. */
+int cli_output_check(const char *path);
+/** SIGINT, SIGTERM, SIGHUP remove the registered temporary files, then end the
+ * process by the same signal (called once, from main). */
+void cli_signals_install(void);
+/** Add a temporary file to the list the signal handler removes; returns its
+ * slot (-1 if the list is full or the path too long). */
+int cli_tmp_register(const char *path);
+/** Take slot @p slot off the list (after the rename or the removal); -1 is ignored. */
+void cli_tmp_release(int slot);
+
 /** Where results go: stdout, or a temporary file renamed onto -o FILE at the end. */
 typedef struct cli_out {
   FILE *fp;
   const char *path; /**< final path, NULL for stdout */
   char *tmp;        /**< temporary path while writing */
+  int slot;         /**< its entry in the signal handler's list (-1: none) */
 } cli_out;
 
+/** Default of --max-output: the largest output accepted, MB (10^6 bytes). */
+#define CLI_MAX_OUTPUT_MB 2000.0
+/**
+ * @brief Refuse, before any work, an output of @p rows rows of @p numbers
+ * numbers each whose size (~25 bytes a number as text, "%.17g" and a
+ * separator) is above --max-output MB; 0 or a usage error (exit 2).
+ */
+int cli_check_size(const cli_args *a, double rows, double numbers);
 /** Open the destination; refuses to write over the model file. 0 or exit 5. */
 int cli_out_open(cli_out *o, const cli_args *a);
+/** Flush and close the temporary file, not yet renamed (cli_out_close or
+ * cli_out_abort follows); on error remove it, exit 5. */
+int cli_out_flush(cli_out *o);
 /** Flush and commit (rename the temporary file); on any error remove it, exit 5. */
 int cli_out_close(cli_out *o);
 /** Abandon the output: the temporary file is removed, nothing is left. */
 void cli_out_abort(cli_out *o);
+
+/** A file written by a library call (which makes its own temporary beside the
+ * path it is given): the call writes write_path, a temporary of ours. */
+typedef struct cli_tmpfile {
+  const char *path;       /**< final path */
+  const char *write_path; /**< what to give the writer (path itself for a device) */
+  char *tmp;
+  int slot[2];
+} cli_tmpfile;
+/** Make the temporary (on the signal handler's list); 0 or exit 5. */
+int cli_tmpfile_open(cli_tmpfile *t, const char *path);
+/** Rename the temporary onto the path if @p ok, else remove it; 0 or exit 5. */
+int cli_tmpfile_close(cli_tmpfile *t, int ok);
 
 /** Number as CSV field: "%.17g" ("nan", "inf" as printf spells them). */
 void cli_csv_num(FILE *fp, double x);
@@ -215,7 +267,11 @@ int cli_split_meas(int argc, char **argv, const cli_opt *opts, size_t nopts, cha
  * points into it) is set in every case, NULL when out of memory. */
 int cli_parse_meas_cmd(int argc, char **argv, cli_opt *opts, size_t nopts, const char *help,
                        const char *expected, cli_args *a, const char **meas, char ***args);
-/** Read a measurement by extension (UFF with --map or the model's [uff] map,
+/** Record the model and @p meas as inputs and refuse, before any work, an
+ * output (-o, --history, the --plot files) that is one of them or a history
+ * file that is not one; 0 or exit 5. */
+int cli_guard_outputs(const cli_args *a, const char *meas);
+/** Read a measurement by extension ("-": standard input, CSV or UFF by content) (UFF with --map or the model's [uff] map,
  * or CSV); exit code 0, 2, 3 or 4 with the message printed. */
 int cli_meas_read(const cli_args *a, const char *path, const rcb_model *m, rcb_meas **out);
 
@@ -239,6 +295,9 @@ void cli_params_free(cli_params *ps);
  * bounds around the start if @p any; else a usage error (2). */
 int cli_param_bounds(const cli_args *a, const cli_param_spec *p, double start, int any,
                      double *lo, double *hi);
+/** 0 if @p path may take history records: new, empty, or history lines only,
+ * and no input of this run; else a message and exit 5 (nothing written). */
+int cli_history_check(const char *path);
 /** Append a step to a history file (JSON lines, rewritten atomically): the
  * command, the model, its error % (and the noise floor, NaN if unknown), the
  * number of parameters fitted so far, and a note; exit code 0 or 5. */

@@ -29,7 +29,7 @@ static void list_options(const cli_args *a, char *buf, size_t size) {
       if (k > 0) len += (size_t)k;
     }
   }
-  if (len < size) snprintf(buf + len, size - len, "-o FILE, --json, --progress, --help");
+  if (len < size) snprintf(buf + len, size - len, "-o FILE, --json, --progress, --max-output MB, --help");
 }
 
 /* Take the value of option @p name: after '=' or the next argument. */
@@ -59,6 +59,16 @@ static int parse_common(cli_args *a, int argc, char **argv, int *k, int *rc) {
     a->json = 1;
   } else if (strcmp(arg, "--progress") == 0) {
     a->progress = 1;
+  } else if (names(arg, "--max-output")) {
+    const char *v = NULL;
+    char *end;
+    if (a->max_output_mb > 0) *rc = cli_usage(a->cmd, "option --max-output given twice");
+    if (!*rc) *rc = take_value(a, argc, argv, k, "--max-output", "MB", &v);
+    if (!*rc) {
+      a->max_output_mb = strtod(v, &end);
+      if (*end || !(a->max_output_mb > 0) || !isfinite(a->max_output_mb))
+        *rc = cli_usage(a->cmd, "option --max-output expects a size in MB > 0, got '%s'", v);
+    }
   } else if (strcmp(arg, "-o") == 0 || names(arg, "--output")) {
     if (a->output) *rc = cli_usage(a->cmd, "option -o/--output given twice");
     if (!*rc) *rc = take_value(a, argc, argv, k, "-o", "FILE", &a->output);

@@ -2,17 +2,57 @@
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
 #include "cli.h"
+
+/* Write @p s to stderr with control bytes (C0, DEL) shown as \xNN: a name or
+ * value echoed from a file or the command line cannot move the cursor, clear
+ * the screen or set the window title. */
+static void put_escaped(const char *s) {
+  for (; *s; s++) {
+    unsigned char c = (unsigned char)*s;
+    if (c < 0x20 || c == 0x7f)
+      fprintf(stderr, "\\x%02x", c);
+    else
+      fputc(c, stderr);
+  }
+}
+
+/* Format and print escaped (a message of any length). */
+static void vput_escaped(const char *fmt, va_list ap) {
+  char small[1024], *buf = small;
+  va_list aq;
+  int n;
+  va_copy(aq, ap);
+  n = vsnprintf(small, sizeof small, fmt, ap);
+  if (n >= (int)sizeof small && (buf = malloc((size_t)n + 1)) != NULL)
+    vsnprintf(buf, (size_t)n + 1, fmt, aq);
+  else if (n >= (int)sizeof small)
+    buf = small; /* out of memory: the first 1023 bytes */
+  va_end(aq);
+  if (n >= 0) put_escaped(buf);
+  if (buf != small) free(buf);
+}
 
 int (cli_fail)(int code, const char *fmt, ...) {
   va_list ap;
   fputs("rcbtool: ", stderr);
   va_start(ap, fmt);
-  vfprintf(stderr, fmt, ap);
+  vput_escaped(fmt, ap);
   va_end(ap);
   fputc('\n', stderr);
   return code;
+}
+
+void cli_warn(const char *fmt, ...) {
+  va_list ap;
+  fputs("rcbtool: warning: ", stderr);
+  va_start(ap, fmt);
+  vput_escaped(fmt, ap);
+  va_end(ap);
+  fputc('\n', stderr);
 }
 
 int (cli_usage)(const char *cmd, const char *fmt, ...) {
@@ -20,7 +60,7 @@ int (cli_usage)(const char *cmd, const char *fmt, ...) {
   fputs("rcbtool: ", stderr);
   if (cmd) fprintf(stderr, "%s: ", cmd);
   va_start(ap, fmt);
-  vfprintf(stderr, fmt, ap);
+  vput_escaped(fmt, ap);
   va_end(ap);
   fputc('\n', stderr);
   if (cmd)
@@ -83,4 +123,32 @@ void cli_warn_condition(const char *cmd, const rcb_frf_condition *c, int by_spee
           "undamped resonance\n",
           cmd, where, c->rcond_min, c->threshold, c->ill, c->checked,
           c->rcond_min > 0 ? fmin(1.0, 2.220446049250313e-16 / c->rcond_min) : 1.0);
+}
+
+char *cli_read_stdin(size_t *len) {
+  size_t cap = 0, n = 0, r;
+  char *buf = NULL;
+  *len = 0;
+  for (;;) {
+    if (n + 4096 + 1 > cap) {
+      char *nb = realloc(buf, cap = 2 * cap + 65536);
+      if (!nb) {
+        free(buf);
+        cli_fail(CLI_EXIT_NUMERIC, "out of memory reading standard input");
+        return NULL;
+      }
+      buf = nb;
+    }
+    r = fread(buf + n, 1, cap - n - 1, stdin);
+    n += r;
+    if (r == 0) break;
+  }
+  if (ferror(stdin)) {
+    free(buf);
+    cli_fail(CLI_EXIT_INPUT, "cannot read standard input");
+    return NULL;
+  }
+  buf[n] = '\0';
+  *len = n;
+  return buf;
 }

@@ -3,6 +3,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "cli.h"
 
@@ -45,17 +46,97 @@ int cli_parse_meas_cmd(int argc, char **argv, cli_opt *opts, size_t nopts, const
   if ((rc = cli_parse(nargs, *args, opts, nopts, a))) return rc;
   if (a->help) return (rc = cli_print_help(help)) ? rc : -1;
   if (!*meas) return cli_usage(a->cmd, "missing the measurement file: expected %s", expected);
+  if (strcmp(a->model, "-") == 0 && strcmp(*meas, "-") == 0)
+    return cli_usage(a->cmd, "the model and the measurement cannot both come from standard "
+                     "input ('-'); give one of them as a file");
+  return cli_guard_outputs(a, *meas);
+}
+
+int cli_guard_outputs(const cli_args *a, const char *meas) {
+  static const char *const plot_files[] = {"_compare.json", "_overlay.png",
+                                           "_residual_map.png"};
+  const char *plot = cli_opt_value(a, "--plot"), *hist = cli_opt_value(a, "--history");
+  size_t i;
+  int rc = 0;
+  /* before any work: the inputs are known, every output is checked against them */
+  cli_input_add(a->model, "model");
+  cli_input_add(meas, "measurement");
+  if (a->output && (rc = cli_output_check(a->output))) return rc;
+  if (hist && (rc = cli_history_check(hist))) return rc;
+  for (i = 0; plot && i < sizeof plot_files / sizeof plot_files[0] && !rc; i++) {
+    char *name = malloc(strlen(plot) + strlen(plot_files[i]) + 1);
+    if (!name) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+    strcpy(name, plot);
+    strcat(name, plot_files[i]);
+    rc = cli_output_check(name);
+    free(name);
+  }
+  return rc;
+}
+
+/* A measurement on standard input goes to a temporary file (on the signal
+ * handler's list, removed after reading); UFF when its first field is the
+ * "-1" delimiter, else CSV. */
+static int stdin_to_file(char *path, size_t size, int *slot, int *is_uff) {
+  const char *dir = getenv("TMPDIR"), *p;
+  size_t len = 0;
+  char *text;
+  FILE *fp;
+  int fd, ok;
+  *slot = -1;
+  if (!(text = cli_read_stdin(&len))) return CLI_EXIT_INPUT;
+  for (p = text; p < text + len && (*p == ' ' || *p == '\t' || *p == '\r' || *p == '\n'); p++) {
+  }
+  *is_uff = p + 1 < text + len && p[0] == '-' && p[1] == '1';
+  snprintf(path, size, "%s/rcbtool-stdin-XXXXXX", dir && *dir ? dir : "/tmp");
+  if ((fd = mkstemp(path)) < 0 || !(fp = fdopen(fd, "wb"))) {
+    if (fd >= 0) close(fd), remove(path);
+    free(text);
+    return cli_fail(CLI_EXIT_IO, "cannot copy the measurement from standard input to a "
+                    "temporary file in %s (set TMPDIR)", dir && *dir ? dir : "/tmp");
+  }
+  *slot = cli_tmp_register(path);
+  ok = fwrite(text, 1, len, fp) == len;
+  ok = (fclose(fp) == 0) && ok;
+  free(text);
+  if (!ok) {
+    remove(path);
+    cli_tmp_release(*slot);
+    return cli_fail(CLI_EXIT_IO, "cannot write a temporary copy of standard input");
+  }
   return 0;
 }
 
+static int meas_read(const cli_args *a, const char *path, const rcb_model *m, int is_uff,
+                     rcb_meas **out);
+
 int cli_meas_read(const cli_args *a, const char *path, const rcb_model *m,
+                     rcb_meas **out) {
+  int is_uff = 0, rc, slot = -1, from_stdin = strcmp(path, "-") == 0;
+  char tmp[4200];
+  *out = NULL;
+  if (from_stdin) {
+    if ((rc = stdin_to_file(tmp, sizeof tmp, &slot, &is_uff))) return rc;
+    path = tmp;
+  } else if ((rc = cli_meas_format(a->cmd, path, &is_uff))) {
+    return rc;
+  }
+  cli_input_add(path, "measurement");
+  rc = meas_read(a, path, m, is_uff, out);
+  if (from_stdin) {
+    if (rc) fputs("rcbtool: (the measurement came from standard input)\n", stderr);
+    remove(tmp);
+    cli_tmp_release(slot);
+  }
+  return rc;
+}
+
+static int meas_read(const cli_args *a, const char *path, const rcb_model *m, int is_uff,
                      rcb_meas **out) {
   cli_uff_map mp;
   rcb_meas *ms = NULL;
   rcb_status st;
-  int is_uff = 0, rc;
-  *out = NULL;
-  if ((rc = cli_meas_format(a->cmd, path, &is_uff))) return rc;
+  int rc;
   if ((rc = cli_uff_map_parse(a, "--map", m, &mp))) {
     cli_uff_map_free(&mp);
     return rc;
@@ -73,7 +154,7 @@ int cli_meas_read(const cli_args *a, const char *path, const rcb_model *m,
   if (st) {
     const char *msg = cli_msg(rcb_meas_errmsg(ms), st);
     rc = cli_fail(st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC : CLI_EXIT_INPUT, "%s", msg);
-    if (!strstr(msg, path)) fprintf(stderr, "rcbtool: (while reading measurement '%s')\n", path);
+    if (!strstr(msg, path)) (void)cli_fail(rc, "(while reading measurement '%s')", path);
     rcb_meas_destroy(ms);
     return rc;
   }

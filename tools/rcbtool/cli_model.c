@@ -8,22 +8,39 @@
 int cli_load_model(const cli_args *a, rcb_model **out) {
   rcb_model *m = NULL;
   rcb_status st;
-  FILE *probe = fopen(a->model, "r");
+  char *text = NULL;
+  int from_stdin = strcmp(a->model, "-") == 0;
   *out = NULL;
-  /* A clear message for the commonest mistake, before the parser sees it. */
-  if (!probe)
-    return cli_fail(CLI_EXIT_INPUT, "cannot open model file '%s': %s", a->model,
-                    strerror(errno));
-  fclose(probe);
+  if (from_stdin) {
+    size_t len;
+    if (!(text = cli_read_stdin(&len))) return CLI_EXIT_INPUT;
+    if (strlen(text) != len) {
+      free(text);
+      return cli_fail(CLI_EXIT_INPUT, "model from standard input: a NUL byte in the text; "
+                      "expected an INI model");
+    }
+  } else {
+    /* A clear message for the commonest mistake, before the parser sees it. */
+    FILE *probe = fopen(a->model, "r");
+    if (!probe)
+      return cli_fail(CLI_EXIT_INPUT, "cannot open model file '%s': %s", a->model,
+                      strerror(errno));
+    fclose(probe);
+    cli_input_add(a->model, "model");
+  }
   st = rcb_model_create(&m, NULL);
-  if (st) return cli_fail(CLI_EXIT_NUMERIC, "cannot create a model: %s", rcb_status_str(st));
-  st = rcb_model_load_file(m, a->model);
+  if (st) {
+    free(text);
+    return cli_fail(CLI_EXIT_NUMERIC, "cannot create a model: %s", rcb_status_str(st));
+  }
+  st = from_stdin ? rcb_model_load_string(m, text, "<stdin>") : rcb_model_load_file(m, a->model);
+  free(text);
   if (st) {
     const char *msg = rcb_model_errmsg(m);
     cli_fail(CLI_EXIT_INPUT, "%s", msg && *msg ? msg : rcb_status_str(st));
     if (!msg || !strstr(msg, a->model))
-      fprintf(stderr, "rcbtool: (while loading model file '%s': %s)\n", a->model,
-              rcb_status_str(st));
+      (void)cli_fail(CLI_EXIT_INPUT, "(while loading model file '%s': %s)", a->model,
+                     rcb_status_str(st));
     rcb_model_destroy(m);
     return st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC : CLI_EXIT_INPUT;
   }

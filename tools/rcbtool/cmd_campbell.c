@@ -172,8 +172,8 @@ static void write_json(FILE *fp, const camp_job *j) {
 static int run(const cli_args *a, const rcb_model *m, camp_job *j, double lo, double hi) {
   cli_out o;
   size_t i;
-  int rc = alloc_job(j);
-  if (rc) return rc;
+  int rc = cli_check_size(a, (double)j->ns, 1.0 + 3.0 * (double)j->nm);
+  if (rc || (rc = alloc_job(j))) return rc;
   cli_linspace(lo, hi, j->ns, j->rpm);
   for (i = 0; i < j->ns; i++) j->speed[i] = j->rpm[i] * CLI_RPM_TO_RAD_S;
   if ((rc = compute(a, m, j)) || (rc = cli_out_open(&o, a))) return rc;

@@ -102,7 +102,7 @@ int cmd_check(int argc, char **argv) {
   if ((rc = cli_load_model(&a, &m))) return rc;
   /* implausible values (unit slips) and separate rotors: stderr, exit 0 */
   for (size_t w = 0; w < rcb_model_warning_count(m); w++)
-    fprintf(stderr, "rcbtool: warning: %s\n", rcb_model_warning(m, w));
+    cli_warn("%s", rcb_model_warning(m, w));
   if (!(rc = cli_out_open(&o, &a))) {
     if (a.json)
       write_json(o.fp, m, a.model);

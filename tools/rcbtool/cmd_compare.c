@@ -409,6 +409,9 @@ static int find_plots_script(char *buf, size_t size) {
   return -1;
 }
 
+/* A failed --plot leaves no output file (the run failed as a whole). */
+#define NOTHING_KEPT "no output file was kept (run without --plot for the comparison alone)"
+
 /* Run PYTHON SCRIPT compare JSON PREFIX; its messages go to our stderr. */
 static int run_plotter(const char *json, const char *prefix) {
   const char *py = getenv("RCB_PYTHON");
@@ -418,8 +421,7 @@ static int run_plotter(const char *json, const char *prefix) {
   if (!py || !*py) py = "python3";
   if (find_plots_script(script, sizeof script))
     return cli_fail(CLI_EXIT_IO, "--plot: cannot find the plotting script %s (set RCB_PLOTS "
-                    "to the path of tools/python/rcb_plots.py); the data are in %s",
-                    script, json);
+                    "to the path of tools/python/rcb_plots.py); %s", script, NOTHING_KEPT);
   fflush(stdout);
   fflush(stderr);
   pid = fork();
@@ -435,27 +437,49 @@ static int run_plotter(const char *json, const char *prefix) {
   if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return 0;
   if (WIFEXITED(status) && WEXITSTATUS(status) == 3)
     return cli_fail(CLI_EXIT_IO, "--plot: Python '%s' has no matplotlib (pip install "
-                    "matplotlib, or set RCB_PYTHON to an interpreter that has it); the data "
-                    "are in %s", py, json);
-  return cli_fail(CLI_EXIT_IO, "--plot: the plotting script failed (%s %s); the data are "
-                  "in %s", py, script, json);
+                    "matplotlib, or set RCB_PYTHON to an interpreter that has it); %s", py,
+                    NOTHING_KEPT);
+  return cli_fail(CLI_EXIT_IO, "--plot: the plotting script failed (%s %s); %s", py, script,
+                  NOTHING_KEPT);
 }
 
+/* PREFIX + @p suffix, or NULL (message printed). */
+static char *prefixed(const char *prefix, const char *suffix) {
+  char *s = malloc(strlen(prefix) + strlen(suffix) + 1);
+  if (!s) {
+    cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+    return NULL;
+  }
+  strcpy(s, prefix);
+  return strcat(s, suffix);
+}
+
+/* The JSON is committed only when the plotter succeeded; pictures it left
+ * behind on a failure are removed unless they were there before. */
 static int write_plots(const cli_args *a, const cmp_job *j, const rcb_meas *ms,
                        const rcb_compare *c, const size_t *ord) {
+  static const char *const pics[2] = {"_overlay.png", "_residual_map.png"};
   cli_args pa = *a;
   cli_out o;
-  char *json = malloc(strlen(j->plot) + sizeof "_compare.json");
-  int rc;
-  if (!json) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
-  strcpy(json, j->plot);
-  strcat(json, "_compare.json");
-  pa.output = json;
-  if (!(rc = cli_out_open(&o, &pa))) {
-    print_json(o.fp, a, j, ms, c, ord);
-    if (!(rc = cli_out_close(&o))) rc = run_plotter(json, j->plot);
+  char *json = prefixed(j->plot, "_compare.json"), *pic[2] = {NULL, NULL};
+  int rc = json ? 0 : CLI_EXIT_NUMERIC, existed[2] = {1, 1}, k;
+  for (k = 0; k < 2 && !rc; k++) {
+    if (!(pic[k] = prefixed(j->plot, pics[k]))) rc = CLI_EXIT_NUMERIC;
+    if (pic[k]) existed[k] = access(pic[k], F_OK) == 0;
   }
+  pa.output = json;
+  if (!rc && !(rc = cli_out_open(&o, &pa))) {
+    print_json(o.fp, a, j, ms, c, ord);
+    if (!(rc = cli_out_flush(&o)) && !(rc = run_plotter(o.tmp ? o.tmp : json, j->plot)))
+      rc = cli_out_close(&o);
+    else
+      cli_out_abort(&o);
+  }
+  for (k = 0; k < 2 && rc; k++)
+    if (pic[k] && !existed[k]) remove(pic[k]);
   free(json);
+  free(pic[0]);
+  free(pic[1]);
   return rc;
 }
 
@@ -509,8 +533,12 @@ static int run(const cli_args *a, cmp_job *j) {
     print_json(o.fp, a, j, ms, c, ord);
   else
     print_text(o.fp, a, j, ms, c, ord);
-  if ((rc = cli_out_close(&o))) goto done;
-  if (j->plot) rc = write_plots(a, j, ms, c, ord);
+  /* -o FILE is renamed into place only once the plots are done */
+  if (j->plot && ((rc = cli_out_flush(&o)) || (rc = write_plots(a, j, ms, c, ord)))) {
+    cli_out_abort(&o);
+    goto done;
+  }
+  rc = cli_out_close(&o);
 done:
   free(ord);
   rcb_compare_destroy(c);

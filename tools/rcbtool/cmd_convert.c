@@ -198,13 +198,14 @@ int cli_meas_write(const char *cmd, const rcb_meas *ms, const char *path, int bi
                    cli_uff_map *mp) {
   int is_uff = 0, rc;
   rcb_status st;
-  if ((rc = cli_meas_format(cmd, path, &is_uff))) return rc;
-  if (is_uff) {
-    if ((rc = cli_uff_automap(cmd, ms, mp))) return rc;
-    st = rcb_meas_write_uff(ms, path, binary, mp->n, mp->nodes);
-  } else {
-    st = rcb_meas_write_csv(ms, path);
-  }
+  cli_tmpfile tf;
+  if ((rc = cli_meas_format(cmd, path, &is_uff)) || (rc = cli_output_check(path))) return rc;
+  if (is_uff && (rc = cli_uff_automap(cmd, ms, mp))) return rc;
+  /* written to a temporary file of ours (removed on a signal), renamed at the end */
+  if ((rc = cli_tmpfile_open(&tf, path))) return rc;
+  st = is_uff ? rcb_meas_write_uff(ms, tf.write_path, binary, mp->n, mp->nodes)
+              : rcb_meas_write_csv(ms, tf.write_path);
+  if ((rc = cli_tmpfile_close(&tf, st == RCB_OK))) return rc;
   if (st)
     return cli_fail(st == RCB_ERR_IO ? CLI_EXIT_IO : st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC
                                                                          : CLI_EXIT_INPUT,
@@ -247,6 +248,7 @@ static int read_input(const cli_args *a, rcb_meas *ms, const cli_uff_map *mp) {
   int is_uff = 0, rc;
   rcb_status st;
   if ((rc = cli_meas_format(a->cmd, a->model, &is_uff))) return rc;
+  cli_input_add(a->model, "input");
   st = is_uff ? rcb_meas_read_uff(ms, a->model, mp->n, mp->nodes)
               : rcb_meas_read_csv(ms, a->model);
   if (st)

@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "cli.h"
 
@@ -126,7 +127,9 @@ static void print_text(FILE *fp, const diag_job *j, const rcb_diag *d, const cha
   size_t k, n = rcb_diag_candidate_count(d);
   rcb_diag_baseline(d, &e0, NULL, &floor_pct);
   fprintf(fp, "the model as it is: error %.4g %%", e0);
-  if (isfinite(floor_pct)) fprintf(fp, " (noise floor %.4g %%)", floor_pct);
+  if (isfinite(floor_pct))
+    fprintf(fp, " (noise floor %.4g %%, predicted by the --noise model; the error reached can "
+            "be lower)", floor_pct);
   fprintf(fp, "; %zu candidates scored\n\n", n);
   fprintf(fp, "%-4s %-5s %-58s %9s %9s %10s  %s\n", "rank", "sig", "candidate", "score %",
           "error %", "dBIC", "fitted");
@@ -193,6 +196,15 @@ static int apply(const cli_args *a, const diag_job *j, const rcb_diag *d) {
                      rcb_diag_candidate_count(d));
   if (rcb_diag_apply_ini(d, j->apply - 1, NULL, 0, &need) != RCB_ERR_WORKSPACE)
     return cli_fail(CLI_EXIT_INPUT, "%s: %s", a->cmd, rcb_diag_errmsg(d));
+  {
+    rcb_diag_candidate c;
+    if (rcb_diag_candidate_get(d, j->apply - 1, &c) == RCB_OK && !c.significant)
+      cli_warn("%s: --apply %zu: candidate %zu (%s) is not significant (dBIC %+.1f; "
+               "significant needs BIC to fall by more than 10 and the error to fall): the "
+               "model written may be fitting noise; prefer a significant candidate or more "
+               "data",
+               a->cmd, j->apply, j->apply, c.description, c.delta_bic);
+  }
   if (!(buf = malloc(need))) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   rcb_diag_apply_ini(d, j->apply - 1, buf, need, &need);
   if ((rc = cli_out_open(&o, a))) {
@@ -239,7 +251,11 @@ static int run(const cli_args *a, diag_job *j) {
   }
   if ((rc = setup(a, j, m, ms, d))) goto done;
   rcb_diag_set_progress(d, progress_cb, &pc);
+  /* the first step (fitting the model's own parameters) reports nothing: say so */
+  if (a->progress || isatty(fileno(stderr)))
+    fputs("diagnose: fitting the model as it is, then scoring the candidates\n", stderr);
   if ((st = rcb_diag_run(d))) {
+    if (pc.started) cli_progress_end(&pc.p);
     rc = cli_fail(cli_status_exit(st), "%s: %s", a->cmd, cli_msg(rcb_diag_errmsg(d), st));
     goto done;
   }

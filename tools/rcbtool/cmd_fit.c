@@ -269,7 +269,7 @@ static int check_output(const cli_args *a, const fit_job *j) {
 }
 
 static int read_meas(const cli_args *a, fit_job *j, const rcb_model *m, rcb_meas **out) {
-  int rc = cli_meas_format(a->cmd, j->meas_path, &j->is_uff);
+  int rc = strcmp(j->meas_path, "-") == 0 ? 0 : cli_meas_format(a->cmd, j->meas_path, &j->is_uff);
   return rc ? rc : cli_meas_read(a, j->meas_path, m, out);
 }
 
@@ -414,7 +414,8 @@ static void write_text(FILE *fp, const fit_result *r) {
   fprintf(fp, "\nerror at start (E0): %.6g %%\nerror at end (E1):   %.6g %%\n",
           r->rep.error0_pct, r->rep.error_pct);
   if (isfinite(r->rep.floor_pct))
-    fprintf(fp, "noise floor (from --noise): %.6g %%\n", r->rep.floor_pct);
+    fprintf(fp, "noise floor (predicted by the --noise model; the error reached can be "
+            "lower): %.6g %%\n", r->rep.floor_pct);
   fprintf(fp, "iterations: %zu\nmodel evaluations: %zu\nstarting points: %zu\n"
           "residuals: %zu\nconverged: %s\n",
           r->rep.iterations, r->rep.evaluations, r->rep.starts, r->rep.residuals,

@@ -311,7 +311,9 @@ static int run(const cli_args *a, rcb_model *m, frf_job *j, double fmin, double 
   cli_out o;
   int rc;
   if ((rc = cli_channels_parse(a, m, "--out", &j->out)) ||
-      (rc = cli_channels_parse(a, m, "--in", &j->in)) || (rc = alloc_job(j)))
+      (rc = cli_channels_parse(a, m, "--in", &j->in)) ||
+      (rc = cli_check_size(a, (double)j->npts, 1.0 + 2.0 * (double)j->out.n * (double)j->in.n)) ||
+      (rc = alloc_job(j)))
     return rc;
   cli_linspace(fmin, fmax, j->npts, j->freq);
   if ((rc = compute(a, m, j)) || (rc = cli_out_open(&o, a))) return rc;

@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "cli.h"
 
@@ -50,20 +51,76 @@ static char *slurp(const char *path, size_t *len) {
   return buf;
 }
 
+/* A line (@p n bytes, no newline) is a history record: one JSON object with the
+ * fields cli_history_append writes. */
+static int is_record(const char *line, size_t n) {
+  static const char *const keys[] = {"\"command\": ", "\"model\": ", "\"error_pct\": "};
+  char buf[4096];
+  size_t i;
+  if (n < 2 || n >= sizeof buf || line[0] != '{' || line[n - 1] != '}') return 0;
+  memcpy(buf, line, n);
+  buf[n] = '\0';
+  for (i = 0; i < sizeof keys / sizeof keys[0]; i++)
+    if (!strstr(buf, keys[i])) return 0;
+  return strlen(buf) == n; /* no NUL byte inside */
+}
+
+/* 0 if @p text (@p len bytes) is empty or history lines only; else the
+ * number of the first line that is not. */
+static size_t first_bad_line(const char *text, size_t len) {
+  size_t pos = 0, k = 0;
+  while (pos < len) {
+    const char *nl = memchr(text + pos, '\n', len - pos);
+    size_t end = nl ? (size_t)(nl - text) : len, n = end - pos;
+    k++;
+    if (n > 0 && text[end - 1] == '\r') n--;
+    if (n > 0 && !is_record(text + pos, n)) return k;
+    pos = end + 1;
+  }
+  return 0;
+}
+
+int cli_history_check(const char *path) {
+  size_t len = 0, bad;
+  struct stat st;
+  char *text;
+  if (cli_output_check(path)) return CLI_EXIT_IO;
+  if (stat(path, &st) != 0) return 0; /* a new history */
+  if (!S_ISREG(st.st_mode))
+    return cli_fail(CLI_EXIT_IO, "--history '%s': not a regular file; expected a history "
+                    "file (JSON lines written by --history) or a new file name", path);
+  if (!(text = slurp(path, &len)))
+    return cli_fail(CLI_EXIT_IO, "--history '%s': cannot read it", path);
+  bad = first_bad_line(text, len);
+  free(text);
+  if (bad)
+    return cli_fail(CLI_EXIT_IO, "--history '%s':%zu: not a history record; refusing to "
+                    "append to a file that is not a history (expected one JSON line per "
+                    "step, as --history writes them): give a new file name", path, bad);
+  return 0;
+}
+
 int cli_history_append(const char *path, const char *command, const char *model,
                        double error_pct, double floor_pct, size_t nparams, const char *note) {
   size_t len = 0;
-  char *old = slurp(path, &len);
-  char *tmp = malloc(strlen(path) + 16);
+  char *old, *tmp;
   FILE *fp;
-  int ok;
-  if (!tmp) return cli_fail(CLI_EXIT_IO, "out of memory");
+  int ok, rc, slot = -1;
+  if ((rc = cli_history_check(path))) return rc;
+  old = slurp(path, &len);
+  if (!(tmp = malloc(strlen(path) + 16))) {
+    free(old);
+    return cli_fail(CLI_EXIT_IO, "out of memory");
+  }
   sprintf(tmp, "%s.tmpXXXXXX", path);
   {
     int fd = mkstemp(tmp);
+    if (fd >= 0) slot = cli_tmp_register(tmp);
     fp = fd >= 0 ? fdopen(fd, "w") : NULL;
   }
   if (!fp) {
+    if (slot >= 0) remove(tmp);
+    cli_tmp_release(slot);
     free(old);
     free(tmp);
     return cli_fail(CLI_EXIT_IO, "history '%s': cannot write next to it", path);
@@ -84,6 +141,7 @@ int cli_history_append(const char *path, const char *command, const char *model,
   ok = (fclose(fp) == 0) && ok;
   if (ok) ok = rename(tmp, path) == 0;
   if (!ok) remove(tmp);
+  cli_tmp_release(slot);
   free(old);
   free(tmp);
   return ok ? 0 : cli_fail(CLI_EXIT_IO, "history '%s': write failed", path);
@@ -117,6 +175,15 @@ static double num_field(const char *s) {
   return end == s ? 0.0 : v;
 }
 
+/* The model column: the file name whole (a long directory is cut to ".../"),
+ * so two models never look alike. */
+static const char *short_name(const char *path, char *buf, size_t size) {
+  const char *slash = strrchr(path, '/');
+  if (strlen(path) <= 28 || !slash) return path;
+  snprintf(buf, size, ".../%s", slash + 1);
+  return buf;
+}
+
 static void print_steps(char *text) {
   char *line, *save = NULL;
   double emax = 0;
@@ -127,11 +194,11 @@ static void print_steps(char *text) {
     step = 0;
     if (pass == 1) {
       printf("%-4s %-10s %-28s %10s %10s %6s  %s\n", "step", "command", "model", "error %",
-             "floor %", "params", "note");
+             "floor % *", "params", "note");
     }
     for (line = strtok_r(copy, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
       char cmd[32] = "", model[256] = "", err[64] = "", flo[64] = "", np[16] = "",
-           note[512] = "";
+           note[512] = "", shown[300];
       double e;
       field(line, "command", cmd, sizeof cmd);
       field(line, "model", model, sizeof model);
@@ -146,14 +213,17 @@ static void print_steps(char *text) {
         continue;
       }
       if (strcmp(flo, "null") != 0 && flo[0])
-        printf("%-4d %-10s %-28.28s %10.4g %10.4g %6s  %s\n", step, cmd, model, e,
+        printf("%-4d %-10s %-28s %10.4g %10.4g %6s  %s\n", step, cmd, short_name(model, shown, sizeof shown), e,
                num_field(flo), np, note);
       else
-        printf("%-4d %-10s %-28.28s %10.4g %10s %6s  %s\n", step, cmd, model, e, "-", np, note);
+        printf("%-4d %-10s %-28s %10.4g %10s %6s  %s\n", step, cmd, short_name(model, shown, sizeof shown), e, "-",
+               np, note);
     }
     free(copy);
   }
   if (step == 0) return;
+  puts("* predicted by the --noise model (eq. 19), not measured: the error reached can be "
+       "lower");
   printf("\nerror %% by step (each # is %.3g %%):\n", emax / 50);
   {
     char *copy = strdup(text);

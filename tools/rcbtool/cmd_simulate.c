@@ -183,7 +183,9 @@ static int run(const cli_args *a, sim_job *j, rcb_model *m) {
   int rc;
   if ((rc = cli_uff_map_parse(a, "--map", m, &mp)) ||
       (rc = cli_channels_parse(a, m, "--out", &j->out)) ||
-      (j->frf && (rc = cli_channels_parse(a, m, "--in", &j->in)))) {
+      (j->frf && (rc = cli_channels_parse(a, m, "--in", &j->in))) ||
+      (rc = cli_check_size(a, (double)j->npts,
+                           1.0 + 2.0 * (double)j->out.n * (double)(j->frf ? j->in.n : 1)))) {
     cli_uff_map_free(&mp);
     return rc;
   }

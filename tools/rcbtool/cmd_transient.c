@@ -191,7 +191,8 @@ int cmd_transient(int argc, char **argv) {
   if (rc) return rc;
   if (a.help) return cli_print_help(cli_help_transient);
   if ((rc = tr_parse(&a, &o)) || (rc = cli_load_model(&a, &m))) return rc;
-  if (!(rc = cli_channels_parse(&a, m, "--out", &ch))) {
+  if (!(rc = cli_channels_parse(&a, m, "--out", &ch)) &&
+      !(rc = cli_check_size(&a, floor(o.t_end / o.dt) + 1.0, 3.0 + (double)ch.n))) {
     h.nout = ch.n;
     if (!(rc = tr_compute(&a, m, &ch, &o, &h, &s)) && !(rc = cli_out_open(&out, &a))) {
       if (a.json)

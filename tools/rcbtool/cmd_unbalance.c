@@ -159,7 +159,9 @@ static void write_json(FILE *fp, const unb_job *j) {
 static int run(const cli_args *a, rcb_model *m, unb_job *j, double lo, double hi) {
   cli_out o;
   int rc;
-  if ((rc = cli_channels_parse(a, m, "--out", &j->out))) return rc;
+  if ((rc = cli_channels_parse(a, m, "--out", &j->out)) ||
+      (rc = cli_check_size(a, (double)j->npts, 1.0 + 2.0 * (double)j->out.n)))
+    return rc;
   j->rpm = malloc(j->npts * sizeof *j->rpm);
   /* calloc: the static analyzer cannot see compute fill them */
   j->re = calloc(j->npts * j->out.n, sizeof *j->re);

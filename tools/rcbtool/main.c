@@ -80,6 +80,7 @@ static int print_version(void) {
 
 int main(int argc, char **argv) {
   const cli_command *c;
+  cli_signals_install();
   if (argc < 2) {
     print_usage(stderr);
     return CLI_EXIT_USAGE;
