@@ -165,7 +165,8 @@ cmd_demo() {
   rcbtool campbell "$MODEL" --rpm-min 0 --rpm-max 20000 --points 81 --modes 6 --json \
     -o "$out/campbell.json"
   # Damped frequencies (Hz) every 5000 rpm, from the fd*_hz columns.
-  awk -F, 'NR == 1 { for (j = 1; j <= NF; j++) if ($j ~ /^fd[0-9]+_hz$/) fd[++n] = j
+  awk -F, '/^#/ { next }
+    !h { h = 1; for (j = 1; j <= NF; j++) if ($j ~ /^fd[0-9]+_hz$/) fd[++n] = j
                      printf "  %7s", "rpm"; for (k = 1; k <= n; k++) printf " %9s", "fd" k "_hz"
                      print ""; next }
     $1 ~ /^[0-9.]+$/ && ($1 % 5000) == 0 && n {
@@ -181,7 +182,9 @@ EOF
   say "FRF at 10000 rpm, coupling hubs per disk-A force, 0-500 Hz"
   rcbtool frf "$MODEL" --out C.A.x,C.A.y,C.B.x,C.B.y --in DA.x --fmin 0 --fmax 500 \
     --points 2001 --rpm 10000 -o "$out/frf.csv"
-  awk -F, 'NR == 1 { for (j = 2; j <= NF; j += 2) { n[j] = $j; sub(/ re$/, "", n[j]) } next }
+  awk -F, '/^#/ { next }
+    !h { h = 1; for (j = 2; j <= NF; j += 2) { n[j] = $j; sub(/ re( \[.*\])?$/, "", n[j]) }
+         next }
     { for (j = 2; j <= NF; j += 2) { a = sqrt($j * $j + $(j + 1) * $(j + 1));
         if (a > pk[j]) { pk[j] = a; f[j] = $1 } } }
     END { for (j = 2; j in n; j += 2)
@@ -191,7 +194,9 @@ EOF
   say "unbalance response 0-20000 rpm (UA at DA phase 0, UB at DB phase 90 deg)"
   rcbtool unbalance "$MODEL" --out DA.x,DA.y,DB.x,DB.y --rpm-min 0 --rpm-max 20000 \
     --points 401 -o "$out/unbalance.csv"
-  awk -F, 'NR == 1 { for (j = 2; j <= NF; j += 2) { n[j] = $j; sub(/ amp$/, "", n[j]) } next }
+  awk -F, '/^#/ { next }
+    !h { h = 1; for (j = 2; j <= NF; j += 2) { n[j] = $j; sub(/ amp( \[.*\])?$/, "", n[j]) }
+         next }
     { for (j = 2; j <= NF; j += 2) if ($j > pk[j]) { pk[j] = $j; r[j] = $1 } }
     END { for (j = 2; j in n; j += 2)
             printf "  %-6s max amplitude %.3e m at %.0f rpm\n", n[j], pk[j], r[j] }' \

@@ -103,9 +103,20 @@ static rcb_status comment(csv_state *S, char *text) {
 static rcb_status header_col(csv_state *S, const char *f, size_t k) {
   static const char *const parts[] = {"re", "im", "mag", "phase_deg", "amp"};
   static const col_part pval[] = {COL_RE, COL_IM, COL_MAG, COL_PHASE, COL_MAG};
-  const char *sp = strrchr(f, ' ');
+  const char *sp;
   csv_col *c;
   size_t i, len;
+  char g[RCB_NAME_MAX + 64];
+  /* a unit in brackets after the part, as rcbtool frf/unbalance write: "DA.x/DB.y re [m/N]" */
+  len = strlen(f);
+  if (len > 0 && len < sizeof g && f[len - 1] == ']' && strrchr(f, '[')) {
+    len = (size_t)(strrchr(f, '[') - f);
+    while (len > 0 && f[len - 1] == ' ') len--;
+    memcpy(g, f, len);
+    g[len] = '\0';
+    f = g;
+  }
+  sp = strrchr(f, ' ');
   if (!sp || sp == f)
     return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: column %zu '%s': expected \"CHANNEL "
                          "re\", \"CHANNEL im\", \"CHANNEL mag\"/\"amp\" or \"CHANNEL "

@@ -168,17 +168,58 @@ json_campbell) run campbell "$MODEL" --rpm-max 6000 --points 5 --modes 4 --json;
 
 # ---- CSV shapes ----
 csv_frf_header)
-  run frf "$MODEL" --out DA.x --in DB.y --fmax 100 --points 3; expect_rc 0
-  [ "$(head -1 "$W/out")" = "freq_hz,DA.x/DB.y re,DA.x/DB.y im" ] || fail "header: $(head -1 "$W/out")"
-  [ "$(wc -l <"$W/out")" -eq 4 ] || fail "expected 3 data rows" ;;
+  # issue #17: the kind and speed lines of a measurement CSV, units (SI) in the header:
+  # receptance m/N, mobility m/(N s), inertance m/(N s^2); rotations rad, moments N m
+  run frf "$MODEL" --out DA.x --in DB.y --fmax 100 --points 3 --rpm 1500; expect_rc 0
+  [ "$(sed -n 1p "$W/out")" = "# kind = receptance" ] || fail "kind line: $(sed -n 1p "$W/out")"
+  [ "$(sed -n 2p "$W/out")" = "# rpm = 1500" ] || fail "rpm line: $(sed -n 2p "$W/out")"
+  [ "$(sed -n 3p "$W/out")" = "freq_hz,DA.x/DB.y re [m/N],DA.x/DB.y im [m/N]" ] || fail "header: $(sed -n 3p "$W/out")"
+  [ "$(grep -c -v '^#' "$W/out")" -eq 4 ] || fail "expected a header and 3 data rows"
+  run frf "$MODEL" --out DA.rx,DA.y --in DA.ry --fmax 100 --points 2 --kind inertance --synchronous
+  expect_rc 0; out_has "# rpm = synchronous"
+  out_has "DA.rx/DA.ry re [rad/(N m s^2)]"; out_has "DA.y/DA.ry im [m/(N m s^2)]"
+  run frf "$MODEL" --out DA.x --in DA.x --fmax 100 --points 2 --kind mobility; out_has "[m/(N s)]"
+  # the frf CSV is a measurement CSV: compare reads it back (error 0)
+  run frf "$MODEL" --out C.A.x --in DA.x --fmin 200 --fmax 400 --points 11 --rpm 10000 -o "$W/f.csv"
+  expect_rc 0
+  run compare "$MODEL" "$W/f.csv" --json; expect_rc 0
+  python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert d["summary"]["error_pct"] < 1e-9 and abs(d["rpm"]-10000) < 1e-6' "$W/out" ||
+    fail "frf CSV not read back as the same FRF" ;;
+csv_unbalance_header)
+  run unbalance "$MODEL" --out DA.x,DA.rx --rpm-max 1000 --points 2; expect_rc 0
+  grep -q '^# unbalance response' "$W/out" || fail "no comment line"
+  [ "$(grep -v '^#' "$W/out" | head -1)" = "rpm,DA.x amp [m],DA.x phase_deg,DA.rx amp [rad],DA.rx phase_deg" ] ||
+    fail "header: $(grep -v '^#' "$W/out" | head -1)" ;;
 campbell_one_speed)
   run campbell "$MODEL" --rpm-min 100 --rpm-max 100 --points 1 --modes 2 --json; expect_rc 0; json_ok
   python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert d["rpm"]==[100] and d["critical_rpm"]==[]' "$W/out" ||
     fail "one-speed Campbell" ;;
 csv_campbell_sections)
-  run campbell "$MODEL" --rpm-max 6000 --points 4 --modes 2; expect_rc 0
-  [ "$(head -1 "$W/out")" = "rpm,fd1_hz,fd2_hz,logdec1,logdec2,whirl1,whirl2" ] || fail "header"
-  out_has "critical_rpm,mode" ;;
+  # issue #17: one table a CSV reader loads (critical speeds in "#" lines), and with
+  # -o FILE.csv a second file FILE_critical.csv; both agree with the JSON
+  run campbell "$MODEL" --rpm-max 20000 --points 21 --modes 2 --json; expect_rc 0; cp "$W/out" "$W/c.json"
+  run campbell "$MODEL" --rpm-max 20000 --points 21 --modes 2; expect_rc 0
+  [ "$(grep -v '^#' "$W/out" | head -1)" = "rpm,fd1_hz,fd2_hz,logdec1,logdec2,whirl1,whirl2" ] || fail "header"
+  out_has "# kind = campbell"
+  run campbell "$MODEL" --rpm-max 20000 --points 21 --modes 2 -o "$W/camp.csv"; expect_rc 0
+  [ "$(ls -A "$W" | grep -c camp)" -eq 2 ] || fail "expected camp.csv and camp_critical.csv: $(ls -A "$W")"
+  python3 - "$W/camp.csv" "$W/camp_critical.csv" "$W/c.json" <<'EOF' || fail "campbell CSV tables"
+import csv, json, sys
+def table(p):
+    rows = list(csv.reader(l for l in open(p) if not l.startswith("#")))
+    assert all(len(r) == len(rows[0]) for r in rows), p   # one rectangular table
+    return rows[0], rows[1:]
+d = json.load(open(sys.argv[3]))
+h, rows = table(sys.argv[1])
+assert len(rows) == 21 and [float(r[0]) for r in rows] == d["rpm"]
+h2, crit = table(sys.argv[2])
+assert h2 == ["critical_rpm", "mode"] and len(crit) == len(d["critical_rpm"]) > 0
+for r, c, k in zip(crit, d["critical_rpm"], d["critical_mode"]):
+    assert float(r[0]) == c and int(r[1]) == k
+head = [l for l in open(sys.argv[1]) if l.startswith("# critical_rpm =")][0]
+assert [float(v) for v in head.split("=")[1].split(",")] == d["critical_rpm"]
+EOF
+  ;;
 
 # ---- units at the edge: rpm and Hz are converted consistently ----
 rpm_hz_consistency)
@@ -241,10 +282,11 @@ simulate_frf_uff_roundtrip)
     run convert "$W/s.uff" "$W/s.csv" --map 1=DA,2=C.A,3=C.B; expect_rc 0
     grep -q "^# rpm = 10000$" "$W/s.csv" || fail "rotor speed not carried through UFF"
     python3 - "$W/ref.csv" "$W/s.csv" "${b:-ascii}" <<'EOF' || fail "simulate/convert values differ from rcbtool frf"
-import sys
+import re, sys
 def rd(p):
     rows = [l.rstrip("\n").split(",") for l in open(p) if not l.startswith("#")]
-    return rows[0], [[float(v) for v in r] for r in rows[1:]]
+    # rcbtool frf gives units in brackets ("DA.x/DA.x re [m/N]"), convert does not
+    return [re.sub(r" \[.*\]$", "", h) for h in rows[0]], [[float(v) for v in r] for r in rows[1:]]
 (h1, a), (h2, b) = rd(sys.argv[1]), rd(sys.argv[2])
 assert h1 == h2, (h1, h2)
 tol = 1e-15 if sys.argv[3] == "--binary" else 5e-13

@@ -199,6 +199,16 @@ int cli_tmpfile_open(cli_tmpfile *t, const char *path);
 /** Rename the temporary onto the path if @p ok, else remove it; 0 or exit 5. */
 int cli_tmpfile_close(cli_tmpfile *t, int ok);
 
+/** A rotation channel ("STATION.rx" or ".ry")? */
+int cli_is_rotation(const char *channel);
+/**
+ * @brief SI unit of a channel for CSV headers: the FRF @p resp / @p ref of
+ * kind @p kind (rcb_frf_kind: m/N, m/(N s), m/(N s^2); rad and N m for
+ * rotations), or with @p ref NULL the response itself (m or rad).
+ */
+const char *cli_channel_unit(const char *resp, const char *ref, int kind, char *buf,
+                             size_t size);
+
 /** Number as CSV field: "%.17g" ("nan", "inf" as printf spells them). */
 void cli_csv_num(FILE *fp, double x);
 /** Number as JSON: "%.17g", null for NaN and infinities. */

@@ -91,8 +91,57 @@ int cli_status_exit(rcb_status st) {
   }
 }
 
+/* One example per command, run from the source tree (the commands in this
+ * order make the files the later ones read: meas.csv, session.jsonl). Each
+ * runs as written; tests/cli runs them all (case help_examples). */
+static const char *const examples[][2] = {
+    {"check", "rcbtool check examples/paper_system.ini"},
+    {"matrices", "rcbtool matrices examples/paper_system.ini --rpm 3000 --json -o matrices.json"},
+    {"frf", "rcbtool frf examples/paper_system.ini --out C.A.x,C.A.y --in DA.x --fmax 500 "
+            "--points 501 --rpm 10000 -o frf.csv"},
+    {"unbalance", "rcbtool unbalance examples/paper_system.ini --out DA.x,DA.y --rpm-max 20000 "
+                  "--points 401 -o unbalance.csv"},
+    {"modes", "rcbtool modes examples/paper_system.ini --rpm 10000 --modes 8"},
+    {"campbell", "rcbtool campbell examples/paper_system.ini --rpm-max 20000 --points 81 "
+                 "-o campbell.csv"},
+    {"simulate", "rcbtool simulate examples/paper_system.ini --frf --out C.A.x,C.A.y,C.B.x,C.B.y "
+                 "--in DA.x --fmin 200 --fmax 400 --points 201 --rpm 10000 --kind inertance "
+                 "--noise 10,1 --seed 1 -o meas.csv"},
+    {"convert", "rcbtool convert meas.csv meas.uff"},
+    {"fit", "rcbtool fit examples/paper_system.ini meas.csv --params "
+            "coupling.C.kt,coupling.C.kr,coupling.C.ct --log --noise 10,1 --history "
+            "session.jsonl -o fitted.ini"},
+    {"sensitivity", "rcbtool sensitivity examples/paper_system.ini --params "
+                    "coupling.C.kt,coupling.C.kr --frf --in DA.x --fmin 200 --fmax 400 "
+                    "--rpm 10000"},
+    {"compare", "rcbtool compare fitted.ini meas.csv"},
+    {"diagnose", "rcbtool diagnose fitted.ini meas.csv --params "
+                 "coupling.C.kt,coupling.C.kr,coupling.C.ct --log --noise 10,1 --history "
+                 "session.jsonl"},
+    {"history", "rcbtool history session.jsonl"},
+    {"transient", "rcbtool transient examples/paper_system.ini --out DA.x,DA.y --rpm 3000 "
+                  "--t-end 0.05 -o transient.csv"},
+    {"timecheck", "rcbtool timecheck examples/paper_system.ini --out DA.x --rpm-min 3000 "
+                  "--rpm-max 9000 --points 3"},
+};
+
+/* The command a help text is for: the word after "usage: rcbtool ". */
+static const char *example_for(const char *text) {
+  static const char usage[] = "usage: rcbtool ";
+  size_t i, n;
+  if (strncmp(text, usage, sizeof usage - 1) != 0) return NULL;
+  text += sizeof usage - 1;
+  n = strcspn(text, " \n");
+  for (i = 0; i < sizeof examples / sizeof examples[0]; i++)
+    if (strlen(examples[i][0]) == n && strncmp(text, examples[i][0], n) == 0)
+      return examples[i][1];
+  return NULL;
+}
+
 int cli_print_help(const char *text) {
+  const char *ex = example_for(text);
   fputs(text, stdout);
+  if (ex) printf("\nexample (from the source tree):\n  %s\n", ex);
   if (fflush(stdout) != 0 || ferror(stdout))
     return cli_fail(CLI_EXIT_IO, "cannot write the help text to standard output");
   return CLI_EXIT_OK;

@@ -275,6 +275,26 @@ int cli_out_close(cli_out *o) {
   return 0;
 }
 
+int cli_is_rotation(const char *channel) {
+  const char *dot = strrchr(channel, '.');
+  return dot && (strcmp(dot, ".rx") == 0 || strcmp(dot, ".ry") == 0);
+}
+
+const char *cli_channel_unit(const char *resp, const char *ref, int kind, char *buf,
+                             size_t size) {
+  static const char *const per[3] = {"", " s", " s^2"}; /* receptance, mobility, inertance */
+  const char *num = cli_is_rotation(resp) ? "rad" : "m";
+  char den[32];
+  if (!ref) {
+    snprintf(buf, size, "%s", num);
+    return buf;
+  }
+  snprintf(den, sizeof den, "%s%s", cli_is_rotation(ref) ? "N m" : "N",
+           per[kind >= 0 && kind < 3 ? kind : 0]);
+  snprintf(buf, size, strchr(den, ' ') ? "%s/(%s)" : "%s/%s", num, den);
+  return buf;
+}
+
 void cli_csv_num(FILE *fp, double x) { fprintf(fp, "%.17g", x); }
 
 void cli_json_num(FILE *fp, double x) {

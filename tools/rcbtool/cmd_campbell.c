@@ -1,6 +1,7 @@
 /* rcbtool campbell: damped frequencies over a speed range and 1X critical speeds. */
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "cli.h"
 
@@ -17,8 +18,10 @@ const char cli_help_campbell[] =
     "  --modes N     curves per speed (default 6)\n"
     "  --max-zeta Z  leave out roots with damping ratio above Z (default 0.99)\n"
     "\n"
-    "CSV: rpm,fd1_hz..fdN_hz,logdec1..logdecN,whirl1..whirlN (nan and an empty\n"
-    "whirl where fewer modes exist), then a blank line and critical_rpm,mode.\n"
+    "CSV: lines \"# kind = campbell\", \"# critical_rpm = ...\" and \"# critical_mode =\n"
+    "...\", then one table rpm,fd1_hz..fdN_hz,logdec1..logdecN,whirl1..whirlN (nan\n"
+    "and an empty whirl where fewer modes exist). With -o FILE.csv the critical\n"
+    "speeds also go to FILE_critical.csv, a table critical_rpm,mode.\n"
     "JSON: {\"rpm\": [...], \"fd_hz\": [[per mode] per speed], \"logdec\": [[...]],\n"
     "\"whirl\": [[...]], \"critical_rpm\": [...], \"critical_mode\": [...]}\n"
     "(null where fewer modes exist; critical_mode numbered from 1).\n";
@@ -101,8 +104,34 @@ static int compute(const cli_args *a, const rcb_model *m, camp_job *j) {
   return rc;
 }
 
+/* The 1X critical speeds as "# critical_rpm = a, b" and "# critical_mode = i, j"
+ * lines: the speed table below them stays one table a CSV reader loads. */
+static void write_crit_comments(FILE *fp, const camp_job *j) {
+  size_t k;
+  fputs("# critical_rpm =", fp);
+  for (k = 0; k < j->ncrit; k++) {
+    fputs(k ? ", " : " ", fp);
+    cli_csv_num(fp, j->crit[k] / CLI_RPM_TO_RAD_S);
+  }
+  fputs("\n# critical_mode =", fp);
+  for (k = 0; k < j->ncrit; k++) fprintf(fp, "%s%zu", k ? ", " : " ", j->crit_mode[k] + 1);
+  fputc('\n', fp);
+}
+
+/* The critical speeds as their own table (the second file of -o FILE). */
+static void write_crit_csv(FILE *fp, const camp_job *j) {
+  size_t k;
+  fputs("# kind = campbell critical speeds (1X)\ncritical_rpm,mode\n", fp);
+  for (k = 0; k < j->ncrit; k++) {
+    cli_csv_num(fp, j->crit[k] / CLI_RPM_TO_RAD_S);
+    fprintf(fp, ",%zu\n", j->crit_mode[k] + 1);
+  }
+}
+
 static void write_csv(FILE *fp, const camp_job *j) {
   size_t i, k, nm = j->nm;
+  fputs("# kind = campbell\n", fp);
+  write_crit_comments(fp, j);
   fputs("rpm", fp);
   for (k = 1; k <= nm; k++) fprintf(fp, ",fd%zu_hz", k);
   for (k = 1; k <= nm; k++) fprintf(fp, ",logdec%zu", k);
@@ -123,11 +152,32 @@ static void write_csv(FILE *fp, const camp_job *j) {
       fprintf(fp, ",%s", isnan(j->wd[off + k]) ? "" : cli_whirl_name(j->whirl[off + k]));
     fputc('\n', fp);
   }
-  fputs("\ncritical_rpm,mode\n", fp);
-  for (k = 0; k < j->ncrit; k++) {
-    cli_csv_num(fp, j->crit[k] / CLI_RPM_TO_RAD_S);
-    fprintf(fp, ",%zu\n", j->crit_mode[k] + 1);
+}
+
+/* -o FILE.csv: the critical speeds also go to FILE_critical.csv; both files
+ * are renamed into place together, or neither. */
+static int write_csv_files(const cli_args *a, const camp_job *j, cli_out *o) {
+  size_t n = strlen(a->output);
+  size_t stem = n >= 4 && strcmp(a->output + n - 4, ".csv") == 0 ? n - 4 : n;
+  char *name = malloc(stem + sizeof "_critical.csv");
+  cli_args ca = *a;
+  cli_out c;
+  int rc;
+  write_csv(o->fp, j);
+  if (!name) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  memcpy(name, a->output, stem);
+  strcpy(name + stem, "_critical.csv");
+  ca.output = name;
+  if (!(rc = cli_out_flush(o)) && !(rc = cli_out_open(&c, &ca))) {
+    write_crit_csv(c.fp, j);
+    if ((rc = cli_out_flush(&c)) || (rc = cli_out_close(o)))
+      cli_out_abort(&c);
+    else
+      rc = cli_out_close(&c);
   }
+  cli_out_abort(o);
+  free(name);
+  return rc;
 }
 
 /* A per-speed list of per-mode values: [[...], [...]]; x NULL writes whirl names. */
@@ -177,6 +227,7 @@ static int run(const cli_args *a, const rcb_model *m, camp_job *j, double lo, do
   cli_linspace(lo, hi, j->ns, j->rpm);
   for (i = 0; i < j->ns; i++) j->speed[i] = j->rpm[i] * CLI_RPM_TO_RAD_S;
   if ((rc = compute(a, m, j)) || (rc = cli_out_open(&o, a))) return rc;
+  if (!a->json && o.tmp) return write_csv_files(a, j, &o);
   (a->json ? write_json : write_csv)(o.fp, j);
   return cli_out_close(&o);
 }

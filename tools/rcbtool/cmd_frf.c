@@ -247,11 +247,20 @@ static int compute(const cli_args *a, const rcb_model *m, frf_job *j) {
 
 static void write_csv(FILE *fp, const frf_job *j) {
   size_t p, c, o, i;
+  char u[32];
+  /* the "# key = value" lines of a measurement CSV: rcbtool compare/fit read it back */
+  fprintf(fp, "# kind = %s\n", kind_names[j->kind]);
+  if (j->sync)
+    fputs("# rpm = synchronous\n", fp);
+  else
+    fprintf(fp, "# rpm = %.17g\n", j->rpm);
   fputs("freq_hz", fp);
   for (o = 0; o < j->out.n; o++)
-    for (i = 0; i < j->in.n; i++)
-      fprintf(fp, ",%s/%s re,%s/%s im", j->out.names[o], j->in.names[i], j->out.names[o],
-              j->in.names[i]);
+    for (i = 0; i < j->in.n; i++) {
+      cli_channel_unit(j->out.names[o], j->in.names[i], j->kind, u, sizeof u);
+      fprintf(fp, ",%s/%s re [%s],%s/%s im [%s]", j->out.names[o], j->in.names[i], u,
+              j->out.names[o], j->in.names[i], u);
+    }
   fputc('\n', fp);
   for (p = 0; p < j->npts; p++) {
     cli_csv_num(fp, j->freq[p]);

@@ -105,9 +105,12 @@ static double phase_deg(double re, double im) { return atan2(im, re) * 180.0 / C
 
 static void write_csv(FILE *fp, const unb_job *j) {
   size_t p, o, n = j->out.n;
-  fputs("rpm", fp);
+  char u[32];
+  fputs("# unbalance response: amplitude (m, or rad for rotations) and phase in degrees "
+        "from +x towards +y\nrpm", fp);
   for (o = 0; o < n; o++)
-    fprintf(fp, ",%s amp,%s phase_deg", j->out.names[o], j->out.names[o]);
+    fprintf(fp, ",%s amp [%s],%s phase_deg", j->out.names[o],
+            cli_channel_unit(j->out.names[o], NULL, 0, u, sizeof u), j->out.names[o]);
   fputc('\n', fp);
   for (p = 0; p < j->npts; p++) {
     cli_csv_num(fp, j->rpm[p]);
