@@ -589,6 +589,173 @@ bad_fit_params)
   err_has "coupling.C.nope"
   [ "$(cat "$W/f.ini")" = old ] || fail "a refused fit overwrote the output"
   cmp -s "$MODEL" "$W/model.ini" || fail "the model was modified" ;;
+# ---- issue #17: never lose or spoil a user's file ----
+guard_output_is_input)
+  # one guard on every output path: an output may not be an input of the same run
+  # (device and inode: a link or another spelling is the same file)
+  run simulate "$MODEL" --frf --out C.A.x,C.A.y --in DA.x --fmin 200 --fmax 400 --points 21 \
+    --rpm 10000 -o "$W/meas.csv"; expect_rc 0
+  cp "$W/meas.csv" "$W/meas.orig"; cp "$MODEL" "$W/model.ini"
+  ln -s "$W/meas.csv" "$W/link.csv"; ln -s "$W/model.ini" "$W/model.csv"
+  run compare "$W/model.ini" "$W/meas.csv" -o "$W/meas.csv"; expect_rc 5; err_has "refusing"
+  run compare "$W/model.ini" "$W/meas.csv" -o "$W/link.csv"; expect_rc 5
+  run compare "$W/model.ini" "$W/meas.csv" -o "$W/../$(basename "$W")/meas.csv"; expect_rc 5
+  ln -s "$W/meas.csv" "$W/p_compare.json"
+  run compare "$W/model.ini" "$W/meas.csv" --plot "$W/p"; expect_rc 5; err_has "p_compare.json"
+  run fit "$W/model.ini" "$W/link.csv" --params coupling.C.kt -o "$W/meas.csv"; expect_rc 5
+  run diagnose "$W/model.ini" "$W/meas.csv" --apply 1 -o "$W/link.csv"; expect_rc 5
+  run convert "$W/meas.csv" "$W/link.csv"; expect_rc 5; err_has "refusing"
+  run simulate "$W/model.ini" --frf --out DA.x --in DA.x --fmax 10 --points 2 -o "$W/model.csv"
+  expect_rc 5; err_has "model"
+  cmp -s "$W/meas.csv" "$W/meas.orig" || fail "the measurement was overwritten"
+  cmp -s "$W/model.ini" "$MODEL" || fail "the model was overwritten"
+  stray=$(ls -A "$W" | grep -v -x -e err -e out -e meas.csv -e meas.orig -e link.csv -e model.ini \
+    -e model.csv -e p_compare.json)
+  [ -z "$stray" ] || fail "stray files: $stray" ;;
+history_not_history)
+  # --history appends only to a history file (new, empty, or history JSON lines)
+  run simulate "$MODEL" --frf --out C.A.x --in DA.x --fmin 200 --fmax 400 --points 21 \
+    --rpm 10000 -o "$W/meas.csv"; expect_rc 0
+  cp "$W/meas.csv" "$W/meas.orig"; cp "$MODEL" "$W/model.ini"; echo "notes" >"$W/notes.txt"
+  for h in "$W/model.ini" "$W/meas.csv" "$W/notes.txt"; do
+    run fit "$W/model.ini" "$W/meas.csv" --params coupling.C.kt --history "$h" -o "$W/f.ini"
+    expect_rc 5; err_has "$(basename "$h")"
+    [ ! -e "$W/f.ini" ] || fail "a refused run wrote its model"
+  done
+  cmp -s "$W/model.ini" "$MODEL" || fail "the model was spoilt"
+  cmp -s "$W/meas.csv" "$W/meas.orig" || fail "the measurement was spoilt"
+  [ "$(cat "$W/notes.txt")" = notes ] || fail "a text file was appended to"
+  : >"$W/h.jsonl"
+  for k in 1 2; do
+    run fit "$W/model.ini" "$W/meas.csv" --params coupling.C.kt --history "$W/h.jsonl"; expect_rc 0
+  done
+  [ "$(wc -l <"$W/h.jsonl")" -eq 2 ] || fail "history should hold 2 steps"
+  run history "$W/h.jsonl"; expect_rc 0; out_has "fit" ;;
+signal_removes_temporaries)
+  # SIGTERM / SIGINT while -o FILE is being written: no FILE.XXXXXX left, FILE intact
+  for sig in TERM INT; do
+    mkdir "$W/$sig"; echo old >"$W/$sig/big.csv"
+    # a background job of a non-interactive shell ignores SIGINT: python restores the
+    # default before it execs rcbtool (which keeps an ignored signal ignored, as nohup wants)
+    python3 -c 'import os, signal, sys; signal.signal(signal.SIGINT, signal.SIG_DFL); os.execv(sys.argv[1], sys.argv[1:])' \
+      "$T" frf "$MODEL" --out DA.x,C.A.x --in DA.x,DA.y --fmax 400 --points 300000 --solver modal \
+      --rpm 3000 -o "$W/$sig/big.csv" 2>/dev/null &
+    pid=$!
+    i=0
+    while [ $i -lt 3000 ] && [ "$(ls -A "$W/$sig" | wc -l)" -lt 2 ] && kill -0 $pid 2>/dev/null; do
+      sleep 0.01; i=$((i + 1))
+    done
+    [ "$(ls -A "$W/$sig" | wc -l)" -ge 2 ] || { kill $pid; fail "never saw the temporary file ($sig)"; }
+    kill -$sig $pid; wait $pid; rc=$?
+    [ $rc -gt 128 ] || fail "SIG$sig: exit code $rc, expected death by the signal"
+    [ "$(ls -A "$W/$sig")" = big.csv ] || fail "SIG$sig left: $(ls -A "$W/$sig")"
+    [ "$(cat "$W/$sig/big.csv")" = old ] || fail "SIG$sig: the target was changed"
+  done ;;
+plot_failure_leaves_nothing)
+  # a failed compare --plot (no matplotlib, or the script fails after one picture)
+  # leaves no output: no PREFIX_compare.json, no -o file, no picture
+  run simulate "$MODEL" --frf --out C.A.x --in DA.x --fmin 200 --fmax 400 --points 21 \
+    --rpm 10000 -o "$W/meas.csv"; expect_rc 0
+  mkdir "$W/p"
+  printf '#!/bin/sh\necho "no matplotlib" >&2\nexit 3\n' >"$W/nompl"
+  printf '#!/bin/sh\n: >"$4_overlay.png"\nexit 5\n' >"$W/halfway"
+  chmod +x "$W/nompl" "$W/halfway"
+  for py in nompl halfway; do
+    RCB_PYTHON="$W/$py" run compare "$MODEL" "$W/meas.csv" --plot "$W/p/run" -o "$W/p/c.txt"
+    expect_rc 5
+    [ -z "$(ls -A "$W/p")" ] || fail "$py: a failed --plot left $(ls -A "$W/p")"
+  done
+  err_has "no output file was kept" ;;
+escape_control_bytes)
+  # bytes from INI values and keys, CSV cells and the command line reach the terminal
+  # escaped (\x1b), never raw (an escape sequence could clear the screen)
+  printf '[material steel]\ndensity = \0332J\033]0;PWNED\007\nyoung = 2e11\npoisson = 0.3\n' >"$W/v.ini"
+  printf '[material steel]\nden\033[2Jsity = 1\n' >"$W/k.ini"
+  printf 'freq_hz,DA.x/DA.x re,DA.x/DA.x im\n10,1,2\n20,\033[2J,2\n' >"$W/c.csv"
+  run check "$W/v.ini"; expect_rc 3; err_has '\x1b2J\x1b]0;PWNED\x07'
+  run check "$W/k.ini"; expect_rc 3; err_has 'den\x1b[2Jsity'
+  run convert "$W/c.csv" "$W/o.uff"; expect_rc 3; err_has "'\\x1b[2J' is not a number"
+  run frf "$MODEL" --out "$(printf 'D\033[2J.x')" --in DA.x --fmax 10; expect_rc 2
+  if LC_ALL=C grep -q "$(printf '\033')" "$W/err"; then fail "a raw ESC byte reached stderr"; fi
+  for f in v k; do
+    run check "$W/$f.ini"
+    if LC_ALL=C grep -q "$(printf '\033')" "$W/err"; then fail "raw ESC from $f.ini"; fi
+  done ;;
+size_guard)
+  # a 1e8-point FRF (about 7.5 GB of CSV) is refused at once, the limit can be raised
+  run frf "$MODEL" --out DA.x --in DA.x --fmax 100 --points 100000000; expect_rc 2
+  err_has "--max-output MB"; err_has "7.5e+03 MB"
+  run frf "$MODEL" --out DA.x --in DA.x --fmax 100 --points 3 --max-output 0.0001; expect_rc 2
+  run frf "$MODEL" --out DA.x --in DA.x --fmax 100 --points 3 --max-output 1; expect_rc 0
+  run unbalance "$MODEL" --out DA.x --rpm-max 100 --points 100000000; expect_rc 2; err_has "--max-output"
+  run campbell "$MODEL" --rpm-max 100 --points 100000000; expect_rc 2; err_has "--max-output"
+  run simulate "$MODEL" --frf --out DA.x --in DA.x --fmax 100 --points 100000000 -o "$W/s.csv"
+  expect_rc 2; [ ! -e "$W/s.csv" ] || fail "simulate wrote a file"
+  run frf "$MODEL" --out DA.x --in DA.x --fmax 100 --points 3 --max-output nope; expect_rc 2 ;;
+diagnose_progress_and_warnings)
+  # progress: a count that only rises; --apply of a candidate that is not significant
+  # warns; the noise floor is labelled as a prediction; history shows the file name
+  run simulate "$MODEL" --frf --out C.A.x,C.A.y,C.B.x,C.B.y --in DA.x --fmin 100 --fmax 400 \
+    --points 41 --rpm 10000 --kind inertance --noise 10,1 --seed 5 -o "$W/meas.csv"; expect_rc 0
+  mkdir -p "$W/a/rather/long/directory/name"; M2="$W/a/rather/long/directory/name/the_model_file.ini"
+  cp "$MODEL" "$M2"
+  run fit "$M2" "$W/meas.csv" --params coupling.C.kt --history "$W/h.jsonl"; expect_rc 0
+  run diagnose "$M2" "$W/meas.csv" --params coupling.C.kt,coupling.C.kr --log --noise 10,1 \
+    --progress --apply 1 -o "$W/m2.ini" --history "$W/h.jsonl"
+  expect_rc 0
+  grep -o '[0-9]*/[0-9]* steps' "$W/err" | cut -d/ -f1 >"$W/counts"
+  [ "$(wc -l <"$W/counts")" -ge 2 ] || fail "no progress lines"
+  sort -n -c "$W/counts" 2>/dev/null && [ -z "$(uniq -d "$W/counts")" ] ||
+    fail "progress counts not rising: $(tr '\n' ' ' <"$W/counts")"
+  out_has "predicted by the --noise model"
+  grep -q '"significant": true' "$W/out" && fail "null case: a candidate came out significant"
+  err_has "is not significant"
+  run history "$W/h.jsonl"; expect_rc 0; out_has "the_model_file.ini"; out_has "predicted" ;;
+diagnose_progress_tty)
+  # a long run on a terminal says what it does before the first step is done
+  command -v script >/dev/null 2>&1 || exit 77
+  run simulate "$MODEL" --frf --out C.A.x,C.A.y --in DA.x --fmin 100 --fmax 400 \
+    --points 21 --rpm 10000 --kind inertance -o "$W/meas.csv"; expect_rc 0
+  script -qec "\"$T\" diagnose \"$MODEL\" \"$W/meas.csv\" --params coupling.C.kt --top 1 >/dev/null" \
+    /dev/null >"$W/tty" 2>&1 || exit 77
+  grep -q "diagnose: fitting the model as it is" "$W/tty" || fail "no start line on a terminal"
+  grep -q "diagnose: [0-9]*/[0-9]* steps" "$W/tty" || fail "no progress on a terminal" ;;
+stdin_inputs)
+  # models and measurements from '-' (standard input), CSV or UFF by content
+  run check - <"$MODEL"; expect_rc 0; out_has "node,shaft,z_m"
+  run simulate "$MODEL" --frf --out C.A.x --in DA.x --fmin 200 --fmax 400 --points 11 \
+    --rpm 10000 --map 1=DA,2=C.A -o "$W/m.uff"; expect_rc 0
+  run convert "$W/m.uff" "$W/m.csv" --map 1=DA,2=C.A; expect_rc 0
+  run compare "$MODEL" - --json <"$W/m.csv"; expect_rc 0
+  python3 -c 'import json,sys; assert json.load(open(sys.argv[1]))["summary"]["error_pct"] < 1e-9' "$W/out" || fail "CSV on stdin"
+  run compare "$MODEL" - --map 1=DA,2=C.A --json <"$W/m.uff"; expect_rc 0
+  python3 -c 'import json,sys; assert json.load(open(sys.argv[1]))["summary"]["error_pct"] < 1e-9' "$W/out" || fail "UFF on stdin"
+  usage compare - - <"$W/m.csv"; err_has "standard input"
+  printf 'freq_hz,DA.x/DA.x re,DA.x/DA.x im\n10,1\n' | "$T" compare "$MODEL" - >"$W/out" 2>"$W/err"; RC=$?
+  expect_rc 3; err_has "standard input"
+  [ -z "$(ls "${TMPDIR:-/tmp}" | grep '^rcbtool-stdin-')" ] || fail "stdin copy left in ${TMPDIR:-/tmp}" ;;
+help_examples)
+  # every command's --help ends with an example that runs as written (from the source tree)
+  mkdir "$W/x"; ln -s "$EX" "$W/x/examples"
+  n=0
+  for c in check matrices frf unbalance modes campbell simulate convert fit sensitivity compare \
+           diagnose history transient timecheck; do
+    run "$c" --help; expect_rc 0
+    ex=$(sed -n '/^example (from the source tree):$/{n;p;}' "$W/out" | sed 's/^  rcbtool //')
+    [ -n "$ex" ] || fail "$c --help has no example line"
+    # shellcheck disable=SC2086 # the example is split into words as a shell would
+    (cd "$W/x" && "$T" $ex >/dev/null 2>"$W/err"); rc=$?
+    if [ $rc -eq 4 ] && grep -F -q "without SUNDIALS" "$W/err"; then continue; fi
+    [ $rc -eq 0 ] || fail "$c example exits $rc: rcbtool $ex"
+    n=$((n + 1))
+  done
+  run diagnose --help; out_has "Units of the report"; out_has "Hz for FRF data, rpm for unbalance"
+  # docs/rcbtool.md's synopsis lists every command
+  doc="$EX/../docs/rcbtool.md"
+  for c in check matrices frf unbalance modes campbell simulate convert fit sensitivity compare \
+           diagnose history transient timecheck; do
+    sed -n '/^## Synopsis/,/^## /p' "$doc" | grep -q "rcbtool $c " || fail "synopsis lacks $c"
+  done ;;
 # ==== end of the bad-input catalogue ====
 
 # ==== rcbtool compare ====

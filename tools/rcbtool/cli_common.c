@@ -122,7 +122,7 @@ static const char *const examples[][2] = {
     {"transient", "rcbtool transient examples/paper_system.ini --out DA.x,DA.y --rpm 3000 "
                   "--t-end 0.05 -o transient.csv"},
     {"timecheck", "rcbtool timecheck examples/paper_system.ini --out DA.x --rpm-min 3000 "
-                  "--rpm-max 9000 --points 3"},
+                  "--rpm-max 3000 --points 1 --steady-tol 1e-3"},
 };
 
 /* The command a help text is for: the word after "usage: rcbtool ". */
