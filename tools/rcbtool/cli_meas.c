@@ -89,8 +89,12 @@ static int stdin_to_file(char *path, size_t size, int *slot, int *is_uff) {
   }
   *is_uff = p + 1 < text + len && p[0] == '-' && p[1] == '1';
   snprintf(path, size, "%s/rcbtool-stdin-XXXXXX", dir && *dir ? dir : "/tmp");
-  if ((fd = mkstemp(path)) < 0 || !(fp = fdopen(fd, "wb"))) {
-    if (fd >= 0) close(fd), remove(path);
+  fp = (fd = mkstemp(path)) >= 0 ? fdopen(fd, "wb") : NULL;
+  if (!fp) {
+    if (fd >= 0) {
+      close(fd);
+      remove(path);
+    }
     free(text);
     return cli_fail(CLI_EXIT_IO, "cannot copy the measurement from standard input to a "
                     "temporary file in %s (set TMPDIR)", dir && *dir ? dir : "/tmp");
