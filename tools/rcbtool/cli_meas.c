@@ -62,6 +62,9 @@ int cli_guard_outputs(const cli_args *a, const char *meas) {
   cli_input_add(a->model, "model");
   cli_input_add(meas, "measurement");
   if (a->output && (rc = cli_output_check(a->output))) return rc;
+  if (hist && a->output && strcmp(hist, a->output) == 0)
+    return cli_usage(a->cmd, "--history and -o name the same file '%s'; give the history its "
+                     "own file", hist);
   if (hist && (rc = cli_history_check(hist))) return rc;
   for (i = 0; plot && i < sizeof plot_files / sizeof plot_files[0] && !rc; i++) {
     char *name = malloc(strlen(plot) + strlen(plot_files[i]) + 1);
