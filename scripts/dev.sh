@@ -440,7 +440,8 @@ cmd_valgrind() {
     -o "$out/unbalance.csv"
   vg modes modes "$W/model.ini" --rpm 10000 --modes 6 -o "$out/modes.csv"
   vg compare compare "$W/model.ini" "$W/measured.uff"
-  vg fit fit "$W/model.ini" "$W/measured.uff" --params "$P" --log --noise 10,1 --max-iter 5
+  vg fit fit "$W/model.ini" "$W/measured.uff" --params "$P" --log --noise 10,1 --max-iter 5 \
+    --starts 1
   vg diagnose diagnose "$W/model.ini" "$W/measured.uff" --params "$P" --log --noise 10,1 \
     --band 200:400 --refits 1 --top 3
   ((rc == 0)) || die "valgrind found errors or leaks ($((SECONDS - t0)) s)"
