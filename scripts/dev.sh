@@ -485,6 +485,11 @@ cmd_embedded() {
   say "library size"
   ls -l "$lib" | awk '{ printf "  %s: %d bytes on disk\n", $NF, $5 }'
   size -t "$lib" | awk 'END { printf "  code (text) %d bytes, data %d, bss %d: total %d bytes\n", $1, $2, $3, $4 }'
+  # examples/firmware is built in this preset too (no tests, no cmocka): run it
+  local fw=build-embedded/examples/firmware/firmware_example
+  [[ -x $fw ]] || die "$fw was not built"
+  say "examples/firmware on the embedded library"
+  OPENBLAS_NUM_THREADS=1 "$fw" | tail -n 1 | sed 's/^/  /'
 }
 
 usage() { awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$ROOT/scripts/dev.sh"; }
