@@ -439,6 +439,17 @@ EOF
   expect_rc 0
   python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert d["error_pct"] < d["error0_pct"], d' \
     "$W/out" || fail "a linear unweighted fit raised E" ;;
+compare_plot_mkdir)
+  # issue #17: README's `--plot out/walk` in a fresh clone: the prefix's
+  # directories are made (a stand-in interpreter takes the plotting step)
+  printf '#!/bin/sh\necho "$@" > "%s"\n' "$W/py_args" >"$W/fakepy"; chmod +x "$W/fakepy"
+  W2=$EX/walkthrough
+  RCB_PYTHON="$W/fakepy"; export RCB_PYTHON
+  run compare "$W2/model.ini" "$W2/measured.uff" --plot "$W/plots/sub/walk"
+  expect_rc 0
+  [ -s "$W/plots/sub/walk_compare.json" ] || fail "no walk_compare.json in the new directory"
+  grep -q "compare $W/plots/sub/walk_compare.json $W/plots/sub/walk" "$W/py_args" ||
+    fail "the plotter was not run on the JSON: $(cat "$W/py_args")" ;;
 fit_not_identifiable)
   # eq. 19 noise (10 %, 1 %): cR no longer shows in the data (the paper's
   # Table 3 gives it an "infinite" error); the fit must say so
@@ -680,7 +691,8 @@ compare_usage)
   usage compare "$MODEL" "$W/m.csv" --prominence -1; err_has "--prominence"
   usage compare "$MODEL" "$W/m.csv" --map 10=DA; err_has "UFF measurements only"
   run compare "$MODEL" "$W/none.csv"; expect_rc 3; err_has "none.csv"
-  run compare "$MODEL" "$W/m.csv" --plot "$W/nodir/p"; expect_rc 5; err_has "nodir"
+  # --plot under a path that cannot be a directory (a file): exit 5, named
+  run compare "$MODEL" "$W/m.csv" --plot "$W/m.csv/p"; expect_rc 5; err_has "m.csv' is not a directory"
   run compare --help; expect_rc 0; out_has "usage: rcbtool compare MODEL.ini"
   run help; expect_rc 0; out_has "  compare " ;;
 # ==== end of rcbtool compare ====
