@@ -21,12 +21,24 @@ install(FILES ${PROJECT_BINARY_DIR}/include/rcb/rcb_config.h
   DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/rcb COMPONENT dev)
 
 # Consumers of the export get rcb::rcb (EXPORT_NAME of target rcb) and
-# rcb::rcb_static.
-install(TARGETS ${RCB_LIB_TARGETS} EXPORT rcbTargets
-  LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT runtime
-    NAMELINK_COMPONENT dev
-  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT dev
-  RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
+# rcb::rcb_static, in two files: the static one names the dependencies as
+# link items, and rcbConfig.cmake reads it only when those are found or
+# wanted (a shared-library consumer needs none of them; issue #17).
+if(TARGET rcb)
+  install(TARGETS rcb EXPORT rcbTargets
+    LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT runtime
+      NAMELINK_COMPONENT dev
+    ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT dev
+    RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
+  install(EXPORT rcbTargets NAMESPACE rcb:: FILE rcbTargets.cmake
+    DESTINATION ${RCB_INSTALL_CMAKEDIR} COMPONENT dev)
+endif()
+if(TARGET rcb_static)
+  install(TARGETS rcb_static EXPORT rcbStaticTargets
+    ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT dev)
+  install(EXPORT rcbStaticTargets NAMESPACE rcb:: FILE rcbStaticTargets.cmake
+    DESTINATION ${RCB_INSTALL_CMAKEDIR} COMPONENT dev)
+endif()
 
 if(TARGET rcbtool)
   # tools/CMakeLists.txt installs rcbtool to bin; the installed tool finds the
@@ -35,9 +47,6 @@ if(TARGET rcbtool)
     ${CMAKE_INSTALL_FULL_LIBDIR})
   set_target_properties(rcbtool PROPERTIES INSTALL_RPATH "$ORIGIN/${_rcb_bin_to_lib}")
 endif()
-
-install(EXPORT rcbTargets NAMESPACE rcb:: FILE rcbTargets.cmake
-  DESTINATION ${RCB_INSTALL_CMAKEDIR} COMPONENT dev)
 
 # What the static library needs at link time, for rcbConfig.cmake.
 set(RCB_CONFIG_WITH_SUITESPARSE ${RCB_WITH_SUITESPARSE})

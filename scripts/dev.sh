@@ -1,12 +1,15 @@
 #!/usr/bin/env bash
 # librcb developer entry point. Run from anywhere inside the repository.
 #
-#   ./scripts/dev.sh demo       install what is missing, build, run the paper-system demo
-#   ./scripts/dev.sh test       install what is missing, build, run every test:
-#                               ctest, Python cross-validation against ROSS, the core
+#   ./scripts/dev.sh demo       install what the demo needs (no test toolchain, no
+#                               SUNDIALS, no venv), build, run the paper-system demo,
+#                               print where rcbtool is
+#   ./scripts/dev.sh test       install everything, build with every backend, run every
+#                               test: ctest, Python cross-validation against ROSS, the core
 #                               configuration (no optional backend), ASan+UBSan build
-#   ./scripts/dev.sh deps       Debian packages + the pinned Python venv (.venv)
-#   ./scripts/dev.sh build      configure + build in build/ (Release)
+#   ./scripts/dev.sh deps       all Debian packages + the pinned Python venv (.venv)
+#   ./scripts/dev.sh build      configure + build in build/ (Release; SUNDIALS and the
+#                               tests when their packages are installed)
 #   ./scripts/dev.sh core       build + ctest with every optional backend OFF (build-core/)
 #   ./scripts/dev.sh sanitize   AddressSanitizer + UBSan build and ctest (build-asan/)
 #   ./scripts/dev.sh bench      FRF sweep benchmark (C dense/banded; SciPy and ROSS if .venv)
@@ -51,10 +54,20 @@ JOBS=${JOBS:-$(nproc 2>/dev/null || echo 2)}
 CI=${CI:-false}
 MODEL=examples/paper_system.ini
 
-DEB_PACKAGES=(build-essential cmake pkg-config libopenblas-dev liblapacke-dev
-  libsuitesparse-dev libnlopt-dev libsundials-dev libcmocka-dev libinih-dev
-  python3-venv python3-pip
+# What the demo needs (issue #17: the first hour installs no test toolchain):
+# compiler, CMake, LAPACK, the sparse and NLopt backends, inih: 98 packages,
+# ~490 MB on a fresh Debian 12 where everything took 297 packages, ~1.3 GB,
+# plus the 1.3 GB venv. No SUNDIALS: Debian's libsundials-dev pulls PETSc,
+# MPI and hypre by its own Depends (162 packages, ~475 MB more), and the demo
+# runs no time integration. No Python: the demo draws no picture (matplotlib
+# for `rcbtool compare --plot` comes with the venv of `test`).
+DEB_DEMO=(build-essential cmake pkg-config libopenblas-dev liblapacke-dev
+  libsuitesparse-dev libnlopt-dev libinih-dev)
+# The rest, for `test` (and `deps`): SUNDIALS, cmocka, the Python venv's
+# prerequisites, sanitizer/fuzzer runtime, valgrind, linters.
+DEB_TEST=(libsundials-dev libcmocka-dev python3-venv python3-pip
   clang libclang-rt-14-dev valgrind cppcheck clang-tidy)
+DEB_PACKAGES=("${DEB_DEMO[@]}" "${DEB_TEST[@]}")
 
 say() { printf '\n==> %s\n' "$*"; }
 die() { printf 'dev.sh: %s\n' "$*" >&2; exit 1; }
@@ -63,17 +76,20 @@ as_root() {
   if [[ $(id -u) -eq 0 ]]; then "$@"; else sudo "$@"; fi
 }
 
-# Debian packages: install only the missing ones; apt-get update only then.
+deb_installed() { dpkg-query -W -f='${Status}' "$1" 2> /dev/null | grep -q 'install ok installed'; }
+
+# Debian packages (default: all of DEB_PACKAGES): install only the missing
+# ones; apt-get update only then.
 deps_debian() {
+  local want=("$@")
+  ((${#want[@]})) || want=("${DEB_PACKAGES[@]}")
   if ! command -v dpkg-query > /dev/null; then
-    echo "not a Debian system: install the equivalents of: ${DEB_PACKAGES[*]}"
+    echo "not a Debian system: install the equivalents of: ${want[*]}"
     return 0
   fi
   local missing=() p
-  for p in "${DEB_PACKAGES[@]}"; do
-    if ! dpkg-query -W -f='${Status}' "$p" 2> /dev/null | grep -q 'install ok installed'; then
-      missing+=("$p")
-    fi
+  for p in "${want[@]}"; do
+    deb_installed "$p" || missing+=("$p")
   done
   if ((${#missing[@]} == 0)); then
     echo "Debian packages: all present"
@@ -124,9 +140,18 @@ configure_build() {
   cmake --build "$dir" -j "$JOBS"
 }
 
+# The build with what is installed: SUNDIALS and the tests when their packages
+# are there (after `test` or `deps`), else without (a fresh machine after the
+# demo's packages). `test` builds with everything, ON explicitly.
 cmd_build() {
-  say "build ($BUILD_DIR, Release, warnings as errors: $CI)"
-  configure_build "$BUILD_DIR"
+  local sundials=ON tests=ON
+  if [[ ${1:-} != full ]] && command -v dpkg-query > /dev/null; then
+    deb_installed libsundials-dev || sundials=OFF
+    deb_installed libcmocka-dev || tests=OFF
+  fi
+  say "build ($BUILD_DIR, Release, SUNDIALS $sundials, tests $tests, warnings as errors: $CI)"
+  configure_build "$BUILD_DIR" -DRCB_WITH_SUNDIALS=$sundials -DRCB_BUILD_TESTS=$tests \
+    -DRCB_TEST_VENV="$(cd "$ROOT" && realpath -m "$VENV")"
 }
 
 # The rcbtool executable of a build tree (tools/rcbtool/rcbtool or tools/rcbtool).
@@ -140,7 +165,8 @@ rcbtool_exe() {
 rcbtool() { "$(rcbtool_exe)" "$@"; }
 
 cmd_demo() {
-  cmd_deps
+  say "dependencies of the demo"
+  deps_debian "${DEB_DEMO[@]}"
   cmd_build
   [[ -x $(rcbtool_exe) && -f $(rcbtool_exe) ]] || die "rcbtool was not built"
   local out=out/demo
@@ -172,12 +198,11 @@ cmd_demo() {
     $1 ~ /^[0-9.]+$/ && ($1 % 5000) == 0 && n {
       printf "  %7.0f", $1; for (k = 1; k <= n; k++) printf " %9.2f", $fd[k]; print "" }' \
     "$out/campbell.csv"
-  "$(python_for_summary)" - "$out/campbell.json" << 'EOF'
-import json, sys
-d = json.load(open(sys.argv[1]))
-crit = d.get("critical_rpm", [])
-print("1X critical speeds (rpm):", ", ".join("%.0f" % c for c in crit) if crit else "none in range")
-EOF
+  # "critical_rpm": [a, b, ...] of the JSON, without Python
+  tr -d '\n' < "$out/campbell.json" | grep -o '"critical_rpm": *\[[^]]*\]' |
+    sed 's/.*\[//; s/\]//' | tr ',' '\n' |
+    awk '{ if ($1 != "") { s = s (n++ ? ", " : "") sprintf("%.0f", $1) } }
+      END { print "1X critical speeds (rpm):", (n ? s : "none in range") }'
 
   say "FRF at 10000 rpm, coupling hubs per disk-A force, 0-500 Hz"
   rcbtool frf "$MODEL" --out C.A.x,C.A.y,C.B.x,C.B.y --in DA.x --fmin 0 --fmax 500 \
@@ -225,13 +250,14 @@ EOF
   rcbtool compare "$wk/model.ini" "$wk/measured.uff" | sed -n '3,12p' | sed 's/^/  /'
   echo "-- rcbtool fit: the best the model can do as it is"
   rcbtool fit "$wk/model.ini" "$wk/measured.uff" --params "$P" --log --noise 10,1 \
-    --history "$out/history.jsonl" | grep -E '^(error|noise|UNSURE)' | sed 's/^/  /'
+    --history "$out/history.jsonl" | grep -E '^(error|objective|note|noise|UNSURE)' |
+    sed 's/^/  /'
   echo "-- rcbtool diagnose: which physical effect is missing, and where?"
   rcbtool diagnose "$wk/model.ini" "$wk/measured.uff" --params "$P" --log --noise 10,1 \
     --top 5 --apply 1 -o "$out/model2.ini" --history "$out/history.jsonl" | sed 's/^/  /'
   echo "-- rcbtool fit on the model with the effect added"
   rcbtool fit "$out/model2.ini" "$wk/measured.uff" --params "$P,bearing.B2.kcross:-7e7:7e7" \
-    --noise 10,1 --history "$out/history.jsonl" | grep -E '^(bearing|error|noise)' |
+    --noise 10,1 --history "$out/history.jsonl" | grep -E '^(bearing|error|objective|noise)' |
     sed 's/^/  /'
   echo "-- rcbtool history: the error falling"
   rcbtool history "$out/history.jsonl" | sed 's/^/  /'
@@ -239,10 +265,12 @@ EOF
   echo "   see examples/walkthrough/README.md)"
   echo
   echo "full tables (CSV, JSON, UFF, fitted models, history) in $out/"
-}
-
-python_for_summary() {
-  if [[ -x $VENV/bin/python ]]; then echo "$VENV/bin/python"; else echo python3; fi
+  local exe rel
+  exe=$(rcbtool_exe)
+  rel=${exe#"$ROOT"/}
+  echo
+  echo "rcbtool is built at $rel; for the README's examples, from $ROOT:"
+  echo "  export PATH=\$PWD/$(dirname "$rel"):\$PATH"
 }
 
 run_ctest() {
@@ -305,7 +333,7 @@ cmd_ctest() {
 cmd_test() {
   local t0=$SECONDS failed=() stage rc
   cmd_deps
-  cmd_build
+  cmd_build full
   local stages=(ctest pytest core)
   [[ ${RCB_SKIP_SANITIZE:-0} == 1 ]] || stages+=(sanitize)
   # issue #7: valgrind on the CLI, a libFuzzer smoke (FUZZ_SECONDS per harness)
@@ -445,7 +473,8 @@ cmd_valgrind() {
     -o "$out/unbalance.csv"
   vg modes modes "$W/model.ini" --rpm 10000 --modes 6 -o "$out/modes.csv"
   vg compare compare "$W/model.ini" "$W/measured.uff"
-  vg fit fit "$W/model.ini" "$W/measured.uff" --params "$P" --log --noise 10,1 --max-iter 5
+  vg fit fit "$W/model.ini" "$W/measured.uff" --params "$P" --log --noise 10,1 --max-iter 5 \
+    --starts 1
   vg diagnose diagnose "$W/model.ini" "$W/measured.uff" --params "$P" --log --noise 10,1 \
     --band 200:400 --refits 1 --top 3
   ((rc == 0)) || die "valgrind found errors or leaks ($((SECONDS - t0)) s)"
@@ -489,6 +518,11 @@ cmd_embedded() {
   say "library size"
   ls -l "$lib" | awk '{ printf "  %s: %d bytes on disk\n", $NF, $5 }'
   size -t "$lib" | awk 'END { printf "  code (text) %d bytes, data %d, bss %d: total %d bytes\n", $1, $2, $3, $4 }'
+  # examples/firmware is built in this preset too (no tests, no cmocka): run it
+  local fw=build-embedded/examples/firmware/firmware_example
+  [[ -x $fw ]] || die "$fw was not built"
+  say "examples/firmware on the embedded library"
+  OPENBLAS_NUM_THREADS=1 "$fw" | tail -n 1 | sed 's/^/  /'
 }
 
 usage() { awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$ROOT/scripts/dev.sh"; }

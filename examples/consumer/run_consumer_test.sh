@@ -28,6 +28,59 @@ fi
 runs=("$work/build/rcb_consumer")
 [[ -x $work/build/rcb_consumer_static ]] && runs+=("$work/build/rcb_consumer_static")
 
+# 1b. A shared-library consumer on a machine without the static library's
+# dependencies (issue #17): NLopt and SUNDIALS made unfindable. find_package(rcb)
+# still succeeds, rcb::rcb links, and rcb::rcb_static is left out.
+cfg=$(find "$prefix" -name rcbConfig.cmake | head -n 1)
+if [[ -f $(dirname "$cfg")/rcbTargets.cmake ]]; then
+  "$cmake_cmd" -S "$here" -B "$work/build-nodeps" -DCMAKE_PREFIX_PATH="$prefix" \
+    -DCMAKE_DISABLE_FIND_PACKAGE_NLopt=ON -DCMAKE_DISABLE_FIND_PACKAGE_SUNDIALS=ON \
+    -DCMAKE_C_COMPILER="$cc" -DCMAKE_BUILD_TYPE=Release > "$work/configure-nodeps.log" 2>&1 ||
+    { cat "$work/configure-nodeps.log"; echo "FAIL: find_package(rcb) needs NLopt/SUNDIALS for the shared library"; exit 1; }
+  "$cmake_cmd" --build "$work/build-nodeps" > "$work/build-nodeps.log"
+  runs+=("$work/build-nodeps/rcb_consumer")
+fi
+if [[ -f $(dirname "$cfg")/rcbTargets.cmake && -f $(dirname "$cfg")/rcbStaticTargets.cmake ]] &&
+  grep -Eq '^set\(RCB_WITH_(NLOPT|SUNDIALS) ON\)' "$cfg"; then
+  [[ ! -e $work/build-nodeps/rcb_consumer_static ]] ||
+    { echo "FAIL: rcb::rcb_static defined without its dependencies"; exit 1; }
+  # 1c. asking for the static library then fails, naming what is missing
+  if "$cmake_cmd" -S "$here/../firmware" -B "$work/fw-nodeps" -DCMAKE_PREFIX_PATH="$prefix" \
+    -DCMAKE_DISABLE_FIND_PACKAGE_NLopt=ON -DCMAKE_DISABLE_FIND_PACKAGE_SUNDIALS=ON \
+    -DCMAKE_C_COMPILER="$cc" > "$work/fw-nodeps.log" 2>&1; then
+    echo "FAIL: COMPONENTS static found without NLopt/SUNDIALS"; exit 1
+  fi
+  grep -Eq 'NLopt|SUNDIALS' "$work/fw-nodeps.log" ||
+    { cat "$work/fw-nodeps.log"; echo "FAIL: the static refusal does not name the package"; exit 1; }
+fi
+
+# 1d. examples/firmware on its own (its own project(), the static library).
+if [[ -f $(dirname "$cfg")/rcbStaticTargets.cmake ]]; then
+  "$cmake_cmd" -S "$here/../firmware" -B "$work/fw" -DCMAKE_PREFIX_PATH="$prefix" \
+    -DCMAKE_C_COMPILER="$cc" -DCMAKE_BUILD_TYPE=Release > "$work/fw-configure.log" 2>&1 ||
+    { cat "$work/fw-configure.log"; echo "FAIL: examples/firmware does not configure on its own"; exit 1; }
+  "$cmake_cmd" --build "$work/fw" > "$work/fw-build.log"
+  OPENBLAS_NUM_THREADS=1 "$work/fw/firmware_example" | tee "$work/fw.out" | tail -n 1
+  grep -q "OK: alarm from the fault cycle on, no allocation in the loop" "$work/fw.out" ||
+    { echo "FAIL: examples/firmware (standalone) did not print its OK line"; exit 1; }
+fi
+
+# 1e. The installed rcbtool runs the installed plotting script
+# (<prefix>/share/rcb/rcb_plots.py), not the source tree's: a stand-in
+# interpreter records the script it is given.
+if [[ -e $prefix/bin/rcbtool ]]; then
+  [[ -f $prefix/share/rcb/rcb_plots.py ]] || { echo "FAIL: rcb_plots.py not installed"; exit 1; }
+  printf '#!/bin/sh\necho "$1" > "%s"\n' "$work/plots_script" > "$work/fake_python"
+  chmod +x "$work/fake_python"
+  wk=$here/../walkthrough
+  env -u RCB_PLOTS RCB_PYTHON="$work/fake_python" "$prefix/bin/rcbtool" compare \
+    "$wk/model.ini" "$wk/measured.uff" --plot "$work/walk" > /dev/null
+  got=$(cat "$work/plots_script")
+  [[ $got -ef $prefix/share/rcb/rcb_plots.py ]] ||
+    { echo "FAIL: the installed rcbtool ran '$got', not $prefix/share/rcb/rcb_plots.py"; exit 1; }
+  echo "installed rcbtool: plotting script $got"
+fi
+
 # 2. pkg-config, shared (rpath to the scratch prefix) and --static.
 pcfile=$(find "$prefix" -name rcb.pc | head -n 1)
 PKG_CONFIG_PATH=$(dirname "$pcfile")

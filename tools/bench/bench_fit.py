@@ -312,8 +312,7 @@ def librcb_fit(exe, start_ini, meas, method, lo, hi, scale):
     params = ",".join(f"{n}:{a!r}:{b!r}" for n, a, b in zip(PNAMES, lo, hi))
     extra = ["--map", UFF_MAP] if meas.endswith(".uff") else []
     method, _, starts = method.partition("@")  # "ALG@N": --starts N (restarts while unsure)
-    if starts:
-        extra += ["--starts", starts]
+    extra += ["--starts", starts or "1"]  # rcbtool's default is 8 (issue #17): one start unless @N
     t0 = time.perf_counter()
     res = run(exe, "fit", start_ini, meas, *extra, "--params", params, "--log", "--scale", scale,
               "--noise", f"{BETA_A:g},{BETA_S:g}", "--method", method, "--json", check=False)

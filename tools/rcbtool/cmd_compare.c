@@ -412,6 +412,36 @@ static int find_plots_script(char *buf, size_t size) {
 /* A failed --plot leaves no output file (the run failed as a whole). */
 #define NOTHING_KEPT "no output file was kept (run without --plot for the comparison alone)"
 
+/* --plot PREFIX: the directories of PREFIX are made when missing (mkdir -p), so
+ * `--plot out/walk` runs in a fresh clone (issue #17). */
+static int make_plot_dir(const char *prefix) {
+  char *dir = malloc(strlen(prefix) + 1), *p;
+  struct stat sb;
+  int rc = 0;
+  if (!dir) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  strcpy(dir, prefix);
+  p = strrchr(dir, '/');
+  if (!p || p == dir) {
+    free(dir);
+    return 0; /* the current or the root directory */
+  }
+  *p = '\0';
+  for (p = dir + 1; !rc; p++) {
+    char c = *p;
+    if (c != '/' && c != '\0') continue;
+    *p = '\0';
+    if (mkdir(dir, 0777) != 0 && errno != EEXIST)
+      rc = cli_fail(CLI_EXIT_IO, "--plot %s: cannot create the directory '%s': %s", prefix,
+                    dir, strerror(errno));
+    else if (stat(dir, &sb) != 0 || !S_ISDIR(sb.st_mode))
+      rc = cli_fail(CLI_EXIT_IO, "--plot %s: '%s' is not a directory", prefix, dir);
+    *p = c;
+    if (c == '\0') break;
+  }
+  free(dir);
+  return rc;
+}
+
 /* Run PYTHON SCRIPT compare JSON PREFIX; its messages go to our stderr. */
 static int run_plotter(const char *json, const char *prefix) {
   const char *py = getenv("RCB_PYTHON");
@@ -534,7 +564,8 @@ static int run(const cli_args *a, cmp_job *j) {
   else
     print_text(o.fp, a, j, ms, c, ord);
   /* -o FILE is renamed into place only once the plots are done */
-  if (j->plot && ((rc = cli_out_flush(&o)) || (rc = write_plots(a, j, ms, c, ord)))) {
+  if (j->plot && ((rc = cli_out_flush(&o)) || (rc = make_plot_dir(j->plot)) ||
+                  (rc = write_plots(a, j, ms, c, ord)))) {
     cli_out_abort(&o);
     goto done;
   }

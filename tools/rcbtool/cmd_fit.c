@@ -45,7 +45,7 @@ const char cli_help_fit[] =
     "  --starts N     when the fit ends unsure (above 1.5 x the noise floor that\n"
     "                 --noise predicts, or not converged: a local minimum or a\n"
     "                 missing effect), retry from up to N - 1 random starts within\n"
-    "                 the bounds and keep the best (default 1)\n"
+    "                 the bounds and keep the best (default 8; 1: no restart)\n"
     "  --map LIST     UFF node number <-> model station, e.g. 10=DA,20=C.A (UFF\n"
     "                 nodes without an entry read as model node \"#N\")\n"
     "  -o FILE        write the fitted model as INI to FILE (atomically; never over\n"
@@ -53,12 +53,15 @@ const char cli_help_fit[] =
     "\n"
     "Prints per parameter: start, fitted value, standard error, 95 % confidence\n"
     "interval and whether the data determine it (SVD test); then the paper's error\n"
-    "in % at the start (E0) and the end (E1), iterations, model evaluations,\n"
-    "residuals used, convergence and the parameter correlation matrix. Progress per\n"
+    "in % at the start (E0) and the end (E1) (linear |H|, unweighted: the figure of\n"
+    "rcbtool compare), the objective F the fit minimises (on --scale, --noise\n"
+    "weights: E can rise while F falls), iterations, model evaluations, starting\n"
+    "points, residuals used, convergence and the parameter correlation matrix. Progress per\n"
     "iteration goes to stderr (on a terminal, or with --progress).\n"
     "JSON: {\"params\": [{\"name\", \"start\", \"fitted\", \"stderr\", \"ci95\": [lo, hi],\n"
     "\"lo\", \"hi\", \"log\", \"identifiable\"}], \"error0_pct\", \"error_pct\",\n"
-    "\"iterations\", \"evaluations\", \"residuals\", \"converged\", \"objective0\",\n"
+    "\"iterations\", \"evaluations\", \"starts\", \"starts_max\", \"residuals\", \"converged\",\n"
+    "\"objective0\", "
     "\"objective\", \"sigma\", \"correlation\": [[...]], \"notes\": [...], \"output\"}\n"
     "Exit codes: 2 usage, 3 bad model, measurement or parameter name, 4 numerical\n"
     "failure, 5 output not written.\n";
@@ -224,7 +227,7 @@ static int parse_job(const cli_args *a, fit_job *j) {
   j->log_all = cli_opt_value(a, "--log") != NULL;
   if ((rc = cli_opt_choice(a, "--scale", scale_names, 4, RCB_SCALE_LOG10, &j->scale)) ||
       (rc = parse_method(a, j)) || (rc = cli_opt_count(a, "--max-iter", 100, &j->max_iter)) ||
-      (rc = cli_opt_count(a, "--starts", 1, &j->starts)))
+      (rc = cli_opt_count(a, "--starts", 8, &j->starts)))
     return rc;
   if (cli_opt_value(a, "--band")) {
     if ((rc = parse_pair(a, "--band", ':', "LO:HI (Hz for FRFs, rpm for unbalance data)",
@@ -408,18 +411,62 @@ static void write_text_params(FILE *fp, const fit_result *r) {
       fprintf(fp, "note: %s is " NOT_IDENTIFIABLE "\n", r->par[k].name);
 }
 
-static void write_text(FILE *fp, const fit_result *r) {
+/* E0/E1 are the paper's error (linear magnitudes, every point alike: the figure
+ * rcbtool compare prints); the fit minimises its objective F, on the --scale
+ * with the --noise weights. The two can move apart (E rising while F falls),
+ * so F is printed beside E with what it measures (issue #17). */
+static void write_text_objective(FILE *fp, const fit_result *r, const fit_job *j) {
+  double f0 = r->rep.objective0, f1 = r->rep.objective;
+  fprintf(fp, "  (E: the paper's error on linear |H|, every point weighted alike, as rcbtool "
+          "compare reports it)\n");
+  fprintf(fp, "objective F:         %.6g -> %.6g (%+.3g %%; what the fit minimises: squared "
+          "residuals on %s%s)\n",
+          f0, f1, f0 > 0 ? 100.0 * (f1 - f0) / f0 : 0.0,
+          j->scale == RCB_SCALE_COMPLEX ? "Re/Im of H" : j->scale == RCB_SCALE_LINEAR ? "|H|"
+          : j->scale == RCB_SCALE_DB ? "20 log10 |H|" : "log10 |H|",
+          j->have_noise ? ", weighted by the --noise model" : ", unweighted");
+  if (r->rep.error_pct > r->rep.error0_pct && f1 <= f0)
+    fprintf(fp, "note: E rose (%.4g %% -> %.4g %%) while F fell: the fit lowers F, not E%s\n",
+            r->rep.error0_pct, r->rep.error_pct,
+            r->rep.unsure ? "; here it also ends unsure (see below)"
+            : j->scale == RCB_SCALE_LINEAR && !j->have_noise
+                ? ""
+                : " (--scale linear without --noise minimises E itself)");
+}
+
+/* Starting points tried, of the most --starts allows, and why it stopped there. */
+static void write_text_starts(FILE *fp, const fit_result *r, const fit_job *j) {
+  fprintf(fp, "starting points: %zu of at most %zu", r->rep.starts, j->starts);
+  if (r->rep.starts < j->starts && j->have_noise)
+    fputs(" (restarts run only while the result is unsure: not converged, or above 1.5 x "
+          "the noise floor)",
+          fp);
+  else if (r->rep.starts < j->starts)
+    fputs(" (without --noise a restart runs only when the fit does not converge: a local "
+          "minimum cannot be told from measurement noise; give --noise A,S)",
+          fp);
+  else if (j->starts > 1 && r->rep.unsure)
+    fputs(" (every one ended unsure: the best is kept)", fp);
+  fputc('\n', fp);
+}
+
+static void write_text(FILE *fp, const fit_result *r, const fit_job *j) {
   size_t k, l;
   write_text_params(fp, r);
   fprintf(fp, "\nerror at start (E0): %.6g %%\nerror at end (E1):   %.6g %%\n",
           r->rep.error0_pct, r->rep.error_pct);
+  write_text_objective(fp, r, j);
   if (isfinite(r->rep.floor_pct))
     fprintf(fp, "noise floor (predicted by the --noise model; the error reached can be "
             "lower): %.6g %%\n", r->rep.floor_pct);
-  fprintf(fp, "iterations: %zu\nmodel evaluations: %zu\nstarting points: %zu\n"
-          "residuals: %zu\nconverged: %s\n",
-          r->rep.iterations, r->rep.evaluations, r->rep.starts, r->rep.residuals,
-          r->rep.converged ? "yes" : "no");
+  fprintf(fp, "iterations: %zu\nmodel evaluations: %zu\n", r->rep.iterations,
+          r->rep.evaluations);
+  write_text_starts(fp, r, j);
+  fprintf(fp, "residuals: %zu\nconverged: %s\n", r->rep.residuals,
+          !r->rep.converged ? "no"
+          : r->rep.unsure   ? "yes, to a minimum of the objective that may not be the best "
+                              "(see UNSURE below)"
+                            : "yes");
   fprintf(fp, "stopped: %s\n", rcb_fit_stop_str(r->stop));
   if (r->stop == RCB_FIT_STOP_AT_BOUND && r->stop_param < r->np) {
     const rcb_fit_param *p = &r->par[r->stop_param];
@@ -433,10 +480,10 @@ static void write_text(FILE *fp, const fit_result *r) {
             r->stop == RCB_FIT_STOP_STALLED ? "try --fd or another --method"
                                             : "raise --max-iter, or try --starts 8");
   else if (r->rep.unsure)
-    fputs("UNSURE: the fit did not converge or ends well above the noise floor: a local "
-          "minimum (try --starts 8 or --method nlopt:direct-l+bobyqa) or a physical effect "
-          "the model lacks (rcbtool diagnose)\n",
-          fp);
+    fprintf(fp, "UNSURE: the fit did not converge or ends well above the noise floor after "
+            "%zu starting point%s: a local minimum (try --starts %zu or --method "
+            "nlopt:direct-l+bobyqa) or a physical effect the model lacks (rcbtool diagnose)\n",
+            r->rep.starts, r->rep.starts == 1 ? "" : "s", r->rep.starts < 8 ? 8 : 4 * r->rep.starts);
   fputs("\ncorrelation matrix:\n    ", fp);
   for (l = 0; l < r->np; l++) fprintf(fp, " %7s(%zu)", "", l + 1);
   fputc('\n', fp);
@@ -503,9 +550,10 @@ static void write_json(FILE *fp, const fit_result *r, const fit_job *j, const cl
   fputs(", \"floor_pct\": ", fp);
   cli_json_num(fp, r->rep.floor_pct);
   fprintf(fp, ", \"iterations\": %zu, \"evaluations\": %zu, \"starts\": %zu, "
+          "\"starts_max\": %zu, "
           "\"residuals\": %zu, \"converged\": %s, \"unsure\": %s, \"stop\": \"%s\",\n"
           "\"objective0\": ",
-          r->rep.iterations, r->rep.evaluations, r->rep.starts, r->rep.residuals,
+          r->rep.iterations, r->rep.evaluations, r->rep.starts, j->starts, r->rep.residuals,
           r->rep.converged ? "true" : "false", r->rep.unsure ? "true" : "false",
           rcb_fit_stop_str(r->stop));
   cli_json_num(fp, r->rep.objective0);
@@ -567,14 +615,20 @@ static int report(const cli_args *a, const fit_job *j, rcb_fit *f, const rcb_mod
     if (a->json)
       write_json(stdout, &r, j, a);
     else
-      write_text(stdout, &r);
+      write_text(stdout, &r, j);
     if (fflush(stdout) != 0 || ferror(stdout))
       rc = cli_fail(CLI_EXIT_IO, "cannot write to standard output");
   }
   if (!rc && cli_opt_value(a, "--history")) {
     char note[160];
-    snprintf(note, sizeof note, "fit: error %.4g %% -> %.4g %%%s", r.rep.error0_pct,
-             r.rep.error_pct, r.rep.unsure ? " (unsure)" : "");
+    /* E is the paper's error (compare's figure); the objective's change beside it
+     * says why E may rise in a fit that lowered what it minimises */
+    snprintf(note, sizeof note, "fit: error %.4g %% -> %.4g %% (objective %+.3g %%)%s",
+             r.rep.error0_pct, r.rep.error_pct,
+             r.rep.objective0 > 0
+                 ? 100.0 * (r.rep.objective - r.rep.objective0) / r.rep.objective0
+                 : 0.0,
+             r.rep.unsure ? " (unsure)" : "");
     rc = cli_history_append(cli_opt_value(a, "--history"), "fit", a->model, r.rep.error_pct,
                             r.rep.floor_pct, r.np, note);
   }

@@ -72,7 +72,7 @@ class FitResult:
 
 
 def fit(model, meas, params, log=None, scale="log10", noise=None, band=None,
-        method="paper", algorithm=None, starts=1, seed=1, max_iter=None, ftol_rel=None,
+        method="paper", algorithm=None, starts=8, seed=1, max_iter=None, ftol_rel=None,
         xtol_rel=None, inplace=False):
     """Fit model parameters to a measurement (paper's eq. 12 objective).
 
@@ -80,7 +80,10 @@ def fit(model, meas, params, log=None, scale="log10", noise=None, band=None,
     log: optimise log(p) (None: wherever lo > 0); scale: linear|log10|db|complex;
     noise: (beta_a, beta_s) %, noise-aware weights and floor; band: (lo, hi) in Hz
     (FRFs) or rpm (unbalance); method "paper" or "nlopt" with algorithm
-    ("LN_BOBYQA"...); starts/seed: restarts while the fit ends unsure.
+    ("LN_BOBYQA"...); starts/seed: up to `starts` starting points, restarts only
+    while the fit ends unsure (not converged, or above 1.5 x the noise floor);
+    8 by default, as rcbtool fit (issue #17: FRF fits have local minima), 1 for
+    a single run.
     The model is copied unless inplace=True; the result holds the fitted model.
     """
     m = model if inplace else model.copy()
