@@ -53,6 +53,7 @@ MODEL=examples/paper_system.ini
 
 DEB_PACKAGES=(build-essential cmake pkg-config libopenblas-dev liblapacke-dev
   libsuitesparse-dev libnlopt-dev libsundials-dev libcmocka-dev libinih-dev
+  libfftw3-dev libkissfft-dev
   python3-venv python3-pip
   clang libclang-rt-14-dev valgrind cppcheck clang-tidy)
 

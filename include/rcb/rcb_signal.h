@@ -1,0 +1,195 @@
+/**
+ * @file rcb_signal.h
+ * @brief The measurement front end: sampled time signals (read from CSV, WAV
+ * or UFF dataset 58 time records, with their units) and the Welch estimator
+ * that turns them into FRFs with coherence and per-point standard deviations.
+ *
+ * Memory: the estimator lives in one caller buffer sized by
+ * rcb_spectral_workspace_size() (two-call sizing, as the FRF sweep); feeding
+ * segments and reading results allocate nothing. The FFT backend is chosen at
+ * build time (rcb_config.h): FFTW3 in double precision (RCB_WITH_FFTW) plans
+ * its transform at rcb_spectral_init() and allocates the plan itself, with
+ * FFTW's malloc, outside the hooks (as KLU does, see rcb_analysis.h); its
+ * planner is not thread-safe, so create estimators from one thread at a time
+ * (feeding and reading from several threads, one object each, is safe).
+ * Without an FFT backend the estimator calls return RCB_ERR_UNSUPPORTED.
+ *
+ * Units: signals are held in SI (m, m/s, m/s^2, N; V for a keyphasor or an
+ * uncalibrated channel); sample rates in samples/s; frequencies in rad/s.
+ */
+#ifndef RCB_SIGNAL_H
+#define RCB_SIGNAL_H
+
+#include "rcb/rcb_core.h"
+#include "rcb/rcb_measure.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------------ units -- */
+
+/** @brief The physical quantity of a channel (values held in its SI unit). */
+typedef enum rcb_quantity {
+  RCB_QTY_UNKNOWN = 0,      /**< no unit given */
+  RCB_QTY_DISPLACEMENT = 1, /**< m */
+  RCB_QTY_VELOCITY = 2,     /**< m/s */
+  RCB_QTY_ACCELERATION = 3, /**< m/s^2 */
+  RCB_QTY_FORCE = 4,        /**< N */
+  RCB_QTY_VOLTAGE = 5       /**< V (keyphasor, uncalibrated sensor) */
+} rcb_quantity;
+
+/**
+ * @brief Parse a unit label ("m", "mm", "um", "mil", "m/s", "mm/s", "in/s",
+ * "m/s^2", "m/s2", "g", "N", "kN", "lbf", "V", "mV"; case-sensitive where it
+ * matters: "mm" vs "Mm" is not guessed).
+ * @param to_si factor: SI value = file value * to_si
+ * @return 0, or -1 if the label is not a unit librcb knows.
+ */
+RCB_API int rcb_unit_parse(const char *label, rcb_quantity *q, double *to_si);
+/** @brief "displacement", "velocity", ... (never NULL). */
+RCB_API const char *rcb_quantity_name(rcb_quantity q);
+
+/* ---------------------------------------------------------- signals -- */
+
+/** @brief A set of channels sampled together (one sample rate, one length). */
+typedef struct rcb_signals rcb_signals;
+
+RCB_API rcb_status rcb_signals_create(rcb_signals **out, const rcb_allocator *alloc);
+RCB_API void rcb_signals_destroy(rcb_signals *s);
+/** @brief Last error, with file name and line (or record) where it applies. */
+RCB_API const char *rcb_signals_errmsg(const rcb_signals *s);
+
+/** @brief Start a new set: sample rate (samples/s, > 0) and length (samples). */
+RCB_API rcb_status rcb_signals_reset(rcb_signals *s, double rate, size_t nsamples);
+/**
+ * @brief Add a channel (values copied, in SI of @p q).
+ * @param name channel name ("DA.x" for a response, "C.B.y" for a force, "KP"
+ * for a keyphasor) @param q what the values are
+ */
+RCB_API rcb_status rcb_signals_add(rcb_signals *s, const char *name, rcb_quantity q,
+                                   const double *values);
+RCB_API size_t rcb_signals_channel_count(const rcb_signals *s);
+RCB_API size_t rcb_signals_length(const rcb_signals *s);
+/** @brief Sample rate, samples/s. */
+RCB_API double rcb_signals_rate(const rcb_signals *s);
+/** @brief Channel i: its name, quantity and rcb_signals_length() values (SI). */
+RCB_API rcb_status rcb_signals_channel(const rcb_signals *s, size_t i, const char **name,
+                                       rcb_quantity *q, const double **values);
+/** @brief Index of the channel named @p name, or RCB_ERR_NOT_FOUND. */
+RCB_API rcb_status rcb_signals_find(const rcb_signals *s, const char *name, size_t *index);
+
+/**
+ * @brief Read CSV: optional "# units = U1,U2,..." line (one unit per channel
+ * column, e.g. "N,g,mm"), then a header "time_s,NAME1,NAME2,..." (a name may
+ * carry its unit in brackets: "DA.x [mm]"), then rows of numbers. The time
+ * column must be evenly spaced (1e-6 relative); the rate is taken from it.
+ */
+RCB_API rcb_status rcb_signals_read_csv(rcb_signals *s, const char *path);
+/**
+ * @brief Read a WAV file (RIFF, PCM 16/24/32-bit integer or 32/64-bit float,
+ * any number of channels). Integer samples are scaled to [-1, 1). WAV carries
+ * no names nor units: @p names and @p units give them per channel ("DA.x",
+ * "mm"; NULL: "ch1", ... and V) and @p scale the full-scale value in that
+ * unit (1 for float files; NULL: 1).
+ */
+RCB_API rcb_status rcb_signals_read_wav(rcb_signals *s, const char *path, size_t nnames,
+                                        const char *const *names, const char *const *units,
+                                        const double *scale);
+
+/* ------------------------------------------------------- estimation -- */
+
+/** @brief Segment window. */
+typedef enum rcb_window {
+  RCB_WINDOW_HANN = 0,     /**< periodic Hann (SciPy's 'hann') */
+  RCB_WINDOW_FLATTOP = 1,  /**< periodic flat-top (SciPy's 'flattop') */
+  RCB_WINDOW_RECT = 2,     /**< rectangular (boxcar) */
+  RCB_WINDOW_FORCE_EXP = 3 /**< impact test: force window on the inputs (1 over
+                                the first force_frac of the segment, 0 after),
+                                times an exponential window exp(-t/tau) on every
+                                channel, tau such that it ends at exp_end */
+} rcb_window;
+
+/** @brief How H is formed from the averaged spectra. */
+typedef enum rcb_estimator {
+  RCB_EST_H1 = 0, /**< Gxx^-1 Gxy: noise on the outputs (any number of inputs) */
+  RCB_EST_H2 = 1, /**< Gyy / Gyx: noise on the input (one input) */
+  RCB_EST_HV = 2  /**< total least squares, noise on both (one input) */
+} rcb_estimator;
+
+/** @brief Estimator settings (zero-initialise, then set what you need). */
+typedef struct rcb_spectral_opts {
+  size_t ninputs;    /**< force channels (>= 1 for FRFs; 0: spectra only) */
+  size_t noutputs;   /**< response channels */
+  size_t nseg;       /**< samples per segment (>= 8; the FFT length) */
+  size_t noverlap;   /**< samples shared by consecutive segments (< nseg) */
+  double rate;       /**< samples/s */
+  rcb_window window;
+  int no_detrend;    /**< 0: remove each segment's mean (SciPy's default), 1: keep it */
+  double force_frac; /**< RCB_WINDOW_FORCE_EXP: force window length / segment (0: 0.1) */
+  double exp_end;    /**< RCB_WINDOW_FORCE_EXP: exponential window's last value (0: 0.01) */
+} rcb_spectral_opts;
+
+typedef struct rcb_spectral rcb_spectral;
+
+/** @brief Bytes rcb_spectral_init needs for these settings (and the object's
+ * whole memory besides the FFT backend's plan). */
+RCB_API rcb_status rcb_spectral_workspace_size(const rcb_spectral_opts *o, size_t *bytes);
+/**
+ * @brief Build an estimator inside @p work (bytes from
+ * rcb_spectral_workspace_size, any alignment; the caller keeps it alive and
+ * frees it after rcb_spectral_release). No allocation besides FFTW's plan.
+ */
+RCB_API rcb_status rcb_spectral_init(rcb_spectral **out, const rcb_spectral_opts *o,
+                                     void *work, size_t bytes);
+/** @brief Release the FFT plan (the workspace stays the caller's). */
+RCB_API void rcb_spectral_release(rcb_spectral *e);
+RCB_API const char *rcb_spectral_errmsg(const rcb_spectral *e);
+/** @brief Forget the averages (same settings). */
+RCB_API void rcb_spectral_clear(rcb_spectral *e);
+/**
+ * @brief Average one segment: @p chan[0..ninputs) are the inputs, then the
+ * outputs, each nseg samples (SI). Allocation-free: the streaming entry.
+ */
+RCB_API rcb_status rcb_spectral_add_segment(rcb_spectral *e, const double *const *chan);
+/**
+ * @brief Welch over whole records of @p n samples (segments every
+ * nseg - noverlap samples; trailing samples that fill no segment are unused,
+ * as in SciPy).
+ */
+RCB_API rcb_status rcb_spectral_add_record(rcb_spectral *e, size_t n,
+                                           const double *const *chan);
+/** @brief Segments averaged so far. */
+RCB_API size_t rcb_spectral_averages(const rcb_spectral *e);
+/** @brief nseg / 2 + 1 one-sided frequency lines. */
+RCB_API size_t rcb_spectral_bin_count(const rcb_spectral *e);
+/** @brief The frequency lines, rad/s (bin_count values). */
+RCB_API void rcb_spectral_frequencies(const rcb_spectral *e, double *w);
+/**
+ * @brief Averaged one-sided cross spectral density conj(X_a) X_b of channels
+ * a and b (indices as in add_segment), unit^2 s (per Hz, as SciPy's csd with
+ * scaling='density'); the pairs held are input-input, input-output and
+ * output-output on the diagonal (RCB_ERR_ARG for two different outputs).
+ */
+RCB_API rcb_status rcb_spectral_cross(const rcb_spectral *e, size_t a, size_t b,
+                                      rcb_complex *g);
+/**
+ * @brief FRF from input @p in to output @p out, with coherence and standard
+ * deviation per frequency line (any pointer may be NULL).
+ * @param h response per unit input (SI units of the channels)
+ * @param coh ordinary coherence of the pair (one input) or the multiple
+ * coherence of the output on all inputs
+ * @param sd standard deviation of each of Re h and Im h (of |h|, and of
+ * |h| times the phase in rad): sqrt((1 - coh) Gyy [Gxx^-1]_jj / (2 (nd - p + 1)))
+ * (Bendat & Piersol, eq. 9.90 generalised; for one input
+ * |h| sqrt((1 - coh) / (2 nd coh))), the same expression for H2 and Hv
+ * @return RCB_ERR_SINGULAR (with the line in the message) if Gxx is singular
+ */
+RCB_API rcb_status rcb_spectral_frf(rcb_spectral *e, rcb_estimator est, size_t out,
+                                    size_t in, rcb_complex *h, double *coh, double *sd);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* RCB_SIGNAL_H */
