@@ -18,6 +18,8 @@ static const cli_command commands[] = {
      cmd_campbell},
     {"simulate", "synthetic measurements (FRF or unbalance, eq. 19 noise) as UFF58/CSV",
      cli_help_simulate, cmd_simulate},
+    {"estimate", "FRFs with coherence and standard deviations from sampled signals (Welch)",
+     cli_help_estimate, cmd_estimate},
     {"convert", "measurements between UFF58 (ASCII/binary) and CSV, and between kinds",
      cli_help_convert, cmd_convert},
     {"fit", "fit model parameters to a measurement, with uncertainty", cli_help_fit,
