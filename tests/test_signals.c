@@ -416,6 +416,76 @@ static void test_units_table(void **state) {
   assert_string_equal(rcb_quantity_name(RCB_QTY_VELOCITY), "velocity");
 }
 
+/* ---- units of FRF files (UFF 164, record-9/10 labels) ---- */
+
+/* An FRF file: optional dataset 164 (length, force factors), one record of
+ * data type 8/11/12 over 13 with the given units labels, 1 + 2i at 10 Hz. */
+static const char *frf_uff(const char *u164, int s9, const char *lab9, const char *lab10) {
+  const char *p = rcb_test_tmp_path("units.uff");
+  FILE *fp = fopen(p, "w");
+  assert_non_null(fp);
+  if (u164) fputs(u164, fp);
+  fprintf(fp, "%6d\n%6d%74s\n", -1, 58, "");
+  fprintf(fp, "%-80s\n%-80s\n%-80s\n%-80s\n%-80s\n", "id1", "NONE", "NONE", "NONE", "NONE");
+  fprintf(fp, "%5d%10d%5d%10d %10s%10ld%4d %10s%10ld%4d\n", 4, 0, 0, 0, "NONE", 1L, 1, "NONE",
+          2L, 1);
+  fprintf(fp, "%10d%10ld%10d%13.5e%13.5e%13.5e\n", 6, 1L, 1, 10.0, 1.0, 0.0);
+  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", 18, 0, 0, 0, "Frequency", "Hz");
+  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", s9, 0, 0, 0, "Response", lab9);
+  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", 13, 0, 0, 0, "Force", lab10);
+  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", 0, 0, 0, 0, "NONE", "NONE");
+  fputs("   1.00000000000e+00   2.00000000000e+00\n", fp);
+  fprintf(fp, "%6d\n", -1);
+  fclose(fp);
+  return p;
+}
+
+static const char U164_MM[] =
+    "    -1\n   164\n         5mm (milli newton)         2\n"
+    "  1.00000000000000000D+03  1.00000000000000000D+00  1.00000000000000000D+00\n"
+    "  2.73150000000000000D+02\n    -1\n";
+
+static void read_frf_value(const char *p, rcb_frf_kind kind, double factor) {
+  rcb_meas *ms;
+  rcb_meas_channel_info c;
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  if (rcb_meas_read_uff(ms, p, 0, NULL)) fail_msg("%s", rcb_meas_errmsg(ms));
+  assert_int_equal(rcb_meas_channel(ms, 0, &c), RCB_OK);
+  assert_int_equal(c.kind, kind);
+  assert_true(fabs(creal(c.data[0]) - factor) < 1e-15 * factor &&
+              fabs(cimag(c.data[0]) - 2.0 * factor) < 2e-15 * factor);
+  rcb_meas_destroy(ms);
+}
+
+static void refused(const char *p, const char *frag) {
+  rcb_meas *ms;
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  assert_int_equal(rcb_meas_read_uff(ms, p, 0, NULL), RCB_ERR_PARSE);
+  if (!strstr(rcb_meas_errmsg(ms), frag))
+    fail_msg("message '%s' lacks '%s'", rcb_meas_errmsg(ms), frag);
+  assert_int_equal(rcb_meas_channel_count(ms), 0);
+  rcb_meas_destroy(ms);
+}
+
+static void test_frf_units(void **state) {
+  (void)state;
+  /* mm/N through dataset 164 (length factor 1000, force 1): 1e-3 m/N */
+  read_frf_value(frf_uff(U164_MM, 8, "NONE", "NONE"), RCB_RECEPTANCE, 1e-3);
+  read_frf_value(frf_uff(U164_MM, 8, "mm", "N"), RCB_RECEPTANCE, 1e-3);
+  /* g/N by the labels: 9.80665 (m/s^2)/N */
+  read_frf_value(frf_uff(NULL, 12, "g", "N"), RCB_INERTANCE, 9.80665);
+  read_frf_value(frf_uff(NULL, 11, "mm/s", "kN"), RCB_MOBILITY, 1e-6);
+  /* SI labels as librcb writes them */
+  read_frf_value(frf_uff(NULL, 8, "m", "N"), RCB_RECEPTANCE, 1.0);
+  /* refusals: wrong quantity, 164 disagreeing, unknown label */
+  refused(frf_uff(NULL, 12, "mm", "N"), "is a displacement, but its data type 12 says "
+                                        "acceleration");
+  refused(frf_uff(NULL, 8, "m", "g"), "is an acceleration, but its data type 13 says force");
+  refused(frf_uff(U164_MM, 8, "m", "N"), "disagrees with dataset 164");
+  refused(frf_uff(NULL, 8, "furlong", "N"), "'furlong' is not a unit");
+  refused(frf_uff("    -1\n   164\n        42\n    -1\n", 8, "m", "N"), "dataset 164");
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_white_noise_level),
@@ -427,6 +497,7 @@ int main(void) {
       cmocka_unit_test(test_csv_units),
       cmocka_unit_test(test_wav),
       cmocka_unit_test(test_units_table),
+      cmocka_unit_test(test_frf_units),
   };
   return cmocka_run_group_tests(tests, rcb_test_setup_tmpdir, rcb_test_teardown_tmpdir);
 }

@@ -15,7 +15,11 @@
  * (abscissa type 18 or 0), or rpm (type 19); ordinate type 8/11/12
  * (displacement/velocity/acceleration) over 13 (excitation force) for
  * receptance/mobility/inertance; z axis of type 19 carries the rotor speed
- * of an FRF test in rpm (negative: synchronous). Units are taken as SI.
+ * of an FRF test in rpm (negative: synchronous). Units: the record-9/10
+ * unit labels (m, mm, um, m/s, m/s^2, g, N, ... : io/units.c) and a dataset
+ * 164 before the records (units code and factors) scale the values to SI;
+ * a label of the wrong quantity for the data type, an unknown label, or a
+ * label that disagrees with dataset 164 is refused; neither given: SI.
  *
  * Binary 58b data (IEEE, either byte order): double complex as pairs of
  * doubles; an uneven abscissa as doubles interleaved (as pyuff writes), or
@@ -98,6 +102,7 @@ typedef struct uff_rec {
   long ord_type, npts, spacing;
   double xmin, dx, zval;   /* Hz, Hz, z value */
   long spec[4];            /* records 8..11 specific data types */
+  char lab[4][24];         /* records 8..11 axis units labels */
   double *x;               /* Hz (or rpm), npts */
   rcb_complex *y;          /* npts */
 } uff_rec;
@@ -108,6 +113,10 @@ typedef struct uff_reader {
   cursor c;
   size_t nmap;
   const rcb_uff_node *map;
+  int has164;          /* a dataset 164 was read (-1: malformed, see err164) */
+  char err164[RCB_ERRMSG_MAX];
+  double lf, ff;       /* its length and force factors (file units per SI unit) */
+  size_t line164;
 } uff_reader;
 
 static rcb_status rfail(uff_reader *R, const uff_rec *r, size_t line, const char *fmt, ...)
@@ -152,6 +161,7 @@ static rcb_status read_headers(uff_reader *R, uff_rec *r) {
     if (!get_line(&R->c, &s, &n) || is_delim(s, n))
       return rfail(R, r, R->c.line, "truncated: record %d (data characteristics) missing",
                    8 + k);
+    field(s, n, 47, 20, r->lab[k], sizeof r->lab[k]);
     if (field_long(s, n, 0, 10, &r->spec[k]))
       return rfail(R, r, R->c.line, "record %d is malformed; expected I10,3I5,2(1X,20A1) "
                    "starting with the specific data type", 8 + k);
@@ -406,6 +416,97 @@ static rcb_status record_kind(uff_reader *R, const uff_rec *r, int frf, rcb_frf_
   return RCB_OK;
 }
 
+/* Dataset 164 (units): record 1 I10,20A1,I10 (units code, description,
+ * temperature mode), record 2 3D25.17 (length, force, temperature factors:
+ * file value / factor = SI). Without record 2, the factors of the units code
+ * (1 SI, 2 BG, 3 MG, 4 BA, 5 MM, 6 CM, 7 IN, 8 GM). A malformed 164 is
+ * remembered and refused only if a record it would scale is read. */
+static void bad_164(uff_reader *R, size_t line, const char *what) { /* remember it */
+  snprintf(R->err164, sizeof R->err164, "%s:%zu: dataset 164 (units): %s", R->path, line, what);
+  R->has164 = -1;
+}
+
+static void read_164(uff_reader *R) {
+  static const double code_lf[] = {1.0, 3.280839895013123, 1.0, 3.280839895013123, 1000.0,
+                                   100.0, 39.37007874015748, 1000.0};
+  static const double code_ff[] = {1.0, 0.2248089430997105, 0.10197162129779283,
+                                   7.233013851209894, 1000.0, 100.0, 0.2248089430997105,
+                                   0.10197162129779283};
+  const char *s;
+  size_t n;
+  long code;
+  R->line164 = R->c.line;
+  if (!get_line(&R->c, &s, &n) || is_delim(s, n)) {
+    bad_164(R, R->c.line, "record 1 missing; expected I10 units code");
+    return; /* the dataset's "-1" (or the end) is consumed */
+  }
+  if (field_long(s, n, 0, 10, &code)) {
+    bad_164(R, R->c.line, "record 1 malformed; expected I10 units code");
+    skip_dataset(&R->c);
+    return;
+  }
+  if (get_line(&R->c, &s, &n) && !is_delim(s, n)) {
+    if (field_double(s, n, 0, 25, &R->lf) || field_double(s, n, 25, 25, &R->ff) ||
+        !(R->lf > 0.0) || !(R->ff > 0.0) || !isfinite(R->lf) || !isfinite(R->ff)) {
+      bad_164(R, R->c.line, "record 2 malformed; expected 3D25.17 length, force and "
+              "temperature factors > 0");
+      skip_dataset(&R->c);
+      return;
+    }
+    skip_dataset(&R->c);
+  } else if (code >= 1 && code <= 8) {
+    R->lf = code_lf[code - 1];
+    R->ff = code_ff[code - 1];
+  } else {
+    bad_164(R, R->line164 + 1, "units code without factors; expected code 1-8 or record 2 "
+            "with the factors");
+    return;
+  }
+  R->has164 = 1;
+}
+
+static int no_label(const char *lab) { return !lab[0] || strcmp(lab, "NONE") == 0; }
+
+/* Factor to SI of record 9 (k = 1) or 10 (k = 2), whose data type says
+ * quantity @p want: from its units label, or dataset 164, or 1 (SI). */
+static rcb_status unit_factor(uff_reader *R, const uff_rec *r, int k, rcb_quantity want,
+                              double *f) {
+  double f164 = 1.0, fl = 1.0;
+  rcb_quantity q;
+  const char *lab = r->lab[k];
+  if (R->has164 < 0) return rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s", R->err164);
+  if (R->has164) f164 = want == RCB_QTY_FORCE ? 1.0 / R->ff : 1.0 / R->lf;
+  *f = f164;
+  if (no_label(lab)) return RCB_OK;
+  if (rcb_unit_parse(lab, &q, &fl))
+    return rfail(R, r, r->line + 8 + (size_t)k, "record %d units label '%s' is not a unit "
+                 "librcb knows; expected %s (m, mm, um, mil, m/s, mm/s, m/s^2, g, N, kN, "
+                 "lbf) or NONE", 8 + k, lab, rcb_quantity_name(want));
+  if (q != want)
+    return rfail(R, r, r->line + 8 + (size_t)k, "record %d units label '%s' is %s %s, but "
+                 "its data type %ld says %s; fix the label or the data type", 8 + k, lab,
+                 q == RCB_QTY_ACCELERATION ? "an" : "a", rcb_quantity_name(q), r->spec[k],
+                 rcb_quantity_name(want));
+  if (R->has164 && fabs(fl - f164) > 1e-6 * fl)
+    return rfail(R, r, r->line + 8 + (size_t)k, "record %d units label '%s' (%.9g SI) "
+                 "disagrees with dataset 164 at line %zu (%.9g SI per file unit); fix one "
+                 "of them", 8 + k, lab, fl, R->line164, f164);
+  *f = fl;
+  return RCB_OK;
+}
+
+/* File value -> SI for the record's ordinate (numerator over denominator). */
+static rcb_status unit_scale(uff_reader *R, const uff_rec *r, int frf, rcb_frf_kind kind,
+                             double *scale) {
+  double fn = 1.0, fd = 1.0;
+  rcb_status st;
+  if ((st = unit_factor(R, r, 1, (rcb_quantity)(RCB_QTY_DISPLACEMENT + (int)kind), &fn)))
+    return st;
+  if (frf && (st = unit_factor(R, r, 2, RCB_QTY_FORCE, &fd))) return st;
+  *scale = fn / fd;
+  return RCB_OK;
+}
+
 /* Collected channels of accepted records. */
 typedef struct uff_set {
   size_t n, cap;
@@ -455,7 +556,7 @@ static rcb_status accept(uff_reader *R, uff_set *S, uff_rec *r) {
   int type = frf ? RCB_MEAS_FRF : RCB_MEAS_UNBALANCE;
   const char *rd = NULL, *fd = NULL;
   char st_r[RCB_MEAS_CH_MAX], st_f[RCB_MEAS_CH_MAX];
-  double scale, speed = 0.0;
+  double scale, speed = 0.0, uscale = 1.0;
   rcb_frf_kind kind = RCB_RECEPTANCE;
   rcb_status st;
   struct uff_chan *c;
@@ -466,6 +567,7 @@ static rcb_status accept(uff_reader *R, uff_set *S, uff_rec *r) {
   if ((st = dir_name(R, r, r->rsp_dir, "response", &rd))) return st;
   if (frf && (st = dir_name(R, r, r->ref_dir, "reference", &fd))) return st;
   if ((st = record_kind(R, r, frf, &kind))) return st;
+  if ((st = unit_scale(R, r, frf, kind, &uscale))) return st;
   if (r->spec[0] == 19) {
     scale = RCB_PI / 30.0;
   } else if (r->spec[0] == 18 || r->spec[0] == 0) {
@@ -501,8 +603,9 @@ static rcb_status accept(uff_reader *R, uff_set *S, uff_rec *r) {
   c->line = r->line;
   c->y = r->y;
   r->y = NULL;
-  if ((r->rsp_dir < 0) != (frf && r->ref_dir < 0))
-    for (i = 0; i < S->npts; i++) c->y[i] = -c->y[i];
+  if ((r->rsp_dir < 0) != (frf && r->ref_dir < 0)) uscale = -uscale;
+  if (uscale != 1.0)
+    for (i = 0; i < S->npts; i++) c->y[i] *= uscale;
   return RCB_OK;
 }
 
@@ -535,6 +638,10 @@ static rcb_status scan(uff_reader *R, uff_set *S) {
     if (field_long(s, n, 0, 6, &id))
       return rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s:%zu: dataset id '%.10s' is not a number",
                            R->path, R->c.line, s);
+    if (id == 164) {
+      read_164(R);
+      continue;
+    }
     if (id != 58) {
       skip_dataset(&R->c);
       continue;
