@@ -16,6 +16,7 @@ struct rcb_spectral {
   const struct rcb_fft_ops *fft;
   size_t nb, nd;         /* lines, segments averaged */
   double wss;            /* sum of the output window squared */
+  double ovl;            /* variance factor of overlapped segments, 1 + 2 sum_j rho_j^2 */
   double *win_in, *win_out; /* nseg each (the same array unless FORCE_EXP) */
   double *buf;           /* nseg: FFT input */
   rcb_complex *spec;     /* (p + 1) * nb: input spectra, then the output's */

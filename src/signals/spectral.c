@@ -54,6 +54,21 @@ rcb_status rcb_spectral_workspace_size(const rcb_spectral_opts *o, size_t *bytes
   return RCB_OK;
 }
 
+/* Overlapped segments are not independent: the variance of an average of
+ * many is that of independent ones times 1 + 2 sum_j rho_j^2, rho_j the
+ * window's correlation at a shift of j steps (Welch 1967; Bendat & Piersol
+ * eq. 11.107): 1.056 for Hann at 50 %, 1.5 for rectangular at 50 %. */
+static void overlap_factor(rcb_spectral *e) {
+  size_t n = e->o.nseg, step = n - e->o.noverlap, lag, t;
+  e->ovl = 1.0;
+  for (lag = step; lag < n; lag += step) {
+    double r = 0.0;
+    for (t = 0; t + lag < n; t++) r += e->win_out[t] * e->win_out[t + lag];
+    r /= e->wss;
+    e->ovl += 2.0 * r * r;
+  }
+}
+
 /* SciPy's periodic windows (get_window(..., fftbins=True)). */
 static void make_windows(rcb_spectral *e) {
   static const double ft[5] = {0.21557895, 0.41663158, 0.277263158, 0.083578947, 0.006947368};
@@ -81,6 +96,7 @@ static void make_windows(rcb_spectral *e) {
     for (t = (size_t)ceil(frac * (double)n); t < n; t++) e->win_in[t] = 0.0;
   }
   for (e->wss = 0.0, t = 0; t < n; t++) e->wss += e->win_out[t] * e->win_out[t];
+  overlap_factor(e);
 }
 
 rcb_status rcb_spectral_init(rcb_spectral **out, const rcb_spectral_opts *o, void *work,

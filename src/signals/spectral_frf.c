@@ -5,7 +5,9 @@
  * spectral matrix [Gxx Gxy; Gyx Gyy]) for one input; ordinary (one input)
  * or multiple coherence; per-line standard deviation of Re h and Im h,
  * sigma^2 = (1 - coh) Gyy [Gxx^-1]_jj / (2 (nd - p + 1)), which for one
- * input is B&P's eps[|H|] = sqrt(1 - coh) / (sqrt(coh) sqrt(2 nd)) times |H|.
+ * input is B&P's eps[|H|] = sqrt(1 - coh) / (sqrt(coh) sqrt(2 nd)) times |H|;
+ * nd is the number of segments divided by the overlap factor (spectral.c),
+ * the equivalent number of independent averages.
  * Several inputs: Gxx is Hermitian positive definite unless two inputs are
  * fully coherent, so it is factored by LAPACK zpotrf (zpotrs, zpotri).
  */
@@ -58,7 +60,7 @@ static int frf_miso(rcb_spectral *e, size_t k, size_t out, size_t in, rcb_comple
   *coh = gyy > 0.0 ? fmin(1.0, num / gyy) : (double)NAN;
   info = LAPACKE_zpotri_work(LAPACK_COL_MAJOR, 'L', n, (lapack_complex_double *)e->a, n);
   if (info) return -1;
-  nd = (double)e->nd - (double)p + 1.0;
+  nd = (double)e->nd / e->ovl - (double)p + 1.0;
   *sd = nd > 0.0 ? sqrt(fmax(0.0, 1.0 - *coh) * gyy * creal(e->a[in * p + in]) / (2.0 * nd))
                  : (double)NAN;
   return 0;
@@ -82,8 +84,8 @@ rcb_status rcb_spectral_frf(rcb_spectral *e, rcb_estimator est, size_t out, size
     rcb_complex hk;
     double ck, sk;
     if (p == 1) {
-      frf_siso(est, creal(e->gxx[k]), e->gxy[k * q + out], e->gyy[k * q + out], (double)e->nd,
-               &hk, &ck, &sk);
+      frf_siso(est, creal(e->gxx[k]), e->gxy[k * q + out], e->gyy[k * q + out],
+               (double)e->nd / e->ovl, &hk, &ck, &sk);
     } else if (frf_miso(e, k, out, in, &hk, &ck, &sk)) {
       hk = CMPLX((double)NAN, (double)NAN);
       ck = sk = (double)NAN;

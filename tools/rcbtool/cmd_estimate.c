@@ -22,6 +22,9 @@ const char cli_help_estimate[] =
     "  --input CH     force channel (unit N, kN or lbf); several: CH1,CH2 (H1 only)\n"
     "  --outputs LIST response channels: displacement (m, mm, um, mil), velocity\n"
     "                 (m/s, mm/s, in/s) or acceleration (m/s^2, g)\n"
+    "                 Items NAME (a model channel STATION.DIR) or NAME=STATION.DIR\n"
+    "                 (file channel NAME is model channel STATION.DIR: a driving\n"
+    "                 point has force 'f=DA.x' and response 'DA.x')\n"
     "  --kind K       write receptance, mobility or inertance (default: what the\n"
     "                 first output measures; the others are converted to it)\n"
     "  --nseg N       samples per segment (default 4096)\n"
@@ -53,7 +56,8 @@ typedef struct est_job {
   size_t p, q;
   size_t *idx;  /* p + q channel indices into sig */
   char *buf;    /* --input and --outputs text, split */
-  char **names; /* p + q */
+  char **names; /* p + q: channel names in the file */
+  char **model; /* p + q: model channels "STATION.DIR" (NAME=STATION.DIR, else NAME) */
   rcb_spectral_opts o;
   rcb_spectral *e;
   void *work;
@@ -86,7 +90,11 @@ static int split_list(est_job *j, char *list, size_t *count) {
   while (p) {
     char *comma = strchr(p, ',');
     if (comma) *comma = '\0';
-    if (!*p) return cli_usage(j->a->cmd, "empty channel name in a list");
+    char *eq = strchr(p, '=');
+    if (!*p || eq == p || (eq && !eq[1]))
+      return cli_usage(j->a->cmd, "empty channel name in a list (items NAME or NAME=STATION.DIR)");
+    if (eq) *eq = '\0';
+    j->model[j->p + j->q + *count] = eq ? eq + 1 : p;
     j->names[j->p + j->q + (*count)++] = p;
     p = comma ? comma + 1 : NULL;
     if (j->p + j->q + *count >= 64 + 256 && p)
@@ -101,8 +109,9 @@ static int channels(est_job *j) {
   int rc;
   j->buf = malloc(strlen(in) + strlen(out) + 2);
   j->names = calloc(64 + 256, sizeof *j->names);
+  j->model = calloc(64 + 256, sizeof *j->model);
   j->idx = calloc(64 + 256, sizeof *j->idx);
-  if (!j->buf || !j->names || !j->idx) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  if (!j->buf || !j->names || !j->model || !j->idx) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   strcpy(j->buf, in);
   strcpy(j->buf + strlen(in) + 1, out);
   if ((rc = split_list(j, j->buf, &n))) return rc;
@@ -272,7 +281,7 @@ static int write_meas(est_job *j, const est_out *r) {
   st = rcb_meas_set_grid(ms, RCB_MEAS_FRF, r->n, r->w + 1, fabs(rpm) * CLI_RPM_TO_RAD_S);
   for (o = 0; !st && o < j->q; o++)
     for (i = 0; !st && i < j->p; i++)
-      st = rcb_meas_add_channel(ms, j->names[j->p + o], j->names[i], (rcb_frf_kind)j->kind,
+      st = rcb_meas_add_channel(ms, j->model[j->p + o], j->model[i], (rcb_frf_kind)j->kind,
                                 r->h + (o * j->p + i) * nb + 1);
   if (st) {
     rc = cli_fail(CLI_EXIT_INPUT, "estimate: %s", cli_msg(rcb_meas_errmsg(ms), st));
@@ -303,8 +312,8 @@ static int write_stats(est_job *j, const est_out *r, const char *path) {
           "kind = %s\nfreq_hz", est_names[j->est], rcb_spectral_averages(j->e), j->o.nseg,
           j->o.noverlap, window_names[j->o.window], kind_names[j->kind]);
   for (c = 0; c < np; c++)
-    fprintf(out.fp, ",%s/%s coh,%s/%s sd", j->names[j->p + c / j->p], j->names[c % j->p],
-            j->names[j->p + c / j->p], j->names[c % j->p]);
+    fprintf(out.fp, ",%s/%s coh,%s/%s sd", j->model[j->p + c / j->p], j->model[c % j->p],
+            j->model[j->p + c / j->p], j->model[c % j->p]);
   fputc('\n', out.fp);
   for (k = 1; k <= r->n; k++) {
     cli_csv_num(out.fp, r->w[k] / CLI_HZ_TO_RAD_S);
@@ -391,6 +400,7 @@ static int estimate(const cli_args *a) {
   free(r.sd);
   free(j.buf);
   free(j.names);
+  free(j.model);
   free(j.idx);
   rcb_signals_destroy(j.sig);
   return rc;
