@@ -487,6 +487,80 @@ static void test_frf_units(void **state) {
   refused(frf_uff("    -1\n   164\n        42\n    -1\n", 8, "m", "N"), "dataset 164");
 }
 
+/* ---- order tracking ---- */
+
+/* Keyphasor with a linear rising edge of +-7.2 deg about each mark (5 V). */
+static double keyphasor(double phi) {
+  double w = fmod(phi, 2 * PI), d = 2 * PI * 0.02;
+  if (w > PI) w -= 2 * PI;
+  if (w >= -d && w <= d) return 2.5 + 2.5 * w / d;
+  return w > d && w < PI / 4 ? 5.0 : 0.0;
+}
+
+/* A run-up 1000 -> 3000 rpm in 4 s with y = 2 cos(phi + 0.3) + 0.5 cos(2 phi - 1)
+ * (+ noise): every bin's 1X and 2X equal 2 e^{0.3i} and 0.5 e^{-i} (to the
+ * within-revolution speed change), and with noise the sd predicts the error. */
+static void test_order_runup(void **state) {
+  enum { N = 4 * 20000 };
+  const double fs = 20000.0, w0 = 1000 * PI / 30, al = 500 * PI / 30;
+  double *kp = malloc(N * sizeof *kp), *y = malloc(N * sizeof *y), *yn = malloc(N * sizeof *yn);
+  const double *ch[2];
+  rcb_order_opts o;
+  rcb_order *e;
+  size_t bytes, b, reported = 0, within = 0, n;
+  void *work;
+  rng r = {5};
+  (void)state;
+  for (n = 0; n < N; n++) {
+    double t = (double)n / fs, phi = w0 * t + 0.5 * al * t * t;
+    kp[n] = keyphasor(phi);
+    y[n] = 2 * cos(phi + 0.3) + 0.5 * cos(2 * phi - 1.0);
+    yn[n] = y[n] + 0.2 * gauss(&r);
+  }
+  memset(&o, 0, sizeof o);
+  o.norders = 2;
+  o.trigger = NAN;
+  o.bin_width = 100 * PI / 30;
+  o.speed_max = 4000 * PI / 30;
+  assert_int_equal(rcb_order_workspace_size(&o, 2, &bytes), RCB_OK);
+  work = malloc(bytes);
+  assert_int_equal(rcb_order_init(&e, &o, 2, work, bytes - 1), RCB_ERR_WORKSPACE);
+  assert_int_equal(rcb_order_init(&e, &o, 2, work, bytes), RCB_OK);
+  ch[0] = y;
+  ch[1] = yn;
+  assert_int_equal(rcb_order_add(e, fs, N, kp, ch), RCB_OK);
+  /* phi(4 s) / 2 pi = (1000/60) 4 + (500/60) 8 = 133.3: 133 pulses (the mark
+   * at t = 0 is no crossing), 132 revolutions, the first without a pulse
+   * before it */
+  assert_int_equal(rcb_order_revolutions(e), 131);
+  for (b = 0; b < rcb_order_bin_count(e); b++) {
+    double speed, sd, sd2;
+    rcb_complex q1, q2, qn;
+    size_t nr;
+    assert_int_equal(rcb_order_result(e, b, 0, 1, &speed, &q1, NULL, &nr), RCB_OK);
+    if (nr < 2) continue;
+    reported++;
+    assert_true(speed >= (double)b * o.bin_width && speed < (double)(b + 1) * o.bin_width);
+    rcb_order_result(e, b, 0, 2, NULL, &q2, &sd2, NULL);
+    if (cabs(q1 - 2 * cexp(CMPLX(0, 0.3))) > 1e-4 * 2 || cabs(q2 - 0.5 * cexp(CMPLX(0, -1.0))) > 1e-4 * 0.5)
+      fail_msg("bin %zu: 1X error %g, 2X error %g", b, cabs(q1 - 2 * cexp(CMPLX(0, 0.3))) / 2, cabs(q2 - 0.5 * cexp(CMPLX(0, -1.0))) / 0.5);
+    rcb_order_result(e, b, 1, 1, NULL, &qn, &sd, NULL);
+    within += cabs(qn - 2 * cexp(CMPLX(0, 0.3))) <= 2.4477 * sd;
+  }
+  assert_int_equal(reported, 20); /* 1000 .. 2999 rpm in 100 rpm bins */
+  printf("order tracking, noise 0.2: 1X inside its 95 %% band in %zu of %zu bins\n", within,
+         reported);
+  assert_true(within >= 16);
+  /* no keyphasor pulse: refused */
+  memset(kp, 0, N * sizeof *kp);
+  assert_int_equal(rcb_order_add(e, fs, N, kp, ch), RCB_ERR_ARG);
+  assert_non_null(strstr(rcb_order_errmsg(e), "keyphasor"));
+  free(work);
+  free(kp);
+  free(y);
+  free(yn);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_white_noise_level),
@@ -499,6 +573,7 @@ int main(void) {
       cmocka_unit_test(test_wav),
       cmocka_unit_test(test_units_table),
       cmocka_unit_test(test_frf_units),
+      cmocka_unit_test(test_order_runup),
   };
   return cmocka_run_group_tests(tests, rcb_test_setup_tmpdir, rcb_test_teardown_tmpdir);
 }

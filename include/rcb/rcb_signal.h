@@ -190,6 +190,66 @@ RCB_API rcb_status rcb_spectral_cross(const rcb_spectral *e, size_t a, size_t b,
 RCB_API rcb_status rcb_spectral_frf(rcb_spectral *e, rcb_estimator est, size_t out,
                                     size_t in, rcb_complex *h, double *coh, double *sd);
 
+/* --------------------------------------------------- order tracking -- */
+
+/**
+ * @brief Order-tracking settings. Method: computed order tracking, one
+ * revolution at a time. Keyphasor pulses (upward crossings of @c trigger,
+ * interpolated between samples) bound each revolution; its samples are
+ * resampled (linear interpolation in time) to @c per_rev equally spaced
+ * shaft angles, the angle taken as a quadratic in time through the pulses
+ * before, at and after the revolution (constant angular acceleration; Fyfe
+ * & Munck 1997, so the first revolution is not reported), and an exact
+ * per_rev-point DFT gives the order-m phasor Q_m = (2/N) sum_j y_j
+ * e^{-i m theta_j}, y = Re(Q_m e^{i m theta}), theta from the keyphasor mark
+ * plus @c kp_angle. Revolutions are grouped into speed bins of width
+ * @c bin_width; a bin reports the mean phasor, the mean speed and the
+ * standard deviation of the mean from the scatter over its revolutions.
+ * Why not Vold-Kalman: with the angle exact for a constant acceleration,
+ * the per-revolution DFT is exact for every order at any run-up rate,
+ * needs no tuning of a filter bandwidth, runs in O(samples) and gives the
+ * revolution-to-revolution scatter that the statistics need.
+ */
+typedef struct rcb_order_opts {
+  size_t norders;   /**< orders 1..norders (1 to 8) */
+  size_t per_rev;   /**< angle samples per revolution (>= 4 norders; 0: 64) */
+  double trigger;   /**< keyphasor threshold in its unit (NaN: halfway between its min and max) */
+  double kp_angle;  /**< shaft angle at the keyphasor mark, rad */
+  double bin_width; /**< speed bin, rad/s (> 0) */
+  double speed_max; /**< highest speed binned, rad/s (faster revolutions are ignored) */
+  size_t min_revs;  /**< revolutions a bin needs to be reported (>= 2; 0: 2) */
+} rcb_order_opts;
+
+typedef struct rcb_order rcb_order;
+
+/** @brief Bytes for an order tracker of @p nch channels (two-call sizing). */
+RCB_API rcb_status rcb_order_workspace_size(const rcb_order_opts *o, size_t nch,
+                                            size_t *bytes);
+/** @brief Build an order tracker in @p work (no allocation, ever). */
+RCB_API rcb_status rcb_order_init(rcb_order **out, const rcb_order_opts *o, size_t nch,
+                                  void *work, size_t bytes);
+RCB_API const char *rcb_order_errmsg(const rcb_order *e);
+/**
+ * @brief Track a record: @p kp the keyphasor, @p chan the nch responses,
+ * n samples each at @p rate samples/s. May be called for several records.
+ * @return RCB_ERR_ARG with a message if fewer than three pulses are found
+ */
+RCB_API rcb_status rcb_order_add(rcb_order *e, double rate, size_t n, const double *kp,
+                                 const double *const *chan);
+/** @brief Revolutions tracked so far. */
+RCB_API size_t rcb_order_revolutions(const rcb_order *e);
+/** @brief Bins (speed_max / bin_width, rounded up). */
+RCB_API size_t rcb_order_bin_count(const rcb_order *e);
+/**
+ * @brief One bin's result for channel @p ch and order @p m (1-based).
+ * @param speed mean speed of its revolutions, rad/s
+ * @param Q mean phasor (channel unit) @param sd standard deviation of Re Q and
+ * of Im Q of the mean, sqrt(sum |Q_r - Q|^2 / (2 n (n - 1)))
+ * @param nrev revolutions in the bin (results valid when >= min_revs)
+ */
+RCB_API rcb_status rcb_order_result(const rcb_order *e, size_t bin, size_t ch, size_t m,
+                                    double *speed, rcb_complex *Q, double *sd, size_t *nrev);
+
 #ifdef __cplusplus
 }
 #endif
