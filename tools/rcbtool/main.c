@@ -20,6 +20,8 @@ static const cli_command commands[] = {
      cli_help_simulate, cmd_simulate},
     {"estimate", "FRFs with coherence and standard deviations from sampled signals (Welch)",
      cli_help_estimate, cmd_estimate},
+    {"order", "1X/2X unbalance responses per speed from run-up signals with a keyphasor",
+     cli_help_order, cmd_order},
     {"convert", "measurements between UFF58 (ASCII/binary) and CSV, and between kinds",
      cli_help_convert, cmd_convert},
     {"fit", "fit model parameters to a measurement, with uncertainty", cli_help_fit,
