@@ -479,18 +479,21 @@ static rcb_status unit_factor(uff_reader *R, const uff_rec *r, int k, rcb_quanti
   *f = f164;
   if (no_label(lab)) return RCB_OK;
   if (rcb_unit_parse(lab, &q, &fl))
-    return rfail(R, r, r->line + 8 + (size_t)k, "record %d units label '%s' is not a unit "
-                 "librcb knows; expected %s (m, mm, um, mil, m/s, mm/s, m/s^2, g, N, kN, "
-                 "lbf) or NONE", 8 + k, lab, rcb_quantity_name(want));
+    return rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu: record %d "
+                         "units label '%s' is not a unit librcb knows; expected %s (m, mm, um, "
+                         "mil, m/s, mm/s, m/s^2, g, N, kN, lbf) or NONE", R->path,
+                         r->line + 8 + (size_t)k, r->index, 8 + k, lab, rcb_quantity_name(want));
   if (q != want)
-    return rfail(R, r, r->line + 8 + (size_t)k, "record %d units label '%s' is %s %s, but "
-                 "its data type %ld says %s; fix the label or the data type", 8 + k, lab,
-                 q == RCB_QTY_ACCELERATION ? "an" : "a", rcb_quantity_name(q), r->spec[k],
-                 rcb_quantity_name(want));
+    return rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu: record %d "
+                         "units label '%s' is %s %s, but its data type %ld says %s; fix the "
+                         "label or the data type", R->path, r->line + 8 + (size_t)k, r->index,
+                         8 + k, lab, q == RCB_QTY_ACCELERATION ? "an" : "a",
+                         rcb_quantity_name(q), r->spec[k], rcb_quantity_name(want));
   if (R->has164 && fabs(fl - f164) > 1e-6 * fl)
-    return rfail(R, r, r->line + 8 + (size_t)k, "record %d units label '%s' (%.9g SI) "
-                 "disagrees with dataset 164 at line %zu (%.9g SI per file unit); fix one "
-                 "of them", 8 + k, lab, fl, R->line164, f164);
+    return rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu: record %d "
+                         "units label '%s' (%.9g SI) disagrees with dataset 164 at line %zu "
+                         "(%.9g SI per file unit); fix one of them", R->path,
+                         r->line + 8 + (size_t)k, r->index, 8 + k, lab, fl, R->line164, f164);
   *f = fl;
   return RCB_OK;
 }

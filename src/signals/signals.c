@@ -9,9 +9,9 @@
 
 #include "signals/signals_internal.h"
 
-#undef rcb_signals_fail
-rcb_status rcb_signals_fail(rcb_signals *s, rcb_status st, const char *fmt, ...) {
+rcb_status (rcb_signals_fail)(rcb_signals *s, rcb_status st, const char *fmt, ...) {
   va_list ap;
+  if (!s) return st;
   va_start(ap, fmt);
   vsnprintf(s->errmsg, sizeof s->errmsg, fmt, ap);
   va_end(ap);
