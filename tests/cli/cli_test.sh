@@ -569,6 +569,12 @@ order_runup_signals)
   expect_rc 0
   run convert "$W/o1.uff" "$W/o1.csv" --map 1=DA,2=DB; expect_rc 0
   [ "$(grep -c '^[0-9]' "$W/o1.csv")" -ge 3 ] || fail "fewer than 3 speed bins"
+  # the per-bin sd as fit weights and noise floor; a stats file of other rows refused
+  run fit "$MODEL" "$W/o1.csv" --params unbalance.UA.amount --scale complex --sd "$W/st.csv"
+  expect_rc 0; out_has "noise floor (from --noise or --sd):"
+  head -n 3 "$W/st.csv" >"$W/st2.csv"
+  run fit "$MODEL" "$W/o1.csv" --params unbalance.UA.amount --sd "$W/st2.csv"
+  expect_rc 3; err_has "rows for a measurement of"
   # no keyphasor pulse: refused
   sed -e 's/^\([^#t][^,]*\),[^,]*,/\1,0,/' "$W/s.csv" >"$W/nokp.csv"
   run order "$W/nokp.csv" --kp KP --outputs DA.x -o "$W/n.uff"; expect_rc 3; err_has "keyphasor pulses"
