@@ -561,6 +561,64 @@ static void test_order_runup(void **state) {
   free(yn);
 }
 
+/* ---- UFF58 time records ---- */
+
+/* One real, evenly spaced time record (4E20.12): node, direction, ordinate
+ * data type and units label, 4 samples from t = 0 every 1 ms. */
+static void time_rec(FILE *fp, long node, int dir, int s9, const char *lab, const double *v) {
+  fprintf(fp, "%6d\n%6d%74s\n", -1, 58, "");
+  fprintf(fp, "%-80s\n%-80s\n%-80s\n%-80s\n%-80s\n", "time", "NONE", "NONE", "NONE", "NONE");
+  fprintf(fp, "%5d%10d%5d%10d %10s%10ld%4d %10s%10ld%4d\n", 1, 0, 0, 0, "NONE", node, dir,
+          "NONE", 0L, 0);
+  fprintf(fp, "%10d%10ld%10d%13.5e%13.5e%13.5e\n", 4, 4L, 1, 0.0, 1e-3, 0.0);
+  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", 17, 0, 0, 0, "Time", "s");
+  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", s9, 0, 0, 0, "Signal", lab);
+  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", 0, 0, 0, 0, "NONE", "NONE");
+  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", 0, 0, 0, 0, "NONE", "NONE");
+  fprintf(fp, "%20.11e%20.11e%20.11e%20.11e\n", v[0], v[1], v[2], v[3]);
+  fprintf(fp, "%6d\n", -1);
+}
+
+static void test_uff_time_records(void **state) {
+  const char *p = rcb_test_tmp_path("time.uff");
+  const double v[4] = {1.0, -2.0, 0.5, 4.0};
+  rcb_uff_node map[] = {{1, "DA"}, {99, "KP"}};
+  rcb_signals *s;
+  const char *name;
+  const double *x;
+  rcb_quantity q;
+  FILE *fp = fopen(p, "w");
+  (void)state;
+  assert_non_null(fp);
+  time_rec(fp, 1, 1, 8, "mm", v);     /* DA.x in mm */
+  time_rec(fp, 1, -2, 12, "g", v);    /* DA.y in g, negative direction */
+  time_rec(fp, 99, 0, 0, "V", v);     /* keyphasor */
+  fclose(fp);
+  assert_int_equal(rcb_signals_create(&s, NULL), RCB_OK);
+  if (rcb_signals_read_uff(s, p, 2, map)) fail_msg("%s", rcb_signals_errmsg(s));
+  assert_int_equal(rcb_signals_channel_count(s), 3);
+  assert_true(fabs(rcb_signals_rate(s) - 1000.0) < 1e-6 && rcb_signals_length(s) == 4);
+  rcb_signals_channel(s, 0, &name, &q, &x);
+  assert_string_equal(name, "DA.x");
+  assert_true(q == RCB_QTY_DISPLACEMENT && fabs(x[1] + 2e-3) < 1e-15);
+  rcb_signals_channel(s, 1, &name, &q, &x);
+  assert_string_equal(name, "DA.y");
+  assert_true(q == RCB_QTY_ACCELERATION && fabs(x[3] + 4 * 9.80665) < 1e-12);
+  rcb_signals_channel(s, 2, &name, &q, &x);
+  assert_string_equal(name, "KP");
+  assert_true(q == RCB_QTY_VOLTAGE && x[3] == 4.0);
+  /* an FRF file has no time record; a label contradicting its data type */
+  assert_int_equal(rcb_signals_read_uff(s, frf_uff(NULL, 8, "m", "N"), 0, NULL), RCB_ERR_PARSE);
+  assert_non_null(strstr(rcb_signals_errmsg(s), "no dataset 58 time record"));
+  fp = fopen(p, "w");
+  time_rec(fp, 1, 1, 8, "g", v);
+  fclose(fp);
+  assert_int_equal(rcb_signals_read_uff(s, p, 2, map), RCB_ERR_PARSE);
+  assert_non_null(strstr(rcb_signals_errmsg(s), "is an acceleration, but its data type 8"));
+  assert_int_equal(rcb_signals_channel_count(s), 0);
+  rcb_signals_destroy(s);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_white_noise_level),
@@ -574,6 +632,7 @@ int main(void) {
       cmocka_unit_test(test_units_table),
       cmocka_unit_test(test_frf_units),
       cmocka_unit_test(test_order_runup),
+      cmocka_unit_test(test_uff_time_records),
   };
   return cmocka_run_group_tests(tests, rcb_test_setup_tmpdir, rcb_test_teardown_tmpdir);
 }

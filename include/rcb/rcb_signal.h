@@ -97,6 +97,21 @@ RCB_API rcb_status rcb_signals_read_wav(rcb_signals *s, const char *path, size_t
                                         const char *const *names, const char *const *units,
                                         const double *scale);
 
+/**
+ * @brief Read UFF dataset 58 time records (function type 1, abscissa type 17
+ * time, real data (types 2, 4), evenly sampled: spacing 1, or the times
+ * listed (as pyuff writes) within 0.1 sample of an even grid; ASCII or
+ * binary 58b), one
+ * channel per record, all with one sample interval and length. Channel names
+ * "STATION.DIR" through @p map (as rcb_meas_read_uff), or the station alone
+ * for direction 0 (a keyphasor). Quantity from the ordinate data type (8
+ * displacement, 11 velocity, 12 acceleration, 9/13 force) or else from the
+ * record-9 units label (V, ...); units from that label or a dataset 164
+ * (a disagreement of the two is refused).
+ */
+RCB_API rcb_status rcb_signals_read_uff(rcb_signals *s, const char *path, size_t nmap,
+                                        const rcb_uff_node *map);
+
 /* ------------------------------------------------------- estimation -- */
 
 /** @brief Segment window. */

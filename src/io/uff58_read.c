@@ -102,6 +102,7 @@ typedef struct uff_rec {
   long ord_type, npts, spacing;
   double xmin, dx, zval;   /* Hz, Hz, z value */
   long spec[4];            /* records 8..11 specific data types */
+  int real;                /* real ordinates (types 2, 4): time records only */
   char lab[4][24];         /* records 8..11 axis units labels */
   double *x;               /* Hz (or rpm), npts */
   rcb_complex *y;          /* npts */
@@ -114,6 +115,9 @@ typedef struct uff_reader {
   size_t nmap;
   const rcb_uff_node *map;
   int has164;          /* a dataset 164 was read (-1: malformed, see err164) */
+  rcb_uff_time_fn on_time; /* time mode (rcb_uff58_read_time): records go here */
+  void *user;
+  size_t ntime;
   char err164[RCB_ERRMSG_MAX];
   double lf, ff;       /* its length and force factors (file units per SI unit) */
   size_t line164;
@@ -172,10 +176,14 @@ static rcb_status read_headers(uff_reader *R, uff_rec *r) {
 /* The data form: complex, a sane count and spacing. */
 static rcb_status check_form(uff_reader *R, uff_rec *r) {
   size_t line = r->line + 7;
-  if (r->ord_type == 2 || r->ord_type == 4)
+  r->real = r->ord_type == 2 || r->ord_type == 4;
+  if (R->on_time && !r->real)
+    return rfail(R, r, line, "time record with ordinate data type %ld; expected real data (2 "
+                 "single or 4 double precision)", r->ord_type);
+  if (r->real && !R->on_time)
     return rfail(R, r, line, "ordinate data type %ld is real; expected complex (5 single or 6 "
                  "double precision)", r->ord_type);
-  if (r->ord_type != 5 && r->ord_type != 6)
+  if (!r->real && r->ord_type != 5 && r->ord_type != 6)
     return rfail(R, r, line, "unknown ordinate data type %ld; expected 5 or 6 (complex)",
                  r->ord_type);
   if (r->npts < 1 || r->npts > 100000000L)
@@ -193,7 +201,14 @@ static rcb_status check_form(uff_reader *R, uff_rec *r) {
 
 /* Store value k of the record's value stream (ASCII or binary). */
 static void put_value(uff_rec *r, size_t k, double v) {
-  if (r->spacing == 1) {
+  if (r->real && r->spacing == 1) {
+    r->y[k] = CMPLX(v, 0.0);
+  } else if (r->real) { /* uneven: abscissa and value pairs */
+    if (k % 2 == 0)
+      r->x[k / 2] = v;
+    else
+      r->y[k / 2] = CMPLX(v, 0.0);
+  } else if (r->spacing == 1) {
     if (k % 2 == 0)
       r->y[k / 2] = CMPLX(v, cimag(r->y[k / 2]));
     else
@@ -212,9 +227,14 @@ static rcb_status read_ascii(uff_reader *R, uff_rec *r) {
   static const size_t w_single[] = {13, 13, 13, 13, 13, 13};
   static const size_t w_even[] = {20, 20, 20, 20};
   static const size_t w_uneven[] = {13, 20, 20};
-  const size_t *w = r->ord_type == 5 ? w_single : r->spacing ? w_even : w_uneven;
-  size_t nw = r->ord_type == 5 ? 6 : r->spacing ? 4 : 3;
-  size_t need = (size_t)r->npts * (r->spacing ? 2 : 3), k = 0;
+  static const size_t w_uneven_real[] = {13, 20, 13, 20}; /* 2(E13.5,E20.12) */
+  int single = r->ord_type == 5 || r->ord_type == 2;
+  const size_t *w = single                      ? w_single
+                    : r->spacing                ? w_even
+                    : r->real                   ? w_uneven_real
+                                                : w_uneven;
+  size_t nw = single ? 6 : r->spacing || r->real ? 4 : 3;
+  size_t need = (size_t)r->npts * (r->real ? (r->spacing ? 1 : 2) : r->spacing ? 2 : 3), k = 0;
   const char *s;
   size_t n;
   while (k < need) {
@@ -260,7 +280,8 @@ static double get_real(const unsigned char *p, size_t size, int big) {
 }
 
 static rcb_status read_binary(uff_reader *R, uff_rec *r) {
-  size_t vs = r->ord_type == 6 ? 8 : 4, n = (size_t)r->npts, xs = vs, k, need, off;
+  size_t vs = r->ord_type == 6 || r->ord_type == 4 ? 8 : 4, n = (size_t)r->npts, xs = vs, k;
+  size_t need, off, count;
   const unsigned char *p = (const unsigned char *)R->c.buf + R->c.pos;
   const char *s;
   size_t ln;
@@ -271,17 +292,20 @@ static rcb_status read_binary(uff_reader *R, uff_rec *r) {
     return rfail(R, r, r->line, "58b floating-point format %d; only 2 (IEEE 754) is "
                  "supported", r->fp_format);
   if (r->spacing == 0 && r->n_bytes == (long)(n * (4 + 2 * vs))) xs = 4;
-  need = r->spacing ? 2 * n * vs : n * (xs + 2 * vs);
+  if (r->real && r->spacing == 0) xs = r->n_bytes == (long)(n * (4 + vs)) ? 4 : vs;
+  need = r->real ? (r->spacing ? n * vs : n * (xs + vs))
+                 : r->spacing ? 2 * n * vs : n * (xs + 2 * vs);
+  count = r->real ? (r->spacing ? n : 2 * n) : r->spacing ? 2 * n : 3 * n;
   if (R->c.len - R->c.pos < need)
     return rfail(R, r, R->c.line, "truncated binary data: %zu bytes in the file, %zu needed "
                  "for %zu points", R->c.len - R->c.pos, need, n);
-  for (k = 0, off = 0; k < (r->spacing ? 2 * n : 3 * n); k++) {
-    size_t sz = (r->spacing == 0 && k % 3 == 0) ? xs : vs;
+  for (k = 0, off = 0; k < count; k++) {
+    size_t sz = r->spacing == 0 && k % (r->real ? 2 : 3) == 0 ? xs : vs;
     double v = get_real(p + off, sz, r->byte_order == 2);
     off += sz;
     if (!isfinite(v))
       return rfail(R, r, R->c.line, "binary value %zu of %zu is not finite; expected finite "
-                   "numbers", k + 1, r->spacing ? 2 * n : 3 * n);
+                   "numbers", k + 1, count);
     put_value(r, k, v);
   }
   /* the data may contain '\n' bytes: count lines past it for later messages */
@@ -354,7 +378,8 @@ static rcb_status read_record(uff_reader *R, uff_rec *r, int *used) {
   rcb_status st;
   *used = 0;
   if ((st = read_headers(R, r))) return st;
-  if (r->func_type != 4 && r->func_type != 1) {
+  if (R->on_time ? !(r->func_type == 1 && r->spec[0] == 17)
+                 : (r->func_type != 4 && r->func_type != 1)) {
     skip_values(R, r);
     return RCB_OK;
   }
@@ -366,7 +391,7 @@ static rcb_status read_record(uff_reader *R, uff_rec *r, int *used) {
     return rcb_meas_fail(R->ms, RCB_ERR_NOMEM, "%s: out of memory (%ld points)", R->path,
                          r->npts);
   st = r->binary ? read_binary(R, r) : read_ascii(R, r);
-  return st ? st : check_abscissa(R, r);
+  return st || R->on_time ? st : check_abscissa(R, r);
 }
 
 /* ---- record -> channel ---- */
@@ -612,6 +637,91 @@ static rcb_status accept(uff_reader *R, uff_set *S, uff_rec *r) {
   return RCB_OK;
 }
 
+static rcb_status scan(uff_reader *R, uff_set *S);
+
+/* A time record (function type 1, abscissa time): channel "STATION.DIR" (or
+ * the station alone for direction 0, e.g. a keyphasor), quantity from the
+ * ordinate data type (8, 11, 12 motion; 9, 13 force) or else from the units
+ * label, values to SI, then handed to the caller. */
+static rcb_status accept_time(uff_reader *R, uff_rec *r) {
+  static const long motion[] = {8, 11, 12};
+  rcb_uff_time_rec t;
+  rcb_quantity want = RCB_QTY_UNKNOWN;
+  char st_r[RCB_MEAS_CH_MAX];
+  const char *dir = NULL;
+  double f = 1.0;
+  size_t i;
+  rcb_status st;
+  memset(&t, 0, sizeof t);
+  for (i = 0; i < 3; i++)
+    if (r->spec[1] == motion[i]) want = (rcb_quantity)(RCB_QTY_DISPLACEMENT + (int)i);
+  if (r->spec[1] == 9 || r->spec[1] == 13) want = RCB_QTY_FORCE;
+  if (want != RCB_QTY_UNKNOWN) {
+    if ((st = unit_factor(R, r, 1, want, &f))) return st;
+  } else if (!no_label(r->lab[1]) && rcb_unit_parse(r->lab[1], &want, &f)) {
+    return rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu: record 9 units "
+                         "label '%s' is not a unit librcb knows (m, mm, um, m/s, m/s^2, g, N, "
+                         "V, ...)", R->path, r->line + 9, r->index, r->lab[1]);
+  }
+  if (r->rsp_dir != 0 && (st = dir_name(R, r, r->rsp_dir, "response", &dir))) return st;
+  station_of(R, r->rsp_node, st_r, sizeof st_r);
+  if (dir)
+    snprintf(t.name, sizeof t.name, "%.*s.%s", (int)(sizeof t.name - 4), st_r, dir);
+  else
+    snprintf(t.name, sizeof t.name, "%s", st_r);
+  if (r->rsp_dir < 0) f = -f;
+  for (i = 0; i < (size_t)r->npts; i++) r->y[i] *= f;
+  t.t0 = r->xmin;
+  t.dt = r->dx;
+  if (r->spacing == 0 && r->npts > 1) { /* times listed (pyuff): evenly spaced? */
+    size_t n = (size_t)r->npts;
+    t.t0 = r->x[0];
+    t.dt = (r->x[n - 1] - r->x[0]) / (double)(n - 1);
+    for (i = 0; i < n; i++)
+      if (!(fabs(r->x[i] - (t.t0 + (double)i * t.dt)) <= 0.1 * t.dt))
+        return rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu: time %zu "
+                             "is %.9g s, expected %.9g s: the samples must be evenly spaced "
+                             "(a dropped sample?)", R->path, r->line + 12, r->index, i + 1,
+                             r->x[i], t.t0 + (double)i * t.dt);
+  }
+  t.n = (size_t)r->npts;
+  t.y = r->y;
+  t.q = want;
+  t.index = r->index;
+  t.line = r->line;
+  R->ntime++;
+  return R->on_time(R->user, &t);
+}
+
+rcb_status rcb_uff58_read_time(rcb_meas *ms, const char *path, size_t nmap,
+                               const rcb_uff_node *map, rcb_uff_time_fn fn, void *user) {
+  uff_reader R;
+  uff_set S;
+  char *buf = NULL;
+  size_t len;
+  rcb_status st;
+  if (!ms || !fn) return RCB_ERR_ARG;
+  if (nmap && !map) return rcb_meas_fail(ms, RCB_ERR_ARG, "read_uff: node map is NULL");
+  if ((st = rcb_meas_slurp(ms, path, &buf, &len))) return st;
+  memset(&R, 0, sizeof R);
+  memset(&S, 0, sizeof S);
+  S.type = -1;
+  R.ms = ms;
+  R.path = path;
+  R.c.buf = buf;
+  R.c.len = len;
+  R.nmap = nmap;
+  R.map = map;
+  R.on_time = fn;
+  R.user = user;
+  st = scan(&R, &S);
+  if (!st && R.ntime == 0)
+    st = rcb_meas_fail(ms, RCB_ERR_PARSE, "%s: no dataset 58 time record (function type 1, "
+                       "abscissa data type 17)", path);
+  rcb_free(&ms->alloc, buf);
+  return st;
+}
+
 /* Skip a dataset other than 58 up to its closing "-1". */
 static void skip_dataset(cursor *c) {
   const char *s;
@@ -654,11 +764,11 @@ static rcb_status scan(uff_reader *R, uff_set *S) {
     r.line = R->c.line;
     parse_id(s, n, &r);
     st = read_record(R, &r, &used);
-    if (!st && used) st = accept(R, S, &r);
+    if (!st && used) st = R->on_time ? accept_time(R, &r) : accept(R, S, &r);
     rcb_free(&R->ms->alloc, r.x);
     rcb_free(&R->ms->alloc, r.y);
   }
-  if (!st && S->type < 0)
+  if (!st && S->type < 0 && !R->on_time)
     st = rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s: no dataset 58 record with function type 4 "
                        "(FRF) or 1 (unbalance response) in %zu datasets", R->path, count);
   return st;

@@ -261,6 +261,10 @@ int cli_params_add(const cli_args *a, rcb_fit *f, const rcb_model *m, const cli_
 int cli_sd_weights(const char *path, const rcb_meas *ms, int scale, const double *band,
                    double **w, double *floor_pct);
 
+/** Read SIGNALS (a->model) by extension: .csv, .uff/.unv (UFF58 time records,
+ * --map), .wav (--wav-names, --wav-units, --wav-scale); exit code 0, 2, 3, 4. */
+int cli_signals_read(const cli_args *a, rcb_signals *s);
+
 /* ---- subcommands (one file each) ---- */
 
 int cmd_check(int argc, char **argv);

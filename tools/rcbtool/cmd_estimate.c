@@ -17,8 +17,10 @@ const char cli_help_estimate[] =
     "FRFs as a measurement that compare, fit and diagnose read.\n"
     "  SIGNALS        .csv: optional '# units = U1,U2,...', header 'time_s,CH1,CH2\n"
     "                 [unit],...', rows of numbers (evenly spaced time, s);\n"
-    "                 .wav: PCM 16/24/32-bit or float; give --wav-names, --wav-units\n"
-    "                 and --wav-scale (full scale in that unit)\n"
+    "                 .uff/.unv: UFF58 time records (function type 1, abscissa 17;\n"
+    "                 units from the record-9 label or dataset 164; --map)\n"
+    "                 .wav: PCM 16/24/32-bit or float; give --wav-names NAME,...,\n"
+    "                 --wav-units U,... and --wav-scale S,... (full scale in that unit)\n"
     "  --input CH     force channel (unit N, kN or lbf); several: CH1,CH2 (H1 only)\n"
     "  --outputs LIST response channels: displacement (m, mm, um, mil), velocity\n"
     "                 (m/s, mm/s, in/s) or acceleration (m/s^2, g)\n"
@@ -41,7 +43,7 @@ const char cli_help_estimate[] =
     "  --spectra FILE CSV: freq_hz and the averaged density spectra G (unit^2/Hz,\n"
     "                 SciPy's csd/welch scaling): 'G IN' per input, 'G IN/OUT re',\n"
     "                 'G IN/OUT im' per pair, 'G OUT' per output\n"
-    "  --map LIST     UFF node map for OUT, NODE=STATION,... (as rcbtool convert)\n"
+    "  --map LIST     UFF node map for SIGNALS and OUT, NODE=STATION,... (as convert)\n"
     "  --binary       write binary 58b\n"
     "Files are written atomically. Exit codes: 2 usage, 3 bad signals or units,\n"
     "4 numerical failure, 5 output not written.\n";
@@ -65,23 +67,6 @@ typedef struct est_job {
   int kind;
   rcb_frf_kind meas_kind[64 + 256];
 } est_job;
-
-static int read_signals(const cli_args *a, rcb_signals *s) {
-  const char *path = a->model, *dot = strrchr(path, '.');
-  rcb_status st;
-  if (dot && (strcmp(dot, ".csv") == 0 || strcmp(dot, ".CSV") == 0)) {
-    st = rcb_signals_read_csv(s, path);
-  } else if (dot && (strcmp(dot, ".wav") == 0 || strcmp(dot, ".WAV") == 0)) {
-    return cli_fail(CLI_EXIT_USAGE, "estimate: WAV input needs --wav-names, --wav-units and "
-                    "--wav-scale: not available in this rcbtool yet; convert to CSV");
-  } else {
-    return cli_usage(a->cmd, "'%s': unknown signal file type; expected .csv or .wav", path);
-  }
-  if (st)
-    return cli_fail(st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC : CLI_EXIT_INPUT, "%s",
-                    cli_msg(rcb_signals_errmsg(s), st));
-  return 0;
-}
 
 /* Split "A,B,C" into names (appended to j->names). */
 static int split_list(est_job *j, char *list, size_t *count) {
@@ -381,7 +366,7 @@ static int estimate(const cli_args *a) {
     return cli_usage(a->cmd, "missing -o OUT (.uff, .unv or .csv) for the estimated FRFs");
   if ((rc = options(&j))) return rc;
   if (rcb_signals_create(&j.sig, NULL)) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
-  rc = read_signals(a, j.sig);
+  rc = cli_signals_read(a, j.sig);
   if (!rc) rc = channels(&j);
   if (!rc && j.est != RCB_EST_H1 && j.p != 1)
     rc = cli_usage(a->cmd, "--estimator %s takes one input (%zu given); use h1",
@@ -414,7 +399,9 @@ int cmd_estimate(int argc, char **argv) {
                     {"--estimator", "E", NULL},   {"--no-detrend", NULL, NULL},
                     {"--rpm", "R", NULL},         {"--fmax", "HZ", NULL},
                     {"--stats", "FILE", NULL},    {"--spectra", "FILE", NULL},
-                    {"--map", "NODE=STATION,...", NULL}, {"--binary", NULL, NULL}};
+                    {"--map", "NODE=STATION,...", NULL}, {"--binary", NULL, NULL},
+                    {"--wav-names", "LIST", NULL}, {"--wav-units", "LIST", NULL},
+                    {"--wav-scale", "LIST", NULL}};
   cli_args a;
   int rc = cli_parse(argc, argv, opts, sizeof opts / sizeof opts[0], &a);
   if (rc || a.help) return rc ? rc : cli_print_help(cli_help_estimate);

@@ -20,7 +20,8 @@ const char cli_help_order[] =
     "is relative to the keyphasor mark (plus --kp-angle), as the model's unbalance\n"
     "angles are relative to the rotor's angle 0.\n"
     "  SIGNALS        .csv as rcbtool transient --signals writes ('# units = V,m',\n"
-    "                 'time_s,KP,DA.x,...'); responses in m, mm, um or mil\n"
+    "                 'time_s,KP,DA.x,...'); responses in m, mm, um or mil; or .uff\n"
+    "                 (UFF58 time records, --map) or .wav (as rcbtool estimate)\n"
     "  --kp CH        keyphasor channel\n"
     "  --outputs LIST response channels (NAME or NAME=STATION.DIR)\n"
     "  --bin-rpm W    speed bin width, rpm (default 50)\n"
@@ -200,8 +201,7 @@ static int order_run(const cli_args *a) {
       (rc = cli_opt_require(a, "--outputs", "the response channels, e.g. --outputs DA.x")))
     return rc;
   if (rcb_signals_create(&j.sig, NULL)) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
-  if (rcb_signals_read_csv(j.sig, a->model))
-    rc = cli_fail(CLI_EXIT_INPUT, "%s", cli_msg(rcb_signals_errmsg(j.sig), RCB_ERR_PARSE));
+  rc = cli_signals_read(a, j.sig);
   if (!rc) rc = ord_channels(&j);
   if (!rc) rc = ord_track(&j);
   if (!rc) {
@@ -226,7 +226,9 @@ int cmd_order(int argc, char **argv) {
                     {"--bin-rpm", "W", NULL},     {"--rpm-max", "R", NULL},
                     {"--trigger", "V", NULL},     {"--kp-angle", "DEG", NULL},
                     {"--min-revs", "N", NULL},    {"--order2", "FILE", NULL},
-                    {"--stats", "FILE", NULL},    {"--map", "NODE=STATION,...", NULL}};
+                    {"--stats", "FILE", NULL},    {"--map", "NODE=STATION,...", NULL},
+                    {"--wav-names", "LIST", NULL}, {"--wav-units", "LIST", NULL},
+                    {"--wav-scale", "LIST", NULL}};
   cli_args a;
   int rc = cli_parse(argc, argv, opts, sizeof opts / sizeof opts[0], &a);
   if (rc || a.help) return rc ? rc : cli_print_help(cli_help_order);
