@@ -98,3 +98,34 @@ def test_estimate_matches_scipy(tmp_path: Path, window, scipy_window):
     errs.append(_close(h["DA.x/C.B.y re"] + 1j * h["DA.x/C.B.y im"], h1, "H1 DA.x"))
     errs.append(_close(h["DB.x/C.B.y re"] + 1j * h["DB.x/C.B.y im"], h2, "H1 DB.x (g -> m/N)"))
     print(f"{window}: largest relative difference to SciPy {max(errs):.2e}")
+
+
+def test_estimate_uff_time_records_from_pyuff(tmp_path: Path):
+    """UFF58 time records written by pyuff (an independent writer; force in N,
+    displacement labelled mm) read by librcb give SciPy's H1 and coherence on
+    the samples pyuff reads back (times 1e-3 mm -> m) to 1e-10."""
+    pyuff = pytest.importorskip("pyuff")
+    exe = _rcbtool()
+    fs, f, d, _ = _signals(n=16384)
+    path = tmp_path / "sig.uff"
+    sets = [pyuff.prepare_58(func_type=1, rsp_node=node, rsp_dir=dirn, ref_node=0, ref_dir=0,
+                             data=sig, x=np.arange(sig.size) / fs, abscissa_spec_data_type=17,
+                             ordinate_spec_data_type=typ, ordinate_axis_units_lab=lab,
+                             orddenom_spec_data_type=0, z_axis_spec_data_type=0, binary=0)
+            for node, dirn, sig, typ, lab in [(1, 1, d * 1e3, 8, "mm"), (2, 2, f, 13, "N")]]
+    pyuff.UFF(str(path)).write_sets(sets, mode="overwrite")
+    back = pyuff.UFF(str(path)).read_sets()
+    dm, fm = back[0]["data"].real * 1e-3, back[1]["data"].real
+    out, stats = tmp_path / "h.csv", tmp_path / "s.csv"
+    res = subprocess.run([exe, "estimate", str(path), "--map", "1=DA,2=C.B", "--input", "C.B.y",
+                          "--outputs", "DA.x", "--nseg", "1024", "--stats", str(stats),
+                          "-o", str(out)], capture_output=True, text=True, timeout=120)
+    assert res.returncode == 0, res.stderr
+    kw = dict(fs=fs, window="hann", nperseg=1024, noverlap=512)
+    _, pxx = signal.welch(fm, **kw)
+    _, pxy = signal.csd(fm, dm, **kw)
+    _, coh = signal.coherence(fm, dm, **kw)
+    h, s = _read(out), _read(stats)
+    e1 = _close(h["DA.x/C.B.y re"] + 1j * h["DA.x/C.B.y im"], (pxy / pxx)[1:], "H1 from pyuff")
+    e2 = _close(s["DA.x/C.B.y coh"], coh[1:], "coherence from pyuff")
+    print(f"pyuff time records: largest relative difference to SciPy {max(e1, e2):.2e}")
