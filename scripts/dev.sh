@@ -249,9 +249,9 @@ run_ctest() {
 
 cmd_core() {
   local dir=$BUILD_DIR-core
-  say "core configuration: SuiteSparse, NLopt, SUNDIALS, threads OFF ($dir)"
+  say "core configuration: SuiteSparse, NLopt, SUNDIALS, threads, FFTW OFF ($dir)"
   configure_build "$dir" -DRCB_WITH_SUITESPARSE=OFF -DRCB_WITH_NLOPT=OFF \
-    -DRCB_WITH_SUNDIALS=OFF -DRCB_WITH_THREADS=OFF
+    -DRCB_WITH_SUNDIALS=OFF -DRCB_WITH_THREADS=OFF -DRCB_WITH_FFTW=OFF
   run_ctest "$dir"
 }
 

@@ -174,6 +174,9 @@ static int average(est_job *j) {
   st = rcb_spectral_workspace_size(&j->o, &bytes);
   if (st) {
     free(seg);
+    if (st == RCB_ERR_UNSUPPORTED)
+      return cli_fail(CLI_EXIT_NUMERIC, "estimate: librcb was built without an FFT backend "
+                      "(RCB_WITH_FFTW or RCB_WITH_KISSFFT)");
     return cli_fail(cli_status_exit(st), "estimate: %s", rcb_status_str(st));
   }
   j->work = malloc(bytes);
