@@ -62,10 +62,10 @@ MODEL=examples/paper_system.ini
 # runs no time integration. No Python: the demo draws no picture (matplotlib
 # for `rcbtool compare --plot` comes with the venv of `test`).
 DEB_DEMO=(build-essential cmake pkg-config libopenblas-dev liblapacke-dev
-  libsuitesparse-dev libnlopt-dev libinih-dev)
+  libsuitesparse-dev libnlopt-dev libinih-dev libfftw3-dev)
 # The rest, for `test` (and `deps`): SUNDIALS, cmocka, the Python venv's
 # prerequisites, sanitizer/fuzzer runtime, valgrind, linters.
-DEB_TEST=(libsundials-dev libcmocka-dev python3-venv python3-pip
+DEB_TEST=(libsundials-dev libcmocka-dev libkissfft-dev python3-venv python3-pip
   clang libclang-rt-14-dev valgrind cppcheck clang-tidy)
 DEB_PACKAGES=("${DEB_DEMO[@]}" "${DEB_TEST[@]}")
 
@@ -281,9 +281,9 @@ run_ctest() {
 
 cmd_core() {
   local dir=$BUILD_DIR-core
-  say "core configuration: SuiteSparse, NLopt, SUNDIALS, threads OFF ($dir)"
+  say "core configuration: SuiteSparse, NLopt, SUNDIALS, threads, FFTW OFF ($dir)"
   configure_build "$dir" -DRCB_WITH_SUITESPARSE=OFF -DRCB_WITH_NLOPT=OFF \
-    -DRCB_WITH_SUNDIALS=OFF -DRCB_WITH_THREADS=OFF
+    -DRCB_WITH_SUNDIALS=OFF -DRCB_WITH_THREADS=OFF -DRCB_WITH_FFTW=OFF
   run_ctest "$dir"
 }
 

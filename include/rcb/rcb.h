@@ -2,7 +2,7 @@
  * @file rcb.h
  * @brief librcb umbrella header: lateral dynamics of rotor-coupling-bearing
  * systems (model, FRFs, unbalance response, modes, Campbell,
- * measurements, identification).
+ * measurements, signals -> FRFs, identification).
  */
 #ifndef RCB_H
 #define RCB_H
@@ -15,5 +15,6 @@
 #include "rcb/rcb_compare.h"
 #include "rcb/rcb_diagnose.h"
 #include "rcb/rcb_transient.h"
+#include "rcb/rcb_signal.h"
 
 #endif /* RCB_H */

@@ -74,6 +74,24 @@ rcb_status rcb_atomic_open(rcb_meas *ms, rcb_atomic_file *af, const char *path, 
 rcb_status rcb_atomic_commit(rcb_meas *ms, rcb_atomic_file *af, const char *path);
 void rcb_atomic_abort(rcb_atomic_file *af);
 
+/* UFF dataset 58 time records (uff58_read.c), for the signal readers
+ * (src/signals/): each record of function type 1 with a time abscissa
+ * (type 17), real and evenly spaced, goes to @p fn in file order with its
+ * values in SI (dataset 164 and the record-9 label applied, a negative
+ * direction flipped). Errors (and a file without such a record) land in
+ * ms's message; a nonzero return of fn stops the read with that status. */
+typedef struct rcb_uff_time_rec {
+  char name[RCB_MEAS_CH_MAX]; /* "STATION.DIR", or the station for direction 0 */
+  double t0, dt;              /* s */
+  size_t n;
+  const rcb_complex *y;       /* n values, SI, imaginary parts 0 */
+  rcb_quantity q;             /* from the data type or the label; unknown if neither */
+  size_t index, line;         /* dataset ordinal, line of its id line */
+} rcb_uff_time_rec;
+typedef rcb_status (*rcb_uff_time_fn)(void *user, const rcb_uff_time_rec *rec);
+rcb_status rcb_uff58_read_time(rcb_meas *ms, const char *path, size_t nmap,
+                               const rcb_uff_node *map, rcb_uff_time_fn fn, void *user);
+
 /* Whole file into memory (NUL-terminated), through the object's allocator. */
 rcb_status rcb_meas_slurp(rcb_meas *ms, const char *path, char **buf, size_t *len);
 

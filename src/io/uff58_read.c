@@ -15,7 +15,11 @@
  * (abscissa type 18 or 0), or rpm (type 19); ordinate type 8/11/12
  * (displacement/velocity/acceleration) over 13 (excitation force) for
  * receptance/mobility/inertance; z axis of type 19 carries the rotor speed
- * of an FRF test in rpm (negative: synchronous). Units are taken as SI.
+ * of an FRF test in rpm (negative: synchronous). Units: the record-9/10
+ * unit labels (m, mm, um, m/s, m/s^2, g, N, ... : io/units.c) and a dataset
+ * 164 before the records (units code and factors) scale the values to SI;
+ * a label of the wrong quantity for the data type, an unknown label, or a
+ * label that disagrees with dataset 164 is refused; neither given: SI.
  *
  * Binary 58b data (IEEE, either byte order): double complex as pairs of
  * doubles; an uneven abscissa as doubles interleaved (as pyuff writes), or
@@ -98,6 +102,8 @@ typedef struct uff_rec {
   long ord_type, npts, spacing;
   double xmin, dx, zval;   /* Hz, Hz, z value */
   long spec[4];            /* records 8..11 specific data types */
+  int real;                /* real ordinates (types 2, 4): time records only */
+  char lab[4][24];         /* records 8..11 axis units labels */
   double *x;               /* Hz (or rpm), npts */
   rcb_complex *y;          /* npts */
 } uff_rec;
@@ -108,6 +114,13 @@ typedef struct uff_reader {
   cursor c;
   size_t nmap;
   const rcb_uff_node *map;
+  int has164;          /* a dataset 164 was read (-1: malformed, see err164) */
+  rcb_uff_time_fn on_time; /* time mode (rcb_uff58_read_time): records go here */
+  void *user;
+  size_t ntime;
+  char err164[RCB_ERRMSG_MAX];
+  double lf, ff;       /* its length and force factors (file units per SI unit) */
+  size_t line164;
 } uff_reader;
 
 static rcb_status rfail(uff_reader *R, const uff_rec *r, size_t line, const char *fmt, ...)
@@ -152,6 +165,7 @@ static rcb_status read_headers(uff_reader *R, uff_rec *r) {
     if (!get_line(&R->c, &s, &n) || is_delim(s, n))
       return rfail(R, r, R->c.line, "truncated: record %d (data characteristics) missing",
                    8 + k);
+    field(s, n, 47, 20, r->lab[k], sizeof r->lab[k]);
     if (field_long(s, n, 0, 10, &r->spec[k]))
       return rfail(R, r, R->c.line, "record %d is malformed; expected I10,3I5,2(1X,20A1) "
                    "starting with the specific data type", 8 + k);
@@ -162,10 +176,14 @@ static rcb_status read_headers(uff_reader *R, uff_rec *r) {
 /* The data form: complex, a sane count and spacing. */
 static rcb_status check_form(uff_reader *R, uff_rec *r) {
   size_t line = r->line + 7;
-  if (r->ord_type == 2 || r->ord_type == 4)
+  r->real = r->ord_type == 2 || r->ord_type == 4;
+  if (R->on_time && !r->real)
+    return rfail(R, r, line, "time record with ordinate data type %ld; expected real data (2 "
+                 "single or 4 double precision)", r->ord_type);
+  if (r->real && !R->on_time)
     return rfail(R, r, line, "ordinate data type %ld is real; expected complex (5 single or 6 "
                  "double precision)", r->ord_type);
-  if (r->ord_type != 5 && r->ord_type != 6)
+  if (!r->real && r->ord_type != 5 && r->ord_type != 6)
     return rfail(R, r, line, "unknown ordinate data type %ld; expected 5 or 6 (complex)",
                  r->ord_type);
   if (r->npts < 1 || r->npts > 100000000L)
@@ -183,7 +201,14 @@ static rcb_status check_form(uff_reader *R, uff_rec *r) {
 
 /* Store value k of the record's value stream (ASCII or binary). */
 static void put_value(uff_rec *r, size_t k, double v) {
-  if (r->spacing == 1) {
+  if (r->real && r->spacing == 1) {
+    r->y[k] = CMPLX(v, 0.0);
+  } else if (r->real) { /* uneven: abscissa and value pairs */
+    if (k % 2 == 0)
+      r->x[k / 2] = v;
+    else
+      r->y[k / 2] = CMPLX(v, 0.0);
+  } else if (r->spacing == 1) {
     if (k % 2 == 0)
       r->y[k / 2] = CMPLX(v, cimag(r->y[k / 2]));
     else
@@ -202,9 +227,14 @@ static rcb_status read_ascii(uff_reader *R, uff_rec *r) {
   static const size_t w_single[] = {13, 13, 13, 13, 13, 13};
   static const size_t w_even[] = {20, 20, 20, 20};
   static const size_t w_uneven[] = {13, 20, 20};
-  const size_t *w = r->ord_type == 5 ? w_single : r->spacing ? w_even : w_uneven;
-  size_t nw = r->ord_type == 5 ? 6 : r->spacing ? 4 : 3;
-  size_t need = (size_t)r->npts * (r->spacing ? 2 : 3), k = 0;
+  static const size_t w_uneven_real[] = {13, 20, 13, 20}; /* 2(E13.5,E20.12) */
+  int single = r->ord_type == 5 || r->ord_type == 2;
+  const size_t *w = single                      ? w_single
+                    : r->spacing                ? w_even
+                    : r->real                   ? w_uneven_real
+                                                : w_uneven;
+  size_t nw = single ? 6 : r->spacing || r->real ? 4 : 3;
+  size_t need = (size_t)r->npts * (r->real ? (r->spacing ? 1 : 2) : r->spacing ? 2 : 3), k = 0;
   const char *s;
   size_t n;
   while (k < need) {
@@ -250,7 +280,8 @@ static double get_real(const unsigned char *p, size_t size, int big) {
 }
 
 static rcb_status read_binary(uff_reader *R, uff_rec *r) {
-  size_t vs = r->ord_type == 6 ? 8 : 4, n = (size_t)r->npts, xs = vs, k, need, off;
+  size_t vs = r->ord_type == 6 || r->ord_type == 4 ? 8 : 4, n = (size_t)r->npts, xs = vs, k;
+  size_t need, off, count;
   const unsigned char *p = (const unsigned char *)R->c.buf + R->c.pos;
   const char *s;
   size_t ln;
@@ -261,17 +292,20 @@ static rcb_status read_binary(uff_reader *R, uff_rec *r) {
     return rfail(R, r, r->line, "58b floating-point format %d; only 2 (IEEE 754) is "
                  "supported", r->fp_format);
   if (r->spacing == 0 && r->n_bytes == (long)(n * (4 + 2 * vs))) xs = 4;
-  need = r->spacing ? 2 * n * vs : n * (xs + 2 * vs);
+  if (r->real && r->spacing == 0) xs = r->n_bytes == (long)(n * (4 + vs)) ? 4 : vs;
+  need = r->real ? (r->spacing ? n * vs : n * (xs + vs))
+                 : r->spacing ? 2 * n * vs : n * (xs + 2 * vs);
+  count = r->real ? (r->spacing ? n : 2 * n) : r->spacing ? 2 * n : 3 * n;
   if (R->c.len - R->c.pos < need)
     return rfail(R, r, R->c.line, "truncated binary data: %zu bytes in the file, %zu needed "
                  "for %zu points", R->c.len - R->c.pos, need, n);
-  for (k = 0, off = 0; k < (r->spacing ? 2 * n : 3 * n); k++) {
-    size_t sz = (r->spacing == 0 && k % 3 == 0) ? xs : vs;
+  for (k = 0, off = 0; k < count; k++) {
+    size_t sz = r->spacing == 0 && k % (r->real ? 2 : 3) == 0 ? xs : vs;
     double v = get_real(p + off, sz, r->byte_order == 2);
     off += sz;
     if (!isfinite(v))
       return rfail(R, r, R->c.line, "binary value %zu of %zu is not finite; expected finite "
-                   "numbers", k + 1, r->spacing ? 2 * n : 3 * n);
+                   "numbers", k + 1, count);
     put_value(r, k, v);
   }
   /* the data may contain '\n' bytes: count lines past it for later messages */
@@ -344,7 +378,8 @@ static rcb_status read_record(uff_reader *R, uff_rec *r, int *used) {
   rcb_status st;
   *used = 0;
   if ((st = read_headers(R, r))) return st;
-  if (r->func_type != 4 && r->func_type != 1) {
+  if (R->on_time ? !(r->func_type == 1 && r->spec[0] == 17)
+                 : (r->func_type != 4 && r->func_type != 1)) {
     skip_values(R, r);
     return RCB_OK;
   }
@@ -356,7 +391,7 @@ static rcb_status read_record(uff_reader *R, uff_rec *r, int *used) {
     return rcb_meas_fail(R->ms, RCB_ERR_NOMEM, "%s: out of memory (%ld points)", R->path,
                          r->npts);
   st = r->binary ? read_binary(R, r) : read_ascii(R, r);
-  return st ? st : check_abscissa(R, r);
+  return st || R->on_time ? st : check_abscissa(R, r);
 }
 
 /* ---- record -> channel ---- */
@@ -403,6 +438,100 @@ static rcb_status record_kind(uff_reader *R, const uff_rec *r, int frf, rcb_frf_
   if (r->spec[2] != 13)
     return rfail(R, r, r->line + 10, "FRF ordinate denominator data type %ld: wrong units; "
                  "expected 13 (excitation force)", r->spec[2]);
+  return RCB_OK;
+}
+
+/* Dataset 164 (units): record 1 I10,20A1,I10 (units code, description,
+ * temperature mode), record 2 3D25.17 (length, force, temperature factors:
+ * file value / factor = SI). Without record 2, the factors of the units code
+ * (1 SI, 2 BG, 3 MG, 4 BA, 5 MM, 6 CM, 7 IN, 8 GM). A malformed 164 is
+ * remembered and refused only if a record it would scale is read. */
+static void bad_164(uff_reader *R, size_t line, const char *what) { /* remember it */
+  snprintf(R->err164, sizeof R->err164, "%s:%zu: dataset 164 (units): %s", R->path, line, what);
+  R->has164 = -1;
+}
+
+static void read_164(uff_reader *R) {
+  static const double code_lf[] = {1.0, 3.280839895013123, 1.0, 3.280839895013123, 1000.0,
+                                   100.0, 39.37007874015748, 1000.0};
+  static const double code_ff[] = {1.0, 0.2248089430997105, 0.10197162129779283,
+                                   7.233013851209894, 1000.0, 100.0, 0.2248089430997105,
+                                   0.10197162129779283};
+  const char *s;
+  size_t n;
+  long code;
+  R->line164 = R->c.line;
+  if (!get_line(&R->c, &s, &n) || is_delim(s, n)) {
+    bad_164(R, R->c.line, "record 1 missing; expected I10 units code");
+    return; /* the dataset's "-1" (or the end) is consumed */
+  }
+  if (field_long(s, n, 0, 10, &code)) {
+    bad_164(R, R->c.line, "record 1 malformed; expected I10 units code");
+    skip_dataset(&R->c);
+    return;
+  }
+  if (get_line(&R->c, &s, &n) && !is_delim(s, n)) {
+    if (field_double(s, n, 0, 25, &R->lf) || field_double(s, n, 25, 25, &R->ff) ||
+        !(R->lf > 0.0) || !(R->ff > 0.0) || !isfinite(R->lf) || !isfinite(R->ff)) {
+      bad_164(R, R->c.line, "record 2 malformed; expected 3D25.17 length, force and "
+              "temperature factors > 0");
+      skip_dataset(&R->c);
+      return;
+    }
+    skip_dataset(&R->c);
+  } else if (code >= 1 && code <= 8) {
+    R->lf = code_lf[code - 1];
+    R->ff = code_ff[code - 1];
+  } else {
+    bad_164(R, R->line164 + 1, "units code without factors; expected code 1-8 or record 2 "
+            "with the factors");
+    return;
+  }
+  R->has164 = 1;
+}
+
+static int no_label(const char *lab) { return !lab[0] || strcmp(lab, "NONE") == 0; }
+
+/* Factor to SI of record 9 (k = 1) or 10 (k = 2), whose data type says
+ * quantity @p want: from its units label, or dataset 164, or 1 (SI). */
+static rcb_status unit_factor(uff_reader *R, const uff_rec *r, int k, rcb_quantity want,
+                              double *f) {
+  double f164 = 1.0, fl = 1.0;
+  rcb_quantity q;
+  const char *lab = r->lab[k];
+  if (R->has164 < 0) return rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s", R->err164);
+  if (R->has164) f164 = want == RCB_QTY_FORCE ? 1.0 / R->ff : 1.0 / R->lf;
+  *f = f164;
+  if (no_label(lab)) return RCB_OK;
+  if (rcb_unit_parse(lab, &q, &fl))
+    return rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu: record %d "
+                         "units label '%s' is not a unit librcb knows; expected %s (m, mm, um, "
+                         "mil, m/s, mm/s, m/s^2, g, N, kN, lbf) or NONE", R->path,
+                         r->line + 8 + (size_t)k, r->index, 8 + k, lab, rcb_quantity_name(want));
+  if (q != want)
+    return rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu: record %d "
+                         "units label '%s' is %s %s, but its data type %ld says %s; fix the "
+                         "label or the data type", R->path, r->line + 8 + (size_t)k, r->index,
+                         8 + k, lab, q == RCB_QTY_ACCELERATION ? "an" : "a",
+                         rcb_quantity_name(q), r->spec[k], rcb_quantity_name(want));
+  if (R->has164 && fabs(fl - f164) > 1e-6 * fl)
+    return rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu: record %d "
+                         "units label '%s' (%.9g SI) disagrees with dataset 164 at line %zu "
+                         "(%.9g SI per file unit); fix one of them", R->path,
+                         r->line + 8 + (size_t)k, r->index, 8 + k, lab, fl, R->line164, f164);
+  *f = fl;
+  return RCB_OK;
+}
+
+/* File value -> SI for the record's ordinate (numerator over denominator). */
+static rcb_status unit_scale(uff_reader *R, const uff_rec *r, int frf, rcb_frf_kind kind,
+                             double *scale) {
+  double fn = 1.0, fd = 1.0;
+  rcb_status st;
+  if ((st = unit_factor(R, r, 1, (rcb_quantity)(RCB_QTY_DISPLACEMENT + (int)kind), &fn)))
+    return st;
+  if (frf && (st = unit_factor(R, r, 2, RCB_QTY_FORCE, &fd))) return st;
+  *scale = fn / fd;
   return RCB_OK;
 }
 
@@ -455,7 +584,7 @@ static rcb_status accept(uff_reader *R, uff_set *S, uff_rec *r) {
   int type = frf ? RCB_MEAS_FRF : RCB_MEAS_UNBALANCE;
   const char *rd = NULL, *fd = NULL;
   char st_r[RCB_MEAS_CH_MAX], st_f[RCB_MEAS_CH_MAX];
-  double scale, speed = 0.0;
+  double scale, speed = 0.0, uscale = 1.0;
   rcb_frf_kind kind = RCB_RECEPTANCE;
   rcb_status st;
   struct uff_chan *c;
@@ -466,6 +595,7 @@ static rcb_status accept(uff_reader *R, uff_set *S, uff_rec *r) {
   if ((st = dir_name(R, r, r->rsp_dir, "response", &rd))) return st;
   if (frf && (st = dir_name(R, r, r->ref_dir, "reference", &fd))) return st;
   if ((st = record_kind(R, r, frf, &kind))) return st;
+  if ((st = unit_scale(R, r, frf, kind, &uscale))) return st;
   if (r->spec[0] == 19) {
     scale = RCB_PI / 30.0;
   } else if (r->spec[0] == 18 || r->spec[0] == 0) {
@@ -501,9 +631,95 @@ static rcb_status accept(uff_reader *R, uff_set *S, uff_rec *r) {
   c->line = r->line;
   c->y = r->y;
   r->y = NULL;
-  if ((r->rsp_dir < 0) != (frf && r->ref_dir < 0))
-    for (i = 0; i < S->npts; i++) c->y[i] = -c->y[i];
+  if ((r->rsp_dir < 0) != (frf && r->ref_dir < 0)) uscale = -uscale;
+  if (uscale != 1.0)
+    for (i = 0; i < S->npts; i++) c->y[i] *= uscale;
   return RCB_OK;
+}
+
+static rcb_status scan(uff_reader *R, uff_set *S);
+
+/* A time record (function type 1, abscissa time): channel "STATION.DIR" (or
+ * the station alone for direction 0, e.g. a keyphasor), quantity from the
+ * ordinate data type (8, 11, 12 motion; 9, 13 force) or else from the units
+ * label, values to SI, then handed to the caller. */
+static rcb_status accept_time(uff_reader *R, uff_rec *r) {
+  static const long motion[] = {8, 11, 12};
+  rcb_uff_time_rec t;
+  rcb_quantity want = RCB_QTY_UNKNOWN;
+  char st_r[RCB_MEAS_CH_MAX];
+  const char *dir = NULL;
+  double f = 1.0;
+  size_t i;
+  rcb_status st;
+  memset(&t, 0, sizeof t);
+  for (i = 0; i < 3; i++)
+    if (r->spec[1] == motion[i]) want = (rcb_quantity)(RCB_QTY_DISPLACEMENT + (int)i);
+  if (r->spec[1] == 9 || r->spec[1] == 13) want = RCB_QTY_FORCE;
+  if (want != RCB_QTY_UNKNOWN) {
+    if ((st = unit_factor(R, r, 1, want, &f))) return st;
+  } else if (!no_label(r->lab[1]) && rcb_unit_parse(r->lab[1], &want, &f)) {
+    return rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu: record 9 units "
+                         "label '%s' is not a unit librcb knows (m, mm, um, m/s, m/s^2, g, N, "
+                         "V, ...)", R->path, r->line + 9, r->index, r->lab[1]);
+  }
+  if (r->rsp_dir != 0 && (st = dir_name(R, r, r->rsp_dir, "response", &dir))) return st;
+  station_of(R, r->rsp_node, st_r, sizeof st_r);
+  if (dir)
+    snprintf(t.name, sizeof t.name, "%.*s.%s", (int)(sizeof t.name - 4), st_r, dir);
+  else
+    snprintf(t.name, sizeof t.name, "%s", st_r);
+  if (r->rsp_dir < 0) f = -f;
+  for (i = 0; i < (size_t)r->npts; i++) r->y[i] *= f;
+  t.t0 = r->xmin;
+  t.dt = r->dx;
+  if (r->spacing == 0 && r->npts > 1) { /* times listed (pyuff): evenly spaced? */
+    size_t n = (size_t)r->npts;
+    t.t0 = r->x[0];
+    t.dt = (r->x[n - 1] - r->x[0]) / (double)(n - 1);
+    for (i = 0; i < n; i++)
+      if (!(fabs(r->x[i] - (t.t0 + (double)i * t.dt)) <= 0.1 * t.dt))
+        return rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu: time %zu "
+                             "is %.9g s, expected %.9g s: the samples must be evenly spaced "
+                             "(a dropped sample?)", R->path, r->line + 12, r->index, i + 1,
+                             r->x[i], t.t0 + (double)i * t.dt);
+  }
+  t.n = (size_t)r->npts;
+  t.y = r->y;
+  t.q = want;
+  t.index = r->index;
+  t.line = r->line;
+  R->ntime++;
+  return R->on_time(R->user, &t);
+}
+
+rcb_status rcb_uff58_read_time(rcb_meas *ms, const char *path, size_t nmap,
+                               const rcb_uff_node *map, rcb_uff_time_fn fn, void *user) {
+  uff_reader R;
+  uff_set S;
+  char *buf = NULL;
+  size_t len;
+  rcb_status st;
+  if (!ms || !fn) return RCB_ERR_ARG;
+  if (nmap && !map) return rcb_meas_fail(ms, RCB_ERR_ARG, "read_uff: node map is NULL");
+  if ((st = rcb_meas_slurp(ms, path, &buf, &len))) return st;
+  memset(&R, 0, sizeof R);
+  memset(&S, 0, sizeof S);
+  S.type = -1;
+  R.ms = ms;
+  R.path = path;
+  R.c.buf = buf;
+  R.c.len = len;
+  R.nmap = nmap;
+  R.map = map;
+  R.on_time = fn;
+  R.user = user;
+  st = scan(&R, &S);
+  if (!st && R.ntime == 0)
+    st = rcb_meas_fail(ms, RCB_ERR_PARSE, "%s: no dataset 58 time record (function type 1, "
+                       "abscissa data type 17)", path);
+  rcb_free(&ms->alloc, buf);
+  return st;
 }
 
 /* Skip a dataset other than 58 up to its closing "-1". */
@@ -535,6 +751,10 @@ static rcb_status scan(uff_reader *R, uff_set *S) {
     if (field_long(s, n, 0, 6, &id))
       return rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s:%zu: dataset id '%.10s' is not a number",
                            R->path, R->c.line, s);
+    if (id == 164) {
+      read_164(R);
+      continue;
+    }
     if (id != 58) {
       skip_dataset(&R->c);
       continue;
@@ -544,11 +764,11 @@ static rcb_status scan(uff_reader *R, uff_set *S) {
     r.line = R->c.line;
     parse_id(s, n, &r);
     st = read_record(R, &r, &used);
-    if (!st && used) st = accept(R, S, &r);
+    if (!st && used) st = R->on_time ? accept_time(R, &r) : accept(R, S, &r);
     rcb_free(&R->ms->alloc, r.x);
     rcb_free(&R->ms->alloc, r.y);
   }
-  if (!st && S->type < 0)
+  if (!st && S->type < 0 && !R->on_time)
     st = rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s: no dataset 58 record with function type 4 "
                        "(FRF) or 1 (unbalance response) in %zu datasets", R->path, count);
   return st;

@@ -639,6 +639,63 @@ bad_uff_mislabelled)
   sed -e 's/^    58 /    5x /' "$W/s.uff" >"$W/u.uff"
   run convert "$W/u.uff" "$W/o.csv" --map 1=DA; expect_rc 3; err_has "u.uff:2:"; err_has "not a number"
   [ ! -e "$W/o.csv" ] || fail "output written from a mislabelled file" ;;
+bad_signal_units)
+  # estimate: a force without a force unit, a response in an unknown unit
+  printf '# units = V,mm\ntime_s,f,DA.x\n0,1,1\n0.001,2,1\n0.002,3,2\n' >"$W/s.csv"
+  run estimate "$W/s.csv" --input f=DA.x --outputs DA.x --nseg 8 -o "$W/h.uff"
+  expect_rc 3; err_has "input channel 'f' is voltage; expected a force"
+  printf 'time_s,f [N],DA.x [furlong]\n0,1,1\n0.001,2,1\n' >"$W/s.csv"
+  run estimate "$W/s.csv" --input f=DA.x --outputs DA.x --nseg 8 -o "$W/h.uff"
+  expect_rc 3; err_has "s.csv:1: channel 'DA.x': unit 'furlong' is not one librcb knows"
+  printf 'time_s,f [N],DA.x [g]\n0,1,1\n0.001,2,1\n0.003,2,1\n' >"$W/s.csv"
+  run estimate "$W/s.csv" --input f=DA.x --outputs DA.x --nseg 8 -o "$W/h.uff"
+  expect_rc 3; err_has "evenly spaced"
+  [ ! -e "$W/h.uff" ] || fail "output written from bad signals" ;;
+bad_uff_units)
+  run simulate "$MODEL" --frf --out DA.x --in DA.x --fmin 10 --fmax 100 --points 5 \
+    --map 1=DA -o "$W/s.uff"; expect_rc 0
+  # record 9 says displacement (type 8) but its units label says g
+  sed -e 's/^\(         8    0    0    0 Displacement \{9\}\)m /\1g /' "$W/s.uff" >"$W/g.uff"
+  cmp -s "$W/s.uff" "$W/g.uff" && fail "sed changed nothing"
+  run convert "$W/g.uff" "$W/o.csv" --map 1=DA; expect_rc 3
+  err_has "units label 'g' is an acceleration, but its data type 8 says displacement"
+  # a dataset 164 in mm in front of records labelled m
+  { printf '    -1\n   164\n         5mm (milli newton)         2\n'
+    printf '  1.00000000000000000D+03  1.00000000000000000D+00  1.00000000000000000D+00\n'
+    printf '  2.73150000000000000D+02\n    -1\n'; cat "$W/s.uff"; } >"$W/mm.uff"
+  run convert "$W/mm.uff" "$W/o.csv" --map 1=DA; expect_rc 3; err_has "disagrees with dataset 164"
+  [ ! -e "$W/o.csv" ] || fail "output written from a mislabelled file"
+  # the same 164 with the labels left NONE: read as mm/N, 1e-3 of the values
+  sed -e 's/^\(         8    0    0    0 Displacement \{9\}\)m  /\1NONE/' \
+      -e 's/^\(        13    0    0    0 Force \{16\}\)N   /\1NONE/' "$W/mm.uff" >"$W/mm2.uff"
+  run convert "$W/mm2.uff" "$W/mm.csv" --map 1=DA; expect_rc 0
+  run convert "$W/s.uff" "$W/si.csv" --map 1=DA; expect_rc 0
+  python3 - "$W/si.csv" "$W/mm.csv" <<'PY' || fail "mm file not read as 1e-3 of the SI one"
+import csv, sys
+a, b = ([r for r in csv.reader(open(p)) if r and not r[0].startswith("#")][1:] for p in sys.argv[1:])
+assert all(abs(float(x[i]) * 1e-3 - float(y[i])) <= 1e-12 * abs(float(x[i])) for x, y in zip(a, b) for i in (1, 2))
+PY
+  ;;
+order_runup_signals)
+  run transient "$MODEL" --out DA.x,DB.x --rpm 3000 --rpm-end 4500 --accel 3000 --dt 1e-4 \
+    --signals --noise 1e-7 -o "$W/s.csv"
+  if [ "$RC" -eq 4 ] && grep -F -q "without SUNDIALS" "$W/err"; then exit 77; fi
+  expect_rc 0
+  run order "$W/s.csv" --kp KP --outputs DA.x,DB.x --bin-rpm 300 --stats "$W/st.csv" -o "$W/o1.uff" \
+    --map 1=DA,2=DB
+  expect_rc 0
+  run convert "$W/o1.uff" "$W/o1.csv" --map 1=DA,2=DB; expect_rc 0
+  [ "$(grep -c '^[0-9]' "$W/o1.csv")" -ge 3 ] || fail "fewer than 3 speed bins"
+  # the per-bin sd as fit weights and noise floor; a stats file of other rows refused
+  run fit "$MODEL" "$W/o1.csv" --params unbalance.UA.amount --scale complex --sd "$W/st.csv"
+  expect_rc 0; out_has "noise floor (predicted by the --noise model or the --sd deviations"
+  head -n 3 "$W/st.csv" >"$W/st2.csv"
+  run fit "$MODEL" "$W/o1.csv" --params unbalance.UA.amount --sd "$W/st2.csv"
+  expect_rc 3; err_has "rows for a measurement of"
+  # no keyphasor pulse: refused
+  sed -e 's/^\([^#t][^,]*\),[^,]*,/\1,0,/' "$W/s.csv" >"$W/nokp.csv"
+  run order "$W/nokp.csv" --kp KP --outputs DA.x -o "$W/n.uff"; expect_rc 3; err_has "keyphasor pulses"
+  [ ! -e "$W/n.uff" ] || fail "output written without a keyphasor" ;;
 bad_csv_missing_columns)
   printf 'freq_hz\n10\n20\n' >"$W/a.csv"
   run convert "$W/a.csv" "$W/o.uff"; expect_rc 3; err_has "no channel columns"

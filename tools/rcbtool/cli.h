@@ -318,6 +318,22 @@ int cli_history_append(const char *path, const char *command, const char *model,
 int cli_params_add(const cli_args *a, rcb_fit *f, const rcb_model *m, const cli_params *ps,
                    int log_all, int any_bounds);
 
+/* ---- per-point standard deviations (cli_sd.c; used by fit) ---- */
+
+/**
+ * Weights 1 / variance on the fit @p scale (0 linear, 1 log10, 2 dB, 3
+ * complex) from a --stats file of rcbtool estimate ('RESP/REF sd') or order
+ * ('RESP 1X sd') matching @p ms point by point, and the error % the sds alone
+ * explain (the noise floor: 100 sqrt(sum sd^2 / sum |e|^2) over the points in
+ * @p band, rad/s, NULL for all). *w (channel-major) is the caller's to free.
+ */
+int cli_sd_weights(const char *path, const rcb_meas *ms, int scale, const double *band,
+                   double **w, double *floor_pct);
+
+/** Read SIGNALS (a->model) by extension: .csv, .uff/.unv (UFF58 time records,
+ * --map), .wav (--wav-names, --wav-units, --wav-scale); exit code 0, 2, 3, 4. */
+int cli_signals_read(const cli_args *a, rcb_signals *s);
+
 /* ---- subcommands (one file each) ---- */
 
 int cmd_check(int argc, char **argv);
@@ -327,6 +343,8 @@ int cmd_unbalance(int argc, char **argv);
 int cmd_modes(int argc, char **argv);
 int cmd_campbell(int argc, char **argv);
 int cmd_simulate(int argc, char **argv);
+int cmd_estimate(int argc, char **argv);
+int cmd_order(int argc, char **argv);
 int cmd_convert(int argc, char **argv);
 int cmd_fit(int argc, char **argv);
 int cmd_sensitivity(int argc, char **argv);
@@ -343,6 +361,8 @@ extern const char cli_help_unbalance[];
 extern const char cli_help_modes[];
 extern const char cli_help_campbell[];
 extern const char cli_help_simulate[];
+extern const char cli_help_estimate[];
+extern const char cli_help_order[];
 extern const char cli_help_convert[];
 extern const char cli_help_fit[];
 extern const char cli_help_sensitivity[];

@@ -38,6 +38,10 @@ const char cli_help_fit[] =
     "  --noise A,S    noise-aware weights from the paper's eq. 19 noise model (random\n"
     "                 factor A %, systematic factor S %); points at the noise floor\n"
     "                 are left out\n"
+    "  --sd FILE      weight each point by 1 / its variance from the --stats file\n"
+    "                 of rcbtool estimate or rcbtool order written with the\n"
+    "                 measurement, instead of --noise; the noise floor reported\n"
+    "                 is the error % these standard deviations alone explain\n"
     "  --fd           sensitivities by finite differences (eq. 11) instead of the\n"
     "                 analytic ones (eq. 9)\n"
     "  --max-iter N   iteration limit (default 100)\n"
@@ -193,6 +197,7 @@ typedef struct fit_job {
   double beta_a, beta_s;   /* % */
   size_t max_iter, starts;
   int is_uff; /* the measurement is a UFF file (set by read_meas) */
+  double sd_floor_pct; /* --sd: error % the standard deviations explain (NaN without) */
 } fit_job;
 
 /* "A<sep>B": two finite numbers. */
@@ -457,8 +462,8 @@ static void write_text(FILE *fp, const fit_result *r, const fit_job *j) {
           r->rep.error0_pct, r->rep.error_pct);
   write_text_objective(fp, r, j);
   if (isfinite(r->rep.floor_pct))
-    fprintf(fp, "noise floor (predicted by the --noise model; the error reached can be "
-            "lower): %.6g %%\n", r->rep.floor_pct);
+    fprintf(fp, "noise floor (predicted by the --noise model or the --sd deviations; the "
+            "error reached can be lower): %.6g %%\n", r->rep.floor_pct);
   fprintf(fp, "iterations: %zu\nmodel evaluations: %zu\n", r->rep.iterations,
           r->rep.evaluations);
   write_text_starts(fp, r, j);
@@ -611,6 +616,7 @@ static int report(const cli_args *a, const fit_job *j, rcb_fit *f, const rcb_mod
   int rc;
   memset(&r, 0, sizeof r);
   if (!(rc = collect(f, &r))) {
+    if (!isfinite(r.rep.floor_pct)) r.rep.floor_pct = j->sd_floor_pct;
     cli_warn_condition(a->cmd, &r.cond, 0);
     if (a->json)
       write_json(stdout, &r, j, a);
@@ -638,14 +644,35 @@ static int report(const cli_args *a, const fit_job *j, rcb_fit *f, const rcb_mod
   return rc;
 }
 
+/* --sd FILE: weights from the estimated standard deviations. */
+static int sd_weights(const cli_args *a, fit_job *j, rcb_fit *f, const rcb_meas *ms) {
+  const char *path = cli_opt_value(a, "--sd");
+  double unit = rcb_meas_get_type(ms) == RCB_MEAS_FRF ? CLI_HZ_TO_RAD_S : CLI_RPM_TO_RAD_S;
+  double band[2], *w = NULL;
+  rcb_status st;
+  int rc;
+  if (!path) return 0;
+  if (j->have_noise) return cli_usage(a->cmd, "give --noise or --sd, not both");
+  band[0] = j->band_lo * unit;
+  band[1] = j->band_hi * unit;
+  if ((rc = cli_sd_weights(path, ms, j->scale, j->have_band ? band : NULL, &w,
+                           &j->sd_floor_pct)))
+    return rc;
+  st = rcb_fit_set_weights(f, w);
+  free(w);
+  if (st) return cli_fail(fit_exit(st), "%s: %s", a->cmd, fit_msg(f, st));
+  return 0;
+}
+
 static int run(const cli_args *a, fit_job *j) {
   rcb_model *m = NULL;
   rcb_meas *ms = NULL;
   rcb_fit *f = NULL;
   int rc;
   if ((rc = check_output(a, j)) || (rc = cli_load_model(a, &m))) return rc;
+  j->sd_floor_pct = (double)NAN;
   if (!(rc = read_meas(a, j, m, &ms)) && !(rc = make_fit(a, j, m, ms, &f)) &&
-      !(rc = run_fit(a, f)))
+      !(rc = sd_weights(a, j, f, ms)) && !(rc = run_fit(a, f)))
     rc = report(a, j, f, m);
   rcb_fit_destroy(f);
   rcb_meas_destroy(ms);
@@ -660,6 +687,7 @@ int cmd_fit(int argc, char **argv) {
                     {"--scale", "SCALE", NULL},
                     {"--band", "LO:HI", NULL},
                     {"--noise", "BETA_A,BETA_S", NULL},
+                    {"--sd", "FILE", NULL},
                     {"--fd", NULL, NULL},
                     {"--max-iter", "N", NULL},
                     {"--starts", "N", NULL},

@@ -11,6 +11,7 @@
 const char cli_help_transient[] =
     "usage: rcbtool transient MODEL.ini --out CH[,CH...] --rpm A [--rpm-end B --accel R]\n"
     "                         [--t-end S] [--dt S] [--rtol X]\n"
+    "                         [--signals [--noise SD] [--seed N]]\n"
     "                         [--json] [-o FILE] [--progress]\n"
     "\n"
     "Integrates M q'' + (C + Omega(t) G) q' + K q = f(t) from rest (CVODE BDF, SUNDIALS)\n"
@@ -26,6 +27,13 @@ const char cli_help_transient[] =
     "  --dt S        sampling interval, s (default: 1/40 of the revolution at the\n"
     "                highest speed)\n"
     "  --rtol X      integrator relative tolerance (default 1e-7)\n"
+    "  --signals     write the signals a data recorder would hold instead: CSV\n"
+    "                '# units = V,m,...', 'time_s,KP,<out>,...' that rcbtool order\n"
+    "                and rcbtool estimate read; KP is a 5 V once-per-revolution\n"
+    "                keyphasor whose rising edge (linear over +-7.2 deg of shaft\n"
+    "                angle) crosses 2.5 V at the mark, angle 0 of the unbalances\n"
+    "  --noise SD    with --signals: Gaussian sensor noise, m RMS, on every output\n"
+    "  --seed N      noise seed (default 1)\n"
     "\n"
     "CSV: t_s,rpm,angle_deg,<out>,... (displacements m, rotations rad) - orbit plots\n"
     "pair the x and y columns of a station; the rpm column per sample makes the\n"
@@ -107,6 +115,49 @@ static void tr_csv(FILE *fp, const tr_hist *h, const cli_channels *ch) {
   }
 }
 
+/* The keyphasor: 5 V pulse over [0, 45 deg) of shaft angle, its rising edge
+ * linear over +-7.2 deg so that a sampled record locates the mark (2.5 V)
+ * by interpolation, as a proximity probe over a notch does. */
+static double kp_volts(double ang_deg) {
+  double w = ang_deg >= 180.0 ? ang_deg - 360.0 : ang_deg;
+  if (w >= -7.2 && w <= 7.2) return 2.5 + 2.5 * w / 7.2;
+  return w > 7.2 && w < 45.0 ? 5.0 : 0.0;
+}
+
+/* Gaussian samples (xorshift64* + Box-Muller), reproducible on every platform. */
+static double noise_gauss(unsigned long long *s) {
+  double u[2];
+  int k;
+  for (k = 0; k < 2; k++) {
+    *s ^= *s >> 12;
+    *s ^= *s << 25;
+    *s ^= *s >> 27;
+    u[k] = ((double)((*s * 2685821657736338717ULL) >> 11) + 0.5) / 9007199254740992.0;
+  }
+  return sqrt(-2.0 * log(u[0])) * cos(2.0 * CLI_PI * u[1]);
+}
+
+static void tr_signals(FILE *fp, const tr_hist *h, const cli_channels *ch, double sd,
+                       unsigned long long seed) {
+  size_t k, o;
+  unsigned long long s = seed * 0x9E3779B97F4A7C15ULL + 1;
+  fputs("# rcbtool transient --signals: keyphasor in V, displacements in m\n# units = V", fp);
+  for (o = 0; o < ch->n; o++) fputs(",m", fp);
+  fputs("\ntime_s,KP", fp);
+  for (o = 0; o < ch->n; o++) fprintf(fp, ",%s", ch->names[o]);
+  fputc('\n', fp);
+  for (k = 0; k < h->n; k++) {
+    cli_csv_num(fp, h->t[k]);
+    fputc(',', fp);
+    cli_csv_num(fp, kp_volts(h->ang[k]));
+    for (o = 0; o < ch->n; o++) {
+      fputc(',', fp);
+      cli_csv_num(fp, h->q[k * h->nout + o] + (sd > 0.0 ? sd * noise_gauss(&s) : 0.0));
+    }
+    fputc('\n', fp);
+  }
+}
+
 static void tr_json(FILE *fp, const tr_hist *h, const cli_channels *ch,
                     const rcb_transient_stats *s) {
   size_t o;
@@ -179,9 +230,12 @@ static int tr_compute(const cli_args *a, rcb_model *m, const cli_channels *ch, c
 int cmd_transient(int argc, char **argv) {
   cli_opt opts[] = {{"--out", "CH,...", NULL}, {"--rpm", "A", NULL},  {"--rpm-end", "B", NULL},
                     {"--accel", "R", NULL},    {"--t-end", "S", NULL}, {"--dt", "S", NULL},
-                    {"--rtol", "X", NULL}};
+                    {"--rtol", "X", NULL},     {"--signals", NULL, NULL},
+                    {"--noise", "SD", NULL},   {"--seed", "N", NULL}};
   cli_args a;
   cli_channels ch = {0};
+  double noise = 0.0;
+  size_t seed = 1;
   tr_opts o = {{0, 0, 0}, 0, 0, 0};
   tr_hist h = {0};
   rcb_transient_stats s = {0};
@@ -190,12 +244,21 @@ int cmd_transient(int argc, char **argv) {
   int rc = cli_parse(argc, argv, opts, sizeof opts / sizeof opts[0], &a);
   if (rc) return rc;
   if (a.help) return cli_print_help(cli_help_transient);
-  if ((rc = tr_parse(&a, &o)) || (rc = cli_load_model(&a, &m))) return rc;
+  if ((rc = tr_parse(&a, &o)) || (rc = cli_opt_nonneg(&a, "--noise", "m", 0.0, &noise)) ||
+      (rc = cli_opt_count(&a, "--seed", 1, &seed)))
+    return rc;
+  if ((noise > 0.0 || cli_opt_value(&a, "--seed")) && !cli_opt_value(&a, "--signals"))
+    return cli_usage(a.cmd, "--noise and --seed apply with --signals");
+  if (a.json && cli_opt_value(&a, "--signals"))
+    return cli_usage(a.cmd, "--signals writes CSV: drop --json");
+  if ((rc = cli_load_model(&a, &m))) return rc;
   if (!(rc = cli_channels_parse(&a, m, "--out", &ch)) &&
       !(rc = cli_check_size(&a, floor(o.t_end / o.dt) + 1.0, 3.0 + (double)ch.n))) {
     h.nout = ch.n;
     if (!(rc = tr_compute(&a, m, &ch, &o, &h, &s)) && !(rc = cli_out_open(&out, &a))) {
-      if (a.json)
+      if (cli_opt_value(&a, "--signals"))
+        tr_signals(out.fp, &h, &ch, noise, (unsigned long long)seed);
+      else if (a.json)
         tr_json(out.fp, &h, &ch, &s);
       else
         tr_csv(out.fp, &h, &ch);

@@ -1,0 +1,272 @@
+/**
+ * @file rcb_signal.h
+ * @brief The measurement front end: sampled time signals (read from CSV, WAV
+ * or UFF dataset 58 time records, with their units) and the Welch estimator
+ * that turns them into FRFs with coherence and per-point standard deviations.
+ *
+ * Memory: the estimator lives in one caller buffer sized by
+ * rcb_spectral_workspace_size() (two-call sizing, as the FRF sweep); feeding
+ * segments and reading results allocate nothing. The FFT backend is chosen at
+ * build time (rcb_config.h): FFTW3 in double precision (RCB_WITH_FFTW) plans
+ * its transform at rcb_spectral_init() and allocates the plan itself, with
+ * FFTW's malloc, outside the hooks (as KLU does, see rcb_analysis.h); its
+ * planner is not thread-safe, so create estimators from one thread at a time
+ * (feeding and reading from several threads, one object each, is safe).
+ * Without an FFT backend the estimator calls return RCB_ERR_UNSUPPORTED.
+ *
+ * Units: signals are held in SI (m, m/s, m/s^2, N; V for a keyphasor or an
+ * uncalibrated channel); sample rates in samples/s; frequencies in rad/s.
+ */
+#ifndef RCB_SIGNAL_H
+#define RCB_SIGNAL_H
+
+#include "rcb/rcb_core.h"
+#include "rcb/rcb_measure.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------------ units -- */
+
+/** @brief The physical quantity of a channel (values held in its SI unit). */
+typedef enum rcb_quantity {
+  RCB_QTY_UNKNOWN = 0,      /**< no unit given */
+  RCB_QTY_DISPLACEMENT = 1, /**< m */
+  RCB_QTY_VELOCITY = 2,     /**< m/s */
+  RCB_QTY_ACCELERATION = 3, /**< m/s^2 */
+  RCB_QTY_FORCE = 4,        /**< N */
+  RCB_QTY_VOLTAGE = 5       /**< V (keyphasor, uncalibrated sensor) */
+} rcb_quantity;
+
+/**
+ * @brief Parse a unit label ("m", "mm", "um", "mil", "m/s", "mm/s", "in/s",
+ * "m/s^2", "m/s2", "g", "N", "kN", "lbf", "V", "mV"; case-sensitive where it
+ * matters: "mm" vs "Mm" is not guessed).
+ * @param to_si factor: SI value = file value * to_si
+ * @return 0, or -1 if the label is not a unit librcb knows.
+ */
+RCB_API int rcb_unit_parse(const char *label, rcb_quantity *q, double *to_si);
+/** @brief "displacement", "velocity", ... (never NULL). */
+RCB_API const char *rcb_quantity_name(rcb_quantity q);
+
+/* ---------------------------------------------------------- signals -- */
+
+/** @brief A set of channels sampled together (one sample rate, one length). */
+typedef struct rcb_signals rcb_signals;
+
+RCB_API rcb_status rcb_signals_create(rcb_signals **out, const rcb_allocator *alloc);
+RCB_API void rcb_signals_destroy(rcb_signals *s);
+/** @brief Last error, with file name and line (or record) where it applies. */
+RCB_API const char *rcb_signals_errmsg(const rcb_signals *s);
+
+/** @brief Start a new set: sample rate (samples/s, > 0) and length (samples). */
+RCB_API rcb_status rcb_signals_reset(rcb_signals *s, double rate, size_t nsamples);
+/**
+ * @brief Add a channel (values copied, in SI of @p q).
+ * @param name channel name ("DA.x" for a response, "C.B.y" for a force, "KP"
+ * for a keyphasor) @param q what the values are
+ */
+RCB_API rcb_status rcb_signals_add(rcb_signals *s, const char *name, rcb_quantity q,
+                                   const double *values);
+RCB_API size_t rcb_signals_channel_count(const rcb_signals *s);
+RCB_API size_t rcb_signals_length(const rcb_signals *s);
+/** @brief Sample rate, samples/s. */
+RCB_API double rcb_signals_rate(const rcb_signals *s);
+/** @brief Channel i: its name, quantity and rcb_signals_length() values (SI). */
+RCB_API rcb_status rcb_signals_channel(const rcb_signals *s, size_t i, const char **name,
+                                       rcb_quantity *q, const double **values);
+/** @brief Index of the channel named @p name, or RCB_ERR_NOT_FOUND. */
+RCB_API rcb_status rcb_signals_find(const rcb_signals *s, const char *name, size_t *index);
+
+/**
+ * @brief Read CSV: optional "# units = U1,U2,..." line (one unit per channel
+ * column, e.g. "N,g,mm"), then a header "time_s,NAME1,NAME2,..." (a name may
+ * carry its unit in brackets: "DA.x [mm]"), then rows of numbers. The time
+ * column must be evenly spaced (1e-6 relative); the rate is taken from it.
+ */
+RCB_API rcb_status rcb_signals_read_csv(rcb_signals *s, const char *path);
+/**
+ * @brief Read a WAV file (RIFF, PCM 16/24/32-bit integer or 32/64-bit float,
+ * any number of channels). Integer samples are scaled to [-1, 1). WAV carries
+ * no names nor units: @p names and @p units give them per channel ("DA.x",
+ * "mm"; NULL: "ch1", ... and V) and @p scale the full-scale value in that
+ * unit (1 for float files; NULL: 1).
+ */
+RCB_API rcb_status rcb_signals_read_wav(rcb_signals *s, const char *path, size_t nnames,
+                                        const char *const *names, const char *const *units,
+                                        const double *scale);
+
+/**
+ * @brief Read UFF dataset 58 time records (function type 1, abscissa type 17
+ * time, real data (types 2, 4), evenly sampled: spacing 1, or the times
+ * listed (as pyuff writes) within 0.1 sample of an even grid; ASCII or
+ * binary 58b), one
+ * channel per record, all with one sample interval and length. Channel names
+ * "STATION.DIR" through @p map (as rcb_meas_read_uff), or the station alone
+ * for direction 0 (a keyphasor). Quantity from the ordinate data type (8
+ * displacement, 11 velocity, 12 acceleration, 9/13 force) or else from the
+ * record-9 units label (V, ...); units from that label or a dataset 164
+ * (a disagreement of the two is refused).
+ */
+RCB_API rcb_status rcb_signals_read_uff(rcb_signals *s, const char *path, size_t nmap,
+                                        const rcb_uff_node *map);
+
+/* ------------------------------------------------------- estimation -- */
+
+/** @brief Segment window. */
+typedef enum rcb_window {
+  RCB_WINDOW_HANN = 0,     /**< periodic Hann (SciPy's 'hann') */
+  RCB_WINDOW_FLATTOP = 1,  /**< periodic flat-top (SciPy's 'flattop') */
+  RCB_WINDOW_RECT = 2,     /**< rectangular (boxcar) */
+  RCB_WINDOW_FORCE_EXP = 3 /**< impact test: force window on the inputs (1 over
+                                the first force_frac of the segment, 0 after),
+                                times an exponential window exp(-t/tau) on every
+                                channel, tau such that it ends at exp_end */
+} rcb_window;
+
+/** @brief How H is formed from the averaged spectra. */
+typedef enum rcb_estimator {
+  RCB_EST_H1 = 0, /**< Gxx^-1 Gxy: noise on the outputs (any number of inputs) */
+  RCB_EST_H2 = 1, /**< Gyy / Gyx: noise on the input (one input) */
+  RCB_EST_HV = 2  /**< total least squares, noise on both (one input) */
+} rcb_estimator;
+
+/** @brief Estimator settings (zero-initialise, then set what you need). */
+typedef struct rcb_spectral_opts {
+  size_t ninputs;    /**< force channels (>= 1 for FRFs; 0: spectra only) */
+  size_t noutputs;   /**< response channels */
+  size_t nseg;       /**< samples per segment (>= 8; the FFT length) */
+  size_t noverlap;   /**< samples shared by consecutive segments (< nseg) */
+  double rate;       /**< samples/s */
+  rcb_window window;
+  int no_detrend;    /**< 0: remove each segment's mean (SciPy's default), 1: keep it */
+  double force_frac; /**< RCB_WINDOW_FORCE_EXP: force window length / segment (0: 0.1) */
+  double exp_end;    /**< RCB_WINDOW_FORCE_EXP: exponential window's last value (0: 0.01) */
+} rcb_spectral_opts;
+
+typedef struct rcb_spectral rcb_spectral;
+
+/** @brief Bytes rcb_spectral_init needs for these settings (and the object's
+ * whole memory besides the FFT backend's plan). */
+RCB_API rcb_status rcb_spectral_workspace_size(const rcb_spectral_opts *o, size_t *bytes);
+/**
+ * @brief Build an estimator inside @p work (bytes from
+ * rcb_spectral_workspace_size, any alignment; the caller keeps it alive and
+ * frees it after rcb_spectral_release). No allocation besides FFTW's plan.
+ */
+RCB_API rcb_status rcb_spectral_init(rcb_spectral **out, const rcb_spectral_opts *o,
+                                     void *work, size_t bytes);
+/** @brief Release the FFT plan (the workspace stays the caller's). */
+RCB_API void rcb_spectral_release(rcb_spectral *e);
+RCB_API const char *rcb_spectral_errmsg(const rcb_spectral *e);
+/** @brief Forget the averages (same settings). */
+RCB_API void rcb_spectral_clear(rcb_spectral *e);
+/**
+ * @brief Average one segment: @p chan[0..ninputs) are the inputs, then the
+ * outputs, each nseg samples (SI). Allocation-free: the streaming entry.
+ */
+RCB_API rcb_status rcb_spectral_add_segment(rcb_spectral *e, const double *const *chan);
+/**
+ * @brief Welch over whole records of @p n samples (segments every
+ * nseg - noverlap samples; trailing samples that fill no segment are unused,
+ * as in SciPy).
+ */
+RCB_API rcb_status rcb_spectral_add_record(rcb_spectral *e, size_t n,
+                                           const double *const *chan);
+/** @brief Segments averaged so far. */
+RCB_API size_t rcb_spectral_averages(const rcb_spectral *e);
+/** @brief nseg / 2 + 1 one-sided frequency lines. */
+RCB_API size_t rcb_spectral_bin_count(const rcb_spectral *e);
+/** @brief The frequency lines, rad/s (bin_count values). */
+RCB_API void rcb_spectral_frequencies(const rcb_spectral *e, double *w);
+/**
+ * @brief Averaged one-sided cross spectral density conj(X_a) X_b of channels
+ * a and b (indices as in add_segment), unit^2 s (per Hz, as SciPy's csd with
+ * scaling='density'); the pairs held are input-input, input-output and
+ * output-output on the diagonal (RCB_ERR_ARG for two different outputs).
+ */
+RCB_API rcb_status rcb_spectral_cross(const rcb_spectral *e, size_t a, size_t b,
+                                      rcb_complex *g);
+/**
+ * @brief FRF from input @p in to output @p out, with coherence and standard
+ * deviation per frequency line (any pointer may be NULL).
+ * @param h response per unit input (SI units of the channels)
+ * @param coh ordinary coherence of the pair (one input) or the multiple
+ * coherence of the output on all inputs
+ * @param sd standard deviation of each of Re h and Im h (of |h|, and of
+ * |h| times the phase in rad): sqrt((1 - coh) Gyy [Gxx^-1]_jj / (2 (nd - p + 1)))
+ * (Bendat & Piersol, eq. 9.90 generalised; for one input
+ * |h| sqrt((1 - coh) / (2 nd coh))), the same expression for H2 and Hv;
+ * nd = segments / (1 + 2 sum_j rho_j^2), the independent averages the
+ * overlapped segments are worth (rho_j: the window's overlap correlation)
+ * @return RCB_ERR_SINGULAR (with the line in the message) if Gxx is singular
+ */
+RCB_API rcb_status rcb_spectral_frf(rcb_spectral *e, rcb_estimator est, size_t out,
+                                    size_t in, rcb_complex *h, double *coh, double *sd);
+
+/* --------------------------------------------------- order tracking -- */
+
+/**
+ * @brief Order-tracking settings. Method: computed order tracking, one
+ * revolution at a time. Keyphasor pulses (upward crossings of @c trigger,
+ * interpolated between samples) bound each revolution; its samples are
+ * resampled (linear interpolation in time) to @c per_rev equally spaced
+ * shaft angles, the angle taken as a quadratic in time through the pulses
+ * before, at and after the revolution (constant angular acceleration; Fyfe
+ * & Munck 1997, so the first revolution is not reported), and an exact
+ * per_rev-point DFT gives the order-m phasor Q_m = (2/N) sum_j y_j
+ * e^{-i m theta_j}, y = Re(Q_m e^{i m theta}), theta from the keyphasor mark
+ * plus @c kp_angle. Revolutions are grouped into speed bins of width
+ * @c bin_width; a bin reports the mean phasor, the mean speed and the
+ * standard deviation of the mean from the scatter over its revolutions.
+ * Why not Vold-Kalman: with the angle exact for a constant acceleration,
+ * the per-revolution DFT is exact for every order at any run-up rate,
+ * needs no tuning of a filter bandwidth, runs in O(samples) and gives the
+ * revolution-to-revolution scatter that the statistics need.
+ */
+typedef struct rcb_order_opts {
+  size_t norders;   /**< orders 1..norders (1 to 8) */
+  size_t per_rev;   /**< angle samples per revolution (>= 4 norders; 0: 64) */
+  double trigger;   /**< keyphasor threshold in its unit (NaN: halfway between its min and max) */
+  double kp_angle;  /**< shaft angle at the keyphasor mark, rad */
+  double bin_width; /**< speed bin, rad/s (> 0) */
+  double speed_max; /**< highest speed binned, rad/s (faster revolutions are ignored) */
+  size_t min_revs;  /**< revolutions a bin needs to be reported (>= 2; 0: 2) */
+} rcb_order_opts;
+
+typedef struct rcb_order rcb_order;
+
+/** @brief Bytes for an order tracker of @p nch channels (two-call sizing). */
+RCB_API rcb_status rcb_order_workspace_size(const rcb_order_opts *o, size_t nch,
+                                            size_t *bytes);
+/** @brief Build an order tracker in @p work (no allocation, ever). */
+RCB_API rcb_status rcb_order_init(rcb_order **out, const rcb_order_opts *o, size_t nch,
+                                  void *work, size_t bytes);
+RCB_API const char *rcb_order_errmsg(const rcb_order *e);
+/**
+ * @brief Track a record: @p kp the keyphasor, @p chan the nch responses,
+ * n samples each at @p rate samples/s. May be called for several records.
+ * @return RCB_ERR_ARG with a message if fewer than three pulses are found
+ */
+RCB_API rcb_status rcb_order_add(rcb_order *e, double rate, size_t n, const double *kp,
+                                 const double *const *chan);
+/** @brief Revolutions tracked so far. */
+RCB_API size_t rcb_order_revolutions(const rcb_order *e);
+/** @brief Bins (speed_max / bin_width, rounded up). */
+RCB_API size_t rcb_order_bin_count(const rcb_order *e);
+/**
+ * @brief One bin's result for channel @p ch and order @p m (1-based).
+ * @param speed mean speed of its revolutions, rad/s
+ * @param Q mean phasor (channel unit) @param sd standard deviation of Re Q and
+ * of Im Q of the mean, sqrt(sum |Q_r - Q|^2 / (2 n (n - 1)))
+ * @param nrev revolutions in the bin (results valid when >= min_revs)
+ */
+RCB_API rcb_status rcb_order_result(const rcb_order *e, size_t bin, size_t ch, size_t m,
+                                    double *speed, rcb_complex *Q, double *sd, size_t *nrev);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* RCB_SIGNAL_H */

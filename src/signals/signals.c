@@ -1,0 +1,157 @@
+/*
+ * The signal container: channels sampled together, held in SI with their
+ * quantity. Readers (signals_csv.c, signals_wav.c, signals_uff.c) fill it.
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "signals/signals_internal.h"
+
+rcb_status (rcb_signals_fail)(rcb_signals *s, rcb_status st, const char *fmt, ...) {
+  va_list ap;
+  if (!s) return st;
+  va_start(ap, fmt);
+  vsnprintf(s->errmsg, sizeof s->errmsg, fmt, ap);
+  va_end(ap);
+  return st;
+}
+
+rcb_status rcb_signals_create(rcb_signals **out, const rcb_allocator *alloc) {
+  rcb_allocator a;
+  rcb_signals *s;
+  if (!out) return RCB_ERR_ARG;
+  rcb_allocator_init(&a, alloc);
+  s = rcb_alloc(&a, sizeof *s);
+  *out = s;
+  if (!s) return RCB_ERR_NOMEM;
+  s->alloc = a;
+  return RCB_OK;
+}
+
+void rcb_signals_empty(rcb_signals *s) {
+  size_t i;
+  for (i = 0; i < s->nch; i++) rcb_free(&s->alloc, s->ch[i].v);
+  s->nch = 0;
+  s->n = 0;
+  s->rate = 0.0;
+}
+
+void rcb_signals_destroy(rcb_signals *s) {
+  if (!s) return;
+  rcb_signals_empty(s);
+  rcb_free(&s->alloc, s->ch);
+  rcb_free(&s->alloc, s);
+}
+
+const char *rcb_signals_errmsg(const rcb_signals *s) { return s ? s->errmsg : ""; }
+
+rcb_status rcb_signals_reset(rcb_signals *s, double rate, size_t nsamples) {
+  if (!s) return RCB_ERR_ARG;
+  rcb_signals_empty(s);
+  if (!isfinite(rate) || !(rate > 0.0) || nsamples == 0)
+    return rcb_signals_fail(s, RCB_ERR_ARG, "sample rate %g samples/s, %zu samples: expected "
+                            "a rate > 0 and at least one sample", rate, nsamples);
+  s->rate = rate;
+  s->n = nsamples;
+  return RCB_OK;
+}
+
+rcb_status rcb_signals_take(rcb_signals *s, const char *name, rcb_quantity q, double *values) {
+  size_t i;
+  rcb_signal_ch *c;
+  if (!name || !name[0] || strlen(name) >= RCB_SIGNAL_NAME_MAX) {
+    rcb_free(&s->alloc, values);
+    return rcb_signals_fail(s, RCB_ERR_ARG, "channel name '%.80s': expected 1 to %d characters",
+                            name ? name : "", RCB_SIGNAL_NAME_MAX - 1);
+  }
+  for (i = 0; i < s->nch; i++)
+    if (strcmp(s->ch[i].name, name) == 0) {
+      rcb_free(&s->alloc, values);
+      return rcb_signals_fail(s, RCB_ERR_ARG, "channel '%s' given twice", name);
+    }
+  if (rcb_grow(&s->alloc, (void **)&s->ch, &s->capch, s->nch + 1, sizeof *s->ch)) {
+    rcb_free(&s->alloc, values);
+    return rcb_signals_fail(s, RCB_ERR_NOMEM, "out of memory");
+  }
+  c = &s->ch[s->nch++];
+  snprintf(c->name, sizeof c->name, "%s", name);
+  c->q = q;
+  c->v = values;
+  return RCB_OK;
+}
+
+rcb_status rcb_signals_add(rcb_signals *s, const char *name, rcb_quantity q,
+                           const double *values) {
+  double *v;
+  size_t i;
+  if (!s || !values) return RCB_ERR_ARG;
+  if (s->n == 0)
+    return rcb_signals_fail(s, RCB_ERR_STATE, "add a channel after rcb_signals_reset");
+  if ((unsigned)q > RCB_QTY_VOLTAGE)
+    return rcb_signals_fail(s, RCB_ERR_ARG, "channel '%s': unknown quantity %d", name, (int)q);
+  for (i = 0; i < s->n; i++)
+    if (!isfinite(values[i]))
+      return rcb_signals_fail(s, RCB_ERR_ARG, "channel '%s': sample %zu is not finite", name,
+                              i + 1);
+  v = rcb_alloc(&s->alloc, s->n * sizeof *v);
+  if (!v) return rcb_signals_fail(s, RCB_ERR_NOMEM, "out of memory (%zu samples)", s->n);
+  memcpy(v, values, s->n * sizeof *v);
+  return rcb_signals_take(s, name, q, v);
+}
+
+size_t rcb_signals_channel_count(const rcb_signals *s) { return s ? s->nch : 0; }
+size_t rcb_signals_length(const rcb_signals *s) { return s ? s->n : 0; }
+double rcb_signals_rate(const rcb_signals *s) { return s ? s->rate : 0.0; }
+
+rcb_status rcb_signals_channel(const rcb_signals *s, size_t i, const char **name,
+                               rcb_quantity *q, const double **values) {
+  if (!s || i >= s->nch) return RCB_ERR_ARG;
+  if (name) *name = s->ch[i].name;
+  if (q) *q = s->ch[i].q;
+  if (values) *values = s->ch[i].v;
+  return RCB_OK;
+}
+
+rcb_status rcb_signals_find(const rcb_signals *s, const char *name, size_t *index) {
+  size_t i;
+  if (!s || !name || !index) return RCB_ERR_ARG;
+  for (i = 0; i < s->nch; i++)
+    if (strcmp(s->ch[i].name, name) == 0) {
+      *index = i;
+      return RCB_OK;
+    }
+  return RCB_ERR_NOT_FOUND;
+}
+
+rcb_status rcb_signals_slurp(rcb_signals *s, const char *path, char **buf, size_t *len) {
+  FILE *fp;
+  long size;
+  char *b;
+  *buf = NULL;
+  *len = 0;
+  if (!path || !path[0]) return rcb_signals_fail(s, RCB_ERR_ARG, "no file name given");
+  fp = fopen(path, "rb");
+  if (!fp)
+    return rcb_signals_fail(s, RCB_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+  if (fseek(fp, 0, SEEK_END) || (size = ftell(fp)) < 0 || fseek(fp, 0, SEEK_SET)) {
+    fclose(fp);
+    return rcb_signals_fail(s, RCB_ERR_IO, "%s: cannot read: not a regular file", path);
+  }
+  b = rcb_alloc(&s->alloc, (size_t)size + 1);
+  if (!b) {
+    fclose(fp);
+    return rcb_signals_fail(s, RCB_ERR_NOMEM, "%s: out of memory (%ld bytes)", path, size);
+  }
+  if (fread(b, 1, (size_t)size, fp) != (size_t)size) {
+    fclose(fp);
+    rcb_free(&s->alloc, b);
+    return rcb_signals_fail(s, RCB_ERR_IO, "%s: read error", path);
+  }
+  fclose(fp);
+  b[size] = '\0';
+  *buf = b;
+  *len = (size_t)size;
+  return RCB_OK;
+}

@@ -1,0 +1,68 @@
+/*
+ * Internals of the measurement front end (src/signals/): the estimator and
+ * the signal container, shared by its files. Not installed.
+ */
+#ifndef RCB_SIGNALS_INTERNAL_H
+#define RCB_SIGNALS_INTERNAL_H
+
+#include "core/rcb_internal.h"
+#include "rcb/rcb_signal.h"
+
+struct rcb_fft_ops;
+
+struct rcb_spectral {
+  char errmsg[RCB_ERRMSG_MAX];
+  rcb_spectral_opts o;
+  const struct rcb_fft_ops *fft;
+  size_t nb, nd;         /* lines, segments averaged */
+  double wss;            /* sum of the output window squared */
+  double ovl;            /* variance factor of overlapped segments, 1 + 2 sum_j rho_j^2 */
+  double *win_in, *win_out; /* nseg each (the same array unless FORCE_EXP) */
+  double *buf;           /* nseg: FFT input */
+  rcb_complex *spec;     /* (p + 1) * nb: input spectra, then the output's */
+  rcb_complex *gxx;      /* nb * p * p, column-major per line */
+  rcb_complex *gxy;      /* nb * p * q: line k, input i, output o at (k q + o) p + i */
+  double *gyy;           /* nb * q */
+  rcb_complex *a, *b;    /* p * p, p: solve scratch */
+  const double **seg;    /* p + q segment starts (add_record) */
+  void *fft_state;
+};
+
+/* Density scale of line k for the averaged sums (spectral.c). */
+double rcb_spectral_line_scale(const rcb_spectral *e, size_t k);
+
+#define RCB_SIGNAL_NAME_MAX 64
+
+typedef struct rcb_signal_ch {
+  char name[RCB_SIGNAL_NAME_MAX];
+  rcb_quantity q;
+  double *v; /* n samples, SI */
+} rcb_signal_ch;
+
+struct rcb_signals {
+  rcb_allocator alloc;
+  char errmsg[RCB_ERRMSG_MAX];
+  double rate; /* samples/s */
+  size_t n;    /* samples per channel */
+  rcb_signal_ch *ch;
+  size_t nch, capch;
+};
+
+/* printf into s->errmsg, returns st. */
+rcb_status rcb_signals_fail(rcb_signals *s, rcb_status st, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+#ifdef __clang_analyzer__ /* returns st: see rcb_set_error in core/rcb_internal.h */
+#define rcb_signals_fail(o, st, ...) ((void)(rcb_signals_fail)((o), (st), __VA_ARGS__), (st))
+#endif
+
+/* Add a channel whose values are already allocated through s->alloc (taken over). */
+rcb_status rcb_signals_take(rcb_signals *s, const char *name, rcb_quantity q, double *values);
+/* Drop every channel (before reading, and after a failed read). */
+void rcb_signals_empty(rcb_signals *s);
+/* Whole file into memory through the set's allocator. */
+rcb_status rcb_signals_slurp(rcb_signals *s, const char *path, char **buf, size_t *len);
+
+#endif /* RCB_SIGNALS_INTERNAL_H */

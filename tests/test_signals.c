@@ -1,0 +1,638 @@
+/* Measurement front end (src/signals): the Welch estimator against closed
+ * forms (white noise, a digital SDOF resonator, known coherence and the known
+ * biases of H1, H2 and Hv), and the signal readers with their units. The
+ * agreement with SciPy to 1e-10 is in tests/python/test_signals_scipy.py. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+#include <complex.h>
+#include <math.h>
+
+#include "rcb/rcb.h"
+#include "rcb/rcb_config.h"
+#include "rcb_test_util.h"
+
+#define PI 3.14159265358979323846
+
+/* Gaussian samples (xorshift64* + Box-Muller): independent of libc. */
+typedef struct rng {
+  uint64_t s;
+} rng;
+static double uni(rng *r) {
+  r->s ^= r->s >> 12;
+  r->s ^= r->s << 25;
+  r->s ^= r->s >> 27;
+  return ((double)((r->s * 2685821657736338717ULL) >> 11) + 0.5) / 9007199254740992.0;
+}
+static double gauss(rng *r) { return sqrt(-2.0 * log(uni(r))) * cos(2.0 * PI * uni(r)); }
+static void white(rng *r, double *x, size_t n, double sd) {
+  size_t i;
+  for (i = 0; i < n; i++) x[i] = sd * gauss(r);
+}
+
+/* An estimator in a malloc'ed workspace (the test's; the library allocates nothing). */
+typedef struct est {
+  rcb_spectral *e;
+  void *work;
+} est;
+static int make(est *t, size_t p, size_t q, size_t nseg, rcb_window w, double rate) {
+  rcb_spectral_opts o;
+  size_t bytes = 0;
+  rcb_status st;
+  memset(&o, 0, sizeof o);
+  o.ninputs = p;
+  o.noutputs = q;
+  o.nseg = nseg;
+  o.noverlap = nseg / 2;
+  o.rate = rate;
+  o.window = w;
+  st = rcb_spectral_workspace_size(&o, &bytes);
+  if (st == RCB_ERR_UNSUPPORTED) return -1;
+  assert_int_equal(st, RCB_OK);
+  t->work = malloc(bytes);
+  assert_non_null(t->work);
+  assert_int_equal(rcb_spectral_init(&t->e, &o, t->work, bytes), RCB_OK);
+  return 0;
+}
+static void done(est *t) {
+  rcb_spectral_release(t->e);
+  free(t->work);
+}
+#define NEED_FFT(t, ...)     \
+  if (make(t, __VA_ARGS__)) { \
+    skip();                  \
+    return;                  \
+  }
+
+/* Signal buffers of the estimator tests (static: nothing to free on a skip). */
+static double buf_a[512 * 1000], buf_b[512 * 1000], buf_c[512 * 1000];
+
+/* Unit-variance white noise: one-sided density 2 / rate on every line. */
+static void test_white_noise_level(void **state) {
+  enum { N = 256 * 400 };
+  double *x = buf_a, mean = 0.0;
+  rcb_complex g[129];
+  const double *ch[1];
+  rng r = {12345};
+  est t;
+  size_t k;
+  (void)state;
+  NEED_FFT(&t, 0, 1, 256, RCB_WINDOW_HANN, 1000.0);
+  white(&r, x, N, 1.0);
+  ch[0] = x;
+  assert_int_equal(rcb_spectral_add_record(t.e, N, ch), RCB_OK);
+  assert_int_equal(rcb_spectral_averages(t.e), 799);
+  assert_int_equal(rcb_spectral_cross(t.e, 0, 0, g), RCB_OK);
+  for (k = 1; k < 128; k++) mean += creal(g[k]);
+  mean /= 127.0;
+  /* 799 averages x 127 lines: the mean's scatter is ~0.2 % */
+  assert_true(fabs(mean / (2.0 / 1000.0) - 1.0) < 0.01);
+  done(&t);
+}
+
+/* Digital SDOF resonator y_n = a1 y_{n-1} + a2 y_{n-2} + b x_{n-1}: H1 is its
+ * exact transfer function b z^-1 / (1 - a1 z^-1 - a2 z^-2), z = e^{i w T}. */
+static void test_sdof_resonator(void **state) {
+  enum { N = 1024 * 200, NB = 513 };
+  const double fs = 1000.0, fn = 100.0, zeta = 0.05, T = 1.0 / fs;
+  double wn = 2 * PI * fn, rr = exp(-zeta * wn * T), th = wn * sqrt(1 - zeta * zeta) * T;
+  double a1 = 2 * rr * cos(th), a2 = -rr * rr, b = 1.0, worst = 0.0, rms = 0.0, w[NB], coh[NB];
+  double *x = buf_a, *y = buf_b;
+  rcb_complex h[NB];
+  const double *ch[2];
+  rng r = {777};
+  est t;
+  size_t k, n;
+  (void)state;
+  NEED_FFT(&t, 1, 1, 1024, RCB_WINDOW_HANN, fs);
+  white(&r, x, N, 1.0);
+  y[0] = 0.0;
+  y[1] = b * x[0] + a1 * y[0];
+  for (n = 2; n < N; n++) y[n] = a1 * y[n - 1] + a2 * y[n - 2] + b * x[n - 1];
+  ch[0] = x;
+  ch[1] = y;
+  assert_int_equal(rcb_spectral_add_record(t.e, N, ch), RCB_OK);
+  assert_int_equal(rcb_spectral_frf(t.e, RCB_EST_H1, 0, 0, h, coh, NULL), RCB_OK);
+  rcb_spectral_frequencies(t.e, w);
+  assert_true(fabs(w[1] - 2 * PI * fs / 1024) < 1e-12);
+  for (k = 1; k < NB; k++) {
+    rcb_complex z1 = cexp(-CMPLX(0.0, w[k] * T));
+    rcb_complex hz = b * z1 / (1.0 - a1 * z1 - a2 * z1 * z1);
+    double e = cabs(h[k] - hz) / cabs(hz);
+    if (e > worst) worst = e;
+    rms += e * e;
+    assert_true(coh[k] > 0.98);
+  }
+  rms = sqrt(rms / (NB - 1));
+  printf("SDOF resonator: H1 vs closed form: worst %.3g, RMS %.3g\n", worst, rms);
+  /* Hann leakage and random error at the 10-line half-power band: ~1 % */
+  assert_true(worst < 0.03 && rms < 0.005);
+  done(&t);
+}
+
+/* y = x + n, var n = var x: coherence 1/2; H1 = 1 unbiased with its 95 %
+ * band holding ~95 % of lines; H2 = Gyy/Gyx = 2 and Hv = (1 + sqrt 5)/2. */
+static void test_known_coherence_and_biases(void **state) {
+  enum { N = 512 * 1000, NB = 257 };
+  double *x = buf_a, *y = buf_b, coh[NB], sd[NB];
+  double mc = 0.0, m2 = 0.0, mv = 0.0, inside = 0.0;
+  rcb_complex h1[NB], h2[NB], hv[NB];
+  const double *ch[2];
+  rng r = {4242};
+  est t;
+  size_t k, n;
+  (void)state;
+  NEED_FFT(&t, 1, 1, 512, RCB_WINDOW_HANN, 2048.0);
+  white(&r, x, N, 1.0);
+  for (n = 0; n < N; n++) y[n] = x[n] + gauss(&r);
+  ch[0] = x;
+  ch[1] = y;
+  assert_int_equal(rcb_spectral_add_record(t.e, N, ch), RCB_OK);
+  assert_int_equal(rcb_spectral_frf(t.e, RCB_EST_H1, 0, 0, h1, coh, sd), RCB_OK);
+  assert_int_equal(rcb_spectral_frf(t.e, RCB_EST_H2, 0, 0, h2, NULL, NULL), RCB_OK);
+  assert_int_equal(rcb_spectral_frf(t.e, RCB_EST_HV, 0, 0, hv, NULL, NULL), RCB_OK);
+  for (k = 1; k < NB - 1; k++) {
+    mc += coh[k];
+    m2 += creal(h2[k]);
+    mv += creal(hv[k]);
+    /* circular Gaussian error, sd per component: 95 % radius sqrt(-2 ln 0.05) sd */
+    inside += cabs(h1[k] - 1.0) <= 2.4477 * sd[k];
+  }
+  mc /= NB - 2;
+  m2 /= NB - 2;
+  mv /= NB - 2;
+  inside /= NB - 2;
+  assert_true(fabs(mc - 0.5) < 0.01);
+  assert_true(fabs(m2 - 2.0) < 0.02);
+  assert_true(fabs(mv - 0.5 * (1.0 + sqrt(5.0))) < 0.02);
+  printf("known coherence: mean %.4f, H1 inside its 95 %% band at %.1f %% of lines\n", mc,
+         100.0 * inside);
+  assert_true(inside > 0.90 && inside < 0.99);
+  /* and sd itself: |H1| sqrt((1 - coh) / (2 nd coh)), nd = 1999 segments over
+   * Hann's 50 % overlap factor 1 + 2 rho^2, rho = 1/6 (periodic Hann at N/2) */
+  assert_true(fabs(sd[10] - cabs(h1[10]) * sqrt((1 - coh[10]) * (1.0 + 2.0 / 36.0) /
+                                                (2 * 1999.0 * coh[10]))) < 1e-12);
+  done(&t);
+}
+
+/* Noise on the input only: H2 unbiased, H1 = 1/(1 + 1) biased low. */
+static void test_input_noise(void **state) {
+  enum { N = 256 * 1000, NB = 129 };
+  double *x = buf_a, *xm = buf_b, m1 = 0.0, m2 = 0.0;
+  rcb_complex h1[NB], h2[NB];
+  const double *ch[2];
+  rng r = {99};
+  est t;
+  size_t k, n;
+  (void)state;
+  NEED_FFT(&t, 1, 1, 256, RCB_WINDOW_FLATTOP, 1000.0);
+  white(&r, x, N, 1.0);
+  for (n = 0; n < N; n++) xm[n] = x[n] + gauss(&r);
+  ch[0] = xm;
+  ch[1] = x;
+  assert_int_equal(rcb_spectral_add_record(t.e, N, ch), RCB_OK);
+  assert_int_equal(rcb_spectral_frf(t.e, RCB_EST_H1, 0, 0, h1, NULL, NULL), RCB_OK);
+  assert_int_equal(rcb_spectral_frf(t.e, RCB_EST_H2, 0, 0, h2, NULL, NULL), RCB_OK);
+  for (k = 1; k < NB - 1; k++) {
+    m1 += creal(h1[k]);
+    m2 += creal(h2[k]);
+  }
+  assert_true(fabs(m1 / (NB - 2) - 0.5) < 0.02);
+  assert_true(fabs(m2 / (NB - 2) - 1.0) < 0.03);
+  done(&t);
+}
+
+/* Two independent inputs, y = 2 x1 - 3 x2 + n: H1 = (2, -3), multiple
+ * coherence 13/14; the same input twice is refused as singular. */
+static void test_two_inputs(void **state) {
+  enum { N = 256 * 400, NB = 129 };
+  double *x1 = buf_a, *x2 = buf_b, *y = buf_c;
+  double coh[NB], sd[NB], mc = 0.0;
+  rcb_complex ha[NB], hb[NB];
+  const double *ch[3];
+  rng r = {31337};
+  est t;
+  size_t k, n, in_a = 0;
+  (void)state;
+  NEED_FFT(&t, 2, 1, 256, RCB_WINDOW_HANN, 1000.0);
+  white(&r, x1, N, 1.0);
+  white(&r, x2, N, 1.0);
+  for (n = 0; n < N; n++) y[n] = 2 * x1[n] - 3 * x2[n] + gauss(&r);
+  ch[0] = x1;
+  ch[1] = x2;
+  ch[2] = y;
+  assert_int_equal(rcb_spectral_add_record(t.e, N, ch), RCB_OK);
+  assert_int_equal(rcb_spectral_frf(t.e, RCB_EST_H1, 0, 0, ha, coh, sd), RCB_OK);
+  assert_int_equal(rcb_spectral_frf(t.e, RCB_EST_H1, 0, 1, hb, NULL, NULL), RCB_OK);
+  assert_int_equal(rcb_spectral_frf(t.e, RCB_EST_H2, 0, 0, hb, NULL, NULL), RCB_ERR_ARG);
+  for (k = 1; k < NB - 1; k++) {
+    mc += coh[k];
+    in_a += cabs(ha[k] - 2.0) <= 2.4477 * sd[k];
+    assert_true(cabs(ha[k] - 2.0) < 0.2 && cabs(hb[k] + 3.0) < 0.2);
+  }
+  assert_true(fabs(mc / (NB - 2) - 13.0 / 14.0) < 0.005);
+  assert_true(in_a > 0.85 * (NB - 2));
+  done(&t);
+  NEED_FFT(&t, 2, 1, 256, RCB_WINDOW_HANN, 1000.0);
+  ch[1] = x1;
+  assert_int_equal(rcb_spectral_add_record(t.e, N, ch), RCB_OK);
+  assert_int_equal(rcb_spectral_frf(t.e, RCB_EST_H1, 0, 0, ha, NULL, NULL), RCB_ERR_SINGULAR);
+  assert_non_null(strstr(rcb_spectral_errmsg(t.e), "fully coherent"));
+  done(&t);
+}
+
+/* Sizing: too small a workspace is refused, the object sits in the caller's
+ * buffer (any alignment), and bad settings are refused. */
+static void test_workspace(void **state) {
+  rcb_spectral_opts o;
+  rcb_spectral *e = NULL;
+  size_t bytes = 0;
+  unsigned char *work;
+  (void)state;
+  memset(&o, 0, sizeof o);
+  o.ninputs = 1;
+  o.noutputs = 3;
+  o.nseg = 4096;
+  o.noverlap = 2048;
+  o.rate = 1000.0;
+  if (rcb_spectral_workspace_size(&o, &bytes) == RCB_ERR_UNSUPPORTED) skip();
+  assert_true(bytes > (size_t)4 * 2049 * 16 && bytes < 600000);
+  work = malloc(bytes + 1);
+  assert_int_equal(rcb_spectral_init(&e, &o, work + 1, bytes - 1), RCB_ERR_WORKSPACE);
+  assert_int_equal(rcb_spectral_init(&e, &o, work + 1, bytes), RCB_OK);
+  assert_true((unsigned char *)e >= work + 1 && (unsigned char *)e < work + 1 + bytes);
+  rcb_spectral_release(e);
+  o.noverlap = 4096;
+  assert_int_equal(rcb_spectral_workspace_size(&o, &bytes), RCB_ERR_ARG);
+  o.noverlap = 0;
+  o.rate = -1.0;
+  assert_int_equal(rcb_spectral_workspace_size(&o, &bytes), RCB_ERR_ARG);
+  free(work);
+}
+
+/* ---- readers ---- */
+
+static void write_text(const char *path, const char *text) {
+  FILE *fp = fopen(path, "w");
+  assert_non_null(fp);
+  fputs(text, fp);
+  fclose(fp);
+}
+
+static void test_csv_units(void **state) {
+  const char *p = rcb_test_tmp_path("sig.csv");
+  rcb_signals *s;
+  const char *name;
+  const double *v;
+  rcb_quantity q;
+  (void)state;
+  write_text(p, "# a test signal\n# units = N,m,mm\ntime_s,C.B.y,DA.x [g],DB.x\n"
+                "0,1,1,1\n0.001,2,0.5,-2\n0.002,3,0,3\n");
+  assert_int_equal(rcb_signals_create(&s, NULL), RCB_OK);
+  if (rcb_signals_read_csv(s, p)) fail_msg("%s", rcb_signals_errmsg(s));
+  assert_int_equal(rcb_signals_channel_count(s), 3);
+  assert_int_equal(rcb_signals_length(s), 3);
+  assert_true(fabs(rcb_signals_rate(s) - 1000.0) < 1e-9);
+  assert_int_equal(rcb_signals_channel(s, 1, &name, &q, &v), RCB_OK);
+  assert_string_equal(name, "DA.x");
+  assert_int_equal(q, RCB_QTY_ACCELERATION);
+  assert_true(v[0] == 9.80665 && v[1] == 0.5 * 9.80665); /* g: CGPM standard gravity */
+  assert_int_equal(rcb_signals_channel(s, 2, &name, &q, &v), RCB_OK);
+  assert_int_equal(q, RCB_QTY_DISPLACEMENT);
+  assert_true(fabs(v[1] + 2e-3) < 1e-18);
+  assert_int_equal(rcb_signals_channel(s, 0, &name, &q, &v), RCB_OK);
+  assert_int_equal(q, RCB_QTY_FORCE);
+  /* refusals: unknown unit, uneven time, ragged row */
+  write_text(p, "time_s,DA.x [furlong]\n0,1\n0.001,2\n");
+  assert_int_equal(rcb_signals_read_csv(s, p), RCB_ERR_PARSE);
+  assert_non_null(strstr(rcb_signals_errmsg(s), "unit 'furlong'"));
+  assert_int_equal(rcb_signals_channel_count(s), 0);
+  write_text(p, "time_s,DA.x [m]\n0,1\n0.001,2\n0.003,2\n0.004,2\n");
+  assert_int_equal(rcb_signals_read_csv(s, p), RCB_ERR_PARSE);
+  assert_non_null(strstr(rcb_signals_errmsg(s), "evenly spaced"));
+  write_text(p, "time_s,DA.x [m],DB.x [m]\n0,1,1\n0.001,2\n");
+  assert_int_equal(rcb_signals_read_csv(s, p), RCB_ERR_PARSE);
+  assert_non_null(strstr(rcb_signals_errmsg(s), ":3:"));
+  rcb_signals_destroy(s);
+}
+
+static void put_tag(unsigned char *p, const char *tag) {
+  int i;
+  for (i = 0; i < 4; i++) p[i] = (unsigned char)tag[i];
+}
+
+static void put_le(unsigned char *p, unsigned long v, int n) {
+  int i;
+  for (i = 0; i < n; i++) p[i] = (unsigned char)(v >> (8 * i));
+}
+
+/* A WAV file: 2 channels, nsamp frames, PCM of @p bits or float (fmt 3). */
+static void write_wav(const char *path, unsigned fmt, unsigned bits, const long *pcm,
+                      const float *flt, size_t nsamp) {
+  unsigned char h[44];
+  size_t nb = bits / 8, data = nsamp * 2 * nb, i;
+  FILE *fp = fopen(path, "wb");
+  assert_non_null(fp);
+  put_tag(h, "RIFF");
+  put_le(h + 4, (unsigned long)(36 + data), 4);
+  put_tag(h + 8, "WAVE");
+  put_tag(h + 12, "fmt ");
+  put_le(h + 16, 16, 4);
+  put_le(h + 20, fmt, 2);
+  put_le(h + 22, 2, 2);
+  put_le(h + 24, 8000, 4);
+  put_le(h + 28, 8000UL * 2 * nb, 4);
+  put_le(h + 32, (unsigned long)(2 * nb), 2);
+  put_le(h + 34, bits, 2);
+  put_tag(h + 36, "data");
+  put_le(h + 40, (unsigned long)data, 4);
+  fwrite(h, 1, 44, fp);
+  for (i = 0; i < 2 * nsamp; i++) {
+    unsigned char b[4];
+    if (flt) {
+      uint32_t u;
+      memcpy(&u, &flt[i], 4);
+      put_le(b, u, 4);
+    } else {
+      put_le(b, (unsigned long)pcm[i], (int)nb);
+    }
+    fwrite(b, 1, nb, fp);
+  }
+  fclose(fp);
+}
+
+static void test_wav(void **state) {
+  const char *p = rcb_test_tmp_path("sig.wav");
+  const char *names[2] = {"C.B.y", "DA.x"}, *units[2] = {"N", "g"};
+  const double scale[2] = {500.0, 50.0}; /* full scale: 500 N, 50 g */
+  long pcm16[4] = {16384, -32768, -16384, 32767};
+  long pcm24[4] = {4194304, -8388608, 1, -1};
+  float flt[4] = {0.25f, -1.0f, 0.5f, 2.0f};
+  rcb_signals *s;
+  const double *v;
+  rcb_quantity q;
+  (void)state;
+  assert_int_equal(rcb_signals_create(&s, NULL), RCB_OK);
+  write_wav(p, 1, 16, pcm16, NULL, 2);
+  assert_int_equal(rcb_signals_read_wav(s, p, 2, names, units, scale), RCB_OK);
+  assert_true(rcb_signals_rate(s) == 8000.0 && rcb_signals_length(s) == 2);
+  rcb_signals_channel(s, 0, NULL, &q, &v);
+  assert_int_equal(q, RCB_QTY_FORCE);
+  assert_true(v[0] == 250.0 && v[1] == -250.0);
+  rcb_signals_channel(s, 1, NULL, &q, &v);
+  assert_int_equal(q, RCB_QTY_ACCELERATION);
+  assert_true(v[0] == -50.0 * 9.80665 && fabs(v[1] - 50.0 * 9.80665 * 32767.0 / 32768.0) < 1e-12);
+  write_wav(p, 1, 24, pcm24, NULL, 2);
+  assert_int_equal(rcb_signals_read_wav(s, p, 0, NULL, NULL, NULL), RCB_OK);
+  rcb_signals_channel(s, 1, NULL, &q, &v);
+  assert_int_equal(q, RCB_QTY_VOLTAGE);
+  assert_true(v[0] == -1.0 && v[1] == -1.0 / 8388608.0);
+  write_wav(p, 3, 32, NULL, flt, 2);
+  assert_int_equal(rcb_signals_read_wav(s, p, 0, NULL, NULL, NULL), RCB_OK);
+  rcb_signals_channel(s, 1, NULL, &q, &v);
+  assert_true(v[0] == -1.0 && v[1] == 2.0);
+  write_wav(p, 1, 8, pcm16, NULL, 2);
+  assert_int_equal(rcb_signals_read_wav(s, p, 0, NULL, NULL, NULL), RCB_ERR_PARSE);
+  assert_non_null(strstr(rcb_signals_errmsg(s), "8 bits"));
+  rcb_signals_destroy(s);
+}
+
+static void test_units_table(void **state) {
+  rcb_quantity q;
+  double f;
+  (void)state;
+  assert_int_equal(rcb_unit_parse(" um ", &q, &f), 0);
+  assert_true(q == RCB_QTY_DISPLACEMENT && f == 1e-6);
+  assert_int_equal(rcb_unit_parse("mil", &q, &f), 0);
+  assert_true(fabs(f - 25.4e-6) < 1e-20);
+  assert_int_equal(rcb_unit_parse("m/s^2", &q, &f), 0);
+  assert_int_equal(q, RCB_QTY_ACCELERATION);
+  assert_int_equal(rcb_unit_parse("Mm", &q, &f), -1);
+  assert_string_equal(rcb_quantity_name(RCB_QTY_VELOCITY), "velocity");
+}
+
+/* ---- units of FRF files (UFF 164, record-9/10 labels) ---- */
+
+/* An FRF file: optional dataset 164 (length, force factors), one record of
+ * data type 8/11/12 over 13 with the given units labels, 1 + 2i at 10 Hz. */
+static const char *frf_uff(const char *u164, int s9, const char *lab9, const char *lab10) {
+  const char *p = rcb_test_tmp_path("units.uff");
+  FILE *fp = fopen(p, "w");
+  assert_non_null(fp);
+  if (u164) fputs(u164, fp);
+  fprintf(fp, "%6d\n%6d%74s\n", -1, 58, "");
+  fprintf(fp, "%-80s\n%-80s\n%-80s\n%-80s\n%-80s\n", "id1", "NONE", "NONE", "NONE", "NONE");
+  fprintf(fp, "%5d%10d%5d%10d %10s%10ld%4d %10s%10ld%4d\n", 4, 0, 0, 0, "NONE", 1L, 1, "NONE",
+          2L, 1);
+  fprintf(fp, "%10d%10ld%10d%13.5e%13.5e%13.5e\n", 6, 1L, 1, 10.0, 1.0, 0.0);
+  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", 18, 0, 0, 0, "Frequency", "Hz");
+  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", s9, 0, 0, 0, "Response", lab9);
+  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", 13, 0, 0, 0, "Force", lab10);
+  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", 0, 0, 0, 0, "NONE", "NONE");
+  fputs("   1.00000000000e+00   2.00000000000e+00\n", fp);
+  fprintf(fp, "%6d\n", -1);
+  fclose(fp);
+  return p;
+}
+
+static const char U164_MM[] =
+    "    -1\n   164\n         5mm (milli newton)         2\n"
+    "  1.00000000000000000D+03  1.00000000000000000D+00  1.00000000000000000D+00\n"
+    "  2.73150000000000000D+02\n    -1\n";
+
+static void read_frf_value(const char *p, rcb_frf_kind kind, double factor) {
+  rcb_meas *ms;
+  rcb_meas_channel_info c;
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  if (rcb_meas_read_uff(ms, p, 0, NULL)) fail_msg("%s", rcb_meas_errmsg(ms));
+  assert_int_equal(rcb_meas_channel(ms, 0, &c), RCB_OK);
+  assert_int_equal(c.kind, kind);
+  assert_true(fabs(creal(c.data[0]) - factor) < 1e-15 * factor &&
+              fabs(cimag(c.data[0]) - 2.0 * factor) < 2e-15 * factor);
+  rcb_meas_destroy(ms);
+}
+
+static void refused(const char *p, const char *frag) {
+  rcb_meas *ms;
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  assert_int_equal(rcb_meas_read_uff(ms, p, 0, NULL), RCB_ERR_PARSE);
+  if (!strstr(rcb_meas_errmsg(ms), frag))
+    fail_msg("message '%s' lacks '%s'", rcb_meas_errmsg(ms), frag);
+  assert_int_equal(rcb_meas_channel_count(ms), 0);
+  rcb_meas_destroy(ms);
+}
+
+static void test_frf_units(void **state) {
+  (void)state;
+  /* mm/N through dataset 164 (length factor 1000, force 1): 1e-3 m/N */
+  read_frf_value(frf_uff(U164_MM, 8, "NONE", "NONE"), RCB_RECEPTANCE, 1e-3);
+  read_frf_value(frf_uff(U164_MM, 8, "mm", "N"), RCB_RECEPTANCE, 1e-3);
+  /* g/N by the labels: 9.80665 (m/s^2)/N */
+  read_frf_value(frf_uff(NULL, 12, "g", "N"), RCB_INERTANCE, 9.80665);
+  read_frf_value(frf_uff(NULL, 11, "mm/s", "kN"), RCB_MOBILITY, 1e-6);
+  /* SI labels as librcb writes them */
+  read_frf_value(frf_uff(NULL, 8, "m", "N"), RCB_RECEPTANCE, 1.0);
+  /* refusals: wrong quantity, 164 disagreeing, unknown label */
+  refused(frf_uff(NULL, 12, "mm", "N"), "is a displacement, but its data type 12 says "
+                                        "acceleration");
+  refused(frf_uff(NULL, 8, "m", "g"), "is an acceleration, but its data type 13 says force");
+  refused(frf_uff(U164_MM, 8, "m", "N"), "disagrees with dataset 164");
+  refused(frf_uff(NULL, 8, "furlong", "N"), "'furlong' is not a unit");
+  refused(frf_uff("    -1\n   164\n        42\n    -1\n", 8, "m", "N"), "dataset 164");
+}
+
+/* ---- order tracking ---- */
+
+/* Keyphasor with a linear rising edge of +-7.2 deg about each mark (5 V). */
+static double keyphasor(double phi) {
+  double w = fmod(phi, 2 * PI), d = 2 * PI * 0.02;
+  if (w > PI) w -= 2 * PI;
+  if (w >= -d && w <= d) return 2.5 + 2.5 * w / d;
+  return w > d && w < PI / 4 ? 5.0 : 0.0;
+}
+
+/* A run-up 1000 -> 3000 rpm in 4 s with y = 2 cos(phi + 0.3) + 0.5 cos(2 phi - 1)
+ * (+ noise): every bin's 1X and 2X equal 2 e^{0.3i} and 0.5 e^{-i} (to the
+ * within-revolution speed change), and with noise the sd predicts the error. */
+static void test_order_runup(void **state) {
+  enum { N = 4 * 20000 };
+  const double fs = 20000.0, w0 = 1000 * PI / 30, al = 500 * PI / 30;
+  double *kp = malloc(N * sizeof *kp), *y = malloc(N * sizeof *y), *yn = malloc(N * sizeof *yn);
+  const double *ch[2];
+  rcb_order_opts o;
+  rcb_order *e;
+  size_t bytes, b, reported = 0, within = 0, n;
+  void *work;
+  rng r = {5};
+  (void)state;
+  for (n = 0; n < N; n++) {
+    double t = (double)n / fs, phi = w0 * t + 0.5 * al * t * t;
+    kp[n] = keyphasor(phi);
+    y[n] = 2 * cos(phi + 0.3) + 0.5 * cos(2 * phi - 1.0);
+    yn[n] = y[n] + 0.2 * gauss(&r);
+  }
+  memset(&o, 0, sizeof o);
+  o.norders = 2;
+  o.trigger = NAN;
+  o.bin_width = 100 * PI / 30;
+  o.speed_max = 4000 * PI / 30;
+  assert_int_equal(rcb_order_workspace_size(&o, 2, &bytes), RCB_OK);
+  work = malloc(bytes);
+  assert_int_equal(rcb_order_init(&e, &o, 2, work, bytes - 1), RCB_ERR_WORKSPACE);
+  assert_int_equal(rcb_order_init(&e, &o, 2, work, bytes), RCB_OK);
+  ch[0] = y;
+  ch[1] = yn;
+  assert_int_equal(rcb_order_add(e, fs, N, kp, ch), RCB_OK);
+  /* phi(4 s) / 2 pi = (1000/60) 4 + (500/60) 8 = 133.3: 133 pulses (the mark
+   * at t = 0 is no crossing), 132 revolutions, the first without a pulse
+   * before it */
+  assert_int_equal(rcb_order_revolutions(e), 131);
+  for (b = 0; b < rcb_order_bin_count(e); b++) {
+    double speed, sd, sd2;
+    rcb_complex q1, q2, qn;
+    size_t nr;
+    assert_int_equal(rcb_order_result(e, b, 0, 1, &speed, &q1, NULL, &nr), RCB_OK);
+    if (nr < 2) continue;
+    reported++;
+    assert_true(speed >= (double)b * o.bin_width && speed < (double)(b + 1) * o.bin_width);
+    rcb_order_result(e, b, 0, 2, NULL, &q2, &sd2, NULL);
+    if (cabs(q1 - 2 * cexp(CMPLX(0, 0.3))) > 1e-4 * 2 || cabs(q2 - 0.5 * cexp(CMPLX(0, -1.0))) > 1e-4 * 0.5)
+      fail_msg("bin %zu: 1X error %g, 2X error %g", b, cabs(q1 - 2 * cexp(CMPLX(0, 0.3))) / 2, cabs(q2 - 0.5 * cexp(CMPLX(0, -1.0))) / 0.5);
+    rcb_order_result(e, b, 1, 1, NULL, &qn, &sd, NULL);
+    within += cabs(qn - 2 * cexp(CMPLX(0, 0.3))) <= 2.4477 * sd;
+  }
+  assert_int_equal(reported, 20); /* 1000 .. 2999 rpm in 100 rpm bins */
+  printf("order tracking, noise 0.2: 1X inside its 95 %% band in %zu of %zu bins\n", within,
+         reported);
+  assert_true(within >= 16);
+  /* no keyphasor pulse: refused */
+  memset(kp, 0, N * sizeof *kp);
+  assert_int_equal(rcb_order_add(e, fs, N, kp, ch), RCB_ERR_ARG);
+  assert_non_null(strstr(rcb_order_errmsg(e), "keyphasor"));
+  free(work);
+  free(kp);
+  free(y);
+  free(yn);
+}
+
+/* ---- UFF58 time records ---- */
+
+/* One real, evenly spaced time record (4E20.12): node, direction, ordinate
+ * data type and units label, 4 samples from t = 0 every 1 ms. */
+static void time_rec(FILE *fp, long node, int dir, int s9, const char *lab, const double *v) {
+  fprintf(fp, "%6d\n%6d%74s\n", -1, 58, "");
+  fprintf(fp, "%-80s\n%-80s\n%-80s\n%-80s\n%-80s\n", "time", "NONE", "NONE", "NONE", "NONE");
+  fprintf(fp, "%5d%10d%5d%10d %10s%10ld%4d %10s%10ld%4d\n", 1, 0, 0, 0, "NONE", node, dir,
+          "NONE", 0L, 0);
+  fprintf(fp, "%10d%10ld%10d%13.5e%13.5e%13.5e\n", 4, 4L, 1, 0.0, 1e-3, 0.0);
+  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", 17, 0, 0, 0, "Time", "s");
+  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", s9, 0, 0, 0, "Signal", lab);
+  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", 0, 0, 0, 0, "NONE", "NONE");
+  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", 0, 0, 0, 0, "NONE", "NONE");
+  fprintf(fp, "%20.11e%20.11e%20.11e%20.11e\n", v[0], v[1], v[2], v[3]);
+  fprintf(fp, "%6d\n", -1);
+}
+
+static void test_uff_time_records(void **state) {
+  const char *p = rcb_test_tmp_path("time.uff");
+  const double v[4] = {1.0, -2.0, 0.5, 4.0};
+  rcb_uff_node map[] = {{1, "DA"}, {99, "KP"}};
+  rcb_signals *s;
+  const char *name;
+  const double *x;
+  rcb_quantity q;
+  FILE *fp = fopen(p, "w");
+  (void)state;
+  assert_non_null(fp);
+  time_rec(fp, 1, 1, 8, "mm", v);     /* DA.x in mm */
+  time_rec(fp, 1, -2, 12, "g", v);    /* DA.y in g, negative direction */
+  time_rec(fp, 99, 0, 0, "V", v);     /* keyphasor */
+  fclose(fp);
+  assert_int_equal(rcb_signals_create(&s, NULL), RCB_OK);
+  if (rcb_signals_read_uff(s, p, 2, map)) fail_msg("%s", rcb_signals_errmsg(s));
+  assert_int_equal(rcb_signals_channel_count(s), 3);
+  assert_true(fabs(rcb_signals_rate(s) - 1000.0) < 1e-6 && rcb_signals_length(s) == 4);
+  rcb_signals_channel(s, 0, &name, &q, &x);
+  assert_string_equal(name, "DA.x");
+  assert_true(q == RCB_QTY_DISPLACEMENT && fabs(x[1] + 2e-3) < 1e-15);
+  rcb_signals_channel(s, 1, &name, &q, &x);
+  assert_string_equal(name, "DA.y");
+  assert_true(q == RCB_QTY_ACCELERATION && fabs(x[3] + 4 * 9.80665) < 1e-12);
+  rcb_signals_channel(s, 2, &name, &q, &x);
+  assert_string_equal(name, "KP");
+  assert_true(q == RCB_QTY_VOLTAGE && x[3] == 4.0);
+  /* an FRF file has no time record; a label contradicting its data type */
+  assert_int_equal(rcb_signals_read_uff(s, frf_uff(NULL, 8, "m", "N"), 0, NULL), RCB_ERR_PARSE);
+  assert_non_null(strstr(rcb_signals_errmsg(s), "no dataset 58 time record"));
+  fp = fopen(p, "w");
+  time_rec(fp, 1, 1, 8, "g", v);
+  fclose(fp);
+  assert_int_equal(rcb_signals_read_uff(s, p, 2, map), RCB_ERR_PARSE);
+  assert_non_null(strstr(rcb_signals_errmsg(s), "is an acceleration, but its data type 8"));
+  assert_int_equal(rcb_signals_channel_count(s), 0);
+  rcb_signals_destroy(s);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_white_noise_level),
+      cmocka_unit_test(test_sdof_resonator),
+      cmocka_unit_test(test_known_coherence_and_biases),
+      cmocka_unit_test(test_input_noise),
+      cmocka_unit_test(test_two_inputs),
+      cmocka_unit_test(test_workspace),
+      cmocka_unit_test(test_csv_units),
+      cmocka_unit_test(test_wav),
+      cmocka_unit_test(test_units_table),
+      cmocka_unit_test(test_frf_units),
+      cmocka_unit_test(test_order_runup),
+      cmocka_unit_test(test_uff_time_records),
+  };
+  return cmocka_run_group_tests(tests, rcb_test_setup_tmpdir, rcb_test_teardown_tmpdir);
+}

@@ -1,0 +1,97 @@
+/* Reading a signal file by its extension (rcbtool estimate and order): CSV,
+ * UFF dataset 58 time records (with --map), WAV (with --wav-names, --wav-units
+ * and --wav-scale: WAV carries no names nor units). */
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+
+static int ext_is(const char *path, const char *const *ext, size_t n) {
+  const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
+  size_t i;
+  if (!dot || (slash && dot < slash)) return 0;
+  for (i = 0; i < n; i++)
+    if (strcmp(dot, ext[i]) == 0) return 1;
+  return 0;
+}
+
+/* Split option @p opt's comma list into *items (count *n); *buf owns the text. */
+static int list(const cli_args *a, const char *opt, char **buf, char ***items, size_t *n) {
+  const char *v = cli_opt_value(a, opt), *q;
+  char *p;
+  size_t k = 1;
+  *buf = NULL;
+  *items = NULL;
+  *n = 0;
+  if (!v) return 0;
+  for (q = v; *q; q++) k += *q == ',';
+  *buf = malloc(strlen(v) + 1);
+  *items = malloc(k * sizeof **items);
+  if (!*buf || !*items) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  strcpy(*buf, v);
+  for (p = *buf; p; (*n)++) {
+    char *c = strchr(p, ',');
+    if (c) *c = '\0';
+    (*items)[*n] = p;
+    p = c ? c + 1 : NULL;
+  }
+  return 0;
+}
+
+static int read_wav(const cli_args *a, rcb_signals *s) {
+  char *b[3] = {NULL, NULL, NULL}, **it[3] = {NULL, NULL, NULL};
+  static const char *const opt[3] = {"--wav-names", "--wav-units", "--wav-scale"};
+  size_t n[3] = {0, 0, 0}, k;
+  double *scale = NULL;
+  int rc = 0;
+  rcb_status st;
+  for (k = 0; k < 3 && !rc; k++) rc = list(a, opt[k], &b[k], &it[k], &n[k]);
+  if (!rc && (n[0] == 0 || n[1] != n[0] || (n[2] && n[2] != n[0])))
+    rc = cli_usage(a->cmd, "a WAV file needs --wav-names and --wav-units with one item per "
+                   "channel (and optionally --wav-scale, the full scale in that unit)");
+  if (!rc && !(scale = malloc(n[0] * sizeof *scale))) rc = cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  for (k = 0; !rc && k < n[0]; k++) {
+    char *end;
+    scale[k] = n[2] ? strtod(it[2][k], &end) : 1.0;
+    if (n[2] && (end == it[2][k] || *end))
+      rc = cli_usage(a->cmd, "--wav-scale item '%s' is not a number", it[2][k]);
+  }
+  if (!rc) {
+    st = rcb_signals_read_wav(s, a->model, n[0], (const char *const *)it[0],
+                              (const char *const *)it[1], scale);
+    if (st) rc = cli_fail(st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC : CLI_EXIT_INPUT, "%s",
+                          cli_msg(rcb_signals_errmsg(s), st));
+  }
+  for (k = 0; k < 3; k++) {
+    free(b[k]);
+    free(it[k]);
+  }
+  free(scale);
+  return rc;
+}
+
+int cli_signals_read(const cli_args *a, rcb_signals *s) {
+  static const char *const csv[] = {".csv", ".CSV"}, *const uff[] = {".uff", ".unv", ".uf", ".UFF", ".UNV"};
+  static const char *const wav[] = {".wav", ".WAV"};
+  rcb_status st;
+  cli_uff_map mp;
+  int rc;
+  if (ext_is(a->model, wav, 2)) return read_wav(a, s);
+  if (ext_is(a->model, csv, 2)) {
+    st = rcb_signals_read_csv(s, a->model);
+  } else if (ext_is(a->model, uff, 5)) {
+    if ((rc = cli_uff_map_parse(a, "--map", NULL, &mp))) {
+      cli_uff_map_free(&mp);
+      return rc;
+    }
+    st = rcb_signals_read_uff(s, a->model, mp.n, mp.nodes);
+    cli_uff_map_free(&mp);
+  } else {
+    return cli_usage(a->cmd, "'%s': unknown signal file type; expected .csv, .uff/.unv (UFF58 "
+                     "time records) or .wav", a->model);
+  }
+  if (st)
+    return cli_fail(st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC : CLI_EXIT_INPUT, "%s",
+                    cli_msg(rcb_signals_errmsg(s), st));
+  return 0;
+}

@@ -1,0 +1,413 @@
+/* rcbtool estimate: sampled signals (CSV or WAV) -> FRFs by Welch averaging,
+ * with coherence and per-line standard deviations (UFF58 or CSV). */
+#include <complex.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+
+const char cli_help_estimate[] =
+    "usage: rcbtool estimate SIGNALS --input CH --outputs CH,... -o OUT [options]\n"
+    "\n"
+    "Estimates FRFs from sampled signals by Welch averaging: segments of --nseg\n"
+    "samples, windowed, overlapping, averaged; H1 (default), H2 or Hv; coherence\n"
+    "and the standard deviation of each line from the coherence and the number of\n"
+    "averages (Bendat & Piersol). OUT (.uff/.unv: UFF dataset 58; .csv) holds the\n"
+    "FRFs as a measurement that compare, fit and diagnose read.\n"
+    "  SIGNALS        .csv: optional '# units = U1,U2,...', header 'time_s,CH1,CH2\n"
+    "                 [unit],...', rows of numbers (evenly spaced time, s);\n"
+    "                 .uff/.unv: UFF58 time records (function type 1, abscissa 17;\n"
+    "                 units from the record-9 label or dataset 164; --map)\n"
+    "                 .wav: PCM 16/24/32-bit or float; give --wav-names NAME,...,\n"
+    "                 --wav-units U,... and --wav-scale S,... (full scale in that unit)\n"
+    "  --input CH     force channel (unit N, kN or lbf); several: CH1,CH2 (H1 only)\n"
+    "  --outputs LIST response channels: displacement (m, mm, um, mil), velocity\n"
+    "                 (m/s, mm/s, in/s) or acceleration (m/s^2, g)\n"
+    "                 Items NAME (a model channel STATION.DIR) or NAME=STATION.DIR\n"
+    "                 (file channel NAME is model channel STATION.DIR: a driving\n"
+    "                 point has force 'f=DA.x' and response 'DA.x')\n"
+    "  --kind K       write receptance, mobility or inertance (default: what the\n"
+    "                 first output measures; the others are converted to it)\n"
+    "  --nseg N       samples per segment (default 4096)\n"
+    "  --overlap F    overlap fraction of a segment, 0 <= F < 1 (default 0.5)\n"
+    "  --window W     hann (default), flattop, rect, force-exp (impact tests)\n"
+    "  --force-frac F force window length / segment (force-exp; default 0.1)\n"
+    "  --exp-end E    exponential window's last value (force-exp; default 0.01)\n"
+    "  --estimator E  h1 (default), h2 or hv (h2 and hv: one input)\n"
+    "  --no-detrend   keep each segment's mean (default: removed, as SciPy)\n"
+    "  --rpm R        rotor speed during the test, rpm (default 0)\n"
+    "  --fmax HZ      write lines up to HZ only (default: up to Nyquist)\n"
+    "  --stats FILE   CSV: freq_hz, then per FRF 'OUT/IN coh' and 'OUT/IN sd' (sd of\n"
+    "                 Re and of Im, in the written kind's unit)\n"
+    "  --spectra FILE CSV: freq_hz and the averaged density spectra G (unit^2/Hz,\n"
+    "                 SciPy's csd/welch scaling): 'G IN' per input, 'G IN/OUT re',\n"
+    "                 'G IN/OUT im' per pair, 'G OUT' per output\n"
+    "  --map LIST     UFF node map for SIGNALS and OUT, NODE=STATION,... (as convert)\n"
+    "  --binary       write binary 58b\n"
+    "Files are written atomically. Exit codes: 2 usage, 3 bad signals or units,\n"
+    "4 numerical failure, 5 output not written.\n";
+
+static const char *const window_names[] = {"hann", "flattop", "rect", "force-exp"};
+static const char *const est_names[] = {"h1", "h2", "hv"};
+static const char *const kind_names[] = {"receptance", "mobility", "inertance"};
+
+typedef struct est_job {
+  const cli_args *a;
+  rcb_signals *sig;
+  size_t p, q;
+  size_t *idx;  /* p + q channel indices into sig */
+  char *buf;    /* --input and --outputs text, split */
+  char **names; /* p + q: channel names in the file */
+  char **model; /* p + q: model channels "STATION.DIR" (NAME=STATION.DIR, else NAME) */
+  rcb_spectral_opts o;
+  rcb_spectral *e;
+  void *work;
+  rcb_estimator est;
+  int kind;
+  rcb_frf_kind meas_kind[64 + 256];
+} est_job;
+
+/* Split "A,B,C" into names (appended to j->names). */
+static int split_list(est_job *j, char *list, size_t *count) {
+  char *p = list;
+  *count = 0;
+  while (p) {
+    char *comma = strchr(p, ',');
+    if (comma) *comma = '\0';
+    char *eq = strchr(p, '=');
+    if (!*p || eq == p || (eq && !eq[1]))
+      return cli_usage(j->a->cmd, "empty channel name in a list (items NAME or NAME=STATION.DIR)");
+    if (eq) *eq = '\0';
+    j->model[j->p + j->q + *count] = eq ? eq + 1 : p;
+    j->names[j->p + j->q + (*count)++] = p;
+    p = comma ? comma + 1 : NULL;
+    if (j->p + j->q + *count >= 64 + 256 && p)
+      return cli_usage(j->a->cmd, "too many channels (at most 64 inputs, 256 outputs)");
+  }
+  return 0;
+}
+
+static int channels(est_job *j) {
+  const char *in = cli_opt_value(j->a, "--input"), *out = cli_opt_value(j->a, "--outputs");
+  size_t n, i, total;
+  int rc;
+  j->buf = malloc(strlen(in) + strlen(out) + 2);
+  j->names = calloc(64 + 256, sizeof *j->names);
+  j->model = calloc(64 + 256, sizeof *j->model);
+  j->idx = calloc(64 + 256, sizeof *j->idx);
+  if (!j->buf || !j->names || !j->model || !j->idx) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  strcpy(j->buf, in);
+  strcpy(j->buf + strlen(in) + 1, out);
+  if ((rc = split_list(j, j->buf, &n))) return rc;
+  if (n > 64) return cli_usage(j->a->cmd, "--input: at most 64 inputs");
+  j->p = n;
+  if ((rc = split_list(j, j->buf + strlen(in) + 1, &n))) return rc;
+  if (n > 256) return cli_usage(j->a->cmd, "--outputs: at most 256 outputs");
+  j->q = n;
+  total = j->p + j->q;
+  for (i = 0; i < total; i++) {
+    rcb_quantity q;
+    if (rcb_signals_find(j->sig, j->names[i], &j->idx[i]))
+      return cli_fail(CLI_EXIT_INPUT, "%s: no channel '%s' in the file", j->a->model,
+                      j->names[i]);
+    rcb_signals_channel(j->sig, j->idx[i], NULL, &q, NULL);
+    if (i < j->p && q != RCB_QTY_FORCE)
+      return cli_fail(CLI_EXIT_INPUT, "%s: input channel '%s' is %s; expected a force (N, kN or "
+                      "lbf): give its unit in the file ('%s [N]' or '# units = ...')",
+                      j->a->model, j->names[i], rcb_quantity_name(q), j->names[i]);
+    if (i >= j->p && (q < RCB_QTY_DISPLACEMENT || q > RCB_QTY_ACCELERATION))
+      return cli_fail(CLI_EXIT_INPUT, "%s: output channel '%s' is %s; expected a displacement, "
+                      "velocity or acceleration (m, mm, um, m/s, m/s^2, g, ...): give its unit "
+                      "in the file", j->a->model, j->names[i], rcb_quantity_name(q));
+    if (i >= j->p) j->meas_kind[i - j->p] = (rcb_frf_kind)(q - RCB_QTY_DISPLACEMENT);
+  }
+  return 0;
+}
+
+static int options(est_job *j) {
+  const cli_args *a = j->a;
+  double overlap = 0.5, ff = 0.1, ee = 0.01;
+  int w = 0, e = 0, rc;
+  size_t nseg = 4096;
+  if ((rc = cli_opt_require(a, "--input", "the force channel, e.g. --input C.B.y")) ||
+      (rc = cli_opt_require(a, "--outputs", "the response channels, e.g. --outputs DA.x,DA.y")) ||
+      (rc = cli_opt_count(a, "--nseg", 4096, &nseg)) ||
+      (rc = cli_opt_nonneg(a, "--overlap", "", 0.5, &overlap)) ||
+      (rc = cli_opt_choice(a, "--window", window_names, 4, 0, &w)) ||
+      (rc = cli_opt_choice(a, "--estimator", est_names, 3, 0, &e)) ||
+      (rc = cli_opt_choice(a, "--kind", kind_names, 3, -1, &j->kind)) ||
+      (rc = cli_opt_nonneg(a, "--force-frac", "", 0.1, &ff)) ||
+      (rc = cli_opt_nonneg(a, "--exp-end", "", 0.01, &ee)))
+    return rc;
+  if (overlap >= 1.0) return cli_usage(a->cmd, "--overlap %g: expected 0 <= F < 1", overlap);
+  if (nseg < 8) return cli_usage(a->cmd, "--nseg %zu: expected at least 8", nseg);
+  if (ff <= 0.0 || ff > 1.0 || ee <= 0.0 || ee >= 1.0)
+    return cli_usage(a->cmd, "--force-frac in (0, 1] and --exp-end in (0, 1) expected");
+  memset(&j->o, 0, sizeof j->o);
+  j->o.nseg = nseg;
+  j->o.noverlap = (size_t)floor(overlap * (double)nseg);
+  j->o.window = (rcb_window)w;
+  j->o.force_frac = ff;
+  j->o.exp_end = ee;
+  j->o.no_detrend = cli_opt_value(a, "--no-detrend") != NULL;
+  j->est = (rcb_estimator)e;
+  return 0;
+}
+
+/* Feed the segments (progress on long files). */
+static int average(est_job *j) {
+  size_t n = rcb_signals_length(j->sig), step = j->o.nseg - j->o.noverlap, start, c, nseg;
+  const double **seg = calloc(j->p + j->q, sizeof *seg);
+  cli_progress pr;
+  size_t bytes = 0, done = 0;
+  rcb_status st;
+  if (!seg) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  j->o.ninputs = j->p;
+  j->o.noutputs = j->q;
+  j->o.rate = rcb_signals_rate(j->sig);
+  if (n < j->o.nseg) {
+    free(seg);
+    return cli_fail(CLI_EXIT_INPUT, "%s: %zu samples, fewer than one segment (--nseg %zu)",
+                    j->a->model, n, j->o.nseg);
+  }
+  st = rcb_spectral_workspace_size(&j->o, &bytes);
+  if (st) {
+    free(seg);
+    if (st == RCB_ERR_UNSUPPORTED)
+      return cli_fail(CLI_EXIT_NUMERIC, "estimate: librcb was built without an FFT backend "
+                      "(RCB_WITH_FFTW or RCB_WITH_KISSFFT)");
+    return cli_fail(cli_status_exit(st), "estimate: %s", rcb_status_str(st));
+  }
+  j->work = malloc(bytes);
+  if (!j->work || rcb_spectral_init(&j->e, &j->o, j->work, bytes)) {
+    free(seg);
+    return cli_fail(CLI_EXIT_NUMERIC, "estimate: cannot set up the estimator (%zu bytes)", bytes);
+  }
+  nseg = (n - j->o.noverlap) / step;
+  cli_progress_start(&pr, j->a, "estimate", "segments", nseg);
+  for (start = 0; start + j->o.nseg <= n; start += step) {
+    for (c = 0; c < j->p + j->q; c++) {
+      const double *v;
+      rcb_signals_channel(j->sig, j->idx[c], NULL, NULL, &v);
+      seg[c] = v + start;
+    }
+    if ((st = rcb_spectral_add_segment(j->e, seg))) break;
+    cli_progress_step(&pr, ++done);
+  }
+  cli_progress_end(&pr);
+  free(seg);
+  if (st) return cli_fail(cli_status_exit(st), "%s", cli_msg(rcb_spectral_errmsg(j->e), st));
+  return 0;
+}
+
+/* Lines written: 1 (DC has no FRF after detrending) up to --fmax. */
+static int line_range(est_job *j, size_t *k1) {
+  double fmax = 0.0, df = rcb_signals_rate(j->sig) / (double)j->o.nseg;
+  size_t nb = rcb_spectral_bin_count(j->e);
+  int rc;
+  if ((rc = cli_opt_nonneg(j->a, "--fmax", "Hz", 0.0, &fmax))) return rc;
+  *k1 = nb;
+  if (fmax > 0.0) *k1 = (size_t)floor(fmax / df) + 1;
+  if (*k1 > nb) *k1 = nb;
+  if (*k1 < 2) return cli_usage(j->a->cmd, "--fmax %g Hz is below the first line (%g Hz)", fmax, df);
+  return 0;
+}
+
+/* h (and sd) of output o from the measured kind to the written one: (i w)^d. */
+static void to_kind(rcb_complex *h, double *sd, const double *w, size_t n, int d) {
+  size_t k;
+  for (k = 0; k < n; k++) {
+    rcb_complex f = 1.0;
+    int i;
+    for (i = 0; i < (d > 0 ? d : -d); i++) f *= w[k] * (rcb_complex)_Complex_I;
+    if (d < 0) f = 1.0 / f;
+    h[k] *= f;
+    sd[k] *= cabs(f);
+  }
+}
+
+typedef struct est_out {
+  size_t n;       /* lines written (1 .. k1 - 1) */
+  double *w;      /* nb */
+  rcb_complex *h; /* pairs * nb */
+  double *coh, *sd;
+} est_out;
+
+static int compute(est_job *j, est_out *r, size_t k1) {
+  size_t nb = rcb_spectral_bin_count(j->e), o, i, np = j->p * j->q;
+  int kind = j->kind >= 0 ? j->kind : (int)j->meas_kind[0];
+  r->n = k1 - 1;
+  r->w = malloc(nb * sizeof *r->w);
+  r->h = malloc(np * nb * sizeof *r->h);
+  r->coh = malloc(np * nb * sizeof *r->coh);
+  r->sd = malloc(np * nb * sizeof *r->sd);
+  if (!r->w || !r->h || !r->coh || !r->sd) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  rcb_spectral_frequencies(j->e, r->w);
+  j->kind = kind;
+  for (o = 0; o < j->q; o++)
+    for (i = 0; i < j->p; i++) {
+      size_t at = (o * j->p + i) * nb;
+      rcb_status st = rcb_spectral_frf(j->e, j->est, o, i, r->h + at, r->coh + at, r->sd + at);
+      if (st) return cli_fail(cli_status_exit(st), "%s", cli_msg(rcb_spectral_errmsg(j->e), st));
+      to_kind(r->h + at, r->sd + at, r->w, nb, kind - (int)j->meas_kind[o]);
+    }
+  return 0;
+}
+
+static int write_meas(est_job *j, const est_out *r) {
+  size_t nb = rcb_spectral_bin_count(j->e), o, i;
+  double rpm = 0.0;
+  rcb_meas *ms = NULL;
+  rcb_status st;
+  cli_uff_map mp;
+  int rc, is_uff = 0;
+  if ((rc = cli_opt_double(j->a, "--rpm", "rpm", 0.0, &rpm)) ||
+      (rc = cli_meas_format(j->a->cmd, j->a->output, &is_uff)))
+    return rc;
+  if (rcb_meas_create(&ms, NULL)) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  st = rcb_meas_set_grid(ms, RCB_MEAS_FRF, r->n, r->w + 1, fabs(rpm) * CLI_RPM_TO_RAD_S);
+  for (o = 0; !st && o < j->q; o++)
+    for (i = 0; !st && i < j->p; i++)
+      st = rcb_meas_add_channel(ms, j->model[j->p + o], j->model[i], (rcb_frf_kind)j->kind,
+                                r->h + (o * j->p + i) * nb + 1);
+  if (st) {
+    rc = cli_fail(CLI_EXIT_INPUT, "estimate: %s", cli_msg(rcb_meas_errmsg(ms), st));
+    rcb_meas_destroy(ms);
+    return rc;
+  }
+  if ((rc = cli_uff_map_parse(j->a, "--map", NULL, &mp)) == 0)
+    rc = cli_meas_write(j->a->cmd, ms, j->a->output, cli_opt_value(j->a, "--binary") != NULL,
+                        &mp);
+  cli_uff_map_free(&mp);
+  rcb_meas_destroy(ms);
+  return rc;
+}
+
+/* Open a side file (--stats, --spectra) atomically through cli_out. */
+static int side_open(const est_job *j, const char *path, cli_out *out) {
+  cli_args b = *j->a;
+  b.output = path;
+  return cli_out_open(out, &b);
+}
+
+static int write_stats(est_job *j, const est_out *r, const char *path) {
+  size_t nb = rcb_spectral_bin_count(j->e), k, c, np = j->p * j->q;
+  cli_out out;
+  int rc;
+  if ((rc = side_open(j, path, &out))) return rc;
+  fprintf(out.fp, "# estimator = %s, averages = %zu, nseg = %zu, overlap = %zu, window = %s, "
+          "kind = %s\nfreq_hz", est_names[j->est], rcb_spectral_averages(j->e), j->o.nseg,
+          j->o.noverlap, window_names[j->o.window], kind_names[j->kind]);
+  for (c = 0; c < np; c++)
+    fprintf(out.fp, ",%s/%s coh,%s/%s sd", j->model[j->p + c / j->p], j->model[c % j->p],
+            j->model[j->p + c / j->p], j->model[c % j->p]);
+  fputc('\n', out.fp);
+  for (k = 1; k <= r->n; k++) {
+    cli_csv_num(out.fp, r->w[k] / CLI_HZ_TO_RAD_S);
+    for (c = 0; c < np; c++) {
+      fputc(',', out.fp);
+      cli_csv_num(out.fp, r->coh[c * nb + k]);
+      fputc(',', out.fp);
+      cli_csv_num(out.fp, r->sd[c * nb + k]);
+    }
+    fputc('\n', out.fp);
+  }
+  return cli_out_close(&out);
+}
+
+static int write_spectra(est_job *j, const est_out *r, const char *path) {
+  size_t nb = rcb_spectral_bin_count(j->e), k, a, b, nc = j->p + j->q;
+  rcb_complex *g = malloc(nc * nc * nb * sizeof *g);
+  cli_out out;
+  int rc;
+  if (!g) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  for (a = 0; a < nc; a++)
+    for (b = 0; b < nc; b++)
+      if (a < j->p || a == b) rcb_spectral_cross(j->e, a, b, g + (a * nc + b) * nb);
+  if ((rc = side_open(j, path, &out))) {
+    free(g);
+    return rc;
+  }
+  fputs("freq_hz", out.fp);
+  for (a = 0; a < nc; a++) fprintf(out.fp, ",G %s", j->names[a]);
+  for (a = 0; a < j->p; a++)
+    for (b = a + 1; b < nc; b++)
+      fprintf(out.fp, ",G %s/%s re,G %s/%s im", j->names[a], j->names[b], j->names[a],
+              j->names[b]);
+  fputc('\n', out.fp);
+  for (k = 0; k < nb; k++) {
+    cli_csv_num(out.fp, r->w[k] / CLI_HZ_TO_RAD_S);
+    for (a = 0; a < nc; a++) {
+      fputc(',', out.fp);
+      cli_csv_num(out.fp, creal(g[(a * nc + a) * nb + k]));
+    }
+    for (a = 0; a < j->p; a++)
+      for (b = a + 1; b < nc; b++) {
+        fputc(',', out.fp);
+        cli_csv_num(out.fp, creal(g[(a * nc + b) * nb + k]));
+        fputc(',', out.fp);
+        cli_csv_num(out.fp, cimag(g[(a * nc + b) * nb + k]));
+      }
+    fputc('\n', out.fp);
+  }
+  free(g);
+  return cli_out_close(&out);
+}
+
+static int estimate(const cli_args *a) {
+  est_job j;
+  est_out r;
+  size_t k1 = 0;
+  const char *stats = cli_opt_value(a, "--stats"), *spectra = cli_opt_value(a, "--spectra");
+  int rc;
+  memset(&j, 0, sizeof j);
+  memset(&r, 0, sizeof r);
+  j.a = a;
+  j.kind = -1;
+  if (!a->output)
+    return cli_usage(a->cmd, "missing -o OUT (.uff, .unv or .csv) for the estimated FRFs");
+  if ((rc = options(&j))) return rc;
+  if (rcb_signals_create(&j.sig, NULL)) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  rc = cli_signals_read(a, j.sig);
+  if (!rc) rc = channels(&j);
+  if (!rc && j.est != RCB_EST_H1 && j.p != 1)
+    rc = cli_usage(a->cmd, "--estimator %s takes one input (%zu given); use h1",
+                   est_names[j.est], j.p);
+  if (!rc) rc = average(&j);
+  if (!rc) rc = line_range(&j, &k1);
+  if (!rc) rc = compute(&j, &r, k1);
+  if (!rc && stats) rc = write_stats(&j, &r, stats);
+  if (!rc && spectra) rc = write_spectra(&j, &r, spectra);
+  if (!rc) rc = write_meas(&j, &r);
+  if (j.e) rcb_spectral_release(j.e);
+  free(j.work);
+  free(r.w);
+  free(r.h);
+  free(r.coh);
+  free(r.sd);
+  free(j.buf);
+  free(j.names);
+  free(j.model);
+  free(j.idx);
+  rcb_signals_destroy(j.sig);
+  return rc;
+}
+
+int cmd_estimate(int argc, char **argv) {
+  cli_opt opts[] = {{"--input", "CH", NULL},      {"--outputs", "LIST", NULL},
+                    {"--kind", "KIND", NULL},     {"--nseg", "N", NULL},
+                    {"--overlap", "F", NULL},     {"--window", "W", NULL},
+                    {"--force-frac", "F", NULL},  {"--exp-end", "E", NULL},
+                    {"--estimator", "E", NULL},   {"--no-detrend", NULL, NULL},
+                    {"--rpm", "R", NULL},         {"--fmax", "HZ", NULL},
+                    {"--stats", "FILE", NULL},    {"--spectra", "FILE", NULL},
+                    {"--map", "NODE=STATION,...", NULL}, {"--binary", NULL, NULL},
+                    {"--wav-names", "LIST", NULL}, {"--wav-units", "LIST", NULL},
+                    {"--wav-scale", "LIST", NULL}};
+  cli_args a;
+  int rc = cli_parse(argc, argv, opts, sizeof opts / sizeof opts[0], &a);
+  if (rc || a.help) return rc ? rc : cli_print_help(cli_help_estimate);
+  if (a.json) return cli_usage(a.cmd, "--json does not apply: the format follows OUT's extension");
+  return estimate(&a);
+}
