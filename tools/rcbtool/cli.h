@@ -25,6 +25,9 @@ enum {
 #define CLI_PI 3.14159265358979323846
 #define CLI_RPM_TO_RAD_S (CLI_PI / 30.0) /* rad/s per rpm */
 #define CLI_HZ_TO_RAD_S (2.0 * CLI_PI)   /* rad/s per Hz */
+/* A numeric macro as a string literal, for help texts (a default stated once). */
+#define CLI_STR_(x) #x
+#define CLI_STR(x) CLI_STR_(x)
 
 /** One command-specific option, e.g. {"--rpm", "R"}; metavar NULL = flag. */
 typedef struct cli_opt {
