@@ -173,6 +173,35 @@ def test_simulate_unbalance_read_by_pyuff(exe, tmp_path, binary):
     for s, c in zip(sets, ref["channels"]):
         assert s["func_type"] == 1 and s["ref_node"] == 0
         assert (s["rsp_node"], s["rsp_dir"]) == node_dir(c["output"])
-        np.testing.assert_allclose(s["x"] * 60.0, ref["rpm"], rtol=1e-12)  # Hz of rotation
+        assert s["abscissa_spec_data_type"] == 19  # rpm (issue #17)
+        np.testing.assert_allclose(s["x"], ref["rpm"], rtol=1e-12)
         want = np.array(c["re"]) + 1j * np.array(c["im"])
         assert np.all(np.abs(s["data"] - want) <= rtol * np.abs(want)), c["output"]
+
+
+def test_simulate_runup_speeds_exact(exe, tmp_path):
+    """A run-up grid in whole rpm (0..10000 by 50) is written in rpm (type 19):
+    pyuff reads the speeds exactly. In Hz the step 0.8333.. Hz does not fit the
+    E13.6 fields (the last speed came back as 10000.002 rpm)."""
+    uff = tmp_path / "r.uff"
+    run(exe, "simulate", MODEL, "--unbalance", "--out", "DA.x", "--rpm-min", 0,
+        "--rpm-max", 10000, "--points", 201, "--map", "1=DA", "-o", uff)
+    s = pyuff.UFF(str(uff)).read_sets()
+    s = s[0] if isinstance(s, list) else s
+    assert s["abscissa_spec_data_type"] == 19
+    np.testing.assert_allclose(s["x"], np.linspace(0.0, 10000.0, 201), rtol=1e-14, atol=0)
+
+
+def test_simulate_rotation_labels(exe, tmp_path):
+    """A rotation response over a moment is labelled rad over N m, a
+    translation over a force m over N (not "Acceleration m/s^2" for all)."""
+    uff = tmp_path / "l.uff"
+    run(exe, "simulate", MODEL, "--frf", "--out", "DA.rx,DA.x", "--in", "DB.ry",
+        "--fmin", 100, "--fmax", 200, "--points", 5, "--kind", "inertance",
+        "--map", "1=DA,10=DB", "-o", uff)
+    sets = pyuff.UFF(str(uff)).read_sets()
+    lab = {s["rsp_dir"]: s for s in sets}
+    assert lab[4]["ordinate_axis_units_lab"].strip() == "rad/s^2"
+    assert lab[1]["ordinate_axis_units_lab"].strip() == "m/s^2"
+    for s in sets:
+        assert s["orddenom_axis_units_lab"].strip() == "N m"
