@@ -537,6 +537,15 @@ static void test_bad_csv_files(void **state) {
       {"D.x/D.x re,D.x/D.x im\n1,2\n", "bad.csv:1:", "first column"},
       {"freq_hz,D.x/D.x re,D.x/D.x im\n1,2,inf\n", "bad.csv:2:", "not finite"},
       {"", "no header line", NULL},
+      /* issue #17: spellings that leave a unit open, node numbers as stations */
+      {"frequency,D.x/D.x re,D.x/D.x im\n1,2,3\n", "gives no unit", "rename it freq_hz"},
+      {"omega_rad_s,D.x/D.x re,D.x/D.x im\n1,2,3\n", "rad/s is not read", "freq_hz"},
+      {"speed,D.x re,D.x im\n1,2,3\n", "gives no unit", "rename it rpm"},
+      {"freq_hz,D.x/D.x mag,D.x/D.x phase\n1,2,3\n", "without the unit degrees",
+       "\"D.x/D.x phase_deg\""},
+      {"freq_hz,3.x/10.y re,3.x/10.y im\n1,2,3\n", "station '3' is a number",
+       "or to '#3' for model node 3"},
+      {"freq_hz,D.x/10.y re,D.x/10.y im\n1,2,3\n", "station '10' is a number", NULL},
   };
   size_t k;
   (void)state;

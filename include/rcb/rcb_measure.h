@@ -108,6 +108,10 @@ RCB_API rcb_status rcb_meas_write_uff(const rcb_meas *ms, const char *path, int 
  * "RESP/REF mag","RESP/REF phase_deg" (unbalance: "RESP re"/"RESP im" or
  * "RESP amp"/"RESP phase_deg"); optional "# key = value" lines before the
  * header: kind = receptance|mobility|inertance, rpm = rotor speed of an FRF test.
+ * Other spellings are read too (case, spaces, '_' and a unit in brackets do not
+ * matter: "Frequency (Hz)", "speed_rpm", "DA.x/C.y Real", "... Phase (deg)");
+ * a header that leaves the unit open or a numeric station ("3.x") is refused
+ * with the name to use.
  */
 RCB_API rcb_status rcb_meas_read_csv(rcb_meas *ms, const char *path);
 /** @brief Write CSV (re/im columns) that rcb_meas_read_csv reads back, atomically. */
