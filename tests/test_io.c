@@ -231,6 +231,56 @@ static void test_uff_read_hand_written(void **state) {
   assert_string_equal(c.reference, "#3.y");
   assert_int_equal(c.kind, RCB_RECEPTANCE);
   assert_true(c.data[2] == CMPLX(5.0, 6.5));
+  /* issue #17: node 3 has no map entry: one warning naming it (4 channel ends) */
+  assert_int_equal(rcb_meas_warning_count(ms), 1);
+  assert_non_null(strstr(rcb_meas_warning(ms, 0), "UFF node 3 is not in the node map"));
+  assert_non_null(strstr(rcb_meas_warning(ms, 0), "model node #3"));
+  assert_int_equal(rcb_meas_speed_given(ms), 1); /* z axis type 19 */
+  /* with node 3 mapped: no warning */
+  {
+    rcb_uff_node map2[] = {{10, "DA"}, {3, "DB"}};
+    assert_int_equal(rcb_meas_read_uff(ms, p, 2, map2), RCB_OK);
+    assert_int_equal(rcb_meas_warning_count(ms), 0);
+  }
+  rcb_meas_destroy(ms);
+}
+
+/* A UFF whose z axis is not of type 19 (the speed only in the ID text, as
+ * several acquisition systems write it): read as 0 rpm, but not silently
+ * (issue #17); rcb_meas_set_speed states it and drops the warning. */
+static void test_uff_speed_not_stated(void **state) {
+  const char *p = rcb_test_tmp_path("zaxis0.uff");
+  FILE *fp = fopen(p, "w");
+  rcb_meas *ms = NULL;
+  rcb_uff_node map[] = {{10, "DA"}, {3, "DB"}};
+  (void)state;
+  assert_non_null(fp);
+  rec58(fp, 4, 10, 1, 3, 1, 6, 3, 1, 10.0, 10.0, 0.0, 18, 8, 13, 0, V3);
+  fclose(fp);
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  if (rcb_meas_read_uff(ms, p, 2, map) != RCB_OK) fail_msg("%s", rcb_meas_errmsg(ms));
+  assert_true(rcb_meas_speed(ms) == 0.0);
+  assert_int_equal(rcb_meas_speed_given(ms), 0);
+  assert_int_equal(rcb_meas_warning_count(ms), 1);
+  assert_non_null(strstr(rcb_meas_warning(ms, 0), "z axis has data type 0, not 19"));
+  assert_non_null(strstr(rcb_meas_warning(ms, 0), "reads as 0 rpm"));
+  assert_int_equal(rcb_meas_set_speed(ms, -2.0), RCB_OK); /* synchronous */
+  assert_true(rcb_meas_speed(ms) < 0.0);
+  assert_int_equal(rcb_meas_set_speed(ms, 1000.0), RCB_OK);
+  assert_true(rcb_meas_speed(ms) == 1000.0);
+  assert_int_equal(rcb_meas_speed_given(ms), 1);
+  assert_int_equal(rcb_meas_warning_count(ms), 0);
+  assert_int_equal(rcb_meas_set_speed(ms, (double)NAN), RCB_ERR_ARG);
+  /* a CSV states it with '# rpm', or leaves it out */
+  write_text(p, "freq_hz,DA.x/DA.x re,DA.x/DA.x im\n10,1,2\n");
+  assert_int_equal(rcb_meas_read_csv(ms, p), RCB_OK);
+  assert_int_equal(rcb_meas_speed_given(ms), 0);
+  assert_int_equal(rcb_meas_warning_count(ms), 1);
+  assert_non_null(strstr(rcb_meas_warning(ms, 0), "no '# rpm = R' line"));
+  write_text(p, "# rpm = 0\nfreq_hz,DA.x/DA.x re,DA.x/DA.x im\n10,1,2\n");
+  assert_int_equal(rcb_meas_read_csv(ms, p), RCB_OK);
+  assert_int_equal(rcb_meas_speed_given(ms), 1);
+  assert_int_equal(rcb_meas_warning_count(ms), 0);
   rcb_meas_destroy(ms);
 }
 
@@ -755,6 +805,7 @@ int main(void) {
       cmocka_unit_test(test_noise_seeds),           cmocka_unit_test(test_noise_stream),
       cmocka_unit_test(test_bad_uff),               cmocka_unit_test(test_bad_uff_binary),
       cmocka_unit_test(test_csv_header_variants),
+      cmocka_unit_test(test_uff_speed_not_stated),
       cmocka_unit_test(test_bad_csv),               cmocka_unit_test(test_bad_api),
       cmocka_unit_test(test_write_atomic),          cmocka_unit_test(test_allocator),
       cmocka_unit_test(test_uff_binary_big_endian),

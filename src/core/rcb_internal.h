@@ -179,6 +179,8 @@ struct rcb_model {
                           bearing terms (1: as stated; [model] speed_factor) */
   size_t ndof;      /* independent DOFs */
   size_t bandwidth; /* max |row - col| of any nonzero (kl = ku) */
+  int has_test_speed; /* [test] rpm given (model/test_speed.c) */
+  double test_speed;  /* rad/s: rotor speed of the measurements to compare with */
 };
 
 /* model/warnings.c: rebuild m->warnings (called by finalize once the mesh

@@ -402,12 +402,20 @@ rcb_status rcb_meas_read_csv(rcb_meas *ms, const char *path) {
   S.path = path;
   S.kind = RCB_RECEPTANCE;
   rcb_meas_clear(ms);
+  rcb_meas_clear_warnings(ms);
   if ((st = rcb_meas_slurp(ms, path, &buf, &len))) return st;
   if (strlen(buf) != len)
     st = rcb_meas_fail(ms, RCB_ERR_PARSE, "%s: contains NUL bytes; expected a text CSV file",
                        path);
   if (!st) st = parse_lines(&S, buf);
   if (!st) st = build(&S);
+  if (!st) ms->speed_given = S.type == RCB_MEAS_FRF && S.have_rpm;
+  if (!st && S.type == RCB_MEAS_FRF && !S.have_rpm) {
+    st = rcb_meas_warn(ms, "%s: no '# rpm = R' line before the header: the file does not "
+                       "state the test speed, so it reads as 0 rpm; state it (the line, "
+                       "rcbtool --rpm R, the model's [test] rpm, rcb_meas_set_speed)", path);
+    ms->speed_warning = ms->n_warnings;
+  }
   if (st) rcb_meas_clear(ms);
   rcb_free(&ms->alloc, buf);
   rcb_free(&ms->alloc, S.cols);

@@ -190,8 +190,9 @@ typedef struct cli_uff_map {
   char **owned;  /**< station names added by cli_uff_automap */
   size_t nowned;
 } cli_uff_map;
-/** Parse option @p opt (absent: the model's [uff] map when @p m is given, else an
- * empty map); usage error (2) when malformed. */
+/** Parse option @p opt, added to the model's [uff] map when @p m is given (an
+ * option entry replaces the model's entry for the same node or station); usage
+ * error (2) when malformed. */
 int cli_uff_map_parse(const cli_args *a, const char *opt, const rcb_model *m,
                       cli_uff_map *mp);
 void cli_uff_map_free(cli_uff_map *mp);
