@@ -693,7 +693,12 @@ transient_csv)
   [ "$(wc -l <"$W/out")" -eq 4 ] || fail "expected a header and 3 samples" ;;
 transient_usage)
   usage transient "$MODEL" --out DA.x --rpm 3000; err_has "expected --t-end"
-  usage transient "$MODEL" --out DA.x --rpm 3000 --rpm-end 6000; err_has "expected --accel > 0" ;;
+  usage transient "$MODEL" --out DA.x --rpm 3000 --rpm-end 6000; err_has "expected --accel > 0"
+  # issue #17: a stated 0 is refused, not replaced by the default
+  usage transient "$MODEL" --out DA.x --rpm 3000 --t-end 0.01 --dt 0
+  err_has "option --dt expects a sampling interval > 0"
+  usage transient "$MODEL" --out DA.x --rpm 3000 --rpm-end 6000 --accel 100 --t-end 0
+  err_has "option --t-end expects a duration > 0" ;;
 timecheck_json)
   run timecheck "$MODEL" --out DA.x --rpm-min 3000 --rpm-max 3000 --points 1 --rtol 1e-6 \
     --steady-tol 1e-3 --json
