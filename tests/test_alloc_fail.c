@@ -338,6 +338,58 @@ static rcb_status sc_diag(const rcb_allocator *a, int check) {
   return st;
 }
 
+/* Modes at two speeds and a three-speed Campbell diagram (issue #17): every
+ * array and the dgeev workspace come from the hooks. */
+static rcb_status sc_modes(const rcb_allocator *a, int check) {
+  rcb_model *m = NULL;
+  rcb_modes *e = NULL;
+  rcb_mode md[4];
+  size_t n = 0;
+  const double speeds[3] = {0.0, 300.0, 600.0};
+  double wd[3 * 3];
+  rcb_status st = load(a, &m);
+  if (st) return st;
+  st = rcb_modes_create(&e, m, a);
+  if (st) assert_null(e);
+  if (!st) st = rcb_modes_compute(e, 300.0, 4, md, &n, NULL);
+  if (!st) st = rcb_campbell(e, 3, speeds, 3, wd, NULL, NULL);
+  if (st && e) assert_true(rcb_modes_errmsg(e)[0] != '\0');
+  if (!st && check) {
+    assert_true(n >= 3);
+    assert_true(wd[3] == md[0].wd); /* the Campbell column at 300 rad/s is that list */
+    assert_true(wd[0] > 0.0 && wd[0] < wd[1]);
+  }
+  rcb_modes_destroy(e);
+  rcb_model_destroy(m);
+  return st;
+}
+
+#if RCB_WITH_SUNDIALS
+/* A short run-up; CVODE's own vectors come from SUNDIALS' malloc (not
+ * walked), its out-of-memory flag maps to RCB_ERR_NOMEM. */
+static rcb_status sc_transient(const rcb_allocator *a, int check) {
+  rcb_model *m = NULL;
+  rcb_transient *t = NULL;
+  rcb_dof d;
+  rcb_speed_profile p = {100.0, 200.0, 1000.0};
+  rcb_transient_stats s;
+  rcb_status st = load(a, &m);
+  if (st) return st;
+  assert_int_equal(rcb_model_find_dof(m, "D.x", &d), RCB_OK);
+  st = rcb_transient_create(&t, m, 1, &d, a); /* on failure t (if any) holds the message */
+  if (!st) st = rcb_transient_run(t, &p, 0.02, 0.005, NULL, NULL, NULL, NULL);
+  if (st && t) assert_true(rcb_transient_errmsg(t)[0] != '\0');
+  if (!st && check) {
+    assert_int_equal(rcb_transient_get_stats(t, &s), RCB_OK);
+    assert_true(rcb_test_close(s.t_final, 0.02, 1e-12, 0.0));
+    assert_true(s.steps > 0);
+  }
+  rcb_transient_destroy(t);
+  rcb_model_destroy(m);
+  return st;
+}
+#endif
+
 /* ---- tests ---- */
 
 static void test_load(void **state) {
@@ -346,6 +398,22 @@ static void test_load(void **state) {
   n = walk("model load", sc_load);
   print_message("model load: %zu allocation sites walked\n", n);
   assert_true(n > 10);
+}
+
+static void test_modes(void **state) {
+  size_t n;
+  (void)state;
+  n = walk("modes + campbell", sc_modes);
+  print_message("modes + campbell: %zu allocation sites walked\n", n);
+}
+
+static void test_transient(void **state) {
+  (void)state;
+#if RCB_WITH_SUNDIALS
+  print_message("transient: %zu allocation sites walked\n", walk("transient", sc_transient));
+#else
+  skip();
+#endif
 }
 
 static void test_frf(void **state) {
@@ -425,6 +493,8 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_load),
       cmocka_unit_test(test_frf),
+      cmocka_unit_test(test_modes),
+      cmocka_unit_test(test_transient),
       cmocka_unit_test(test_csv),
       cmocka_unit_test(test_uff),
       cmocka_unit_test(test_fit_nlopt),

@@ -75,6 +75,14 @@ typedef struct ini_case {
 } ini_case;
 
 static const ini_case INI_CASES[] = {
+    /* ---- magnitudes that overflow (issue #17: these read as "singular ... free-free") ---- */
+    {"kxx = 1e7", "kxx = 1e308", RCB_ERR_MODEL, "<t>:16: [bearing B1]",
+     "kxx = 1e+308 N/m is beyond any machine"},
+    {"amount = 1e-4", "amount = 1e200", RCB_ERR_MODEL, "unbalance 'U': amount = 1e+200 kg m",
+     "beyond any machine"},
+    {"density = 7800", "density = 1e308", RCB_ERR_MODEL,
+     "<t>:3: [material steel]", "density = 1e+308 kg/m^3 is beyond any machine"},
+    {"kt = 1e5", "kt = 1e150", RCB_ERR_MODEL, "<t>:29: [coupling C]", "kt = 1e+150 N/m"},
     /* ---- sections and keys ---- */
     {"[station P]", "[gizmo P]", RCB_ERR_PARSE, "<t>:38:", "unknown section type [gizmo]"},
     {"[disk D]", "[disc D]", RCB_ERR_PARSE, "<t>:24:", "did you mean [disk]?"},
@@ -180,6 +188,13 @@ static const warn_case WARN_CASES[] = {
      "<t>:7: shaft 'A': segment 1 outer diameter = 20 m", "mm where m is meant"},
     {"segment = 0.5 0.02 0 5", "segment = 0.5 0.0005 0 5", "outer diameter = 0.0005 m",
      "outside the plausible 0.001 to 5 m"},
+    /* issue #17: layouts and magnitudes that compute but are likely wrong */
+    {"between = A end, B start", "between = A start, B end",
+     "<t>:29: coupling 'C': joins the start of shaft 'A' (z = 0 m) to the end of shaft 'B'",
+     "'between = A end, B start'"},
+    {"between = A end, B start", "between = A 0.3, B start",
+     "coupling 'C': station a (shaft 'A', z = 0.3 m) is not an end", NULL},
+    {"amount = 1e-4", "amount = 150", "<t>:34: unbalance 'U': amount = 150 kg m", "g mm"},
 };
 
 static char *subst(const char *base, const char *from, const char *to) {
@@ -300,13 +315,17 @@ static void test_unconnected_shafts(void **state) {
   assert_int_equal(rcb_model_add_segment(m, "B", 0.5, 0.02, 0, 2), RCB_OK);
   assert_int_equal(rcb_model_add_segment(m, "E", 0.5, 0.02, 0, 2), RCB_OK);
   assert_int_equal(rcb_model_add_bearing(m, "B1", "A", 0.0, &bc), RCB_OK);
-  /* E joined to A (through a coupling), B alone: 2 rotors, one warning for B */
+  /* E joined to A (through a coupling), B alone: 2 rotors, one warning for B;
+   * the coupling reaches over B (issue #17), and B has no bearing */
   assert_int_equal(rcb_model_add_coupling(m, "C", RCB_COUPLING_RIGID, "E", 2.0, "A", 0.5, NULL),
                    RCB_OK);
   assert_int_equal(rcb_model_finalize(m), RCB_OK);
-  assert_int_equal(rcb_model_warning_count(m), 1);
+  assert_int_equal(rcb_model_warning_count(m), 3);
   expect_msg("builder", rcb_model_warning(m, 0), "shaft 'B': not joined to shaft 'A'",
              "2 separate rotors");
+  expect_msg("builder", rcb_model_warning(m, 1), "coupling 'C': shaft 'B' (1 to 1.5 m) lies "
+             "between the ends it joins", "expected adjacent shafts");
+  expect_msg("builder", rcb_model_warning(m, 2), "shaft 'B': the rotor train", "no bearing");
   rcb_model_destroy(m);
 }
 
@@ -352,6 +371,76 @@ static void test_names_round_trip(void **state) {
 /* ---------------------------------------------------------- analyses -- */
 
 /* All free (no bearing) at omega = 0: K is singular (rigid-body modes). */
+/* BASE with several substitutions applied in turn (each its first occurrence). */
+static char *subst_all(const char *const *pairs, size_t n) {
+  char *t = subst(BASE, pairs[0], pairs[1]), *u;
+  size_t k;
+  for (k = 2; k + 1 < n; k += 2) {
+    u = subst(t, pairs[k], pairs[k + 1]);
+    free(t);
+    t = u;
+  }
+  return t;
+}
+
+static rcb_model *load_warned(const char *text, size_t nwarn) {
+  rcb_model *m = NULL;
+  size_t w;
+  assert_int_equal(rcb_model_create(&m, NULL), RCB_OK);
+  if (rcb_model_load_string(m, text, "<t>")) fail_msg("load failed: %s", rcb_model_errmsg(m));
+  if (rcb_model_warning_count(m) != nwarn) {
+    for (w = 0; w < rcb_model_warning_count(m); w++)
+      print_error("warning %zu: %s\n", w + 1, rcb_model_warning(m, w));
+    fail_msg("%zu warnings, expected %zu", rcb_model_warning_count(m), nwarn);
+  }
+  return m;
+}
+
+/* Layouts that compute but are likely wrong (issue #17), each with the
+ * warnings it must give; BASE itself gives none (test_base_is_valid). */
+static void test_plausible_layouts(void **state) {
+  static const char *const overlap[] = {"start = 0.6", "start = 0.4", "at = B 1.0",
+                                        "at = B 0.8"};
+  static const char *const zero[] = {"kxx = 1e7", "kxx = 0", "kxx = 1e7", "kxx = 0",
+                                     "kyy = 1e7", "kyy = 0", "kyy = 1e7", "kyy = 0",
+                                     "kt = 1e5",  "kt = 0",  "kr = 1e3",  "kr = 0"};
+  static const char *const alone[] = {
+      "[bearing B2]\nat = B 1.0\nkxx = 1e7\nkyy = 1e7\n", "",
+      "[coupling C]\nmodel = nelson_crandall_1\nbetween = A end, B start\nkt = 1e5\nkr = "
+      "1e3\n", ""};
+  char *t;
+  rcb_model *m;
+  (void)state;
+  /* B starts inside A: the shafts overlap, and the coupling's ends no longer face */
+  t = subst_all(overlap, 4);
+  m = load_warned(t, 2);
+  expect_msg("overlap", rcb_model_warning(m, 0), "coupling 'C': joins the end of shaft 'A'",
+             "do not face each other");
+  expect_msg("overlap", rcb_model_warning(m, 1), "shaft 'B': overlaps shaft 'A' from z = 0.4 "
+             "to 0.5 m", "check the 'start' keys");
+  rcb_model_destroy(m);
+  free(t);
+  /* every stiffness 0 */
+  t = subst_all(zero, sizeof zero / sizeof zero[0]);
+  m = load_warned(t, 1);
+  expect_msg("zero", rcb_model_warning(m, 0), "every bearing and coupling stiffness is zero",
+             "2 bearings, 1 couplings");
+  rcb_model_destroy(m);
+  free(t);
+  /* B neither coupled nor on a bearing: separate rotor, and floating free */
+  t = subst_all(alone, 4);
+  m = load_warned(t, 2);
+  expect_msg("alone", rcb_model_warning(m, 0), "shaft 'B': not joined", NULL);
+  expect_msg("alone", rcb_model_warning(m, 1), "shaft 'B': the rotor train it belongs to has "
+             "no bearing", "floats free");
+  rcb_model_destroy(m);
+  free(t);
+  /* the free-free example (no bearing at all, on purpose) is not warned */
+  m = rcb_test_model_from_example("paper_freefree.ini");
+  assert_int_equal(rcb_model_warning_count(m), 0);
+  rcb_model_destroy(m);
+}
+
 static void test_free_free_at_zero(void **state) {
   rcb_model *m = rcb_test_model_from_example("paper_freefree.ini");
   rcb_frf *f = NULL;
@@ -537,6 +626,15 @@ static void test_bad_csv_files(void **state) {
       {"D.x/D.x re,D.x/D.x im\n1,2\n", "bad.csv:1:", "first column"},
       {"freq_hz,D.x/D.x re,D.x/D.x im\n1,2,inf\n", "bad.csv:2:", "not finite"},
       {"", "no header line", NULL},
+      /* issue #17: spellings that leave a unit open, node numbers as stations */
+      {"frequency,D.x/D.x re,D.x/D.x im\n1,2,3\n", "gives no unit", "rename it freq_hz"},
+      {"omega_rad_s,D.x/D.x re,D.x/D.x im\n1,2,3\n", "rad/s is not read", "freq_hz"},
+      {"speed,D.x re,D.x im\n1,2,3\n", "gives no unit", "rename it rpm"},
+      {"freq_hz,D.x/D.x mag,D.x/D.x phase\n1,2,3\n", "without the unit degrees",
+       "\"D.x/D.x phase_deg\""},
+      {"freq_hz,3.x/10.y re,3.x/10.y im\n1,2,3\n", "station '3' is a number",
+       "or to '#3' for model node 3"},
+      {"freq_hz,D.x/10.y re,D.x/10.y im\n1,2,3\n", "station '10' is a number", NULL},
   };
   size_t k;
   (void)state;
@@ -625,6 +723,7 @@ int main(void) {
       cmocka_unit_test(test_unconnected_shafts),  cmocka_unit_test(test_names_round_trip),
       cmocka_unit_test(test_free_free_at_zero),
       cmocka_unit_test(test_bad_frequencies),     cmocka_unit_test(test_bad_uff_files),
+      cmocka_unit_test(test_plausible_layouts),
       cmocka_unit_test(test_bad_csv_files),       cmocka_unit_test(test_bad_fits),
       cmocka_unit_test(test_fit_unknown_channel),
   };

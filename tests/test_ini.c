@@ -561,6 +561,33 @@ static void test_uff_map(void **state) {
   expect_error(1, "[uff x]\n", RCB_ERR_PARSE, "takes no name", NULL);
 }
 
+/* [test] rpm: the rotor speed of the measurements (issue #17), in rad/s in the
+ * model, written back by the INI writer; absent: not found. */
+static void test_test_speed(void **state) {
+  char text[4096], out[8192];
+  rcb_model *m, *m2;
+  double w = -1.0;
+  size_t need;
+  (void)state;
+  m = rcb_test_model_from_string(BASE);
+  assert_int_equal(rcb_model_get_test_speed(m, &w), RCB_ERR_NOT_FOUND);
+  rcb_model_destroy(m);
+  snprintf(text, sizeof text, "%s[test]\nrpm = 10000\n", BASE);
+  m = rcb_test_model_from_string(text);
+  assert_int_equal(rcb_model_get_test_speed(m, &w), RCB_OK);
+  assert_true(rcb_test_close(w, 10000.0 * RCB_PI / 30.0, 1e-15, 0));
+  assert_int_equal(rcb_model_write_ini(m, out, sizeof out, &need), RCB_OK);
+  m2 = rcb_test_model_from_string(out);
+  assert_int_equal(rcb_model_get_test_speed(m2, &w), RCB_OK);
+  assert_true(rcb_test_close(w, 10000.0 * RCB_PI / 30.0, 1e-15, 0));
+  assert_int_equal(rcb_model_set_test_speed(m2, -1.0), RCB_ERR_ARG);
+  rcb_model_destroy(m);
+  rcb_model_destroy(m2);
+  expect_error(1, "[test]\nrpm = -5\n", RCB_ERR_PARSE, "t.ini:10: [test] rpm", ">= 0");
+  expect_error(1, "[test]\nspeed = 5\n", RCB_ERR_PARSE, "unknown key", "rpm");
+  expect_error(1, "[test x]\n", RCB_ERR_PARSE, "takes no name", NULL);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_paper_system),
@@ -586,6 +613,7 @@ int main(void) {
       cmocka_unit_test(test_err_syntax),
       cmocka_unit_test(test_err_file),
       cmocka_unit_test(test_uff_map),
+      cmocka_unit_test(test_test_speed),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

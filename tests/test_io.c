@@ -231,6 +231,56 @@ static void test_uff_read_hand_written(void **state) {
   assert_string_equal(c.reference, "#3.y");
   assert_int_equal(c.kind, RCB_RECEPTANCE);
   assert_true(c.data[2] == CMPLX(5.0, 6.5));
+  /* issue #17: node 3 has no map entry: one warning naming it (4 channel ends) */
+  assert_int_equal(rcb_meas_warning_count(ms), 1);
+  assert_non_null(strstr(rcb_meas_warning(ms, 0), "UFF node 3 is not in the node map"));
+  assert_non_null(strstr(rcb_meas_warning(ms, 0), "model node #3"));
+  assert_int_equal(rcb_meas_speed_given(ms), 1); /* z axis type 19 */
+  /* with node 3 mapped: no warning */
+  {
+    rcb_uff_node map2[] = {{10, "DA"}, {3, "DB"}};
+    assert_int_equal(rcb_meas_read_uff(ms, p, 2, map2), RCB_OK);
+    assert_int_equal(rcb_meas_warning_count(ms), 0);
+  }
+  rcb_meas_destroy(ms);
+}
+
+/* A UFF whose z axis is not of type 19 (the speed only in the ID text, as
+ * several acquisition systems write it): read as 0 rpm, but not silently
+ * (issue #17); rcb_meas_set_speed states it and drops the warning. */
+static void test_uff_speed_not_stated(void **state) {
+  const char *p = rcb_test_tmp_path("zaxis0.uff");
+  FILE *fp = fopen(p, "w");
+  rcb_meas *ms = NULL;
+  rcb_uff_node map[] = {{10, "DA"}, {3, "DB"}};
+  (void)state;
+  assert_non_null(fp);
+  rec58(fp, 4, 10, 1, 3, 1, 6, 3, 1, 10.0, 10.0, 0.0, 18, 8, 13, 0, V3);
+  fclose(fp);
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  if (rcb_meas_read_uff(ms, p, 2, map) != RCB_OK) fail_msg("%s", rcb_meas_errmsg(ms));
+  assert_true(rcb_meas_speed(ms) == 0.0);
+  assert_int_equal(rcb_meas_speed_given(ms), 0);
+  assert_int_equal(rcb_meas_warning_count(ms), 1);
+  assert_non_null(strstr(rcb_meas_warning(ms, 0), "z axis has data type 0, not 19"));
+  assert_non_null(strstr(rcb_meas_warning(ms, 0), "reads as 0 rpm"));
+  assert_int_equal(rcb_meas_set_speed(ms, -2.0), RCB_OK); /* synchronous */
+  assert_true(rcb_meas_speed(ms) < 0.0);
+  assert_int_equal(rcb_meas_set_speed(ms, 1000.0), RCB_OK);
+  assert_true(rcb_meas_speed(ms) == 1000.0);
+  assert_int_equal(rcb_meas_speed_given(ms), 1);
+  assert_int_equal(rcb_meas_warning_count(ms), 0);
+  assert_int_equal(rcb_meas_set_speed(ms, (double)NAN), RCB_ERR_ARG);
+  /* a CSV states it with '# rpm', or leaves it out */
+  write_text(p, "freq_hz,DA.x/DA.x re,DA.x/DA.x im\n10,1,2\n");
+  assert_int_equal(rcb_meas_read_csv(ms, p), RCB_OK);
+  assert_int_equal(rcb_meas_speed_given(ms), 0);
+  assert_int_equal(rcb_meas_warning_count(ms), 1);
+  assert_non_null(strstr(rcb_meas_warning(ms, 0), "no '# rpm = R' line"));
+  write_text(p, "# rpm = 0\nfreq_hz,DA.x/DA.x re,DA.x/DA.x im\n10,1,2\n");
+  assert_int_equal(rcb_meas_read_csv(ms, p), RCB_OK);
+  assert_int_equal(rcb_meas_speed_given(ms), 1);
+  assert_int_equal(rcb_meas_warning_count(ms), 0);
   rcb_meas_destroy(ms);
 }
 
@@ -264,6 +314,42 @@ static void test_csv_read_rcbtool_output(void **state) {
   assert_null(c.reference);
   assert_true(cclose(c.data[0], CMPLX(0.0, -1e-5), 1e-15));
   assert_true(cclose(c.data[1], 2e-5 * CMPLX(sqrt(0.5), -sqrt(0.5)), 1e-15));
+  rcb_meas_destroy(ms);
+}
+
+/* Other tools' header spellings (issue #17): case, '_', spaces and a unit in
+ * brackets do not matter; the values are those of the canonical header. */
+static void test_csv_header_variants(void **state) {
+  static const char *const heads[] = {
+      "frequency_hz,DA.x/DB.y re,DA.x/DB.y im,DA.y/DB.y mag,DA.y/DB.y phase_deg\n",
+      "Frequency (Hz),DA.x/DB.y Real,DA.x/DB.y Imag,DA.y/DB.y Magnitude,DA.y/DB.y Phase (deg)\n",
+      "f [Hz],DA.x/DB.y re (m/N),DA.x/DB.y im (m/N),DA.y/DB.y amp [m/N],DA.y/DB.y phase [deg]\n",
+      "FREQ_HZ,DA.x/DB.y RE,DA.x/DB.y IM,DA.y/DB.y ABS,DA.y/DB.y PHASE_DEG\n"};
+  const char *p = rcb_test_tmp_path("variants.csv");
+  rcb_meas *ms = NULL;
+  rcb_meas_channel_info c;
+  char text[512];
+  size_t k;
+  (void)state;
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  for (k = 0; k < sizeof heads / sizeof heads[0]; k++) {
+    snprintf(text, sizeof text, "%s10,1e-6,-2e-6,3e-6,90\n20,4e-6,5e-6,6e-6,180\n", heads[k]);
+    write_text(p, text);
+    if (rcb_meas_read_csv(ms, p) != RCB_OK) fail_msg("%s: %s", heads[k], rcb_meas_errmsg(ms));
+    assert_int_equal(rcb_meas_get_type(ms), RCB_MEAS_FRF);
+    assert_true(rcb_meas_grid(ms)[1] == TWO_PI * 20.0);
+    assert_int_equal(rcb_meas_channel(ms, 0, &c), RCB_OK);
+    assert_string_equal(c.response, "DA.x");
+    assert_string_equal(c.reference, "DB.y");
+    assert_true(cclose(c.data[1], CMPLX(4e-6, 5e-6), 1e-15));
+    assert_int_equal(rcb_meas_channel(ms, 1, &c), RCB_OK);
+    assert_true(cclose(c.data[0], CMPLX(0.0, 3e-6), 1e-15));
+    assert_true(cclose(c.data[1], CMPLX(-6e-6, 0.0), 1e-15));
+  }
+  write_text(p, "Speed (rpm),DA.x re,DA.x im\n600,1,2\n");
+  if (rcb_meas_read_csv(ms, p) != RCB_OK) fail_msg("%s", rcb_meas_errmsg(ms));
+  assert_int_equal(rcb_meas_get_type(ms), RCB_MEAS_UNBALANCE);
+  assert_true(rcb_test_close(rcb_meas_grid(ms)[0], 20.0 * RCB_PI, 1e-15, 0));
   rcb_meas_destroy(ms);
 }
 
@@ -629,7 +715,9 @@ static void test_bad_csv(void **state) {
   bad_csv("freq_hz,DA.x/DA.x re,DA.x/DA.x im,DA.x/DA.x re,DA.x/DA.x im\n1,1,2,3,4\n",
           "duplicate channel DA.x/DA.x", "columns 4-5");
   bad_csv("freq_hz,DA.z/DA.x re,DA.z/DA.x im\n1,1,2\n", "unknown direction", "DA.z");
-  bad_csv("freq_hz,DA.x/DA.x re,DA.x/DA.x imag\n1,1,2\n", "bad.csv:1: column 3", "imag");
+  /* "imag" is read since issue #17; an unknown part word still is not */
+  bad_csv("freq_hz,DA.x/DA.x re,DA.x/DA.x quad\n1,1,2\n", "bad.csv:1: column 3",
+          "unknown part 'quad'");
   bad_csv("freq_hz,DA.x/DA.x re,DB.x/DA.x im\n1,1,2\n", "bad.csv:1: column 2", "pair");
   bad_csv("freq_hz,DA.x re,DA.x im\n1,1,2\n", "RESPONSE/REFERENCE", NULL);
   bad_csv("# kind = velocity\nfreq_hz,DA.x/DA.x re,DA.x/DA.x im\n1,1,2\n", "bad.csv:1:",
@@ -716,6 +804,8 @@ int main(void) {
       cmocka_unit_test(test_noise_proportional),    cmocka_unit_test(test_noise_systematic),
       cmocka_unit_test(test_noise_seeds),           cmocka_unit_test(test_noise_stream),
       cmocka_unit_test(test_bad_uff),               cmocka_unit_test(test_bad_uff_binary),
+      cmocka_unit_test(test_csv_header_variants),
+      cmocka_unit_test(test_uff_speed_not_stated),
       cmocka_unit_test(test_bad_csv),               cmocka_unit_test(test_bad_api),
       cmocka_unit_test(test_write_atomic),          cmocka_unit_test(test_allocator),
       cmocka_unit_test(test_uff_binary_big_endian),

@@ -370,6 +370,7 @@ static void test_paper_max_zeta(void **state) {
   double w0;
   (void)state;
   assert_int_equal(rcb_modes_create(&e, m, NULL), RCB_OK);
+  assert_int_equal(rcb_modes_set_max_zeta(e, 1.0), RCB_OK); /* every root, as ROSS */
   n0 = modes_at(e, 0.0);
   w0 = g_modes[0].wd;
   assert_true(w0 > 100.0 && g_modes[0].zeta < 0.5); /* a physical bending mode */
@@ -386,6 +387,27 @@ static void test_paper_max_zeta(void **state) {
   assert_true(k < n);
   assert_true(rcb_test_close(g_modes[0].wd, w0, 0.02, 0));
   for (n = 0; n < k; n++) assert_true(g_modes[n].zeta <= 0.99);
+  rcb_modes_destroy(e);
+  rcb_model_destroy(m);
+}
+
+/* A fresh object (what a firmware caller gets without a setter) starts from
+ * RCB_MODES_MAX_ZETA_DEFAULT, rcbtool's and Python's value: at 300 rpm the
+ * paper system's first mode is the bending mode near 150 Hz, not a root of
+ * the overdamped cluster with wd < 0.1 w0 and zeta ~ 1 (issue #17). */
+static void test_default_max_zeta(void **state) {
+  rcb_model *m = rcb_test_model_from_example("paper_system.ini");
+  rcb_modes *e = NULL;
+  const double w300 = 300.0 * 2 * RCB_PI / 60;
+  size_t n;
+  (void)state;
+  assert_int_equal(rcb_modes_create(&e, m, NULL), RCB_OK);
+  assert_true(rcb_modes_get_max_zeta(e) == RCB_MODES_MAX_ZETA_DEFAULT);
+  assert_true(RCB_MODES_MAX_ZETA_DEFAULT < 1.0);
+  n = modes_at(e, w300);
+  assert_true(n > 0);
+  assert_true(g_modes[0].zeta < 0.5);
+  assert_true(g_modes[0].wd / (2 * RCB_PI) > 140.0 && g_modes[0].wd / (2 * RCB_PI) < 160.0);
   rcb_modes_destroy(e);
   rcb_model_destroy(m);
 }
@@ -446,6 +468,7 @@ int main(void) {
       cmocka_unit_test(test_critical_synthetic),
       cmocka_unit_test(test_critical_model),
       cmocka_unit_test(test_paper_max_zeta),
+      cmocka_unit_test(test_default_max_zeta),
       cmocka_unit_test(test_no_allocation),
       cmocka_unit_test(test_errors),
   };

@@ -273,16 +273,25 @@ RCB_API void rcb_modes_destroy(rcb_modes *e);
 RCB_API const char *rcb_modes_errmsg(const rcb_modes *e);
 
 /**
- * @brief Leave out modes whose damping ratio exceeds @p max_zeta (default 1:
- * every oscillating root is kept, as ROSS does). With strong
+ * @brief Default of rcb_modes_set_max_zeta (-): the one value the library,
+ * rcbtool (--max-zeta) and the Python package start from.
+ */
+#define RCB_MODES_MAX_ZETA_DEFAULT 0.99
+
+/**
+ * @brief Leave out modes whose damping ratio exceeds @p max_zeta (default
+ * RCB_MODES_MAX_ZETA_DEFAULT; 1 keeps every oscillating root, as ROSS does).
+ * With strong
  * stiffness-proportional damping (qz_k), the overdamped high-frequency modes
  * leave a cluster of roots near -1/qz_k that gyroscopic coupling turns into
  * pairs with tiny wd and zeta ~ 1 - 1e-9; sorted by wd they come first and
- * would fill a Campbell diagram (and cross 1X at a few rad/s). A value such
- * as 0.99 (logdec ~ 44) removes them. Applies to rcb_modes_compute and
+ * would fill a Campbell diagram (and cross 1X at a few rad/s); the default
+ * 0.99 (logdec ~ 44) removes them. Applies to rcb_modes_compute and
  * rcb_campbell. @return RCB_ERR_ARG unless 0 < max_zeta <= 1
  */
 RCB_API rcb_status rcb_modes_set_max_zeta(rcb_modes *e, double max_zeta);
+/** @brief The damping-ratio limit in force (-), RCB_MODES_MAX_ZETA_DEFAULT until set. */
+RCB_API double rcb_modes_get_max_zeta(const rcb_modes *e);
 
 /**
  * @brief Damped modes at rotor speed @p speed (rad/s) from the state-space

@@ -60,6 +60,27 @@ RCB_API size_t rcb_meas_channel_count(const rcb_meas *ms);
 RCB_API const double *rcb_meas_grid(const rcb_meas *ms);
 /** @brief Rotor speed of an FRF test, rad/s (negative: synchronous). */
 RCB_API double rcb_meas_speed(const rcb_meas *ms);
+/**
+ * @brief 1 when the rotor speed was stated (UFF z axis of type 19, CSV "# rpm",
+ * rcb_meas_set_grid or rcb_meas_set_speed), 0 when a file left it out and it
+ * reads as 0 (a UFF whose speed is only in the text header, z axis type 0).
+ */
+RCB_API int rcb_meas_speed_given(const rcb_meas *ms);
+/**
+ * @brief State the rotor speed of an FRF test after reading (rad/s, negative:
+ * synchronous), e.g. when the file leaves it out; the read's warning that the
+ * speed was not stated is dropped. @return RCB_ERR_STATE for
+ * an unbalance response or an empty object, RCB_ERR_ARG if not finite
+ */
+RCB_API rcb_status rcb_meas_set_speed(rcb_meas *ms, double speed);
+/**
+ * @brief Warnings of the last read: input that is valid but likely misread
+ * (a UFF node with no entry in the node map, a UFF FRF that does not state
+ * the rotor speed). A warning never fails the read; show the list.
+ */
+RCB_API size_t rcb_meas_warning_count(const rcb_meas *ms);
+/** @brief Warning @p i (0-based) of the last read, NULL past the end. */
+RCB_API const char *rcb_meas_warning(const rcb_meas *ms, size_t i);
 
 typedef struct rcb_meas_channel_info {
   const char *response;     /**< "DA.x" */
@@ -91,7 +112,9 @@ typedef struct rcb_uff_node {
 /**
  * @brief Read UFF dataset 58 records (ASCII 58 or binary 58b, any mix; other
  * datasets are skipped). Node numbers map through @p map; a node without an
- * entry maps to model node "#N". Directions: UFF 1, 2, 4, 5 (+/-) are x, y,
+ * entry maps to model node "#N", with a warning (rcb_meas_warning) naming it.
+ * The rotor speed of an FRF is the z value of a z axis of type 19 (rpm); any
+ * other z axis reads as 0 rpm with a warning (rcb_meas_set_speed states it). Directions: UFF 1, 2, 4, 5 (+/-) are x, y,
  * rx, ry (a negative direction flips the sign). All records must share one
  * abscissa (Hz in the file). Ordinate units/type decide the kind (function
  * type 4 FRF: displacement, velocity or acceleration over force; type 1 with
@@ -108,6 +131,10 @@ RCB_API rcb_status rcb_meas_write_uff(const rcb_meas *ms, const char *path, int 
  * "RESP/REF mag","RESP/REF phase_deg" (unbalance: "RESP re"/"RESP im" or
  * "RESP amp"/"RESP phase_deg"); optional "# key = value" lines before the
  * header: kind = receptance|mobility|inertance, rpm = rotor speed of an FRF test.
+ * Other spellings are read too (case, spaces, '_' and a unit in brackets do not
+ * matter: "Frequency (Hz)", "speed_rpm", "DA.x/C.y Real", "... Phase (deg)");
+ * a header that leaves the unit open or a numeric station ("3.x") is refused
+ * with the name to use.
  */
 RCB_API rcb_status rcb_meas_read_csv(rcb_meas *ms, const char *path);
 /** @brief Write CSV (re/im columns) that rcb_meas_read_csv reads back, atomically. */

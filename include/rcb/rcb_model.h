@@ -192,6 +192,16 @@ RCB_API size_t rcb_model_uff_node_count(const rcb_model *m);
 RCB_API rcb_status rcb_model_uff_node(const rcb_model *m, size_t i, long *node,
                                       const char **station);
 
+/**
+ * @brief State the rotor speed (rad/s, >= 0) of the measurements this model
+ * is compared with, for files that leave it out (INI: [test] rpm). Used by
+ * rcbtool compare, fit and diagnose when neither --rpm nor the file gives it.
+ * @return RCB_ERR_ARG unless finite and >= 0
+ */
+RCB_API rcb_status rcb_model_set_test_speed(rcb_model *m, double speed);
+/** @brief The test speed (rad/s) in *speed; RCB_ERR_NOT_FOUND when none is stated. */
+RCB_API rcb_status rcb_model_get_test_speed(const rcb_model *m, double *speed);
+
 /** @brief Build the mesh and the DOF map, check consistency. */
 RCB_API rcb_status rcb_model_finalize(rcb_model *m);
 

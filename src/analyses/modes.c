@@ -157,7 +157,7 @@ rcb_status rcb_modes_create(rcb_modes **out, const rcb_model *m, const rcb_alloc
   if (!e) return RCB_ERR_NOMEM;
   e->alloc = a;
   e->model = m;
-  e->max_zeta = 1.0;
+  e->max_zeta = RCB_MODES_MAX_ZETA_DEFAULT;
   e->n = n;
   e->N = 2 * n;
   e->nnodes = rcb_model_node_count(m);
@@ -186,6 +186,8 @@ rcb_status rcb_modes_set_max_zeta(rcb_modes *e, double max_zeta) {
   e->max_zeta = max_zeta;
   return RCB_OK;
 }
+
+double rcb_modes_get_max_zeta(const rcb_modes *e) { return e ? e->max_zeta : (double)NAN; }
 
 /* A = [0, I; -M^-1 K, -M^-1 (C + Omega G)] at rotor speed Omega (rad/s). */
 static rcb_status build_state_matrix(rcb_modes *e, double speed) {

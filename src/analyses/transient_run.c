@@ -22,9 +22,13 @@
  * system at 1e-6 (measured, docs/benchmarks.md). */
 #define RCB_TRANSIENT_MAX_ORDER 3
 
+/* CVODE's out-of-memory flag is RCB_ERR_NOMEM (SUNDIALS allocates with its
+ * own malloc; issue #17), every other failure a numerical one. */
+static rcb_status cv_status(int flag) { return flag == CV_MEM_FAIL ? RCB_ERR_NOMEM : RCB_ERR_SINGULAR; }
+
 static rcb_status cv_check(rcb_transient *t, int flag, const char *call) {
   if (flag >= 0) return RCB_OK;
-  return rcb_set_error(t->errmsg, RCB_ERR_SINGULAR, "transient: %s failed (flag %d): %s", call,
+  return rcb_set_error(t->errmsg, cv_status(flag), "transient: %s failed (flag %d): %s", call,
                        flag, t->sunmsg[0] ? t->sunmsg : "no message");
 }
 
@@ -79,7 +83,7 @@ static rcb_status cv_advance(rcb_transient *t, double tout) {
     int flag = CVode(t->cvode, tout, t->y, &tret, CV_NORMAL);
     if (flag < 0) {
       cv_stats(t, tret);
-      return rcb_set_error(t->errmsg, RCB_ERR_SINGULAR,
+      return rcb_set_error(t->errmsg, cv_status(flag),
                            "transient: CVode failed at t = %.9g s (flag %d): %s", tret, flag,
                            t->sunmsg[0] ? t->sunmsg : "no message");
     }

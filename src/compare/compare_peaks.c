@@ -179,7 +179,6 @@ static rcb_status model_refs(rcb_compare *c, const rcb_model *m, mref *refs, siz
   if (!modes) return rcb_cmp_fail(c, RCB_ERR_NOMEM, "out of memory");
   st = rcb_modes_create(&me, m, &c->alloc);
   if (st) rcb_cmp_fail(c, st, "modes: %s", rcb_status_str(st));
-  if (!st) st = rcb_modes_set_max_zeta(me, 0.99);
   if (!st && c->type == RCB_MEAS_FRF && c->speed >= 0) {
     st = rcb_modes_compute(me, c->speed, cap, modes, &nm, NULL);
     if (st) rcb_cmp_fail(c, st, "modes at %g rad/s: %s", c->speed, rcb_modes_errmsg(me));

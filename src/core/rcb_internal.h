@@ -182,11 +182,23 @@ struct rcb_model {
                           bearing terms (1: as stated; [model] speed_factor) */
   size_t ndof;      /* independent DOFs */
   size_t bandwidth; /* max |row - col| of any nonzero (kl = ku) */
+  int has_test_speed; /* [test] rpm given (model/test_speed.c) */
+  double test_speed;  /* rad/s: rotor speed of the measurements to compare with */
 };
 
 /* model/warnings.c: rebuild m->warnings (called by finalize once the mesh
  * exists); RCB_ERR_NOMEM only. */
 rcb_status rcb_model_collect_warnings(rcb_model *m);
+/* model/plausibility.c: refuse magnitudes that overflow (finalize, before the
+ * mesh); warn on layouts that are legal but likely wrong (from
+ * collect_warnings); add one warning. */
+rcb_status rcb_model_check_magnitudes(rcb_model *m);
+rcb_status rcb_model_check_plausible(rcb_model *m);
+rcb_status rcb_model_add_warning(rcb_model *m, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
 
 /* Bearing coefficients at a rotor speed (linear interpolation, clamped). */
 void rcb_bearing_eval(const rcb_bearing_t *b, double speed, rcb_bearing_coefs *out);

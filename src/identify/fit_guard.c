@@ -61,8 +61,50 @@ void rcb_fit_classify_stop(rcb_fit *f) {
   f->evaluations = evals;
 }
 
+/* Why residual j is not finite, for the message (issue #17: "objective is
+ * infinite" alone left a user with a UFF read at 0 rpm nowhere to look). */
+static const char *likely_cause(const rcb_fit *f, size_t j) {
+  rcb_complex h = f->Hmod[f->res_ch[j] * f->npts + f->res_pt[j]];
+  int logs = f->scale == RCB_SCALE_LOG10 || f->scale == RCB_SCALE_DB;
+  if (!isfinite(f->res_sqrtw[j]))
+    return "its weight is infinite (the noise model with a measured value of 0 there: "
+           "leave the point out with --band, or drop --noise)";
+  if (!isfinite(creal(h)) || !isfinite(cimag(h)))
+    return "the model's response there is not finite (a singular model at this frequency: "
+           "no support, or no damping at a resonance)";
+  if (logs && cabs(h) == 0.0) {
+    if (!f->unbalance && f->speed == 0.0)
+      return rcb_meas_speed_given(f->meas)
+                 ? "the model's response there is exactly 0 (the log of 0): at 0 rpm nothing "
+                   "couples this response to this force (the gyroscopic terms are off); is "
+                   "the test speed right?"
+                 : "the model's response there is exactly 0 (the log of 0): the measurement "
+                   "does not state its rotor speed and was read as 0 rpm, where nothing "
+                   "couples this response to this force; give the speed (--rpm R, the "
+                   "model's [test] rpm)";
+    return "the model's response there is exactly 0 (the log of 0): the model does not "
+           "couple this response to this force; use the linear scale or leave the channel "
+           "out";
+  }
+  return "its residual overflows (model and measurement many orders of magnitude apart: "
+         "check the units of the measurement and the model)";
+}
+
 rcb_status rcb_fit_check_finite(rcb_fit *f, double F, const char *where) {
+  size_t j;
   if (isfinite(F)) return RCB_OK;
+  for (j = 0; f->r && f->Hmod && j < f->nres; j++) {
+    rcb_meas_channel_info ci;
+    double x = f->grid[f->res_pt[j]];
+    if (isfinite(f->r[j])) continue;
+    if (rcb_meas_channel(f->meas, f->res_ch[j], &ci) != RCB_OK) break;
+    return rcb_fit_fail(f, RCB_ERR_NOT_CONVERGED,
+                        "objective is %s %s: channel %s%s%s at %.6g %s: %s; no result",
+                        isnan(F) ? "NaN" : "infinite", where, ci.response,
+                        ci.reference ? "/" : "", ci.reference ? ci.reference : "",
+                        f->unbalance ? x * 30.0 / RCB_PI : x / (2.0 * RCB_PI),
+                        f->unbalance ? "rpm" : "Hz", likely_cause(f, j));
+  }
   return rcb_fit_fail(f, RCB_ERR_NOT_CONVERGED,
                       "objective is %s %s (residuals overflow or are not numbers: check the "
                       "weights, the measurement and the model there); no result",

@@ -6,8 +6,13 @@
  *   rpm,DA.x amp,DA.x phase_deg,...         (unbalance, abscissa rpm)
  * Per channel two adjacent columns: "re","im", or "mag"/"amp","phase_deg"
  * (degrees). Other "#" lines are comments. Errors name the file, line and
- * column.
+ * column. Other tools' spellings are read too (case, spaces, '_' and a unit
+ * in brackets do not matter: "Frequency (Hz)", "frequency_hz", "Speed [rpm]",
+ * "DA.x/C.y Real", "DA.x/C.y Phase (deg)", "DA.x/C.y re (m/N)"); a spelling
+ * that leaves the unit open (frequency, phase) or a station given as a
+ * number is refused with the name to use.
  */
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdlib.h>
@@ -99,24 +104,134 @@ static rcb_status comment(csv_state *S, char *text) {
   return RCB_OK;
 }
 
+/* Header token folded for comparison: lower case, without ' ', '_', '-' and
+ * brackets, so "Frequency (Hz)", "frequency_hz" and "FREQ-HZ" all read
+ * "frequencyhz". */
+static void fold(const char *s, char *out, size_t size) {
+  size_t k = 0;
+  for (; *s && k + 1 < size; s++)
+    if (!strchr(" _-()[]\t", *s)) out[k++] = (char)tolower((unsigned char)*s);
+  out[k] = '\0';
+}
+
+static int in_list(const char *s, const char *const *list) {
+  for (; *list; list++)
+    if (strcmp(s, *list) == 0) return 1;
+  return 0;
+}
+
+/* First header field: Hz or rpm, under the usual names. */
+static rcb_status abscissa(csv_state *S, const char *f) {
+  static const char *const hz[] = {"freqhz", "frequencyhz", "fhz", "hz", "frequencyinhz",
+                                   NULL};
+  static const char *const rpm[] = {"rpm", "speedrpm", "rotorspeedrpm", "nrpm",
+                                    "rotationalspeedrpm", "speedinrpm", NULL};
+  char g[64];
+  fold(f, g, sizeof g);
+  if (in_list(g, hz)) {
+    S->type = RCB_MEAS_FRF;
+    return RCB_OK;
+  }
+  if (in_list(g, rpm)) {
+    S->type = RCB_MEAS_UNBALANCE;
+    return RCB_OK;
+  }
+  if (strstr(g, "rad") || strstr(g, "omega"))
+    return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: first column '%s': an abscissa in "
+                         "rad/s is not read; convert it to Hz and name the column freq_hz "
+                         "(FRF), or to rpm and name it rpm (unbalance response)", S->path,
+                         S->line, f);
+  if (strncmp(g, "freq", 4) == 0 || strcmp(g, "f") == 0)
+    return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: first column '%s' gives no unit; "
+                         "rename it freq_hz if the values are in Hz", S->path, S->line, f);
+  if (strncmp(g, "speed", 5) == 0 || strncmp(g, "rotorspeed", 10) == 0)
+    return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: first column '%s' gives no unit; "
+                         "rename it rpm if the values are rotor speeds in rpm", S->path,
+                         S->line, f);
+  return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: first column '%s': expected freq_hz "
+                       "(FRF, Hz; also read: frequency_hz, \"Frequency (Hz)\", f_hz) or rpm "
+                       "(unbalance response; also read: speed_rpm, \"Speed (rpm)\")",
+                       S->path, S->line, f);
+}
+
+/* A trailing unit in brackets, "(m/N)" or "[deg]": cut off *end, the unit
+ * (folded) into unit ("" without one). */
+static void cut_unit(const char *f, size_t *end, char *unit, size_t size) {
+  size_t n = *end;
+  char close;
+  unit[0] = '\0';
+  while (n > 0 && f[n - 1] == ' ') n--;
+  if (n == 0 || (f[n - 1] != ')' && f[n - 1] != ']')) return;
+  close = f[n - 1];
+  while (n > 0 && f[n - 1] != (close == ')' ? '(' : '[')) n--;
+  if (n == 0) return;
+  {
+    char u[64];
+    size_t len = *end - n;
+    if (len >= sizeof u) len = sizeof u - 1;
+    memcpy(u, f + n, len);
+    u[len] = '\0';
+    fold(u, unit, size);
+  }
+  n--;
+  while (n > 0 && f[n - 1] == ' ') n--;
+  *end = n;
+}
+
+/* The part word of a column ("re", "Real", "Phase" + its unit) -> col_part;
+ * -1 unknown, -2 a phase whose unit is not degrees. */
+static int part_of(const char *word, size_t n, const char *unit) {
+  static const char *const re[] = {"re", "real", NULL};
+  static const char *const im[] = {"im", "imag", "imaginary", NULL};
+  static const char *const mag[] = {"mag", "amp", "abs", "magnitude", "amplitude", NULL};
+  char w[32], g[32];
+  if (n >= sizeof w) return -1;
+  memcpy(w, word, n);
+  w[n] = '\0';
+  fold(w, g, sizeof g);
+  if (in_list(g, re)) return COL_RE;
+  if (in_list(g, im)) return COL_IM;
+  if (in_list(g, mag)) return COL_MAG;
+  if (strcmp(g, "phasedeg") == 0) return COL_PHASE;
+  if (strcmp(g, "phase") == 0 || strcmp(g, "ph") == 0)
+    return strcmp(unit, "deg") == 0 || strcmp(unit, "degrees") == 0 || strcmp(unit, "\u00b0") == 0
+               ? COL_PHASE
+               : -2;
+  return -1;
+}
+
+/* A station written as a number ("3.x/10.y"): a test system's node number,
+ * which is not a model station; say what to write instead. */
+static rcb_status numeric_station(csv_state *S, const char *name, size_t k) {
+  const char *p = name;
+  while (p) {
+    const char *slash = strchr(p, '/'), *end = slash ? slash : p + strlen(p), *dot = end, *q;
+    while (dot > p && dot[-1] != '.') dot--;
+    if (dot > p + 1) {
+      for (q = p; q < dot - 1 && isdigit((unsigned char)*q); q++) continue;
+      if (q == dot - 1)
+        return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: column %zu ('%s'): station '%.*s' "
+                             "is a number, not a model station; rename it to the station it "
+                             "stands for (e.g. DA; 'rcbtool check' lists them) or to '#%.*s' "
+                             "for model node %.*s", S->path, S->line, k + 1, name,
+                             (int)(dot - 1 - p), p, (int)(dot - 1 - p), p, (int)(dot - 1 - p),
+                             p);
+    }
+    p = slash ? slash + 1 : NULL;
+  }
+  return RCB_OK;
+}
+
 /* One header field "NAME part" -> column. */
 static rcb_status header_col(csv_state *S, const char *f, size_t k) {
-  static const char *const parts[] = {"re", "im", "mag", "phase_deg", "amp"};
-  static const col_part pval[] = {COL_RE, COL_IM, COL_MAG, COL_PHASE, COL_MAG};
-  const char *sp;
   csv_col *c;
-  size_t i, len;
-  char g[RCB_NAME_MAX + 64];
-  /* a unit in brackets after the part, as rcbtool frf/unbalance write: "DA.x/DB.y re [m/N]" */
-  len = strlen(f);
-  if (len > 0 && len < sizeof g && f[len - 1] == ']' && strrchr(f, '[')) {
-    len = (size_t)(strrchr(f, '[') - f);
-    while (len > 0 && f[len - 1] == ' ') len--;
-    memcpy(g, f, len);
-    g[len] = '\0';
-    f = g;
-  }
-  sp = strrchr(f, ' ');
+  const char *sp;
+  char unit[32];
+  size_t len, end = strlen(f);
+  int part;
+  cut_unit(f, &end, unit, sizeof unit);
+  for (sp = f + end; sp > f && sp[-1] != ' '; sp--) continue;
+  sp = sp > f ? sp - 1 : NULL;
   if (!sp || sp == f)
     return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: column %zu '%s': expected \"CHANNEL "
                          "re\", \"CHANNEL im\", \"CHANNEL mag\"/\"amp\" or \"CHANNEL "
@@ -131,15 +246,18 @@ static rcb_status header_col(csv_state *S, const char *f, size_t k) {
                          S->path, S->line, k + 1);
   memcpy(c->name, f, len);
   c->name[len] = '\0';
-  for (i = 0; i < 5; i++)
-    if (strcmp(sp + 1, parts[i]) == 0) break;
-  if (i == 5)
-    return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: column %zu '%s': unknown part '%s'; "
+  part = part_of(sp + 1, (size_t)(f + end - sp - 1), unit);
+  if (part == -2)
+    return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: column %zu '%s': a phase without "
+                         "the unit degrees; give it in degrees and name the column \"%s "
+                         "phase_deg\"", S->path, S->line, k + 1, f, c->name);
+  if (part < 0)
+    return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: column %zu '%s': unknown part '%.*s'; "
                          "expected re, im, mag, amp or phase_deg", S->path, S->line, k + 1, f,
-                         sp + 1);
-  c->part = pval[i];
+                         (int)(f + end - sp - 1), sp + 1);
+  c->part = (col_part)part;
   S->ncols++;
-  return RCB_OK;
+  return numeric_station(S, c->name, k);
 }
 
 /* Columns come in pairs re+im or mag+phase_deg of one channel. */
@@ -172,14 +290,7 @@ static rcb_status header(csv_state *S, char *text) {
   char *p = text, *f = next_field(&p);
   size_t k = 0;
   rcb_status st;
-  if (strcmp(f, "freq_hz") == 0) {
-    S->type = RCB_MEAS_FRF;
-  } else if (strcmp(f, "rpm") == 0) {
-    S->type = RCB_MEAS_UNBALANCE;
-  } else {
-    return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: first column '%s': expected freq_hz "
-                         "(FRF) or rpm (unbalance response)", S->path, S->line, f);
-  }
+  if ((st = abscissa(S, f))) return st;
   while ((f = next_field(&p)) != NULL)
     if ((st = header_col(S, f, ++k))) return st;
   S->have_header = 1;
@@ -291,12 +402,20 @@ rcb_status rcb_meas_read_csv(rcb_meas *ms, const char *path) {
   S.path = path;
   S.kind = RCB_RECEPTANCE;
   rcb_meas_clear(ms);
+  rcb_meas_clear_warnings(ms);
   if ((st = rcb_meas_slurp(ms, path, &buf, &len))) return st;
   if (strlen(buf) != len)
     st = rcb_meas_fail(ms, RCB_ERR_PARSE, "%s: contains NUL bytes; expected a text CSV file",
                        path);
   if (!st) st = parse_lines(&S, buf);
   if (!st) st = build(&S);
+  if (!st) ms->speed_given = S.type == RCB_MEAS_FRF && S.have_rpm;
+  if (!st && S.type == RCB_MEAS_FRF && !S.have_rpm) {
+    st = rcb_meas_warn(ms, "%s: no '# rpm = R' line before the header: the file does not "
+                       "state the test speed, so it reads as 0 rpm; state it (the line, "
+                       "rcbtool --rpm R, the model's [test] rpm, rcb_meas_set_speed)", path);
+    ms->speed_warning = ms->n_warnings;
+  }
   if (st) rcb_meas_clear(ms);
   rcb_free(&ms->alloc, buf);
   rcb_free(&ms->alloc, S.cols);

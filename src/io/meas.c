@@ -47,13 +47,61 @@ void rcb_meas_clear(rcb_meas *ms) {
   ms->x = NULL;
   ms->n = 0;
   ms->speed = 0.0;
+  ms->speed_given = 0;
   ms->type = RCB_MEAS_FRF;
+}
+
+rcb_status rcb_meas_warn(rcb_meas *ms, const char *fmt, ...) {
+  va_list ap;
+  if (rcb_grow(&ms->alloc, (void **)&ms->warnings, &ms->cap_warnings, ms->n_warnings + 1,
+               sizeof *ms->warnings))
+    return rcb_meas_fail(ms, RCB_ERR_NOMEM, "out of memory recording a measurement warning");
+  va_start(ap, fmt);
+  vsnprintf(ms->warnings[ms->n_warnings].text, RCB_WARNING_MAX, fmt, ap);
+  va_end(ap);
+  ms->n_warnings++;
+  return RCB_OK;
+}
+
+void rcb_meas_clear_warnings(rcb_meas *ms) {
+  rcb_free(&ms->alloc, ms->warnings);
+  ms->warnings = NULL;
+  ms->n_warnings = ms->cap_warnings = 0;
+  ms->speed_warning = 0;
+}
+
+size_t rcb_meas_warning_count(const rcb_meas *ms) { return ms ? ms->n_warnings : 0; }
+
+const char *rcb_meas_warning(const rcb_meas *ms, size_t i) {
+  return ms && i < ms->n_warnings ? ms->warnings[i].text : NULL;
+}
+
+int rcb_meas_speed_given(const rcb_meas *ms) { return ms ? ms->speed_given : 0; }
+
+rcb_status rcb_meas_set_speed(rcb_meas *ms, double speed) {
+  if (!ms) return RCB_ERR_ARG;
+  if (ms->n == 0 || ms->type != RCB_MEAS_FRF)
+    return rcb_meas_fail(ms, RCB_ERR_STATE, "set_speed: the measurement holds no FRFs (the "
+                         "rotor speed of an unbalance response is its abscissa)");
+  if (!isfinite(speed))
+    return rcb_meas_fail(ms, RCB_ERR_ARG, "set_speed: rotor speed %g: expected a finite "
+                         "value (rad/s, negative for synchronous)", speed);
+  ms->speed = speed < 0.0 ? -1.0 : speed;
+  ms->speed_given = 1;
+  if (ms->speed_warning) { /* answered: drop the read's "speed not stated" warning */
+    size_t i = ms->speed_warning - 1;
+    memmove(&ms->warnings[i], &ms->warnings[i + 1], (ms->n_warnings - i - 1) * sizeof *ms->warnings);
+    ms->n_warnings--;
+    ms->speed_warning = 0;
+  }
+  return RCB_OK;
 }
 
 void rcb_meas_destroy(rcb_meas *ms) {
   rcb_allocator a;
   if (!ms) return;
   rcb_meas_clear(ms);
+  rcb_meas_clear_warnings(ms);
   a = ms->alloc;
   rcb_free(&a, ms);
 }
@@ -96,6 +144,7 @@ rcb_status rcb_meas_set_grid_at(rcb_meas *ms, rcb_meas_type type, size_t n, cons
   ms->n = n;
   ms->type = type;
   ms->speed = type == RCB_MEAS_FRF ? speed : 0.0;
+  ms->speed_given = 1; /* a reader sets what its file stated */
   ms->errmsg[0] = '\0';
   return RCB_OK;
 }

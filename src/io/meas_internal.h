@@ -28,8 +28,12 @@ struct rcb_meas {
   size_t n;     /* points */
   double *x;    /* rad/s, n of them */
   double speed; /* rad/s (FRF test speed, < 0 synchronous) */
+  int speed_given; /* the file or the caller stated the speed (not a default 0) */
   rcb_meas_ch *ch;
   size_t nch, capch;
+  rcb_warning_t *warnings; /* of the last read (rcb_meas_warning) */
+  size_t n_warnings, cap_warnings;
+  size_t speed_warning; /* 1 + index of the "speed not stated" warning, 0: none */
 };
 
 /* printf into ms->errmsg, returns st. */
@@ -41,6 +45,20 @@ rcb_status rcb_meas_fail(rcb_meas *ms, rcb_status st, const char *fmt, ...)
 #ifdef __clang_analyzer__ /* returns st: see rcb_set_error in core/rcb_internal.h */
 #define rcb_meas_fail(o, st, ...) ((void)(rcb_meas_fail)((o), (st), __VA_ARGS__), (st))
 #endif
+
+/* Record a warning of a read (valid but likely misread input); RCB_ERR_NOMEM
+ * with the message set when it cannot be stored. */
+rcb_status rcb_meas_warn(rcb_meas *ms, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+/* Forget the warnings (at the start of every read). */
+void rcb_meas_clear_warnings(rcb_meas *ms);
+/* uff58_warn.c: after a UFF read, warn on channels at "#N" (a node the map
+ * of @p nmap entries does not name) and, for FRFs, on a z axis of type
+ * @p ztype other than 19 (the speed is not stated); sets ms->speed_given. */
+rcb_status rcb_uff_read_warnings(rcb_meas *ms, const char *path, size_t nmap, long ztype);
 
 /* Drop grid and channels (the object stays usable). */
 void rcb_meas_clear(rcb_meas *ms);

@@ -549,6 +549,7 @@ typedef struct uff_set {
   double *x; /* Hz or rpm, owned */
   double scale; /* to rad/s */
   double speed; /* rad/s */
+  long ztype;   /* z axis data type of the first record (19: speed in rpm) */
   size_t first_index, first_line;
 } uff_set;
 
@@ -612,6 +613,7 @@ static rcb_status accept(uff_reader *R, uff_set *S, uff_rec *r) {
     r->x = NULL;
     S->scale = scale;
     S->speed = speed;
+    S->ztype = r->spec[3];
     S->first_index = r->index;
     S->first_line = r->line;
   } else if ((st = match_first(R, S, r, type, scale, speed))) {
@@ -802,6 +804,7 @@ rcb_status rcb_meas_read_uff(rcb_meas *ms, const char *path, size_t nmap,
   if (!ms) return RCB_ERR_ARG;
   if (nmap && !map) return rcb_meas_fail(ms, RCB_ERR_ARG, "read_uff: node map is NULL");
   rcb_meas_clear(ms);
+  rcb_meas_clear_warnings(ms);
   if ((st = rcb_meas_slurp(ms, path, &buf, &len))) return st;
   memset(&R, 0, sizeof R);
   memset(&S, 0, sizeof S);
@@ -814,6 +817,7 @@ rcb_status rcb_meas_read_uff(rcb_meas *ms, const char *path, size_t nmap,
   R.map = map;
   st = scan(&R, &S);
   if (!st) st = build(&R, &S);
+  if (!st) st = rcb_uff_read_warnings(ms, path, nmap, S.ztype);
   if (st) rcb_meas_clear(ms);
   for (i = 0; i < S.n; i++) rcb_free(&ms->alloc, S.ch[i].y);
   rcb_free(&ms->alloc, S.ch);

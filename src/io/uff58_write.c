@@ -2,8 +2,12 @@
  * UFF dataset 58 writer (ASCII 58 and binary 58b), the counterpart of
  * uff58_read.c (record layout described there). One record per channel:
  * function type 4 (FRF) or 1 (unbalance response, reference node 0), double
- * complex data (type 6), abscissa in Hz (type 18), ordinate 8/11/12 over 13
- * by kind, rotor speed of an FRF test as the z value (type 19, rpm).
+ * complex data (type 6), abscissa in Hz (type 18) for FRFs and in rpm (type
+ * 19) for unbalance responses (a run-up grid in whole rpm stays exact in the
+ * E13.6 fields, which the same grid in Hz does not), ordinate 8/11/12 over 13
+ * by kind, labelled as translations (m) or rotations (rad) and forces (N) or
+ * moments (N m) by direction, rotor speed of an FRF test as the z value
+ * (type 19, rpm).
  * ASCII values are 4E20.12 and the abscissa E13.6 fields (13 columns, as the
  * format's E13.5); binary data is IEEE little-endian doubles, an uneven
  * abscissa interleaved as doubles (as pyuff writes and reads it). The file is
@@ -89,16 +93,19 @@ typedef struct uff_out {
   FILE *fp;
   int binary, even, frf;
   size_t n;
-  const double *hz; /* abscissa in Hz */
-  double x0, dx;    /* Hz, as written */
+  const double *hz; /* abscissa in Hz (FRF) or rpm (unbalance) */
+  double x0, dx;    /* Hz or rpm, as written */
   double zrpm;      /* z value: rotor speed, rpm */
 } uff_out;
 
 static void write_header(const uff_out *o, const rcb_meas_ch *c, size_t idx, const uff_dof *rd,
                          const uff_dof *fd) {
   static const long ord_type[] = {8, 11, 12};
-  static const char *const ord_lab[] = {"Displacement", "Velocity", "Acceleration"};
-  static const char *const ord_unit[] = {"m", "m/s", "m/s^2"};
+  static const char *const ord_lab[2][3] = {
+      {"Displacement", "Velocity", "Acceleration"},
+      {"Rotation", "Angular velocity", "Angular acceleration"}};
+  static const char *const ord_unit[2][3] = {{"m", "m/s", "m/s^2"}, {"rad", "rad/s", "rad/s^2"}};
+  int rot = rd->dir == 4 || rd->dir == 5, mom = o->frf && (fd->dir == 4 || fd->dir == 5);
   FILE *fp = o->fp;
   size_t nbytes = o->n * (o->even ? 16 : 24);
   fprintf(fp, "%6d\n%6d", -1, 58);
@@ -115,12 +122,13 @@ static void write_header(const uff_out *o, const rcb_meas_ch *c, size_t idx, con
           o->frf ? fd->dir : 0L);
   fprintf(fp, "%10d%10zu%10d%13.6E%13.6E%13.6E\n", 6, o->n, o->even ? 1 : 0,
           o->even ? o->x0 : 0.0, o->even ? o->dx : 0.0, o->frf ? o->zrpm : 0.0);
-  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", 18, 0, 0, 0,
-          o->frf ? "Frequency" : "Rotor speed", "Hz");
-  fprintf(fp, "%10ld%5d%5d%5d %-20s %-20s\n", ord_type[c->kind], 0, 0, 0, ord_lab[c->kind],
-          ord_unit[c->kind]);
+  fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", o->frf ? 18 : 19, 0, 0, 0,
+          o->frf ? "Frequency" : "Rotor speed", o->frf ? "Hz" : "rpm");
+  fprintf(fp, "%10ld%5d%5d%5d %-20s %-20s\n", ord_type[c->kind], 0, 0, 0,
+          ord_lab[rot][c->kind], ord_unit[rot][c->kind]);
   if (o->frf) {
-    fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", 13, 0, 0, 0, "Force", "N");
+    fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", 13, 0, 0, 0, mom ? "Moment" : "Force",
+            mom ? "N m" : "N");
     fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", 19, 0, 0, 0, "Rotor speed", "rpm");
   } else {
     fprintf(fp, "%10d%5d%5d%5d %-20s %-20s\n", 0, 0, 0, 0, "NONE", "NONE");
@@ -176,10 +184,10 @@ rcb_status rcb_meas_write_uff(const rcb_meas *cms, const char *path, int binary,
   if (!st) st = rcb_atomic_open(ms, &af, path, 1);
   if (!st) {
     memset(&o, 0, sizeof o);
-    for (i = 0; i < ms->n; i++) hz[i] = ms->x[i] / (2.0 * RCB_PI);
+    o.frf = ms->type == RCB_MEAS_FRF;
+    for (i = 0; i < ms->n; i++) hz[i] = ms->x[i] * (o.frf ? 1.0 / (2.0 * RCB_PI) : 30.0 / RCB_PI);
     o.fp = af.fp;
     o.binary = binary != 0;
-    o.frf = ms->type == RCB_MEAS_FRF;
     o.n = ms->n;
     o.hz = hz;
     o.even = even_grid(hz, ms->n, o.binary, &o.x0, &o.dx);

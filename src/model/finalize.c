@@ -271,7 +271,7 @@ rcb_status rcb_model_finalize(rcb_model *m) {
   m->n_nodes = 0;
   m->n_elements = 0;
   m->n_peds = 0;
-  if ((st = mesh_shafts(m)) || (st = resolve_all(m)) || (st = number_dofs(m)) ||
+  if ((st = rcb_model_check_magnitudes(m)) || (st = mesh_shafts(m)) || (st = resolve_all(m)) || (st = number_dofs(m)) ||
       (st = build_stations(m)) || (st = check_uffmap(m)) ||
       (st = rcb_model_collect_warnings(m)))
     return st;

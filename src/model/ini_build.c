@@ -441,12 +441,25 @@ static rcb_status build_uff(ini_ctx *c, const ini_section *s) {
   return RCB_OK;
 }
 
+/* [test] rpm = rotor speed of the measurements this model is compared with. */
+static rcb_status build_test(ini_ctx *c, const ini_section *s) {
+  double rpm;
+  if (!rcb_ini_get(s, "rpm")) return RCB_OK;
+  TRY(rcb_ini_get_num(c, s, "rpm", "the test's rotor speed >= 0, rpm", 1, 0.0, &rpm));
+  if (rcb_model_set_test_speed(c->m, rpm * RCB_PI / 30.0)) {
+    const ini_entry *e = rcb_ini_get(s, "rpm");
+    return rcb_ini_error(c, RCB_ERR_PARSE, e->line, s, "rpm", "%g: expected a rotor speed >= 0 "
+                         "(rpm)", rpm);
+  }
+  return RCB_OK;
+}
+
 rcb_status rcb_ini_build(ini_ctx *c) {
   /* dependency order: what is placed on a shaft comes after the shafts */
   static const ini_sec_type order[] = {INI_SEC_MODEL,     INI_SEC_MATERIAL, INI_SEC_SHAFT,
                                        INI_SEC_DISK,
                                        INI_SEC_BEARING,   INI_SEC_COUPLING, INI_SEC_UNBALANCE,
-                                       INI_SEC_STATION,   INI_SEC_UFF};
+                                       INI_SEC_STATION,   INI_SEC_UFF,      INI_SEC_TEST};
   size_t k, i;
   rcb_status st = RCB_OK;
   for (k = 0; k < sizeof order / sizeof order[0] && !st; k++)
@@ -463,6 +476,7 @@ rcb_status rcb_ini_build(ini_ctx *c) {
         case INI_SEC_UNBALANCE: st = build_unbalance(c, s); break;
         case INI_SEC_STATION: st = build_station(c, s); break;
         case INI_SEC_UFF: st = build_uff(c, s); break;
+        case INI_SEC_TEST: st = build_test(c, s); break;
         default: break;
       }
     }

@@ -26,7 +26,8 @@
 #define INI_MAX_FILE ((size_t)16 * 1024 * 1024)
 
 static const char *const type_names[INI_SEC_COUNT] = {
-    "model", "material", "shaft", "disk", "bearing", "coupling", "unbalance", "station", "uff"};
+    "model", "material", "shaft", "disk", "bearing", "coupling", "unbalance", "station", "uff",
+    "test"};
 
 /* Keys of each section type, in the order the format documents them. */
 static const char *const keys_model[] = {"name", "description", "speed_factor"};
@@ -48,6 +49,7 @@ static const char *const keys_coupling[] = {
 static const char *const keys_unbalance[] = {"at", "amount", "phase_deg"};
 static const char *const keys_station[] = {"at"};
 static const char *const keys_uff[] = {"map"};
+static const char *const keys_test[] = {"rpm"};
 
 typedef struct key_table {
   const char *const *keys;
@@ -58,7 +60,7 @@ typedef struct key_table {
 static const key_table key_tables[INI_SEC_COUNT] = {
     KT(keys_model),    KT(keys_material), KT(keys_shaft),     KT(keys_disk),
     KT(keys_bearing),  KT(keys_coupling), KT(keys_unbalance), KT(keys_station),
-    KT(keys_uff)};
+    KT(keys_uff),      KT(keys_test)};
 #undef KT
 
 const char *rcb_ini_type_name(ini_sec_type t) {
@@ -75,7 +77,7 @@ rcb_status (rcb_ini_error)(ini_ctx *c, rcb_status st, int line, const ini_sectio
   va_start(ap, fmt);
   vsnprintf(what, sizeof what, fmt, ap);
   va_end(ap);
-  if (s && (s->type == INI_SEC_MODEL || s->type == INI_SEC_UFF))
+  if (s && !s->name[0]) /* [model], [uff], [test] take no name */
     snprintf(where, sizeof where, " [%s]", type_names[s->type]);
   else if (s)
     snprintf(where, sizeof where, " [%s %s]", type_names[s->type], s->name);
@@ -224,11 +226,11 @@ static rcb_status open_section(ini_ctx *c, const char *p) {
     return rcb_ini_error(c, RCB_ERR_PARSE, c->line, NULL, NULL,
                          "unknown section type [%s]; expected one of: %s", type, all);
   }
-  if ((t == INI_SEC_MODEL || t == INI_SEC_UFF) && nf > 1)
+  if ((t == INI_SEC_MODEL || t == INI_SEC_UFF || t == INI_SEC_TEST) && nf > 1)
     return rcb_ini_error(c, RCB_ERR_PARSE, c->line, NULL, NULL,
                          "[%s %s]: the [%s] section takes no name; expected [%s]", type, name,
                          type, type);
-  if (t != INI_SEC_MODEL && t != INI_SEC_UFF && nf < 2)
+  if (t != INI_SEC_MODEL && t != INI_SEC_UFF && t != INI_SEC_TEST && nf < 2)
     return rcb_ini_error(c, RCB_ERR_PARSE, c->line, NULL, NULL,
                          "[%s] needs a name; expected [%s NAME], e.g. [%s %s]", type, type,
                          type, t == INI_SEC_SHAFT ? "A" : "X1");
@@ -433,6 +435,7 @@ static void model_reset(rcb_model *m) {
   m->ndof = m->bandwidth = 0;
   m->n_peds = 0;
   m->speed_factor = 1.0;
+  m->has_test_speed = 0;
   m->finalized = 0;
 }
 

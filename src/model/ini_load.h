@@ -23,6 +23,7 @@ typedef enum ini_sec_type {
   INI_SEC_UNBALANCE,
   INI_SEC_STATION,
   INI_SEC_UFF,
+  INI_SEC_TEST,
   INI_SEC_COUNT
 } ini_sec_type;
 

@@ -302,6 +302,10 @@ static void write_rest(wbuf *w, const rcb_model *m) {
       wr(w, "%s%ld %s", i ? ", " : "", m->uffmap[i].node, m->uffmap[i].station);
     wr(w, "\n");
   }
+  if (m->has_test_speed) {
+    wr(w, "\n[test]\n");
+    kv_num(w, "rpm", m->test_speed * 30.0 / RCB_PI, "rotor speed of the measurements");
+  }
 }
 
 rcb_status rcb_model_write_ini(const rcb_model *m, char *buf, size_t size, size_t *needed) {

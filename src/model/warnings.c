@@ -134,7 +134,7 @@ rcb_status rcb_model_collect_warnings(rcb_model *m) {
   rcb_status st;
   m->n_warnings = 0;
   if ((st = check_materials(m)) || (st = check_shafts(m)) || (st = check_disks(m)) ||
-      (st = check_connected(m)))
+      (st = check_connected(m)) || (st = rcb_model_check_plausible(m)))
     return st;
   return RCB_OK;
 }

@@ -938,6 +938,31 @@ assert any(abs(p["meas_x"] - 150.3) < 1 and abs(p["freq_err_pct"]) < 0.5 for p i
 EOF2
   # the channel the model does not know: exit 3, names it and --map
   run compare "$W/soft.ini" "$W/noisy.uff"; expect_rc 3; err_has "#10"; err_has "--map" ;;
+compare_map_adds)
+  # issue #17: --map adds to the model's [uff] map (it replaced it: the other nodes read
+  # as model nodes #10, #11, #16, 42 % error); a node the map leaves out is warned
+  WK=$EX/walkthrough
+  run compare "$WK/model.ini" "$WK/measured.uff"; expect_rc 0; out_has "overall: error 6.53 %"
+  run compare "$WK/model.ini" "$WK/measured.uff" --map 3=DA; expect_rc 0
+  out_has "overall: error 6.53 %"
+  ! grep -q "not in the node map" "$W/err" || fail "a mapped node was warned"
+  sed -e 's/^map = 3 DA, 10 C.A, 11 C.B, 16 DB/map = 3 DA, 10 C.A, 11 C.B, 15 DB/' \
+    "$WK/model.ini" >"$W/offbyone.ini"
+  grep -q '15 DB' "$W/offbyone.ini" || fail "sed did not change the map"
+  run compare "$W/offbyone.ini" "$WK/measured.uff"; expect_rc 0
+  err_has "UFF node 16 is not in the node map"; err_has "read as model node #16" ;;
+compare_rpm)
+  # issue #17: a CSV without '# rpm' reads as 0 rpm with a warning; --rpm states the speed
+  run simulate "$MODEL" --frf --out DA.x,DA.y --in DA.x --fmin 100 --fmax 300 --points 21 \
+    --rpm 10000 -o "$W/s.csv"
+  [ "$RC" -eq 0 ] || fail "simulate failed"
+  grep -v '^# rpm' "$W/s.csv" >"$W/norpm.csv"
+  run compare "$MODEL" "$W/norpm.csv"; expect_rc 0; err_has "no '# rpm = R' line"
+  out_has "FRFs at 0 rpm"
+  run compare "$MODEL" "$W/norpm.csv" --rpm 10000; expect_rc 0; out_has "overall: error 0 %"
+  ! grep -q "warning" "$W/err" || fail "warned after --rpm"
+  run compare "$MODEL" "$W/s.csv" --rpm 3000; expect_rc 0; err_has "--rpm 3000 replaces"
+  usage compare "$MODEL" "$W/norpm.csv" --rpm fast; err_has "--rpm" ;;
 compare_unbalance)
   run simulate "$MODEL" --unbalance --out DA.x,DA.y,DB.x,DB.y --rpm-min 300 --rpm-max 18300 \
     --points 301 -o "$W/unb.csv"
@@ -1010,7 +1035,12 @@ transient_csv)
   [ "$(wc -l <"$W/out")" -eq 4 ] || fail "expected a header and 3 samples" ;;
 transient_usage)
   usage transient "$MODEL" --out DA.x --rpm 3000; err_has "expected --t-end"
-  usage transient "$MODEL" --out DA.x --rpm 3000 --rpm-end 6000; err_has "expected --accel > 0" ;;
+  usage transient "$MODEL" --out DA.x --rpm 3000 --rpm-end 6000; err_has "expected --accel > 0"
+  # issue #17: a stated 0 is refused, not replaced by the default
+  usage transient "$MODEL" --out DA.x --rpm 3000 --t-end 0.01 --dt 0
+  err_has "option --dt expects a sampling interval > 0"
+  usage transient "$MODEL" --out DA.x --rpm 3000 --rpm-end 6000 --accel 100 --t-end 0
+  err_has "option --t-end expects a duration > 0" ;;
 timecheck_json)
   run timecheck "$MODEL" --out DA.x --rpm-min 3000 --rpm-max 3000 --points 1 --rtol 1e-6 \
     --steady-tol 1e-3 --json

@@ -54,8 +54,8 @@ def test_unbalance_export_read_by_pyuff(rcb, paper, tmp_path):
     node_of = {v: k for k, v in mp.items()}
     for c, (st, d) in enumerate((("DA", 1), ("DB", 2))):
         r = next(r for r in recs if r["rsp_node"] == node_of[st] and abs(r["rsp_dir"]) == d)
-        # abscissa in Hz in the file: rotor speed / 60; an even grid is stored as
-        # start and increment in the header's E13.5 fields (6 digits)
-        np.testing.assert_allclose(r["x"], rpm / 60, rtol=1e-6)
+        # abscissa in rpm in the file (type 19): this grid of whole rpm is exact
+        assert r["abscissa_spec_data_type"] == 19
+        np.testing.assert_allclose(r["x"], rpm, rtol=1e-14)
         np.testing.assert_allclose(np.sign(r["rsp_dir"]) * r["data"], Q[:, c], rtol=1e-12)
     assert all(math.isfinite(abs(v)) for v in Q.ravel())

@@ -173,6 +173,106 @@ def test_simulate_unbalance_read_by_pyuff(exe, tmp_path, binary):
     for s, c in zip(sets, ref["channels"]):
         assert s["func_type"] == 1 and s["ref_node"] == 0
         assert (s["rsp_node"], s["rsp_dir"]) == node_dir(c["output"])
-        np.testing.assert_allclose(s["x"] * 60.0, ref["rpm"], rtol=1e-12)  # Hz of rotation
+        assert s["abscissa_spec_data_type"] == 19  # rpm (issue #17)
+        np.testing.assert_allclose(s["x"], ref["rpm"], rtol=1e-12)
         want = np.array(c["re"]) + 1j * np.array(c["im"])
         assert np.all(np.abs(s["data"] - want) <= rtol * np.abs(want)), c["output"]
+
+
+def test_simulate_runup_speeds_exact(exe, tmp_path):
+    """A run-up grid in whole rpm (0..10000 by 50) is written in rpm (type 19):
+    pyuff reads the speeds exactly. In Hz the step 0.8333.. Hz does not fit the
+    E13.6 fields (the last speed came back as 10000.002 rpm)."""
+    uff = tmp_path / "r.uff"
+    run(exe, "simulate", MODEL, "--unbalance", "--out", "DA.x", "--rpm-min", 0,
+        "--rpm-max", 10000, "--points", 201, "--map", "1=DA", "-o", uff)
+    s = pyuff.UFF(str(uff)).read_sets()
+    s = s[0] if isinstance(s, list) else s
+    assert s["abscissa_spec_data_type"] == 19
+    np.testing.assert_allclose(s["x"], np.linspace(0.0, 10000.0, 201), rtol=1e-14, atol=0)
+
+
+def test_simulate_rotation_labels(exe, tmp_path):
+    """A rotation response over a moment is labelled rad over N m, a
+    translation over a force m over N (not "Acceleration m/s^2" for all)."""
+    uff = tmp_path / "l.uff"
+    run(exe, "simulate", MODEL, "--frf", "--out", "DA.rx,DA.x", "--in", "DB.ry",
+        "--fmin", 100, "--fmax", 200, "--points", 5, "--kind", "inertance",
+        "--map", "1=DA,10=DB", "-o", uff)
+    sets = pyuff.UFF(str(uff)).read_sets()
+    lab = {s["rsp_dir"]: s for s in sets}
+    assert lab[4]["ordinate_axis_units_lab"].strip() == "rad/s^2"
+    assert lab[1]["ordinate_axis_units_lab"].strip() == "m/s^2"
+    for s in sets:
+        assert s["orddenom_axis_units_lab"].strip() == "N m"
+
+
+# ---- issue #17: what another tool's file leaves out is not read silently ----
+
+SPEED_CH = [("DA.x", "DA.x", 1, 1, 1, 1), ("DA.y", "DA.x", 1, 2, 1, 1)]
+
+
+def write_speed_in_text_only(exe, path, nodes=(1, 1)):
+    """FRFs of the model at 10000 rpm, written by pyuff as another tool does:
+    the speed only in the ID text, z axis of type 0 (unknown), z value 0."""
+    import json
+
+    f = np.linspace(100.0, 300.0, 21)
+    ref = json.loads(run(exe, "frf", MODEL, "--out", "DA.x,DA.y", "--in", "DA.x",
+                         "--fmin", 100, "--fmax", 300, "--points", 21, "--rpm", 10000,
+                         "--json").stdout)
+    if path.exists():
+        path.unlink()
+    u = pyuff.UFF(str(path))
+    for k, c in enumerate(ref["channels"]):
+        d = pyuff.prepare_58(
+            func_type=4, rsp_node=nodes[k], rsp_dir=1 + k, ref_node=1, ref_dir=1,
+            data=np.array(c["re"]) + 1j * np.array(c["im"]), x=f,
+            id1="run 7", id2="speed 10000 rpm", abscissa_spacing=1,
+            abscissa_spec_data_type=18, ordinate_spec_data_type=8,
+            orddenom_spec_data_type=13, z_axis_spec_data_type=0, z_axis_value=0.0)
+        u._write_set(d, "add")
+
+
+def test_speed_only_in_text_header(exe, tmp_path):
+    uff = tmp_path / "other.uff"
+    write_speed_in_text_only(exe, uff)
+    import json
+
+    def summary(r):
+        return json.loads(r.stdout)["summary"]
+
+    # before: read as 0 rpm without a word (error 8.2 %, FRAC nan)
+    r = run(exe, "compare", MODEL, uff, "--map", "1=DA", "--json")
+    assert "does not state the test speed" in r.stderr and "reads as 0 rpm" in r.stderr
+    assert summary(r)["error_pct"] > 1.0
+    # --rpm states it: the model at 10000 rpm is the data (error ~ 0), no warning
+    r = run(exe, "compare", MODEL, uff, "--map", "1=DA", "--rpm", 10000, "--json")
+    assert summary(r)["error_pct"] < 1e-6 and "warning" not in r.stderr
+    # the model's [test] rpm states it too
+    model = tmp_path / "m.ini"
+    model.write_text(MODEL.read_text() + "\n[test]\nrpm = 10000\n")
+    r = run(exe, "compare", model, uff, "--map", "1=DA", "--json")
+    assert summary(r)["error_pct"] < 1e-6 and "[test] rpm = 10000" in r.stderr
+    # a fit at 0 rpm names the channel and the cause instead of "infinite"
+    r = run(exe, "fit", MODEL, uff, "--map", "1=DA", "--params", "coupling.C.kt",
+            code=4)
+    assert "channel DA.y/DA.x" in r.stderr and "read as 0 rpm" in r.stderr
+
+
+def test_unmapped_node_warned(exe, tmp_path):
+    """Node 2 (DA.y's record) is not in the map: read as model node #2, warned;
+    --map adds to the model's [uff] map instead of replacing it."""
+    uff = tmp_path / "nodes.uff"
+    write_speed_in_text_only(exe, uff, nodes=(1, 2))
+    r = run(exe, "compare", MODEL, uff, "--map", "1=DA", "--rpm", 10000)
+    assert "UFF node 2 is not in the node map" in r.stderr
+    model = tmp_path / "m.ini"
+    model.write_text(MODEL.read_text() + "\n[uff]\nmap = 2 DA\n")
+    # the model maps node 2; the option maps node 1 to the same station: the
+    # option's entry replaces the model's, node 2 is unmapped again
+    r = run(exe, "compare", model, uff, "--map", "1=DA", "--rpm", 10000)
+    assert "UFF node 2 is not in the node map" in r.stderr
+    model.write_text(MODEL.read_text() + "\n[uff]\nmap = 2 P1\n")
+    r = run(exe, "compare", model, uff, "--map", "1=DA", "--rpm", 10000)
+    assert "not in the node map" not in r.stderr  # both maps used

@@ -25,6 +25,9 @@ enum {
 #define CLI_PI 3.14159265358979323846
 #define CLI_RPM_TO_RAD_S (CLI_PI / 30.0) /* rad/s per rpm */
 #define CLI_HZ_TO_RAD_S (2.0 * CLI_PI)   /* rad/s per Hz */
+/* A numeric macro as a string literal, for help texts (a default stated once). */
+#define CLI_STR_(x) #x
+#define CLI_STR(x) CLI_STR_(x)
 
 /** One command-specific option, e.g. {"--rpm", "R"}; metavar NULL = flag. */
 typedef struct cli_opt {
@@ -249,8 +252,9 @@ typedef struct cli_uff_map {
   char **owned;  /**< station names added by cli_uff_automap */
   size_t nowned;
 } cli_uff_map;
-/** Parse option @p opt (absent: the model's [uff] map when @p m is given, else an
- * empty map); usage error (2) when malformed. */
+/** Parse option @p opt, added to the model's [uff] map when @p m is given (an
+ * option entry replaces the model's entry for the same node or station); usage
+ * error (2) when malformed. */
 int cli_uff_map_parse(const cli_args *a, const char *opt, const rcb_model *m,
                       cli_uff_map *mp);
 void cli_uff_map_free(cli_uff_map *mp);

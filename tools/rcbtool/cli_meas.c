@@ -1,5 +1,6 @@
 /* Commands that take a model and a measurement (fit, compare, diagnose):
  * both positional, and the measurement read by its extension. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -116,6 +117,8 @@ static int stdin_to_file(char *path, size_t size, int *slot, int *is_uff) {
 
 static int meas_read(const cli_args *a, const char *path, const rcb_model *m, int is_uff,
                      rcb_meas **out);
+static int cli_meas_speed_and_warnings(const cli_args *a, const rcb_model *m, rcb_meas *ms,
+                                       const char *path);
 
 int cli_meas_read(const cli_args *a, const char *path, const rcb_model *m,
                      rcb_meas **out) {
@@ -165,7 +168,55 @@ static int meas_read(const cli_args *a, const char *path, const rcb_model *m, in
     rcb_meas_destroy(ms);
     return rc;
   }
+  if ((rc = cli_meas_speed_and_warnings(a, m, ms, path))) {
+    rcb_meas_destroy(ms);
+    return rc;
+  }
   *out = ms;
   return 0;
 }
 
+
+/* The rotor speed of an FRF test (issue #17): --rpm, else what the file
+ * states, else the model's [test] rpm; a mismatch or a speed nobody stated
+ * is said on stderr. */
+static int test_speed(const cli_args *a, const rcb_model *m, rcb_meas *ms, const char *path) {
+  double rpm = 0.0, model_w = 0.0;
+  int have_model = m && rcb_model_get_test_speed(m, &model_w) == RCB_OK, rc;
+  double file_rpm = rcb_meas_speed(ms) * 30.0 / CLI_PI;
+  if (cli_opt_value(a, "--rpm")) {
+    if (rcb_meas_get_type(ms) != RCB_MEAS_FRF)
+      return cli_usage(a->cmd, "--rpm applies to FRF measurements ('%s' holds unbalance "
+                       "responses, whose speeds are their abscissa)", path);
+    if ((rc = cli_opt_nonneg(a, "--rpm", "rpm", 0.0, &rpm))) return rc;
+    if (rcb_meas_speed_given(ms) && rcb_meas_speed(ms) >= 0.0 && fabs(file_rpm - rpm) > 1e-9 * rpm)
+      fprintf(stderr, "rcbtool: note: --rpm %g replaces the speed '%s' states (%g rpm)\n", rpm,
+              path, file_rpm);
+    return rcb_meas_set_speed(ms, rpm * CLI_RPM_TO_RAD_S) ? cli_fail(CLI_EXIT_INPUT, "%s",
+                                                                     rcb_meas_errmsg(ms))
+                                                          : 0;
+  }
+  if (rcb_meas_get_type(ms) != RCB_MEAS_FRF || !have_model) return 0;
+  rpm = model_w * 30.0 / CLI_PI;
+  if (!rcb_meas_speed_given(ms)) {
+    fprintf(stderr, "rcbtool: note: '%s' does not state the rotor speed; using the model's "
+            "[test] rpm = %g\n", path, rpm);
+    return rcb_meas_set_speed(ms, model_w) ? cli_fail(CLI_EXIT_INPUT, "%s", rcb_meas_errmsg(ms))
+                                           : 0;
+  }
+  if (rcb_meas_speed(ms) >= 0.0 && fabs(file_rpm - rpm) > 1e-6 * (rpm > 1.0 ? rpm : 1.0))
+    fprintf(stderr, "rcbtool: warning: '%s' states %g rpm, the model's [test] rpm is %g; "
+            "comparing at the file's %g rpm (--rpm R to choose)\n", path, file_rpm, rpm,
+            file_rpm);
+  return 0;
+}
+
+static int cli_meas_speed_and_warnings(const cli_args *a, const rcb_model *m, rcb_meas *ms,
+                                       const char *path) {
+  size_t w;
+  int rc = test_speed(a, m, ms, path);
+  if (rc) return rc;
+  for (w = 0; w < rcb_meas_warning_count(ms); w++)
+    fprintf(stderr, "rcbtool: warning: %s\n", rcb_meas_warning(ms, w));
+  return 0;
+}

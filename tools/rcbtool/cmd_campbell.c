@@ -16,7 +16,8 @@ const char cli_help_campbell[] =
     "  --rpm-max B   last speed, rpm (required, >= rpm-min)\n"
     "  --points P    number of speeds (default 50, >= 1; with P > 1 rpm-min < rpm-max)\n"
     "  --modes N     curves per speed (default 6)\n"
-    "  --max-zeta Z  leave out roots with damping ratio above Z (default 0.99)\n"
+    "  --max-zeta Z  leave out roots with damping ratio above Z (default "
+    CLI_STR(RCB_MODES_MAX_ZETA_DEFAULT) ")\n"
     "\n"
     "CSV: lines \"# kind = campbell\", \"# critical_rpm = ...\" and \"# critical_mode =\n"
     "...\", then one table rpm,fd1_hz..fdN_hz,logdec1..logdecN,whirl1..whirlN (nan\n"
@@ -239,7 +240,7 @@ static int parse_job(const cli_args *a, camp_job *j, double *lo, double *hi) {
       (rc = cli_opt_nonneg(a, "--rpm-max", "rpm", 0.0, hi)) ||
       (rc = cli_opt_count(a, "--points", 50, &j->ns)) ||
       (rc = cli_opt_count(a, "--modes", 6, &j->nm)) ||
-      (rc = cli_opt_nonneg(a, "--max-zeta", "damping ratio", 0.99, &j->max_zeta)))
+      (rc = cli_opt_nonneg(a, "--max-zeta", "damping ratio", RCB_MODES_MAX_ZETA_DEFAULT, &j->max_zeta)))
     return rc;
   if (*lo > *hi)
     return cli_usage(a->cmd, "--rpm-min %g is above --rpm-max %g; expected rpm-min <= rpm-max",

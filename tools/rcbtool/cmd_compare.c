@@ -15,14 +15,16 @@
 
 const char cli_help_compare[] =
     "usage: rcbtool compare MODEL.ini MEAS.uff|MEAS.unv|MEAS.csv [--map NODE=STATION,...]\n"
-    "                       [--bands N] [--worst N] [--prominence DB] [--tol PCT]\n"
+    "                       [--rpm R] [--bands N] [--worst N] [--prominence DB] [--tol PCT]\n"
     "                       [--plot PREFIX] [--json] [-o FILE]\n"
     "\n"
     "Compares the model with a measurement (FRFs at a rotor speed, synchronous FRFs,\n"
     "or unbalance responses over speed): the model is evaluated at every measured\n"
     "point, as the measured kind (receptance, mobility, inertance).\n"
-    "  --map LIST       UFF node number <-> model station, e.g. 10=DA,20=C.A (default:\n"
-    "                   the model's [uff] map; nodes without one read as \"#N\")\n"
+    "  --map LIST       UFF node number <-> model station, e.g. 10=DA,20=C.A, added to\n"
+    "                   the model's [uff] map; nodes without one read as \"#N\" (warned)\n"
+    "  --rpm R          rotor speed of an FRF test, rpm (default: the file's, else the\n"
+    "                   model's [test] rpm, else 0 with a warning)\n"
     "  --bands N        frequency bands of the residual map (default 10)\n"
     "  --worst N        bands listed as the worst (default 3)\n"
     "  --prominence DB  a measured resonance stands at least DB above the higher of\n"
@@ -579,7 +581,8 @@ done:
 }
 
 int cmd_compare(int argc, char **argv) {
-  cli_opt opts[] = {{"--map", "NODE=STATION,...", NULL}, {"--bands", "N", NULL},
+  cli_opt opts[] = {{"--map", "NODE=STATION,...", NULL}, {"--rpm", "R", NULL},
+                    {"--bands", "N", NULL},
                     {"--worst", "N", NULL},              {"--prominence", "DB", NULL},
                     {"--tol", "PCT", NULL},              {"--plot", "PREFIX", NULL}};
   size_t nopts = sizeof opts / sizeof opts[0];

@@ -73,6 +73,21 @@ static int map_from_model(const rcb_model *m, cli_uff_map *mp) {
   return 0;
 }
 
+/* The option adds to the model's [uff] map (issue #17: a --map of one node
+ * used to drop the model's whole map): the model's entries whose node and
+ * station the option does not give follow the option's (mp->nodes has room). */
+static void add_model_entries(const rcb_model *m, cli_uff_map *mp) {
+  size_t i, j, nopt = mp->n, n = rcb_model_uff_node_count(m);
+  for (i = 0; i < n; i++) {
+    rcb_uff_node e;
+    int clash = 0;
+    if (rcb_model_uff_node(m, i, &e.node, &e.station)) continue;
+    for (j = 0; j < nopt && !clash; j++)
+      clash = mp->nodes[j].node == e.node || strcmp(mp->nodes[j].station, e.station) == 0;
+    if (!clash) mp->nodes[mp->n++] = e;
+  }
+}
+
 int cli_uff_map_parse(const cli_args *a, const char *opt, const rcb_model *m,
                       cli_uff_map *mp) {
   const char *list = cli_opt_value(a, opt);
@@ -85,7 +100,7 @@ int cli_uff_map_parse(const cli_args *a, const char *opt, const rcb_model *m,
   if (!mp->buf) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   strcpy(mp->buf, list);
   for (p = mp->buf; *p; p++) n += (*p == ',');
-  mp->nodes = malloc(n * sizeof *mp->nodes);
+  mp->nodes = malloc((n + (m ? rcb_model_uff_node_count(m) : 0)) * sizeof *mp->nodes);
   if (!mp->nodes) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   p = mp->buf;
   for (i = 0; i < n; i++) {
@@ -100,6 +115,7 @@ int cli_uff_map_parse(const cli_args *a, const char *opt, const rcb_model *m,
     mp->n++;
     if (comma) p = comma + 1;
   }
+  if (m) add_model_entries(m, mp);
   return 0;
 }
 

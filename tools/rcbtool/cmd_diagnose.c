@@ -11,7 +11,7 @@
 const char cli_help_diagnose[] =
     "usage: rcbtool diagnose MODEL.ini MEAS.uff|MEAS.csv [--params NAME[:LO:HI],...]\n"
     "                        [--log] [--scale linear|log10|db|complex] [--noise A,S]\n"
-    "                        [--band LO:HI] [--map NODE=STATION,...] [--refits N]\n"
+    "                        [--band LO:HI] [--map NODE=STATION,...] [--rpm R] [--refits N]\n"
     "                        [--top N] [--apply K -o MODEL2.ini] [--history FILE]\n"
     "                        [--json] [--progress]\n"
     "\n"
@@ -286,6 +286,7 @@ int cmd_diagnose(int argc, char **argv) {
                     {"--noise", "BETA_A,BETA_S", NULL},
                     {"--band", "LO:HI", NULL},
                     {"--map", "NODE=STATION,...", NULL},
+                    {"--rpm", "R", NULL},
                     {"--refits", "N", NULL},
                     {"--top", "N", NULL},
                     {"--apply", "K", NULL},

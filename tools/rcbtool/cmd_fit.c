@@ -16,7 +16,7 @@ const char cli_help_fit[] =
     "                   [--log] [--method paper|nlopt:ALG]\n"
     "                   [--scale linear|log10|db|complex] [--band LO:HI]\n"
     "                   [--noise BETA_A,BETA_S] [--fd] [--max-iter N] [--starts N]\n"
-    "                   [--map NODE=STATION,...] [-o FITTED.ini] [--json] [--progress]\n"
+    "                   [--map NODE=STATION,...] [--rpm R] [-o FITTED.ini] [--json] [--progress]\n"
     "\n"
     "Fits model parameters so that the model reproduces the measurement (paper\n"
     "eq. 12: least squares over every channel and point), starting from the values\n"
@@ -50,8 +50,10 @@ const char cli_help_fit[] =
     "                 --noise predicts, or not converged: a local minimum or a\n"
     "                 missing effect), retry from up to N - 1 random starts within\n"
     "                 the bounds and keep the best (default 8; 1: no restart)\n"
-    "  --map LIST     UFF node number <-> model station, e.g. 10=DA,20=C.A (UFF\n"
-    "                 nodes without an entry read as model node \"#N\")\n"
+    "  --map LIST     UFF node number <-> model station, e.g. 10=DA,20=C.A, added to\n"
+    "                 the model's [uff] map (nodes without one: model node \"#N\", warned)\n"
+    "  --rpm R        rotor speed of an FRF test, rpm (default: the file's, else the\n"
+    "                 model's [test] rpm, else 0 with a warning)\n"
     "  -o FILE        write the fitted model as INI to FILE (atomically; never over\n"
     "                 MODEL.ini)\n"
     "\n"
@@ -692,7 +694,8 @@ int cmd_fit(int argc, char **argv) {
                     {"--max-iter", "N", NULL},
                     {"--starts", "N", NULL},
                     {"--history", "FILE", NULL},
-                    {"--map", "NODE=STATION,...", NULL}};
+                    {"--map", "NODE=STATION,...", NULL},
+                    {"--rpm", "R", NULL}};
   size_t nopts = sizeof opts / sizeof opts[0];
   fit_job j;
   cli_args a;

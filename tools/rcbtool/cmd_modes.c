@@ -11,7 +11,8 @@ const char cli_help_modes[] =
     "increasing damped frequency; only oscillating modes (wd > 0) are listed.\n"
     "  --rpm R     rotor speed, rpm (default 0)\n"
     "  --modes N   how many modes at most (default 10)\n"
-    "  --max-zeta Z  leave out roots with damping ratio above Z (default 0.99:\n"
+    "  --max-zeta Z  leave out roots with damping ratio above Z (default "
+    CLI_STR(RCB_MODES_MAX_ZETA_DEFAULT) ":\n"
     "              near-critically damped roots of stiffness-proportional damping\n"
     "              are not modes anyone measures; 1 keeps every root, as ROSS)\n"
     "\n"
@@ -99,7 +100,7 @@ int cmd_modes(int argc, char **argv) {
   if (a.help) return cli_print_help(cli_help_modes);
   if ((rc = cli_opt_nonneg(&a, "--rpm", "rotor speed, rpm", 0.0, &rpm)) ||
       (rc = cli_opt_count(&a, "--modes", MODES_DEFAULT, &want)) ||
-      (rc = cli_opt_nonneg(&a, "--max-zeta", "damping ratio", 0.99, &zmax)))
+      (rc = cli_opt_nonneg(&a, "--max-zeta", "damping ratio", RCB_MODES_MAX_ZETA_DEFAULT, &zmax)))
     return rc;
   if ((rc = cli_load_model(&a, &m))) return rc;
   rc = run(&a, m, rpm, want, zmax);

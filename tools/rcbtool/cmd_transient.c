@@ -199,6 +199,13 @@ static int tr_parse(const cli_args *a, tr_opts *o) {
   if (r1 != r0 && acc <= 0.0)
     return cli_usage(a->cmd, "--rpm-end %g differs from --rpm %g; expected --accel > 0 (rpm/s)",
                      r1, r0);
+  /* a stated 0 is refused, not replaced by the default (issue #17) */
+  if (cli_opt_value(a, "--dt") && !(o->dt > 0.0))
+    return cli_usage(a->cmd, "option --dt expects a sampling interval > 0 (s); leave it out "
+                     "for the default (1/40 of the revolution at the highest speed)");
+  if (cli_opt_value(a, "--t-end") && !(o->t_end > 0.0))
+    return cli_usage(a->cmd, "option --t-end expects a duration > 0 (s); leave it out for the "
+                     "ramp time |B - A|/R");
   if (o->t_end <= 0.0) {
     if (r1 == r0) return cli_usage(a->cmd, "expected --t-end S (s) at constant speed");
     o->t_end = fabs(r1 - r0) / acc;

@@ -91,8 +91,9 @@ class _Modes(Handle):
         super().__init__()
         self.model = model
         self._create("rcb_modes_create", model.handle, None)
-        self.check(_lib.lib().rcb_modes_set_max_zeta(self.handle, float(max_zeta)),
-                   "rcb_modes_set_max_zeta")
+        if max_zeta is not None:  # None: the library's RCB_MODES_MAX_ZETA_DEFAULT
+            self.check(_lib.lib().rcb_modes_set_max_zeta(self.handle, float(max_zeta)),
+                       "rcb_modes_set_max_zeta")
 
 
 @dataclass
@@ -126,9 +127,10 @@ class Modes:
         return out
 
 
-def modes(model, rpm=0.0, n=10, max_zeta=0.99, shapes=True):
+def modes(model, rpm=0.0, n=10, max_zeta=None, shapes=True):
     """The n lowest damped modes at rotor speed rpm (only oscillating modes;
-    damping ratios above max_zeta left out, as rcbtool modes does)."""
+    damping ratios above max_zeta left out, as rcbtool modes does; None: the
+    library's default, RCB_MODES_MAX_ZETA_DEFAULT)."""
     nd = model.dofs
     n = int(n)
     arr = (_lib.Mode * max(n, 1))()
@@ -168,7 +170,7 @@ class Campbell:
     critical_mode: np.ndarray  # column crossing at each critical speed
 
 
-def campbell(model, rpm, n=6, max_zeta=0.99, ratio=1.0, max_crit=64):
+def campbell(model, rpm, n=6, max_zeta=None, ratio=1.0, max_crit=64):
     """Campbell diagram over rotor speeds rpm (increasing), n modes, critical
     speeds where a curve crosses wd = ratio * Omega."""
     r = _as_array(rpm)
