@@ -56,14 +56,15 @@ static int get_line(cursor *c, const char **s, size_t *n) {
   return 1;
 }
 
-/* Columns [from, from + width) of a line, trimmed, into out (size >= 64). */
+/* Columns [from, from + width) of a line, trimmed, into out (size >= 64); text
+ * as written (units labels such as "rad/s" keep their letters). */
 static void field(const char *s, size_t n, size_t from, size_t width, char *out, size_t size) {
   size_t a = from, b = from + width, k = 0;
   if (a > n) a = n;
   if (b > n) b = n;
   while (a < b && (s[a] == ' ' || s[a] == '\t')) a++;
   while (b > a && (s[b - 1] == ' ' || s[b - 1] == '\t')) b--;
-  for (; a < b && k + 1 < size; a++) out[k++] = s[a] == 'D' || s[a] == 'd' ? 'E' : s[a];
+  for (; a < b && k + 1 < size; a++) out[k++] = s[a];
   out[k] = '\0';
 }
 
@@ -79,6 +80,8 @@ static int field_long(const char *s, size_t n, size_t from, size_t width, long *
 static int field_double(const char *s, size_t n, size_t from, size_t width, double *v) {
   char f[64], *end;
   field(s, n, from, width, f, sizeof f);
+  for (char *p = f; *p; p++) /* Fortran exponents: 1.0D+02 */
+    if (*p == 'D' || *p == 'd') *p = 'E';
   if (!f[0]) return -1;
   errno = 0;
   *v = strtod(f, &end);

@@ -34,6 +34,16 @@ static const unit_row units[] = {
     {"N", RCB_QTY_FORCE, 1.0},
     {"kN", RCB_QTY_FORCE, 1e3},
     {"lbf", RCB_QTY_FORCE, 4.4482216152605},
+    /* Rotation channels (rot_x, rot_y) and moments, as the UFF writer labels
+     * them: the quantity is the order of the derivative, rad for m. */
+    {"rad", RCB_QTY_DISPLACEMENT, 1.0},
+    {"mrad", RCB_QTY_DISPLACEMENT, 1e-3},
+    {"rad/s", RCB_QTY_VELOCITY, 1.0},
+    {"rad/s^2", RCB_QTY_ACCELERATION, 1.0},
+    {"rad/s2", RCB_QTY_ACCELERATION, 1.0},
+    {"N m", RCB_QTY_FORCE, 1.0},
+    {"Nm", RCB_QTY_FORCE, 1.0},
+    {"N*m", RCB_QTY_FORCE, 1.0},
     {"V", RCB_QTY_VOLTAGE, 1.0},
     {"mV", RCB_QTY_VOLTAGE, 1e-3},
 };
