@@ -425,6 +425,7 @@ static void test_alloc_failures(void **state) {
     if (k > 10000) fail_msg("no end to the walk");
   }
   assert_true(k > 10); /* the walk went through the clone, the edits and finalize */
+  print_message("clone + edits + finalize: %zu allocation sites walked\n", k - 1);
   {
     rcb_model *ref = load("pedestal_mass = 12\npedestal_kxx = 3e7\npedestal_kyy = 4e7\n"
                           "pedestal_cxx = 500\npedestal_cyy = 600\n",

@@ -48,10 +48,10 @@ int rcb_coupling_tied(rcb_coupling_model t) { return valid(t) ? kinds[t].tied : 
 const char *rcb_coupling_coef_key(int k) { return k >= 0 && k < 4 ? coef_keys[k] : NULL; }
 
 double *rcb_coupling_coef(rcb_coupling_params *p, int k) {
-  switch (k) {
-    case 0: return &p->kt;
-    case 1: return &p->kr;
-    case 2: return &p->ct;
-    default: return &p->cr;
-  }
+  double *v[4];
+  v[0] = &p->kt;
+  v[1] = &p->kr;
+  v[2] = &p->ct;
+  v[3] = &p->cr;
+  return v[k >= 0 && k < 4 ? k : 3];
 }
