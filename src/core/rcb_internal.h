@@ -232,7 +232,8 @@ void rcb_bearing_eval(const rcb_bearing_t *b, double speed, rcb_bearing_coefs *o
 /* A bearing's stiffness and damping blocks, column-major nd x nd with nd the
  * return value: on [shaft x, y] (nd = 2, the bearing to ground) or, with a
  * pedestal, on [shaft x, y, pedestal x, y] (nd = 4): [B -B; -B B] with
- * B = [kxx kxy; kyx kyy] (rows: force x, y; columns: displacement x, y). */
+ * B = [kxx kxy; kyx kyy] (rows: force x, y; columns: displacement x, y).
+ * Only the first nd * nd entries of Kb and Cb are written. */
 int rcb_bearing_element(const rcb_bearing_coefs *c, int pedestal, double Kb[16], double Cb[16]);
 /* A pedestal's own mass, springs and dampers to ground, 2x2 diagonal on its
  * [x, y]: M = m I, K = diag(kx, ky), C = diag(cx, cy). */

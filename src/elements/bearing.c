@@ -38,8 +38,8 @@ void rcb_bearing_eval(const rcb_bearing_t *b, double speed, rcb_bearing_coefs *o
 int rcb_bearing_element(const rcb_bearing_coefs *c, int pedestal, double Kb[16], double Cb[16]) {
   const double *kv = &c->kxx, *cv = &c->cxx; /* kxx kxy kyx kyy, row-major 2x2 */
   int nd = pedestal ? 4 : 2, bi, bj, r, s;
-  memset(Kb, 0, 16 * sizeof *Kb);
-  memset(Cb, 0, 16 * sizeof *Cb);
+  /* every entry of the nd x nd block is written (no clearing: this runs at
+   * every frequency point of a sweep, once per bearing) */
   for (bj = 0; bj < nd / 2; bj++)
     for (bi = 0; bi < nd / 2; bi++) {
       double sign = bi == bj ? 1.0 : -1.0;
