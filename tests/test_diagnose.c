@@ -92,12 +92,16 @@ static void diagnose(rcb_model *truth, unsigned seed, rcb_diag_candidate *best,
 static void apply_reaches_floor(rcb_diag *d, double floor0) {
   char *ini;
   size_t need = 0;
-  rcb_model *m2;
-  assert_int_equal(rcb_diag_apply_ini(d, 0, NULL, 0, &need), RCB_ERR_WORKSPACE);
+  rcb_model *m1 = NULL, *m2;
+  assert_int_equal(rcb_diag_apply_model(d, 0, NULL, &m1), RCB_OK);
+  assert_true(rcb_model_dof_count(m1) > 0); /* finalized */
+  assert_int_equal(rcb_model_write_ini(m1, NULL, 0, &need), RCB_ERR_WORKSPACE);
   ini = malloc(need);
-  assert_int_equal(rcb_diag_apply_ini(d, 0, ini, need, &need), RCB_OK);
-  m2 = rcb_test_model_from_string(ini); /* the applied model loads */
+  assert_int_equal(rcb_model_write_ini(m1, ini, need, &need), RCB_OK);
+  m2 = rcb_test_model_from_string(ini); /* the applied model written as INI loads */
+  assert_int_equal(rcb_model_dof_count(m2), rcb_model_dof_count(m1));
   rcb_model_destroy(m2);
+  rcb_model_destroy(m1);
   free(ini);
   {
     rcb_diag_candidate c;

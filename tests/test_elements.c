@@ -5,7 +5,9 @@
  *    diametral inertia, v^T G v = polar inertia;
  *  - static deflection of a cantilever with shear (Timoshenko elements are
  *    exact for end loads): P L^3/(3 E I) + P L/(kappa G A);
- *  - disks and bearings land on the right rows.
+ *  - disks and bearings land on the right rows;
+ *  - coupling blocks of the five models, bearing blocks (to ground, on a
+ *    pedestal), pedestal blocks and the bearing-table interpolation.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -241,6 +243,109 @@ static void test_bearing_table(void **state) {
   rcb_model_destroy(m);
 }
 
+/* Coupling block of each model (paper section 3): a relative motion of the
+ * stations, unit in one DOF, pulls the two back with the coefficient the
+ * model uses (kt for x, y; kr for rx, ry; damping alike) and 0 for those it
+ * does not; a common motion of both stations (any vector) loads nothing. */
+static void test_coupling_element(void **state) {
+  /* kt, kr, ct, cr used by kramer_1, kramer_2, nelson_crandall_1, _2, rigid */
+  static const int uses[5][4] = {
+      {0, 0, 0, 0}, {0, 1, 0, 1}, {1, 1, 0, 0}, {1, 1, 1, 1}, {0, 0, 0, 0}};
+  rcb_coupling_params p = {2e5, 3e3, 40.0, 0.5, {0}, {0}, {0}};
+  const double val[4] = {2e5, 3e3, 40.0, 0.5};
+  double Ke[64], Ce[64];
+  int t, a, b, k;
+  (void)state;
+  for (t = 0; t < 5; t++) {
+    rcb_coupling_element((rcb_coupling_model)t, &p, Ke, Ce);
+    for (a = 0; a < 4; a++) {
+      double kv = uses[t][a < 2 ? 0 : 1] ? val[a < 2 ? 0 : 1] : 0.0;
+      double cv = uses[t][a < 2 ? 2 : 3] ? val[a < 2 ? 2 : 3] : 0.0;
+      /* station b moved by 1 in DOF a: force -k on a, +k on b, nothing else */
+      for (b = 0; b < 8; b++) {
+        double ek = b == a ? -kv : b == a + 4 ? kv : 0.0;
+        double ec = b == a ? -cv : b == a + 4 ? cv : 0.0;
+        assert_true(Ke[b + 8 * (a + 4)] == ek);
+        assert_true(Ce[b + 8 * (a + 4)] == ec);
+      }
+    }
+    for (b = 0; b < 8; b++) { /* common motion v on both stations */
+      const double v[4] = {1.0, -2.0, 0.3, 0.7};
+      double fk = 0, fc = 0;
+      for (k = 0; k < 8; k++) {
+        fk += Ke[b + 8 * k] * v[k % 4];
+        fc += Ce[b + 8 * k] * v[k % 4];
+      }
+      assert_true(fabs(fk) <= 1e-12 * 2e5 && fabs(fc) <= 1e-12 * 40.0);
+    }
+  }
+}
+
+/* Bearing table: linear interpolation between rows, held outside. */
+static void test_bearing_interp(void **state) {
+  const double speeds[3] = {0.0, 100.0, 300.0};
+  const rcb_bearing_coefs rows[3] = {{1, 2, 3, 4, 5, 6, 7, 8},
+                                     {3, 2, 1, 0, 5, 6, 7, 8},
+                                     {7, 0, 0, 0, 9, 6, 7, 0}};
+  rcb_bearing_coefs o;
+  (void)state;
+  rcb_bearing_interp(3, speeds, rows, 50.0, &o); /* halfway through the first interval */
+  assert_true(o.kxx == 2.0 && o.kxy == 2.0 && o.kyx == 2.0 && o.kyy == 2.0 && o.cyy == 8.0);
+  rcb_bearing_interp(3, speeds, rows, 250.0, &o); /* 3/4 through the second */
+  assert_true(rcb_test_close(o.kxx, 6.0, 1e-15, 0) && rcb_test_close(o.kxy, 0.5, 1e-15, 0));
+  assert_true(rcb_test_close(o.cxx, 8.0, 1e-15, 0) && rcb_test_close(o.cyy, 2.0, 1e-15, 0));
+  rcb_bearing_interp(3, speeds, rows, -10.0, &o);
+  assert_true(o.kxx == 1.0 && o.kyy == 4.0);
+  rcb_bearing_interp(3, speeds, rows, 1e9, &o);
+  assert_true(o.kxx == 7.0 && o.cxx == 9.0);
+  rcb_bearing_interp(1, NULL, rows + 1, 1e9, &o); /* constant bearing */
+  assert_true(o.kxx == 3.0 && o.kyy == 0.0);
+}
+
+/* Bearing block: force -B (q_shaft - q_ped). To ground: B itself. On a
+ * pedestal: a unit shaft motion loads the shaft with +B e and the pedestal
+ * with -B e; equal motion of shaft and pedestal loads neither. */
+static void test_bearing_element(void **state) {
+  const rcb_bearing_coefs c = {1e7, 2e5, -3e5, 2e7, 10, 1, 2, 20};
+  const double B[2][2] = {{1e7, 2e5}, {-3e5, 2e7}}, D[2][2] = {{10, 1}, {2, 20}};
+  double Kb[16], Cb[16];
+  int r, s, k;
+  (void)state;
+  assert_int_equal(rcb_bearing_element(&c, 0, Kb, Cb), 2);
+  for (r = 0; r < 2; r++)
+    for (s = 0; s < 2; s++) {
+      assert_true(Kb[r + 2 * s] == B[r][s]);
+      assert_true(Cb[r + 2 * s] == D[r][s]);
+    }
+  assert_int_equal(rcb_bearing_element(&c, 1, Kb, Cb), 4);
+  for (s = 0; s < 2; s++)
+    for (r = 0; r < 2; r++) {
+      assert_true(Kb[r + 4 * s] == B[r][s] && Kb[(r + 2) + 4 * s] == -B[r][s]);
+      assert_true(Cb[r + 4 * s] == D[r][s] && Cb[(r + 2) + 4 * s] == -D[r][s]);
+    }
+  for (r = 0; r < 4; r++) {
+    const double v[2] = {0.4, -1.3};
+    double f = 0;
+    for (k = 0; k < 4; k++) f += Kb[r + 4 * k] * v[k % 2];
+    assert_true(fabs(f) <= 1e-12 * 2e7);
+  }
+}
+
+/* Pedestal: a mass on springs to ground, x and y uncoupled; its natural
+ * frequencies sqrt(k/m) follow from the diagonal blocks. */
+static void test_pedestal_element(void **state) {
+  const double k[2] = {4e6, 9e6}, c[2] = {30, 50};
+  double Mp[4], Cp[4], Kp[4];
+  int a;
+  (void)state;
+  rcb_pedestal_element(25.0, k, c, Mp, Cp, Kp);
+  assert_true(Mp[1] == 0 && Mp[2] == 0 && Kp[1] == 0 && Kp[2] == 0 && Cp[1] == 0 && Cp[2] == 0);
+  for (a = 0; a < 2; a++) {
+    assert_true(rcb_test_close(sqrt(Kp[3 * a] / Mp[3 * a]), a ? 600.0 : 400.0, 1e-15, 0));
+    assert_true(Cp[3 * a] == c[a]);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_element_symmetry),
@@ -248,6 +353,10 @@ int main(void) {
       cmocka_unit_test(test_cantilever_shear),
       cmocka_unit_test(test_disk_and_bearing_rows),
       cmocka_unit_test(test_bearing_table),
+      cmocka_unit_test(test_coupling_element),
+      cmocka_unit_test(test_bearing_interp),
+      cmocka_unit_test(test_bearing_element),
+      cmocka_unit_test(test_pedestal_element),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -105,11 +105,15 @@ typedef struct rcb_diag_stats {
 } rcb_diag_stats;
 RCB_API rcb_status rcb_diag_get_stats(const rcb_diag *d, rcb_diag_stats *out);
 /**
- * @brief The model with candidate @p rank added and fitted, as INI text
- * (two-call sizing as rcb_model_write_ini).
+ * @brief The model with candidate @p rank added and fitted: a finalized copy
+ * that the caller owns (rcb_model_destroy), e.g. to analyse it, to diagnose
+ * it again, or to write it as INI (rcb_model_write_ini, `rcbtool diagnose
+ * --apply -o`).
+ * @param alloc allocator of the copy, NULL for malloc
+ * @return RCB_ERR_STATE when the candidate was not refitted (nothing to apply)
  */
-RCB_API rcb_status rcb_diag_apply_ini(const rcb_diag *d, size_t rank, char *buf, size_t size,
-                                      size_t *needed);
+RCB_API rcb_status rcb_diag_apply_model(const rcb_diag *d, size_t rank,
+                                        const rcb_allocator *alloc, rcb_model **out);
 /**
  * @brief An explanation in an engineer's words, with its evidence (two-call
  * sizing). Names the best significant candidate, or says that no candidate is

@@ -12,7 +12,11 @@
  * Life cycle: rcb_model_create -> rcb_model_load_* or rcb_model_add_* ->
  * rcb_model_finalize (done by the loaders) -> analyses -> rcb_model_destroy.
  * After finalize the model is read-only for the analyses; rcb_model_set_param
- * may still change numeric values (not the mesh).
+ * may still change numeric values (not the mesh). A structural variant of a
+ * model is made on a copy: rcb_model_clone (unfinalized) -> edits
+ * (rcb_model_set_coupling_model, rcb_model_set_pedestal,
+ * rcb_model_add_disk_at, rcb_model_set_bearing_coefs, any rcb_model_add_*)
+ * -> rcb_model_finalize -> rcb_model_set_param.
  */
 #ifndef RCB_MODEL_H
 #define RCB_MODEL_H
@@ -204,6 +208,56 @@ RCB_API rcb_status rcb_model_get_test_speed(const rcb_model *m, double *speed);
 
 /** @brief Build the mesh and the DOF map, check consistency. */
 RCB_API rcb_status rcb_model_finalize(rcb_model *m);
+
+/* ---- editing a copy: clone, edit, finalize, set parameters ---- */
+
+/**
+ * @brief Deep copy of a model, with its own allocator hooks.
+ *
+ * The copy holds every item of @p src (materials, shafts and segments,
+ * disks, bearings with their tables and pedestals, couplings with their
+ * hubs, unbalances, stations, the UFF map, the speed factor) and nothing of
+ * what finalize derives from them: it is NOT finalized, whatever the state of
+ * @p src, so the rcb_model_add_* calls and the edits below apply to it, and
+ * it must go through rcb_model_finalize before any query or analysis.
+ * Finalizing an unedited copy gives the same nodes, DOF numbers and matrices
+ * as the source (warnings are rebuilt, without the INI file:line prefix).
+ * @p src is only read; the two models share nothing.
+ * @param out the copy (NULL on failure) @param alloc its allocator, NULL for malloc
+ * @return RCB_OK, RCB_ERR_ARG, RCB_ERR_NOMEM (nothing is left allocated)
+ */
+RCB_API rcb_status rcb_model_clone(rcb_model **out, const rcb_model *src,
+                                   const rcb_allocator *alloc);
+/**
+ * @brief Change the model of coupling @p coupling, before finalize.
+ * Of kt, kr, ct, cr, those the new model uses keep their values and the
+ * others become 0 (as the INI format holds them); hubs are unchanged. Set
+ * the new model's values with rcb_model_set_param (before or after finalize).
+ */
+RCB_API rcb_status rcb_model_set_coupling_model(rcb_model *m, const char *coupling,
+                                                rcb_coupling_model type);
+/**
+ * @brief Replace the coefficients of bearing @p bearing, before finalize: a
+ * constant bearing (n = 1, @p speeds may be NULL) or a table against speed
+ * as rcb_model_add_bearing_table. Adds any property the bearing lacked
+ * (cross-coupling kxy, kyx, anisotropy kxx != kyy, damping, cross damping);
+ * a tabulated bearing made constant has fittable coefficients
+ * (bearing.B.kxx, ...). Its pedestal, if any, is kept.
+ * @param n rows (>= 1) @param speeds rad/s, strictly increasing
+ */
+RCB_API rcb_status rcb_model_set_bearing_coefs(rcb_model *m, const char *bearing, size_t n,
+                                               const double *speeds,
+                                               const rcb_bearing_coefs *c);
+/**
+ * @brief Rigid disk (or a point mass: Id = Ip = 0) at a station, before
+ * finalize: @p station is the name of a disk, bearing, coupling ("C" is
+ * station a, "C.SHAFT" either one), unbalance or station, or "#N" for node N
+ * of the mesh finalize builds (as rcb_model_find_dof numbers them: 0-based
+ * along the shafts in definition order). Otherwise as rcb_model_add_disk.
+ * @param mass kg @param Id kg m^2 @param Ip kg m^2
+ */
+RCB_API rcb_status rcb_model_add_disk_at(rcb_model *m, const char *name, const char *station,
+                                         double mass, double Id, double Ip);
 
 /* ---- queries (after finalize) ---- */
 

@@ -1,7 +1,8 @@
 /*
  * Direct stiffness assembly (paper eq. 2): shaft elements with proportional
  * damping C = qz_m M + qz_k K, rigid disks, coupling springs/dampers and hub
- * inertia (paper eq. 1), bearings. Tied DOFs (Kramer, rigid couplings) share
+ * inertia (paper eq. 1), bearings, each block from src/elements/: this file
+ * only scatters. Tied DOFs (Kramer, rigid couplings) share
  * a matrix row, so adding into the shared row is the constraint elimination
  * q_full = T q with T a 0/1 selection: M_r = T^T M T.
  */
@@ -78,72 +79,37 @@ static void add_disk(const rcb_model *m, const rcb_layout *L, size_t node, doubl
   scatter(L, G, m->nodes[node].dof, 4, Gd, m->speed_factor);
 }
 
-/* Pedestals: mass on x and y, springs and dampers to ground (diagonal). */
+/* Pedestals: mass on x and y, springs and dampers to ground. */
 static void add_pedestals(const rcb_model *m, const rcb_layout *L, double *M, double *C,
                           double *K) {
+  double Mp[4], Cp[4], Kp[4];
   size_t b;
-  int k;
   for (b = 0; b < m->n_bearings; b++) {
     const rcb_bearing_t *br = &m->bearings[b];
     if (!br->has_ped) continue;
-    for (k = 0; k < 2; k++) {
-      size_t at = rcb_layout_at(L, (size_t)br->ped_dof[k], (size_t)br->ped_dof[k]);
-      if (M) M[at] += br->ped_m;
-      if (C) C[at] += br->ped_c[k];
-      if (K) K[at] += br->ped_k[k];
-    }
-  }
-}
-
-/* Translational and rotational spring (or damper) between the two coupling
- * stations: [k -k; -k k] with k = diag(t, t, r, r) on [x, y, rx, ry]. */
-static void coupling_block(double t, double r, double blk[64]) {
-  int a;
-  memset(blk, 0, 64 * sizeof *blk);
-  for (a = 0; a < 4; a++) {
-    double v = a < 2 ? t : r;
-    blk[a + 8 * a] = v;
-    blk[(a + 4) + 8 * (a + 4)] = v;
-    blk[a + 8 * (a + 4)] = -v;
-    blk[(a + 4) + 8 * a] = -v;
+    rcb_pedestal_element(br->ped_m, br->ped_k, br->ped_c, Mp, Cp, Kp);
+    scatter(L, M, br->ped_dof, 2, Mp, 1.0);
+    scatter(L, C, br->ped_dof, 2, Cp, 1.0);
+    scatter(L, K, br->ped_dof, 2, Kp, 1.0);
   }
 }
 
 static void add_couplings(const rcb_model *m, const rcb_layout *L, double *M, double *C,
                           double *G, double *K) {
-  double blk[64];
+  double Ke[64], Ce[64];
   long rows[8];
   size_t i;
   int k;
   for (i = 0; i < m->n_couplings; i++) {
     const rcb_coupling_t *c = &m->couplings[i];
     const rcb_coupling_params *p = &c->p;
-    double kt = 0, kr = 0, ct = 0, cr = 0;
-    switch (c->type) {
-      case RCB_COUPLING_NELSON_CRANDALL_2:
-        ct = p->ct;
-        cr = p->cr;
-        /* fall through */
-      case RCB_COUPLING_NELSON_CRANDALL_1:
-        kt = p->kt;
-        kr = p->kr;
-        break;
-      case RCB_COUPLING_KRAMER_2:
-        kr = p->kr;
-        cr = p->cr;
-        break;
-      case RCB_COUPLING_KRAMER_1:
-      case RCB_COUPLING_RIGID:
-        break;
-    }
     for (k = 0; k < 4; k++) {
       rows[k] = m->nodes[c->at[0].node].dof[k];
       rows[4 + k] = m->nodes[c->at[1].node].dof[k];
     }
-    coupling_block(kt, kr, blk);
-    scatter(L, K, rows, 8, blk, 1.0);
-    coupling_block(ct, cr, blk);
-    scatter(L, C, rows, 8, blk, 1.0);
+    rcb_coupling_element(c->type, p, Ke, Ce);
+    scatter(L, K, rows, 8, Ke, 1.0);
+    scatter(L, C, rows, 8, Ce, 1.0);
     for (k = 0; k < 2; k++)
       add_disk(m, L, c->at[k].node, p->mass[k], p->Id[k], p->Ip[k], M, G);
   }
@@ -163,31 +129,30 @@ void rcb_assemble_structure(const rcb_model *m, const rcb_layout *L, double *M, 
   add_pedestals(m, L, M, C, K);
 }
 
-/* The bearing force -K (q_shaft - q_ped) acts on the shaft and, reversed,
- * on the pedestal: blocks [+B -B; -B +B] on (shaft, pedestal). */
+/* The bearing block (elements/bearing.c) on the shaft node's x, y rows and,
+ * with a pedestal, the pedestal's. */
 size_t rcb_bearing_entries(const rcb_model *m, size_t b, double speed,
                            rcb_entry out[RCB_BEARING_ENTRIES_MAX]) {
   const rcb_bearing_t *br = &m->bearings[b];
-  const rcb_node_t *nd = &m->nodes[br->at.node];
   const long *dof[2];
   rcb_bearing_coefs c;
-  const double *kv = &c.kxx, *cv = &c.cxx;
+  double Kb[16], Cb[16];
   size_t n = 0;
-  int r, s, bi, bj, nb = br->has_ped ? 2 : 1;
-  dof[0] = nd->dof;
+  int r, s, bi, bj, nd;
+  dof[0] = m->nodes[br->at.node].dof;
   dof[1] = br->ped_dof;
   rcb_bearing_eval(br, speed * m->speed_factor, &c);
-  for (bj = 0; bj < nb; bj++)
-    for (bi = 0; bi < nb; bi++) {
-      double sign = bi == bj ? 1.0 : -1.0;
+  nd = rcb_bearing_element(&c, br->has_ped, Kb, Cb);
+  for (bj = 0; bj < nd / 2; bj++)
+    for (bi = 0; bi < nd / 2; bi++)
       for (r = 0; r < 2; r++)
         for (s = 0; s < 2; s++) {
           rcb_entry *e = &out[n++];
+          int at = (2 * bi + r) + nd * (2 * bj + s);
           e->row = (size_t)dof[bi][r];
           e->col = (size_t)dof[bj][s];
-          e->k = sign * kv[2 * r + s]; /* kxx kxy kyx kyy */
-          e->c = sign * cv[2 * r + s];
+          e->k = Kb[at];
+          e->c = Cb[at];
         }
-    }
   return n;
 }

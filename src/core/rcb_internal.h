@@ -200,8 +200,23 @@ rcb_status rcb_model_add_warning(rcb_model *m, const char *fmt, ...)
 #endif
     ;
 
-/* Bearing coefficients at a rotor speed (linear interpolation, clamped). */
-void rcb_bearing_eval(const rcb_bearing_t *b, double speed, rcb_bearing_coefs *out);
+/* ---- model/coupling_models.c: the one table of the five coupling models ---- */
+#define RCB_COUPLING_MODEL_COUNT 5
+/* Coefficient bits of rcb_coupling_uses, in the order kt, kr, ct, cr (the
+ * order of rcb_coupling_coef_key and rcb_coupling_coef). */
+#define RCB_CPL_KT 0x1u
+#define RCB_CPL_KR 0x2u
+#define RCB_CPL_CT 0x4u
+#define RCB_CPL_CR 0x8u
+/* Which of kt, kr, ct, cr model t uses (0 for an invalid t). */
+unsigned rcb_coupling_uses(rcb_coupling_model t);
+/* DOFs of station a tied to those of station b, first ones first: 0, 2
+ * (x, y: Kramer) or 4 (rigid). */
+int rcb_coupling_tied(rcb_coupling_model t);
+/* INI key of coefficient k (0..3: "kt", "kr", "ct", "cr"), NULL otherwise. */
+const char *rcb_coupling_coef_key(int k);
+/* Storage of coefficient k (0..3) in p. */
+double *rcb_coupling_coef(rcb_coupling_params *p, int k);
 
 /* ---- elements/ : local matrices, 8x8 column-major on
  * [x0, y0, rx0, ry0, x1, y1, rx1, ry1] for shafts, 4x4 on [x, y, rx, ry]. ---- */
@@ -212,5 +227,32 @@ typedef struct rcb_beam_props_s {
 } rcb_beam_props;
 void rcb_shaft_element(const rcb_beam_props *p, double Me[64], double Ge[64], double Ke[64]);
 void rcb_disk_element(double m, double Id, double Ip, double Md[16], double Gd[16]);
+
+/* elements/coupling.c: the coupling's springs and dampers between station a
+ * and station b, 8x8 on [a: x, y, rx, ry, b: x, y, rx, ry]: [k -k; -k k]
+ * with k = diag(t, t, r, r), t = kt (Ke) or ct (Ce), r = kr or cr, each 0
+ * unless model t uses it (rcb_coupling_uses; paper section 3). The hubs are
+ * rigid disks (rcb_disk_element); tied DOFs share a matrix row, where the
+ * block's terms of a tied pair cancel. */
+void rcb_coupling_element(rcb_coupling_model t, const rcb_coupling_params *p, double Ke[64],
+                          double Ce[64]);
+
+/* elements/bearing.c. Coefficients of a bearing table at a rotor speed
+ * (rad/s): linear interpolation between the rows (speeds strictly
+ * increasing, n >= 1; speeds unused when n == 1), held constant outside. */
+void rcb_bearing_interp(size_t n, const double *speeds, const rcb_bearing_coefs *rows,
+                        double speed, rcb_bearing_coefs *out);
+/* The same for a model's bearing. */
+void rcb_bearing_eval(const rcb_bearing_t *b, double speed, rcb_bearing_coefs *out);
+/* A bearing's stiffness and damping blocks, column-major nd x nd with nd the
+ * return value: on [shaft x, y] (nd = 2, the bearing to ground) or, with a
+ * pedestal, on [shaft x, y, pedestal x, y] (nd = 4): [B -B; -B B] with
+ * B = [kxx kxy; kyx kyy] (rows: force x, y; columns: displacement x, y).
+ * Only the first nd * nd entries of Kb and Cb are written. */
+int rcb_bearing_element(const rcb_bearing_coefs *c, int pedestal, double Kb[16], double Cb[16]);
+/* A pedestal's own mass, springs and dampers to ground, 2x2 diagonal on its
+ * [x, y]: M = m I, K = diag(kx, ky), C = diag(cx, cy). */
+void rcb_pedestal_element(double mass, const double k[2], const double c[2], double Mp[4],
+                          double Cp[4], double Kp[4]);
 
 #endif /* RCB_INTERNAL_H */

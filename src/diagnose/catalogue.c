@@ -1,8 +1,8 @@
 /*
  * The catalogue of physical effects (issue #4), laid out at every place each
  * can occur in a given model, each with the parameters it adds, their neutral
- * value (the model as it is) and refit bounds; and the INI edits that build a
- * candidate's model.
+ * value (the model as it is) and refit bounds; and the edit of the model
+ * (rcb_model.h's edit API) that builds a candidate's model.
  */
 #include <math.h>
 #include <stdio.h>
@@ -62,6 +62,22 @@ static void bounds(double v, double hi0, double *lo, double *hi, int *logp) {
   *hi = v > 0 ? v * 1e4 : hi0;
 }
 
+/* The coupling model that ties the same DOFs as t and uses what t uses plus
+ * the coefficients of bits (the coupling table): t itself when it has them,
+ * NELSON_CRANDALL_2 for NELSON_CRANDALL_1 + ct or cr, KRAMER_2 for KRAMER_1
+ * + kr or cr; -1 when none does (KRAMER_1 + ct: tied translations have no
+ * translational damping; rigid). */
+static int model_with(rcb_coupling_model t, unsigned bits) {
+  unsigned need = rcb_coupling_uses(t) | bits;
+  int k;
+  if ((rcb_coupling_uses(t) & bits) == bits) return (int)t;
+  for (k = 0; k < RCB_COUPLING_MODEL_COUNT; k++)
+    if (rcb_coupling_tied((rcb_coupling_model)k) == rcb_coupling_tied(t) &&
+        (rcb_coupling_uses((rcb_coupling_model)k) & need) == need)
+      return k;
+  return -1;
+}
+
 static rcb_status couplings(rcb_diag *d, const rcb_model *m) {
   size_t i;
   for (i = 0; i < m->n_couplings; i++) {
@@ -75,6 +91,7 @@ static rcb_status couplings(rcb_diag *d, const rcb_model *m) {
     /* damping and rotational stiffness: NC2 has them; NC1/K1 need a model
      * change with the new parameters at 0 (the same physics) */
     for (t = 0; t < 3; t++) {
+      static const unsigned bit[3] = {RCB_CPL_CT, RCB_CPL_KR, RCB_CPL_CR};
       static const char *const keys[3] = {"ct", "kr", "cr"};
       static const rcb_effect eff[3] = {RCB_EFFECT_COUPLING_TRANSLATIONAL_DAMPING,
                                         RCB_EFFECT_COUPLING_ROTATIONAL_STIFFNESS,
@@ -84,26 +101,21 @@ static rcb_status couplings(rcb_diag *d, const rcb_model *m) {
       double v = t == 0 ? p->ct : t == 1 ? p->kr : p->cr, lo, hi;
       double hi0 = t == 0 ? 1e-2 * kref : t == 1 ? 1e3 * (p->kt > 0 ? 1e-2 * p->kt : 1e3)
                                         : 1e-2 * krr;
-      int logp;
-      rcb_coupling_model to = cp->type;
+      int logp, to = model_with(cp->type, bit[t]);
       snprintf(nm, sizeof nm, "coupling.%s.%s", cp->name, keys[t]);
-      if (is_base(d, nm) || cp->type == RCB_COUPLING_RIGID) continue;
-      if (t != 1 && cp->type == RCB_COUPLING_NELSON_CRANDALL_1) to = RCB_COUPLING_NELSON_CRANDALL_2;
-      if (cp->type == RCB_COUPLING_KRAMER_1) to = RCB_COUPLING_KRAMER_2;
-      if (t == 0 && (cp->type == RCB_COUPLING_KRAMER_1 || cp->type == RCB_COUPLING_KRAMER_2))
-        continue; /* tied translations have no translational damping */
+      if (is_base(d, nm) || to < 0) continue;
       if (!(c = new_cand(d, eff[t], place))) return RCB_ERR_NOMEM;
       snprintf(c->desc, sizeof c->desc, "%s in coupling %s", what[t], cp->name);
-      if (to != cp->type) {
+      if (to != (int)cp->type) {
         c->edit = EDIT_COUPLING_MODEL;
         snprintf(c->target, sizeof c->target, "%s", cp->name);
-        c->new_type = to;
+        c->new_type = (rcb_coupling_model)to;
         c->kt0 = p->kt, c->kr0 = p->kr, c->ct0 = p->ct, c->cr0 = p->cr;
       }
       bounds(v, hi0, &lo, &hi, &logp);
       add_par(c, "%s", nm, lo, hi, logp);
     }
-    for (t = 0; t < 5; t++) { /* another coupling model: refitted */
+    for (t = 0; t < RCB_COUPLING_MODEL_COUNT; t++) { /* another coupling model: refitted */
       if (t == (int)cp->type || (cp->type == RCB_COUPLING_NELSON_CRANDALL_1 &&
                                  t == RCB_COUPLING_NELSON_CRANDALL_2))
         continue; /* NC1 -> NC2 is covered by the damping candidates above */
@@ -116,11 +128,11 @@ static rcb_status couplings(rcb_diag *d, const rcb_model *m) {
       snprintf(c->target, sizeof c->target, "%s", cp->name);
       c->new_type = (rcb_coupling_model)t;
       c->kt0 = kref, c->kr0 = krr, c->ct0 = p->ct, c->cr0 = p->cr;
-      if (t == RCB_COUPLING_NELSON_CRANDALL_1 || t == RCB_COUPLING_NELSON_CRANDALL_2) {
+      if (rcb_coupling_uses((rcb_coupling_model)t) & RCB_CPL_KT) {
         snprintf(nm, sizeof nm, "coupling.%s.kt", cp->name);
         add_par(c, "%s", nm, kref / 1000, kref * 1000, 1);
       }
-      if (t != RCB_COUPLING_KRAMER_1 && t != RCB_COUPLING_RIGID) {
+      if (rcb_coupling_uses((rcb_coupling_model)t) & RCB_CPL_KR) {
         snprintf(nm, sizeof nm, "coupling.%s.kr", cp->name);
         add_par(c, "%s", nm, krr / 1000, krr * 1000, 1);
       }
@@ -226,7 +238,7 @@ static rcb_status added_masses(rcb_diag *d, const rcb_model *m) {
       }
       c->edit = EDIT_ADD_DISK;
       snprintf(c->target, sizeof c->target, "ADDED_%zu", i);
-      snprintf(c->at, sizeof c->at, "%s %.17g", m->shafts[nd->shaft].name, nd->z);
+      snprintf(c->at, sizeof c->at, "#%zu", i);
       add_par(c, k ? "disk.%s.Id" : "disk.%s.mass", c->target, 0.0, k ? 0.01 * mtot : mtot,
               0);
     }
@@ -414,91 +426,64 @@ rcb_status rcb_diag_catalogue(rcb_diag *d, const rcb_model *m) {
   return RCB_OK;
 }
 
-/* ---- candidate models: edits of the base INI text ---- */
+/* ---- candidate models: edits of a copy of the fitted base model ---- */
 
-/* Text of the coupling section of c->target, with its model line and the
- * kt/kr/ct/cr lines replaced by those of the new model. */
-static size_t edit_coupling(const char *ini, const diag_cand *c, char *out, size_t size) {
-  char head[RCB_NAME_MAX + 16];
-  const char *s, *e, *line;
-  size_t n = 0;
-  unsigned uses[5] = {0x0u, 0xAu, 0x3u, 0xFu, 0x0u}; /* kt kr ct cr bits */
-  double v[4];
-  int k;
-  static const char *const keys[4] = {"kt", "kr", "ct", "cr"};
-  v[0] = c->kt0, v[1] = c->kr0, v[2] = c->ct0, v[3] = c->cr0;
-  snprintf(head, sizeof head, "[coupling %s]", c->target);
-  s = strstr(ini, head);
-  if (!s) return 0;
-  e = strstr(s + 1, "\n[");
-  e = e ? e + 1 : ini + strlen(ini);
-#define PUT(...) n += (size_t)snprintf(out + (n < size ? n : size), n < size ? size - n : 0, __VA_ARGS__)
-  PUT("%.*s", (int)(s - ini), ini);
-  for (line = s; line < e;) {
-    const char *nl = memchr(line, '\n', (size_t)(e - line));
-    size_t len = nl ? (size_t)(nl - line) + 1 : (size_t)(e - line);
-    int drop = strncmp(line, "model ", 6) == 0 || strncmp(line, "model=", 6) == 0;
-    for (k = 0; k < 4; k++)
-      if (strncmp(line, keys[k], 2) == 0 && (line[2] == ' ' || line[2] == '=')) drop = 1;
-    if (!drop) PUT("%.*s", (int)len, line);
-    if (line == s) {
-      PUT("model = %s\n", rcb_coupling_model_name(c->new_type));
-      for (k = 0; k < 4; k++)
-        if (uses[c->new_type] & (1u << k)) PUT("%s = %.17g\n", keys[k], v[k]);
-    }
-    line += len;
+rcb_status rcb_diag_copy_model(rcb_diag *d, const rcb_model *src, rcb_model **out) {
+  rcb_model *m = NULL;
+  rcb_status st = rcb_model_clone(&m, src, &d->alloc);
+  *out = NULL;
+  if (st) return rcb_diag_fail(d, st, "copying the model: %s", rcb_status_str(st));
+  if ((st = rcb_model_finalize(m))) {
+    rcb_diag_fail(d, st, "copying the model: %s", rcb_model_errmsg(m));
+    rcb_model_destroy(m);
+    return st;
   }
-  PUT("%s", e);
-#undef PUT
-  return n;
+  *out = m;
+  return RCB_OK;
 }
 
-/* The base text with the pedestal keys put right after c->target's
- * [bearing] header. */
-static size_t edit_pedestal(const char *ini, const diag_cand *c, char *out, size_t size) {
-  char head[RCB_NAME_MAX + 16];
-  const char *s;
-  size_t pre;
-  int n;
-  snprintf(head, sizeof head, "[bearing %s]\n", c->target);
-  if (!(s = strstr(ini, head))) return 0;
-  pre = (size_t)(s - ini) + strlen(head);
-  n = snprintf(out, size,
-               "%.*spedestal_mass = %.17g\npedestal_kxx = %.17g\npedestal_kyy = %.17g\n"
-               "pedestal_cxx = %.17g\npedestal_cyy = %.17g\n%s",
-               (int)pre, ini, c->ped0[0], c->ped0[1], c->ped0[1], c->ped0[2], c->ped0[2],
-               ini + pre);
-  return n < 0 ? 0 : (size_t)n;
+/* The structural edit of c on the unfinalized copy m. */
+static rcb_status edit(const diag_cand *c, rcb_model *m) {
+  if (c->edit == EDIT_COUPLING_MODEL)
+    return rcb_model_set_coupling_model(m, c->target, c->new_type);
+  if (c->edit == EDIT_ADD_PEDESTAL) {
+    rcb_pedestal p;
+    p.mass = c->ped0[0];
+    p.kxx = p.kyy = c->ped0[1];
+    p.cxx = p.cyy = c->ped0[2];
+    return rcb_model_set_pedestal(m, c->target, &p);
+  }
+  if (c->edit == EDIT_ADD_DISK) return rcb_model_add_disk_at(m, c->target, c->at, 0, 0, 0);
+  return RCB_OK;
+}
+
+/* A new coupling model's starting values (the parameters it uses). */
+static rcb_status coupling_start(const diag_cand *c, rcb_model *m) {
+  const double v[4] = {c->kt0, c->kr0, c->ct0, c->cr0};
+  unsigned uses = rcb_coupling_uses(c->new_type);
+  rcb_status st = RCB_OK;
+  int k;
+  for (k = 0; k < 4 && !st; k++) {
+    char nm[RCB_DIAG_NAME];
+    if (!(uses & (1u << k))) continue;
+    snprintf(nm, sizeof nm, "coupling.%s.%s", c->target, rcb_coupling_coef_key(k));
+    st = rcb_model_set_param(m, nm, v[k]);
+  }
+  return st;
 }
 
 rcb_status rcb_diag_candidate_model(rcb_diag *d, const diag_cand *c, rcb_model **out) {
-  size_t len = strlen(d->base_ini), size = len + 4096, n;
-  char *txt = rcb_alloc(&d->alloc, size);
   rcb_model *m = NULL;
-  rcb_status st;
+  rcb_status st = rcb_model_clone(&m, d->base_model, &d->alloc);
   *out = NULL;
-  if (!txt) return rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
-  if (c->edit == EDIT_COUPLING_MODEL)
-    n = edit_coupling(d->base_ini, c, txt, size);
-  else if (c->edit == EDIT_ADD_PEDESTAL)
-    n = edit_pedestal(d->base_ini, c, txt, size);
-  else if (c->edit == EDIT_ADD_DISK)
-    n = (size_t)snprintf(txt, size, "%s\n[disk %s]\nat = %s\nmass = 0\nId = 0\nIp = 0\n",
-                         d->base_ini, c->target, c->at);
-  else
-    n = (size_t)snprintf(txt, size, "%s", d->base_ini);
-  if (n == 0 || n >= size) {
-    rcb_free(&d->alloc, txt);
-    return rcb_diag_fail(d, RCB_ERR_MODEL, "%s: cannot edit the model text", c->desc);
-  }
-  st = rcb_model_create(&m, &d->alloc);
-  if (!st) st = rcb_model_load_string(m, txt, "<candidate>");
+  if (st) return rcb_diag_fail(d, st, "%s: %s", c->desc, rcb_status_str(st));
+  if (!(st = edit(c, m)) && !(st = rcb_model_finalize(m)) && c->edit == EDIT_COUPLING_MODEL)
+    st = coupling_start(c, m);
   if (st) {
-    rcb_diag_fail(d, st, "%s: %s", c->desc, m ? rcb_model_errmsg(m) : "out of memory");
+    rcb_diag_fail(d, st, "%s: %s", c->desc, rcb_model_errmsg(m));
     rcb_model_destroy(m);
-    m = NULL;
+    return st;
   }
-  rcb_free(&d->alloc, txt);
   *out = m;
-  return st;
+  return RCB_OK;
 }

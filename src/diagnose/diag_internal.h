@@ -1,9 +1,11 @@
 /*
  * The diagnosis object, shared by catalogue.c (the candidate effects of a
  * model) and diagnose.c (scoring, refitting, ranking, explaining).
- * Candidates are expressed as an edit of the model's INI text (none, a
- * coupling model change, an added disk) plus the parameters the effect adds,
- * so every candidate model is built through the public loader.
+ * Candidates are expressed as a structural edit of the model (none, a
+ * coupling model change, an added disk, an added pedestal) plus the
+ * parameters the effect adds, so every candidate model is made through the
+ * public edit API: clone the fitted base model, edit, finalize, set
+ * parameters (rcb_model.h).
  */
 #ifndef RCB_DIAG_INTERNAL_H
 #define RCB_DIAG_INTERNAL_H
@@ -28,7 +30,7 @@ typedef struct diag_cand {
   char target[RCB_NAME_MAX];        /* coupling name, or the new disk's name */
   rcb_coupling_model new_type;      /* EDIT_COUPLING_MODEL */
   double kt0, kr0, ct0, cr0;        /* its starting values */
-  char at[RCB_DIAG_NAME];           /* EDIT_ADD_DISK: "SHAFT z" */
+  char at[RCB_DIAG_NAME];           /* EDIT_ADD_DISK: its node, "#N" */
   double ped0[3];                   /* EDIT_ADD_PEDESTAL: kg, N/m, N s/m */
   int refit_only;                   /* no neutral value: refitted, not scored */
   size_t np;
@@ -41,7 +43,7 @@ typedef struct diag_cand {
   int refitted, significant;
   double F, err, dbic;
   char fitted[RCB_DIAG_MAXP * (RCB_DIAG_NAME + 32)];
-  char *ini;                        /* refitted model as INI (owned) */
+  rcb_model *model;                 /* refitted model (owned, finalized) */
 } diag_cand;
 
 typedef struct diag_base_par {
@@ -65,7 +67,8 @@ struct rcb_diag {
   diag_base_par *base;
   size_t nbase, cap_base;
   /* results */
-  char *base_ini;                   /* the model with its own parameters fitted */
+  rcb_model *base_model;            /* the model with its own parameters fitted
+                                       (owned, finalized) */
   double F0, err0, floor0;
   size_t nres;
   diag_cand *cand;
@@ -90,7 +93,10 @@ rcb_status rcb_diag_catalogue(rcb_diag *d, const rcb_model *m);
  * fitted): move the candidate's parameters to a better start where the
  * neutral start sees nothing (a pedestal: a scan of its mass and stiffness). */
 rcb_status rcb_diag_refit_start(rcb_diag *d, const diag_cand *c, rcb_model *m, rcb_fit *f);
-/* The candidate's model: the base INI text edited, loaded (caller destroys). */
+/* A finalized copy of model src with the diagnosis' allocator (caller destroys). */
+rcb_status rcb_diag_copy_model(rcb_diag *d, const rcb_model *src, rcb_model **out);
+/* The candidate's model: a copy of the fitted base model, edited, finalized,
+ * the edit's starting values set (caller destroys). */
 rcb_status rcb_diag_candidate_model(rcb_diag *d, const diag_cand *c, rcb_model **out);
 
 #endif

@@ -45,11 +45,11 @@ rcb_status rcb_diag_create(rcb_diag **out, const rcb_model *m, const rcb_meas *m
 
 static void free_results(rcb_diag *d) {
   size_t i;
-  for (i = 0; i < d->ncand; i++) rcb_free(&d->alloc, d->cand[i].ini);
+  for (i = 0; i < d->ncand; i++) rcb_model_destroy(d->cand[i].model);
   rcb_free(&d->alloc, d->cand);
   rcb_free(&d->alloc, d->order);
-  rcb_free(&d->alloc, d->base_ini);
-  d->cand = NULL, d->order = NULL, d->base_ini = NULL;
+  rcb_model_destroy(d->base_model);
+  d->cand = NULL, d->order = NULL, d->base_model = NULL;
   d->ncand = d->cap_cand = 0;
   d->ran = 0;
   memset(&d->stats, 0, sizeof d->stats);
@@ -150,19 +150,6 @@ static void drop_fit(rcb_diag *d, rcb_fit *f) {
   rcb_fit_destroy(f);
 }
 
-static rcb_status model_text(rcb_diag *d, const rcb_model *m, char **out) {
-  size_t need = 0;
-  char *t;
-  rcb_model_write_ini(m, NULL, 0, &need);
-  if (!(t = rcb_alloc(&d->alloc, need + 1))) return rcb_diag_fail(d, RCB_ERR_NOMEM, "no memory");
-  if (rcb_model_write_ini(m, t, need + 1, &need)) {
-    rcb_free(&d->alloc, t);
-    return rcb_diag_fail(d, RCB_ERR_MODEL, "the model cannot be written as INI");
-  }
-  *out = t;
-  return RCB_OK;
-}
-
 /* F = r^T r with the fit's weights, and the error % of the same sweep. */
 static rcb_status objective(rcb_diag *d, rcb_fit *f, double *r, double *F, double *err) {
   rcb_status st = rcb_fit_residuals(f, r);
@@ -174,15 +161,13 @@ static rcb_status objective(rcb_diag *d, rcb_fit *f, double *r, double *F, doubl
   return RCB_OK;
 }
 
-/* Fit the model as it is: base INI text, F0, error, floor, residual count. */
+/* Fit the model as it is, on a copy: the base model, F0, error, floor,
+ * residual count. */
 static rcb_status baseline(rcb_diag *d) {
   rcb_model *m = NULL;
   rcb_fit *f = NULL;
   rcb_fit_report rep;
-  char *txt = NULL;
-  rcb_status st = model_text(d, d->m, &txt);
-  if (!st) st = rcb_model_create(&m, &d->alloc);
-  if (!st) st = rcb_model_load_string(m, txt, "<model>");
+  rcb_status st = rcb_diag_copy_model(d, d->m, &m);
   if (!st) st = make_fit(d, m, 1, NULL, &f);
   if (!st && d->nbase) {
     st = rcb_fit_run(f);
@@ -192,18 +177,15 @@ static rcb_status baseline(rcb_diag *d) {
     d->nres = rcb_fit_residual_count(f);
     rcb_fit_get_report(f, &rep);
     d->floor0 = rep.floor_pct;
-    rcb_free(&d->alloc, txt);
-    txt = NULL;
-    st = model_text(d, m, &d->base_ini);
   }
   if (!st) {
     double *r = rcb_alloc(&d->alloc, d->nres * sizeof *r);
     st = r ? objective(d, f, r, &d->F0, &d->err0) : RCB_ERR_NOMEM;
     rcb_free(&d->alloc, r);
   }
-  rcb_free(&d->alloc, txt);
   drop_fit(d, f);
-  rcb_model_destroy(m);
+  if (!st) d->base_model = m; /* the fitted values stay in it */
+  else rcb_model_destroy(m);
   return st;
 }
 
@@ -351,8 +333,7 @@ static rcb_status score_all(rcb_diag *d) {
   w.J = rcb_alloc(&d->alloc, n * w.batch * sizeof *w.J);
   w.r = r, w.Q0 = Q0;
   st = (r && Q0 && w.J) ? RCB_OK : rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
-  if (!st) st = rcb_model_create(&m, &d->alloc);
-  if (!st) st = rcb_model_load_string(m, d->base_ini, "<model>");
+  if (!st) st = rcb_diag_copy_model(d, d->base_model, &m);
   if (!st) ndof = rcb_model_dof_count(m);
   if (!st) st = make_fit(d, m, 1, NULL, &w.f);
   if (!st) st = rcb_fit_residuals(w.f, r);
@@ -450,7 +431,7 @@ static rcb_status refit(rcb_diag *d, diag_cand *c) {
                                                  : (double)d->nres * log(c->F / d->F0);
       c->significant = c->dbic < RCB_DIAG_BIC_MIN && c->err < RCB_DIAG_ERR_FALL * d->err0;
       snprintf(c->fitted, sizeof c->fitted, "no parameter");
-      st = model_text(d, m, &c->ini);
+      c->model = m, m = NULL;
     }
   } else if ((st = rcb_fit_run(f)) != RCB_OK) {
     /* a candidate that cannot be fitted is reported, not fatal (unless the
@@ -472,7 +453,7 @@ static rcb_status refit(rcb_diag *d, diag_cand *c) {
                                                : N * log(c->F / d->F0) + dk * log(N);
     c->significant = c->dbic < RCB_DIAG_BIC_MIN && c->err < RCB_DIAG_ERR_FALL * d->err0;
     record_fit(c, f);
-    st = model_text(d, m, &c->ini);
+    c->model = m, m = NULL;
   }
   drop_fit(d, f);
   rcb_model_destroy(m);
@@ -518,14 +499,10 @@ static rcb_status refit_best(rcb_diag *d) {
 }
 
 static rcb_status run_steps(rcb_diag *d) {
-  rcb_model *fitted = NULL;
   rcb_status st;
   if ((st = baseline(d))) return st;
-  st = rcb_model_create(&fitted, &d->alloc);
-  if (!st) st = rcb_model_load_string(fitted, d->base_ini, "<model>");
-  if (!st && (st = rcb_diag_catalogue(d, fitted)))
+  if ((st = rcb_diag_catalogue(d, d->base_model)))
     rcb_diag_fail(d, st, "laying out the catalogue of effects: %s", rcb_status_str(st));
-  rcb_model_destroy(fitted);
   if (!st && !(d->order = rcb_alloc(&d->alloc, (d->ncand ? d->ncand : 1) * sizeof *d->order)))
     st = rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
   if (!st) st = score_all(d);
@@ -594,16 +571,30 @@ static rcb_status put_text(const char *text, char *buf, size_t size, size_t *nee
   return RCB_OK;
 }
 
-rcb_status rcb_diag_apply_ini(const rcb_diag *d, size_t rank, char *buf, size_t size,
-                              size_t *needed) {
+rcb_status rcb_diag_apply_model(const rcb_diag *d, size_t rank, const rcb_allocator *alloc,
+                                rcb_model **out) {
   const diag_cand *c;
+  rcb_model *m = NULL;
+  rcb_status st;
+  if (!out) return RCB_ERR_ARG;
+  *out = NULL;
   if (!d || !d->ran || rank >= d->ncand) return RCB_ERR_ARG;
   c = &d->cand[d->order[rank]];
-  if (!c->ini)
+  if (!c->model)
     return rcb_diag_fail((rcb_diag *)d, RCB_ERR_STATE,
                          "candidate %zu (%s) was not refitted: nothing to apply", rank + 1,
                          c->desc);
-  return put_text(c->ini, buf, size, needed);
+  if ((st = rcb_model_clone(&m, c->model, alloc)))
+    return rcb_diag_fail((rcb_diag *)d, st, "copying candidate %zu's model: %s", rank + 1,
+                         rcb_status_str(st));
+  if ((st = rcb_model_finalize(m))) {
+    rcb_diag_fail((rcb_diag *)d, st, "candidate %zu's model: %s", rank + 1,
+                  rcb_model_errmsg(m));
+    rcb_model_destroy(m);
+    return st;
+  }
+  *out = m;
+  return RCB_OK;
 }
 
 rcb_status rcb_diag_explain(const rcb_diag *d, char *buf, size_t size, size_t *needed) {

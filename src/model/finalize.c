@@ -49,8 +49,7 @@ static rcb_status mesh_shafts(rcb_model *m) {
         el->od = sg->od;
         el->id = sg->id;
         m->nodes[m->n_nodes].shaft = s;
-        /* positions from the segment start, so rounding does not accumulate */
-        m->nodes[m->n_nodes++].z = zs + sg->L * (double)(e + 1) / (double)sg->nel;
+        m->nodes[m->n_nodes++].z = rcb_segment_node_z(zs, sg->L, e, sg->nel);
       }
       z = zs + sg->L;
     }
@@ -167,9 +166,7 @@ static rcb_status number_dofs(rcb_model *m) {
   for (d = 0; d < nfull; d++) parent[d] = d;
   for (i = 0; i < m->n_couplings; i++) {
     const rcb_coupling_t *c = &m->couplings[i];
-    int ntied = c->type == RCB_COUPLING_RIGID                                          ? 4
-                : (c->type == RCB_COUPLING_KRAMER_1 || c->type == RCB_COUPLING_KRAMER_2) ? 2
-                                                                                         : 0;
+    int ntied = rcb_coupling_tied(c->type);
     int k;
     for (k = 0; k < ntied; k++)
       uf_union(parent, 4 * c->at[0].node + (size_t)k, 4 * c->at[1].node + (size_t)k);

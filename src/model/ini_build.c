@@ -258,27 +258,19 @@ static rcb_status build_bearing(ini_ctx *c, const ini_section *s) {
   return st;
 }
 
-static const char *const model_names[5] = {"kramer_1", "kramer_2", "nelson_crandall_1",
-                                           "nelson_crandall_2", "rigid"};
-
-/* Which of kt, kr, ct, cr (bits 0..3) each coupling model uses (paper section 3). */
-static const unsigned model_uses[5] = {0x0u, 0xAu, 0x3u, 0xFu, 0x0u};
-
+/* Which of kt, kr, ct, cr each model uses, and the names: the coupling
+ * table (model/coupling_models.c). */
 static rcb_status coupling_params(ini_ctx *c, const ini_section *s, rcb_coupling_model type,
                                   rcb_coupling_params *p) {
-  static const char *const pk[4] = {"kt", "kr", "ct", "cr"};
   static const char *const pe[4] = {
       "translational stiffness in N/m", "rotational stiffness in N m/rad",
       "translational damping in N s/m", "rotational damping in N m s/rad"};
-  double *dst[4];
+  const char *pk[4];
   char uses[64];
   const char *used[4];
   size_t nu = 0, k;
-  unsigned mask = model_uses[type];
-  dst[0] = &p->kt;
-  dst[1] = &p->kr;
-  dst[2] = &p->ct;
-  dst[3] = &p->cr;
+  unsigned mask = rcb_coupling_uses(type);
+  for (k = 0; k < 4; k++) pk[k] = rcb_coupling_coef_key((int)k);
   for (k = 0; k < 4; k++)
     if (mask & (1u << k)) used[nu++] = pk[k];
   uses[0] = '\0';
@@ -290,13 +282,14 @@ static rcb_status coupling_params(ini_ctx *c, const ini_section *s, rcb_coupling
       return rcb_ini_error(c, RCB_ERR_PARSE, e->line, s, e->key,
                            "not used by model %s; expected %s%s (remove %s or change the "
                            "model)",
-                           model_names[type], nu ? "only " : "no stiffness or damping keys",
+                           rcb_coupling_model_name(type),
+                           nu ? "only " : "no stiffness or damping keys",
                            uses, pk[k]);
     if (!e && (mask & (1u << k)))
       return rcb_ini_error(c, RCB_ERR_PARSE, s->line, s, NULL,
                            "missing key '%s'; expected %s = %s (model %s needs %s)", pk[k],
-                           pk[k], pe[k], model_names[type], uses);
-    if (e) TRY(rcb_ini_get_num(c, s, pk[k], pe[k], 1, 0, dst[k]));
+                           pk[k], pe[k], rcb_coupling_model_name(type), uses);
+    if (e) TRY(rcb_ini_get_num(c, s, pk[k], pe[k], 1, 0, rcb_coupling_coef(p, (int)k)));
   }
   return RCB_OK;
 }
@@ -344,12 +337,18 @@ static rcb_status build_coupling(ini_ctx *c, const ini_section *s) {
   rcb_coupling_model type;
   rcb_coupling_params p;
   rcb_status st;
+  const char *model_names[RCB_COUPLING_MODEL_COUNT];
+  int k;
   memset(&p, 0, sizeof p);
-  snprintf(all, sizeof all, "%s, %s, %s, %s or %s", model_names[0], model_names[1],
-           model_names[2], model_names[3], model_names[4]);
+  for (k = 0; k < RCB_COUPLING_MODEL_COUNT; k++)
+    model_names[k] = rcb_coupling_model_name((rcb_coupling_model)k);
+  all[0] = '\0';
+  for (k = 0; k < RCB_COUPLING_MODEL_COUNT; k++)
+    snprintf(all + strlen(all), sizeof all - strlen(all), "%s%s",
+             k == 0 ? "" : k + 1 < RCB_COUPLING_MODEL_COUNT ? ", " : " or ", model_names[k]);
   TRY(rcb_ini_get_word(c, s, "model", all, name, sizeof name));
   if (rcb_coupling_model_parse(name, &type)) {
-    const char *near = rcb_ini_closest(name, model_names, 5);
+    const char *near = rcb_ini_closest(name, model_names, RCB_COUPLING_MODEL_COUNT);
     return rcb_ini_error(c, RCB_ERR_PARSE, rcb_ini_get(s, "model")->line, s, "model",
                          "unknown coupling model '%s'%s%s%s; expected %s", name,
                          near ? " (did you mean " : "", near ? near : "", near ? "?)" : "",

@@ -248,9 +248,6 @@ static void write_bearings(wbuf *w, const rcb_model *m) {
 }
 
 static void write_coupling(wbuf *w, const rcb_model *m, const rcb_coupling_t *c) {
-  /* which of kt, kr, ct, cr each model uses (paper section 3) */
-  static const unsigned uses[5] = {0x0u, 0xAu, 0x3u, 0xFu, 0x0u};
-  static const char *const keys[4] = {"kt", "kr", "ct", "cr"};
   static const char *const units[4] = {"N/m", "N m/rad", "N s/m", "N m s/rad"};
   const double v[4] = {c->p.kt, c->p.kr, c->p.ct, c->p.cr};
   const rcb_coupling_params *p = &c->p;
@@ -262,7 +259,8 @@ static void write_coupling(wbuf *w, const rcb_model *m, const rcb_coupling_t *c)
            place_txt(m, &c->at[1], b, sizeof b));
   kv(w, "between", both, "station a, station b (shaft, z m)");
   for (k = 0; k < 4; k++)
-    if (uses[c->type] & (1u << k)) kv_num(w, keys[k], v[k], units[k]);
+    if (rcb_coupling_uses(c->type) & (1u << k))
+      kv_num(w, rcb_coupling_coef_key(k), v[k], units[k]);
   if (p->mass[0] != 0 || p->Id[0] != 0 || p->Ip[0] != 0 || p->mass[1] != 0 || p->Id[1] != 0 ||
       p->Ip[1] != 0) {
     if (p->mass[1] != p->mass[0] || p->Id[1] != p->Id[0] || p->Ip[1] != p->Ip[0]) {

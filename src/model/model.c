@@ -61,7 +61,7 @@ rcb_status (rcb_model_fail)(rcb_model *m, rcb_status st, const char *fmt, ...) {
   return st;
 }
 
-static rcb_status check_editable(rcb_model *m, const char *what) {
+rcb_status rcb_model_check_editable(rcb_model *m, const char *what) {
   if (!m) return RCB_ERR_ARG;
   if (m->finalized)
     return rcb_model_fail(m, RCB_ERR_STATE,
@@ -161,7 +161,7 @@ rcb_status rcb_model_add_material(rcb_model *m, const char *name, double density
                                   double poisson) {
   size_t i;
   rcb_material_t *mat;
-  rcb_status st = check_editable(m, "material");
+  rcb_status st = rcb_model_check_editable(m, "material");
   if (st || (st = check_name(m, "material", name))) return st;
   for (i = 0; i < m->n_materials; i++)
     if (strcmp(m->materials[i].name, name) == 0)
@@ -187,7 +187,7 @@ rcb_status rcb_model_add_shaft(rcb_model *m, const char *name, const char *mater
   size_t i;
   long mat = -1;
   rcb_shaft_t *s;
-  rcb_status st = check_editable(m, "shaft");
+  rcb_status st = rcb_model_check_editable(m, "shaft");
   if (st || (st = check_name(m, "shaft", name))) return st;
   if (find_shaft(m, name) >= 0)
     return rcb_model_fail(m, RCB_ERR_MODEL, "shaft '%s' is defined twice", name);
@@ -215,7 +215,7 @@ rcb_status rcb_model_add_shaft(rcb_model *m, const char *name, const char *mater
 rcb_status rcb_model_set_shaft_damping(rcb_model *m, const char *shaft, double qz_m,
                                        double qz_k) {
   long s;
-  rcb_status st = check_editable(m, "shaft damping");
+  rcb_status st = rcb_model_check_editable(m, "shaft damping");
   if (st) return st;
   s = find_shaft(m, shaft);
   if (s < 0)
@@ -232,7 +232,7 @@ rcb_status rcb_model_add_segment(rcb_model *m, const char *shaft, double length,
                                  double outer_d, double inner_d, int n_elements) {
   long s;
   rcb_shaft_t *sh;
-  rcb_status st = check_editable(m, "segment");
+  rcb_status st = rcb_model_check_editable(m, "segment");
   if (st) return st;
   s = find_shaft(m, shaft);
   if (s < 0)
@@ -280,7 +280,7 @@ rcb_status rcb_model_add_disk(rcb_model *m, const char *name, const char *shaft,
                               double mass, double Id, double Ip) {
   rcb_disk_t *d;
   rcb_place_t at;
-  rcb_status st = check_editable(m, "disk");
+  rcb_status st = rcb_model_check_editable(m, "disk");
   if (st || (st = check_station_name(m, "disk", name))) return st;
   if ((st = place_on(m, "disk", name, shaft, z, &at))) return st;
   CHECK_VALUE("disk", name, "mass (kg)", mass, 0);
@@ -305,15 +305,12 @@ static rcb_status check_coefs(rcb_model *m, const char *name, const rcb_bearing_
   return RCB_OK;
 }
 
-rcb_status rcb_model_add_bearing_table(rcb_model *m, const char *name, const char *shaft,
-                                       double z, size_t n, const double *speeds,
-                                       const rcb_bearing_coefs *c) {
-  rcb_bearing_t *b;
-  rcb_place_t at;
+rcb_status rcb_model_bearing_rows(rcb_model *m, rcb_bearing_t *b, const char *name, size_t n,
+                                  const double *speeds, const rcb_bearing_coefs *c) {
+  double *sp;
+  rcb_bearing_coefs *cc;
   size_t i;
-  rcb_status st = check_editable(m, "bearing");
-  if (st || (st = check_station_name(m, "bearing", name))) return st;
-  if ((st = place_on(m, "bearing", name, shaft, z, &at))) return st;
+  rcb_status st;
   if (n < 1 || !c || (n > 1 && !speeds))
     return rcb_model_fail(m, RCB_ERR_ARG, "bearing '%s': no coefficients given", name);
   for (i = 0; i < n; i++) {
@@ -326,24 +323,40 @@ rcb_status rcb_model_add_bearing_table(rcb_model *m, const char *name, const cha
                             "%g rad/s)",
                             name, i + 1, speeds[i], speeds[i - 1]);
   }
-  GROW(bearings);
-  b = &m->bearings[m->n_bearings];
-  b->speeds = rcb_alloc(&m->alloc, n * sizeof *b->speeds);
-  b->c = rcb_alloc(&m->alloc, n * sizeof *b->c);
-  if (!b->speeds || !b->c) {
-    rcb_free(&m->alloc, b->speeds);
-    rcb_free(&m->alloc, b->c);
-    b->speeds = NULL;
-    b->c = NULL;
+  if (!b) return RCB_OK; /* checked only */
+  sp = rcb_alloc(&m->alloc, n * sizeof *sp);
+  cc = rcb_alloc(&m->alloc, n * sizeof *cc);
+  if (!sp || !cc) {
+    rcb_free(&m->alloc, sp);
+    rcb_free(&m->alloc, cc);
     return rcb_model_fail(m, RCB_ERR_NOMEM, "out of memory adding bearing '%s'", name);
   }
   for (i = 0; i < n; i++) {
-    b->speeds[i] = speeds ? speeds[i] : 0.0;
-    b->c[i] = c[i];
+    sp[i] = speeds ? speeds[i] : 0.0;
+    cc[i] = c[i];
   }
+  rcb_free(&m->alloc, b->speeds);
+  rcb_free(&m->alloc, b->c);
+  b->speeds = sp;
+  b->c = cc;
+  b->n = n;
+  return RCB_OK;
+}
+
+rcb_status rcb_model_add_bearing_table(rcb_model *m, const char *name, const char *shaft,
+                                       double z, size_t n, const double *speeds,
+                                       const rcb_bearing_coefs *c) {
+  rcb_bearing_t *b;
+  rcb_place_t at;
+  rcb_status st = rcb_model_check_editable(m, "bearing");
+  if (st || (st = check_station_name(m, "bearing", name))) return st;
+  if ((st = place_on(m, "bearing", name, shaft, z, &at))) return st;
+  if ((st = rcb_model_bearing_rows(m, NULL, name, n, speeds, c))) return st;
+  GROW(bearings);
+  b = &m->bearings[m->n_bearings];
+  if ((st = rcb_model_bearing_rows(m, b, name, n, speeds, c))) return st;
   snprintf(b->name, sizeof b->name, "%s", name);
   b->at = at;
-  b->n = n;
   b->has_ped = 0;
   b->ped_m = b->ped_k[0] = b->ped_k[1] = b->ped_c[0] = b->ped_c[1] = 0.0;
   m->n_bearings++;
@@ -354,7 +367,7 @@ rcb_status rcb_model_set_pedestal(rcb_model *m, const char *bearing, const rcb_p
   static const rcb_pedestal none = {0, 0, 0, 0, 0};
   rcb_bearing_t *b = NULL;
   size_t i;
-  rcb_status st = check_editable(m, "pedestal");
+  rcb_status st = rcb_model_check_editable(m, "pedestal");
   if (st) return st;
   for (i = 0; bearing && i < m->n_bearings; i++)
     if (strcmp(m->bearings[i].name, bearing) == 0) b = &m->bearings[i];
@@ -379,46 +392,6 @@ rcb_status rcb_model_set_pedestal(rcb_model *m, const char *bearing, const rcb_p
 rcb_status rcb_model_add_bearing(rcb_model *m, const char *name, const char *shaft, double z,
                                  const rcb_bearing_coefs *c) {
   return rcb_model_add_bearing_table(m, name, shaft, z, 1, NULL, c);
-}
-
-void rcb_bearing_eval(const rcb_bearing_t *b, double speed, rcb_bearing_coefs *out) {
-  size_t i = 0;
-  double t;
-  const double *lo, *hi;
-  double *o = &out->kxx;
-  int k;
-  if (b->n == 1 || speed <= b->speeds[0]) {
-    *out = b->c[0];
-    return;
-  }
-  if (speed >= b->speeds[b->n - 1]) {
-    *out = b->c[b->n - 1];
-    return;
-  }
-  while (i + 1 < b->n && b->speeds[i + 1] < speed) i++;
-  t = (speed - b->speeds[i]) / (b->speeds[i + 1] - b->speeds[i]);
-  lo = &b->c[i].kxx;
-  hi = &b->c[i + 1].kxx;
-  for (k = 0; k < 8; k++) o[k] = lo[k] + t * (hi[k] - lo[k]);
-}
-
-static const char *const coupling_names[] = {"kramer_1", "kramer_2", "nelson_crandall_1",
-                                             "nelson_crandall_2", "rigid"};
-
-const char *rcb_coupling_model_name(rcb_coupling_model t) {
-  if ((int)t < 0 || (int)t > 4) return NULL;
-  return coupling_names[t];
-}
-
-rcb_status rcb_coupling_model_parse(const char *name, rcb_coupling_model *t) {
-  int i;
-  if (!name || !t) return RCB_ERR_ARG;
-  for (i = 0; i < 5; i++)
-    if (strcmp(name, coupling_names[i]) == 0) {
-      *t = (rcb_coupling_model)i;
-      return RCB_OK;
-    }
-  return RCB_ERR_NOT_FOUND;
 }
 
 rcb_status rcb_coupling_hubs_from_geometry(double density, double r_inner, double r_outer,
@@ -448,7 +421,7 @@ rcb_status rcb_model_add_coupling(rcb_model *m, const char *name, rcb_coupling_m
   rcb_coupling_params zero = {0};
   const rcb_coupling_params *q = p ? p : &zero;
   int k;
-  rcb_status st = check_editable(m, "coupling");
+  rcb_status st = rcb_model_check_editable(m, "coupling");
   if (st || (st = check_station_name(m, "coupling", name))) return st;
   if (!rcb_coupling_model_name(type))
     return rcb_model_fail(m, RCB_ERR_ARG, "coupling '%s': unknown model %d", name, (int)type);
@@ -482,7 +455,7 @@ rcb_status rcb_model_add_unbalance(rcb_model *m, const char *name, const char *s
                                    double amount, double phase) {
   rcb_unbalance_t *u;
   rcb_place_t at;
-  rcb_status st = check_editable(m, "unbalance");
+  rcb_status st = rcb_model_check_editable(m, "unbalance");
   if (st || (st = check_station_name(m, "unbalance", name))) return st;
   if ((st = place_on(m, "unbalance", name, shaft, z, &at))) return st;
   CHECK_VALUE("unbalance", name, "amount (kg m)", amount, 0);
@@ -499,7 +472,7 @@ rcb_status rcb_model_add_unbalance(rcb_model *m, const char *name, const char *s
 rcb_status rcb_model_add_station(rcb_model *m, const char *name, const char *shaft, double z) {
   rcb_probe_t *p;
   rcb_place_t at;
-  rcb_status st = check_editable(m, "station");
+  rcb_status st = rcb_model_check_editable(m, "station");
   if (st || (st = check_station_name(m, "station", name))) return st;
   if ((st = place_on(m, "station", name, shaft, z, &at))) return st;
   GROW(probes);
@@ -512,7 +485,7 @@ rcb_status rcb_model_add_station(rcb_model *m, const char *name, const char *sha
 rcb_status rcb_model_add_uff_node(rcb_model *m, long node, const char *station) {
   rcb_uffmap_t *u;
   size_t i;
-  rcb_status st = check_editable(m, "uff map");
+  rcb_status st = rcb_model_check_editable(m, "uff map");
   if (st) return st;
   if (!station || !station[0] || strlen(station) >= sizeof u->station)
     return rcb_model_fail(m, RCB_ERR_ARG, "uff map: node %ld: a station name is required",

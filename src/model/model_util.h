@@ -19,4 +19,22 @@ rcb_status rcb_model_fail(rcb_model *m, rcb_status st, const char *fmt, ...)
 rcb_status rcb_model_check_value(rcb_model *m, const char *kind, const char *name,
                                  const char *what, double v, int sign);
 
+/* RCB_ERR_STATE (with a message) unless m is not yet finalized: structural
+ * changes (what: "disk", ...) come before rcb_model_finalize. */
+rcb_status rcb_model_check_editable(rcb_model *m, const char *what);
+
+/* Check a bearing table (n rows, speeds strictly increasing when n > 1) and,
+ * with b not NULL, store a copy of it in b in place of b's rows (b's old rows
+ * are freed only on success). */
+rcb_status rcb_model_bearing_rows(rcb_model *m, rcb_bearing_t *b, const char *name, size_t n,
+                                  const double *speeds, const rcb_bearing_coefs *c);
+
+/* Axial position (m) of node e + 1 of a segment of length L (m) and nel
+ * elements starting at zs (m): from the segment start, so rounding does not
+ * accumulate. The mesh (finalize) and the node lookup of an unfinalized
+ * model (rcb_model_add_disk_at) share it, so both give the same double. */
+static inline double rcb_segment_node_z(double zs, double L, size_t e, int nel) {
+  return zs + L * (double)(e + 1) / (double)nel;
+}
+
 #endif

@@ -65,6 +65,8 @@ static const pkey bearing_keys[] = {
 #define BEARING_OWN_KEYS 8
 #define BEARING_PED_KEYS 10 /* first pedestal key */
 #define BEARING_PED_VIEWS 15 /* pedestal_k, pedestal_c */
+/* kt, kr, ct, cr first, in the order of the coupling table's bits
+ * (rcb_coupling_coef_key, model/coupling_models.c). */
 static const pkey coupling_keys[] = {{"kt", "kt (N/m)", 0},
                                      {"kr", "kr (N m/rad)", 0},
                                      {"ct", "ct (N s/m)", 0},
@@ -87,10 +89,6 @@ static const pkind_info kinds[PK_COUNT] = {
     PK("disk", disk_keys),         PK("bearing", bearing_keys),
     PK("coupling", coupling_keys), PK("unbalance", unbalance_keys)};
 #undef PK
-
-/* Which of kt, kr, ct, cr (bits 0..3) each coupling model uses (paper
- * section 3; the same rule as the assembly and the INI loader). */
-static const unsigned coupling_uses[5] = {0x0u, 0xAu, 0x3u, 0xFu, 0x0u};
 
 static size_t item_count(const rcb_model *m, pkind k) {
   switch (k) {
@@ -126,10 +124,8 @@ static int enumerated(pkind k, size_t j) {
 static int key_usable(const rcb_model *m, pkind k, size_t i, size_t j) {
   if (k == PK_BEARING && j >= BEARING_PED_KEYS) return m->bearings[i].has_ped;
   if (k == PK_BEARING) return m->bearings[i].n == 1;
-  if (k == PK_COUPLING && j < 4) {
-    int t = (int)m->couplings[i].type;
-    return t >= 0 && t < 5 && (coupling_uses[t] & (1u << j)) != 0;
-  }
+  if (k == PK_COUPLING && j < 4) /* kt, kr, ct, cr: the bits of the coupling table */
+    return (rcb_coupling_uses(m->couplings[i].type) & (1u << j)) != 0;
   return 1;
 }
 
@@ -173,13 +169,8 @@ static int slots(rcb_model *m, pkind k, size_t i, size_t j, double *v[2]) {
     }
     case PK_COUPLING: {
       rcb_coupling_params *p = &m->couplings[i].p;
-      double *four[4];
-      four[0] = &p->kt;
-      four[1] = &p->kr;
-      four[2] = &p->ct;
-      four[3] = &p->cr;
       if (j < 4) {
-        v[0] = four[j];
+        v[0] = rcb_coupling_coef(p, (int)j);
         return 1;
       }
       v[0] = j == 4 ? &p->mass[0] : j == 5 ? &p->Id[0] : &p->Ip[0];

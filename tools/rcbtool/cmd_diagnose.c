@@ -193,16 +193,18 @@ static void print_json(FILE *fp, const diag_job *j, const rcb_diag *d, const cha
   fputs("]}\n", fp);
 }
 
-/* --apply K: the candidate's fitted model to -o, the report to stdout. */
+/* --apply K: the candidate's fitted model, written as INI, to -o; the
+ * report to stdout. */
 static int apply(const cli_args *a, const diag_job *j, const rcb_diag *d) {
   size_t need = 0;
   char *buf;
+  rcb_model *m = NULL;
   cli_out o;
   int rc;
   if (j->apply > rcb_diag_candidate_count(d))
     return cli_usage(a->cmd, "--apply %zu: there are %zu candidates", j->apply,
                      rcb_diag_candidate_count(d));
-  if (rcb_diag_apply_ini(d, j->apply - 1, NULL, 0, &need) != RCB_ERR_WORKSPACE)
+  if (rcb_diag_apply_model(d, j->apply - 1, NULL, &m))
     return cli_fail(CLI_EXIT_INPUT, "%s: %s", a->cmd, rcb_diag_errmsg(d));
   {
     rcb_diag_candidate c;
@@ -213,8 +215,17 @@ static int apply(const cli_args *a, const diag_job *j, const rcb_diag *d) {
                "data",
                a->cmd, j->apply, j->apply, c.description, c.delta_bic);
   }
-  if (!(buf = malloc(need))) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
-  rcb_diag_apply_ini(d, j->apply - 1, buf, need, &need);
+  if (rcb_model_write_ini(m, NULL, 0, &need) != RCB_ERR_WORKSPACE) {
+    rc = cli_fail(CLI_EXIT_NUMERIC, "%s: %s", a->cmd, rcb_model_errmsg(m));
+    rcb_model_destroy(m);
+    return rc;
+  }
+  if (!(buf = malloc(need))) {
+    rcb_model_destroy(m);
+    return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  }
+  rcb_model_write_ini(m, buf, need, &need);
+  rcb_model_destroy(m);
   if ((rc = cli_out_open(&o, a))) {
     free(buf);
     return rc;

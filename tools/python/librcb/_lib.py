@@ -205,7 +205,7 @@ _PROTOTYPES = {
     "rcb_diag_candidate_count": (c_size_t, [c_void_p]),
     "rcb_diag_candidate_get": (c_int, [c_void_p, c_size_t, ctypes.POINTER(DiagCandidate)]),
     "rcb_diag_baseline": (c_int, [c_void_p, c_double_p, c_double_p, c_double_p]),
-    "rcb_diag_apply_ini": (c_int, [c_void_p, c_size_t, c_char_p, c_size_t, c_size_t_p]),
+    "rcb_diag_apply_model": (c_int, [c_void_p, c_size_t, c_void_p, PP]),
     "rcb_diag_explain": (c_int, [c_void_p, c_char_p, c_size_t, c_size_t_p]),
     # comparison
     "rcb_compare_create": (c_int, [PP, c_void_p]),

@@ -166,8 +166,15 @@ class Diagnosis(Handle):
 
     def apply(self, rank=0):
         """The model with candidate rank added and fitted (a new Model)."""
-        st, ini = _lib.two_call_string(_lib.lib().rcb_diag_apply_ini, self.handle, int(rank))
-        self.check(st, "rcb_diag_apply_ini")
+        L = _lib.lib()
+        h = ctypes.c_void_p()
+        self.check(L.rcb_diag_apply_model(self.handle, int(rank), None, ctypes.byref(h)),
+                   "rcb_diag_apply_model")
+        try:  # the fitted model, through its INI text (a Model owns its handle)
+            st, ini = _lib.two_call_string(L.rcb_model_write_ini, h)
+            _lib.check(st, L.rcb_model_errmsg, h, "rcb_model_write_ini")
+        finally:
+            L.rcb_model_destroy(h)
         return Model.from_ini(ini, name=f"<diagnosis candidate {rank}>")
 
 
