@@ -164,6 +164,17 @@ static void test_clone_unedited(void **state) {
   assert_int_equal(rcb_model_param_count(c), rcb_model_param_count(orig));
   assert_int_equal(x.n, y.n); /* same assembly: bitwise the same */
   assert_memory_equal(x.a, y.a, 4 * x.n * x.n * sizeof *x.a);
+  /* the test speed ([test] rpm) is part of the model: it travels with the copy */
+  {
+    double w = 0.0, w0 = 2.0 * 3.141592653589793 * 10000.0 / 60.0; /* 10000 rpm, rad/s */
+    rcb_model *c2 = NULL;
+    assert_int_equal(rcb_model_get_test_speed(c, &w), RCB_ERR_NOT_FOUND);
+    assert_int_equal(rcb_model_set_test_speed(orig, w0), RCB_OK);
+    assert_int_equal(rcb_model_clone(&c2, orig, NULL), RCB_OK);
+    assert_int_equal(rcb_model_get_test_speed(c2, &w), RCB_OK);
+    assert_true(w == w0);
+    rcb_model_destroy(c2);
+  }
   /* a value changed on the clone only */
   set(c, "coupling.C.kt", 7e5);
   {

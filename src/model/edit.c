@@ -83,6 +83,8 @@ rcb_status rcb_model_clone(rcb_model **out, const rcb_model *src, const rcb_allo
     return RCB_ERR_NOMEM;
   }
   c->speed_factor = src->speed_factor;
+  c->has_test_speed = src->has_test_speed; /* [test] rpm */
+  c->test_speed = src->test_speed;
   *out = c;
   return RCB_OK;
 }
