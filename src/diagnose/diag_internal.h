@@ -38,6 +38,7 @@ typedef struct diag_cand {
   char params[RCB_DIAG_MAXP * RCB_DIAG_NAME];
   /* results */
   double predicted;                 /* score-test reduction of F */
+  double predicted_nom;             /* the same at the nominal model (far baseline) */
   int refitted, significant;
   double F, err, dbic;
   char fitted[RCB_DIAG_MAXP * (RCB_DIAG_NAME + 32)];
@@ -65,6 +66,9 @@ struct rcb_diag {
   size_t nbase, cap_base;
   /* results */
   char *base_ini;                   /* the model with its own parameters fitted */
+  char *nom_ini;                    /* the model as given (nominal parameters) */
+  int far;                          /* the baseline fit ran off from the nominal model */
+  char drift[256];                  /* which parameter ran off, in words */
   double F0, err0, floor0;
   size_t nres;
   diag_cand *cand;
@@ -89,6 +93,9 @@ rcb_status rcb_diag_catalogue(rcb_diag *d, const rcb_model *m);
  * fitted): move the candidate's parameters to a better start where the
  * neutral start sees nothing (a pedestal: a scan of its mass and stiffness). */
 rcb_status rcb_diag_refit_start(rcb_diag *d, const diag_cand *c, rcb_model *m, rcb_fit *f);
+/* Weights (channel-major, 0 or 1) keeping a subset of the measured
+ * frequencies: one every 2.5 % in frequency, at least 150 (caller frees). */
+double *rcb_diag_grid_weights(rcb_diag *d);
 /* The candidate's model: the base INI text edited, loaded (caller destroys). */
 rcb_status rcb_diag_candidate_model(rcb_diag *d, const diag_cand *c, rcb_model **out);
 
