@@ -39,6 +39,7 @@ typedef struct diag_cand {
   /* results */
   double predicted;                 /* score-test reduction of F */
   double predicted_nom;             /* the same at the nominal model (far baseline) */
+  int from_fit, from_nom;           /* refitted from the fitted / the nominal base */
   int refitted, significant;
   double F, err, dbic;
   char fitted[RCB_DIAG_MAXP * (RCB_DIAG_NAME + 32)];

@@ -495,6 +495,30 @@ static rcb_status refit_setup(rcb_diag *d, const diag_cand *c, char *src, rcb_mo
   return st;
 }
 
+/* The screening fit on the frequency subset w (NULL: the fit on all points)
+ * stops after RCB_DIAG_SCREEN_ITER iterations: it ranks the starts and
+ * brings the polish near its end, and a fit crawling along a bound (a
+ * damping at 0) goes on in the polish only if it is the best start. */
+#define RCB_DIAG_SCREEN_ITER 25
+static rcb_status screen(rcb_fit *f, const double *w) {
+  size_t it = f->max_iter;
+  rcb_status st = rcb_fit_set_weights(f, w);
+  if (!st && w && it > RCB_DIAG_SCREEN_ITER)
+    st = rcb_fit_set_limits(f, RCB_DIAG_SCREEN_ITER, f->ftol_rel, f->xtol_rel);
+  if (!st) st = rcb_fit_run(f);
+  if (w && it > RCB_DIAG_SCREEN_ITER) rcb_fit_set_limits(f, it, f->ftol_rel, f->xtol_rel);
+  return st;
+}
+
+/* The polish of a screened fit on all points, from where the subset left it,
+ * with no further starts. */
+static rcb_status polish(rcb_fit *f) {
+  rcb_status st = rcb_fit_set_weights(f, NULL);
+  if (!st) st = rcb_fit_set_starts(f, 1, 1);
+  if (!st) st = rcb_fit_run(f);
+  return st;
+}
+
 /* BIC change and significance of a refitted candidate (F, err set). */
 static void judge(const rcb_diag *d, diag_cand *c, double k) {
   double N = (double)d->nres;
@@ -518,21 +542,22 @@ static rcb_status evaluate_only(rcb_diag *d, diag_cand *c, rcb_model *m, rcb_fit
 }
 
 /* Refit candidate c with the base parameters, from the fitted base model
- * and, when the baseline fit ran off (d->far), from the nominal one too: a
- * missing effect that pulled the base parameters far leaves the fitted
- * point in a basin the joint fit does not leave. With w (a subset of the
- * frequencies, rcb_diag_grid_weights) each start is fitted on the subset,
- * its further random starts too, and only the best is polished on all the
+ * (c->from_fit) and from the nominal one (c->from_nom: the baseline fit ran
+ * off, and c scores high at the nominal model): a missing effect that
+ * pulled the base parameters far leaves the fitted point in a basin a joint
+ * fit does not leave. With w (a subset of the frequencies, subset()) each
+ * start is screened on the subset and only the best is polished on all
  * points, from where the subset left it. */
 static rcb_status refit(rcb_diag *d, diag_cand *c, const double *w) {
   rcb_model *m[2] = {NULL, NULL};
   rcb_fit *f[2] = {NULL, NULL};
   double F[2] = {HUGE_VAL, HUGE_VAL};
   char why[320] = "";
-  size_t s, n = d->far && !c->refit_only ? 2 : 1, b = 0;
+  size_t s, b = 0;
   rcb_status st = RCB_OK;
   d->stats.refits++;
-  for (s = 0; s < n; s++) {
+  for (s = 0; s < 2; s++) {
+    if (!(s ? c->from_nom : c->from_fit)) continue;
     st = refit_setup(d, c, s ? d->nom_ini : d->base_ini, &m[s], &f[s]);
     if (st == RCB_ERR_NOMEM) break;
     if (st) { /* a candidate that cannot be built is reported, not fatal */
@@ -540,7 +565,7 @@ static rcb_status refit(rcb_diag *d, diag_cand *c, const double *w) {
       continue;
     }
     if (rcb_fit_param_count(f[s]) == 0) break; /* nothing to fit: evaluated below */
-    if (!(st = rcb_fit_set_weights(f[s], w))) st = rcb_fit_run(f[s]);
+    st = screen(f[s], w);
     if (st == RCB_ERR_NOMEM) {
       rcb_diag_fail(d, st, "refitting %s: %s", c->desc, rcb_fit_errmsg(f[s]));
       break;
@@ -558,8 +583,7 @@ static rcb_status refit(rcb_diag *d, diag_cand *c, const double *w) {
       st = evaluate_only(d, c, m[b], f[b]);
     } else if (!(F[b] < HUGE_VAL)) {
       snprintf(c->fitted, sizeof c->fitted, "%s", why);
-    } else if (w && ((st = rcb_fit_set_weights(f[b], NULL)) || (st = rcb_fit_set_starts(f[b], 1, 1)) ||
-                     (st = rcb_fit_run(f[b])))) { /* the polish on all points */
+    } else if (w && (st = polish(f[b]))) {
       if (st == RCB_ERR_NOMEM)
         rcb_diag_fail(d, st, "refitting %s: %s", c->desc, rcb_fit_errmsg(f[b]));
       else
@@ -602,36 +626,39 @@ static void sort_order(rcb_diag *d) {
 }
 
 /* With the baseline run off, the candidates the score test ranks first at
- * the nominal model are refitted too (those not refitted already). */
+ * the nominal model are refitted from there too (from both starts when
+ * they are also among the best at the fitted model). */
 #define RCB_DIAG_NOM_REFITS 3
 
 static rcb_status refit_best(rcb_diag *d) {
-  size_t k, done = 0, extra = 0;
+  size_t k, j, done = 0, todo = 0;
   double *w = subset(d);
   rcb_status st = RCB_OK;
   sort_order(d); /* by predicted reduction (nothing refitted yet) */
-  for (k = 0; !st && k < d->ncand; k++) {
+  for (k = 0; k < d->ncand; k++) {
     diag_cand *c = &d->cand[d->order[k]];
-    if (c->refit_only || done >= d->nrefit || !(c->predicted > 0)) continue;
-    st = refit(d, c, w);
-    c->predicted_nom = 0; /* taken */
-    done++;
-    if (!st && d->progress &&
-        d->progress(d->progress_user, d->ncand + done, d->ncand + d->nrefit))
-      st = rcb_diag_fail(d, RCB_ERR_STATE, "stopped by the caller");
+    c->from_fit = c->refit_only || (todo < d->nrefit && c->predicted > 0);
+    todo += !c->refit_only && c->from_fit;
   }
-  while (!st && d->far && extra < RCB_DIAG_NOM_REFITS) {
+  for (j = 0; d->far && j < RCB_DIAG_NOM_REFITS; j++) {
     diag_cand *c = NULL;
     for (k = 0; k < d->ncand; k++) {
       diag_cand *e = &d->cand[k];
-      if (!e->refit_only && !e->refitted && e->predicted_nom > 0 &&
+      if (!e->refit_only && !e->from_nom && e->predicted_nom > 0 &&
           (!c || e->predicted_nom > c->predicted_nom))
         c = e;
     }
     if (!c) break;
+    todo += !c->from_fit;
+    c->from_nom = 1;
+  }
+  for (k = 0; !st && k < d->ncand; k++) {
+    diag_cand *c = &d->cand[d->order[k]];
+    if (c->refit_only || !(c->from_fit || c->from_nom)) continue;
     st = refit(d, c, w);
-    c->predicted_nom = 0; /* taken, refitted or not */
-    extra++;
+    done++;
+    if (!st && d->progress && d->progress(d->progress_user, d->ncand + done, d->ncand + todo))
+      st = rcb_diag_fail(d, RCB_ERR_STATE, "stopped by the caller");
   }
   for (k = 0; !st && k < d->ncand; k++)
     if (d->cand[k].refit_only) st = refit(d, &d->cand[k], w);
