@@ -179,15 +179,15 @@ static rcb_status objective(rcb_diag *d, rcb_fit *f, double *r, double *F, doubl
  * points: rcb_diag_grid_weights, where it keeps at most half of the points
  * (32 x 1101: 150 points); else NULL, all points (8 x 151: 150 of 151 points
  * would screen for nothing). */
-static double *subset(rcb_diag *d) {
+static rcb_status subset(rcb_diag *d, double **out) {
   size_t n = rcb_meas_point_count(d->meas), i, kept = 0;
   double *w = rcb_diag_grid_weights(d);
-  for (i = 0; w && i < n; i++) kept += w[i] > 0;
-  if (w && 2 * kept > n) {
-    rcb_free(&d->alloc, w);
-    w = NULL;
-  }
-  return w;
+  *out = NULL;
+  if (!w) return rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
+  for (i = 0; i < n; i++) kept += w[i] > 0;
+  if (2 * kept > n) rcb_free(&d->alloc, w);
+  else *out = w;
+  return RCB_OK;
 }
 
 /* A baseline fit that a missing effect has pulled far from the nominal model
@@ -228,8 +228,9 @@ static rcb_status baseline(rcb_diag *d) {
   if (!st) st = rcb_model_load_string(m, txt, "<model>");
   if (!st) st = make_fit(d, m, 1, NULL, &f);
   if (!st && d->nbase) {
-    double *w = subset(d);
+    double *w = NULL;
     /* screened on the subset, polished on all points from there */
+    st = subset(d, &w);
     if (w && !(st = rcb_fit_set_weights(f, w))) st = rcb_fit_run(f);
     if (w && !st) st = rcb_fit_set_weights(f, NULL);
     rcb_free(&d->alloc, w);
@@ -634,8 +635,9 @@ static void sort_order(rcb_diag *d) {
 
 static rcb_status refit_best(rcb_diag *d) {
   size_t k, j, done = 0, todo = 0;
-  double *w = subset(d);
-  rcb_status st = RCB_OK;
+  double *w = NULL;
+  rcb_status st = subset(d, &w);
+  if (st) return st;
   sort_order(d); /* by predicted reduction (nothing refitted yet) */
   for (k = 0; k < d->ncand; k++) {
     diag_cand *c = &d->cand[d->order[k]];
