@@ -339,7 +339,7 @@ static size_t grid_keep(const double *x, size_t n, double step, double *w) {
  * 100-400 Hz. */
 #define RCB_DIAG_GRID_STEP 0.025
 #define RCB_DIAG_GRID_MIN 150
-static double *grid_weights(rcb_diag *d) {
+double *rcb_diag_grid_weights(rcb_diag *d) {
   size_t n = rcb_meas_point_count(d->meas), nch = rcb_meas_channel_count(d->meas), c;
   const double *x = rcb_meas_grid(d->meas);
   double *w = rcb_alloc(&d->alloc, (n * nch > 0 ? n * nch : 1) * sizeof *w);
@@ -375,7 +375,7 @@ rcb_status rcb_diag_refit_start(rcb_diag *d, const diag_cand *c, rcb_model *m, r
   int a, j;
   rcb_status st = RCB_OK;
   if (c->edit != EDIT_ADD_PEDESTAL) return RCB_OK;
-  if ((w = grid_weights(d)) && (st = rcb_fit_set_weights(f, w)) == RCB_OK &&
+  if ((w = rcb_diag_grid_weights(d)) && (st = rcb_fit_set_weights(f, w)) == RCB_OK &&
       (st = rcb_fit_prepare(f)) != RCB_OK && st != RCB_ERR_NOMEM) {
     rcb_fit_set_weights(f, NULL); /* no point left there: all points */
     st = RCB_OK;
@@ -472,9 +472,10 @@ static rcb_status coupling_start(const diag_cand *c, rcb_model *m) {
   return st;
 }
 
-rcb_status rcb_diag_candidate_model(rcb_diag *d, const diag_cand *c, rcb_model **out) {
+rcb_status rcb_diag_candidate_model(rcb_diag *d, const diag_cand *c, const rcb_model *from,
+                                    rcb_model **out) {
   rcb_model *m = NULL;
-  rcb_status st = rcb_model_clone(&m, d->base_model, &d->alloc);
+  rcb_status st = rcb_model_clone(&m, from, &d->alloc);
   *out = NULL;
   if (st) return rcb_diag_fail(d, st, "%s: %s", c->desc, rcb_status_str(st));
   if (!(st = edit(c, m)) && !(st = rcb_model_finalize(m)) && c->edit == EDIT_COUPLING_MODEL)

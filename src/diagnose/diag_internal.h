@@ -40,6 +40,8 @@ typedef struct diag_cand {
   char params[RCB_DIAG_MAXP * RCB_DIAG_NAME];
   /* results */
   double predicted;                 /* score-test reduction of F */
+  double predicted_nom;             /* the same at the nominal model (far baseline) */
+  int from_fit, from_nom;           /* refitted from the fitted / the nominal base */
   int refitted, significant;
   double F, err, dbic;
   char fitted[RCB_DIAG_MAXP * (RCB_DIAG_NAME + 32)];
@@ -69,6 +71,10 @@ struct rcb_diag {
   /* results */
   rcb_model *base_model;            /* the model with its own parameters fitted
                                        (owned, finalized) */
+  rcb_model *nom_model;             /* a finalized copy of the model as given, when
+                                       the baseline fit ran off from it (owned) */
+  int far;                          /* the baseline fit ran off from the nominal model */
+  char drift[256];                  /* which parameter ran off, in words */
   double F0, err0, floor0;
   size_t nres;
   diag_cand *cand;
@@ -95,8 +101,13 @@ rcb_status rcb_diag_catalogue(rcb_diag *d, const rcb_model *m);
 rcb_status rcb_diag_refit_start(rcb_diag *d, const diag_cand *c, rcb_model *m, rcb_fit *f);
 /* A finalized copy of model src with the diagnosis' allocator (caller destroys). */
 rcb_status rcb_diag_copy_model(rcb_diag *d, const rcb_model *src, rcb_model **out);
-/* The candidate's model: a copy of the fitted base model, edited, finalized,
- * the edit's starting values set (caller destroys). */
-rcb_status rcb_diag_candidate_model(rcb_diag *d, const diag_cand *c, rcb_model **out);
+/* Weights (channel-major, 0 or 1) keeping a subset of the measured
+ * frequencies: one every 2.5 % in frequency, at least 150 (caller frees). */
+double *rcb_diag_grid_weights(rcb_diag *d);
+/* The candidate's model: a copy of the base model from (the fitted base, or
+ * the nominal model), edited, finalized, the edit's starting values set
+ * (caller destroys). */
+rcb_status rcb_diag_candidate_model(rcb_diag *d, const diag_cand *c, const rcb_model *from,
+                                    rcb_model **out);
 
 #endif

@@ -49,7 +49,9 @@ static void free_results(rcb_diag *d) {
   rcb_free(&d->alloc, d->cand);
   rcb_free(&d->alloc, d->order);
   rcb_model_destroy(d->base_model);
-  d->cand = NULL, d->order = NULL, d->base_model = NULL;
+  rcb_model_destroy(d->nom_model);
+  d->cand = NULL, d->order = NULL, d->base_model = NULL, d->nom_model = NULL;
+  d->far = 0, d->drift[0] = '\0';
   d->ncand = d->cap_cand = 0;
   d->ran = 0;
   memset(&d->stats, 0, sizeof d->stats);
@@ -161,8 +163,49 @@ static rcb_status objective(rcb_diag *d, rcb_fit *f, double *r, double *F, doubl
   return RCB_OK;
 }
 
+/* The frequency subset the fits are screened on before their polish on all
+ * points: rcb_diag_grid_weights, where it keeps at most half of the points
+ * (32 x 1101: 150 points); else NULL, all points (8 x 151: 150 of 151 points
+ * would screen for nothing). */
+static rcb_status subset(rcb_diag *d, double **out) {
+  size_t n = rcb_meas_point_count(d->meas), i, kept = 0;
+  double *w = rcb_diag_grid_weights(d);
+  *out = NULL;
+  if (!w) return rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
+  for (i = 0; i < n; i++) kept += w[i] > 0;
+  if (2 * kept > n) rcb_free(&d->alloc, w);
+  else *out = w;
+  return RCB_OK;
+}
+
+/* A baseline fit that a missing effect has pulled far from the nominal model
+ * is itself a finding: a parameter moved by more than this factor from its
+ * nominal value (or onto a bound that far away). With 0.07 kg per hub hidden
+ * at coupling C (32 x 1101, and 8 x 151 too) kr falls 1000 x onto its bound
+ * and kt halves; so it does with 1.3 kg at DB and with the two-effect case
+ * (tests/python/diag_cases.py); in every other case of the success table no
+ * parameter moves by 2 x or more. */
+#define RCB_DIAG_FAR 10.0
+
+/* Note the base parameters the fit f moved by more than RCB_DIAG_FAR. */
+static void note_drift(rcb_diag *d, const rcb_fit *f) {
+  size_t k, n = 0;
+  for (k = 0; k < rcb_fit_param_count(f); k++) {
+    rcb_fit_param p;
+    double ratio, v0; /* fitted / nominal */
+    if (rcb_fit_get_param(f, k, &p) || rcb_model_get_param(d->m, p.name, &v0) || !(v0 != 0) ||
+        !(p.value / v0 > 0))
+      continue;
+    ratio = p.value / v0;
+    if (!(ratio > RCB_DIAG_FAR || ratio < 1.0 / RCB_DIAG_FAR)) continue;
+    d->far = 1;
+    n += (size_t)snprintf(d->drift + n, n < sizeof d->drift ? sizeof d->drift - n : 0,
+                          "%s%s %.3g -> %.3g", n ? ", " : "", p.name, v0, p.value);
+  }
+}
+
 /* Fit the model as it is, on a copy: the base model, F0, error, floor,
- * residual count. */
+ * residual count; whether the fit ran off from the nominal model. */
 static rcb_status baseline(rcb_diag *d) {
   rcb_model *m = NULL;
   rcb_fit *f = NULL;
@@ -170,13 +213,21 @@ static rcb_status baseline(rcb_diag *d) {
   rcb_status st = rcb_diag_copy_model(d, d->m, &m);
   if (!st) st = make_fit(d, m, 1, NULL, &f);
   if (!st && d->nbase) {
-    st = rcb_fit_run(f);
+    double *w = NULL;
+    /* screened on the subset, polished on all points from there */
+    st = subset(d, &w);
+    if (w && !(st = rcb_fit_set_weights(f, w))) st = rcb_fit_run(f);
+    if (w && !st) st = rcb_fit_set_weights(f, NULL);
+    rcb_free(&d->alloc, w);
+    if (!st) st = rcb_fit_run(f);
     if (st) rcb_diag_fail(d, st, "fitting the model as it is: %s", rcb_fit_errmsg(f));
+    else note_drift(d, f);
   }
   if (!st) {
     d->nres = rcb_fit_residual_count(f);
     rcb_fit_get_report(f, &rep);
     d->floor0 = rep.floor_pct;
+    if (d->far) st = rcb_diag_copy_model(d, d->m, &d->nom_model);
   }
   if (!st) {
     double *r = rcb_alloc(&d->alloc, d->nres * sizeof *r);
@@ -234,7 +285,7 @@ static double explained(double *J, size_t n, size_t np, const double *r, const d
 /* The candidate's model and a fit of its own parameters (the base's
  * residual layout); the caller destroys both. */
 static rcb_status candidate_fit(rcb_diag *d, const diag_cand *c, rcb_model **m, rcb_fit **f) {
-  rcb_status st = rcb_diag_candidate_model(d, c, m);
+  rcb_status st = rcb_diag_candidate_model(d, c, d->base_model, m);
   *f = NULL;
   if (!st) st = make_fit(d, *m, 0, c, f);
   if (!st && rcb_fit_residual_count(*f) != d->nres)
@@ -244,13 +295,14 @@ static rcb_status candidate_fit(rcb_diag *d, const diag_cand *c, rcb_model **m, 
 
 /* A candidate whose model has other DOFs than the base: its own sweep. */
 static rcb_status score_alone(rcb_diag *d, diag_cand *c, const double *r, const double *Q0,
-                              size_t q0, double *J) {
+                              size_t q0, double *J, int nominal) {
   rcb_model *m = NULL;
   rcb_fit *f = NULL;
   rcb_status st = candidate_fit(d, c, &m, &f);
   if (!st && (st = rcb_fit_jacobian(f, 1, J)))
     rcb_diag_fail(d, st, "%s: %s", c->desc, rcb_fit_errmsg(f));
-  if (!st) c->predicted = explained(J, d->nres, c->np, r, Q0, q0);
+  if (!st)
+    *(nominal ? &c->predicted_nom : &c->predicted) = explained(J, d->nres, c->np, r, Q0, q0);
   drop_fit(d, f);
   rcb_model_destroy(m);
   return st;
@@ -263,7 +315,7 @@ static rcb_status candidate_dz(rcb_diag *d, const diag_cand *c, size_t ndof, rcb
                                int *same) {
   rcb_model *m = NULL;
   rcb_fit *f = NULL;
-  rcb_status st = rcb_diag_candidate_model(d, c, &m);
+  rcb_status st = rcb_diag_candidate_model(d, c, d->base_model, &m);
   if (!st) st = make_fit(d, m, 0, c, &f); /* no residual layout needed */
   *same = !st && rcb_model_dof_count(m) == ndof;
   if (*same && (st = rcb_fit_dz_get(f, &d->alloc, dz))) {
@@ -291,6 +343,7 @@ typedef struct score_ws {
   size_t batch;         /* parameters per sweep */
   rcb_fit_dz dz[RCB_DIAG_BATCH];
   size_t which[RCB_DIAG_BATCH], ncand, npar; /* candidates of the batch, their parameters */
+  int nominal;          /* scoring at the nominal model: into predicted_nom */
 } score_ws;
 
 /* One more candidate scored. Candidates finish out of index order (a batch of
@@ -309,7 +362,8 @@ static rcb_status flush_batch(rcb_diag *d, score_ws *w) {
     rcb_diag_fail(d, st, "scoring the candidates: %s", rcb_fit_errmsg(w->f));
   for (b = 0; !st && b < w->ncand; b++) {
     diag_cand *c = &d->cand[w->which[b]];
-    c->predicted = explained(w->J + d->nres * off, d->nres, c->np, w->r, w->Q0, w->q0);
+    double pred = explained(w->J + d->nres * off, d->nres, c->np, w->r, w->Q0, w->q0);
+    *(w->nominal ? &c->predicted_nom : &c->predicted) = pred;
     off += c->np;
     st = progress(d);
   }
@@ -318,7 +372,10 @@ static rcb_status flush_batch(rcb_diag *d, score_ws *w) {
   return st;
 }
 
-static rcb_status score_all(rcb_diag *d) {
+/* Score every candidate at the fitted base model (nominal = 0: predicted)
+ * or at the nominal one (predicted_nom; the base text swapped for the
+ * nominal one, so the candidates' models are built on it too). */
+static rcb_status score_all(rcb_diag *d, int nominal) {
   rcb_model *m = NULL;
   score_ws w;
   size_t n = d->nres, k, ndof = rcb_model_dof_count(d->m);
@@ -331,7 +388,7 @@ static rcb_status score_all(rcb_diag *d) {
             : w.batch > RCB_DIAG_BATCH  ? RCB_DIAG_BATCH
                                         : w.batch;
   w.J = rcb_alloc(&d->alloc, n * w.batch * sizeof *w.J);
-  w.r = r, w.Q0 = Q0;
+  w.r = r, w.Q0 = Q0, w.nominal = nominal;
   st = (r && Q0 && w.J) ? RCB_OK : rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
   if (!st) st = rcb_diag_copy_model(d, d->base_model, &m);
   if (!st) ndof = rcb_model_dof_count(m);
@@ -343,12 +400,12 @@ static rcb_status score_all(rcb_diag *d) {
     diag_cand *c = &d->cand[k];
     int same;
     if (c->refit_only) continue;
-    d->stats.scored++;
+    d->stats.scored += !nominal;
     if (w.npar + c->np > w.batch && (st = flush_batch(d, &w))) break;
     if ((st = candidate_dz(d, c, ndof, w.dz + w.npar, &same))) break;
     if (same) {
       w.which[w.ncand++] = k, w.npar += c->np;
-    } else if (!(st = score_alone(d, c, r, Q0, w.q0, w.J + n * w.npar))) {
+    } else if (!(st = score_alone(d, c, r, Q0, w.q0, w.J + n * w.npar, nominal))) {
       st = progress(d);
     }
   }
@@ -372,9 +429,12 @@ static rcb_status score_all(rcb_diag *d) {
  * random starts over the whole bounds of every parameter, the fitted ones
  * too, did not lower any of these objectives by 1e-5 of itself on 32 x 1101
  * and took 476 of the 709 refit sweeps. Only the scored candidates, started
- * at their neutral value, get them. */
-static size_t refit_starts(const diag_cand *c) {
-  return c->refit_only || c->edit == EDIT_ADD_PEDESTAL ? 1 : 3;
+ * at their neutral value, get them, and only while the baseline stayed near
+ * the nominal model: when it ran off (d->far) each candidate is fitted from
+ * the fitted and from the nominal base, two informed starts in place of the
+ * random ones (see refit). */
+static size_t refit_starts(const rcb_diag *d, const diag_cand *c) {
+  return c->refit_only || c->edit == EDIT_ADD_PEDESTAL || d->far ? 1 : 3;
 }
 
 /* Another coupling model (no neutral value, no score) is fitted to the
@@ -405,58 +465,131 @@ static void record_fit(diag_cand *c, rcb_fit *f) {
   }
 }
 
-static rcb_status refit(rcb_diag *d, diag_cand *c) {
-  rcb_model *m = NULL;
-  rcb_fit *f = NULL;
-  rcb_fit_report rep;
-  double N = (double)d->nres, dk = (double)c->np;
-  rcb_status st = rcb_diag_candidate_model(d, c, &m);
+/* The candidate's model built on the base model src (the fitted one, or the
+ * nominal one) and its fit, ready to run: start moved where the neutral
+ * start sees nothing, starts, tolerance. */
+static rcb_status refit_setup(rcb_diag *d, const diag_cand *c, const rcb_model *src,
+                              rcb_model **m, rcb_fit **f) {
+  rcb_status st;
+  *m = NULL, *f = NULL;
+  st = rcb_diag_candidate_model(d, c, src, m);
+  if (!st) st = make_fit(d, *m, 1, c, f);
+  if (!st) st = rcb_diag_refit_start(d, c, *m, *f);
+  if (!st) st = rcb_fit_set_starts(*f, refit_starts(d, c), 1);
+  if (!st) st = refit_tolerance(d, c, *f);
+  return st;
+}
+
+/* The screening fit on the frequency subset w (NULL: the fit on all points)
+ * stops after RCB_DIAG_SCREEN_ITER iterations: it ranks the starts and
+ * brings the polish near its end, and a fit crawling along a bound (a
+ * damping at 0) goes on in the polish only if it is the best start. */
+#define RCB_DIAG_SCREEN_ITER 25
+static rcb_status screen(rcb_fit *f, const double *w) {
+  size_t it = f->max_iter;
+  rcb_status st = rcb_fit_set_weights(f, w);
+  if (!st && w && it > RCB_DIAG_SCREEN_ITER)
+    st = rcb_fit_set_limits(f, RCB_DIAG_SCREEN_ITER, f->ftol_rel, f->xtol_rel);
+  if (!st) st = rcb_fit_run(f);
+  if (w && it > RCB_DIAG_SCREEN_ITER) rcb_fit_set_limits(f, it, f->ftol_rel, f->xtol_rel);
+  return st;
+}
+
+/* The polish of a screened fit on all points, from where the subset left it,
+ * with no further starts. */
+static rcb_status polish(rcb_fit *f) {
+  rcb_status st = rcb_fit_set_weights(f, NULL);
+  if (!st) st = rcb_fit_set_starts(f, 1, 1);
+  if (!st) st = rcb_fit_run(f);
+  return st;
+}
+
+/* BIC change and significance of a refitted candidate (F, err set). */
+static void judge(const rcb_diag *d, diag_cand *c, double k) {
+  double N = (double)d->nres;
+  /* with noise-aware weights F is a chi-square: BIC = F + k ln N; else the
+   * Gaussian likelihood with the variance estimated */
+  c->dbic = (d->beta_a > 0 || d->beta_s > 0) ? (c->F - d->F0) + k * log(N)
+                                             : N * log(c->F / d->F0) + k * log(N);
+  c->significant = c->dbic < RCB_DIAG_BIC_MIN && c->err < RCB_DIAG_ERR_FALL * d->err0;
+}
+
+/* A refit with nothing to fit (kramer_1, rigid): the model evaluated. */
+static rcb_status evaluate_only(rcb_diag *d, diag_cand *c, rcb_model **m, rcb_fit *f) {
+  double *r = rcb_alloc(&d->alloc, d->nres * sizeof *r);
+  rcb_status st = r ? objective(d, f, r, &c->F, &c->err) : RCB_ERR_NOMEM;
+  rcb_free(&d->alloc, r);
+  if (st) return st;
+  c->refitted = 1;
+  judge(d, c, 0.0);
+  snprintf(c->fitted, sizeof c->fitted, "no parameter");
+  c->model = *m, *m = NULL; /* kept: --apply writes it */
+  return RCB_OK;
+}
+
+/* Refit candidate c with the base parameters, from the fitted base model
+ * (c->from_fit) and from the nominal one (c->from_nom: the baseline fit ran
+ * off, and c scores high at the nominal model): a missing effect that
+ * pulled the base parameters far leaves the fitted point in a basin a joint
+ * fit does not leave. With w (a subset of the frequencies, subset()) each
+ * start is screened on the subset and only the best is polished on all
+ * points, from where the subset left it. */
+static rcb_status refit(rcb_diag *d, diag_cand *c, const double *w) {
+  rcb_model *m[2] = {NULL, NULL};
+  rcb_fit *f[2] = {NULL, NULL};
+  double F[2] = {HUGE_VAL, HUGE_VAL};
+  char why[320] = "";
+  size_t s, b = 0;
+  rcb_status st = RCB_OK;
   d->stats.refits++;
-  if (!st) st = make_fit(d, m, 1, c, &f);
-  if (!st) st = rcb_diag_refit_start(d, c, m, f);
-  if (!st) st = rcb_fit_set_starts(f, refit_starts(c), 1);
-  if (!st) st = refit_tolerance(d, c, f);
-  if (st == RCB_ERR_NOMEM) {
-    /* out of memory is the caller's to know, not a property of the candidate */
-  } else if (st) { /* a candidate that cannot be built is reported, not fatal */
-    snprintf(c->fitted, sizeof c->fitted, "not fitted: %.300s", d->errmsg);
-    st = RCB_OK;
-  } else if (rcb_fit_param_count(f) == 0) { /* nothing to fit: evaluate (kramer_1, rigid) */
-    double *r = rcb_alloc(&d->alloc, d->nres * sizeof *r);
-    st = r ? objective(d, f, r, &c->F, &c->err) : RCB_ERR_NOMEM;
-    rcb_free(&d->alloc, r);
-    if (!st) {
-      c->refitted = 1;
-      c->dbic = (d->beta_a > 0 || d->beta_s > 0) ? c->F - d->F0
-                                                 : (double)d->nres * log(c->F / d->F0);
-      c->significant = c->dbic < RCB_DIAG_BIC_MIN && c->err < RCB_DIAG_ERR_FALL * d->err0;
-      snprintf(c->fitted, sizeof c->fitted, "no parameter");
-      c->model = m, m = NULL;
+  for (s = 0; s < 2; s++) {
+    if (!(s ? c->from_nom : c->from_fit)) continue;
+    st = refit_setup(d, c, s ? d->nom_model : d->base_model, &m[s], &f[s]);
+    if (st == RCB_ERR_NOMEM) break;
+    if (st) { /* a candidate that cannot be built is reported, not fatal */
+      if (!why[0]) snprintf(why, sizeof why, "not fitted: %.300s", d->errmsg);
+      continue;
     }
-  } else if ((st = rcb_fit_run(f)) != RCB_OK) {
-    /* a candidate that cannot be fitted is reported, not fatal (unless the
-     * memory ran out) */
-    if (st == RCB_ERR_NOMEM)
-      rcb_diag_fail(d, st, "refitting %s: %s", c->desc, rcb_fit_errmsg(f));
-    else {
-      snprintf(c->fitted, sizeof c->fitted, "refit failed: %.300s", rcb_fit_errmsg(f));
-      st = RCB_OK;
+    if (rcb_fit_param_count(f[s]) == 0) break; /* nothing to fit: evaluated below */
+    st = screen(f[s], w);
+    if (st == RCB_ERR_NOMEM) {
+      rcb_diag_fail(d, st, "refitting %s: %s", c->desc, rcb_fit_errmsg(f[s]));
+      break;
     }
-  } else if (!st) {
-    rcb_fit_get_report(f, &rep);
-    c->refitted = 1;
-    c->F = rep.objective;
-    c->err = rep.error_pct;
-    /* with noise-aware weights F is a chi-square: BIC = F + k ln N; else
-     * the Gaussian likelihood with the variance estimated */
-    c->dbic = (d->beta_a > 0 || d->beta_s > 0) ? (c->F - d->F0) + dk * log(N)
-                                               : N * log(c->F / d->F0) + dk * log(N);
-    c->significant = c->dbic < RCB_DIAG_BIC_MIN && c->err < RCB_DIAG_ERR_FALL * d->err0;
-    record_fit(c, f);
-    c->model = m, m = NULL;
+    if (st) { /* a candidate that cannot be fitted is reported, not fatal */
+      if (!why[0]) snprintf(why, sizeof why, "refit failed: %.300s", rcb_fit_errmsg(f[s]));
+      continue;
+    }
+    F[s] = f[s]->obj;
+    if (F[s] < F[b]) b = s;
   }
-  drop_fit(d, f);
-  rcb_model_destroy(m);
+  if (st != RCB_ERR_NOMEM) {
+    st = RCB_OK;
+    if (f[b] && rcb_fit_param_count(f[b]) == 0) {
+      st = evaluate_only(d, c, &m[b], f[b]);
+    } else if (!(F[b] < HUGE_VAL)) {
+      snprintf(c->fitted, sizeof c->fitted, "%s", why);
+    } else if (w && (st = polish(f[b]))) {
+      if (st == RCB_ERR_NOMEM)
+        rcb_diag_fail(d, st, "refitting %s: %s", c->desc, rcb_fit_errmsg(f[b]));
+      else
+        snprintf(c->fitted, sizeof c->fitted, "refit failed: %.300s", rcb_fit_errmsg(f[b]));
+      st = st == RCB_ERR_NOMEM ? st : RCB_OK;
+    } else {
+      rcb_fit_report rep;
+      rcb_fit_get_report(f[b], &rep);
+      c->refitted = 1;
+      c->F = rep.objective;
+      c->err = rep.error_pct;
+      judge(d, c, (double)c->np);
+      record_fit(c, f[b]);
+      c->model = m[b], m[b] = NULL;
+    }
+  }
+  for (s = 0; s < 2; s++) {
+    drop_fit(d, f[s]);
+    rcb_model_destroy(m[s]);
+  }
   return st;
 }
 
@@ -478,23 +611,48 @@ static void sort_order(rcb_diag *d) {
     }
 }
 
+/* With the baseline run off, the candidates the score test ranks first at
+ * the nominal model are refitted from there too (from both starts when
+ * they are also among the best at the fitted model). */
+#define RCB_DIAG_NOM_REFITS 3
+
 static rcb_status refit_best(rcb_diag *d) {
-  size_t k, done = 0;
-  rcb_status st = RCB_OK;
+  size_t k, j, done = 0, todo = 0;
+  double *w = NULL;
+  rcb_status st = subset(d, &w);
+  if (st) return st;
   sort_order(d); /* by predicted reduction (nothing refitted yet) */
+  for (k = 0; k < d->ncand; k++) {
+    diag_cand *c = &d->cand[d->order[k]];
+    c->from_fit = c->refit_only || (todo < d->nrefit && c->predicted > 0);
+    todo += !c->refit_only && c->from_fit;
+  }
+  for (j = 0; d->far && j < RCB_DIAG_NOM_REFITS; j++) {
+    diag_cand *c = NULL;
+    for (k = 0; k < d->ncand; k++) {
+      diag_cand *e = &d->cand[k];
+      if (!e->refit_only && !e->from_nom && e->predicted_nom > 0 &&
+          (!c || e->predicted_nom > c->predicted_nom))
+        c = e;
+    }
+    if (!c) break;
+    todo += !c->from_fit;
+    c->from_nom = 1;
+  }
   for (k = 0; !st && k < d->ncand; k++) {
     diag_cand *c = &d->cand[d->order[k]];
-    if (c->refit_only || done >= d->nrefit || !(c->predicted > 0)) continue;
-    st = refit(d, c);
+    if (c->refit_only || !(c->from_fit || c->from_nom)) continue;
+    st = refit(d, c, w);
     done++;
     if (d->progress_done < d->ncand) d->progress_done = d->ncand; /* refit-only ones */
     if (!st && d->progress &&
-        d->progress(d->progress_user, ++d->progress_done, d->ncand + d->nrefit))
+        d->progress(d->progress_user, ++d->progress_done, d->ncand + todo))
       st = rcb_diag_fail(d, RCB_ERR_STATE, "stopped by the caller");
   }
   for (k = 0; !st && k < d->ncand; k++)
-    if (d->cand[k].refit_only) st = refit(d, &d->cand[k]);
+    if (d->cand[k].refit_only) st = refit(d, &d->cand[k], w);
   if (!st) sort_order(d);
+  rcb_free(&d->alloc, w);
   return st;
 }
 
@@ -505,7 +663,13 @@ static rcb_status run_steps(rcb_diag *d) {
     rcb_diag_fail(d, st, "laying out the catalogue of effects: %s", rcb_status_str(st));
   if (!st && !(d->order = rcb_alloc(&d->alloc, (d->ncand ? d->ncand : 1) * sizeof *d->order)))
     st = rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
-  if (!st) st = score_all(d);
+  if (!st) st = score_all(d, 0);
+  if (!st && d->far) { /* the candidates scored at the nominal model too */
+    rcb_model *fitted = d->base_model;
+    d->base_model = d->nom_model;
+    st = score_all(d, 1);
+    d->base_model = fitted;
+  }
   if (!st) st = refit_best(d);
   return st;
 }
@@ -598,7 +762,7 @@ rcb_status rcb_diag_apply_model(const rcb_diag *d, size_t rank, const rcb_alloca
 }
 
 rcb_status rcb_diag_explain(const rcb_diag *d, char *buf, size_t size, size_t *needed) {
-  char text[1024];
+  char text[1536];
   const diag_cand *c;
   if (!d || !d->ran) return RCB_ERR_STATE;
   c = d->ncand ? &d->cand[d->order[0]] : NULL;
@@ -621,6 +785,14 @@ rcb_status rcb_diag_explain(const rcb_diag *d, char *buf, size_t size, size_t *n
              "falls from %.3g %% to %.3g %%%s, BIC %+.1f.",
              c->desc, c->fitted, 100.0 * (d->F0 - c->F) / d->F0, d->err0, c->err, floor_txt,
              c->dbic);
+  }
+  if (d->far) { /* the run-off baseline is a finding of its own */
+    size_t n = strlen(text);
+    snprintf(text + n, sizeof text - n,
+             " The fit of the model as it is ran far from the nominal model (%s): a missing "
+             "effect pulls it there; the candidates were scored and refitted from the nominal "
+             "model too.",
+             d->drift);
   }
   return put_text(text, buf, size, needed);
 }

@@ -56,6 +56,13 @@ UFF_DIRS = {"x": 1, "y": 2, "rx": 4, "ry": 5}
 FIT_PARAMS = "coupling.C.kt,coupling.C.kr,coupling.C.ct"  # what the user fits anyway
 AT_FLOOR = 1.1  # "at the noise floor": error below 1.1 x the floor
 
+# The issue #14 size (a user's full test): the 8 responses per forces at DA and
+# DB in x and y (32 channels), 1101 points 50-600 Hz, eq. 19 noise plus a phase
+# noise of PHASE_DEG (uniform in +-2 degrees, each point its own draw).
+LARGE_FREQ_HZ = 50.0 + 0.5 * np.arange(1101)  # Hz; exact in E13.5
+LARGE_INS = ["DA.x", "DA.y", "DB.x", "DB.y"]
+PHASE_DEG = 2.0  # degrees
+
 # --------------------------------------------------------------------------
 # INI text edits (a truth INI for rcbtool simulate; the model with [uff])
 # --------------------------------------------------------------------------
@@ -182,6 +189,23 @@ def add_noise(data, beta_a, beta_s, seed):
     return out
 
 
+def add_phase_noise(data, deg, seed):
+    """Every point turned by its own angle, uniform in [-deg, deg] degrees
+    (numpy's PCG64 seeded by seed; independent of the eq. 19 draws)."""
+    data = np.asarray(data, dtype=complex)
+    u = np.random.default_rng(seed).uniform(-1.0, 1.0, size=data.shape)
+    return data * np.exp(1j * math.radians(deg) * u)
+
+
+def noisy(case, H, seed):
+    """The measurement of a case's truth H for a noise seed: eq. 19, and on the
+    large grid the phase noise too."""
+    out = add_noise(H, *NOISE, seed)
+    if case.grid == "large":
+        out = add_phase_noise(out, PHASE_DEG, seed)
+    return out
+
+
 # --------------------------------------------------------------------------
 # Truth FRFs from ROSS
 # --------------------------------------------------------------------------
@@ -191,9 +215,12 @@ def _speed():
     return RPM * math.pi / 30.0
 
 
-def ross_inertance(text, model_edit=None, check=True):
-    """Inertances (len(OUTS) x len(FREQ_HZ), m/s^2/N) of the ROSS rotor built
-    from INI text; model_edit(model) changes the parsed Python model first."""
+def ross_inertance(text, model_edit=None, check=True, freq=None, ins=(IN,)):
+    """Inertances (len(ins) * len(OUTS) x len(freq), m/s^2/N; the channels of
+    input ins[q] are rows q * len(OUTS) ...) of the ROSS rotor built from INI
+    text; model_edit(model) changes the parsed Python model first. freq: Hz,
+    FREQ_HZ by default."""
+    freq = FREQ_HZ if freq is None else freq
     model = rm.Model(text)
     if model_edit:
         model_edit(model)
@@ -203,22 +230,24 @@ def ross_inertance(text, model_edit=None, check=True):
         rmod = rm.RossModel(model, speed=speed)
         rot = rmod.rotor
         M, C, K, G = rot.M(frequency=speed), rot.C(frequency=speed), rot.K(frequency=speed), rot.G()
-    jin = rmod.station_dof(IN)
+    jin = [rmod.station_dof(i) for i in ins]
     rows = [rmod.station_dof(o) for o in OUTS]
-    e = np.zeros(M.shape[0])
-    e[jin] = 1.0
-    H = np.empty((len(OUTS), len(FREQ_HZ)), dtype=complex)
-    for i, f in enumerate(FREQ_HZ):
+    E = np.zeros((M.shape[0], len(ins)))
+    for q, j in enumerate(jin):
+        E[j, q] = 1.0
+    H = np.empty((len(ins) * len(OUTS), len(freq)), dtype=complex)
+    for i, f in enumerate(freq):
         w = 2.0 * math.pi * f
-        col = np.linalg.solve(K - w * w * M + 1j * w * (C + speed * G), e)
-        H[:, i] = -w * w * col[rows]
+        X = np.linalg.solve(K - w * w * M + 1j * w * (C + speed * G), E)
+        H[:, i] = (-w * w * X[rows, :]).T.reshape(-1)
     if check:  # the same as ROSS's own transfer matrix
-        w = 2.0 * math.pi * FREQ_HZ[len(FREQ_HZ) // 2]
+        mid = len(freq) // 2
+        w = 2.0 * math.pi * freq[mid]
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             T = rot.transfer_matrix(speed=speed, frequency=w)
-        ref = -w * w * T[rows, jin]
-        got = H[:, len(FREQ_HZ) // 2]
+        ref = (-w * w * T[np.ix_(rows, jin)]).T.reshape(-1)
+        got = H[:, mid]
         assert np.max(np.abs(got - ref)) <= 1e-9 * np.max(np.abs(ref)), (got, ref)
     return H
 
@@ -288,7 +317,7 @@ class Case:
     order two rounds of diagnose-apply may find them (any order accepted)."""
 
     def __init__(self, name, what, expect, source, model_edit=None, truth_ini=None,
-                 needs=None):
+                 needs=None, grid="small"):
         self.name = name
         self.what = what  # the hidden effect, in words
         self.expect = expect
@@ -296,6 +325,8 @@ class Case:
         self.model_edit = model_edit
         self.truth_ini = truth_ini  # for source "rcbtool": INI text -> truth INI text
         self.needs = needs  # INI keys the model loader must accept ("pedestal")
+        self.grid = grid  # "small": 8 x 151 (FREQ_HZ, IN); "large": 32 x 1101
+        self.slow = False  # a slow case of test_diag_ross.py (RCB_DIAG_ALL=1)
 
     def __repr__(self):
         return self.name
@@ -361,6 +392,25 @@ SIM_CASES = [
 NULL_CASE = Case("null", "nothing hidden", [], "rcbtool", truth_ini=lambda t: t)
 
 
+# Issue #14: the users' cases, truth by ROSS on the large grid (32 x 1101, eq. 19
+# + 2 degrees of phase noise). The hub shifts every resonance.
+LARGE_CASES = [
+    Case("large_hub_C", "coupling C hub mass 0.07 kg per station",
+         [(HUB, "coupling C")], "ross", model_edit=hub_mass_edit(0.07),
+         grid="large"),
+    Case("large_cr_C", "coupling C rotational damping 0.02 N m s/rad", [(CR, "coupling C")],
+         "ross", model_edit=coupling_keys(cr=0.02), grid="large"),
+    Case("large_cross_B3", "kxy = -kyx = 1.5e7 N/m at B3", [(CROSS, "bearing B3")], "ross",
+         model_edit=bearing_keys("B3", kxy=1.5e7, kyx=-1.5e7), grid="large"),
+    Case("large_pedestal_B4", "B4 on a 2 kg pedestal, 5e6 N/m, 500 N s/m",
+         [(PEDESTAL, "B4")], "ross", model_edit=bearing_keys("B4", **PEDESTAL_B4),
+         needs="pedestal", grid="large"),
+    Case("large_aniso_B4", "B4 kyy 9e7 -> 1e7 N/m", [(STIFF, "bearing B4")], "ross",
+         model_edit=bearing_keys("B4", kyy=1e7), grid="large"),
+    Case("large_null", "nothing hidden", [], "ross", grid="large"),
+]
+
+
 # --------------------------------------------------------------------------
 # Running rcbtool
 # --------------------------------------------------------------------------
@@ -394,7 +444,9 @@ def pedestal_probe_ini():
 
 
 def truth_clean(case, tool=None, workdir=None):
-    """Noise-free truth inertances (len(OUTS) x len(FREQ_HZ))."""
+    """Noise-free truth inertances (channels x frequencies of the case's grid)."""
+    if case.source == "ross" and case.grid == "large":
+        return ross_inertance(BASE_INI, case.model_edit, freq=LARGE_FREQ_HZ, ins=LARGE_INS)
     if case.source == "ross":
         return ross_inertance(BASE_INI, case.model_edit)
     ini = Path(workdir) / f"{case.name}_truth.ini"
@@ -405,27 +457,38 @@ def truth_clean(case, tool=None, workdir=None):
     return np.array([np.array(c["re"]) + 1j * np.array(c["im"]) for c in res["channels"]])
 
 
-def write_uff(path, data):
-    """Inertance channels OUTS / IN as UFF 58 (ASCII, pyuff), rpm on the z axis."""
+def write_uff(path, data, freq=None, ins=(IN,)):
+    """Inertance channels (OUTS per each of ins, in ross_inertance's order) as
+    UFF 58 (ASCII, pyuff), rpm on the z axis; freq in Hz (FREQ_HZ by default)."""
     import pyuff
 
+    freq = FREQ_HZ if freq is None else freq
     path = Path(path)
     if path.exists():
         path.unlink()
     u = pyuff.UFF(str(path))
-    rn, _, rd = IN.rpartition(".")
-    for c, out in enumerate(OUTS):
-        st, _, d = out.rpartition(".")
-        u._write_set(
-            pyuff.prepare_58(
-                binary=0, func_type=4, rsp_node=UFF_NODES[st], rsp_dir=UFF_DIRS[d],
-                ref_node=UFF_NODES[rn], ref_dir=UFF_DIRS[rd], data=data[c], x=FREQ_HZ,
-                id1=f"{out}/{IN}", abscissa_spacing=1, abscissa_spec_data_type=18,
-                ordinate_spec_data_type=12, orddenom_spec_data_type=13,
-                z_axis_spec_data_type=19, z_axis_value=RPM,
-            ),
-            "add",
-        )
+    for q, inp in enumerate(ins):
+        rn, _, rd = inp.rpartition(".")
+        for o, out in enumerate(OUTS):
+            st, _, d = out.rpartition(".")
+            u._write_set(
+                pyuff.prepare_58(
+                    binary=0, func_type=4, rsp_node=UFF_NODES[st], rsp_dir=UFF_DIRS[d],
+                    ref_node=UFF_NODES[rn], ref_dir=UFF_DIRS[rd], data=data[q * len(OUTS) + o],
+                    x=freq, id1=f"{out}/{inp}", abscissa_spacing=1, abscissa_spec_data_type=18,
+                    ordinate_spec_data_type=12, orddenom_spec_data_type=13,
+                    z_axis_spec_data_type=19, z_axis_value=RPM,
+                ),
+                "add",
+            )
+
+
+def write_case_uff(path, case, H, seed):
+    """The noisy measurement of a case (its grid, its noise) as UFF 58."""
+    if case.grid == "large":
+        write_uff(path, noisy(case, H, seed), LARGE_FREQ_HZ, LARGE_INS)
+    else:
+        write_uff(path, noisy(case, H, seed))
 
 
 _FITTED = re.compile(r"([A-Za-z_][\w.]*)\s*=\s*([-+0-9.eE]+)")
