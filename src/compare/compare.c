@@ -11,14 +11,6 @@
 
 #include "compare/compare_internal.h"
 
-rcb_status (rcb_cmp_fail)(rcb_compare *c, rcb_status st, const char *fmt, ...) {
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(c->errmsg, sizeof c->errmsg, fmt, ap);
-  va_end(ap);
-  return st;
-}
-
 rcb_status rcb_compare_create(rcb_compare **out, const rcb_allocator *alloc) {
   rcb_allocator a;
   rcb_compare *c;

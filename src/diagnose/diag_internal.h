@@ -75,14 +75,8 @@ struct rcb_diag {
   int ran;
 };
 
-rcb_status rcb_diag_fail(rcb_diag *d, rcb_status st, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
-#ifdef __clang_analyzer__ /* returns st: see rcb_set_error in core/rcb_internal.h */
-#define rcb_diag_fail(o, st, ...) ((void)(rcb_diag_fail)((o), (st), __VA_ARGS__), (st))
-#endif
+/* The error message of rcb_diag (core/rcb_internal.h, rcb_fail). */
+#define rcb_diag_fail(d, st, ...) rcb_fail((d), (st), __VA_ARGS__)
 
 /* Lay out every candidate effect of the (fitted) model m. */
 rcb_status rcb_diag_catalogue(rcb_diag *d, const rcb_model *m);

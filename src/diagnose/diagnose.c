@@ -16,14 +16,6 @@
 #define RCB_DIAG_BIC_MIN (-10.0) /* "strong" evidence (Kass & Raftery) */
 #define RCB_DIAG_ERR_FALL 0.98   /* the error must fall by at least 2 % of itself */
 
-rcb_status (rcb_diag_fail)(rcb_diag *d, rcb_status st, const char *fmt, ...) {
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(d->errmsg, sizeof d->errmsg, fmt, ap);
-  va_end(ap);
-  return st;
-}
-
 rcb_status rcb_diag_create(rcb_diag **out, const rcb_model *m, const rcb_meas *meas,
                            const rcb_allocator *alloc) {
   rcb_allocator a;

@@ -9,14 +9,6 @@
 
 #include "identify/fit_internal.h"
 
-rcb_status (rcb_fit_fail)(rcb_fit *f, rcb_status st, const char *fmt, ...) {
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(f->errmsg, sizeof f->errmsg, fmt, ap);
-  va_end(ap);
-  return st;
-}
-
 /* Index of dof in list (appending it when new). */
 static size_t dof_slot(rcb_dof *list, size_t *n, rcb_dof d) {
   size_t i;

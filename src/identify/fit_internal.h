@@ -89,14 +89,8 @@ struct rcb_fit {
   double *cov, *corr;    /* np x np */
 };
 
-rcb_status rcb_fit_fail(rcb_fit *f, rcb_status st, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
-#ifdef __clang_analyzer__ /* returns st: see rcb_set_error in core/rcb_internal.h */
-#define rcb_fit_fail(o, st, ...) ((void)(rcb_fit_fail)((o), (st), __VA_ARGS__), (st))
-#endif
+/* The error message of rcb_fit (core/rcb_internal.h, rcb_fail). */
+#define rcb_fit_fail(f, st, ...) rcb_fail((f), (st), __VA_ARGS__)
 double rcb_fit_sumsq(const double *r, size_t n);
 void rcb_fit_free_layout(rcb_fit *f);
 
