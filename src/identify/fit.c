@@ -8,33 +8,21 @@
 #include <string.h>
 
 #include "identify/fit_internal.h"
+#include "io/io.h"
 
-/* Index of dof in list (appending it when new). */
-static size_t dof_slot(rcb_dof *list, size_t *n, rcb_dof d) {
-  size_t i;
-  for (i = 0; i < *n; i++)
-    if (list[i].node == d.node && list[i].dir == d.dir) return i;
-  list[*n] = d;
-  return (*n)++;
-}
-
+/* Channels -> FRF outputs and inputs (the resolver shared with the
+ * comparison), and the kind of each channel's values. */
 static rcb_status resolve_channels(rcb_fit *f, rcb_dof *outs, rcb_dof *ins) {
+  rcb_meas_dofs d;
   size_t c;
+  rcb_status st;
+  d.ch_out = f->ch_out, d.ch_in = f->ch_in, d.outs = outs, d.ins = ins;
+  if ((st = rcb_meas_resolve_dofs(f->meas, f->m, &d, f->errmsg))) return st;
+  f->nout = d.nout, f->nin = d.nin;
   for (c = 0; c < f->nch; c++) {
     rcb_meas_channel_info ci;
-    rcb_dof d;
     if (rcb_meas_channel(f->meas, c, &ci)) return rcb_fit_fail(f, RCB_ERR_ARG, "channel %zu", c);
-    if (rcb_model_find_dof(f->m, ci.response, &d))
-      return rcb_fit_fail(f, RCB_ERR_NOT_FOUND, "measurement channel %zu: %s", c + 1,
-                          rcb_model_errmsg(f->m));
-    f->ch_out[c] = dof_slot(outs, &f->nout, d);
     f->ch_kind[c] = ci.kind;
-    if (f->unbalance) continue;
-    if (!ci.reference || rcb_model_find_dof(f->m, ci.reference, &d))
-      return rcb_fit_fail(f, RCB_ERR_NOT_FOUND, "measurement channel %zu (%s): %s", c + 1,
-                          ci.response, ci.reference ? rcb_model_errmsg(f->m)
-                                                    : "an FRF channel needs a reference");
-    f->ch_in[c] = dof_slot(ins, &f->nin, d);
   }
   return RCB_OK;
 }
