@@ -11,7 +11,7 @@
 #include <string.h>
 
 #include "diagnose/diag_internal.h"
-#include "identify/fit_internal.h"
+#include "identify/identify.h"
 
 #define RCB_DIAG_BIC_MIN (-10.0) /* "strong" evidence (Kass & Raftery) */
 #define RCB_DIAG_ERR_FALL 0.98   /* the error must fall by at least 2 % of itself */
@@ -111,7 +111,7 @@ static rcb_status make_fit(rcb_diag *d, rcb_model *m, int with_base, const diag_
   rcb_fit *f = NULL;
   rcb_status st = rcb_fit_create(&f, m, d->meas, &d->alloc);
   size_t k;
-  if (!st) f->no_uncertainty = 1; /* intervals are not part of a diagnosis */
+  if (!st) st = rcb_fit_set_uncertainty(f, 0); /* intervals are not part of a diagnosis */
   if (!st) st = rcb_fit_set_scale(f, d->scale);
   if (!st && (d->beta_a > 0 || d->beta_s > 0))
     st = rcb_fit_set_noise_model(f, d->beta_a, d->beta_s);
@@ -138,7 +138,7 @@ static rcb_status make_fit(rcb_diag *d, rcb_model *m, int with_base, const diag_
 
 /* Destroy a fit, counting its model sweeps in the diagnosis' figures. */
 static void drop_fit(rcb_diag *d, rcb_fit *f) {
-  if (f) d->stats.evaluations += f->sweeps;
+  d->stats.evaluations += rcb_fit_sweeps(f);
   rcb_fit_destroy(f);
 }
 
@@ -400,9 +400,11 @@ static size_t refit_starts(const diag_cand *c) {
 #define RCB_DIAG_BIC_RESOLUTION 0.1
 static rcb_status refit_tolerance(const rcb_diag *d, const diag_cand *c, rcb_fit *f) {
   double scale = (d->beta_a > 0 || d->beta_s > 0) ? d->F0 : (double)d->nres;
-  double tol = RCB_DIAG_BIC_RESOLUTION / scale;
-  if (!c->refit_only || !(scale > 0) || !(tol < 1e-2) || tol <= f->ftol_rel) return RCB_OK;
-  return rcb_fit_set_limits(f, f->max_iter, tol, f->xtol_rel);
+  double tol = RCB_DIAG_BIC_RESOLUTION / scale, ftol, xtol;
+  size_t max_iter;
+  rcb_fit_get_limits(f, &max_iter, &ftol, &xtol);
+  if (!c->refit_only || !(scale > 0) || !(tol < 1e-2) || tol <= ftol) return RCB_OK;
+  return rcb_fit_set_limits(f, max_iter, tol, xtol);
 }
 
 static void record_fit(diag_cand *c, rcb_fit *f) {

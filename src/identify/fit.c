@@ -252,11 +252,88 @@ rcb_status rcb_fit_set_progress(rcb_fit *f,
   return RCB_OK;
 }
 
+rcb_status rcb_fit_set_uncertainty(rcb_fit *f, int compute) {
+  if (!f) return RCB_ERR_ARG;
+  f->no_uncertainty = !compute;
+  return RCB_OK;
+}
+
+/* ---- getters (NLopt's set/get pairing) ---- */
+
+rcb_status rcb_fit_get_param_bounds(const rcb_fit *f, size_t k, double *lo, double *hi,
+                                    int *log_param) {
+  if (!f || k >= f->np) return RCB_ERR_ARG;
+  if (lo) *lo = f->par[k].lo;
+  if (hi) *hi = f->par[k].hi;
+  if (log_param) *log_param = f->par[k].log_param;
+  return RCB_OK;
+}
+
+rcb_fit_scale rcb_fit_get_scale(const rcb_fit *f) { return f ? f->scale : RCB_SCALE_LINEAR; }
+
+rcb_status rcb_fit_get_band(const rcb_fit *f, double *lo, double *hi) {
+  if (!f || !lo || !hi) return RCB_ERR_ARG;
+  *lo = f->band_lo, *hi = f->band_hi;
+  return RCB_OK;
+}
+
+int rcb_fit_get_weights(const rcb_fit *f, double *w) {
+  size_t i, n;
+  if (!f || !w) return RCB_ERR_ARG;
+  n = f->nch * f->npts;
+  if (f->wuser) {
+    memcpy(w, f->wuser, n * sizeof *w);
+    return 1;
+  }
+  for (i = 0; i < n; i++) w[i] = 1.0;
+  return 0;
+}
+
+rcb_status rcb_fit_get_noise_model(const rcb_fit *f, double *beta_a, double *beta_s) {
+  if (!f || !beta_a || !beta_s) return RCB_ERR_ARG;
+  *beta_a = f->beta_a, *beta_s = f->beta_s;
+  return RCB_OK;
+}
+
+rcb_fit_method rcb_fit_get_method(const rcb_fit *f, const char **algorithm) {
+  if (algorithm) *algorithm = f ? f->algorithm : "";
+  return f ? f->method : RCB_FIT_PAPER;
+}
+
+int rcb_fit_get_analytic(const rcb_fit *f) { return f ? f->analytic : 1; }
+
+rcb_status rcb_fit_get_limits(const rcb_fit *f, size_t *max_iter, double *ftol_rel,
+                              double *xtol_rel) {
+  if (!f) return RCB_ERR_ARG;
+  if (max_iter) *max_iter = f->max_iter;
+  if (ftol_rel) *ftol_rel = f->ftol_rel;
+  if (xtol_rel) *xtol_rel = f->xtol_rel;
+  return RCB_OK;
+}
+
+rcb_status rcb_fit_get_progress(const rcb_fit *f,
+                                int (**cb)(void *user, size_t iter, size_t evals,
+                                           double objective),
+                                void **user) {
+  if (!f || !cb || !user) return RCB_ERR_ARG;
+  *cb = f->progress, *user = f->progress_user;
+  return RCB_OK;
+}
+
+rcb_status rcb_fit_get_starts(const rcb_fit *f, size_t *n, unsigned long *seed) {
+  if (!f || !n || !seed) return RCB_ERR_ARG;
+  *n = f->nstarts ? f->nstarts : 1, *seed = f->seed;
+  return RCB_OK;
+}
+
+int rcb_fit_get_uncertainty(const rcb_fit *f) { return f ? !f->no_uncertainty : 1; }
+
 /* ---- run and results ---- */
 
 rcb_status rcb_fit_set_starts(rcb_fit *f, size_t n, unsigned long seed) {
   if (!f || n == 0) return RCB_ERR_ARG;
   f->nstarts = n;
+  f->seed = seed;
   f->rng = (unsigned long long)seed * 0x9E3779B97F4A7C15ull + 1ull;
   return RCB_OK;
 }
@@ -403,6 +480,8 @@ rcb_status rcb_fit_get_report(const rcb_fit *f, rcb_fit_report *out) {
 }
 
 size_t rcb_fit_param_count(const rcb_fit *f) { return f ? f->np : 0; }
+
+size_t rcb_fit_sweeps(const rcb_fit *f) { return f ? f->sweeps : 0; }
 
 rcb_status rcb_fit_get_param(const rcb_fit *f, size_t k, rcb_fit_param *out) {
   const rcb_fit_par *p;

@@ -45,16 +45,16 @@ void rcb_fit_dz_free(const rcb_allocator *a, rcb_fit_dz *dz, size_t n) {
 }
 
 rcb_status rcb_fit_dz_collect(rcb_fit *f, const rcb_allocator *a, rcb_fit_dz *dz) {
-  size_t k, ndof = f->m->ndof, sz = 4 * rcb_layout_size(&f->frf->L), d;
+  size_t k, ndof = f->m->ndof, sz = 4 * rcb_layout_size(rcb_frf_layout(f->frf)), d;
   for (k = 0; k < f->np; k++) dz[k].e = NULL, dz[k].dF = NULL, dz[k].ne = 0;
   for (k = 0; k < f->np; k++) {
     const double *dm = f->dmat + k * sz;
     const rcb_complex *F = f->dF + k * ndof;
     size_t ne;
-    collect(&f->frf->L, dm, NULL, &ne);
+    collect(rcb_frf_layout(f->frf), dm, NULL, &ne);
     dz[k].e = rcb_alloc(a, (ne ? ne : 1) * sizeof *dz[k].e);
     if (!dz[k].e) goto nomem;
-    collect(&f->frf->L, dm, dz[k].e, &dz[k].ne);
+    collect(rcb_frf_layout(f->frf), dm, dz[k].e, &dz[k].ne);
     for (d = 0; d < ndof && F[d] == 0.0; d++) continue;
     if (d == ndof) continue; /* the force does not depend on it */
     if (!(dz[k].dF = rcb_alloc(a, ndof * sizeof *dz[k].dF))) goto nomem;
@@ -71,7 +71,8 @@ nomem:
  * the diagnosis takes the derivatives of every candidate (70 x 35 000
  * residuals on 32 x 1101). rcb_fit_prepare frees and resizes them. */
 static rcb_status dz_workspace(rcb_fit *c) {
-  size_t sz = 4 * rcb_layout_size(&c->frf->L) * (c->np + 1), nf = c->m->ndof * (c->np + 1);
+  size_t sz = 4 * rcb_layout_size(rcb_frf_layout(c->frf)) * (c->np + 1);
+  size_t nf = c->m->ndof * (c->np + 1);
   if (c->prepared) return RCB_OK;
   rcb_free(&c->alloc, c->dmat);
   rcb_free(&c->alloc, c->dF);
@@ -106,22 +107,20 @@ static double complex dh_adjoint(const rcb_fit_dz *p, const rcb_complex *y,
   return s;
 }
 
-/* One point: the model solve, the adjoint solutions, then every column. */
+/* One point: the model solve, the adjoint solutions with its factorisation
+ * (rcb_frf_solve_adjoint), then every column. */
 static rcb_status score_point(rcb_fit *f, size_t i, const rcb_fit_dz *dz, size_t ndz,
                               rcb_complex *Y, rcb_complex *dH, double *J) {
-  const rcb_frf *fr = f->frf;
-  size_t n = f->m->ndof, o, k, c, jj;
+  size_t n = f->m->ndof, k, c, jj;
   double w = f->grid[i], W = rcb_fit_point_speed(f, w);
   rcb_status st;
   if ((st = rcb_fit_solve_point(f, i))) return st;
-  memset(Y, 0, n * f->nout * sizeof *Y);
-  for (o = 0; o < f->nout; o++) Y[fr->out_row[o] + n * o] = 1.0;
-  if ((st = fr->ops->resolve(&fr->L, fr->Z, fr->ipiv, Y, f->nout, 'T')))
-    return rcb_fit_fail(f, st, "adjoint solve at %g rad/s failed", w);
+  if ((st = rcb_frf_solve_adjoint(f->frf, Y)))
+    return rcb_fit_fail(f, st, "adjoint solve at %g rad/s: %s", w, rcb_frf_errmsg(f->frf));
   for (k = 0; k < ndz; k++) {
     for (c = 0; c < f->nch; c++) {
-      size_t q = f->unbalance ? 0 : f->ch_in[c];
-      dH[c] = dh_adjoint(&dz[k], Y + n * f->ch_out[c], fr->B + n * q, w, W, f->unbalance, n);
+      const rcb_complex *x = rcb_frf_solution(f->frf, f->unbalance ? 0 : f->ch_in[c]);
+      dH[c] = dh_adjoint(&dz[k], Y + n * f->ch_out[c], x, w, W, f->unbalance, n);
     }
     for (jj = f->pt_first[i]; jj < f->pt_first[i + 1]; jj++) {
       size_t j = f->pt_res[jj];
