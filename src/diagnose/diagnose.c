@@ -201,46 +201,6 @@ static rcb_status baseline(rcb_diag *d) {
 
 /* ---- the score test ---- */
 
-/* Orthonormalise the columns of A (n x k) in place (modified Gram-Schmidt,
- * two passes), also against the q columns of Q; returns the rank kept. */
-static size_t orthonormalise(double *A, size_t n, size_t k, const double *Q, size_t q) {
-  size_t j, i, l, kept = 0;
-  int pass;
-  for (j = 0; j < k; j++) {
-    double *a = A + n * j, norm0 = 0, norm = 0;
-    for (i = 0; i < n; i++) norm0 += a[i] * a[i];
-    for (pass = 0; pass < 2; pass++) {
-      for (l = 0; l < q + kept; l++) {
-        const double *b = l < q ? Q + n * l : A + n * (l - q);
-        double dot = 0;
-        for (i = 0; i < n; i++) dot += a[i] * b[i];
-        for (i = 0; i < n; i++) a[i] -= dot * b[i];
-      }
-    }
-    for (i = 0; i < n; i++) norm += a[i] * a[i];
-    if (!(norm > 1e-20 * norm0) || norm == 0) continue; /* explained by what is fitted */
-    norm = sqrt(norm);
-    for (i = 0; i < n; i++) A[n * kept + i] = a[i] / norm;
-    kept++;
-  }
-  return kept;
-}
-
-/* Predicted reduction of F: || Q_c^T r ||^2 with Q_c the candidate's
- * columns J (n x np, overwritten) made orthonormal to the fitted
- * parameters' (Q0). */
-static double explained(double *J, size_t n, size_t np, const double *r, const double *Q0,
-                        size_t q0) {
-  size_t kept = orthonormalise(J, n, np, Q0, q0), k, i;
-  double pred = 0;
-  for (k = 0; k < kept; k++) {
-    double dot = 0;
-    for (i = 0; i < n; i++) dot += J[n * k + i] * r[i];
-    pred += dot * dot;
-  }
-  return pred;
-}
-
 /* The candidate's model and a fit of its own parameters (the base's
  * residual layout); the caller destroys both. */
 static rcb_status candidate_fit(rcb_diag *d, const diag_cand *c, rcb_model **m, rcb_fit **f) {
@@ -253,14 +213,13 @@ static rcb_status candidate_fit(rcb_diag *d, const diag_cand *c, rcb_model **m, 
 }
 
 /* A candidate whose model has other DOFs than the base: its own sweep. */
-static rcb_status score_alone(rcb_diag *d, diag_cand *c, const double *r, const double *Q0,
-                              size_t q0, double *J) {
+static rcb_status score_alone(rcb_diag *d, diag_cand *c, diag_basis *b, double *J) {
   rcb_model *m = NULL;
   rcb_fit *f = NULL;
   rcb_status st = candidate_fit(d, c, &m, &f);
   if (!st && (st = rcb_fit_jacobian(f, 1, J)))
     rcb_diag_fail(d, st, "%s: %s", c->desc, rcb_fit_errmsg(f));
-  if (!st) c->predicted = explained(J, d->nres, c->np, r, Q0, q0);
+  if (!st) st = rcb_diag_explained(d, b, J, c->np, &c->predicted);
   drop_fit(d, f);
   rcb_model_destroy(m);
   return st;
@@ -295,8 +254,7 @@ static rcb_status candidate_dz(rcb_diag *d, const diag_cand *c, size_t ndof, rcb
 
 typedef struct score_ws {
   rcb_fit *f;           /* the base model, fitted */
-  const double *r, *Q0; /* its weighted residual; the fitted parameters' columns */
-  size_t q0;
+  diag_basis basis;     /* its weighted residual and the fitted parameters' columns */
   double *J;            /* nres x batch */
   size_t batch;         /* parameters per sweep */
   rcb_fit_dz dz[RCB_DIAG_BATCH];
@@ -319,9 +277,9 @@ static rcb_status flush_batch(rcb_diag *d, score_ws *w) {
     rcb_diag_fail(d, st, "scoring the candidates: %s", rcb_fit_errmsg(w->f));
   for (b = 0; !st && b < w->ncand; b++) {
     diag_cand *c = &d->cand[w->which[b]];
-    c->predicted = explained(w->J + d->nres * off, d->nres, c->np, w->r, w->Q0, w->q0);
+    st = rcb_diag_explained(d, &w->basis, w->J + d->nres * off, c->np, &c->predicted);
     off += c->np;
-    st = progress(d);
+    if (!st) st = progress(d);
   }
   rcb_fit_dz_free(&d->alloc, w->dz, w->npar);
   w->ncand = w->npar = 0;
@@ -341,15 +299,14 @@ static rcb_status score_all(rcb_diag *d) {
             : w.batch > RCB_DIAG_BATCH  ? RCB_DIAG_BATCH
                                         : w.batch;
   w.J = rcb_alloc(&d->alloc, n * w.batch * sizeof *w.J);
-  w.r = r, w.Q0 = Q0;
   st = (r && Q0 && w.J) ? RCB_OK : rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
   if (!st) st = rcb_model_create(&m, &d->alloc);
   if (!st) st = rcb_model_load_string(m, d->base_ini, "<model>");
   if (!st) ndof = rcb_model_dof_count(m);
   if (!st) st = make_fit(d, m, 1, NULL, &w.f);
   if (!st) st = rcb_fit_residuals(w.f, r);
-  if (!st && d->nbase && !(st = rcb_fit_jacobian(w.f, 1, Q0)))
-    w.q0 = orthonormalise(Q0, n, d->nbase, NULL, 0);
+  if (!st && d->nbase) st = rcb_fit_jacobian(w.f, 1, Q0);
+  if (!st) st = rcb_diag_basis_init(d, &w.basis, Q0, n, d->nbase, r);
   for (k = 0; !st && k < d->ncand; k++) {
     diag_cand *c = &d->cand[k];
     int same;
@@ -359,12 +316,13 @@ static rcb_status score_all(rcb_diag *d) {
     if ((st = candidate_dz(d, c, ndof, w.dz + w.npar, &same))) break;
     if (same) {
       w.which[w.ncand++] = k, w.npar += c->np;
-    } else if (!(st = score_alone(d, c, r, Q0, w.q0, w.J + n * w.npar))) {
+    } else if (!(st = score_alone(d, c, &w.basis, w.J + n * w.npar))) {
       st = progress(d);
     }
   }
   if (!st) st = flush_batch(d, &w);
   rcb_fit_dz_free(&d->alloc, w.dz, w.npar);
+  rcb_diag_basis_free(d, &w.basis);
   drop_fit(d, w.f);
   rcb_model_destroy(m);
   rcb_free(&d->alloc, r);
