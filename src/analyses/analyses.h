@@ -24,7 +24,8 @@ const rcb_layout *rcb_frf_layout(const rcb_frf *f);
 /* Matrix row (reduced DOF index) of output o. */
 size_t rcb_frf_output_row(const rcb_frf *f, size_t o);
 /* Solution of input q of the last direct solve, X_q = Z^-1 e_q (n values;
- * rcb_frf_unbalance: q = 0, the unbalance response); NULL without one. */
+ * rcb_frf_unbalance: q = 0, the unbalance response); NULL without one. The
+ * inputs' solutions are contiguous: X_q = rcb_frf_solution(f, 0) + n q. */
 const rcb_complex *rcb_frf_solution(const rcb_frf *f, size_t q);
 /* Solve again with the last factorisation: Z X = B for nrhs right-hand
  * sides (B: n x nrhs column-major, the caller's, overwritten by X). */

@@ -36,7 +36,7 @@ rcb_status rcb_frf_solve_again(rcb_frf *f, rcb_complex *B, size_t nrhs) {
 
 rcb_status rcb_frf_solve_adjoint(rcb_frf *f, rcb_complex *Y) {
   size_t n, o;
-  if (!f || (!Y && f->nout)) return RCB_ERR_ARG;
+  if (!f || !Y) return RCB_ERR_ARG;
   n = f->m->ndof;
   memset(Y, 0, n * f->nout * sizeof *Y);
   for (o = 0; o < f->nout; o++) Y[f->out_row[o] + n * o] = 1.0;
