@@ -96,6 +96,60 @@ RCB_API rcb_status rcb_fit_set_progress(rcb_fit *f,
  */
 RCB_API rcb_status rcb_fit_set_starts(rcb_fit *f, size_t n, unsigned long seed);
 
+/**
+ * @brief Whether rcb_fit_run ends with the uncertainty step (standard errors,
+ * confidence intervals, correlation, identifiability; default 1). With 0 the
+ * fit and its report are the same, but rcb_fit_get_param's stderr_, ci_lo,
+ * ci_hi, identifiable and rcb_fit_correlation are not updated by the run (a
+ * caller that compares objectives only, as the diagnosis' refits, saves
+ * that step).
+ */
+RCB_API rcb_status rcb_fit_set_uncertainty(rcb_fit *f, int compute);
+
+/* ---- getters: every setting above, as set (or its default) ---- */
+
+/**
+ * @brief Bounds and parametrisation of parameter @p k (0-based, in the order
+ * added). @param lo, hi bounds, parameter units @param log_param 1 when log(p)
+ * is optimised. Any output may be NULL.
+ */
+RCB_API rcb_status rcb_fit_get_param_bounds(const rcb_fit *f, size_t k, double *lo, double *hi,
+                                            int *log_param);
+/** @brief The residual scale (default RCB_SCALE_LINEAR). */
+RCB_API rcb_fit_scale rcb_fit_get_scale(const rcb_fit *f);
+/** @brief The abscissa band kept, rad/s (default [0, HUGE_VAL]: every point). */
+RCB_API rcb_status rcb_fit_get_band(const rcb_fit *f, double *lo, double *hi);
+/**
+ * @brief The user weights, nch * npoints values in channel-major order (as
+ * rcb_fit_set_weights; all 1 when none are set). @return 1 when weights are
+ * set, 0 when not (w filled with 1), negative on bad arguments.
+ */
+RCB_API int rcb_fit_get_weights(const rcb_fit *f, double *w);
+/** @brief The eq. 19 noise factors, % (both 0: no noise model, unit weights). */
+RCB_API rcb_status rcb_fit_get_noise_model(const rcb_fit *f, double *beta_a, double *beta_s);
+/**
+ * @brief The method and, when @p algorithm is not NULL, the NLopt algorithm
+ * name ("" when none was given; the string belongs to f).
+ */
+RCB_API rcb_fit_method rcb_fit_get_method(const rcb_fit *f, const char **algorithm);
+/** @brief 1: analytic sensitivities (eq. 9, default), 0: finite differences (eq. 11). */
+RCB_API int rcb_fit_get_analytic(const rcb_fit *f);
+/**
+ * @brief Stopping rules: iterations (default 100), relative objective change
+ * (-, default 1e-10), relative step (-, default 1e-8). Any output may be NULL.
+ */
+RCB_API rcb_status rcb_fit_get_limits(const rcb_fit *f, size_t *max_iter, double *ftol_rel,
+                                      double *xtol_rel);
+/** @brief The progress callback and its user pointer (NULL, NULL: none). */
+RCB_API rcb_status rcb_fit_get_progress(const rcb_fit *f,
+                                        int (**cb)(void *user, size_t iter, size_t evals,
+                                                   double objective),
+                                        void **user);
+/** @brief Starting points (default 1) and the PRNG seed of the further ones (default 0). */
+RCB_API rcb_status rcb_fit_get_starts(const rcb_fit *f, size_t *n, unsigned long *seed);
+/** @brief Whether rcb_fit_run computes the uncertainties (default 1). */
+RCB_API int rcb_fit_get_uncertainty(const rcb_fit *f);
+
 /** @brief Run the fit; on success the model holds the fitted values. */
 RCB_API rcb_status rcb_fit_run(rcb_fit *f);
 

@@ -173,6 +173,7 @@ rcb_status rcb_frf_refresh(rcb_frf *f) {
   if (!f) return RCB_ERR_ARG;
   rcb_assemble_structure(f->m, &f->L, f->M, f->C, f->G, f->K);
   rcb_frf_modal_invalidate(f);
+  f->factored = 0;
   return RCB_OK;
 }
 
@@ -207,6 +208,7 @@ rcb_status rcb_frf_factor_solve(rcb_frf *f, double omega, double speed, size_t n
   }
   rcb_frf_cond_before(f);
   st = f->ops->solve(&f->L, f->Z, f->ipiv, f->B, nrhs);
+  f->factored = st == RCB_OK;
   if (!st) rcb_frf_cond_after(f, omega, speed);
   if (st == RCB_ERR_SINGULAR)
     return rcb_set_error(f->errmsg, st,

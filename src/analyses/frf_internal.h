@@ -19,6 +19,8 @@ struct rcb_frf {
   rcb_complex *Z;        /* dynamic stiffness, factored in place */
   rcb_complex *B;        /* n x max(nin, 1) right-hand sides / solutions */
   int *ipiv;
+  int factored;          /* Z / ipiv (or KLU's factors) and B hold the last
+                            successful direct solve (frf_reuse.c) */
   size_t nout, nin, *out_row, *in_row;
   size_t bytes;
   struct rcb_frf_modal *modal; /* frf_modal.c: NULL unless RCB_SOLVER_MODAL */

@@ -38,6 +38,7 @@ typedef struct sweep_part {
 rcb_status rcb_frf_solver_reset(rcb_frf *f) {
   rcb_status st;
   if (!f->L.sparse) return RCB_OK;
+  f->factored = 0;
   f->ops->release(&f->L, &f->alloc);
   if ((st = f->ops->prepare(&f->L, &f->alloc)))
     return rcb_set_error(f->errmsg, st, "%s solver: symbolic analysis failed", f->ops->name);

@@ -10,14 +10,7 @@
 #include <string.h>
 
 #include "compare/compare_internal.h"
-
-rcb_status (rcb_cmp_fail)(rcb_compare *c, rcb_status st, const char *fmt, ...) {
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(c->errmsg, sizeof c->errmsg, fmt, ap);
-  va_end(ap);
-  return st;
-}
+#include "io/io.h"
 
 rcb_status rcb_compare_create(rcb_compare **out, const rcb_allocator *alloc) {
   rcb_allocator a;
@@ -86,33 +79,18 @@ rcb_status rcb_compare_set_peaks(rcb_compare *c, double prominence_db, double fr
 
 /* ---- the model side ---- */
 
-static size_t dof_slot(rcb_dof *list, size_t *n, rcb_dof d) {
-  size_t i;
-  for (i = 0; i < *n; i++)
-    if (list[i].node == d.node && list[i].dir == d.dir) return i;
-  list[*n] = d;
-  return (*n)++;
-}
-
-static rcb_status resolve(rcb_compare *c, rcb_cmp_eval *ev, rcb_dof *outs, rcb_dof *ins) {
-  size_t k;
-  for (k = 0; k < c->nch; k++) {
-    rcb_dof d;
-    if (rcb_model_find_dof(ev->m, c->resp[k], &d))
-      return rcb_cmp_fail(c, RCB_ERR_NOT_FOUND, "measurement channel %zu: %s", k + 1,
-                          rcb_model_errmsg(ev->m));
-    ev->ch_out[k] = dof_slot(outs, &ev->nout, d);
-    if (c->type == RCB_MEAS_UNBALANCE) continue;
-    if (!c->ref[k] || rcb_model_find_dof(ev->m, c->ref[k], &d))
-      return rcb_cmp_fail(c, RCB_ERR_NOT_FOUND, "measurement channel %zu (%s): %s", k + 1,
-                          c->resp[k], c->ref[k] ? rcb_model_errmsg(ev->m)
-                                                : "an FRF channel needs a reference");
-    ev->ch_in[k] = dof_slot(ins, &ev->nin, d);
-  }
+/* Channels -> FRF outputs and inputs (the resolver shared with the fit). */
+static rcb_status resolve(rcb_compare *c, const rcb_meas *ms, rcb_cmp_eval *ev, rcb_dof *outs,
+                          rcb_dof *ins) {
+  rcb_meas_dofs d;
+  rcb_status st;
+  d.ch_out = ev->ch_out, d.ch_in = ev->ch_in, d.outs = outs, d.ins = ins;
+  if ((st = rcb_meas_resolve_dofs(ms, ev->m, &d, c->errmsg))) return st;
+  ev->nout = d.nout, ev->nin = d.nin;
   return RCB_OK;
 }
 
-static rcb_status eval_setup(rcb_compare *c, rcb_cmp_eval *ev) {
+static rcb_status eval_setup(rcb_compare *c, const rcb_meas *ms, rcb_cmp_eval *ev) {
   rcb_dof *outs = rcb_alloc(&c->alloc, c->nch * sizeof *outs);
   rcb_dof *ins = rcb_alloc(&c->alloc, c->nch * sizeof *ins);
   rcb_status st = RCB_OK;
@@ -120,7 +98,7 @@ static rcb_status eval_setup(rcb_compare *c, rcb_cmp_eval *ev) {
   ev->ch_in = rcb_alloc(&c->alloc, c->nch * sizeof *ev->ch_in);
   if (!outs || !ins || !ev->ch_out || !ev->ch_in)
     st = rcb_cmp_fail(c, RCB_ERR_NOMEM, "out of memory setting up the comparison");
-  else if (!(st = resolve(c, ev, outs, ins))) {
+  else if (!(st = resolve(c, ms, ev, outs, ins))) {
     st = rcb_frf_create(&ev->frf, ev->m, ev->nout, outs, ev->nin, ins, RCB_SOLVER_AUTO,
                         &c->alloc);
     if (st) rcb_cmp_fail(c, st, "model FRF workspace: %s", rcb_status_str(st));
@@ -385,7 +363,7 @@ rcb_status rcb_compare_run(rcb_compare *c, const rcb_model *m, const rcb_meas *m
   c->nbands = c->nbands_req < c->npts ? c->nbands_req : c->npts;
   memset(&ev, 0, sizeof ev);
   ev.m = m;
-  if (!(st = copy_meas(c, ms)) && !(st = eval_setup(c, &ev)) && !(st = model_sweep(c, &ev))) {
+  if (!(st = copy_meas(c, ms)) && !(st = eval_setup(c, ms, &ev)) && !(st = model_sweep(c, &ev))) {
     channel_metrics(c);
     point_metrics(c);
     band_map(c);

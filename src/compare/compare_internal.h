@@ -39,14 +39,8 @@ typedef struct rcb_cmp_eval {
   rcb_complex *H; /* nout * max(nin, 1) */
 } rcb_cmp_eval;
 
-rcb_status rcb_cmp_fail(rcb_compare *c, rcb_status st, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
-#ifdef __clang_analyzer__ /* returns st: see rcb_set_error in core/rcb_internal.h */
-#define rcb_cmp_fail(o, st, ...) ((void)(rcb_cmp_fail)((o), (st), __VA_ARGS__), (st))
-#endif
+/* The error message of rcb_compare (core/rcb_internal.h, rcb_fail). */
+#define rcb_cmp_fail(c, st, ...) rcb_fail((c), (st), __VA_ARGS__)
 
 /* Model values of every channel at abscissa w (rad/s) into out[nch]. */
 rcb_status rcb_cmp_model_at(rcb_compare *c, rcb_cmp_eval *ev, double w, rcb_complex *out);

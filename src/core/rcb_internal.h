@@ -30,11 +30,18 @@ void rcb_allocator_init(rcb_allocator *dst, const rcb_allocator *src);
 /* Grow a dynamic array to hold at least need items: 0 or -1. */
 int rcb_grow(const rcb_allocator *a, void **items, size_t *cap, size_t need, size_t item_size);
 
-/* ---- core/errmsg.c ---- */
+/* ---- core/errmsg.c: the library's one error-message helper ---- */
 /* Show control bytes (C0, DEL) of a message as \xNN, in place, truncated to
  * @p size bytes with the NUL: a token echoed from a file cannot drive a terminal. */
 void rcb_escape_controls(char *buf, size_t size);
-/* printf into an object's error buffer, returns st for "return rcb_fail(...)" */
+/* printf into an object's error buffer (RCB_ERRMSG_MAX bytes; NULL: nothing
+ * written), control bytes escaped, and return st, so that a failure reads
+ * "return rcb_fail(obj, RCB_ERR_ARG, "...", ...)". Every folder writes its
+ * messages through it: rcb_fail on any object with a char
+ * errmsg[RCB_ERRMSG_MAX] member, or rcb_set_error on a caller's buffer. The
+ * folders' short names (rcb_fit_fail, rcb_diag_fail, rcb_cmp_fail,
+ * rcb_meas_fail) are rcb_fail on their object; model/ still has its own
+ * rcb_model_fail (to be moved onto this helper). */
 rcb_status rcb_set_error(char *buf, rcb_status st, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 3, 4)))
@@ -48,6 +55,7 @@ rcb_status rcb_set_error(char *buf, rcb_status st, const char *fmt, ...)
  * the other *_fail helpers do the same. */
 #define rcb_set_error(buf, st, ...) ((void)(rcb_set_error)((buf), (st), __VA_ARGS__), (st))
 #endif
+#define rcb_fail(obj, st, ...) rcb_set_error((obj)->errmsg, (st), __VA_ARGS__)
 
 /* ---- core/text.c ---- */
 /* Case-insensitive Levenshtein distance of two names ((size_t)-1 beyond 160

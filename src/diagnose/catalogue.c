@@ -9,7 +9,7 @@
 #include <string.h>
 
 #include "diagnose/diag_internal.h"
-#include "identify/fit_internal.h"
+#include "identify/identify.h"
 
 static const char *const effect_names[RCB_EFFECT_COUNT] = {
     "coupling translational damping", "coupling rotational stiffness",

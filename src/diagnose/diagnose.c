@@ -11,18 +11,10 @@
 #include <string.h>
 
 #include "diagnose/diag_internal.h"
-#include "identify/fit_internal.h"
+#include "identify/identify.h"
 
 #define RCB_DIAG_BIC_MIN (-10.0) /* "strong" evidence (Kass & Raftery) */
 #define RCB_DIAG_ERR_FALL 0.98   /* the error must fall by at least 2 % of itself */
-
-rcb_status (rcb_diag_fail)(rcb_diag *d, rcb_status st, const char *fmt, ...) {
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(d->errmsg, sizeof d->errmsg, fmt, ap);
-  va_end(ap);
-  return st;
-}
 
 rcb_status rcb_diag_create(rcb_diag **out, const rcb_model *m, const rcb_meas *meas,
                            const rcb_allocator *alloc) {
@@ -121,7 +113,7 @@ static rcb_status make_fit(rcb_diag *d, rcb_model *m, int with_base, const diag_
   rcb_fit *f = NULL;
   rcb_status st = rcb_fit_create(&f, m, d->meas, &d->alloc);
   size_t k;
-  if (!st) f->no_uncertainty = 1; /* intervals are not part of a diagnosis */
+  if (!st) st = rcb_fit_set_uncertainty(f, 0); /* intervals are not part of a diagnosis */
   if (!st) st = rcb_fit_set_scale(f, d->scale);
   if (!st && (d->beta_a > 0 || d->beta_s > 0))
     st = rcb_fit_set_noise_model(f, d->beta_a, d->beta_s);
@@ -148,7 +140,7 @@ static rcb_status make_fit(rcb_diag *d, rcb_model *m, int with_base, const diag_
 
 /* Destroy a fit, counting its model sweeps in the diagnosis' figures. */
 static void drop_fit(rcb_diag *d, rcb_fit *f) {
-  if (f) d->stats.evaluations += f->sweeps;
+  d->stats.evaluations += rcb_fit_sweeps(f);
   rcb_fit_destroy(f);
 }
 
@@ -242,46 +234,6 @@ static rcb_status baseline(rcb_diag *d) {
 
 /* ---- the score test ---- */
 
-/* Orthonormalise the columns of A (n x k) in place (modified Gram-Schmidt,
- * two passes), also against the q columns of Q; returns the rank kept. */
-static size_t orthonormalise(double *A, size_t n, size_t k, const double *Q, size_t q) {
-  size_t j, i, l, kept = 0;
-  int pass;
-  for (j = 0; j < k; j++) {
-    double *a = A + n * j, norm0 = 0, norm = 0;
-    for (i = 0; i < n; i++) norm0 += a[i] * a[i];
-    for (pass = 0; pass < 2; pass++) {
-      for (l = 0; l < q + kept; l++) {
-        const double *b = l < q ? Q + n * l : A + n * (l - q);
-        double dot = 0;
-        for (i = 0; i < n; i++) dot += a[i] * b[i];
-        for (i = 0; i < n; i++) a[i] -= dot * b[i];
-      }
-    }
-    for (i = 0; i < n; i++) norm += a[i] * a[i];
-    if (!(norm > 1e-20 * norm0) || norm == 0) continue; /* explained by what is fitted */
-    norm = sqrt(norm);
-    for (i = 0; i < n; i++) A[n * kept + i] = a[i] / norm;
-    kept++;
-  }
-  return kept;
-}
-
-/* Predicted reduction of F: || Q_c^T r ||^2 with Q_c the candidate's
- * columns J (n x np, overwritten) made orthonormal to the fitted
- * parameters' (Q0). */
-static double explained(double *J, size_t n, size_t np, const double *r, const double *Q0,
-                        size_t q0) {
-  size_t kept = orthonormalise(J, n, np, Q0, q0), k, i;
-  double pred = 0;
-  for (k = 0; k < kept; k++) {
-    double dot = 0;
-    for (i = 0; i < n; i++) dot += J[n * k + i] * r[i];
-    pred += dot * dot;
-  }
-  return pred;
-}
-
 /* The candidate's model and a fit of its own parameters (the base's
  * residual layout); the caller destroys both. */
 static rcb_status candidate_fit(rcb_diag *d, const diag_cand *c, rcb_model **m, rcb_fit **f) {
@@ -294,15 +246,14 @@ static rcb_status candidate_fit(rcb_diag *d, const diag_cand *c, rcb_model **m, 
 }
 
 /* A candidate whose model has other DOFs than the base: its own sweep. */
-static rcb_status score_alone(rcb_diag *d, diag_cand *c, const double *r, const double *Q0,
-                              size_t q0, double *J, int nominal) {
+static rcb_status score_alone(rcb_diag *d, diag_cand *c, diag_basis *b, double *J,
+                              int nominal) {
   rcb_model *m = NULL;
   rcb_fit *f = NULL;
   rcb_status st = candidate_fit(d, c, &m, &f);
   if (!st && (st = rcb_fit_jacobian(f, 1, J)))
     rcb_diag_fail(d, st, "%s: %s", c->desc, rcb_fit_errmsg(f));
-  if (!st)
-    *(nominal ? &c->predicted_nom : &c->predicted) = explained(J, d->nres, c->np, r, Q0, q0);
+  if (!st) st = rcb_diag_explained(d, b, J, c->np, nominal ? &c->predicted_nom : &c->predicted);
   drop_fit(d, f);
   rcb_model_destroy(m);
   return st;
@@ -337,8 +288,7 @@ static rcb_status candidate_dz(rcb_diag *d, const diag_cand *c, size_t ndof, rcb
 
 typedef struct score_ws {
   rcb_fit *f;           /* the base model, fitted */
-  const double *r, *Q0; /* its weighted residual; the fitted parameters' columns */
-  size_t q0;
+  diag_basis basis;     /* its weighted residual and the fitted parameters' columns */
   double *J;            /* nres x batch */
   size_t batch;         /* parameters per sweep */
   rcb_fit_dz dz[RCB_DIAG_BATCH];
@@ -362,10 +312,10 @@ static rcb_status flush_batch(rcb_diag *d, score_ws *w) {
     rcb_diag_fail(d, st, "scoring the candidates: %s", rcb_fit_errmsg(w->f));
   for (b = 0; !st && b < w->ncand; b++) {
     diag_cand *c = &d->cand[w->which[b]];
-    double pred = explained(w->J + d->nres * off, d->nres, c->np, w->r, w->Q0, w->q0);
-    *(w->nominal ? &c->predicted_nom : &c->predicted) = pred;
+    st = rcb_diag_explained(d, &w->basis, w->J + d->nres * off, c->np,
+                            w->nominal ? &c->predicted_nom : &c->predicted);
     off += c->np;
-    st = progress(d);
+    if (!st) st = progress(d);
   }
   rcb_fit_dz_free(&d->alloc, w->dz, w->npar);
   w->ncand = w->npar = 0;
@@ -388,14 +338,14 @@ static rcb_status score_all(rcb_diag *d, int nominal) {
             : w.batch > RCB_DIAG_BATCH  ? RCB_DIAG_BATCH
                                         : w.batch;
   w.J = rcb_alloc(&d->alloc, n * w.batch * sizeof *w.J);
-  w.r = r, w.Q0 = Q0, w.nominal = nominal;
+  w.nominal = nominal;
   st = (r && Q0 && w.J) ? RCB_OK : rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
   if (!st) st = rcb_diag_copy_model(d, d->base_model, &m);
   if (!st) ndof = rcb_model_dof_count(m);
   if (!st) st = make_fit(d, m, 1, NULL, &w.f);
   if (!st) st = rcb_fit_residuals(w.f, r);
-  if (!st && d->nbase && !(st = rcb_fit_jacobian(w.f, 1, Q0)))
-    w.q0 = orthonormalise(Q0, n, d->nbase, NULL, 0);
+  if (!st && d->nbase) st = rcb_fit_jacobian(w.f, 1, Q0);
+  if (!st) st = rcb_diag_basis_init(d, &w.basis, Q0, n, d->nbase, r);
   for (k = 0; !st && k < d->ncand; k++) {
     diag_cand *c = &d->cand[k];
     int same;
@@ -405,12 +355,13 @@ static rcb_status score_all(rcb_diag *d, int nominal) {
     if ((st = candidate_dz(d, c, ndof, w.dz + w.npar, &same))) break;
     if (same) {
       w.which[w.ncand++] = k, w.npar += c->np;
-    } else if (!(st = score_alone(d, c, r, Q0, w.q0, w.J + n * w.npar, nominal))) {
+    } else if (!(st = score_alone(d, c, &w.basis, w.J + n * w.npar, nominal))) {
       st = progress(d);
     }
   }
   if (!st) st = flush_batch(d, &w);
   rcb_fit_dz_free(&d->alloc, w.dz, w.npar);
+  rcb_diag_basis_free(d, &w.basis);
   drop_fit(d, w.f);
   rcb_model_destroy(m);
   rcb_free(&d->alloc, r);
@@ -449,9 +400,11 @@ static size_t refit_starts(const rcb_diag *d, const diag_cand *c) {
 #define RCB_DIAG_BIC_RESOLUTION 0.1
 static rcb_status refit_tolerance(const rcb_diag *d, const diag_cand *c, rcb_fit *f) {
   double scale = (d->beta_a > 0 || d->beta_s > 0) ? d->F0 : (double)d->nres;
-  double tol = RCB_DIAG_BIC_RESOLUTION / scale;
-  if (!c->refit_only || !(scale > 0) || !(tol < 1e-2) || tol <= f->ftol_rel) return RCB_OK;
-  return rcb_fit_set_limits(f, f->max_iter, tol, f->xtol_rel);
+  double tol = RCB_DIAG_BIC_RESOLUTION / scale, ftol, xtol;
+  size_t max_iter;
+  rcb_fit_get_limits(f, &max_iter, &ftol, &xtol);
+  if (!c->refit_only || !(scale > 0) || !(tol < 1e-2) || tol <= ftol) return RCB_OK;
+  return rcb_fit_set_limits(f, max_iter, tol, xtol);
 }
 
 static void record_fit(diag_cand *c, rcb_fit *f) {
@@ -486,12 +439,14 @@ static rcb_status refit_setup(rcb_diag *d, const diag_cand *c, const rcb_model *
  * damping at 0) goes on in the polish only if it is the best start. */
 #define RCB_DIAG_SCREEN_ITER 25
 static rcb_status screen(rcb_fit *f, const double *w) {
-  size_t it = f->max_iter;
-  rcb_status st = rcb_fit_set_weights(f, w);
+  size_t it = 0;
+  double ftol = 0.0, xtol = 0.0;
+  rcb_status st = rcb_fit_get_limits(f, &it, &ftol, &xtol);
+  if (!st) st = rcb_fit_set_weights(f, w);
   if (!st && w && it > RCB_DIAG_SCREEN_ITER)
-    st = rcb_fit_set_limits(f, RCB_DIAG_SCREEN_ITER, f->ftol_rel, f->xtol_rel);
+    st = rcb_fit_set_limits(f, RCB_DIAG_SCREEN_ITER, ftol, xtol);
   if (!st) st = rcb_fit_run(f);
-  if (w && it > RCB_DIAG_SCREEN_ITER) rcb_fit_set_limits(f, it, f->ftol_rel, f->xtol_rel);
+  if (w && it > RCB_DIAG_SCREEN_ITER) rcb_fit_set_limits(f, it, ftol, xtol);
   return st;
 }
 
@@ -560,7 +515,11 @@ static rcb_status refit(rcb_diag *d, diag_cand *c, const double *w) {
       if (!why[0]) snprintf(why, sizeof why, "refit failed: %.300s", rcb_fit_errmsg(f[s]));
       continue;
     }
-    F[s] = f[s]->obj;
+    {
+      rcb_fit_report rep;
+      rcb_fit_get_report(f[s], &rep);
+      F[s] = rep.objective;
+    }
     if (F[s] < F[b]) b = s;
   }
   if (st != RCB_ERR_NOMEM) {

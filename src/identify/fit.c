@@ -8,41 +8,21 @@
 #include <string.h>
 
 #include "identify/fit_internal.h"
+#include "io/io.h"
 
-rcb_status (rcb_fit_fail)(rcb_fit *f, rcb_status st, const char *fmt, ...) {
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(f->errmsg, sizeof f->errmsg, fmt, ap);
-  va_end(ap);
-  return st;
-}
-
-/* Index of dof in list (appending it when new). */
-static size_t dof_slot(rcb_dof *list, size_t *n, rcb_dof d) {
-  size_t i;
-  for (i = 0; i < *n; i++)
-    if (list[i].node == d.node && list[i].dir == d.dir) return i;
-  list[*n] = d;
-  return (*n)++;
-}
-
+/* Channels -> FRF outputs and inputs (the resolver shared with the
+ * comparison), and the kind of each channel's values. */
 static rcb_status resolve_channels(rcb_fit *f, rcb_dof *outs, rcb_dof *ins) {
+  rcb_meas_dofs d;
   size_t c;
+  rcb_status st;
+  d.ch_out = f->ch_out, d.ch_in = f->ch_in, d.outs = outs, d.ins = ins;
+  if ((st = rcb_meas_resolve_dofs(f->meas, f->m, &d, f->errmsg))) return st;
+  f->nout = d.nout, f->nin = d.nin;
   for (c = 0; c < f->nch; c++) {
     rcb_meas_channel_info ci;
-    rcb_dof d;
     if (rcb_meas_channel(f->meas, c, &ci)) return rcb_fit_fail(f, RCB_ERR_ARG, "channel %zu", c);
-    if (rcb_model_find_dof(f->m, ci.response, &d))
-      return rcb_fit_fail(f, RCB_ERR_NOT_FOUND, "measurement channel %zu: %s", c + 1,
-                          rcb_model_errmsg(f->m));
-    f->ch_out[c] = dof_slot(outs, &f->nout, d);
     f->ch_kind[c] = ci.kind;
-    if (f->unbalance) continue;
-    if (!ci.reference || rcb_model_find_dof(f->m, ci.reference, &d))
-      return rcb_fit_fail(f, RCB_ERR_NOT_FOUND, "measurement channel %zu (%s): %s", c + 1,
-                          ci.response, ci.reference ? rcb_model_errmsg(f->m)
-                                                    : "an FRF channel needs a reference");
-    f->ch_in[c] = dof_slot(ins, &f->nin, d);
   }
   return RCB_OK;
 }
@@ -272,11 +252,88 @@ rcb_status rcb_fit_set_progress(rcb_fit *f,
   return RCB_OK;
 }
 
+rcb_status rcb_fit_set_uncertainty(rcb_fit *f, int compute) {
+  if (!f) return RCB_ERR_ARG;
+  f->no_uncertainty = !compute;
+  return RCB_OK;
+}
+
+/* ---- getters (NLopt's set/get pairing) ---- */
+
+rcb_status rcb_fit_get_param_bounds(const rcb_fit *f, size_t k, double *lo, double *hi,
+                                    int *log_param) {
+  if (!f || k >= f->np) return RCB_ERR_ARG;
+  if (lo) *lo = f->par[k].lo;
+  if (hi) *hi = f->par[k].hi;
+  if (log_param) *log_param = f->par[k].log_param;
+  return RCB_OK;
+}
+
+rcb_fit_scale rcb_fit_get_scale(const rcb_fit *f) { return f ? f->scale : RCB_SCALE_LINEAR; }
+
+rcb_status rcb_fit_get_band(const rcb_fit *f, double *lo, double *hi) {
+  if (!f || !lo || !hi) return RCB_ERR_ARG;
+  *lo = f->band_lo, *hi = f->band_hi;
+  return RCB_OK;
+}
+
+int rcb_fit_get_weights(const rcb_fit *f, double *w) {
+  size_t i, n;
+  if (!f || !w) return RCB_ERR_ARG;
+  n = f->nch * f->npts;
+  if (f->wuser) {
+    memcpy(w, f->wuser, n * sizeof *w);
+    return 1;
+  }
+  for (i = 0; i < n; i++) w[i] = 1.0;
+  return 0;
+}
+
+rcb_status rcb_fit_get_noise_model(const rcb_fit *f, double *beta_a, double *beta_s) {
+  if (!f || !beta_a || !beta_s) return RCB_ERR_ARG;
+  *beta_a = f->beta_a, *beta_s = f->beta_s;
+  return RCB_OK;
+}
+
+rcb_fit_method rcb_fit_get_method(const rcb_fit *f, const char **algorithm) {
+  if (algorithm) *algorithm = f ? f->algorithm : "";
+  return f ? f->method : RCB_FIT_PAPER;
+}
+
+int rcb_fit_get_analytic(const rcb_fit *f) { return f ? f->analytic : 1; }
+
+rcb_status rcb_fit_get_limits(const rcb_fit *f, size_t *max_iter, double *ftol_rel,
+                              double *xtol_rel) {
+  if (!f) return RCB_ERR_ARG;
+  if (max_iter) *max_iter = f->max_iter;
+  if (ftol_rel) *ftol_rel = f->ftol_rel;
+  if (xtol_rel) *xtol_rel = f->xtol_rel;
+  return RCB_OK;
+}
+
+rcb_status rcb_fit_get_progress(const rcb_fit *f,
+                                int (**cb)(void *user, size_t iter, size_t evals,
+                                           double objective),
+                                void **user) {
+  if (!f || !cb || !user) return RCB_ERR_ARG;
+  *cb = f->progress, *user = f->progress_user;
+  return RCB_OK;
+}
+
+rcb_status rcb_fit_get_starts(const rcb_fit *f, size_t *n, unsigned long *seed) {
+  if (!f || !n || !seed) return RCB_ERR_ARG;
+  *n = f->nstarts ? f->nstarts : 1, *seed = f->seed;
+  return RCB_OK;
+}
+
+int rcb_fit_get_uncertainty(const rcb_fit *f) { return f ? !f->no_uncertainty : 1; }
+
 /* ---- run and results ---- */
 
 rcb_status rcb_fit_set_starts(rcb_fit *f, size_t n, unsigned long seed) {
   if (!f || n == 0) return RCB_ERR_ARG;
   f->nstarts = n;
+  f->seed = seed;
   f->rng = (unsigned long long)seed * 0x9E3779B97F4A7C15ull + 1ull;
   return RCB_OK;
 }
@@ -423,6 +480,8 @@ rcb_status rcb_fit_get_report(const rcb_fit *f, rcb_fit_report *out) {
 }
 
 size_t rcb_fit_param_count(const rcb_fit *f) { return f ? f->np : 0; }
+
+size_t rcb_fit_sweeps(const rcb_fit *f) { return f ? f->sweeps : 0; }
 
 rcb_status rcb_fit_get_param(const rcb_fit *f, size_t k, rcb_fit_param *out) {
   const rcb_fit_par *p;

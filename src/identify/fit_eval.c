@@ -115,7 +115,7 @@ rcb_status rcb_fit_prepare(rcb_fit *f) {
                         "no measured point left to fit (check the band, the weights and the "
                         "noise floor)");
   rcb_fit_free_layout(f);
-  sz = rcb_layout_size(&f->frf->L);
+  sz = rcb_layout_size(rcb_frf_layout(f->frf));
   ncol = f->np * (f->nin ? f->nin : 1);
   f->res_ch = rcb_alloc(&f->alloc, n * sizeof *f->res_ch);
   f->res_pt = rcb_alloc(&f->alloc, n * sizeof *f->res_pt);
@@ -291,7 +291,7 @@ static rcb_status jac_fd(rcb_fit *f, double *r, double *Jx) {
 /* Matrices and unbalance force (at unit speed) of the whole model in the FRF
  * layout, bearings included. */
 static void full_system(rcb_fit *f, double *A, rcb_complex *F1) {
-  const rcb_layout *L = &f->frf->L;
+  const rcb_layout *L = rcb_frf_layout(f->frf);
   size_t sz = rcb_layout_size(L), b;
   int e;
   rcb_assemble_structure(f->m, L, A, A + sz, A + 2 * sz, A + 3 * sz);
@@ -310,7 +310,7 @@ static void full_system(rcb_fit *f, double *A, rcb_complex *F1) {
  * matrices affinely, so a forward difference of any size is exact there; the
  * unbalance phase enters F through e^{i phase}, hence a small central step. */
 rcb_status rcb_fit_derivative_matrices(rcb_fit *f) {
-  size_t sz = 4 * rcb_layout_size(&f->frf->L), n = f->m->ndof, k, i;
+  size_t sz = 4 * rcb_layout_size(rcb_frf_layout(f->frf)), n = f->m->ndof, k, i;
   double *base = f->dmat + f->np * sz;
   rcb_complex *F0 = f->dF + f->np * n, *Fk;
   rcb_status st;
@@ -382,26 +382,30 @@ double rcb_fit_res_deriv(const rcb_fit *f, size_t j, double complex dh) {
 }
 
 /* Analytic Jacobian, eq. 9, one point: X = Z^-1 B (kept by the solve), then
- * dX/dp_k = Z^-1 (dF_k - dZ_k X), all parameters and inputs in one re-solve. */
+ * dX/dp_k = Z^-1 (dF_k - dZ_k X), all parameters and inputs in one re-solve
+ * with the point's factorisation (rcb_frf_solve_again). */
 static rcb_status jac_point(rcb_fit *f, size_t i, double *Jx) {
-  const rcb_frf *fr = f->frf;
-  size_t n = f->m->ndof, nin = f->nin ? f->nin : 1, k, q, jj, sz = 4 * rcb_layout_size(&fr->L);
+  const rcb_layout *L = rcb_frf_layout(f->frf);
+  size_t n = f->m->ndof, nin = f->nin ? f->nin : 1, k, q, jj, sz = 4 * rcb_layout_size(L);
   double w = f->grid[i], W = rcb_fit_point_speed(f, w);
   rcb_status st;
   for (k = 0; k < f->np; k++)
     for (q = 0; q < nin; q++) {
       rcb_complex *y = f->rhs + n * (k * nin + q);
+      const rcb_complex *x = rcb_frf_solution(f->frf, q);
       size_t d;
-      dz_times(&fr->L, f->dmat + k * sz, w, W, fr->B + n * q, y);
+      if (!x) return rcb_fit_fail(f, RCB_ERR_STATE, "no model solution at %g rad/s", w);
+      dz_times(L, f->dmat + k * sz, w, W, x, y);
       for (d = 0; d < n; d++) y[d] = -y[d] + (f->unbalance ? w * w * f->dF[k * n + d] : 0.0);
     }
-  st = fr->ops->resolve(&fr->L, fr->Z, fr->ipiv, f->rhs, f->np * nin, 'N');
-  if (st) return rcb_fit_fail(f, st, "sensitivity solve at %g rad/s failed", w);
+  st = rcb_frf_solve_again(f->frf, f->rhs, f->np * nin);
+  if (st)
+    return rcb_fit_fail(f, st, "sensitivity solve at %g rad/s: %s", w, rcb_frf_errmsg(f->frf));
   for (jj = f->pt_first[i]; jj < f->pt_first[i + 1]; jj++) {
-    size_t j = f->pt_res[jj], c = f->res_ch[j];
+    size_t j = f->pt_res[jj], c = f->res_ch[j], row = rcb_frf_output_row(f->frf, f->ch_out[c]);
     for (k = 0; k < f->np; k++) {
       size_t col = k * nin + (f->unbalance ? 0 : f->ch_in[c]);
-      Jx[j + f->nres * k] = rcb_fit_res_deriv(f, j, f->rhs[n * col + fr->out_row[f->ch_out[c]]]);
+      Jx[j + f->nres * k] = rcb_fit_res_deriv(f, j, f->rhs[n * col + row]);
     }
   }
   return RCB_OK;

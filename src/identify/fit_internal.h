@@ -1,7 +1,9 @@
 /*
- * The fit object, shared by the identification files: fit.c (set-up,
- * residuals, Jacobians, report), fit_paper.c (the paper's algorithm,
- * eqs. 14-18), fit_nlopt.c (NLopt adapter), uncertainty.c.
+ * The fit object, private to identify/ (other folders use the public
+ * rcb_identify.h and the internal interface identify/identify.h), shared by
+ * the identification files: fit.c (set-up, residuals, Jacobians, report),
+ * fit_paper.c (the paper's algorithm, eqs. 14-18), fit_nlopt.c (NLopt
+ * adapter), uncertainty.c.
  *
  * Optimisers work in internal coordinates x: x_k = ln p_k for log
  * parameters, x_k = p_k / s_k otherwise (s_k = |start| or 1), so that all
@@ -10,8 +12,9 @@
 #ifndef RCB_FIT_INTERNAL_H
 #define RCB_FIT_INTERNAL_H
 
-#include "analyses/frf_internal.h"
+#include "analyses/analyses.h"
 #include "core/rcb_internal.h"
+#include "identify/identify.h"
 
 #define RCB_PARAM_NAME_MAX ((size_t)3 * RCB_NAME_MAX)
 
@@ -85,24 +88,16 @@ struct rcb_fit {
   size_t stop_param;     /* parameter at its bound (RCB_FIT_STOP_AT_BOUND) */
   rcb_frf_condition cond; /* condition of the final evaluation's solves */
   size_t nstarts, starts_used;
+  unsigned long seed;    /* as given to rcb_fit_set_starts */
   unsigned long long rng;
   double *cov, *corr;    /* np x np */
 };
 
-rcb_status rcb_fit_fail(rcb_fit *f, rcb_status st, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
-#ifdef __clang_analyzer__ /* returns st: see rcb_set_error in core/rcb_internal.h */
-#define rcb_fit_fail(o, st, ...) ((void)(rcb_fit_fail)((o), (st), __VA_ARGS__), (st))
-#endif
+/* The error message of rcb_fit (core/rcb_internal.h, rcb_fail). */
+#define rcb_fit_fail(f, st, ...) rcb_fail((f), (st), __VA_ARGS__)
 double rcb_fit_sumsq(const double *r, size_t n);
 void rcb_fit_free_layout(rcb_fit *f);
 
-/* Resolve the residual layout (band, weights, noise model) and size the
- * workspaces; called by rcb_fit_run and the building-block functions. */
-rcb_status rcb_fit_prepare(rcb_fit *f);
 /* Parameters <-> internal coordinates. set_x writes the model and refreshes
  * the FRF workspace. */
 void rcb_fit_get_x(const rcb_fit *f, double *x);
@@ -115,8 +110,6 @@ rcb_status rcb_fit_eval_jac(rcb_fit *f, double *r, double *Jx);
 /* F = r^T r at x (sets the model), and its gradient d F / d x when grad is
  * not NULL. */
 rcb_status rcb_fit_objective(rcb_fit *f, const double *x, double *F, double *grad);
-/* Paper's error % of the current model values over the fit's points. */
-double rcb_fit_error_pct(const rcb_fit *f);
 /* Error % the eq. 19 noise model alone explains (NaN without a noise model). */
 double rcb_fit_floor_pct(const rcb_fit *f);
 
@@ -130,28 +123,6 @@ double rcb_fit_point_speed(const rcb_fit *f, double w);
 double rcb_fit_res_deriv(const rcb_fit *f, size_t j, double complex dh);
 rcb_status rcb_fit_derivative_matrices(rcb_fit *f);
 
-/* One parameter's derivatives at a model: dM, dC, dG, dK over their
- * non-zero entries (DOF row, column) and dF/dp at unit speed (NULL when the
- * force does not depend on it). */
-typedef struct rcb_fit_dz_entry {
-  size_t row, col;
-  double m, c, g, k;
-} rcb_fit_dz_entry;
-typedef struct rcb_fit_dz {
-  rcb_fit_dz_entry *e;
-  size_t ne;
-  rcb_complex *dF;
-} rcb_fit_dz;
-
-/* The derivatives of fit c's parameters at its current model, dz[0 .. np)
- * allocated from a (rcb_fit_dz_free). */
-rcb_status rcb_fit_dz_get(rcb_fit *c, const rcb_allocator *a, rcb_fit_dz *dz);
-void rcb_fit_dz_free(const rcb_allocator *a, rcb_fit_dz *dz, size_t n);
-/* Columns d r / d p (parameter units, nres x ndz) of f's residuals for
- * parameters dz[0 .. ndz) of models equal to f's at its current point, with
- * the same DOFs (the score test of candidates at their neutral values): one
- * factorisation per point for all of them (fit_score.c). One sweep. */
-rcb_status rcb_fit_jacobian_dz(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, double *J);
 /* The same from f->dmat, f->dF (after rcb_fit_derivative_matrices). */
 rcb_status rcb_fit_dz_collect(rcb_fit *f, const rcb_allocator *a, rcb_fit_dz *dz);
 /* f's own Jacobian d r / d p by the adjoint (models values into Hmod, no

@@ -45,16 +45,16 @@ void rcb_fit_dz_free(const rcb_allocator *a, rcb_fit_dz *dz, size_t n) {
 }
 
 rcb_status rcb_fit_dz_collect(rcb_fit *f, const rcb_allocator *a, rcb_fit_dz *dz) {
-  size_t k, ndof = f->m->ndof, sz = 4 * rcb_layout_size(&f->frf->L), d;
+  size_t k, ndof = f->m->ndof, sz = 4 * rcb_layout_size(rcb_frf_layout(f->frf)), d;
   for (k = 0; k < f->np; k++) dz[k].e = NULL, dz[k].dF = NULL, dz[k].ne = 0;
   for (k = 0; k < f->np; k++) {
     const double *dm = f->dmat + k * sz;
     const rcb_complex *F = f->dF + k * ndof;
     size_t ne;
-    collect(&f->frf->L, dm, NULL, &ne);
+    collect(rcb_frf_layout(f->frf), dm, NULL, &ne);
     dz[k].e = rcb_alloc(a, (ne ? ne : 1) * sizeof *dz[k].e);
     if (!dz[k].e) goto nomem;
-    collect(&f->frf->L, dm, dz[k].e, &dz[k].ne);
+    collect(rcb_frf_layout(f->frf), dm, dz[k].e, &dz[k].ne);
     for (d = 0; d < ndof && F[d] == 0.0; d++) continue;
     if (d == ndof) continue; /* the force does not depend on it */
     if (!(dz[k].dF = rcb_alloc(a, ndof * sizeof *dz[k].dF))) goto nomem;
@@ -71,7 +71,8 @@ nomem:
  * the diagnosis takes the derivatives of every candidate (70 x 35 000
  * residuals on 32 x 1101). rcb_fit_prepare frees and resizes them. */
 static rcb_status dz_workspace(rcb_fit *c) {
-  size_t sz = 4 * rcb_layout_size(&c->frf->L) * (c->np + 1), nf = c->m->ndof * (c->np + 1);
+  size_t sz = 4 * rcb_layout_size(rcb_frf_layout(c->frf)) * (c->np + 1);
+  size_t nf = c->m->ndof * (c->np + 1);
   if (c->prepared) return RCB_OK;
   rcb_free(&c->alloc, c->dmat);
   rcb_free(&c->alloc, c->dF);
@@ -89,43 +90,72 @@ rcb_status rcb_fit_dz_get(rcb_fit *c, const rcb_allocator *a, rcb_fit_dz *dz) {
   return rcb_fit_dz_collect(c, a, dz);
 }
 
-/* dH_oq/dp of one parameter: Y_o^T (w^2 dF - dZ X_q) (unbalance: the force
- * term, at unit speed as in jac_point). */
-static double complex dh_adjoint(const rcb_fit_dz *p, const rcb_complex *y,
-                                 const rcb_complex *x, double w, double W, int unbalance,
-                                 size_t n) {
-  double complex s = 0.0;
+/* dZ/dp = dK - w^2 dM + i w (dC + W dG) of one parameter at a point, over
+ * its entries (z: 2 ne values, real and imaginary parts), once for all the
+ * channels that use it. */
+static void dz_values(const rcb_fit_dz *p, double w, double W, double *z) {
   size_t a;
   for (a = 0; a < p->ne; a++) {
     const rcb_fit_dz_entry *e = &p->e[a];
-    double complex z = CMPLX(e->k - w * w * e->m, w * (e->c + W * e->g));
-    s -= y[e->row] * z * x[e->col];
+    z[2 * a] = e->k - w * w * e->m;
+    z[2 * a + 1] = w * (e->c + W * e->g);
   }
+}
+
+/* dH_oq/dp of one parameter: Y_o^T (w^2 dF - dZ X_q) (unbalance: the force
+ * term, at unit speed as in jac_point), dZ's entries from dz_values. The
+ * sum, the diagnosis' innermost loop, is in real arithmetic: the products
+ * and sums of the complex (y z) x, without the compiler's NaN-recovery
+ * branches. */
+static double complex dh_adjoint(const rcb_fit_dz *p, const double *z, const rcb_complex *y,
+                                 const rcb_complex *x, double w, int unbalance, size_t n) {
+  double sr = 0.0, si = 0.0;
+  double complex s;
+  size_t a;
+  for (a = 0; a < p->ne; a++) {
+    const rcb_fit_dz_entry *e = &p->e[a];
+    double zr = z[2 * a], zi = z[2 * a + 1];
+    double yr = creal(y[e->row]), yi = cimag(y[e->row]);
+    double xr = creal(x[e->col]), xi = cimag(x[e->col]);
+    double tr = yr * zr - yi * zi, ti = yr * zi + yi * zr; /* y z */
+    sr -= tr * xr - ti * xi;
+    si -= tr * xi + ti * xr;
+  }
+  s = CMPLX(sr, si);
   if (unbalance && p->dF)
     for (a = 0; a < n; a++) s += y[a] * (w * w) * p->dF[a];
   return s;
 }
 
-/* One point: the model solve, the adjoint solutions, then every column. */
+/* Work of the adjoint sweep: adjoint solutions, one point's dH per channel,
+ * one parameter's dZ entries. */
+typedef struct adj_ws {
+  rcb_complex *Y, *dH; /* n x nout, nch */
+  double *z;           /* 2 x the most entries of any parameter */
+} adj_ws;
+
+/* One point: the model solve, the adjoint solutions with its factorisation
+ * (rcb_frf_solve_adjoint), then every column. */
 static rcb_status score_point(rcb_fit *f, size_t i, const rcb_fit_dz *dz, size_t ndz,
-                              rcb_complex *Y, rcb_complex *dH, double *J) {
-  const rcb_frf *fr = f->frf;
-  size_t n = f->m->ndof, o, k, c, jj;
+                              const adj_ws *ws, double *J) {
+  size_t n = f->m->ndof, k, c, jj;
   double w = f->grid[i], W = rcb_fit_point_speed(f, w);
+  const rcb_complex *X;
   rcb_status st;
   if ((st = rcb_fit_solve_point(f, i))) return st;
-  memset(Y, 0, n * f->nout * sizeof *Y);
-  for (o = 0; o < f->nout; o++) Y[fr->out_row[o] + n * o] = 1.0;
-  if ((st = fr->ops->resolve(&fr->L, fr->Z, fr->ipiv, Y, f->nout, 'T')))
-    return rcb_fit_fail(f, st, "adjoint solve at %g rad/s failed", w);
+  if ((st = rcb_frf_solve_adjoint(f->frf, ws->Y)))
+    return rcb_fit_fail(f, st, "adjoint solve at %g rad/s: %s", w, rcb_frf_errmsg(f->frf));
+  X = rcb_frf_solution(f->frf, 0); /* not NULL: the adjoint solve found the factors */
   for (k = 0; k < ndz; k++) {
+    dz_values(&dz[k], w, W, ws->z);
     for (c = 0; c < f->nch; c++) {
       size_t q = f->unbalance ? 0 : f->ch_in[c];
-      dH[c] = dh_adjoint(&dz[k], Y + n * f->ch_out[c], fr->B + n * q, w, W, f->unbalance, n);
+      ws->dH[c] = dh_adjoint(&dz[k], ws->z, ws->Y + n * f->ch_out[c], X + n * q, w,
+                             f->unbalance, n);
     }
     for (jj = f->pt_first[i]; jj < f->pt_first[i + 1]; jj++) {
       size_t j = f->pt_res[jj];
-      J[j + f->nres * k] = rcb_fit_res_deriv(f, j, dH[f->res_ch[j]]);
+      J[j + f->nres * k] = rcb_fit_res_deriv(f, j, ws->dH[f->res_ch[j]]);
     }
   }
   return RCB_OK;
@@ -134,14 +164,20 @@ static rcb_status score_point(rcb_fit *f, size_t i, const rcb_fit_dz *dz, size_t
 /* Every point: columns d r / d p of dz[0 .. ndz) into J, the model values
  * into Hmod. */
 static rcb_status sweep_adjoint(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, double *J) {
-  size_t i, n = f->m->ndof;
-  rcb_complex *Y = rcb_alloc(&f->alloc, n * (f->nout ? f->nout : 1) * sizeof *Y);
-  rcb_complex *dH = rcb_alloc(&f->alloc, (f->nch ? f->nch : 1) * sizeof *dH);
-  rcb_status st = (Y && dH) ? RCB_OK : rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory (adjoint)");
+  size_t i, n = f->m->ndof, ne = 1, k;
+  adj_ws ws;
+  rcb_status st;
+  for (k = 0; k < ndz; k++) ne = dz[k].ne > ne ? dz[k].ne : ne;
+  ws.Y = rcb_alloc(&f->alloc, n * (f->nout ? f->nout : 1) * sizeof *ws.Y);
+  ws.dH = rcb_alloc(&f->alloc, (f->nch ? f->nch : 1) * sizeof *ws.dH);
+  ws.z = rcb_alloc(&f->alloc, 2 * ne * sizeof *ws.z);
+  st = (ws.Y && ws.dH && ws.z) ? RCB_OK
+                               : rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory (adjoint)");
   for (i = 0; !st && i < f->npts; i++)
-    if (f->pt_used[i]) st = score_point(f, i, dz, ndz, Y, dH, J);
-  rcb_free(&f->alloc, Y);
-  rcb_free(&f->alloc, dH);
+    if (f->pt_used[i]) st = score_point(f, i, dz, ndz, &ws, J);
+  rcb_free(&f->alloc, ws.Y);
+  rcb_free(&f->alloc, ws.dH);
+  rcb_free(&f->alloc, ws.z);
   return st;
 }
 

@@ -12,16 +12,6 @@
 
 #define TWO_PI (2.0 * RCB_PI)
 
-rcb_status (rcb_meas_fail)(rcb_meas *ms, rcb_status st, const char *fmt, ...) {
-  va_list ap;
-  if (!ms) return st;
-  va_start(ap, fmt);
-  vsnprintf(ms->errmsg, sizeof ms->errmsg, fmt, ap);
-  va_end(ap);
-  rcb_escape_controls(ms->errmsg, sizeof ms->errmsg);
-  return st;
-}
-
 rcb_status rcb_meas_create(rcb_meas **out, const rcb_allocator *alloc) {
   rcb_allocator a;
   rcb_meas *ms;

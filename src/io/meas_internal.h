@@ -36,15 +36,9 @@ struct rcb_meas {
   size_t speed_warning; /* 1 + index of the "speed not stated" warning, 0: none */
 };
 
-/* printf into ms->errmsg, returns st. */
-rcb_status rcb_meas_fail(rcb_meas *ms, rcb_status st, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
-#ifdef __clang_analyzer__ /* returns st: see rcb_set_error in core/rcb_internal.h */
-#define rcb_meas_fail(o, st, ...) ((void)(rcb_meas_fail)((o), (st), __VA_ARGS__), (st))
-#endif
+/* The error message of rcb_meas (core/rcb_internal.h; ms may be NULL: no
+ * message, st returned). */
+#define rcb_meas_fail(ms, st, ...) rcb_set_error((ms) ? (ms)->errmsg : NULL, (st), __VA_ARGS__)
 
 /* Record a warning of a read (valid but likely misread input); RCB_ERR_NOMEM
  * with the message set when it cannot be stored. */

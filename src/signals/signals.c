@@ -9,15 +9,6 @@
 
 #include "signals/signals_internal.h"
 
-rcb_status (rcb_signals_fail)(rcb_signals *s, rcb_status st, const char *fmt, ...) {
-  va_list ap;
-  if (!s) return st;
-  va_start(ap, fmt);
-  vsnprintf(s->errmsg, sizeof s->errmsg, fmt, ap);
-  va_end(ap);
-  return st;
-}
-
 rcb_status rcb_signals_create(rcb_signals **out, const rcb_allocator *alloc) {
   rcb_allocator a;
   rcb_signals *s;

@@ -48,15 +48,9 @@ struct rcb_signals {
   size_t nch, capch;
 };
 
-/* printf into s->errmsg, returns st. */
-rcb_status rcb_signals_fail(rcb_signals *s, rcb_status st, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
-#ifdef __clang_analyzer__ /* returns st: see rcb_set_error in core/rcb_internal.h */
-#define rcb_signals_fail(o, st, ...) ((void)(rcb_signals_fail)((o), (st), __VA_ARGS__), (st))
-#endif
+/* The error message of rcb_signals (core/rcb_internal.h; s may be NULL: no
+ * message, st returned). */
+#define rcb_signals_fail(s, st, ...) rcb_set_error((s) ? (s)->errmsg : NULL, (st), __VA_ARGS__)
 
 /* Add a channel whose values are already allocated through s->alloc (taken over). */
 rcb_status rcb_signals_take(rcb_signals *s, const char *name, rcb_quantity q, double *values);

@@ -1,0 +1,51 @@
+/*
+ * The internal interface of identify/ that other folders may use (the
+ * diagnosis): what the public rcb_identify.h does not offer, on the same
+ * opaque rcb_fit. fit_internal.h (the fit object's fields) is private to
+ * identify/. Not installed.
+ */
+#ifndef RCB_IDENTIFY_INTERNAL_API_H
+#define RCB_IDENTIFY_INTERNAL_API_H
+
+#include "core/rcb_internal.h"
+
+/* Model sweeps (one model solve at every point the fit uses) done by f
+ * since its creation, by runs, residuals and Jacobians alike (the
+ * diagnosis counts its work with it). */
+size_t rcb_fit_sweeps(const rcb_fit *f);
+
+/* Resolve the residual layout (band, weights, noise model) and size the
+ * workspaces, as rcb_fit_run and the building blocks do first: RCB_ERR_ARG
+ * with a message when no point is left, RCB_ERR_NOMEM. */
+rcb_status rcb_fit_prepare(rcb_fit *f);
+
+/* The paper's error % of the model values of f's last evaluation (as
+ * rcb_fit_error, without another sweep). */
+double rcb_fit_error_pct(const rcb_fit *f);
+
+/* One parameter's derivatives at a model: dM, dC, dG, dK over their
+ * non-zero entries (DOF row, column; the units of M, C, G, K per unit of
+ * the parameter) and dF/dp at unit speed (NULL when the force does not
+ * depend on it). */
+typedef struct rcb_fit_dz_entry {
+  size_t row, col;
+  double m, c, g, k;
+} rcb_fit_dz_entry;
+typedef struct rcb_fit_dz {
+  rcb_fit_dz_entry *e;
+  size_t ne;
+  rcb_complex *dF;
+} rcb_fit_dz;
+
+/* The derivatives of fit c's parameters at its current model, dz[0 .. np)
+ * allocated from a (rcb_fit_dz_free). No residual layout needed. */
+rcb_status rcb_fit_dz_get(rcb_fit *c, const rcb_allocator *a, rcb_fit_dz *dz);
+void rcb_fit_dz_free(const rcb_allocator *a, rcb_fit_dz *dz, size_t n);
+/* Columns d r / d p (parameter units, nres x ndz column-major) of f's
+ * residuals for parameters dz[0 .. ndz) of models equal to f's at its
+ * current point, with the same DOFs (the score test of candidates at their
+ * neutral values): eq. 9 by the adjoint, one factorisation per point for
+ * all of them (fit_score.c). One sweep. */
+rcb_status rcb_fit_jacobian_dz(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, double *J);
+
+#endif /* RCB_IDENTIFY_INTERNAL_API_H */
