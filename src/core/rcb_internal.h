@@ -39,9 +39,8 @@ void rcb_escape_controls(char *buf, size_t size);
  * "return rcb_fail(obj, RCB_ERR_ARG, "...", ...)". Every folder writes its
  * messages through it: rcb_fail on any object with a char
  * errmsg[RCB_ERRMSG_MAX] member, or rcb_set_error on a caller's buffer. The
- * folders' short names (rcb_fit_fail, rcb_diag_fail, rcb_cmp_fail,
- * rcb_meas_fail) are rcb_fail on their object; model/ still has its own
- * rcb_model_fail (to be moved onto this helper). */
+ * folders' short names (rcb_model_fail, rcb_fit_fail, rcb_diag_fail,
+ * rcb_cmp_fail, rcb_meas_fail, rcb_signals_fail) are rcb_fail on their object. */
 rcb_status rcb_set_error(char *buf, rcb_status st, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 3, 4)))

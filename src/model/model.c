@@ -52,15 +52,6 @@ const char *rcb_model_errmsg(const rcb_model *m) { return m ? m->errmsg : "no mo
 
 /* ---- small helpers shared by the builder ---- */
 
-rcb_status (rcb_model_fail)(rcb_model *m, rcb_status st, const char *fmt, ...) {
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(m->errmsg, sizeof m->errmsg, fmt, ap);
-  va_end(ap);
-  rcb_escape_controls(m->errmsg, sizeof m->errmsg);
-  return st;
-}
-
 rcb_status rcb_model_check_editable(rcb_model *m, const char *what) {
   if (!m) return RCB_ERR_ARG;
   if (m->finalized)

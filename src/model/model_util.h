@@ -4,15 +4,9 @@
 
 #include "core/rcb_internal.h"
 
-/* Write the model's error message, return st. */
-rcb_status rcb_model_fail(rcb_model *m, rcb_status st, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
-#ifdef __clang_analyzer__ /* returns st: see rcb_set_error in core/rcb_internal.h */
-#define rcb_model_fail(o, st, ...) ((void)(rcb_model_fail)((o), (st), __VA_ARGS__), (st))
-#endif
+/* Write the model's error message, return st: the core helper (rcb_fail,
+ * core/rcb_internal.h) on the model. */
+#define rcb_model_fail(m, st, ...) rcb_fail((m), (st), __VA_ARGS__)
 
 /* Check a numeric input: finite always; sign > 0 requires v > 0, sign == 0
  * requires v >= 0, sign < 0 accepts any finite value. */

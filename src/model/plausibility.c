@@ -35,18 +35,6 @@
 /* Shaft ends and overlaps are compared to this fraction of the model length. */
 #define PLAUS_ZTOL 1e-9
 
-rcb_status rcb_model_add_warning(rcb_model *m, const char *fmt, ...) {
-  va_list ap;
-  if (rcb_grow(&m->alloc, (void **)&m->warnings, &m->cap_warnings, m->n_warnings + 1,
-               sizeof *m->warnings))
-    return rcb_model_fail(m, RCB_ERR_NOMEM, "out of memory recording a model warning");
-  va_start(ap, fmt);
-  vsnprintf(m->warnings[m->n_warnings].text, RCB_WARNING_MAX, fmt, ap);
-  va_end(ap);
-  m->n_warnings++;
-  return RCB_OK;
-}
-
 /* ---- magnitudes (refused) ---- */
 
 static rcb_status absurd(rcb_model *m, const char *kind, const char *name, const char *key,

@@ -22,13 +22,8 @@
 #define WARN_E_MAX 1e13       /* Pa */
 #define WARN_DISK_MASS 1e6    /* kg */
 
-static rcb_status warn(rcb_model *m, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
-#endif
-    ;
-
-static rcb_status warn(rcb_model *m, const char *fmt, ...) {
+/* One warning more (model/warnings.c; also used by model/plausibility.c). */
+rcb_status rcb_model_add_warning(rcb_model *m, const char *fmt, ...) {
   va_list ap;
   if (rcb_grow(&m->alloc, (void **)&m->warnings, &m->cap_warnings, m->n_warnings + 1,
                sizeof *m->warnings))
@@ -46,12 +41,12 @@ static rcb_status check_materials(rcb_model *m) {
   for (i = 0; i < m->n_materials && !st; i++) {
     const rcb_material_t *mt = &m->materials[i];
     if (mt->rho < WARN_RHO_MIN || mt->rho > WARN_RHO_MAX)
-      st = warn(m,
+      st = rcb_model_add_warning(m,
                 "material '%s': density = %g kg/m^3 is outside the plausible %g to %g "
                 "kg/m^3; a value in g/cm^3 or t/m^3 where kg/m^3 is meant?",
                 mt->name, mt->rho, WARN_RHO_MIN, WARN_RHO_MAX);
     if (!st && (mt->E < WARN_E_MIN || mt->E > WARN_E_MAX))
-      st = warn(m,
+      st = rcb_model_add_warning(m,
                 "material '%s': young = %g Pa is outside the plausible %g to %g Pa; a value "
                 "in MPa or GPa where Pa is meant?",
                 mt->name, mt->E, WARN_E_MIN, WARN_E_MAX);
@@ -68,13 +63,13 @@ static rcb_status check_shafts(rcb_model *m) {
     for (g = 0; g < sh->nseg && !st; g++) {
       len += sh->seg[g].L;
       if (sh->seg[g].od < WARN_OD_MIN || sh->seg[g].od > WARN_OD_MAX)
-        st = warn(m,
+        st = rcb_model_add_warning(m,
                   "shaft '%s': segment %zu outer diameter = %g m is outside the plausible "
                   "%g to %g m; a value in mm where m is meant?",
                   sh->name, g + 1, sh->seg[g].od, WARN_OD_MIN, WARN_OD_MAX);
     }
     if (!st && (len < WARN_LEN_MIN || len > WARN_LEN_MAX))
-      st = warn(m,
+      st = rcb_model_add_warning(m,
                 "shaft '%s': length = %g m is outside the plausible %g to %g m; a value in "
                 "mm where m is meant?",
                 sh->name, len, WARN_LEN_MIN, WARN_LEN_MAX);
@@ -87,7 +82,7 @@ static rcb_status check_disks(rcb_model *m) {
   rcb_status st = RCB_OK;
   for (i = 0; i < m->n_disks && !st; i++)
     if (m->disks[i].m > WARN_DISK_MASS)
-      st = warn(m,
+      st = rcb_model_add_warning(m,
                 "disk '%s': mass = %g kg is above the plausible %g kg; a geometry in mm "
                 "where m is meant?",
                 m->disks[i].name, m->disks[i].m, WARN_DISK_MASS);
@@ -121,7 +116,7 @@ static rcb_status check_connected(rcb_model *m) {
   if (ntrains > 1)
     for (s = 1; s < m->n_shafts && !st; s++)
       if (comp[s] == s)
-        st = warn(m,
+        st = rcb_model_add_warning(m,
                   "shaft '%s': not joined to shaft '%s' by any chain of couplings; the model "
                   "holds %zu separate rotors (expected a [coupling] between them, or check "
                   "its 'between' stations)",
