@@ -119,8 +119,12 @@ static const char *const examples[][2] = {
                  "coupling.C.kt,coupling.C.kr,coupling.C.ct --log --noise 10,1 --history "
                  "session.jsonl"},
     {"history", "rcbtool history session.jsonl"},
-    {"transient", "rcbtool transient examples/paper_system.ini --out DA.x,DA.y --rpm 3000 "
-                  "--t-end 0.05 -o transient.csv"},
+    {"transient", "rcbtool transient examples/paper_system.ini --out DA.x,DB.x --rpm 3000 "
+                  "--rpm-end 4500 --accel 3000 --dt 1e-4 --signals -o runup.csv"},
+    {"order", "rcbtool order runup.csv --kp KP --outputs DA.x,DB.x --bin-rpm 300 "
+              "-o runup_1x.csv"},
+    {"estimate", "rcbtool estimate examples/signals/random_sdof.csv --input force=DA.x "
+                 "--outputs DA.x --nseg 512 --stats sdof_stats.csv -o sdof_h1.csv"},
     {"timecheck", "rcbtool timecheck examples/paper_system.ini --out DA.x --rpm-min 3000 "
                   "--rpm-max 3000 --points 1 --steady-tol 1e-3"},
 };
