@@ -41,7 +41,8 @@ def _run(*args):
 def _read(path):
     rows = [r for r in csv.reader(open(path)) if r and not r[0].startswith("#")]
     body = np.array([[float(v) for v in r] for r in rows[1:]])
-    return {h: body[:, i] for i, h in enumerate(rows[0])}
+    # rcbtool's headers carry their SI unit ("DA.x amp [m]"): keyed without it
+    return {h.split(" [")[0]: body[:, i] for i, h in enumerate(rows[0])}
 
 
 def _peak(x, y):
