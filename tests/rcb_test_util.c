@@ -9,6 +9,8 @@
 #include <string.h>
 #include <cmocka.h>
 
+#define TEST_PI 3.14159265358979323846
+
 int rcb_test_close(double a, double b, double rtol, double atol) {
   double s = fabs(a) > fabs(b) ? fabs(a) : fabs(b);
   return fabs(a - b) <= rtol * s + atol;
@@ -82,6 +84,38 @@ rcb_allocator rcb_test_counting_allocator(rcb_test_counter *c) {
   return a;
 }
 
+/* Synthetic FRF measurement of model m: channels outs x ins, n points on
+ * [f0, f1] Hz at speed rpm, as the given kind. */
+rcb_meas *rcb_test_frf_meas(const rcb_model *m, const char *const *outs, size_t no,
+                            const char *const *ins, size_t ni, double f0, double f1, size_t n,
+                            double rpm, rcb_frf_kind kind) {
+  rcb_meas *ms = NULL;
+  rcb_frf *fr = NULL;
+  rcb_dof od[8], id[8];
+  double *x = calloc(n, sizeof *x);
+  rcb_complex *H = calloc(n * no * ni, sizeof *H), *col = calloc(n, sizeof *col);
+  size_t i, o, q;
+  for (o = 0; o < no; o++) assert_int_equal(rcb_model_find_dof(m, outs[o], &od[o]), RCB_OK);
+  for (q = 0; q < ni; q++) assert_int_equal(rcb_model_find_dof(m, ins[q], &id[q]), RCB_OK);
+  assert_int_equal(rcb_frf_create(&fr, m, no, od, ni, id, RCB_SOLVER_AUTO, NULL), RCB_OK);
+  for (i = 0; i < n; i++) {
+    x[i] = 2.0 * TEST_PI * (f0 + (f1 - f0) * (double)i / (double)(n - 1));
+    assert_int_equal(rcb_frf_eval(fr, x[i], rpm * (TEST_PI / 30.0), kind, H + i * no * ni), RCB_OK);
+  }
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, n, x, rpm * (TEST_PI / 30.0)), RCB_OK);
+  for (q = 0; q < ni; q++)
+    for (o = 0; o < no; o++) {
+      for (i = 0; i < n; i++) col[i] = H[i * no * ni + o + no * q];
+      assert_int_equal(rcb_meas_add_channel(ms, outs[o], ins[q], kind, col), RCB_OK);
+    }
+  rcb_frf_destroy(fr);
+  free(x);
+  free(H);
+  free(col);
+  return ms;
+}
+
 /* Noise-free unbalance responses of m at outs over r0..r1 rpm, n speeds. */
 rcb_meas *rcb_test_unbalance_meas(const rcb_model *m, const char *const *outs, size_t no,
                                   double r0, double r1, size_t n) {
@@ -94,7 +128,7 @@ rcb_meas *rcb_test_unbalance_meas(const rcb_model *m, const char *const *outs, s
   for (o = 0; o < no; o++) assert_int_equal(rcb_model_find_dof(m, outs[o], &od[o]), RCB_OK);
   assert_int_equal(rcb_frf_create(&fr, m, no, od, 0, NULL, RCB_SOLVER_AUTO, NULL), RCB_OK);
   for (i = 0; i < n; i++) {
-    x[i] = (3.14159265358979323846 / 30.0) * (r0 + (r1 - r0) * (double)i / (double)(n - 1));
+    x[i] = (TEST_PI / 30.0) * (r0 + (r1 - r0) * (double)i / (double)(n - 1));
     assert_int_equal(rcb_frf_unbalance(fr, x[i], Q + i * no), RCB_OK);
   }
   assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);

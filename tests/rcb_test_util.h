@@ -20,6 +20,11 @@ typedef struct rcb_test_counter {
 } rcb_test_counter;
 /* Allocator hooks (malloc/free) that count every call into *c. */
 rcb_allocator rcb_test_counting_allocator(rcb_test_counter *c);
+/* Noise-free FRFs of m (the given kind) at outs x ins, n points evenly on
+ * [f0, f1] Hz at rpm, as a measurement (aborts the test on failure). */
+rcb_meas *rcb_test_frf_meas(const rcb_model *m, const char *const *outs, size_t no,
+                            const char *const *ins, size_t ni, double f0, double f1, size_t n,
+                            double rpm, rcb_frf_kind kind);
 /* Noise-free unbalance responses of m at channels outs (no of them), n speeds
  * evenly from r0 to r1 rpm, as a measurement (aborts the test on failure). */
 rcb_meas *rcb_test_unbalance_meas(const rcb_model *m, const char *const *outs, size_t no,

@@ -30,39 +30,6 @@
 #define RPM (RCB_PI / 30.0)
 #define TWO_PI (2.0 * RCB_PI)
 
-/* Synthetic FRF measurement of model m: channels outs x ins, n points on
- * [f0, f1] Hz at speed rpm, as the given kind. */
-static rcb_meas *frf_meas(const rcb_model *m, const char *const *outs, size_t no,
-                          const char *const *ins, size_t ni, double f0, double f1, size_t n,
-                          double rpm, rcb_frf_kind kind) {
-  rcb_meas *ms = NULL;
-  rcb_frf *fr = NULL;
-  rcb_dof od[8], id[8];
-  double *x = calloc(n, sizeof *x);
-  rcb_complex *H = calloc(n * no * ni, sizeof *H), *col = calloc(n, sizeof *col);
-  size_t i, o, q;
-  for (o = 0; o < no; o++) assert_int_equal(rcb_model_find_dof(m, outs[o], &od[o]), RCB_OK);
-  for (q = 0; q < ni; q++) assert_int_equal(rcb_model_find_dof(m, ins[q], &id[q]), RCB_OK);
-  assert_int_equal(rcb_frf_create(&fr, m, no, od, ni, id, RCB_SOLVER_AUTO, NULL), RCB_OK);
-  for (i = 0; i < n; i++) {
-    x[i] = TWO_PI * (f0 + (f1 - f0) * (double)i / (double)(n - 1));
-    assert_int_equal(rcb_frf_eval(fr, x[i], rpm * RPM, kind, H + i * no * ni), RCB_OK);
-  }
-  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
-  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, n, x, rpm * RPM), RCB_OK);
-  for (q = 0; q < ni; q++)
-    for (o = 0; o < no; o++) {
-      for (i = 0; i < n; i++) col[i] = H[i * no * ni + o + no * q];
-      assert_int_equal(rcb_meas_add_channel(ms, outs[o], ins[q], kind, col), RCB_OK);
-    }
-  rcb_frf_destroy(fr);
-  free(x);
-  free(H);
-  free(col);
-  return ms;
-}
-
-
 /* Central difference of the residuals along parameter name, step h. */
 static void central(rcb_model *m, rcb_fit *f, const char *name, double p, double h, size_t n,
                     double *d, double *rp, double *rm) {
@@ -117,7 +84,7 @@ static void test_sensitivities_frf(void **state) {
   const char *outs[] = {"C.A.x", "C.B.y", "DB.x"}, *ins[] = {"DA.x", "C.B.x"};
   const char *names[] = {"coupling.C.kt", "coupling.C.kr", "coupling.C.ct", "coupling.C.cr",
                          "bearing.B2.kxx", "disk.DA.mass", "shaft.B.damping_stiffness"};
-  rcb_meas *ms = frf_meas(m, outs, 3, ins, 2, 120, 400, 15, 10000, RCB_INERTANCE);
+  rcb_meas *ms = rcb_test_frf_meas(m, outs, 3, ins, 2, 120, 400, 15, 10000, RCB_INERTANCE);
   rcb_fit *f = NULL;
   size_t k;
   int sc;
@@ -167,7 +134,7 @@ static void test_paper_fit_noise_free(void **state) {
   rcb_model *m = rcb_test_model_from_example("paper_system.ini");
   const char *outs[] = {"C.A.x", "C.A.y", "C.B.x", "C.B.y"}, *ins[] = {"DA.x"};
   const char *names[] = {"coupling.C.kt", "coupling.C.kr", "coupling.C.ct", "coupling.C.cr"};
-  rcb_meas *ms = frf_meas(truth, outs, 4, ins, 1, 200, 400, 201, 10000, RCB_INERTANCE);
+  rcb_meas *ms = rcb_test_frf_meas(truth, outs, 4, ins, 1, 200, 400, 201, 10000, RCB_INERTANCE);
   rcb_fit *f = NULL;
   rcb_fit_report rep;
   double tv[4];
@@ -215,7 +182,7 @@ static void test_paper_fit_noisy_seeds(void **state) {
   (void)state;
   for (k = 0; k < 4; k++) assert_int_equal(rcb_model_get_param(truth, names[k], &tv[k]), 0);
   for (seed = 0; seed < 20; seed++) {
-    rcb_meas *ms = frf_meas(truth, outs, 4, ins, 1, 200, 400, 101, 10000, RCB_INERTANCE);
+    rcb_meas *ms = rcb_test_frf_meas(truth, outs, 4, ins, 1, 200, 400, 101, 10000, RCB_INERTANCE);
     rcb_model *m = rcb_test_model_from_example("paper_system.ini");
     rcb_fit *f = NULL, *ft = NULL;
     rcb_fit_report rep;
@@ -275,7 +242,7 @@ static rcb_fit *noisy_setup(rcb_model **mp, rcb_meas **msp, const char *model) {
   rcb_fit *f = NULL;
   size_t k, np = strcmp(model, "nelson_crandall_1") == 0 ? 2 : 4;
   char ini[4096];
-  *msp = frf_meas(truth, outs, 4, ins, 1, 200, 400, 101, 10000, RCB_INERTANCE);
+  *msp = rcb_test_frf_meas(truth, outs, 4, ins, 1, 200, 400, 101, 10000, RCB_INERTANCE);
   assert_int_equal(rcb_meas_add_noise(*msp, 10.0, 1.0, 5u), RCB_OK);
   snprintf(ini, sizeof ini,
            "[material steel]\ndensity = 7759.255\nyoung = 1.936e11\npoisson = 0.3\n"
@@ -394,7 +361,7 @@ static void test_multistart_local_minimum(void **state) {
 static void test_bad_settings(void **state) {
   rcb_model *m = rcb_test_model_from_example("paper_system.ini");
   const char *outs[] = {"C.A.x"}, *ins[] = {"DA.x"};
-  rcb_meas *ms = frf_meas(m, outs, 1, ins, 1, 200, 400, 11, 10000, RCB_RECEPTANCE);
+  rcb_meas *ms = rcb_test_frf_meas(m, outs, 1, ins, 1, 200, 400, 11, 10000, RCB_RECEPTANCE);
   rcb_fit *f = NULL;
   (void)state;
   assert_int_equal(rcb_fit_create(&f, m, ms, NULL), RCB_OK);

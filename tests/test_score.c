@@ -27,42 +27,11 @@
 #include <cmocka.h>
 
 #include "diagnose/diag_internal.h"
-#include "identify/fit_internal.h"
+#include "identify/fit_internal.h" /* white-box: the adjoint choice, sums of squares */
 #include "rcb_test_util.h"
 
 #define RPM (RCB_PI / 30.0)
 #define TWO_PI (2.0 * RCB_PI)
-
-/* Inertances of m: outs x ins, n points on [f0, f1] Hz at rpm. */
-static rcb_meas *frf_meas(const rcb_model *m, const char *const *outs, size_t no,
-                          const char *const *ins, size_t ni, double f0, double f1, size_t n,
-                          double rpm) {
-  rcb_meas *ms = NULL;
-  rcb_frf *fr = NULL;
-  rcb_dof od[8], id[8];
-  double *x = calloc(n, sizeof *x);
-  rcb_complex *H = calloc(n * no * ni, sizeof *H), *col = calloc(n, sizeof *col);
-  size_t i, o, q;
-  for (o = 0; o < no; o++) assert_int_equal(rcb_model_find_dof(m, outs[o], &od[o]), RCB_OK);
-  for (q = 0; q < ni; q++) assert_int_equal(rcb_model_find_dof(m, ins[q], &id[q]), RCB_OK);
-  assert_int_equal(rcb_frf_create(&fr, m, no, od, ni, id, RCB_SOLVER_AUTO, NULL), RCB_OK);
-  for (i = 0; i < n; i++) {
-    x[i] = TWO_PI * (f0 + (f1 - f0) * (double)i / (double)(n - 1));
-    assert_int_equal(rcb_frf_eval(fr, x[i], rpm * RPM, RCB_INERTANCE, H + i * no * ni), RCB_OK);
-  }
-  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
-  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, n, x, rpm * RPM), RCB_OK);
-  for (q = 0; q < ni; q++)
-    for (o = 0; o < no; o++) {
-      for (i = 0; i < n; i++) col[i] = H[i * no * ni + o + no * q];
-      assert_int_equal(rcb_meas_add_channel(ms, outs[o], ins[q], RCB_INERTANCE, col), RCB_OK);
-    }
-  rcb_frf_destroy(fr);
-  free(x);
-  free(H);
-  free(col);
-  return ms;
-}
 
 /* A fit of m to ms on log10 magnitudes with parameters names[0 .. np). */
 static rcb_fit *fit_of(rcb_model *m, const rcb_meas *ms, const char *const *names, size_t np) {
@@ -121,7 +90,7 @@ static void test_adjoint_equals_direct_frf(void **state) {
   const char *outs[] = {"C.A.x", "C.B.y", "DB.x"}, *ins[] = {"DA.x", "C.B.x"};
   const char *names[] = {"coupling.C.kt", "coupling.C.kr", "coupling.C.ct", "bearing.B2.kxx",
                          "bearing.B2.kcross", "disk.DA.mass", "shaft.B.damping_stiffness"};
-  rcb_meas *ms = frf_meas(m, outs, 3, ins, 2, 120, 400, 25, 10000);
+  rcb_meas *ms = rcb_test_frf_meas(m, outs, 3, ins, 2, 120, 400, 25, 10000, RCB_INERTANCE);
   (void)state;
   adjoint_vs_direct(m, ms, names, 7);
   rcb_meas_destroy(ms);
@@ -171,7 +140,7 @@ static void case_open(score_case *sc) {
   size_t k;
   memset(sc, 0, sizeof *sc);
   assert_int_equal(rcb_model_set_param(truth, "coupling.C.kt", 3e4), RCB_OK);
-  sc->ms = frf_meas(truth, outs, 6, ins, 1, 100, 400, 61, 10000);
+  sc->ms = rcb_test_frf_meas(truth, outs, 6, ins, 1, 100, 400, 61, 10000, RCB_INERTANCE);
   rcb_model_destroy(truth);
   sc->m = rcb_test_model_from_example("paper_system.ini");
   assert_int_equal(rcb_diag_create(&sc->d, sc->m, sc->ms, NULL), RCB_OK);
