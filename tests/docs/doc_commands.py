@@ -13,6 +13,7 @@ A block can be marked on the line before its fence:
                                    dev.sh commands that rebuild the tree...)
   <!-- doc-test: venv -->          needs the Python venv: run with --venv DIR only
   <!-- doc-test: sundials -->      needs a build with SUNDIALS (RCB_WITH_SUNDIALS)
+  <!-- doc-test: fft -->           needs an FFT backend (RCB_WITH_FFTW or RCB_WITH_KISSFFT)
   <!-- doc-test: matplotlib -->    draws with python3 + matplotlib (rcbtool compare
                                    --plot): run when the python3 on the PATH (the
                                    venv's with --venv) has it
@@ -33,7 +34,7 @@ import sys
 import tempfile
 
 FENCE = re.compile(r"^```(\S*)\s*$")
-MARK = re.compile(r"^<!--\s*doc-test:\s*((?:(?:skip|venv|sundials|matplotlib|slow)\b\s*)+)(.*?)\s*-->\s*$")
+MARK = re.compile(r"^<!--\s*doc-test:\s*((?:(?:skip|venv|sundials|fft|matplotlib|slow)\b\s*)+)(.*?)\s*-->\s*$")
 PATH_LINE = re.compile(r"^export PATH=.*$", re.M)
 
 
@@ -71,12 +72,13 @@ def scratch_clone(src, build, venv):
     return d
 
 
-def with_sundials(build):
+def with_option(build, *options):
+    """Is any of the CMake options on in the build tree's cache?"""
     try:
         cache = open(os.path.join(build, "CMakeCache.txt"), encoding="utf-8").read()
     except OSError:
         return False
-    return re.search(r"^RCB_WITH_SUNDIALS:BOOL=(ON|TRUE|1)$", cache, re.M) is not None
+    return any(re.search(rf"^{o}:BOOL=(ON|TRUE|1)$", cache, re.M) for o in options)
 
 
 def has_matplotlib(venv):
@@ -110,7 +112,8 @@ def main():
         print("FAIL: README.md has no 'export PATH=...' line saying where rcbtool is")
         return 1
     path_line = m.group(0)
-    sundials = with_sundials(args.build)
+    sundials = with_option(args.build, "RCB_WITH_SUNDIALS")
+    fft = with_option(args.build, "RCB_WITH_FFTW", "RCB_WITH_KISSFFT")
     mpl = has_matplotlib(args.venv)
     ran, skipped, failed = 0, [], []
     for page in pages:
@@ -126,6 +129,8 @@ def main():
                 why.append("needs the Python venv (--venv DIR)")
             if "sundials" in mark and not sundials:
                 why.append("needs a build with SUNDIALS (RCB_WITH_SUNDIALS is off here)")
+            if "fft" in mark and not fft:
+                why.append("needs an FFT backend (RCB_WITH_FFTW and RCB_WITH_KISSFFT are off here)")
             if "matplotlib" in mark and not mpl:
                 why.append("needs python3 with matplotlib on the PATH (--venv DIR, or "
                            "Debian's python3-matplotlib)")
