@@ -329,7 +329,8 @@ static void test_all_edits(void **state) {
 static void test_refusals(void **state) {
   rcb_model *m = base(), *c = NULL;
   const rcb_bearing_coefs k = {1, 0, 0, 1, 0, 0, 0, 0};
-  const double bad_w[2] = {10.0, 5.0};
+  const rcb_bearing_coefs k2[2] = {{1, 0, 0, 1, 0, 0, 0, 0}, {1, 0, 0, 1, 0, 0, 0, 0}};
+  const double bad_w[2] = {10.0, 5.0}; /* rad/s, not increasing */
   (void)state;
   assert_int_equal(rcb_model_set_coupling_model(m, "C", RCB_COUPLING_RIGID), RCB_ERR_STATE);
   assert_non_null(strstr(rcb_model_errmsg(m), "finalized"));
@@ -349,7 +350,7 @@ static void test_refusals(void **state) {
   assert_int_equal(rcb_model_add_disk_at(c, "D", "#0", 1, 0, 0), RCB_ERR_MODEL); /* name taken */
   assert_int_equal(rcb_model_add_disk_at(c, "X", "#0", -1, 0, 0), RCB_ERR_ARG);
   assert_int_equal(rcb_model_set_bearing_coefs(c, "B9", 1, NULL, &k), RCB_ERR_NOT_FOUND);
-  assert_int_equal(rcb_model_set_bearing_coefs(c, "B2", 2, bad_w, &k), RCB_ERR_ARG);
+  assert_int_equal(rcb_model_set_bearing_coefs(c, "B2", 2, bad_w, k2), RCB_ERR_ARG);
   /* the failed edits left the clone as it was: it equals the original */
   assert_int_equal(rcb_model_finalize(c), RCB_OK);
   assert_same("after refused edits", c, m);
