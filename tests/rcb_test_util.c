@@ -84,6 +84,33 @@ rcb_allocator rcb_test_counting_allocator(rcb_test_counter *c) {
   return a;
 }
 
+static void *failing_alloc(void *user, size_t size) {
+  rcb_test_failing *f = user;
+  f->allocs++;
+  if (f->fail_at && f->allocs == f->fail_at) {
+    f->hit = 1;
+    return NULL;
+  }
+  f->live++;
+  return malloc(size);
+}
+
+static void failing_free(void *user, void *p) {
+  rcb_test_failing *f = user;
+  if (!p) return;
+  f->frees++;
+  f->live--;
+  free(p);
+}
+
+rcb_allocator rcb_test_failing_allocator(rcb_test_failing *f) {
+  rcb_allocator a;
+  a.alloc = failing_alloc;
+  a.free = failing_free;
+  a.user = f;
+  return a;
+}
+
 /* Synthetic FRF measurement of model m: channels outs x ins, n points on
  * [f0, f1] Hz at speed rpm, as the given kind. */
 rcb_meas *rcb_test_frf_meas(const rcb_model *m, const char *const *outs, size_t no,

@@ -20,6 +20,17 @@ typedef struct rcb_test_counter {
 } rcb_test_counter;
 /* Allocator hooks (malloc/free) that count every call into *c. */
 rcb_allocator rcb_test_counting_allocator(rcb_test_counter *c);
+/* An allocator whose fail_at-th allocation fails (1-based; 0 = never), for the
+ * allocation-failure walks; it counts what it hands out and takes back. */
+typedef struct rcb_test_failing {
+  size_t fail_at; /* 1-based index of the allocation that fails, 0 = never */
+  size_t allocs;  /* allocation calls so far (the failing one included) */
+  size_t frees;   /* free calls on pointers it handed out */
+  size_t live;    /* allocated and not yet freed */
+  int hit;        /* the failing allocation was reached */
+} rcb_test_failing;
+/* Allocator hooks over *f (which must outlive every object made with them). */
+rcb_allocator rcb_test_failing_allocator(rcb_test_failing *f);
 /* Noise-free FRFs of m (the given kind) at outs x ins, n points evenly on
  * [f0, f1] Hz at rpm, as a measurement (aborts the test on failure). */
 rcb_meas *rcb_test_frf_meas(const rcb_model *m, const char *const *outs, size_t no,

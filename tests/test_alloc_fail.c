@@ -30,40 +30,9 @@
 #include "rcb/rcb_config.h"
 #include "rcb_test_util.h"
 
-typedef struct failing {
-  size_t fail_at; /* 1-based index of the allocation that fails, 0 = never */
-  size_t allocs;  /* allocation calls so far (the failing one included) */
-  size_t frees;   /* free calls on pointers we handed out */
-  size_t live;    /* allocated and not yet freed */
-  int hit;        /* the failing allocation was reached */
-} failing;
+typedef rcb_test_failing failing;
 
-static void *f_alloc(void *user, size_t size) {
-  failing *f = user;
-  f->allocs++;
-  if (f->fail_at && f->allocs == f->fail_at) {
-    f->hit = 1;
-    return NULL;
-  }
-  f->live++;
-  return malloc(size);
-}
-
-static void f_free(void *user, void *p) {
-  failing *f = user;
-  if (!p) return;
-  f->frees++;
-  f->live--;
-  free(p);
-}
-
-static rcb_allocator hooks(failing *f) {
-  rcb_allocator a;
-  a.alloc = f_alloc;
-  a.free = f_free;
-  a.user = f;
-  return a;
-}
+static rcb_allocator hooks(failing *f) { return rcb_test_failing_allocator(f); }
 
 /* Two shafts, nelson_crandall_1 coupling, bearings, a disk, an unbalance,
  * a probe and a UFF map: every kind of item the loader allocates for. */

@@ -360,28 +360,6 @@ static void test_refusals(void **state) {
 
 /* ---- allocation failures: the k-th allocation of clone + edits fails ---- */
 
-typedef struct failing {
-  size_t fail_at, allocs, live;
-  int hit;
-} failing;
-
-static void *f_alloc(void *user, size_t size) {
-  failing *f = user;
-  if (++f->allocs == f->fail_at) {
-    f->hit = 1;
-    return NULL;
-  }
-  f->live++;
-  return malloc(size);
-}
-
-static void f_free(void *user, void *p) {
-  failing *f = user;
-  if (!p) return;
-  f->live--;
-  free(p);
-}
-
 /* Clone + every edit + finalize with allocator a: the status of the first
  * failing step (the clone destroyed), or RCB_OK and the model. */
 static rcb_status clone_edit(const rcb_model *orig, const rcb_allocator *a, rcb_model **out) {
@@ -415,17 +393,14 @@ static void test_alloc_failures(void **state) {
   rcb_model *orig = base(), *ok = NULL;
   mats before = matrices(orig), after;
   size_t k;
-  failing f; /* outlives the loop: the model kept from the last run frees through it */
+  rcb_test_failing f; /* outlives the loop: the model kept from the last run frees through it */
   (void)state;
   for (k = 1;; k++) {
-    rcb_allocator a;
+    rcb_allocator a = rcb_test_failing_allocator(&f);
     rcb_model *c = NULL;
     rcb_status st;
     memset(&f, 0, sizeof f);
     f.fail_at = k;
-    a.alloc = f_alloc;
-    a.free = f_free;
-    a.user = &f;
     st = clone_edit(orig, &a, &c);
     if (f.hit && st == RCB_OK) fail_msg("allocation %zu failed but clone + edit succeeded", k);
     if (!f.hit) {

@@ -698,6 +698,20 @@ static rcb_status accept_time(uff_reader *R, uff_rec *r) {
   return R->on_time(R->user, &t);
 }
 
+/* A reader over the file's bytes buf[0 .. len) and an empty set of records. */
+static void reader_init(uff_reader *R, uff_set *S, rcb_meas *ms, const char *path,
+                        const char *buf, size_t len, size_t nmap, const rcb_uff_node *map) {
+  memset(R, 0, sizeof *R);
+  memset(S, 0, sizeof *S);
+  S->type = -1;
+  R->ms = ms;
+  R->path = path;
+  R->c.buf = buf;
+  R->c.len = len;
+  R->nmap = nmap;
+  R->map = map;
+}
+
 rcb_status rcb_uff58_read_time(rcb_meas *ms, const char *path, size_t nmap,
                                const rcb_uff_node *map, rcb_uff_time_fn fn, void *user) {
   uff_reader R;
@@ -708,15 +722,7 @@ rcb_status rcb_uff58_read_time(rcb_meas *ms, const char *path, size_t nmap,
   if (!ms || !fn) return RCB_ERR_ARG;
   if (nmap && !map) return rcb_meas_fail(ms, RCB_ERR_ARG, "read_uff: node map is NULL");
   if ((st = rcb_meas_slurp(ms, path, &buf, &len))) return st;
-  memset(&R, 0, sizeof R);
-  memset(&S, 0, sizeof S);
-  S.type = -1;
-  R.ms = ms;
-  R.path = path;
-  R.c.buf = buf;
-  R.c.len = len;
-  R.nmap = nmap;
-  R.map = map;
+  reader_init(&R, &S, ms, path, buf, len, nmap, map);
   R.on_time = fn;
   R.user = user;
   st = scan(&R, &S);
@@ -809,15 +815,7 @@ rcb_status rcb_meas_read_uff(rcb_meas *ms, const char *path, size_t nmap,
   rcb_meas_clear(ms);
   rcb_meas_clear_warnings(ms);
   if ((st = rcb_meas_slurp(ms, path, &buf, &len))) return st;
-  memset(&R, 0, sizeof R);
-  memset(&S, 0, sizeof S);
-  S.type = -1;
-  R.ms = ms;
-  R.path = path;
-  R.c.buf = buf;
-  R.c.len = len;
-  R.nmap = nmap;
-  R.map = map;
+  reader_init(&R, &S, ms, path, buf, len, nmap, map);
   st = scan(&R, &S);
   if (!st) st = build(&R, &S);
   if (!st) st = rcb_uff_read_warnings(ms, path, nmap, S.ztype);
