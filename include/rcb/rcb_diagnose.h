@@ -11,7 +11,8 @@
  * The best candidates (and the alternative coupling models, which have no
  * neutral value) are then refitted; a candidate is significant when its
  * information criterion (BIC) falls by more than 10 and the error itself
- * falls.
+ * falls. With known standard deviations per point (rcb_diag_set_sd) or the
+ * noise model, the objective is a chi-square and the BIC uses it as one.
  */
 #ifndef RCB_DIAGNOSE_H
 #define RCB_DIAGNOSE_H
@@ -66,6 +67,24 @@ RCB_API rcb_status rcb_diag_add_fitted_param(rcb_diag *d, const char *name, doub
 RCB_API rcb_status rcb_diag_set_scale(rcb_diag *d, rcb_fit_scale scale);
 RCB_API rcb_status rcb_diag_set_noise_model(rcb_diag *d, double beta_a, double beta_s);
 RCB_API rcb_status rcb_diag_set_band(rcb_diag *d, double lo, double hi);
+/**
+ * @brief Known standard deviations of the measured values (as
+ * rcb_fit_set_sd, e.g. rcb_spectral_frf's sd), instead of the noise model:
+ * every fit of the diagnosis (the baseline, the score test, the screening on
+ * a subset of the points, the refits) weights each point by the inverse
+ * variance of its residual, the noise floor comes from them, and F is then a
+ * chi-square, so a candidate's BIC change is F - F0 + k ln N (as with the
+ * noise model) instead of N ln(F / F0) + k ln N.
+ * @param sd channel-major, sd[c * npoints + i], the measurement's units; 0 or
+ * NaN drops a point; NULL removes them @param n channels x points
+ * @return RCB_ERR_ARG for another n, a negative value, or with the noise model set
+ */
+RCB_API rcb_status rcb_diag_set_sd(rcb_diag *d, const double *sd, size_t n);
+/**
+ * @brief The standard deviations of rcb_diag_set_sd (n = channels x points).
+ * @return 1 when set (sd filled), 0 when not, negative on bad arguments.
+ */
+RCB_API int rcb_diag_get_sd(const rcb_diag *d, double *sd, size_t n);
 /** @brief How many of the best-scored candidates to refit (default 8). */
 RCB_API rcb_status rcb_diag_set_refits(rcb_diag *d, size_t n);
 /** @brief Progress callback: called after each candidate is scored or refitted. */

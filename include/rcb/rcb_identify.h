@@ -71,6 +71,22 @@ RCB_API rcb_status rcb_fit_set_weights(rcb_fit *f, const double *w);
  * @param beta_a random factor, % @param beta_s systematic factor, %
  */
 RCB_API rcb_status rcb_fit_set_noise_model(rcb_fit *f, double beta_a, double beta_s);
+/**
+ * @brief Known standard deviations of the measured values (an estimate's own
+ * statistics: rcb_spectral_frf's sd, the order tracker's sd), instead of the
+ * eq. 19 noise model: each point weighted by the inverse variance of its
+ * residual on the chosen scale (sd^2 on |.| and on each of Re, Im;
+ * (sd / (|e| ln 10))^2 on log10; 400 times that on dB), so that F is a
+ * chi-square (about N - np when the model is right), and the noise floor of
+ * the report is 100 sqrt(sum sd^2 / sum |e|^2) over the points used. These
+ * weights multiply the user weights (rcb_fit_set_weights): a 0/1 mask keeps
+ * its meaning.
+ * @param sd one per (channel, point) in channel-major order (sd[c * npoints
+ * + i]), the measurement's units; 0 or NaN drops the point; NULL removes them
+ * @return RCB_ERR_ARG for a negative value, or when the noise model is set
+ * (one or the other)
+ */
+RCB_API rcb_status rcb_fit_set_sd(rcb_fit *f, const double *sd);
 /** @brief Method and, for RCB_FIT_NLOPT, the algorithm name ("LN_BOBYQA", "LD_LBFGS", "GN_DIRECT_L", ...). */
 RCB_API rcb_status rcb_fit_set_method(rcb_fit *f, rcb_fit_method method, const char *algorithm);
 /** @brief Analytic sensitivities (eq. 9, default) or finite differences (eq. 11). */
@@ -125,6 +141,12 @@ RCB_API rcb_status rcb_fit_get_band(const rcb_fit *f, double *lo, double *hi);
  * set, 0 when not (w filled with 1), negative on bad arguments.
  */
 RCB_API int rcb_fit_get_weights(const rcb_fit *f, double *w);
+/**
+ * @brief The standard deviations of rcb_fit_set_sd (nch * npoints values).
+ * @return 1 when set (sd filled), 0 when not (sd untouched), negative on bad
+ * arguments.
+ */
+RCB_API int rcb_fit_get_sd(const rcb_fit *f, double *sd);
 /** @brief The eq. 19 noise factors, % (both 0: no noise model, unit weights). */
 RCB_API rcb_status rcb_fit_get_noise_model(const rcb_fit *f, double *beta_a, double *beta_s);
 /**

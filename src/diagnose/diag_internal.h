@@ -62,6 +62,8 @@ struct rcb_diag {
   rcb_fit_scale scale;
   double beta_a, beta_s, band_lo, band_hi;
   int have_band;
+  double *sd;                       /* known standard deviations (rcb_diag_set_sd), NULL:
+                                       none; every fit weights by them */
   size_t nrefit;
   int (*progress)(void *user, size_t done, size_t total);
   void *progress_user;

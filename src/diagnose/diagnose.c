@@ -56,6 +56,7 @@ void rcb_diag_destroy(rcb_diag *d) {
   a = d->alloc;
   free_results(d);
   rcb_free(&a, d->base);
+  rcb_free(&a, d->sd);
   rcb_free(&a, d);
 }
 
@@ -81,9 +82,50 @@ rcb_status rcb_diag_set_scale(rcb_diag *d, rcb_fit_scale scale) {
 
 rcb_status rcb_diag_set_noise_model(rcb_diag *d, double beta_a, double beta_s) {
   if (!d || !(beta_a >= 0) || !(beta_s >= 0)) return RCB_ERR_ARG;
+  if (d->sd && (beta_a > 0 || beta_s > 0))
+    return rcb_diag_fail(d, RCB_ERR_ARG, "the noise model and standard deviations: give one "
+                         "or the other (both set the weights)");
   d->beta_a = beta_a, d->beta_s = beta_s;
   return RCB_OK;
 }
+
+rcb_status rcb_diag_set_sd(rcb_diag *d, const double *sd, size_t n) {
+  size_t i, want;
+  if (!d) return RCB_ERR_ARG;
+  want = rcb_meas_channel_count(d->meas) * rcb_meas_point_count(d->meas);
+  if (!sd) {
+    rcb_free(&d->alloc, d->sd);
+    d->sd = NULL;
+    return RCB_OK;
+  }
+  if (n != want)
+    return rcb_diag_fail(d, RCB_ERR_ARG, "%zu standard deviations for a measurement of %zu "
+                         "channels x %zu points (%zu)", n, rcb_meas_channel_count(d->meas),
+                         rcb_meas_point_count(d->meas), want);
+  if (d->beta_a > 0 || d->beta_s > 0)
+    return rcb_diag_fail(d, RCB_ERR_ARG, "standard deviations and the noise model: give one "
+                         "or the other (both set the weights)");
+  for (i = 0; i < n; i++)
+    if (sd[i] < 0)
+      return rcb_diag_fail(d, RCB_ERR_ARG, "standard deviation %zu = %g: expected >= 0 (0 or "
+                           "NaN drops the point)", i, sd[i]);
+  if (!d->sd && !(d->sd = rcb_alloc(&d->alloc, n * sizeof *d->sd)))
+    return rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
+  memcpy(d->sd, sd, n * sizeof *sd);
+  return RCB_OK;
+}
+
+int rcb_diag_get_sd(const rcb_diag *d, double *sd, size_t n) {
+  if (!d || !sd) return RCB_ERR_ARG;
+  if (!d->sd) return 0;
+  if (n != rcb_meas_channel_count(d->meas) * rcb_meas_point_count(d->meas)) return RCB_ERR_ARG;
+  memcpy(sd, d->sd, n * sizeof *sd);
+  return 1;
+}
+
+/* Whether F is a chi-square: the weights are inverse variances (the noise
+ * model, or known standard deviations). */
+static int chi2(const rcb_diag *d) { return d->beta_a > 0 || d->beta_s > 0 || d->sd; }
 
 rcb_status rcb_diag_set_band(rcb_diag *d, double lo, double hi) {
   if (!d || !(lo >= 0) || !(hi > lo)) return RCB_ERR_ARG;
@@ -117,6 +159,8 @@ static rcb_status make_fit(rcb_diag *d, rcb_model *m, int with_base, const diag_
   if (!st) st = rcb_fit_set_scale(f, d->scale);
   if (!st && (d->beta_a > 0 || d->beta_s > 0))
     st = rcb_fit_set_noise_model(f, d->beta_a, d->beta_s);
+  /* the fit's subset masks (screening, pedestal scan) multiply these */
+  if (!st && d->sd) st = rcb_fit_set_sd(f, d->sd);
   if (!st && d->have_band) st = rcb_fit_set_band(f, d->band_lo, d->band_hi);
   for (k = 0; !st && with_base && k < d->nbase; k++) {
     double v;
@@ -399,7 +443,7 @@ static size_t refit_starts(const rcb_diag *d, const diag_cand *c) {
  * earlier. */
 #define RCB_DIAG_BIC_RESOLUTION 0.1
 static rcb_status refit_tolerance(const rcb_diag *d, const diag_cand *c, rcb_fit *f) {
-  double scale = (d->beta_a > 0 || d->beta_s > 0) ? d->F0 : (double)d->nres;
+  double scale = chi2(d) ? d->F0 : (double)d->nres;
   double tol = RCB_DIAG_BIC_RESOLUTION / scale, ftol, xtol;
   size_t max_iter;
   rcb_fit_get_limits(f, &max_iter, &ftol, &xtol);
@@ -462,10 +506,10 @@ static rcb_status polish(rcb_fit *f) {
 /* BIC change and significance of a refitted candidate (F, err set). */
 static void judge(const rcb_diag *d, diag_cand *c, double k) {
   double N = (double)d->nres;
-  /* with noise-aware weights F is a chi-square: BIC = F + k ln N; else the
-   * Gaussian likelihood with the variance estimated */
-  c->dbic = (d->beta_a > 0 || d->beta_s > 0) ? (c->F - d->F0) + k * log(N)
-                                             : N * log(c->F / d->F0) + k * log(N);
+  /* with noise-aware weights or known standard deviations F is a
+   * chi-square: BIC = F + k ln N; else the Gaussian likelihood with the
+   * variance estimated */
+  c->dbic = chi2(d) ? (c->F - d->F0) + k * log(N) : N * log(c->F / d->F0) + k * log(N);
   c->significant = c->dbic < RCB_DIAG_BIC_MIN && c->err < RCB_DIAG_ERR_FALL * d->err0;
 }
 

@@ -124,6 +124,7 @@ void rcb_fit_destroy(rcb_fit *f) {
   rcb_free(&a, f->Hmod);
   rcb_free(&a, f->Hwork);
   rcb_free(&a, f->wuser);
+  rcb_free(&a, f->sd);
   rcb_free(&a, f->par);
   rcb_free(&a, f);
 }
@@ -210,8 +211,36 @@ rcb_status rcb_fit_set_weights(rcb_fit *f, const double *w) {
   return RCB_OK;
 }
 
+rcb_status rcb_fit_set_sd(rcb_fit *f, const double *sd) {
+  size_t i, n;
+  if (!f) return RCB_ERR_ARG;
+  n = f->nch * f->npts;
+  if (!sd) {
+    rcb_free(&f->alloc, f->sd);
+    f->sd = NULL;
+    f->prepared = 0;
+    return RCB_OK;
+  }
+  if (f->beta_a > 0 || f->beta_s > 0)
+    return rcb_fit_fail(f, RCB_ERR_ARG, "standard deviations and the noise model: give one "
+                        "or the other (both set the weights)");
+  for (i = 0; i < n; i++)
+    if (sd[i] < 0)
+      return rcb_fit_fail(f, RCB_ERR_ARG, "standard deviation %zu (channel %zu, point %zu) = "
+                          "%g: expected >= 0 (0 or NaN drops the point)", i, i / f->npts,
+                          i % f->npts, sd[i]);
+  if (!f->sd && !(f->sd = rcb_alloc(&f->alloc, n * sizeof *f->sd)))
+    return rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory");
+  memcpy(f->sd, sd, n * sizeof *sd);
+  f->prepared = 0;
+  return RCB_OK;
+}
+
 rcb_status rcb_fit_set_noise_model(rcb_fit *f, double beta_a, double beta_s) {
   if (!f) return RCB_ERR_ARG;
+  if (f->sd && (beta_a > 0 || beta_s > 0))
+    return rcb_fit_fail(f, RCB_ERR_ARG, "the noise model and standard deviations: give one "
+                        "or the other (both set the weights)");
   if (!(beta_a >= 0) || !(beta_s >= 0) || !isfinite(beta_a) || !isfinite(beta_s))
     return rcb_fit_fail(f, RCB_ERR_ARG, "noise factors %g %%, %g %%: expected >= 0", beta_a,
                         beta_s);
@@ -287,6 +316,13 @@ int rcb_fit_get_weights(const rcb_fit *f, double *w) {
   }
   for (i = 0; i < n; i++) w[i] = 1.0;
   return 0;
+}
+
+int rcb_fit_get_sd(const rcb_fit *f, double *sd) {
+  if (!f || !sd) return RCB_ERR_ARG;
+  if (!f->sd) return 0;
+  memcpy(sd, f->sd, f->nch * f->npts * sizeof *sd);
+  return 1;
 }
 
 rcb_status rcb_fit_get_noise_model(const rcb_fit *f, double *beta_a, double *beta_s) {

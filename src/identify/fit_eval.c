@@ -52,12 +52,23 @@ static double noise_var(const rcb_fit *f, double complex e, double a, int part) 
   return f->scale == RCB_SCALE_DB ? 400.0 * v : v;
 }
 
+/* Variance on the scale of a measured value e whose Re and Im (and so |e|)
+ * have the known standard deviation sd (rcb_fit_set_sd), to first order. */
+static double sd_var(rcb_fit_scale s, double complex e, double sd) {
+  double v = sd * sd, mag = cabs(e);
+  if (s == RCB_SCALE_LINEAR || s == RCB_SCALE_COMPLEX) return v;
+  v /= mag * mag * log(10.0) * log(10.0);
+  return s == RCB_SCALE_DB ? 400.0 * v : v;
+}
+
 /* Weight of point (c, i) before the noise model, 0 when left out. */
 static double base_weight(const rcb_fit *f, size_t c, size_t i, double complex e) {
   double w = f->wuser ? f->wuser[c * f->npts + i] : 1.0;
   if (f->grid[i] < f->band_lo || f->grid[i] > f->band_hi) return 0.0;
   if (!isfinite(creal(e)) || !isfinite(cimag(e))) return 0.0;
   if ((f->scale == RCB_SCALE_LOG10 || f->scale == RCB_SCALE_DB) && cabs(e) == 0.0) return 0.0;
+  /* a known sd of 0 or NaN would be an infinite or undefined weight: dropped */
+  if (f->sd && !(f->sd[c * f->npts + i] > 0 && isfinite(f->sd[c * f->npts + i]))) return 0.0;
   return w;
 }
 
@@ -79,7 +90,9 @@ static size_t layout(rcb_fit *f, int fill) {
       /* points at the additive noise floor carry no information on the model */
       if (noisy && cabs(e) < 2.0 * a) continue;
       for (part = 0; part < nparts; part++, n++) {
-        double wp = noisy ? w / noise_var(f, e, a, part) : w;
+        double wp = noisy     ? w / noise_var(f, e, a, part)
+                    : f->sd ? w / sd_var(f->scale, e, f->sd[c * f->npts + i])
+                            : w;
         if (!fill) continue;
         f->res_ch[n] = c;
         f->res_pt[n] = i;
@@ -234,9 +247,23 @@ double rcb_fit_error_pct(const rcb_fit *f) {
   return den > 0 ? 100.0 * sqrt(num / den) : (double)NAN;
 }
 
+int rcb_fit_chi2(const rcb_fit *f) { return f->beta_a > 0 || f->beta_s > 0 || f->sd; }
+
 double rcb_fit_floor_pct(const rcb_fit *f) {
   double num = 0.0, den = 0.0, ba = f->beta_a / 100.0;
   size_t j, c, i;
+  if (f->sd) { /* the known deviations: sd^2 is the variance of |e| too */
+    for (j = 0; j < f->nres; j++) {
+      rcb_meas_channel_info ci;
+      double sd;
+      if (f->res_part[j]) continue;
+      rcb_meas_channel(f->meas, f->res_ch[j], &ci);
+      sd = f->sd[f->res_ch[j] * f->npts + f->res_pt[j]];
+      num += sd * sd;
+      den += creal(ci.data[f->res_pt[j]] * conj(ci.data[f->res_pt[j]]));
+    }
+    return den > 0 ? 100.0 * sqrt(num / den) : (double)NAN;
+  }
   if (!(f->beta_a > 0 || f->beta_s > 0)) return (double)NAN;
   for (c = 0; c < f->nch; c++) {
     rcb_meas_channel_info ci;

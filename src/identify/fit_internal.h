@@ -45,6 +45,7 @@ struct rcb_fit {
   double band_lo, band_hi; /* rad/s */
   double *wuser;         /* nch * npts user weights, NULL: 1 */
   double beta_a, beta_s; /* noise model, %, both 0: none */
+  double *sd;            /* nch * npts known standard deviations, NULL: none */
   rcb_fit_method method;
   char algorithm[64];
   int analytic;
@@ -112,6 +113,9 @@ rcb_status rcb_fit_eval_jac(rcb_fit *f, double *r, double *Jx);
 rcb_status rcb_fit_objective(rcb_fit *f, const double *x, double *F, double *grad);
 /* Error % the eq. 19 noise model alone explains (NaN without a noise model). */
 double rcb_fit_floor_pct(const rcb_fit *f);
+/* 1 when the weights are inverse variances (noise model or known sds): the
+ * objective is then a chi-square. */
+int rcb_fit_chi2(const rcb_fit *f);
 
 /* Pieces of the analytic Jacobian (fit_eval.c) for fit_score.c: the model
  * solve at point i (factors and solutions left in the FRF workspace); the

@@ -239,7 +239,7 @@ static rcb_status iterate(rcb_fit *f, paper_ws *ws, double *phi, int *moved) {
    * spending evaluations on it. The same when the step that can be tried
    * (clipped) promises that little: what is left is an unidentifiable
    * parameter's drift along a flat valley. */
-  noisy = f->beta_a > 0 || f->beta_s > 0;
+  noisy = rcb_fit_chi2(f);
   lim = noisy ? fmax(f->ftol_rel * phi0, 1e-2) : f->ftol_rel * phi0;
   if (ws->pred_full <= lim || (noisy && ws->pred <= lim)) {
     *moved = 0;
@@ -303,7 +303,7 @@ rcb_status rcb_fit_run_paper(rcb_fit *f) {
      * thousandth of one unit is no information (an unidentifiable parameter
      * drifting along a flat valley) */
     if (phi_old - phi <= f->ftol_rel * phi_old ||
-        ((f->beta_a > 0 || f->beta_s > 0) && phi_old - phi < 1e-3) ||
+        (rcb_fit_chi2(f) && phi_old - phi < 1e-3) ||
         sqrt(step) <= f->xtol_rel * (sqrt(xn) + f->xtol_rel)) {
       f->converged = 1;
       break;

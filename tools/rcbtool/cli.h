@@ -322,17 +322,14 @@ int cli_history_append(const char *path, const char *command, const char *model,
 int cli_params_add(const cli_args *a, rcb_fit *f, const rcb_model *m, const cli_params *ps,
                    int log_all, int any_bounds);
 
-/* ---- per-point standard deviations (cli_sd.c; used by fit) ---- */
+/* ---- per-point standard deviations (cli_sd.c; used by fit and diagnose) ---- */
 
 /**
- * Weights 1 / variance on the fit @p scale (0 linear, 1 log10, 2 dB, 3
- * complex) from a --stats file of rcbtool estimate ('RESP/REF sd') or order
- * ('RESP 1X sd') matching @p ms point by point, and the error % the sds alone
- * explain (the noise floor: 100 sqrt(sum sd^2 / sum |e|^2) over the points in
- * @p band, rad/s, NULL for all). *w (channel-major) is the caller's to free.
+ * The standard deviations of a --stats file of rcbtool estimate ('RESP/REF
+ * sd') or order ('RESP 1X sd') matching @p ms point by point, channel-major
+ * (for rcb_fit_set_sd / rcb_diag_set_sd; *sd is the caller's to free).
  */
-int cli_sd_weights(const char *path, const rcb_meas *ms, int scale, const double *band,
-                   double **w, double *floor_pct);
+int cli_sd_read(const char *path, const rcb_meas *ms, double **sd);
 
 /** Read SIGNALS (a->model) by extension: .csv, .uff/.unv (UFF58 time records,
  * --map), .wav (--wav-names, --wav-units, --wav-scale); exit code 0, 2, 3, 4. */

@@ -1,6 +1,6 @@
 /* Per-point standard deviations (the --stats files of rcbtool estimate and
- * rcbtool order) as fit weights and as the noise floor (rcbtool fit --sd). */
-#include <complex.h>
+ * rcbtool order), read for rcb_fit_set_sd / rcb_diag_set_sd (rcbtool fit and
+ * diagnose --sd): the weights and the noise floor are the library's. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -86,24 +86,13 @@ static long find_col(const sd_table *t, const char *name) {
   return -1;
 }
 
-/* Weight of a point with value e and standard deviation sd (of Re, Im and |e|)
- * on the fit's scale: 1 / variance of the residual there. */
-static double weight(int scale, double complex e, double sd) {
-  double m = cabs(e), l10 = log(10.0);
-  if (!(sd > 0.0) || !isfinite(sd)) return 0.0;
-  if (scale == 1) return (m * l10 / sd) * (m * l10 / sd);                   /* log10 */
-  if (scale == 2) return (m * l10 / (20.0 * sd)) * (m * l10 / (20.0 * sd)); /* dB */
-  return 1.0 / (sd * sd);                                                   /* linear, complex */
-}
-
-int cli_sd_weights(const char *path, const rcb_meas *ms, int scale, const double *band,
-                   double **w_out, double *floor_pct) {
+int cli_sd_read(const char *path, const rcb_meas *ms, double **sd_out) {
   sd_table t;
   size_t n = rcb_meas_point_count(ms), nc = rcb_meas_channel_count(ms), c, i;
   int frf = rcb_meas_get_type(ms) == RCB_MEAS_FRF, rc;
-  double unit = frf ? CLI_HZ_TO_RAD_S : CLI_RPM_TO_RAD_S, num = 0.0, den = 0.0, *w;
+  double unit = frf ? CLI_HZ_TO_RAD_S : CLI_RPM_TO_RAD_S, *v;
   const double *x = rcb_meas_grid(ms);
-  *w_out = NULL;
+  *sd_out = NULL;
   if ((rc = read_table(path, &t))) {
     table_free(&t);
     return rc;
@@ -121,8 +110,8 @@ int cli_sd_weights(const char *path, const rcb_meas *ms, int scale, const double
                       "point %zu at %.9g: not the same abscissa", path, i + 1, at,
                       frf ? "Hz" : "rpm", i + 1, x[i] / unit);
     }
-  w = calloc((n ? n : 1) * (nc ? nc : 1), sizeof *w);
-  if (!w) {
+  v = calloc((n ? n : 1) * (nc ? nc : 1), sizeof *v);
+  if (!v) {
     table_free(&t);
     return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   }
@@ -137,21 +126,22 @@ int cli_sd_weights(const char *path, const rcb_meas *ms, int scale, const double
       snprintf(name, sizeof name, "%s 1X sd", ci.response);
     if ((col = find_col(&t, name)) < 0) {
       table_free(&t);
-      free(w);
+      free(v);
       return cli_fail(CLI_EXIT_INPUT, "--sd %s: no column '%s' for channel %s", path, name,
                       ci.response);
     }
     for (i = 0; i < n; i++) {
       double sd = t.v[i * t.ncol + (size_t)col];
-      w[c * n + i] = weight(scale, ci.data[i], sd);
-      if (w[c * n + i] > 0.0 && (!band || (x[i] >= band[0] && x[i] <= band[1]))) {
-        num += sd * sd;
-        den += creal(ci.data[i] * conj(ci.data[i]));
+      if (sd < 0) {
+        table_free(&t);
+        free(v);
+        return cli_fail(CLI_EXIT_INPUT, "--sd %s: column '%s', row %zu: standard deviation "
+                        "%g < 0", path, name, i + 1, sd);
       }
+      v[c * n + i] = sd;
     }
   }
   table_free(&t);
-  *w_out = w;
-  *floor_pct = den > 0.0 ? 100.0 * sqrt(num / den) : (double)NAN;
+  *sd_out = v;
   return 0;
 }

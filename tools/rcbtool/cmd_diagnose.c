@@ -10,7 +10,7 @@
 
 const char cli_help_diagnose[] =
     "usage: rcbtool diagnose MODEL.ini MEAS.uff|MEAS.csv [--params NAME[:LO:HI],...]\n"
-    "                        [--log] [--scale linear|log10|db|complex] [--noise A,S]\n"
+    "                        [--log] [--scale linear|log10|db|complex] [--noise A,S|--sd FILE]\n"
     "                        [--band LO:HI] [--map NODE=STATION,...] [--rpm R] [--refits N]\n"
     "                        [--top N] [--apply K -o MODEL2.ini] [--history FILE]\n"
     "                        [--json] [--progress]\n"
@@ -29,6 +29,10 @@ const char cli_help_diagnose[] =
     "significant when BIC falls by more than 10 and the error itself falls.\n"
     "  --noise A,S    the eq. 19 noise model (random A %, systematic S %): weights\n"
     "                 and the noise floor (strongly recommended)\n"
+    "  --sd FILE      instead of --noise: weights and the noise floor from the\n"
+    "                 standard deviations of the --stats file of rcbtool estimate\n"
+    "                 or order written with the measurement; the objective is\n"
+    "                 then a chi-square, and dBIC = F - F0 + k ln N\n"
     "  --band LO:HI   use only this band: Hz for FRF data, rpm for unbalance data\n"
     "  --refits N     candidates refitted (default 8)\n"
     "  --top N        candidates to print (default 10)\n"
@@ -38,9 +42,9 @@ const char cli_help_diagnose[] =
     "  --json         the ranking as JSON, with \"evaluations\" (model sweeps, a\n"
     "                 Jacobian counting one), \"scored\" and \"refits\"\n"
     "Units of the report: error % and the noise floor %: the relative error of\n"
-    "the model against the data, in percent (the floor is predicted from --noise,\n"
-    "not measured); score %: the part of that error the effect can explain, in\n"
-    "percent; dBIC: change of the Bayesian information criterion (no unit;\n"
+    "the model against the data, in percent (the floor is predicted from --noise\n"
+    "or --sd, not measured); score %: the part of that error the effect can\n"
+    "explain, in percent; dBIC: change of the Bayesian information criterion (no unit;\n"
     "below -10 with a falling error is significant); fitted: values in SI units\n"
     "(N/m, N s/m, N m/rad, N m s/rad, kg, kg m^2).\n"
     "Other options as for rcbtool fit. Exit codes: 0 ok, 2 usage, 3 bad input,\n"
@@ -51,7 +55,7 @@ static const char *const scale_names[] = {"linear", "log10", "db", "complex"};
 typedef struct diag_job {
   const char *meas_path;
   cli_params params;
-  int have_params, log_all, scale, have_noise, have_band;
+  int have_params, log_all, scale, have_noise, have_band, have_sd;
   double beta_a, beta_s, band_lo, band_hi;
   size_t refits, top, apply;
   const char *history;
@@ -73,6 +77,7 @@ static int parse_job(const cli_args *a, diag_job *j) {
   int rc;
   j->log_all = cli_opt_value(a, "--log") != NULL;
   j->history = cli_opt_value(a, "--history");
+  j->have_sd = cli_opt_value(a, "--sd") != NULL;
   if ((rc = cli_opt_choice(a, "--scale", scale_names, 4, RCB_SCALE_LOG10, &j->scale)) ||
       (rc = cli_opt_count(a, "--refits", 8, &j->refits)) ||
       (rc = cli_opt_count(a, "--top", 10, &j->top)) ||
@@ -98,6 +103,15 @@ static int setup(const cli_args *a, const diag_job *j, const rcb_model *m, const
   rcb_status st = rcb_diag_set_scale(d, (rcb_fit_scale)j->scale);
   size_t k;
   if (!st && j->have_noise) st = rcb_diag_set_noise_model(d, j->beta_a, j->beta_s);
+  if (!st && cli_opt_value(a, "--sd")) {
+    double *sd = NULL;
+    int rc;
+    if (j->have_noise) return cli_usage(a->cmd, "give --noise or --sd, not both");
+    if ((rc = cli_sd_read(cli_opt_value(a, "--sd"), ms, &sd))) return rc;
+    st = rcb_diag_set_sd(d, sd, rcb_meas_channel_count(ms) * rcb_meas_point_count(ms));
+    free(sd);
+    if (st) return cli_fail(CLI_EXIT_INPUT, "%s: --sd: %s", a->cmd, rcb_diag_errmsg(d));
+  }
   if (!st && j->have_band) st = rcb_diag_set_band(d, j->band_lo * unit, j->band_hi * unit);
   if (!st) st = rcb_diag_set_refits(d, j->refits);
   if (st) return cli_usage(a->cmd, "invalid --noise, --band or --refits value");
@@ -136,8 +150,8 @@ static void print_text(FILE *fp, const diag_job *j, const rcb_diag *d, const cha
   rcb_diag_baseline(d, &e0, NULL, &floor_pct);
   fprintf(fp, "the model as it is: error %.4g %%", e0);
   if (isfinite(floor_pct))
-    fprintf(fp, " (noise floor %.4g %%, predicted by the --noise model; the error reached can "
-            "be lower)", floor_pct);
+    fprintf(fp, " (noise floor %.4g %%, predicted by the %s; the error reached can be lower)",
+            floor_pct, j->have_sd ? "--sd deviations" : "--noise model");
   fprintf(fp, "; %zu candidates scored\n\n", n);
   fprintf(fp, "%-4s %-5s %-58s %9s %9s %10s  %s\n", "rank", "sig", "candidate", "score %",
           "error %", "dBIC", "fitted");
@@ -295,6 +309,7 @@ int cmd_diagnose(int argc, char **argv) {
                     {"--log", NULL, NULL},
                     {"--scale", "SCALE", NULL},
                     {"--noise", "BETA_A,BETA_S", NULL},
+                    {"--sd", "FILE", NULL},
                     {"--band", "LO:HI", NULL},
                     {"--map", "NODE=STATION,...", NULL},
                     {"--rpm", "R", NULL},

@@ -47,7 +47,7 @@ const char cli_help_fit[] =
     "  --max-iter N   iteration limit (default 100)\n"
     "  --history FILE record this fit as a step (rcbtool history FILE shows them)\n"
     "  --starts N     when the fit ends unsure (above 1.5 x the noise floor that\n"
-    "                 --noise predicts, or not converged: a local minimum or a\n"
+    "                 --noise or --sd predicts, or not converged: a local minimum or a\n"
     "                 missing effect), retry from up to N - 1 random starts within\n"
     "                 the bounds and keep the best (default 8; 1: no restart)\n"
     "  --map LIST     UFF node number <-> model station, e.g. 10=DA,20=C.A, added to\n"
@@ -199,7 +199,7 @@ typedef struct fit_job {
   double beta_a, beta_s;   /* % */
   size_t max_iter, starts;
   int is_uff; /* the measurement is a UFF file (set by read_meas) */
-  double sd_floor_pct; /* --sd: error % the standard deviations explain (NaN without) */
+  int have_sd;          /* --sd: weights and the noise floor from the standard deviations */
 } fit_job;
 
 /* "A<sep>B": two finite numbers. */
@@ -431,12 +431,14 @@ static void write_text_objective(FILE *fp, const fit_result *r, const fit_job *j
           f0, f1, f0 > 0 ? 100.0 * (f1 - f0) / f0 : 0.0,
           j->scale == RCB_SCALE_COMPLEX ? "Re/Im of H" : j->scale == RCB_SCALE_LINEAR ? "|H|"
           : j->scale == RCB_SCALE_DB ? "20 log10 |H|" : "log10 |H|",
-          j->have_noise ? ", weighted by the --noise model" : ", unweighted");
+          j->have_noise ? ", weighted by the --noise model"
+          : j->have_sd  ? ", weighted by the --sd deviations"
+                        : ", unweighted");
   if (r->rep.error_pct > r->rep.error0_pct && f1 <= f0)
     fprintf(fp, "note: E rose (%.4g %% -> %.4g %%) while F fell: the fit lowers F, not E%s\n",
             r->rep.error0_pct, r->rep.error_pct,
             r->rep.unsure ? "; here it also ends unsure (see below)"
-            : j->scale == RCB_SCALE_LINEAR && !j->have_noise
+            : j->scale == RCB_SCALE_LINEAR && !j->have_noise && !j->have_sd
                 ? ""
                 : " (--scale linear without --noise minimises E itself)");
 }
@@ -444,7 +446,7 @@ static void write_text_objective(FILE *fp, const fit_result *r, const fit_job *j
 /* Starting points tried, of the most --starts allows, and why it stopped there. */
 static void write_text_starts(FILE *fp, const fit_result *r, const fit_job *j) {
   fprintf(fp, "starting points: %zu of at most %zu", r->rep.starts, j->starts);
-  if (r->rep.starts < j->starts && j->have_noise)
+  if (r->rep.starts < j->starts && (j->have_noise || j->have_sd))
     fputs(" (restarts run only while the result is unsure: not converged, or above 1.5 x "
           "the noise floor)",
           fp);
@@ -618,7 +620,6 @@ static int report(const cli_args *a, const fit_job *j, rcb_fit *f, const rcb_mod
   int rc;
   memset(&r, 0, sizeof r);
   if (!(rc = collect(f, &r))) {
-    if (!isfinite(r.rep.floor_pct)) r.rep.floor_pct = j->sd_floor_pct;
     cli_warn_condition(a->cmd, &r.cond, 0);
     if (a->json)
       write_json(stdout, &r, j, a);
@@ -646,22 +647,19 @@ static int report(const cli_args *a, const fit_job *j, rcb_fit *f, const rcb_mod
   return rc;
 }
 
-/* --sd FILE: weights from the estimated standard deviations. */
+/* --sd FILE: weights (and the noise floor) from the estimated standard
+ * deviations. */
 static int sd_weights(const cli_args *a, fit_job *j, rcb_fit *f, const rcb_meas *ms) {
   const char *path = cli_opt_value(a, "--sd");
-  double unit = rcb_meas_get_type(ms) == RCB_MEAS_FRF ? CLI_HZ_TO_RAD_S : CLI_RPM_TO_RAD_S;
-  double band[2], *w = NULL;
+  double *sd = NULL;
   rcb_status st;
   int rc;
   if (!path) return 0;
   if (j->have_noise) return cli_usage(a->cmd, "give --noise or --sd, not both");
-  band[0] = j->band_lo * unit;
-  band[1] = j->band_hi * unit;
-  if ((rc = cli_sd_weights(path, ms, j->scale, j->have_band ? band : NULL, &w,
-                           &j->sd_floor_pct)))
-    return rc;
-  st = rcb_fit_set_weights(f, w);
-  free(w);
+  if ((rc = cli_sd_read(path, ms, &sd))) return rc;
+  j->have_sd = 1;
+  st = rcb_fit_set_sd(f, sd);
+  free(sd);
   if (st) return cli_fail(fit_exit(st), "%s: %s", a->cmd, fit_msg(f, st));
   return 0;
 }
@@ -672,7 +670,6 @@ static int run(const cli_args *a, fit_job *j) {
   rcb_fit *f = NULL;
   int rc;
   if ((rc = check_output(a, j)) || (rc = cli_load_model(a, &m))) return rc;
-  j->sd_floor_pct = (double)NAN;
   if (!(rc = read_meas(a, j, m, &ms)) && !(rc = make_fit(a, j, m, ms, &f)) &&
       !(rc = sd_weights(a, j, f, ms)) && !(rc = run_fit(a, f)))
     rc = report(a, j, f, m);
