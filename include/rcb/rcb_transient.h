@@ -118,8 +118,23 @@ RCB_API rcb_status rcb_transient_set_steady(rcb_transient *t, double tol,
                                             size_t samples_per_period, size_t max_periods);
 
 /**
+ * @brief An external force on one DOF during the runs, in addition to the
+ * unbalances: samples f[k] at t = k dt (k = 0 .. nf - 1), linear between
+ * them (first-order hold, as a force-cell record is read), 0 after the last;
+ * the integrator stops at every sample so that no step straddles a kink.
+ * The samples are the caller's and must outlive the runs (not copied).
+ * @param dof the forced DOF (a force, N, on x/y; a moment, N m, on rx/ry)
+ * @param f samples, N or N m; NULL removes the force @param nf >= 2
+ * @param dt sample interval, s (> 0)
+ * @return RCB_ERR_ARG for a DOF not in the model, a non-finite sample, nf < 2
+ * or dt <= 0
+ */
+RCB_API rcb_status rcb_transient_set_force(rcb_transient *t, rcb_dof dof, const double *f,
+                                           size_t nf, double dt);
+
+/**
  * @brief Integrate from t = 0 to @p t_end along a speed profile, with the
- * model's unbalances as forcing, calling @p fn at t = k dt (k = 0, 1, ...,
+ * model's unbalances (and the force of rcb_transient_set_force) as forcing, calling @p fn at t = k dt (k = 0, 1, ...,
  * while k dt <= t_end, t = 0 included).
  * @param q0 initial displacements (n), NULL for rest @param v0 initial
  * velocities (n), NULL for rest

@@ -183,6 +183,10 @@ static void accel(const rcb_transient *t, double tt, const double *q, const doub
   cr = W * W * cs + al * sn;
   ci = W * W * sn - al * cs;
   for (i = 0; i < n; i++) a[i] = cr * t->Pr[i] - ci * t->Pi[i];
+  if (t->fext) {
+    double fe = rcb_transient_force_at(t, tt);
+    for (i = 0; i < n; i++) a[i] += fe * t->Mif[i];
+  }
   for (j = 0; j < n; j++) {
     const double *kc = t->MiK + n * j, *cc = t->MiC + n * j, *gc = t->MiG + n * j;
     double qj = q[j], vj = v[j], wv = W * vj;
@@ -366,6 +370,7 @@ void rcb_transient_destroy(rcb_transient *t) {
   rcb_free(&a, t->MiB);
   rcb_free(&a, t->Pr);
   rcb_free(&a, t->Pi);
+  rcb_free(&a, t->Mif);
   rcb_free(&a, t->q);
   rcb_free(&a, t->v);
   rcb_free(&a, t->out);
@@ -403,6 +408,68 @@ rcb_status rcb_transient_set_steady(rcb_transient *t, double tol, size_t samples
   t->ss_tol = tol;
   t->ss_spp = samples_per_period;
   t->ss_max_periods = max_periods;
+  return RCB_OK;
+}
+
+double rcb_transient_force_at(const rcb_transient *t, double tt) {
+  double x;
+  size_t k;
+  if (!t->fext || !(tt >= 0.0)) return 0.0;
+  x = tt / t->dtf;
+  if (x >= (double)(t->nf - 1)) return x <= (double)(t->nf - 1) * (1.0 + 1e-12) ? t->fext[t->nf - 1] : 0.0;
+  k = (size_t)x;
+  x -= (double)k;
+  return (1.0 - x) * t->fext[k] + x * t->fext[k + 1];
+}
+
+/* M^-1 e_row into t->Mif: M assembled and factored again (creation keeps
+ * only M^-1 K, M^-1 C, M^-1 G). */
+static rcb_status force_column(rcb_transient *t, size_t row) {
+  size_t n = t->n;
+  rcb_layout L;
+  rcb_status st = RCB_OK;
+  double *Mm = rcb_alloc(&t->alloc, n * n * sizeof *Mm);
+  lapack_int info;
+  if (!Mm) return rcb_set_error(t->errmsg, RCB_ERR_NOMEM, "transient: out of memory");
+  rcb_layout_dense(&L, n);
+  rcb_assemble_structure(t->m, &L, Mm, NULL, NULL, NULL);
+  info = LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'L', (lapack_int)n, Mm, (lapack_int)n);
+  memset(t->Mif, 0, n * sizeof *t->Mif);
+  t->Mif[row] = 1.0;
+  if (info != 0)
+    st = rcb_set_error(t->errmsg, RCB_ERR_MODEL, "transient: the mass matrix is not positive "
+                       "definite (dpotrf info %d)", (int)info);
+  else
+    st = solve_all(t, Mm, t->Mif, 1, "the force column");
+  rcb_free(&t->alloc, Mm);
+  return st;
+}
+
+rcb_status rcb_transient_set_force(rcb_transient *t, rcb_dof dof, const double *f, size_t nf,
+                                   double dt) {
+  size_t row, i;
+  if (!t) return RCB_ERR_ARG;
+  t->fext = NULL;
+  if (!f) return RCB_OK;
+  if (nf < 2 || !(dt > 0.0) || !isfinite(dt))
+    return rcb_set_error(t->errmsg, RCB_ERR_ARG, "transient: force of %zu samples every %g s; "
+                         "expected at least 2 samples and dt > 0", nf, dt);
+  for (i = 0; i < nf; i++)
+    if (!isfinite(f[i]))
+      return rcb_set_error(t->errmsg, RCB_ERR_ARG, "transient: force sample %zu is %g; "
+                           "expected finite values (N or N m)", i, f[i]);
+  if (rcb_model_dof_index(t->m, dof, &row) != RCB_OK)
+    return rcb_set_error(t->errmsg, RCB_ERR_ARG, "transient: force DOF (node %zu, direction "
+                         "%d) is not in the model", dof.node, (int)dof.dir);
+  if (!t->Mif && !(t->Mif = tr_alloc(t, t->n * sizeof *t->Mif)))
+    return rcb_set_error(t->errmsg, RCB_ERR_NOMEM, "transient: out of memory");
+  {
+    rcb_status st = force_column(t, row);
+    if (st) return st;
+  }
+  t->fext = f;
+  t->nf = nf;
+  t->dtf = dt;
   return RCB_OK;
 }
 

@@ -28,6 +28,13 @@ struct rcb_transient {
   double *MiB;
   double *Pr, *Pi; /* M^-1 F1 (unbalance phasor at unit speed), m/s^2 per (rad/s)^2 */
   double *q, *v, *out; /* sample buffers: n, n, nout */
+  /* External force (rcb_transient_set_force): M^-1 e_dof (n, 1/kg or
+   * 1/(kg m^2)) and the caller's samples (nf, N or N m, every dtf s from
+   * t = 0, linear between samples, 0 after the last); fext NULL: none. */
+  double *Mif;
+  const double *fext;
+  size_t nf;
+  double dtf;
   rcb_complex *Qa, *Qb; /* steady state: 1X phasors of two revolutions (nout) */
   double rtol, atol_q, atol_v;
   double ss_tol;
@@ -48,6 +55,9 @@ struct rcb_transient {
   int started;      /* CVodeInit done */
 #endif
 };
+
+/* The external force at time t (s), N or N m (0 without one). */
+double rcb_transient_force_at(const rcb_transient *t, double tt);
 
 /* Omega (rad/s), alpha (rad/s^2) and phi (rad) of the profile at time t (s). */
 void rcb_profile_eval(const rcb_speed_profile *p, double t, double *speed, double *accel,

@@ -58,6 +58,8 @@ static rcb_status cv_start(rcb_transient *t, const double *q0, const double *v0)
   } else if ((st = cv_check(t, CVodeReInit(t->cvode, 0.0, t->y), "CVodeReInit"))) {
     return st;
   }
+  /* no stop time left from a run with an external force */
+  if ((st = cv_check(t, CVodeSetStopTime(t->cvode, 1e300), "CVodeSetStopTime"))) return st;
   return cv_check(t, CVodeSVtolerances(t->cvode, t->rtol, t->abstol), "CVodeSVtolerances");
 }
 
@@ -79,14 +81,26 @@ static rcb_status cv_advance(rcb_transient *t, double tout) {
   size_t i, n = t->n;
   const double *y;
   double tret = 0.0;
-  if (tout > 0.0) {
-    int flag = CVode(t->cvode, tout, t->y, &tret, CV_NORMAL);
+  if (tout > 0.0) CVodeGetCurrentTime(t->cvode, &tret);
+  /* without an external force one call returns at tout (interpolated); an
+   * external force is linear between its samples: the integrator stops at
+   * each of them (tret is then the last stop), so no step straddles a kink */
+  while (tout > 0.0 && (!t->fext || tret < tout)) {
+    double tstop = tout;
+    int flag;
+    if (t->fext) {
+      double k = floor(tret / t->dtf * (1.0 + 1e-12)) + 1.0;
+      if (k * t->dtf < tout * (1.0 - 1e-12)) tstop = k * t->dtf;
+      CVodeSetStopTime(t->cvode, tstop);
+    }
+    flag = CVode(t->cvode, tstop, t->y, &tret, CV_NORMAL);
     if (flag < 0) {
       cv_stats(t, tret);
       return rcb_set_error(t->errmsg, cv_status(flag),
                            "transient: CVode failed at t = %.9g s (flag %d): %s", tret, flag,
                            t->sunmsg[0] ? t->sunmsg : "no message");
     }
+    if (!t->fext) break;
   }
   y = N_VGetArrayPointer(t->y);
   memcpy(t->q, y, n * sizeof *t->q);

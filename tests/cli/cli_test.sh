@@ -1044,6 +1044,32 @@ transient_usage)
   err_has "option --dt expects a sampling interval > 0"
   usage transient "$MODEL" --out DA.x --rpm 3000 --rpm-end 6000 --accel 100 --t-end 0
   err_has "option --t-end expects a duration > 0" ;;
+transient_force_usage)
+  usage transient "$MODEL" --out DA.x --rpm 0 --t-end 0.1 --dt 1e-3 --force random --force-at DA.x
+  err_has "give --signals"
+  usage transient "$MODEL" --out DA.x --rpm 0 --t-end 0.1 --dt 1e-3 --signals --force-amp 5
+  err_has "apply with --force random|impact"
+  usage transient "$MODEL" --out DA.x --rpm 0 --t-end 0.1 --dt 1e-3 --signals --force random
+  err_has "option --force-at"
+  usage transient "$MODEL" --out DA.x --rpm 0 --t-end 0.1 --dt 1e-3 --signals --force impact \
+    --force-at DA.x --pulse 1e-3
+  err_has "a pulse of at least 4 samples"
+  usage transient "$MODEL" --out DA.x --rpm 0 --t-end 0.1 --dt 1e-3 --atol 1e-9
+  err_has "option --atol expects Q,V" ;;
+transient_force_impact)
+  # 2 hits of a 0.5 ms half-sine (5 samples at 0.1 ms), 500 N peak, 2 samples
+  # into each 0.005 s block: the force column is 500 sin(pi (t - t0) / 0.5 ms)
+  run transient "$MODEL" --out DA.x --rpm 0 --t-end 0.0099 --dt 1e-4 --signals --force impact \
+    --force-at DA.x --hits 2 --pulse 5e-4 --force-amp 500
+  if [ "$RC" -eq 4 ] && grep -F -q "without SUNDIALS" "$W/err"; then exit 77; fi
+  expect_rc 0; out_has "# units = V,N,m"; out_has "time_s,KP,force,DA.x"
+  awk -F, 'NR > 3 { k = NR - 4; b = k % 50; tau = (b - 2) * 1e-4;
+      want = (b >= 2 && tau <= 5e-4 + 1e-12) ? 500 * sin(3.141592653589793 * tau / 5e-4) : 0;
+      if ((($3 - want) > 1e-9) || ((want - $3) > 1e-9)) { print "force", k, $3, want; bad = 1 }
+      if (k <= 2 && $4 != 0) { print "moved before the hit", k, $4; bad = 1 }
+      if (k == 12 && !($4 > 0)) { print "no response after the hit", $4; bad = 1 } }
+    END { if (NR != 103) { print "rows", NR; bad = 1 }; exit bad }' "$W/out" \
+    || fail "impact force column" ;;
 timecheck_json)
   run timecheck "$MODEL" --out DA.x --rpm-min 3000 --rpm-max 3000 --points 1 --rtol 1e-6 \
     --steady-tol 1e-3 --json

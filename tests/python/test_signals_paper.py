@@ -86,6 +86,28 @@ def _read(path):
     return {h: body[:, i] for i, h in enumerate(head)}
 
 
+def model_through_sampling(exe, fr, outs, fs, rpm, model=MODEL, inp="DA.x"):
+    """The model FRFs outs/inp (receptance) at lines fr (Hz) as a sampled record
+    sees them when the force is linear between its samples (fs, S/s): images
+    k = -3..3 weighted by sinc^2; and the raw model FRFs (k = 0)."""
+    ref = {ch: np.zeros(len(fr), complex) for ch in outs}
+    raw = {}
+    # rcbtool frf takes an even grid: sweep each image's lines exactly
+    for k in range(-3, 4):
+        fq = fr + k * fs
+        lo, hi = np.abs(fq).min(), np.abs(fq).max()
+        d = _json(exe, "frf", model, "--out", ",".join(outs), "--in", inp, "--rpm", rpm,
+                  "--fmin", lo, "--fmax", hi, "--points", len(fr))
+        for c in d["channels"]:
+            hh = np.array(c["re"]) + 1j * np.array(c["im"])
+            if k < 0:  # H(-w) = conj(H(w)): the grid runs backwards
+                hh = np.conj(hh[::-1])
+            ref[c["output"]] += hh * np.sinc(fq / fs) ** 2
+            if k == 0:
+                raw[c["output"]] = hh
+    return ref, raw
+
+
 def test_h1_paper_system_60s(tmp_path: Path):
     exe = _tool()
     f, y = _simulate(exe)
@@ -102,22 +124,7 @@ def test_h1_paper_system_60s(tmp_path: Path):
     h, s = _read(out), _read(stats)
     fr = h["freq_hz"]
     band = fr >= 5.0
-    # the model through the sampling: images k = -3..3 weighted by sinc^2;
-    # rcbtool frf takes an even grid: sweep each image's lines exactly
-    ref = {ch: np.zeros(len(fr), complex) for ch in OUTS}
-    raw = {}
-    for k in range(-3, 4):
-        fq = fr + k * FS
-        lo, hi = np.abs(fq).min(), np.abs(fq).max()
-        d = _json(exe, "frf", MODEL, "--out", ",".join(OUTS), "--in", "DA.x", "--rpm", RPM,
-                  "--fmin", lo, "--fmax", hi, "--points", len(fr))
-        for c in d["channels"]:
-            hh = np.array(c["re"]) + 1j * np.array(c["im"])
-            if k < 0:  # H(-w) = conj(H(w)): the grid runs backwards
-                hh = np.conj(hh[::-1])
-            ref[c["output"]] += hh * np.sinc(fq / FS) ** 2
-            if k == 0:
-                raw[c["output"]] = hh
+    ref, raw = model_through_sampling(exe, fr, OUTS, FS, RPM)
     for ch in OUTS:
         est = h[f"{ch}/DA.x re"] + 1j * h[f"{ch}/DA.x im"]
         sd = s[f"{ch}/DA.x sd"]

@@ -10,8 +10,10 @@
 
 const char cli_help_transient[] =
     "usage: rcbtool transient MODEL.ini --out CH[,CH...] --rpm A [--rpm-end B --accel R]\n"
-    "                         [--t-end S] [--dt S] [--rtol X]\n"
-    "                         [--signals [--noise SD] [--seed N]]\n"
+    "                         [--t-end S] [--dt S] [--rtol X] [--atol Q,V]\n"
+    "                         [--signals [--noise SD] [--seed N]\n"
+    "                          [--force random|impact --force-at CH [--force-amp F]\n"
+    "                           [--hits N] [--pulse S]]]\n"
     "                         [--json] [-o FILE] [--progress]\n"
     "\n"
     "Integrates M q'' + (C + Omega(t) G) q' + K q = f(t) from rest (CVODE BDF, SUNDIALS)\n"
@@ -27,13 +29,30 @@ const char cli_help_transient[] =
     "  --dt S        sampling interval, s (default: 1/40 of the revolution at the\n"
     "                highest speed)\n"
     "  --rtol X      integrator relative tolerance (default 1e-7)\n"
+    "  --atol Q,V    absolute tolerances on displacements, m, and velocities, m/s\n"
+    "                (default 1e-13,1e-10). A random force kinks at every sample and\n"
+    "                costs steps: loosen both for long records (e.g. --rtol 1e-4\n"
+    "                --atol 1e-10,1e-7)\n"
     "  --signals     write the signals a data recorder would hold instead: CSV\n"
     "                '# units = V,m,...', 'time_s,KP,<out>,...' that rcbtool order\n"
     "                and rcbtool estimate read; KP is a 5 V once-per-revolution\n"
     "                keyphasor whose rising edge (linear over +-7.2 deg of shaft\n"
     "                angle) crosses 2.5 V at the mark, angle 0 of the unbalances\n"
     "  --noise SD    with --signals: Gaussian sensor noise, m RMS, on every output\n"
-    "  --seed N      noise seed (default 1)\n"
+    "  --seed N      noise and random-force seed (default 1)\n"
+    "  --force random|impact  with --signals: an external force at --force-at CH\n"
+    "                (STATION.DIR), integrated with the unbalances and written as\n"
+    "                the column 'force' (N) after KP, for rcbtool estimate\n"
+    "                (--input force=CH). random: Gaussian white samples every --dt\n"
+    "                (band-limited white: flat to the Nyquist frequency 1/(2 dt)),\n"
+    "                --force-amp RMS (default 50 N), seeded by --seed. impact: N\n"
+    "                (--hits, default 5) half-sine hammer pulses of --pulse s\n"
+    "                (default 1 ms, at least 4 samples) and peak --force-amp (default\n"
+    "                500 N), one per block of B = floor(t_end / (N dt)) samples,\n"
+    "                each starting 2 samples into its block: estimate with --nseg B\n"
+    "                --overlap 0 --window force-exp (the pulse lies in the force\n"
+    "                window while --pulse <= 0.1 B dt - 2 dt). The force is linear\n"
+    "                between samples (as a force-cell record is read).\n"
     "\n"
     "CSV: t_s,rpm,angle_deg,<out>,... (displacements m, rotations rad) - orbit plots\n"
     "pair the x and y columns of a station; the rpm column per sample makes the\n"
@@ -137,19 +156,35 @@ static double noise_gauss(unsigned long long *s) {
   return sqrt(-2.0 * log(u[0])) * cos(2.0 * CLI_PI * u[1]);
 }
 
+/* The external force of --force: none, random, impact. */
+typedef struct tr_force {
+  int kind;     /* 0 none, 1 random, 2 impact */
+  rcb_dof dof;
+  double amp;   /* N: RMS (random) or peak (impact) */
+  double pulse; /* s, impact */
+  size_t hits, block; /* impact: pulses, samples per block */
+  double *f;    /* samples every dt, n */
+  size_t n;
+} tr_force;
+
 static void tr_signals(FILE *fp, const tr_hist *h, const cli_channels *ch, double sd,
-                       unsigned long long seed) {
+                       unsigned long long seed, const tr_force *fo) {
   size_t k, o;
   unsigned long long s = seed * 0x9E3779B97F4A7C15ULL + 1;
-  fputs("# rcbtool transient --signals: keyphasor in V, displacements in m\n# units = V", fp);
+  fprintf(fp, "# rcbtool transient --signals: keyphasor in V, %sdisplacements in m\n"
+          "# units = V%s", fo->kind ? "force in N, " : "", fo->kind ? ",N" : "");
   for (o = 0; o < ch->n; o++) fputs(",m", fp);
-  fputs("\ntime_s,KP", fp);
+  fputs(fo->kind ? "\ntime_s,KP,force" : "\ntime_s,KP", fp);
   for (o = 0; o < ch->n; o++) fprintf(fp, ",%s", ch->names[o]);
   fputc('\n', fp);
   for (k = 0; k < h->n; k++) {
     cli_csv_num(fp, h->t[k]);
     fputc(',', fp);
     cli_csv_num(fp, kp_volts(h->ang[k]));
+    if (fo->kind) {
+      fputc(',', fp);
+      cli_csv_num(fp, k < fo->n ? fo->f[k] : 0.0);
+    }
     for (o = 0; o < ch->n; o++) {
       fputc(',', fp);
       cli_csv_num(fp, h->q[k * h->nout + o] + (sd > 0.0 ? sd * noise_gauss(&s) : 0.0));
@@ -181,7 +216,7 @@ static void tr_json(FILE *fp, const tr_hist *h, const cli_channels *ch,
 
 typedef struct tr_opts {
   rcb_speed_profile p; /* rad/s, rad/s^2 */
-  double t_end, dt, rtol;
+  double t_end, dt, rtol, atol_q, atol_v;
 } tr_opts;
 
 static int tr_parse(const cli_args *a, tr_opts *o) {
@@ -196,6 +231,17 @@ static int tr_parse(const cli_args *a, tr_opts *o) {
       (rc = cli_opt_nonneg(a, "--dt", "s", 0.0, &o->dt)) ||
       (rc = cli_opt_nonneg(a, "--rtol", "-", 1e-7, &o->rtol)))
     return rc;
+  o->atol_q = 1e-13, o->atol_v = 1e-10;
+  if (cli_opt_value(a, "--atol")) {
+    const char *v = cli_opt_value(a, "--atol"), *c = strchr(v, ',');
+    char *e1 = NULL, *e2 = NULL;
+    o->atol_q = strtod(v, &e1);
+    if (c) o->atol_v = strtod(c + 1, &e2);
+    if (!c || e1 != c || *e2 || !(o->atol_q > 0.0) || !(o->atol_v > 0.0) ||
+        !isfinite(o->atol_q) || !isfinite(o->atol_v))
+      return cli_usage(a->cmd, "option --atol expects Q,V: absolute tolerances > 0 on "
+                       "displacements (m) and velocities (m/s), got '%s'", v);
+  }
   if (r1 != r0 && acc <= 0.0)
     return cli_usage(a->cmd, "--rpm-end %g differs from --rpm %g; expected --accel > 0 (rpm/s)",
                      r1, r0);
@@ -217,13 +263,71 @@ static int tr_parse(const cli_args *a, tr_opts *o) {
   return 0;
 }
 
+/* --force random|impact: parse and make the samples (every dt, t = 0 ..
+ * t_end). */
+static int tr_force_make(const cli_args *a, rcb_model *m, const tr_opts *o, size_t seed,
+                         tr_force *fo) {
+  static const char *const kinds[] = {"none", "random", "impact"};
+  cli_channels at = {0};
+  size_t k, nsamp = (size_t)floor(o->t_end / o->dt * (1.0 + 1e-12)) + 1;
+  int rc;
+  if ((rc = cli_opt_choice(a, "--force", kinds, 3, 0, &fo->kind))) return rc;
+  if (!fo->kind) {
+    if (cli_opt_value(a, "--force-at") || cli_opt_value(a, "--force-amp") ||
+        cli_opt_value(a, "--hits") || cli_opt_value(a, "--pulse"))
+      return cli_usage(a->cmd, "--force-at, --force-amp, --hits and --pulse apply with "
+                       "--force random|impact");
+    return 0;
+  }
+  if (!cli_opt_value(a, "--signals"))
+    return cli_usage(a->cmd, "--force writes the force beside the responses: give --signals");
+  if ((rc = cli_opt_require(a, "--force-at", "the forced channel STATION.DIR, e.g. DA.x")) ||
+      (rc = cli_opt_nonneg(a, "--force-amp", "N", fo->kind == 1 ? 50.0 : 500.0, &fo->amp)) ||
+      (rc = cli_opt_count(a, "--hits", 5, &fo->hits)) ||
+      (rc = cli_opt_nonneg(a, "--pulse", "s", 1e-3, &fo->pulse)))
+    return rc;
+  if ((rc = cli_channels_parse(a, m, "--force-at", &at))) return rc;
+  if (at.n != 1) {
+    cli_channels_free(&at);
+    return cli_usage(a->cmd, "--force-at expects one channel STATION.DIR");
+  }
+  fo->dof = at.dofs[0];
+  cli_channels_free(&at);
+  if (fo->kind == 2) {
+    fo->block = fo->hits ? nsamp / fo->hits : 0;
+    if (fo->hits == 0 || fo->pulse < 4.0 * o->dt || (double)fo->block * o->dt < 10.0 * fo->pulse)
+      return cli_usage(a->cmd, "--force impact: %zu hits of %g s pulses in %g s at dt %g s; "
+                       "expected hits >= 1, a pulse of at least 4 samples (--pulse >= %g s) "
+                       "and blocks (t_end / hits) at least 10 pulses long", fo->hits,
+                       fo->pulse, o->t_end, o->dt, 4.0 * o->dt);
+  }
+  if (!(fo->f = calloc(nsamp, sizeof *fo->f))) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  fo->n = nsamp;
+  if (fo->kind == 1) {
+    unsigned long long s = (unsigned long long)seed * 0xD1B54A32D192ED03ULL + 7;
+    for (k = 0; k < nsamp; k++) fo->f[k] = fo->amp * noise_gauss(&s);
+  } else {
+    size_t hit;
+    for (hit = 0; hit < fo->hits; hit++) {
+      double t0 = (double)(hit * fo->block + 2) * o->dt; /* 2 samples into the block */
+      for (k = hit * fo->block + 2; k < nsamp; k++) {
+        double tau = (double)k * o->dt - t0;
+        if (tau > fo->pulse) break;
+        fo->f[k] = fo->amp * sin(CLI_PI * tau / fo->pulse);
+      }
+    }
+  }
+  return 0;
+}
+
 static int tr_compute(const cli_args *a, rcb_model *m, const cli_channels *ch, const tr_opts *o,
-                      tr_hist *h, rcb_transient_stats *s) {
+                      const tr_force *fo, tr_hist *h, rcb_transient_stats *s) {
   rcb_transient *t = NULL;
   rcb_status st = rcb_transient_create(&t, m, ch->n, ch->dofs, NULL);
   int rc = 0;
   (void)a;
-  if (!st) st = rcb_transient_set_tolerances(t, o->rtol, 1e-13, 1e-10);
+  if (!st) st = rcb_transient_set_tolerances(t, o->rtol, o->atol_q, o->atol_v);
+  if (!st && fo->kind) st = rcb_transient_set_force(t, fo->dof, fo->f, fo->n, o->dt);
   if (!st) st = rcb_transient_run(t, &o->p, o->t_end, o->dt, NULL, NULL, keep_sample, h);
   if (h->nomem) rc = cli_fail(CLI_EXIT_NUMERIC, "transient: out of memory storing samples");
   else if (st)
@@ -237,14 +341,19 @@ static int tr_compute(const cli_args *a, rcb_model *m, const cli_channels *ch, c
 int cmd_transient(int argc, char **argv) {
   cli_opt opts[] = {{"--out", "CH,...", NULL}, {"--rpm", "A", NULL},  {"--rpm-end", "B", NULL},
                     {"--accel", "R", NULL},    {"--t-end", "S", NULL}, {"--dt", "S", NULL},
-                    {"--rtol", "X", NULL},     {"--signals", NULL, NULL},
-                    {"--noise", "SD", NULL},   {"--seed", "N", NULL}};
+                    {"--rtol", "X", NULL},     {"--atol", "Q,V", NULL},
+                    {"--signals", NULL, NULL},
+                    {"--noise", "SD", NULL},   {"--seed", "N", NULL},
+                    {"--force", "random|impact", NULL}, {"--force-at", "CH", NULL},
+                    {"--force-amp", "F", NULL}, {"--hits", "N", NULL},
+                    {"--pulse", "S", NULL}};
   cli_args a;
   cli_channels ch = {0};
   double noise = 0.0;
   size_t seed = 1;
-  tr_opts o = {{0, 0, 0}, 0, 0, 0};
+  tr_opts o = {{0, 0, 0}, 0, 0, 0, 0, 0};
   tr_hist h = {0};
+  tr_force fo = {0};
   rcb_transient_stats s = {0};
   rcb_model *m = NULL;
   cli_out out;
@@ -260,11 +369,12 @@ int cmd_transient(int argc, char **argv) {
     return cli_usage(a.cmd, "--signals writes CSV: drop --json");
   if ((rc = cli_load_model(&a, &m))) return rc;
   if (!(rc = cli_channels_parse(&a, m, "--out", &ch)) &&
-      !(rc = cli_check_size(&a, floor(o.t_end / o.dt) + 1.0, 3.0 + (double)ch.n))) {
+      !(rc = cli_check_size(&a, floor(o.t_end / o.dt) + 1.0, 3.0 + (double)ch.n)) &&
+      !(rc = tr_force_make(&a, m, &o, seed, &fo))) {
     h.nout = ch.n;
-    if (!(rc = tr_compute(&a, m, &ch, &o, &h, &s)) && !(rc = cli_out_open(&out, &a))) {
+    if (!(rc = tr_compute(&a, m, &ch, &o, &fo, &h, &s)) && !(rc = cli_out_open(&out, &a))) {
       if (cli_opt_value(&a, "--signals"))
-        tr_signals(out.fp, &h, &ch, noise, (unsigned long long)seed);
+        tr_signals(out.fp, &h, &ch, noise, (unsigned long long)seed, &fo);
       else if (a.json)
         tr_json(out.fp, &h, &ch, &s);
       else
@@ -276,6 +386,7 @@ int cmd_transient(int argc, char **argv) {
   free(h.rpm);
   free(h.ang);
   free(h.q);
+  free(fo.f);
   cli_channels_free(&ch);
   rcb_model_destroy(m);
   return rc;
