@@ -108,3 +108,58 @@ def test_missing_matplotlib(tmp_path, softer_model):
     r = _run("compare", softer_model, meas, "--plot", tmp_path / "q",
              env={"RCB_PYTHON": str(tmp_path / "no-such-python"), "RCB_PLOTS": str(SCRIPT)})
     assert r.returncode == 5 and "no-such-python" in r.stderr, r.stderr
+
+
+@pytest.fixture(scope="module")
+def test_signals(tmp_path_factory):
+    """A short simulated random test (0.5 s, force at DA.x) and a run-up with
+    a keyphasor, both from rcbtool transient --signals."""
+    d = tmp_path_factory.mktemp("sig")
+    rnd, run = d / "random.csv", d / "runup.csv"
+    r = _run("transient", MODEL, "--out", "DA.x,DB.x", "--rpm", 3000, "--t-end", 0.5, "--dt",
+             1 / 2048, "--rtol", 1e-4, "--atol", "1e-10,1e-7", "--signals", "--force", "random",
+             "--force-at", "DA.x", "-o", rnd)
+    if r.returncode == 4 and "without SUNDIALS" in r.stderr:
+        pytest.skip("librcb built without SUNDIALS")
+    assert r.returncode == 0, r.stderr
+    r = _run("transient", MODEL, "--out", "DA.x,DA.y", "--rpm", 500, "--rpm-end", 6000,
+             "--accel", 2000, "--signals", "-o", run)
+    assert r.returncode == 0, r.stderr
+    return rnd, run
+
+
+def test_estimate_and_order_plots(tmp_path, test_signals):
+    """estimate --plot (FRF with coherence) and order --plot (Bode and polar):
+    pictures not blank, their directories made, no temporary left."""
+    rnd, run = test_signals
+    env = {"RCB_PYTHON": sys.executable, "RCB_PLOTS": str(SCRIPT)}
+    est = tmp_path / "pics" / "est.png"
+    r = _run("estimate", rnd, "--input", "force=DA.x", "--outputs", "DA.x,DB.x", "--nseg", 256,
+             "--rpm", 3000, "--stats", tmp_path / "st.csv", "-o", tmp_path / "h1.csv",
+             "--plot", est, env=env)
+    assert r.returncode == 0, r.stderr
+    _not_blank(est)
+    ordp = tmp_path / "pics" / "order.png"
+    r = _run("order", run, "--kp", "KP", "--outputs", "DA.x,DA.y", "-o", tmp_path / "1x.csv",
+             "--plot", ordp, env=env)
+    assert r.returncode == 0, r.stderr
+    _not_blank(ordp)
+    assert sorted(p.name for p in (tmp_path / "pics").iterdir()) == ["est.png", "order.png"]
+
+
+def test_estimate_plot_failure_writes_nothing(tmp_path, test_signals):
+    """A plot that fails (no such Python) or names an input: exit 5, no output
+    file of the run, the input untouched."""
+    rnd, run = test_signals
+    env = {"RCB_PYTHON": str(tmp_path / "no-such-python"), "RCB_PLOTS": str(SCRIPT)}
+    out, st, png = tmp_path / "h1.csv", tmp_path / "st.csv", tmp_path / "e.png"
+    r = _run("estimate", rnd, "--input", "force=DA.x", "--outputs", "DA.x", "--nseg", 256,
+             "--stats", st, "-o", out, "--plot", png, env=env)
+    assert r.returncode == 5 and "no-such-python" in r.stderr, r.stderr
+    assert "no output file was written" in r.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
+    before = run.read_bytes()
+    r = _run("order", run, "--kp", "KP", "--outputs", "DA.x", "-o", tmp_path / "1x.csv",
+             "--plot", run, env={"RCB_PYTHON": sys.executable, "RCB_PLOTS": str(SCRIPT)})
+    assert r.returncode == 5, r.stderr
+    assert run.read_bytes() == before and not (tmp_path / "1x.csv").exists()

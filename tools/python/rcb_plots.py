@@ -2,6 +2,8 @@
 """Pictures of librcb results, drawn with matplotlib from rcbtool's JSON.
 
     rcb_plots.py compare COMPARE.json PREFIX
+    rcb_plots.py estimate ESTIMATE.json FILE.png
+    rcb_plots.py order ORDER.json FILE.png
 
 reads the JSON of `rcbtool compare --json` (rcbtool compare --plot PREFIX runs
 this script itself) and writes
@@ -11,6 +13,12 @@ this script itself) and writes
                            marked;
   PREFIX_residual_map.png  RMS log10 magnitude error per channel and band, with
                            CSAC and CSF across channels against frequency.
+`rcbtool estimate --plot FILE.png` and `rcbtool order --plot FILE.png` run the
+estimate and order kinds on their own JSON (written to a temporary file):
+  estimate: magnitude (log axis, with the +-2 sd band of each line) and phase
+            of every FRF, its coherence below;
+  order:    Bode plot (amplitude, phase against speed) and polar plot of the
+            1X vectors of every channel.
 Exit codes: 0 written, 2 usage, 3 matplotlib missing, 4 bad JSON, 5 not written.
 """
 
@@ -176,9 +184,75 @@ def residual_map(plt, d, path):
     plt.close(fig)
 
 
+def estimate_plot(plt, d, path):
+    """FRF magnitude and phase with the coherence below (rcbtool estimate --plot)."""
+    fig, (am, ap, ac) = plt.subplots(3, 1, sharex=True, figsize=(9, 9),
+                                     gridspec_kw={"height_ratios": [3, 2, 1.5]})
+    f = d["freq_hz"]
+    for ch in d["channels"][:MAX_CHANNELS]:
+        mag, ph = _mag_phase(ch["re"], ch["im"])
+        sd = [math.nan if v is None else v for v in ch["sd"]]
+        ch["coh"] = [math.nan if v is None else v for v in ch["coh"]]
+        lo = [max(m - 2 * s, m * 1e-3) for m, s in zip(mag, sd)]
+        hi = [m + 2 * s for m, s in zip(mag, sd)]
+        (line,) = am.semilogy(f, mag, lw=1, label=ch["name"])
+        am.fill_between(f, lo, hi, color=line.get_color(), alpha=0.2, lw=0)
+        ap.plot(f, ph, lw=1, color=line.get_color())
+        ac.plot(f, ch["coh"], lw=1, color=line.get_color())
+    am.set_ylabel(f"|H| ({d['kind']}, SI)")
+    am.legend(fontsize="small", ncol=2)
+    am.set_title(f"{d['estimator'].upper()} from {d['averages']} averages, +-2 sd shaded")
+    ap.set_ylabel("phase (deg)")
+    ac.set_ylabel("coherence")
+    ac.set_ylim(0, 1.05)
+    ac.set_xlabel("frequency (Hz)")
+    for ax in (am, ap, ac):
+        ax.grid(True, alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110, format="png")
+    plt.close(fig)
+
+
+def order_plot(plt, d, path):
+    """Bode and polar plot of the 1X vectors (rcbtool order --plot)."""
+    fig = plt.figure(figsize=(12, 6))
+    am = fig.add_subplot(2, 2, 1)
+    ap = fig.add_subplot(2, 2, 3, sharex=am)
+    pol = fig.add_subplot(1, 2, 2)
+    r = d["rpm"]
+    for ch in d["channels"][:MAX_CHANNELS]:
+        mag, ph = _mag_phase(ch["re"], ch["im"])
+        (line,) = am.plot(r, mag, lw=1, label=ch["name"])
+        ap.plot(r, ph, lw=1, color=line.get_color())
+        re = [math.nan if v is None else v for v in ch["re"]]
+        im = [math.nan if v is None else v for v in ch["im"]]
+        pol.plot(re, im, lw=1, color=line.get_color(), label=ch["name"])
+        pol.plot(re[:1], im[:1], "o", ms=3, color=line.get_color())
+    am.set_ylabel(f"{d['order']}X amplitude (m)")
+    am.legend(fontsize="small")
+    am.set_title(f"Bode plot, {d['order']}X")
+    ap.set_ylabel("phase (deg)")
+    ap.set_xlabel("speed (rpm)")
+    pol.set_aspect("equal", adjustable="datalim")
+    pol.axhline(0, color="k", lw=0.5)
+    pol.axvline(0, color="k", lw=0.5)
+    pol.set_xlabel("Re (m)")
+    pol.set_ylabel("Im (m)")
+    pol.set_title(f"polar plot, {d['order']}X (dot: lowest speed)")
+    for ax in (am, ap, pol):
+        ax.grid(True, alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110, format="png")
+    plt.close(fig)
+
+
+KINDS = {"estimate": ("freq_hz", estimate_plot), "order": ("rpm", order_plot)}
+
+
 def main(argv):
-    if len(argv) != 4 or argv[1] != "compare":
-        print("usage: rcb_plots.py compare COMPARE.json PREFIX", file=sys.stderr)
+    if len(argv) != 4 or argv[1] not in ("compare", *KINDS):
+        print("usage: rcb_plots.py compare COMPARE.json PREFIX\n"
+              "       rcb_plots.py estimate|order DATA.json FILE.png", file=sys.stderr)
         return 2
     try:
         import matplotlib
@@ -193,10 +267,19 @@ def main(argv):
         with open(argv[2]) as f:
             d = json.load(f)
         d["channels"][0]
+        if argv[1] in KINDS:
+            d[KINDS[argv[1]][0]][0]
     except (OSError, ValueError, KeyError, IndexError) as e:
-        print(f"rcb_plots.py: cannot read {argv[2]} as rcbtool compare JSON: {e}",
+        print(f"rcb_plots.py: cannot read {argv[2]} as rcbtool {argv[1]} JSON: {e}",
               file=sys.stderr)
         return 4
+    if argv[1] in KINDS:
+        try:
+            KINDS[argv[1]][1](plt, d, argv[3])
+        except OSError as e:
+            print(f"rcb_plots.py: cannot write the picture: {e}", file=sys.stderr)
+            return 5
+        return 0
     prefix = argv[3]
     try:
         overlay(plt, d, prefix + "_overlay.png")

@@ -322,6 +322,22 @@ int cli_history_append(const char *path, const char *command, const char *model,
 int cli_params_add(const cli_args *a, rcb_fit *f, const rcb_model *m, const cli_params *ps,
                    int log_all, int any_bounds);
 
+/* ---- plots (cli_plot.c) ---- */
+
+/** Make the directories of a --plot path (mkdir -p of its dirname); 0 or exit 5. */
+int cli_plot_mkdir(const char *path);
+/** Run rcb_plots.py KIND JSON OUT (RCB_PYTHON, RCB_PLOTS; messages to stderr);
+ * 0, or exit 5 with a message ending in @p kept (what became of the outputs). */
+int cli_plot_run(const char *kind, const char *json, const char *out, const char *kept);
+/** Before any work: --plot @p path is not empty and is none of the inputs. */
+int cli_plot_check(const cli_args *a, const char *path);
+typedef void (*cli_plot_json_fn)(FILE *fp, const void *ctx);
+/** --plot @p png (estimate, order): the data as JSON (@p json) in a temporary
+ * file, rcb_plots.py KIND draws a temporary picture renamed onto @p png on
+ * success; nothing is left on failure. 0 or exit 5. */
+int cli_plot_write(const char *kind, const char *png, cli_plot_json_fn json, const void *ctx,
+                   const char *kept);
+
 /* ---- per-point standard deviations (cli_sd.c; used by fit and diagnose) ---- */
 
 /**

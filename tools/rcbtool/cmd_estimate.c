@@ -45,6 +45,12 @@ const char cli_help_estimate[] =
     "                 'G IN/OUT im' per pair, 'G OUT' per output\n"
     "  --map LIST     UFF node map for SIGNALS and OUT, NODE=STATION,... (as convert)\n"
     "  --binary       write binary 58b\n"
+    "  --plot FILE    also draw FILE (PNG): magnitude and phase of each FRF with the\n"
+    "                 coherence below (Python 3 with matplotlib: RCB_PYTHON, RCB_PLOTS\n"
+    "                 as for compare --plot); drawn first, a failed plot writes nothing\n"
+    "  --plot FILE    also draw FILE (PNG): magnitude and phase of each FRF with the\n"
+    "                 coherence below (Python 3 with matplotlib: RCB_PYTHON, RCB_PLOTS\n"
+    "                 as for compare --plot); drawn first, a failed plot writes nothing\n"
     "Files are written atomically. Exit codes: 2 usage, 3 bad signals or units,\n"
     "4 numerical failure, 5 output not written.\n";
 
@@ -355,11 +361,56 @@ static int write_spectra(est_job *j, const est_out *r, const char *path) {
   return cli_out_close(&out);
 }
 
+typedef struct est_plot {
+  const est_job *j;
+  const est_out *r;
+} est_plot;
+
+/* --plot: the written lines as rcb_plots.py estimate reads them. */
+static void plot_json(FILE *fp, const void *ctx) {
+  const est_plot *pc = ctx;
+  const est_job *j = pc->j;
+  const est_out *r = pc->r;
+  size_t nb = rcb_spectral_bin_count(j->e), c, k, np = j->p * j->q;
+  double *f = malloc((r->n ? r->n : 1) * sizeof *f), *re = malloc((r->n ? r->n : 1) * 2 * sizeof *re);
+  char name[256];
+  if (!f || !re) {
+    free(f);
+    free(re);
+    return; /* an empty file: the plotter refuses it */
+  }
+  for (k = 0; k < r->n; k++) f[k] = r->w[k + 1] / CLI_HZ_TO_RAD_S;
+  fprintf(fp, "{\"kind\": \"%s\", \"estimator\": \"%s\", \"averages\": %zu, \"freq_hz\": ",
+          kind_names[j->kind], est_names[j->est], rcb_spectral_averages(j->e));
+  cli_json_nums(fp, f, r->n, 1);
+  fputs(",\n\"channels\": [", fp);
+  for (c = 0; c < np; c++) {
+    const rcb_complex *h = r->h + c * nb + 1;
+    snprintf(name, sizeof name, "%s/%s", j->model[j->p + c / j->p], j->model[c % j->p]);
+    fputs(c ? ",\n {\"name\": " : "\n {\"name\": ", fp);
+    cli_json_str(fp, name);
+    for (k = 0; k < r->n; k++) re[2 * k] = creal(h[k]), re[2 * k + 1] = cimag(h[k]);
+    fputs(", \"re\": ", fp);
+    cli_json_nums(fp, re, r->n, 2);
+    fputs(", \"im\": ", fp);
+    cli_json_nums(fp, re + 1, r->n, 2);
+    fputs(", \"coh\": ", fp);
+    cli_json_nums(fp, r->coh + c * nb + 1, r->n, 1);
+    fputs(", \"sd\": ", fp);
+    cli_json_nums(fp, r->sd + c * nb + 1, r->n, 1);
+    fputs("}", fp);
+  }
+  fputs("]}\n", fp);
+  free(f);
+  free(re);
+}
+
 static int estimate(const cli_args *a) {
   est_job j;
   est_out r;
   size_t k1 = 0;
   const char *stats = cli_opt_value(a, "--stats"), *spectra = cli_opt_value(a, "--spectra");
+  const char *plot = cli_opt_value(a, "--plot");
   int rc;
   memset(&j, 0, sizeof j);
   memset(&r, 0, sizeof r);
@@ -367,7 +418,7 @@ static int estimate(const cli_args *a) {
   j.kind = -1;
   if (!a->output)
     return cli_usage(a->cmd, "missing -o OUT (.uff, .unv or .csv) for the estimated FRFs");
-  if ((rc = options(&j))) return rc;
+  if ((rc = options(&j)) || (plot && (rc = cli_plot_check(a, plot)))) return rc;
   if (rcb_signals_create(&j.sig, NULL)) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   rc = cli_signals_read(a, j.sig);
   if (!rc) rc = channels(&j);
@@ -377,6 +428,11 @@ static int estimate(const cli_args *a) {
   if (!rc) rc = average(&j);
   if (!rc) rc = line_range(&j, &k1);
   if (!rc) rc = compute(&j, &r, k1);
+  if (!rc && plot) { /* first: a failed plot leaves no output */
+    est_plot pc = {&j, &r};
+    rc = cli_plot_write("estimate", plot, plot_json, &pc,
+                        "no output file was written (run without --plot for the estimate alone)");
+  }
   if (!rc && stats) rc = write_stats(&j, &r, stats);
   if (!rc && spectra) rc = write_spectra(&j, &r, spectra);
   if (!rc) rc = write_meas(&j, &r);
@@ -404,7 +460,7 @@ int cmd_estimate(int argc, char **argv) {
                     {"--stats", "FILE", NULL},    {"--spectra", "FILE", NULL},
                     {"--map", "NODE=STATION,...", NULL}, {"--binary", NULL, NULL},
                     {"--wav-names", "LIST", NULL}, {"--wav-units", "LIST", NULL},
-                    {"--wav-scale", "LIST", NULL}};
+                    {"--wav-scale", "LIST", NULL}, {"--plot", "FILE.png", NULL}};
   cli_args a;
   int rc = cli_parse(argc, argv, opts, sizeof opts / sizeof opts[0], &a);
   if (rc || a.help) return rc ? rc : cli_print_help(cli_help_estimate);

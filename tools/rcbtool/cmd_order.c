@@ -33,6 +33,10 @@ const char cli_help_order[] =
     "  --stats FILE   CSV: rpm, revolutions, per channel '<CH> 1X sd' and '<CH> 2X sd'\n"
     "                 (m, of Re and of Im of the bin's mean phasor)\n"
     "  --map LIST     UFF node map, NODE=STATION,... (as rcbtool convert)\n"
+    "  --plot FILE    also draw FILE (PNG): Bode plot (1X amplitude and phase against\n"
+    "                 speed) and polar plot of every channel (Python 3 with matplotlib:\n"
+    "                 RCB_PYTHON, RCB_PLOTS as for compare --plot); drawn first, a\n"
+    "                 failed plot writes nothing\n"
     "Files are written atomically. Exit codes: 2 usage, 3 bad signals (no keyphasor\n"
     "pulses, a response not a displacement), 5 output not written.\n";
 
@@ -189,16 +193,57 @@ static int ord_stats(const ord_job *j, const size_t *bins, size_t nb, const char
   return cli_out_close(&out);
 }
 
+typedef struct ord_plot {
+  const ord_job *j;
+  const size_t *bins;
+  size_t nb;
+} ord_plot;
+
+/* --plot: the 1X vectors of every channel per speed bin, for rcb_plots.py order. */
+static void plot_json(FILE *fp, const void *ctx) {
+  const ord_plot *pc = ctx;
+  size_t i, c, nb = pc->nb;
+  double *v = malloc((nb ? nb : 1) * 3 * sizeof *v);
+  if (!v) return; /* an empty file: the plotter refuses it */
+  for (i = 0; i < nb; i++) {
+    rcb_order_result(pc->j->e, pc->bins[i], 0, 1, &v[i], NULL, NULL, NULL);
+    v[i] /= CLI_RPM_TO_RAD_S;
+  }
+  fputs("{\"order\": 1, \"rpm\": ", fp);
+  cli_json_nums(fp, v, nb, 1);
+  fputs(",\n\"channels\": [", fp);
+  for (c = 0; c < pc->j->q; c++) {
+    for (i = 0; i < nb; i++) {
+      rcb_complex q;
+      rcb_order_result(pc->j->e, pc->bins[i], c, 1, NULL, &q, &v[2 * nb + i], NULL);
+      v[2 * i] = creal(q), v[2 * i + 1] = cimag(q);
+    }
+    fputs(c ? ",\n {\"name\": " : "\n {\"name\": ", fp);
+    cli_json_str(fp, pc->j->model[c + 1]);
+    fputs(", \"re\": ", fp);
+    cli_json_nums(fp, v, nb, 2);
+    fputs(", \"im\": ", fp);
+    cli_json_nums(fp, v + 1, nb, 2);
+    fputs(", \"sd\": ", fp);
+    cli_json_nums(fp, v + 2 * nb, nb, 1);
+    fputs("}", fp);
+  }
+  fputs("]}\n", fp);
+  free(v);
+}
+
 static int order_run(const cli_args *a) {
   ord_job j;
   size_t *bins = NULL, nb = 0;
   const char *o2 = cli_opt_value(a, "--order2"), *stats = cli_opt_value(a, "--stats");
+  const char *plot = cli_opt_value(a, "--plot");
   int rc;
   memset(&j, 0, sizeof j);
   j.a = a;
   if (!a->output) return cli_usage(a->cmd, "missing -o OUT (.uff, .unv or .csv) for the 1X data");
   if ((rc = cli_opt_require(a, "--kp", "the keyphasor channel, e.g. --kp KP")) ||
-      (rc = cli_opt_require(a, "--outputs", "the response channels, e.g. --outputs DA.x")))
+      (rc = cli_opt_require(a, "--outputs", "the response channels, e.g. --outputs DA.x")) ||
+      (plot && (rc = cli_plot_check(a, plot))))
     return rc;
   if (rcb_signals_create(&j.sig, NULL)) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   rc = cli_signals_read(a, j.sig);
@@ -211,6 +256,11 @@ static int order_run(const cli_args *a) {
   if (!rc && (nb = ord_bins(&j, bins)) < 2)
     rc = cli_fail(CLI_EXIT_INPUT, "%s: %zu speed bins with %zu revolutions or more; need two: "
                   "a longer record or wider --bin-rpm", a->model, nb, j.o.min_revs);
+  if (!rc && plot) { /* first: a failed plot leaves no output */
+    ord_plot pc = {&j, bins, nb};
+    rc = cli_plot_write("order", plot, plot_json, &pc,
+                        "no output file was written (run without --plot for the 1X data alone)");
+  }
   if (!rc && stats) rc = ord_stats(&j, bins, nb, stats);
   if (!rc && o2) rc = ord_write(&j, bins, nb, 2, o2);
   if (!rc) rc = ord_write(&j, bins, nb, 1, a->output);
@@ -228,7 +278,7 @@ int cmd_order(int argc, char **argv) {
                     {"--min-revs", "N", NULL},    {"--order2", "FILE", NULL},
                     {"--stats", "FILE", NULL},    {"--map", "NODE=STATION,...", NULL},
                     {"--wav-names", "LIST", NULL}, {"--wav-units", "LIST", NULL},
-                    {"--wav-scale", "LIST", NULL}};
+                    {"--wav-scale", "LIST", NULL}, {"--plot", "FILE.png", NULL}};
   cli_args a;
   int rc = cli_parse(argc, argv, opts, sizeof opts / sizeof opts[0], &a);
   if (rc || a.help) return rc ? rc : cli_print_help(cli_help_order);
