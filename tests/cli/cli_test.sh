@@ -1044,6 +1044,18 @@ transient_usage)
   err_has "option --dt expects a sampling interval > 0"
   usage transient "$MODEL" --out DA.x --rpm 3000 --rpm-end 6000 --accel 100 --t-end 0
   err_has "option --t-end expects a duration > 0" ;;
+diagnose_sd_usage)
+  run simulate "$MODEL" --frf --out DA.x --in DA.x --fmin 100 --fmax 120 --points 3 --rpm 3000 \
+    -o "$W/m.csv"
+  expect_rc 0
+  printf 'freq_hz,DA.x/DA.x sd\n100,1e-7\n110,-1e-7\n120,1e-7\n' >"$W/sd.csv"
+  usage diagnose "$MODEL" "$W/m.csv" --noise 10,1 --sd "$W/sd.csv"
+  err_has "give --noise or --sd, not both"
+  run diagnose "$MODEL" "$W/m.csv" --sd "$W/sd.csv"
+  expect_rc 3; out_empty; err_has "row 2: standard deviation -1e-07 < 0"
+  printf 'freq_hz,DA.x/DA.x sd\n100,1e-7\n110,1e-7\n' >"$W/sd.csv"
+  run diagnose "$MODEL" "$W/m.csv" --sd "$W/sd.csv"
+  expect_rc 3; out_empty; err_has "2 rows for a measurement of 3 points" ;;
 transient_force_usage)
   usage transient "$MODEL" --out DA.x --rpm 0 --t-end 0.1 --dt 1e-3 --force random --force-at DA.x
   err_has "give --signals"
