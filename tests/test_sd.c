@@ -24,6 +24,7 @@
 #define PI 3.14159265358979323846
 #define NCH 8
 #define NPT 151
+#define NALL ((size_t)NCH * NPT) /* channels x points */
 
 static const char *const outs[NCH] = {"DA.x", "DA.y", "C.A.x", "C.A.y",
                                       "C.B.x", "C.B.y", "DB.x", "DB.y"};
@@ -49,7 +50,7 @@ static rcb_meas *measure(const rcb_model *truth, double rel, double *sd, uint64_
   rcb_frf *fr = NULL;
   rcb_dof od[NCH], in;
   double x[NPT];
-  rcb_complex H[NCH * NPT], col[NPT];
+  rcb_complex H[NALL], col[NPT];
   size_t i, o;
   for (o = 0; o < NCH; o++) assert_int_equal(rcb_model_find_dof(truth, outs[o], &od[o]), 0);
   assert_int_equal(rcb_model_find_dof(truth, "DA.x", &in), RCB_OK);
@@ -81,7 +82,7 @@ static rcb_meas *measure(const rcb_model *truth, double rel, double *sd, uint64_
 /* Settings: read back, refused values and combinations. */
 static void test_settings(void **state) {
   rcb_model *m = rcb_test_model_from_example("paper_system.ini");
-  static double sd[NCH * NPT], back[NCH * NPT];
+  static double sd[NALL], back[NALL];
   rcb_meas *ms = measure(m, 0.02, sd, 1);
   rcb_fit *f = NULL;
   rcb_diag *d = NULL;
@@ -105,16 +106,16 @@ static void test_settings(void **state) {
   rcb_fit_destroy(f);
 
   assert_int_equal(rcb_diag_create(&d, m, ms, NULL), RCB_OK);
-  assert_int_equal(rcb_diag_get_sd(d, back, NCH * NPT), 0);
-  assert_int_equal(rcb_diag_set_sd(d, sd, NCH * NPT - 1), RCB_ERR_ARG); /* size */
+  assert_int_equal(rcb_diag_get_sd(d, back, NALL), 0);
+  assert_int_equal(rcb_diag_set_sd(d, sd, NALL - 1), RCB_ERR_ARG); /* size */
   assert_non_null(strstr(rcb_diag_errmsg(d), "8 channels x 151 points"));
-  assert_int_equal(rcb_diag_set_sd(d, sd, NCH * NPT), RCB_OK);
-  assert_int_equal(rcb_diag_get_sd(d, back, NCH * NPT), 1);
+  assert_int_equal(rcb_diag_set_sd(d, sd, NALL), RCB_OK);
+  assert_int_equal(rcb_diag_get_sd(d, back, NALL), 1);
   assert_memory_equal(sd, back, sizeof sd);
   assert_int_equal(rcb_diag_set_noise_model(d, 10.0, 1.0), RCB_ERR_ARG);
   assert_int_equal(rcb_diag_set_sd(d, NULL, 0), RCB_OK);
   assert_int_equal(rcb_diag_set_noise_model(d, 10.0, 1.0), RCB_OK);
-  assert_int_equal(rcb_diag_set_sd(d, sd, NCH * NPT), RCB_ERR_ARG);
+  assert_int_equal(rcb_diag_set_sd(d, sd, NALL), RCB_ERR_ARG);
   rcb_diag_destroy(d);
   rcb_meas_destroy(ms);
   rcb_model_destroy(m);
@@ -124,7 +125,7 @@ static void test_settings(void **state) {
  * linear and the log10 scale; a NaN sd drops its point; the floor. */
 static void test_weights(void **state) {
   rcb_model *m = rcb_test_model_from_example("paper_system.ini");
-  static double sd[NCH * NPT], r0[NCH * NPT], r1[NCH * NPT];
+  static double sd[NALL], r0[NALL], r1[NALL];
   rcb_meas *ms = measure(m, 0.02, sd, 2);
   rcb_fit *f = NULL;
   rcb_fit_report rep;
@@ -137,7 +138,7 @@ static void test_weights(void **state) {
     assert_int_equal(rcb_fit_set_scale(f, scale ? RCB_SCALE_LOG10 : RCB_SCALE_LINEAR), 0);
     assert_int_equal(rcb_fit_residuals(f, r0), RCB_OK);
     assert_int_equal(rcb_fit_set_sd(f, sd), RCB_OK);
-    assert_int_equal(rcb_fit_residual_count(f), NCH * NPT);
+    assert_int_equal(rcb_fit_residual_count(f), NALL);
     assert_int_equal(rcb_fit_residuals(f, r1), RCB_OK);
     for (c = 0; c < NCH; c++) {
       rcb_meas_channel_info ci;
@@ -169,7 +170,7 @@ static void test_weights(void **state) {
   assert_int_equal(rcb_fit_set_uncertainty(f, 0), RCB_OK);
   assert_int_equal(rcb_fit_run(f), RCB_OK);
   n = rcb_fit_residual_count(f);
-  assert_int_equal(n, 2 * (NCH * NPT - 1));
+  assert_int_equal(n, 2 * (NALL - 1));
   assert_int_equal(rcb_fit_get_report(f, &rep), RCB_OK);
   assert_true(fabs(rep.floor_pct - 100.0 * sqrt(num / den)) < 1e-12 * rep.floor_pct);
   /* F at the fitted truth is a chi-square with n - 1 degrees of freedom */
@@ -185,13 +186,13 @@ static void test_weights(void **state) {
  * hidden, and a hidden cross-coupled stiffness at B2 named. */
 static void diagnose(rcb_model *truth, uint64_t seed, rcb_diag_candidate *best) {
   rcb_model *m = rcb_test_model_from_example("paper_system.ini");
-  static double sd[NCH * NPT];
+  static double sd[NALL];
   rcb_meas *ms = measure(truth, 0.05, sd, seed);
   rcb_diag *d = NULL;
-  double e0, F0, floor0, N = 2 * NCH * NPT;
+  double e0, F0, floor0, N = 2.0 * (double)NALL;
   size_t k;
   assert_int_equal(rcb_diag_create(&d, m, ms, NULL), RCB_OK);
-  assert_int_equal(rcb_diag_set_sd(d, sd, NCH * NPT), RCB_OK);
+  assert_int_equal(rcb_diag_set_sd(d, sd, NALL), RCB_OK);
   /* Re and Im: F is exactly a chi-square (on log10 |H| only to first order in
    * sd / |H|) */
   assert_int_equal(rcb_diag_set_scale(d, RCB_SCALE_COMPLEX), RCB_OK);
