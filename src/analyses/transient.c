@@ -416,7 +416,8 @@ double rcb_transient_force_at(const rcb_transient *t, double tt) {
   size_t k;
   if (!t->fext || !(tt >= 0.0)) return 0.0;
   x = tt / t->dtf;
-  if (x >= (double)(t->nf - 1)) return x <= (double)(t->nf - 1) * (1.0 + 1e-12) ? t->fext[t->nf - 1] : 0.0;
+  if (x >= (double)(t->nf - 1)) /* the last sample, then nothing */
+    return x <= (double)(t->nf - 1) * (1.0 + 1e-12) ? t->fext[t->nf - 1] : 0.0;
   k = (size_t)x;
   x -= (double)k;
   return (1.0 - x) * t->fext[k] + x * t->fext[k + 1];

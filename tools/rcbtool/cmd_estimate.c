@@ -372,7 +372,8 @@ static void plot_json(FILE *fp, const void *ctx) {
   const est_job *j = pc->j;
   const est_out *r = pc->r;
   size_t nb = rcb_spectral_bin_count(j->e), c, k, np = j->p * j->q;
-  double *f = malloc((r->n ? r->n : 1) * sizeof *f), *re = malloc((r->n ? r->n : 1) * 2 * sizeof *re);
+  double *f = malloc((r->n ? r->n : 1) * sizeof *f);
+  double *re = malloc((r->n ? r->n : 1) * 2 * sizeof *re);
   char name[256];
   if (!f || !re) {
     free(f);
