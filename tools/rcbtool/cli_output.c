@@ -96,6 +96,8 @@ void cli_tmp_release(int slot) {
   if (slot >= 0 && slot < CLI_TMP_SLOTS) tmp_live[slot] = 0;
 }
 
+static void plain_mode(int fd);
+
 int cli_tmpfile_open(cli_tmpfile *t, const char *path) {
   struct stat st;
   int fd;
@@ -114,6 +116,7 @@ int cli_tmpfile_open(cli_tmpfile *t, const char *path) {
     t->tmp = NULL;
     return cli_fail(CLI_EXIT_IO, "cannot write output file '%s': %s", path, strerror(e));
   }
+  plain_mode(fd); /* a writer that reuses the file (rcb_plots.py) keeps its mode */
   close(fd);
   t->slot[0] = cli_tmp_register(t->tmp);
   /* the library's own temporary beside it: "<name>.tmp000", ours as its name is unique */
