@@ -333,6 +333,9 @@ int cli_params_add(const cli_args *a, rcb_fit *f, const rcb_model *m, const cli_
  */
 int cli_sd_weights(const char *path, const rcb_meas *ms, int scale, const double *band,
                    double **w, double *floor_pct);
+/** The standard deviations of Re and Im (SI, channel-major, sd[c * npoints + i])
+ * of a --stats file matching @p ms point by point; *sd is the caller's to free. */
+int cli_sd_values(const char *path, const rcb_meas *ms, double **sd);
 
 /** Read SIGNALS (a->model) by extension: .csv, .uff/.unv (UFF58 time records,
  * --map), .wav (--wav-names, --wav-units, --wav-scale); exit code 0, 2, 3, 4. */
@@ -357,6 +360,7 @@ int cmd_timecheck(int argc, char **argv);
 int cmd_compare(int argc, char **argv);
 int cmd_diagnose(int argc, char **argv);
 int cmd_history(int argc, char **argv);
+int cmd_monitor(int argc, char **argv);
 
 extern const char cli_help_check[];
 extern const char cli_help_matrices[];
@@ -375,9 +379,20 @@ extern const char cli_help_timecheck[];
 extern const char cli_help_compare[];
 extern const char cli_help_diagnose[];
 extern const char cli_help_history[];
+extern const char cli_help_monitor[];
 
 /** Print a command's help text to stdout; returns 0 (or 5 if stdout fails). */
 int cli_print_help(const char *text);
+
+/* ---- pictures (cli_plots.c): tools/python/rcb_plots.py run as a child ---- */
+
+/** Make the directories of a --plot PREFIX or file name when missing (mkdir -p);
+ * 0 or exit 5. */
+int cli_plot_dir(const char *prefix);
+/** Run "PYTHON rcb_plots.py WHAT JSON OUT [FORMAT]" (RCB_PYTHON, RCB_PLOTS
+ * choose them); 0, or exit 5 after a message ending with @p nothing_kept. */
+int cli_run_plotter(const char *what, const char *json, const char *out, const char *format,
+                    const char *nothing_kept);
 
 /* ---- sweep options shared by simulate and sensitivity (cli_sweep.c) ---- */
 

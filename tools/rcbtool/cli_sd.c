@@ -96,14 +96,13 @@ static double weight(int scale, double complex e, double sd) {
   return 1.0 / (sd * sd);                                                   /* linear, complex */
 }
 
-int cli_sd_weights(const char *path, const rcb_meas *ms, int scale, const double *band,
-                   double **w_out, double *floor_pct) {
+int cli_sd_values(const char *path, const rcb_meas *ms, double **sd_out) {
   sd_table t;
   size_t n = rcb_meas_point_count(ms), nc = rcb_meas_channel_count(ms), c, i;
   int frf = rcb_meas_get_type(ms) == RCB_MEAS_FRF, rc;
-  double unit = frf ? CLI_HZ_TO_RAD_S : CLI_RPM_TO_RAD_S, num = 0.0, den = 0.0, *w;
+  double unit = frf ? CLI_HZ_TO_RAD_S : CLI_RPM_TO_RAD_S, *sd;
   const double *x = rcb_meas_grid(ms);
-  *w_out = NULL;
+  *sd_out = NULL;
   if ((rc = read_table(path, &t))) {
     table_free(&t);
     return rc;
@@ -121,8 +120,8 @@ int cli_sd_weights(const char *path, const rcb_meas *ms, int scale, const double
                       "point %zu at %.9g: not the same abscissa", path, i + 1, at,
                       frf ? "Hz" : "rpm", i + 1, x[i] / unit);
     }
-  w = calloc((n ? n : 1) * (nc ? nc : 1), sizeof *w);
-  if (!w) {
+  sd = calloc((n ? n : 1) * (nc ? nc : 1), sizeof *sd);
+  if (!sd) {
     table_free(&t);
     return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   }
@@ -137,21 +136,38 @@ int cli_sd_weights(const char *path, const rcb_meas *ms, int scale, const double
       snprintf(name, sizeof name, "%s 1X sd", ci.response);
     if ((col = find_col(&t, name)) < 0) {
       table_free(&t);
-      free(w);
+      free(sd);
       return cli_fail(CLI_EXIT_INPUT, "--sd %s: no column '%s' for channel %s", path, name,
                       ci.response);
     }
+    for (i = 0; i < n; i++) sd[c * n + i] = t.v[i * t.ncol + (size_t)col];
+  }
+  table_free(&t);
+  *sd_out = sd;
+  return 0;
+}
+
+int cli_sd_weights(const char *path, const rcb_meas *ms, int scale, const double *band,
+                   double **w_out, double *floor_pct) {
+  size_t n = rcb_meas_point_count(ms), nc = rcb_meas_channel_count(ms), c, i;
+  double num = 0.0, den = 0.0, *sd;
+  const double *x = rcb_meas_grid(ms);
+  int rc;
+  *w_out = NULL;
+  if ((rc = cli_sd_values(path, ms, &sd))) return rc;
+  for (c = 0; c < nc; c++) {
+    rcb_meas_channel_info ci;
+    rcb_meas_channel(ms, c, &ci);
     for (i = 0; i < n; i++) {
-      double sd = t.v[i * t.ncol + (size_t)col];
-      w[c * n + i] = weight(scale, ci.data[i], sd);
-      if (w[c * n + i] > 0.0 && (!band || (x[i] >= band[0] && x[i] <= band[1]))) {
-        num += sd * sd;
+      double s = sd[c * n + i];
+      sd[c * n + i] = weight(scale, ci.data[i], s); /* in place: sd becomes the weights */
+      if (sd[c * n + i] > 0.0 && (!band || (x[i] >= band[0] && x[i] <= band[1]))) {
+        num += s * s;
         den += creal(ci.data[i] * conj(ci.data[i]));
       }
     }
   }
-  table_free(&t);
-  *w_out = w;
+  *w_out = sd;
   *floor_pct = den > 0.0 ? 100.0 * sqrt(num / den) : (double)NAN;
   return 0;
 }
