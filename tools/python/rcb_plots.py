@@ -2,6 +2,7 @@
 """Pictures of librcb results, drawn with matplotlib from rcbtool's JSON.
 
     rcb_plots.py compare COMPARE.json PREFIX
+    rcb_plots.py monitor MONITOR.json OUT [FORMAT]
 
 reads the JSON of `rcbtool compare --json` (rcbtool compare --plot PREFIX runs
 this script itself) and writes
@@ -11,6 +12,14 @@ this script itself) and writes
                            marked;
   PREFIX_residual_map.png  RMS log10 magnitude error per channel and band, with
                            CSAC and CSF across channels against frequency.
+
+The second reads the JSON of `rcbtool monitor --json` (or its --log .json;
+rcbtool monitor --plot OUT runs this script itself) and writes the trend OUT
+(FORMAT png, pdf or svg; by default from OUT's extension): each tracked
+parameter with its 95 % band against the update, the instant test statistic
+over its threshold (log axis) with the alarm line at 1, and the moments of
+change marked: the first TEST alarm (with the effect and place named) and the
+first CUSUM alarm, as vertical lines on every panel.
 Exit codes: 0 written, 2 usage, 3 matplotlib missing, 4 bad JSON, 5 not written.
 """
 
@@ -176,9 +185,102 @@ def residual_map(plt, d, path):
     plt.close(fig)
 
 
+def _first(updates, key):
+    return next((u["update"] for u in updates if u[key]), None)
+
+
+def trend(plt, d, path, fmt=None):
+    ups = d["updates"]
+    names = [t["name"] for t in d["tracked"]]
+    x = [u["update"] for u in ups]
+    fig, axes = plt.subplots(len(names) + 1, 1, figsize=(9, 2.4 * (len(names) + 1) + 0.6),
+                             sharex=True, squeeze=False)
+    axes = axes[:, 0]
+    t_alarm, c_alarm = _first(ups, "alarm"), _first(ups, "cusum_alarm")
+    for k, (ax, name) in enumerate(zip(axes, names)):
+        v = [u["tracked"][k]["value"] for u in ups]
+        lo = [u["tracked"][k]["ci_lo"] for u in ups]
+        hi = [u["tracked"][k]["ci_hi"] for u in ups]
+        ax.fill_between(x, lo, hi, color="tab:blue", alpha=0.25, lw=0, label="95 % interval")
+        ax.plot(x, v, color="tab:blue", lw=1.0, label="estimate")
+        ax.axhline(d["tracked"][k]["baseline"], color="k", ls="--", lw=0.8, label="baseline")
+        ax.set_ylabel(name, fontsize=8)
+        ax.grid(True, alpha=0.3)
+        ax.tick_params(labelsize=7)
+    ax = axes[-1]
+    ratio = [u["T"] / u["threshold"] if u["T"] is not None and u["threshold"] else math.nan
+             for u in ups]
+    ax.semilogy(x, [max(r, 1e-3) for r in ratio], ".-", color="tab:gray", lw=0.7, ms=3,
+                label="T / threshold")
+    al = [(xi, max(r, 1e-3)) for xi, r, u in zip(x, ratio, ups) if u["alarm"]]
+    if al:
+        ax.semilogy(*zip(*al), "o", color="tab:red", ms=4, label="TEST alarm")
+    ax.axhline(1.0, color="tab:red", lw=1.0, label=f"alarm line (alpha {d.get('alpha') or 0:.2g})")
+    ax.set_ylabel("T / threshold (-)", fontsize=8)
+    ax.set_xlabel("update", fontsize=8)
+    ax.grid(True, alpha=0.3, which="both")
+    ax.tick_params(labelsize=7)
+    for a in axes:
+        if t_alarm is not None:
+            a.axvline(t_alarm, color="tab:red", ls=":", lw=1.2,
+                      label=f"first TEST alarm (update {t_alarm})")
+        if c_alarm is not None:
+            a.axvline(c_alarm, color="tab:orange", ls="-.", lw=1.2,
+                      label=f"first CUSUM alarm (update {c_alarm})")
+        a.legend(fontsize=6, loc="best")
+    title = f"{d['model']}: {len(ups)} updates"
+    if t_alarm is not None:
+        u = next(u for u in ups if u["alarm"])
+        if u["top"]:
+            title += f"; first TEST alarm: {u['top'][0]['effect']} at {u['top'][0]['place']}"
+    axes[0].set_title(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110, format=fmt)
+    plt.close(fig)
+
+
+def _matplotlib():
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError as e:
+        print(f"rcb_plots.py: matplotlib is not available to {sys.executable}: {e}",
+              file=sys.stderr)
+        return None
+    return plt
+
+
+def main_monitor(argv):
+    plt = _matplotlib()
+    if plt is None:
+        return 3
+    try:
+        with open(argv[2]) as f:
+            d = json.load(f)
+        d["updates"][0]["tracked"]
+        d["tracked"]
+    except (OSError, ValueError, KeyError, IndexError) as e:
+        print(f"rcb_plots.py: cannot read {argv[2]} as rcbtool monitor JSON: {e}",
+              file=sys.stderr)
+        return 4
+    out = argv[3]
+    fmt = argv[4] if len(argv) > 4 else None
+    try:
+        trend(plt, d, out, fmt)
+    except OSError as e:
+        print(f"rcb_plots.py: cannot write the picture: {e}", file=sys.stderr)
+        return 5
+    return 0
+
+
 def main(argv):
+    if len(argv) in (4, 5) and argv[1] == "monitor":
+        return main_monitor(argv)
     if len(argv) != 4 or argv[1] != "compare":
-        print("usage: rcb_plots.py compare COMPARE.json PREFIX", file=sys.stderr)
+        print("usage: rcb_plots.py compare COMPARE.json PREFIX\n"
+              "       rcb_plots.py monitor MONITOR.json OUT [FORMAT]", file=sys.stderr)
         return 2
     try:
         import matplotlib
