@@ -1,59 +1,279 @@
 /*
- * rcb_monitor: commissioning (create) and the allocation-free update.
- * (Stub: the API is fixed, the implementation follows.)
+ * rcb_monitor: the update (allocation-free: every buffer was sized by
+ * rcb_monitor_create), the getters and destroy. The statistics are stated
+ * in rcb_monitor.h; here they are applied in the rank space of the
+ * whitened sensitivity columns (y = Q^T r, k values).
  */
+#include <math.h>
 #include <string.h>
 
+#include "identify/identify.h"
 #include "monitor/monitor_internal.h"
 
-struct rcb_monitor {
-  rcb_allocator alloc;
-  char errmsg[RCB_ERRMSG_MAX];
-};
-
-rcb_status rcb_monitor_create(rcb_monitor **out, const rcb_model *baseline,
-                              const rcb_meas *setup, const rcb_monitor_opts *opts,
-                              const rcb_allocator *alloc) {
-  rcb_allocator a;
-  rcb_monitor *mon;
-  (void)baseline, (void)setup, (void)opts;
-  if (!out) return RCB_ERR_ARG;
-  *out = NULL;
-  rcb_allocator_init(&a, alloc);
-  if (!(mon = rcb_alloc(&a, sizeof *mon))) return RCB_ERR_NOMEM;
-  mon->alloc = a;
-  *out = mon;
-  return rcb_fail(mon, RCB_ERR_UNSUPPORTED, "rcb_monitor_create: not implemented yet");
-}
+/* Two-sided 95 % normal quantile. */
+#define MON_Z95 1.959963984540054
 
 void rcb_monitor_destroy(rcb_monitor *mon) {
-  if (mon) rcb_free(&mon->alloc, mon);
+  rcb_allocator a;
+  size_t j;
+  if (!mon) return;
+  a = mon->user;
+  for (j = 0; j < mon->ncand; j++) rcb_free(&mon->alloc, mon->cand[j].est);
+  rcb_free(&mon->alloc, mon->cand);
+  rcb_free(&mon->alloc, mon->test);
+  rcb_free(&mon->alloc, mon->Q);
+  rcb_free(&mon->alloc, mon->y);
+  rcb_fit_destroy(mon->fit);
+  rcb_model_destroy(mon->model);
+  rcb_meas_destroy(mon->setup);
+  rcb_free(&mon->alloc, mon->e0);
+  rcb_free(&mon->alloc, mon->h0abs);
+  rcb_free(&a, mon);
 }
 
 const char *rcb_monitor_errmsg(const rcb_monitor *mon) { return mon ? mon->errmsg : "no monitor"; }
 
-rcb_status rcb_monitor_update(rcb_monitor *mon, const rcb_complex *values, const double *sd,
-                              rcb_monitor_result *res) {
-  (void)values, (void)sd, (void)res;
-  if (!mon) return RCB_ERR_ARG;
-  return rcb_fail(mon, RCB_ERR_UNSUPPORTED, "rcb_monitor_update: not implemented yet");
+static int ready(const rcb_monitor *mon) { return mon && mon->k > 0 && mon->y; }
+
+/* out = Q^T r (k values). */
+static void to_rank(const rcb_monitor *mon, const double *r, double *out) {
+  size_t a, i, n = mon->n;
+  for (a = 0; a < mon->k; a++) {
+    const double *q = mon->Q + n * a;
+    double s = 0;
+    for (i = 0; i < n; i++) s += q[i] * r[i];
+    out[a] = s;
+  }
 }
 
-void rcb_monitor_reset_cusum(rcb_monitor *mon) { (void)mon; }
-size_t rcb_monitor_point_count(const rcb_monitor *mon) { (void)mon; return 0; }
-size_t rcb_monitor_memory(const rcb_monitor *mon) { (void)mon; return 0; }
-rcb_status rcb_monitor_rank(const rcb_monitor *mon, size_t *k, size_t *k_tracked) {
-  (void)mon, (void)k, (void)k_tracked;
-  return RCB_ERR_UNSUPPORTED;
+static double dot(const double *a, const double *b, size_t n) {
+  double s = 0;
+  size_t i;
+  for (i = 0; i < n; i++) s += a[i] * b[i];
+  return s;
 }
-size_t rcb_monitor_candidate_count(const rcb_monitor *mon) { (void)mon; return 0; }
+
+static rcb_status check_input(rcb_monitor *mon, const rcb_complex *v, const double *sd) {
+  size_t p;
+  for (p = 0; p < mon->npt; p++) {
+    if (!isfinite(creal(v[p])) || !isfinite(cimag(v[p])))
+      return rcb_mon_fail(mon, RCB_ERR_ARG, "update %zu: channel %zu point %zu is not finite "
+                          "(NaN or infinite value); the update was not taken", mon->updates + 1,
+                          p / mon->npts + 1, p % mon->npts + 1);
+    if (sd && (!(sd[p] > 0) || !isfinite(sd[p])))
+      return rcb_mon_fail(mon, RCB_ERR_ARG, "update %zu: channel %zu point %zu: sd = %g, "
+                          "expected finite > 0; the update was not taken", mon->updates + 1,
+                          p / mon->npts + 1, p % mon->npts + 1, sd[p]);
+  }
+  return RCB_OK;
+}
+
+/* ym = Q^T W (m(theta) - m(theta_0)) for tracked values t0 + theta. */
+static rcb_status model_change(rcb_monitor *mon, const double *theta) {
+  size_t k, p;
+  rcb_status st = RCB_OK;
+  for (k = 0; !st && k < mon->nt; k++)
+    st = rcb_model_set_param(mon->model, mon->tname[k], mon->t0[k] + theta[k]);
+  if (!st) st = rcb_fit_residuals(mon->fit, mon->rm);
+  if (st) {
+    for (k = 0; k < mon->nt; k++) rcb_model_set_param(mon->model, mon->tname[k], mon->t0[k]);
+    return rcb_mon_fail(mon, st, "re-linearising at the tracked estimate: %s",
+                        rcb_fit_errmsg(mon->fit));
+  }
+  for (p = 0; p < mon->npt; p++) {
+    double complex g = conj(mon->u[p]) * CMPLX(mon->rm[2 * p] - mon->rbase[2 * p],
+                                               mon->rm[2 * p + 1] - mon->rbase[2 * p + 1]);
+    mon->rm[2 * p] = creal(g) * mon->winv[2 * p];
+    mon->rm[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
+  }
+  to_rank(mon, mon->rm, mon->ym);
+  return RCB_OK;
+}
+
+/* The tracked step theta (linear, then chord iterations re-evaluating the
+ * model: theta += E (y - ym(theta)), E the linear estimator); on return
+ * mon->y holds the change the tracked parameters do not explain. */
+static rcb_status tracked_step(rcb_monitor *mon, double *theta) {
+  size_t a, it, i, k = mon->k, nt = mon->nt;
+  rcb_status st;
+  for (a = 0; a < nt; a++) theta[a] = dot(mon->test + a * k, mon->y, k);
+  if (!mon->relin || !nt) return RCB_OK;
+  for (it = 0; it < mon->relin; it++) {
+    if ((st = model_change(mon, theta))) return st;
+    for (i = 0; i < k; i++) mon->ym[i] = mon->y[i] - mon->ym[i];
+    for (a = 0; a < nt; a++) theta[a] += dot(mon->test + a * k, mon->ym, k);
+  }
+  if ((st = model_change(mon, theta))) return st;
+  for (i = 0; i < k; i++) mon->y[i] -= mon->ym[i];
+  /* what is left along the tracked directions is re-expressed in them */
+  for (a = 0; a < nt; a++) theta[a] += dot(mon->test + a * k, mon->y, k);
+  for (a = 0; a < nt; a++) rcb_model_set_param(mon->model, mon->tname[a], mon->t0[a]);
+  return RCB_OK;
+}
+
+static void tracked_result(rcb_monitor *mon, const double *theta, rcb_monitor_result *res) {
+  size_t a;
+  res->ntracked = mon->nt;
+  res->cusum_alarm = 0;
+  for (a = 0; a < mon->nt; a++) {
+    rcb_monitor_tracked *t = &res->tracked[a];
+    double se = mon->tse[a], z = theta[a] / se;
+    t->value = mon->t0[a] + theta[a];
+    t->stderr_ = se;
+    t->ci_lo = t->value - MON_Z95 * se, t->ci_hi = t->value + MON_Z95 * se;
+    t->z = z;
+    mon->cus_up[a] = fmax(0.0, mon->cus_up[a] + z - mon->cusum_k);
+    mon->cus_dn[a] = fmax(0.0, mon->cus_dn[a] - z - mon->cusum_k);
+    t->cusum_up = mon->cus_up[a], t->cusum_down = mon->cus_dn[a];
+    t->cusum_alarm = t->cusum_up > mon->cusum_h ? 1 : t->cusum_down > mon->cusum_h ? -1 : 0;
+    t->out_of_range = t->value < mon->tlo[a] || t->value > mon->thi[a];
+    if (t->cusum_alarm) res->cusum_alarm = 1;
+  }
+}
+
+/* a ranks before b: smaller p-value; where both underflow, larger
+ * standardised score. */
+static int before(const rcb_monitor *mon, size_t a, size_t b) {
+  const mon_cand *ca = &mon->cand[a], *cb = &mon->cand[b];
+  double pa = mon->pscore[a], pb = mon->pscore[b];
+  if (pa != pb) return pa < pb;
+  return (ca->score_now - (double)ca->dof) / sqrt(2.0 * (double)ca->dof) >
+         (cb->score_now - (double)cb->dof) / sqrt(2.0 * (double)cb->dof);
+}
+
+static void candidates(rcb_monitor *mon, rcb_monitor_result *res) {
+  size_t j, a, k = mon->k, nsc = 0, t;
+  for (j = 0; j < mon->ncand; j++) {
+    mon_cand *c = &mon->cand[j];
+    if (!c->dof) continue;
+    c->score_now = 0;
+    for (a = 0; a < c->dof; a++) {
+      double z = dot(c->dir + a * k, mon->y, k);
+      c->score_now += z * z;
+    }
+    mon->pscore[j] = rcb_chi2_sf(c->score_now, (double)c->dof);
+    mon->order[nsc++] = j;
+  }
+  /* partial selection sort: the best mon->top first */
+  res->ntop = nsc < mon->top ? nsc : mon->top;
+  for (t = 0; t < res->ntop; t++) {
+    size_t best = t;
+    for (j = t + 1; j < nsc; j++)
+      if (before(mon, mon->order[j], mon->order[best])) best = j;
+    if (best != t) {
+      size_t s = mon->order[t];
+      mon->order[t] = mon->order[best], mon->order[best] = s;
+    }
+  }
+  for (t = 0; t < res->ntop; t++) {
+    const mon_cand *c = &mon->cand[mon->order[t]];
+    rcb_monitor_candidate *o = &res->top[t];
+    o->index = mon->order[t];
+    o->effect = c->effect;
+    o->np = c->np;
+    o->score = c->score_now;
+    o->dof = c->dof;
+    o->p_value = mon->pscore[mon->order[t]];
+    for (a = 0; a < c->np; a++) {
+      o->size[a] = dot(c->est + a * k, mon->y, k);
+      o->ci_lo[a] = o->size[a] - MON_Z95 * c->se[a];
+      o->ci_hi[a] = o->size[a] + MON_Z95 * c->se[a];
+    }
+  }
+}
+
+/* Paper's error %, change % and the noise floor % of this measurement. */
+static void errors(const rcb_monitor *mon, const rcb_complex *v, rcb_monitor_result *res) {
+  double em = 0, ec = 0, ee = 0, fl = 0;
+  size_t p;
+  for (p = 0; p < mon->npt; p++) {
+    double av = cabs(v[p]), dm = mon->h0abs[p] - av, dc = cabs(mon->e0[p]) - av;
+    em += dm * dm, ec += dc * dc, ee += av * av;
+    fl += mon->sd_new_rad[p] * mon->sd_new_rad[p];
+  }
+  ee = ee > 0 ? sqrt(ee) : 1.0;
+  res->error_pct = 100.0 * sqrt(em) / ee;
+  res->change_pct = 100.0 * sqrt(ec) / ee;
+  res->floor_pct = 100.0 * sqrt(fl) / ee;
+}
+
+rcb_status rcb_monitor_update(rcb_monitor *mon, const rcb_complex *values, const double *sd,
+                              rcb_monitor_result *res) {
+  double theta[RCB_MONITOR_MAX_TRACKED], T;
+  size_t p, a;
+  rcb_status st;
+  if (!mon) return RCB_ERR_ARG;
+  if (!values || !res) return rcb_mon_fail(mon, RCB_ERR_ARG, "rcb_monitor_update: values and "
+                                           "result are required");
+  if (!ready(mon))
+    return rcb_mon_fail(mon, RCB_ERR_STATE, "rcb_monitor_update: the monitor was not created "
+                        "successfully");
+  if (sd)
+    return rcb_mon_fail(mon, RCB_ERR_UNSUPPORTED, "rcb_monitor_update: per-update sd is not "
+                        "implemented yet; give the noise at create (opts.sd / beta)");
+  if ((st = check_input(mon, values, sd))) return st;
+  memset(res, 0, sizeof *res);
+  for (p = 0; p < mon->npt; p++) {
+    double complex g = conj(mon->u[p]) * (values[p] - mon->e0[p]);
+    mon->r[2 * p] = creal(g) * mon->winv[2 * p];
+    mon->r[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
+  }
+  to_rank(mon, mon->r, mon->y);
+  if ((st = tracked_step(mon, theta))) return st;
+  mon->updates++;
+  res->update = mon->updates;
+  errors(mon, values, res);
+  tracked_result(mon, theta, res);
+  /* instant test: the part of y beyond the tracked directions */
+  T = dot(mon->y, mon->y, mon->k);
+  for (a = 0; a < mon->nt; a++) {
+    double z = dot(mon->tdir + a * mon->k, mon->y, mon->k);
+    T -= z * z;
+  }
+  res->T = fmax(T, 0.0);
+  res->dof = mon->k - mon->nt;
+  res->threshold = mon->threshold;
+  res->p_value = res->dof ? rcb_chi2_sf(res->T, (double)res->dof) : 1.0;
+  res->alarm = res->dof && res->T > mon->threshold;
+  candidates(mon, res);
+  return RCB_OK;
+}
+
+void rcb_monitor_reset_cusum(rcb_monitor *mon) {
+  if (!mon) return;
+  memset(mon->cus_up, 0, sizeof mon->cus_up);
+  memset(mon->cus_dn, 0, sizeof mon->cus_dn);
+}
+
+size_t rcb_monitor_point_count(const rcb_monitor *mon) { return ready(mon) ? mon->npt : 0; }
+size_t rcb_monitor_memory(const rcb_monitor *mon) { return mon ? mon->held : 0; }
+
+rcb_status rcb_monitor_rank(const rcb_monitor *mon, size_t *k, size_t *k_tracked) {
+  if (!ready(mon)) return RCB_ERR_STATE;
+  if (k) *k = mon->k;
+  if (k_tracked) *k_tracked = mon->nt;
+  return RCB_OK;
+}
+
+size_t rcb_monitor_candidate_count(const rcb_monitor *mon) { return ready(mon) ? mon->ncand : 0; }
+
 rcb_status rcb_monitor_candidate_info_get(const rcb_monitor *mon, size_t i,
                                           rcb_monitor_candidate_info *out) {
-  (void)mon, (void)i, (void)out;
-  return RCB_ERR_UNSUPPORTED;
+  const mon_cand *c;
+  if (!ready(mon) || !out || i >= mon->ncand) return RCB_ERR_ARG;
+  c = &mon->cand[i];
+  out->effect = c->effect;
+  out->place = c->place;
+  out->description = c->desc;
+  out->params = c->params;
+  out->np = c->np;
+  return RCB_OK;
 }
+
 rcb_status rcb_monitor_tracked_info(const rcb_monitor *mon, size_t k, const char **name,
                                     double *baseline) {
-  (void)mon, (void)k, (void)name, (void)baseline;
-  return RCB_ERR_UNSUPPORTED;
+  if (!ready(mon) || k >= mon->nt) return RCB_ERR_ARG;
+  if (name) *name = mon->tname[k];
+  if (baseline) *baseline = mon->t0[k];
+  return RCB_OK;
 }

@@ -1,0 +1,611 @@
+/*
+ * Commissioning a monitor (rcb_monitor.h): the set-up and the baseline model
+ * copied, the noise of every residual, the sensitivity columns of the
+ * tracked parameters (identify/, eq. 9) and of the diagnosis catalogue's
+ * candidates at their neutral values (diagnose/diagnose.h, fit_score.c's
+ * batched adjoint columns), all whitened and factored once by the score
+ * test's QR (diagnose/score_qr.c), and the small rank-space matrices the
+ * update applies. Everything is allocated here; nothing in monitor.c.
+ */
+#include <lapacke.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "diagnose/diagnose.h"
+#include "identify/identify.h"
+#include "monitor/monitor_internal.h"
+
+/* Relative size of a triangular factor's diagonal below which a column
+ * counts as explained by those before it (as score_qr.c's RCB_DIAG_RANK_TOL). */
+#define MON_RANK_TOL 1e-10
+/* Two-sided 95 % normal quantile. */
+#define MON_Z95 1.959963984540054
+
+/* ---- the counting allocator: every byte the monitor's objects hold ---- */
+
+#define MON_HDR 16u /* keeps the caller's 16-byte alignment */
+
+static void *count_alloc(void *user, size_t size) {
+  rcb_monitor *mon = user;
+  unsigned char *p;
+  if (size > (size_t)-1 - MON_HDR) return NULL;
+  p = rcb_alloc(&mon->user, size + MON_HDR);
+  if (!p) return NULL;
+  memcpy(p, &size, sizeof size);
+  mon->held += size;
+  return p + MON_HDR;
+}
+
+static void count_free(void *user, void *ptr) {
+  rcb_monitor *mon = user;
+  unsigned char *p = (unsigned char *)ptr - MON_HDR;
+  size_t size;
+  memcpy(&size, p, sizeof size);
+  mon->held -= size;
+  rcb_free(&mon->user, p);
+}
+
+static void *mon_alloc(rcb_monitor *mon, size_t count, size_t size) {
+  if (count && size > (size_t)-1 / count) return NULL;
+  return rcb_alloc(&mon->alloc, count * size);
+}
+
+/* ---- set-up: a copy of the commissioning measurement ---- */
+
+static rcb_status copy_setup(rcb_monitor *mon, const rcb_meas *setup) {
+  size_t c, i;
+  rcb_status st;
+  mon->nch = rcb_meas_channel_count(setup);
+  mon->npts = rcb_meas_point_count(setup);
+  if (!mon->nch || !mon->npts)
+    return rcb_mon_fail(mon, RCB_ERR_ARG, "set-up: no channel or no point (%zu channels x %zu "
+                        "points); give the commissioning measurement", mon->nch, mon->npts);
+  mon->npt = mon->nch * mon->npts;
+  mon->n = 2 * mon->npt;
+  if ((st = rcb_meas_create(&mon->setup, &mon->alloc)) ||
+      (st = rcb_meas_set_grid(mon->setup, rcb_meas_get_type(setup), mon->npts,
+                              rcb_meas_grid(setup), rcb_meas_speed(setup))))
+    return rcb_mon_fail(mon, st, "set-up: %s", mon->setup ? rcb_meas_errmsg(mon->setup) : "");
+  for (c = 0; c < mon->nch; c++) {
+    rcb_meas_channel_info ci;
+    rcb_meas_channel(setup, c, &ci);
+    for (i = 0; i < mon->npts; i++)
+      if (!isfinite(creal(ci.data[i])) || !isfinite(cimag(ci.data[i])))
+        return rcb_mon_fail(mon, RCB_ERR_ARG, "set-up: channel %zu (%s) point %zu: the "
+                            "commissioning value is not finite", c + 1, ci.response, i + 1);
+    if ((st = rcb_meas_add_channel(mon->setup, ci.response, ci.reference, ci.kind, ci.data)))
+      return rcb_mon_fail(mon, st, "set-up: %s", rcb_meas_errmsg(mon->setup));
+  }
+  return RCB_OK;
+}
+
+/* ---- noise: the standard deviation of every residual ---- */
+
+/* Radial and tangential sd of one measurement at each point: eq. 19
+ * (proportional part along e_0, variance (beta_a/100)^2 |e_0|^2 / 3 from
+ * r1 uniform on [-1, 1]; additive part circular, a^2 / 3 split over two
+ * components) or the caller's sd (circular). */
+static rcb_status noise(rcb_monitor *mon, const rcb_monitor_opts *o) {
+  double navg = o->setup_averages > 0 ? o->setup_averages : 1.0;
+  double f0 = isinf(navg) ? 1.0 : 1.0 + 1.0 / navg; /* new + commissioning variance */
+  size_t c, i;
+  if (navg < 1.0)
+    return rcb_mon_fail(mon, RCB_ERR_ARG, "setup_averages = %g: expected >= 1 (measurements "
+                        "averaged into the commissioning values)", navg);
+  if (!o->sd && !(o->beta_a > 0 || o->beta_s > 0))
+    return rcb_mon_fail(mon, RCB_ERR_ARG, "no noise: give beta_a/beta_s (eq. 19, %%) or per-point "
+                        "standard deviations (opts.sd)");
+  if (!o->sd && (!(o->beta_a >= 0) || !(o->beta_s >= 0) || !isfinite(o->beta_a + o->beta_s)))
+    return rcb_mon_fail(mon, RCB_ERR_ARG, "noise: beta_a = %g, beta_s = %g %%: expected finite "
+                        ">= 0", o->beta_a, o->beta_s);
+  for (c = 0; c < mon->nch; c++) {
+    const rcb_complex *e = mon->e0 + c * mon->npts;
+    double s2 = 0.0, a;
+    for (i = 0; i < mon->npts; i++) s2 += creal(e[i] * conj(e[i]));
+    mon->e0norm2 += s2;
+    a = o->beta_s / 100.0 * sqrt(s2) / (double)mon->npts; /* eq. 19 additive amplitude */
+    for (i = 0; i < mon->npts; i++) {
+      size_t p = c * mon->npts + i;
+      double ae = cabs(e[i]), vr, vt;
+      mon->u[p] = ae > 0 ? e[i] / ae : 1.0;
+      if (o->sd) {
+        double s = o->sd[p];
+        if (!(s > 0) || !isfinite(s))
+          return rcb_mon_fail(mon, RCB_ERR_ARG, "opts.sd: channel %zu point %zu: sd = %g, "
+                              "expected finite > 0", c + 1, i + 1, s);
+        vr = vt = s * s;
+      } else {
+        double pa = o->beta_a / 100.0 * ae;
+        vt = a * a / 6.0;
+        vr = pa * pa / 3.0 + vt;
+      }
+      if (!(vr > 0) || !(vt > 0))
+        return rcb_mon_fail(mon, RCB_ERR_ARG, "noise: channel %zu point %zu has zero standard "
+                            "deviation (commissioning value 0 and beta_s = 0); give beta_s > 0 "
+                            "or opts.sd", c + 1, i + 1);
+      mon->sd_new_rad[p] = sqrt(vr);
+      mon->winv[2 * p] = 1.0 / sqrt(vr * f0);
+      mon->winv[2 * p + 1] = 1.0 / sqrt(vt * f0);
+    }
+  }
+  return RCB_OK;
+}
+
+/* ---- the baseline model, its fit of the tracked parameters ---- */
+
+static rcb_status baseline(rcb_monitor *mon, const rcb_model *base, const rcb_monitor_opts *o) {
+  rcb_status st = rcb_model_clone(&mon->model, base, &mon->alloc);
+  size_t k, p;
+  if (!st) st = rcb_model_finalize(mon->model);
+  if (st) return rcb_mon_fail(mon, st, "baseline model: %s",
+                              mon->model ? rcb_model_errmsg(mon->model) : rcb_status_str(st));
+  if ((st = rcb_fit_create(&mon->fit, mon->model, mon->setup, &mon->alloc)) ||
+      (st = rcb_fit_set_scale(mon->fit, RCB_SCALE_COMPLEX)) ||
+      (st = rcb_fit_set_uncertainty(mon->fit, 0)))
+    return rcb_mon_fail(mon, st, "set-up against the baseline: %s",
+                        mon->fit ? rcb_fit_errmsg(mon->fit) : rcb_status_str(st));
+  for (k = 0; k < mon->nt; k++) {
+    const rcb_monitor_param *t = &o->tracked[k];
+    if (!t->name || strlen(t->name) >= RCB_MONITOR_NAME)
+      return rcb_mon_fail(mon, RCB_ERR_ARG, "tracked parameter %zu: no name or too long", k + 1);
+    snprintf(mon->tname[k], sizeof mon->tname[k], "%s", t->name);
+    mon->tlo[k] = t->lo, mon->thi[k] = t->hi;
+    if ((st = rcb_model_get_param(mon->model, t->name, &mon->t0[k])))
+      return rcb_mon_fail(mon, st, "tracked parameter '%s': %s", t->name,
+                          rcb_model_errmsg(mon->model));
+    if ((st = rcb_fit_add_param(mon->fit, t->name, t->lo, t->hi, 0)))
+      return rcb_mon_fail(mon, st, "tracked parameter '%s': %s", t->name,
+                          rcb_fit_errmsg(mon->fit));
+  }
+  if ((st = rcb_fit_residuals(mon->fit, mon->rbase)))
+    return rcb_mon_fail(mon, st, "baseline model on the set-up: %s", rcb_fit_errmsg(mon->fit));
+  if (rcb_fit_residual_count(mon->fit) != mon->n)
+    return rcb_mon_fail(mon, RCB_ERR_STATE, "residual layout: %zu, expected %zu",
+                        rcb_fit_residual_count(mon->fit), mon->n);
+  for (p = 0; p < mon->npt; p++)
+    mon->h0abs[p] = cabs(mon->e0[p] + CMPLX(mon->rbase[2 * p], mon->rbase[2 * p + 1]));
+  return RCB_OK;
+}
+
+/* ---- columns ---- */
+
+typedef struct col_plan {
+  size_t *cand;   /* catalogue index of each kept candidate */
+  size_t *col;    /* its first column */
+  int *own;       /* 1: its model has other DOFs (its own sweep) */
+  size_t ncand, ncol;
+} col_plan;
+
+static int wanted(const rcb_diag_cand_desc *c, unsigned mask) {
+  if (c->refit_only || !c->np) return 0;
+  return mask ? (mask >> (unsigned)c->effect) & 1u : 1;
+}
+
+/* A fit of candidate model cm with its parameters (complex scale, as the base). */
+static rcb_status cand_fit(rcb_monitor *mon, rcb_model *cm, const rcb_diag_cand_desc *c,
+                           rcb_fit **out) {
+  rcb_status st = rcb_fit_create(out, cm, mon->setup, &mon->alloc);
+  size_t k;
+  if (!st) st = rcb_fit_set_scale(*out, RCB_SCALE_COMPLEX);
+  if (!st) st = rcb_fit_set_uncertainty(*out, 0);
+  for (k = 0; !st && k < c->np; k++) st = rcb_fit_add_param(*out, c->pname[k], c->lo[k], c->hi[k], 0);
+  if (st)
+    return rcb_mon_fail(mon, st, "%s: %s", c->desc, *out ? rcb_fit_errmsg(*out) : "no memory");
+  return RCB_OK;
+}
+
+/* The candidates' columns into J (n x ncol, after the tracked ones): one
+ * batched adjoint sweep of the base model for those with its DOFs, a sweep
+ * of their own model for the others (a pedestal). */
+static rcb_status cand_columns(rcb_monitor *mon, rcb_diag *d, const col_plan *pl, double *J) {
+  size_t ndz = 0, j, ndof = rcb_model_dof_count(mon->model), batch = 0;
+  rcb_fit_dz *dz = mon_alloc(mon, pl->ncol ? pl->ncol : 1, sizeof *dz);
+  rcb_status st = RCB_OK;
+  if (!dz) return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (candidate columns)");
+  for (j = 0; !st && j < pl->ncand; j++) {
+    rcb_diag_cand_desc c;
+    rcb_model *cm = NULL;
+    rcb_fit *cf = NULL;
+    rcb_diag_catalogue_get(d, pl->cand[j], &c);
+    if ((st = rcb_diag_catalogue_model(d, pl->cand[j], mon->model, &cm))) {
+      rcb_mon_fail(mon, st, "%s", rcb_diag_errmsg(d));
+      break;
+    }
+    st = cand_fit(mon, cm, &c, &cf);
+    pl->own[j] = rcb_model_dof_count(cm) != ndof;
+    if (!st && !pl->own[j]) {
+      if ((st = rcb_fit_dz_get(cf, &mon->alloc, dz + ndz)))
+        rcb_mon_fail(mon, st, "%s: %s", c.desc, rcb_fit_errmsg(cf));
+      else
+        ndz += c.np, batch++;
+    } else if (!st) {
+      if ((st = rcb_fit_jacobian(cf, 1, J + mon->n * pl->col[j])))
+        rcb_mon_fail(mon, st, "%s: %s", c.desc, rcb_fit_errmsg(cf));
+      else if (rcb_fit_residual_count(cf) != mon->n)
+        st = rcb_mon_fail(mon, RCB_ERR_STATE, "%s: residual layout differs", c.desc);
+    }
+    rcb_fit_destroy(cf);
+    rcb_model_destroy(cm);
+  }
+  if (!st && ndz) {
+    /* the batch's columns are contiguous after the tracked ones (plan order) */
+    if ((st = rcb_fit_jacobian_dz(mon->fit, dz, ndz, J + mon->n * mon->nt)))
+      rcb_mon_fail(mon, st, "candidate columns: %s", rcb_fit_errmsg(mon->fit));
+  }
+  (void)batch;
+  rcb_fit_dz_free(&mon->alloc, dz, ndz);
+  rcb_free(&mon->alloc, dz);
+  return st;
+}
+
+/* Which candidates, their columns: the batched (same DOFs) ones first. The
+ * DOF test needs the candidate's model, so it is made twice (cheap). */
+static rcb_status plan(rcb_monitor *mon, rcb_diag *d, unsigned mask, col_plan *pl) {
+  size_t nc = rcb_diag_catalogue_count(d), i, pass, ndof = rcb_model_dof_count(mon->model);
+  rcb_status st;
+  int *same = mon_alloc(mon, nc ? nc : 1, sizeof *same);
+  pl->cand = mon_alloc(mon, nc ? nc : 1, sizeof *pl->cand);
+  pl->col = mon_alloc(mon, nc ? nc : 1, sizeof *pl->col);
+  pl->own = mon_alloc(mon, nc ? nc : 1, sizeof *pl->own);
+  if (!same || !pl->cand || !pl->col || !pl->own) {
+    rcb_free(&mon->alloc, same);
+    return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (catalogue)");
+  }
+  for (i = 0; i < nc; i++) {
+    rcb_diag_cand_desc c;
+    rcb_model *cm = NULL;
+    rcb_diag_catalogue_get(d, i, &c);
+    if (!wanted(&c, mask)) continue;
+    if ((st = rcb_diag_catalogue_model(d, i, mon->model, &cm))) {
+      rcb_free(&mon->alloc, same);
+      return rcb_mon_fail(mon, st, "%s", rcb_diag_errmsg(d));
+    }
+    same[i] = 1 + (rcb_model_dof_count(cm) == ndof);
+    rcb_model_destroy(cm);
+  }
+  pl->ncol = mon->nt;
+  for (pass = 2; pass >= 1; pass--)
+    for (i = 0; i < nc; i++) {
+      rcb_diag_cand_desc c;
+      if (same[i] != (int)pass) continue;
+      rcb_diag_catalogue_get(d, i, &c);
+      pl->cand[pl->ncand] = i;
+      pl->col[pl->ncand++] = pl->ncol;
+      pl->ncol += c.np;
+    }
+  rcb_free(&mon->alloc, same);
+  return RCB_OK;
+}
+
+/* Whiten every column of J (the fit's Re/Im layout) into the radial /
+ * tangential frame. */
+static void whiten_columns(const rcb_monitor *mon, double *J, size_t ncol) {
+  size_t j, p;
+  for (j = 0; j < ncol; j++) {
+    double *c = J + mon->n * j;
+    for (p = 0; p < mon->npt; p++) {
+      double complex g = conj(mon->u[p]) * CMPLX(c[2 * p], c[2 * p + 1]);
+      c[2 * p] = creal(g) * mon->winv[2 * p];
+      c[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
+    }
+  }
+}
+
+void rcb_mon_whiten(const rcb_monitor *mon, const rcb_complex *dv, double *r) {
+  size_t p;
+  for (p = 0; p < mon->npt; p++) {
+    double complex g = conj(mon->u[p]) * dv[p];
+    r[2 * p] = creal(g) * mon->winv[2 * p];
+    r[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
+  }
+}
+
+/* ---- rank space ---- */
+
+/* Thin QR of A (k x p, column-major, overwritten by Qa) with R (p x p,
+ * column-major) and its inverse Ri; *ok = 0 when a diagonal of R falls
+ * below MON_RANK_TOL of its column's norm (a dependent column). */
+static rcb_status small_qr(rcb_monitor *mon, double *A, size_t k, size_t p, double *R,
+                           double *Ri, double *tau, double *work, size_t lwork, int *ok) {
+  size_t i, j;
+  double norm[RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP];
+  lapack_int info;
+  *ok = p <= k;
+  if (!*ok || !p) return RCB_OK;
+  for (j = 0; j < p; j++) {
+    double s = 0;
+    for (i = 0; i < k; i++) s += A[i + k * j] * A[i + k * j];
+    norm[j] = sqrt(s);
+  }
+  info = LAPACKE_dgeqrf_work(LAPACK_COL_MAJOR, (lapack_int)k, (lapack_int)p, A, (lapack_int)k,
+                             tau, work, (lapack_int)lwork);
+  for (j = 0; !info && j < p; j++)
+    for (i = 0; i < p; i++) R[i + p * j] = i <= j ? A[i + k * j] : 0.0;
+  for (j = 0; j < p; j++)
+    if (!(fabs(R[j + p * j]) > MON_RANK_TOL * norm[j])) *ok = 0;
+  if (!info)
+    info = LAPACKE_dorgqr_work(LAPACK_COL_MAJOR, (lapack_int)k, (lapack_int)p, (lapack_int)p, A,
+                               (lapack_int)k, tau, work, (lapack_int)lwork);
+  if (!info && *ok) {
+    memcpy(Ri, R, p * p * sizeof *Ri);
+    info = LAPACKE_dtrtri_work(LAPACK_COL_MAJOR, 'U', 'N', (lapack_int)p, Ri, (lapack_int)p);
+  }
+  if (info < 0 || (info > 0 && *ok))
+    return rcb_mon_fail(mon, RCB_ERR_LAPACK, "rank-space QR failed (LAPACK info %d)", (int)info);
+  return RCB_OK;
+}
+
+/* est (q x k, row-major) = rows first .. first + q of Ri Qa^T, and the
+ * standard errors of those parameters (row norms of Ri). */
+static void estimator(const double *Qa, const double *Ri, size_t k, size_t p, size_t first,
+                      size_t q, double *est, double *se) {
+  size_t a, b, i;
+  for (a = 0; a < q; a++) {
+    size_t row = first + a;
+    double s = 0;
+    for (b = row; b < p; b++) s += Ri[row + p * b] * Ri[row + p * b];
+    se[a] = sqrt(s);
+    for (i = 0; i < k; i++) {
+      double v = 0;
+      for (b = row; b < p; b++) v += Ri[row + p * b] * Qa[i + k * b];
+      est[a * k + i] = v;
+    }
+  }
+}
+
+typedef struct rank_ws {
+  double *A, *R, *Ri, *tau, *work;
+  size_t lwork;
+} rank_ws;
+
+static rcb_status tracked_space(rcb_monitor *mon, const double *G, rank_ws *w) {
+  size_t k = mon->k, nt = mon->nt, i, a;
+  int ok;
+  rcb_status st;
+  if (!nt) return RCB_OK;
+  memcpy(w->A, G, k * nt * sizeof *w->A);
+  if ((st = small_qr(mon, w->A, k, nt, w->R, w->Ri, w->tau, w->work, w->lwork, &ok))) return st;
+  if (!ok)
+    return rcb_mon_fail(mon, RCB_ERR_ARG, "the tracked parameters cannot all be told apart on "
+                        "this set-up (their sensitivity columns are dependent): track fewer, or "
+                        "add channels");
+  estimator(w->A, w->Ri, k, nt, 0, nt, mon->test, mon->tse);
+  for (a = 0; a < nt; a++)
+    for (i = 0; i < k; i++) mon->tdir[a * k + i] = w->A[i + k * a];
+  return RCB_OK;
+}
+
+static rcb_status cand_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
+                             const double *G, rank_ws *w) {
+  size_t k = mon->k, nt = mon->nt, j, a, i;
+  rcb_status st;
+  for (j = 0; j < pl->ncand; j++) {
+    mon_cand *mc = &mon->cand[j];
+    rcb_diag_cand_desc c;
+    size_t p;
+    int ok;
+    rcb_diag_catalogue_get(d, pl->cand[j], &c);
+    mc->effect = c.effect;
+    snprintf(mc->place, sizeof mc->place, "%s", c.place);
+    snprintf(mc->desc, sizeof mc->desc, "%s", c.desc);
+    snprintf(mc->params, sizeof mc->params, "%s", c.params);
+    mc->np = c.np;
+    p = nt + c.np;
+    memcpy(w->A, G, k * nt * sizeof *w->A);
+    memcpy(w->A + k * nt, G + k * pl->col[j], k * c.np * sizeof *w->A);
+    if ((st = small_qr(mon, w->A, k, p, w->R, w->Ri, w->tau, w->work, w->lwork, &ok))) return st;
+    if (!ok) continue; /* explained by the tracked parameters or itself dependent: not scored */
+    mc->est = mon_alloc(mon, 2 * c.np * k, sizeof *mc->est);
+    if (!mc->est) return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (candidates)");
+    mc->dir = mc->est + c.np * k;
+    mc->dof = c.np;
+    estimator(w->A, w->Ri, k, p, nt, c.np, mc->est, mc->se);
+    for (a = 0; a < c.np; a++)
+      for (i = 0; i < k; i++) mc->dir[a * k + i] = w->A[i + k * (nt + a)];
+  }
+  return RCB_OK;
+}
+
+/* G = Q^T J (k x ncol, column-major). */
+static void project(const rcb_monitor *mon, const double *J, size_t ncol, double *G) {
+  size_t j, a, i, n = mon->n, k = mon->k;
+  for (j = 0; j < ncol; j++)
+    for (a = 0; a < k; a++) {
+      const double *q = mon->Q + n * a, *c = J + n * j;
+      double s = 0;
+      for (i = 0; i < n; i++) s += q[i] * c[i];
+      G[a + k * j] = s;
+    }
+}
+
+/* QR of all whitened columns (score_qr.c), Q made explicit. */
+static rcb_status factor(rcb_monitor *mon, rcb_diag *d, const double *J, size_t ncol) {
+  diag_basis b;
+  double q = 0;
+  lapack_int info;
+  rcb_status st = rcb_diag_basis_init(d, &b, J, mon->n, ncol, mon->r);
+  if (st) return rcb_mon_fail(mon, st, "%s", rcb_diag_errmsg(d));
+  mon->k = b.rank;
+  mon->Q = b.qr; /* the block is the monitor's allocator's (d was made with it) */
+  if (!mon->k) {
+    rcb_free(&mon->alloc, b.work);
+    return rcb_mon_fail(mon, RCB_ERR_ARG, "no sensitivity at all: the tracked parameters and "
+                        "the candidates leave the set-up's values unchanged");
+  }
+  info = LAPACKE_dorgqr_work(LAPACK_COL_MAJOR, (lapack_int)mon->n, (lapack_int)mon->k,
+                             (lapack_int)mon->k, b.qr, (lapack_int)mon->n, b.tau, &q, -1);
+  if (!info && (size_t)q > b.lwork) {
+    double *w = mon_alloc(mon, (size_t)q, sizeof *w);
+    if (!w) {
+      rcb_free(&mon->alloc, b.work);
+      return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (QR)");
+    }
+    rcb_free(&mon->alloc, b.work);
+    b.work = w, b.lwork = (size_t)q;
+  }
+  if (!info)
+    info = LAPACKE_dorgqr_work(LAPACK_COL_MAJOR, (lapack_int)mon->n, (lapack_int)mon->k,
+                               (lapack_int)mon->k, b.qr, (lapack_int)mon->n, b.tau, b.work,
+                               (lapack_int)b.lwork);
+  rcb_free(&mon->alloc, b.work);
+  if (info) return rcb_mon_fail(mon, RCB_ERR_LAPACK, "forming Q failed (LAPACK info %d)", (int)info);
+  return RCB_OK;
+}
+
+static rcb_status rank_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
+                             const double *J) {
+  size_t k = mon->k, pmax = mon->nt + RCB_MONITOR_MAXP, lw;
+  double *G = mon_alloc(mon, k * pl->ncol, sizeof *G), q1 = 0, q2 = 0;
+  rank_ws w;
+  rcb_status st;
+  memset(&w, 0, sizeof w);
+  w.A = mon_alloc(mon, k * pmax + 3 * pmax * pmax + pmax, sizeof *w.A);
+  mon->test = mon_alloc(mon, 2 * (mon->nt ? mon->nt : 1) * k, sizeof *mon->test);
+  mon->cand = mon_alloc(mon, pl->ncand ? pl->ncand : 1, sizeof *mon->cand);
+  if (!G || !w.A || !mon->test || !mon->cand) {
+    rcb_free(&mon->alloc, G);
+    rcb_free(&mon->alloc, w.A);
+    return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (rank space)");
+  }
+  mon->ncand = pl->ncand;
+  mon->tdir = mon->test + (mon->nt ? mon->nt : 1) * k;
+  w.R = w.A + k * pmax, w.Ri = w.R + pmax * pmax, w.tau = w.Ri + pmax * pmax;
+  LAPACKE_dgeqrf_work(LAPACK_COL_MAJOR, (lapack_int)k, (lapack_int)pmax, w.A, (lapack_int)k,
+                      w.tau, &q1, -1);
+  LAPACKE_dorgqr_work(LAPACK_COL_MAJOR, (lapack_int)k, (lapack_int)pmax, (lapack_int)pmax, w.A,
+                      (lapack_int)k, w.tau, &q2, -1);
+  lw = (size_t)fmax(fmax(q1, q2), (double)pmax);
+  w.work = mon_alloc(mon, lw, sizeof *w.work);
+  w.lwork = lw;
+  if (!w.work) st = rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (rank space)");
+  else {
+    project(mon, J, pl->ncol, G);
+    st = tracked_space(mon, G, &w);
+    if (!st) st = cand_space(mon, d, pl, G, &w);
+  }
+  rcb_free(&mon->alloc, w.work);
+  rcb_free(&mon->alloc, w.A);
+  rcb_free(&mon->alloc, G);
+  return st;
+}
+
+/* ---- create ---- */
+
+static rcb_status buffers(rcb_monitor *mon) {
+  size_t npt = mon->npt, n = mon->n;
+  mon->e0 = mon_alloc(mon, 2 * npt, sizeof *mon->e0);
+  mon->h0abs = mon_alloc(mon, 2 * npt + 3 * n, sizeof *mon->h0abs);
+  if (!mon->e0 || !mon->h0abs) return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (set-up)");
+  mon->u = mon->e0 + npt;
+  mon->sd_new_rad = mon->h0abs + npt;
+  mon->winv = mon->sd_new_rad + npt;
+  mon->rbase = mon->winv + n;
+  mon->r = mon->rbase + n;
+  mon->rm = mon->r + n;
+  return RCB_OK;
+}
+
+static rcb_status settings(rcb_monitor *mon, const rcb_monitor_opts *o) {
+  mon->alpha = o->alpha > 0 ? o->alpha : 1e-3;
+  mon->cusum_k = o->cusum_k > 0 ? o->cusum_k : 0.5;
+  mon->cusum_h = o->cusum_h > 0 ? o->cusum_h : 8.0;
+  mon->top = o->top ? o->top : RCB_MONITOR_TOP;
+  mon->relin = o->relinearise;
+  mon->nt = o->ntracked;
+  if (!(mon->alpha < 1) || !isfinite(mon->cusum_k) || !isfinite(mon->cusum_h) ||
+      o->alpha < 0 || o->cusum_k < 0 || o->cusum_h < 0)
+    return rcb_mon_fail(mon, RCB_ERR_ARG, "options: alpha = %g (0 < alpha < 1), cusum_k = %g, "
+                        "cusum_h = %g (finite >= 0, 0: default)", o->alpha, o->cusum_k,
+                        o->cusum_h);
+  if (mon->top > RCB_MONITOR_TOP)
+    return rcb_mon_fail(mon, RCB_ERR_ARG, "options: top = %zu, at most %d", mon->top,
+                        RCB_MONITOR_TOP);
+  if (mon->nt > RCB_MONITOR_MAX_TRACKED || (mon->nt && !o->tracked))
+    return rcb_mon_fail(mon, RCB_ERR_ARG, "options: %zu tracked parameters (at most %d, and "
+                        "opts.tracked must list them)", mon->nt, RCB_MONITOR_MAX_TRACKED);
+  return RCB_OK;
+}
+
+static rcb_status commission(rcb_monitor *mon, const rcb_model *base, const rcb_meas *setup,
+                             const rcb_monitor_opts *o) {
+  rcb_diag *d = NULL;
+  col_plan pl;
+  double *J = NULL;
+  size_t c, k;
+  rcb_status st;
+  memset(&pl, 0, sizeof pl);
+  if ((st = settings(mon, o)) || (st = copy_setup(mon, setup)) || (st = buffers(mon)))
+    return st;
+  for (c = 0; c < mon->nch; c++) {
+    rcb_meas_channel_info ci;
+    rcb_meas_channel(mon->setup, c, &ci);
+    memcpy(mon->e0 + c * mon->npts, ci.data, mon->npts * sizeof *mon->e0);
+  }
+  if ((st = noise(mon, o)) || (st = baseline(mon, base, o))) return st;
+  if ((st = rcb_diag_create(&d, mon->model, mon->setup, &mon->alloc)))
+    st = rcb_mon_fail(mon, st, "catalogue: %s", d ? rcb_diag_errmsg(d) : "out of memory");
+  for (k = 0; !st && k < mon->nt; k++)
+    if ((st = rcb_diag_add_fitted_param(d, mon->tname[k], mon->tlo[k], mon->thi[k], 0)))
+      rcb_mon_fail(mon, st, "catalogue: %s", rcb_diag_errmsg(d));
+  if (!st && (st = rcb_diag_catalogue(d, mon->model)))
+    rcb_mon_fail(mon, st, "catalogue: %s", rcb_diag_errmsg(d));
+  if (!st) st = plan(mon, d, o->effects, &pl);
+  if (!st && !(J = mon_alloc(mon, mon->n * (pl.ncol ? pl.ncol : 1), sizeof *J)))
+    st = rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (%zu x %zu sensitivity columns)",
+                      mon->n, pl.ncol);
+  if (!st && mon->nt && (st = rcb_fit_jacobian(mon->fit, 1, J)))
+    rcb_mon_fail(mon, st, "tracked parameters' sensitivities: %s", rcb_fit_errmsg(mon->fit));
+  if (!st) st = cand_columns(mon, d, &pl, J);
+  if (!st) {
+    whiten_columns(mon, J, pl.ncol);
+    memset(mon->r, 0, mon->n * sizeof *mon->r);
+    st = factor(mon, d, J, pl.ncol);
+  }
+  if (!st) st = rank_space(mon, d, &pl, J);
+  if (!st) {
+    mon->y = mon_alloc(mon, 2 * mon->k + 2 * (mon->ncand ? mon->ncand : 1), sizeof *mon->y);
+    if (!mon->y) st = rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (update workspace)");
+    else {
+      mon->ym = mon->y + mon->k;
+      mon->pscore = mon->ym + mon->k;
+      mon->order = (size_t *)(void *)(mon->pscore + (mon->ncand ? mon->ncand : 1));
+    }
+  }
+  if (!st) {
+    size_t dof = mon->k > mon->nt ? mon->k - mon->nt : 0;
+    mon->threshold = dof ? rcb_chi2_quantile(1.0 - mon->alpha, (double)dof) : (double)INFINITY;
+  }
+  rcb_free(&mon->alloc, J);
+  rcb_free(&mon->alloc, pl.cand);
+  rcb_free(&mon->alloc, pl.col);
+  rcb_free(&mon->alloc, pl.own);
+  rcb_diag_destroy(d);
+  return st;
+}
+
+rcb_status rcb_monitor_create(rcb_monitor **out, const rcb_model *baseline_model,
+                              const rcb_meas *setup, const rcb_monitor_opts *opts,
+                              const rcb_allocator *alloc) {
+  rcb_allocator a;
+  rcb_monitor_opts o0;
+  rcb_monitor *mon;
+  if (!out) return RCB_ERR_ARG;
+  *out = NULL;
+  rcb_allocator_init(&a, alloc);
+  if (!(mon = rcb_alloc(&a, sizeof *mon))) return RCB_ERR_NOMEM;
+  mon->user = a;
+  mon->alloc.alloc = count_alloc, mon->alloc.free = count_free, mon->alloc.user = mon;
+  mon->held = sizeof *mon;
+  *out = mon;
+  if (!baseline_model || !setup)
+    return rcb_mon_fail(mon, RCB_ERR_ARG, "rcb_monitor_create: baseline model and set-up "
+                        "measurement are required");
+  if (rcb_model_dof_count(baseline_model) == 0)
+    return rcb_mon_fail(mon, RCB_ERR_STATE, "baseline model not finalized (rcb_model_finalize)");
+  if (!opts) {
+    memset(&o0, 0, sizeof o0);
+    opts = &o0;
+  }
+  return commission(mon, baseline_model, setup, opts);
+}
