@@ -721,7 +721,8 @@ bad_fit_params)
   cmp -s "$MODEL" "$W/model.ini" || fail "the model was modified" ;;
 # ---- rcbtool monitor (issue #16): the series and its refusals ----
 bad_monitor_series)
-  M="--params coupling.C.kt --noise 10,1"
+  M="--params coupling.C.kt --noise 10,1"; O=C.A.x,C.A.y,C.B.x,C.B.y
+  # (4 channels x 61 points: more residuals than the catalogue has columns)
   # shellcheck disable=SC2086 # $M is split into options on purpose
   { run monitor "$MODEL" "$W/no_such_dir" $M --log "$W/log.json"; expect_rc 3; err_has "no_such_dir"
     mkdir "$W/empty"; echo x >"$W/empty/notes.txt"
@@ -729,21 +730,21 @@ bad_monitor_series)
     err_has "'$W/empty' holds no measurement file"
     mkdir "$W/s"
     for k in 0 1 2; do
-      run simulate "$MODEL" --frf --out C.A.x,C.B.y --in DA.x --fmin 200 --fmax 400 --points 21 \
+      run simulate "$MODEL" --frf --out $O --in DA.x --fmin 100 --fmax 400 --points 61 \
         --rpm 10000 --kind inertance --noise 10,1 --seed $((k + 1)) -o "$W/s/m$k.csv"; expect_rc 0
     done
     # a file with other frequencies, then one with another channel, then another speed
-    run simulate "$MODEL" --frf --out C.A.x,C.B.y --in DA.x --fmin 200 --fmax 400 --points 11 \
+    run simulate "$MODEL" --frf --out $O --in DA.x --fmin 100 --fmax 400 --points 31 \
       --rpm 10000 --kind inertance -o "$W/s/m3.csv"; expect_rc 0
     run monitor "$MODEL" "$W/s" $M --log "$W/log.json" -o "$W/lines.txt"; expect_rc 3
-    err_has "m3.csv' has 2 channels x 11 points, the commissioning file"; err_has "m0.csv"
+    err_has "m3.csv' has 4 channels x 31 points, the commissioning file"; err_has "m0.csv"
     [ ! -e "$W/log.json" ] && [ ! -e "$W/lines.txt" ] || fail "partial log or output left"
     ls "$W" | grep -q 'log.json.' && fail "temporary log left behind"
-    run simulate "$MODEL" --frf --out C.A.x,C.A.y --in DA.x --fmin 200 --fmax 400 --points 21 \
-      --rpm 10000 --kind inertance -o "$W/s/m3.csv"; expect_rc 0
+    run simulate "$MODEL" --frf --out C.A.x,C.A.y,C.B.x,DB.y --in DA.x --fmin 100 --fmax 400 \
+      --points 61 --rpm 10000 --kind inertance -o "$W/s/m3.csv"; expect_rc 0
     run monitor "$MODEL" "$W/s" $M --log "$W/log.json"; expect_rc 3
     err_has "m3.csv' has no channel C.B.y/DA.x"
-    run simulate "$MODEL" --frf --out C.A.x,C.B.y --in DA.x --fmin 200 --fmax 400 --points 21 \
+    run simulate "$MODEL" --frf --out $O --in DA.x --fmin 100 --fmax 400 --points 61 \
       --rpm 9000 --kind inertance -o "$W/s/m3.csv"; expect_rc 0
     run monitor "$MODEL" "$W/s" $M --log "$W/log.json"; expect_rc 3
     err_has "m3.csv' was measured at 9000 rpm, the commissioning file"
@@ -785,7 +786,8 @@ monitor_dir_order)
   # DIR is read sorted by name, whatever the order the files were made in
   mkdir "$W/s"
   for k in 3 1 2; do
-    run simulate "$MODEL" --frf --out C.A.x,C.B.y --in DA.x --fmin 200 --fmax 400 --points 21 \
+    run simulate "$MODEL" --frf --out C.A.x,C.A.y,C.B.x,C.B.y --in DA.x --fmin 100 --fmax 400 \
+      --points 61 \
       --rpm 10000 --kind inertance --noise 10,1 --seed $k -o "$W/s/day$k.csv"; expect_rc 0
   done
   echo "not a measurement" >"$W/s/README.txt"

@@ -13,8 +13,9 @@ eq. 19 (10 % random, 1 % systematic, drawn as src/io/noise.c draws it) and
 The series (SERIES):
 
 * null:     200 updates of the paper system as it is;
-* kt_wear:  the coupling's kt falls linearly from its nominal value at update
-            0 to -10 % at update 100 (101 updates, 0.1 % per update);
+* kt_wear:  the coupling's kt stays at its nominal value for the first
+            COMMISSION files (the commissioning period), then falls linearly by
+            0.1 % per update to -10 % at file COMMISSION + 100 (111 files);
 * cross_B3: a cross-coupled stiffness kxy = -kyx = 1.5e7 N/m appears at
             bearing B3 at update 37 of 60 and stays.
 
@@ -106,12 +107,20 @@ class Series:
         }
 
 
-WEAR_UPDATES = 100  # kt reaches -10 % at this update
+COMMISSION = 10  # files averaged into the reference (rcbtool monitor --commission)
+WEAR_UPDATES = 100  # kt falls 10 % over these updates after the commissioning period
+
+
+def _wear(u):
+    k = min(max(u - COMMISSION, 0), WEAR_UPDATES)
+    return KT0 * (1.0 - 0.10 * k / WEAR_UPDATES)
+
+
 SERIES = {
     "null": Series("null", 200, 160000, "nothing changes"),
-    "kt_wear": Series("kt_wear", WEAR_UPDATES + 1, 161000,
-                      "coupling kt falls linearly to -10 % at update 100",
-                      kt=lambda u: KT0 * (1.0 - 0.10 * min(u, WEAR_UPDATES) / WEAR_UPDATES)),
+    "kt_wear": Series("kt_wear", COMMISSION + WEAR_UPDATES + 1, 161000,
+                      f"coupling kt steady for {COMMISSION} files, then falling 0.1 % per "
+                      f"update to -10 % at file {COMMISSION + WEAR_UPDATES}", kt=_wear),
     "cross_B3": Series("cross_B3", 60, 162000,
                        "kxy = -kyx = 1.5e7 N/m appears at bearing B3 at update 37",
                        cross_from=37),

@@ -74,7 +74,7 @@ static int pair(const cli_args *a, const char *opt, double *x, double *y) {
 
 static int parse_job(const cli_args *a, mon_job *j) {
   int rc;
-  size_t relin = 0;
+  double relin = 0.0;
   j->log = cli_opt_value(a, "--log");
   j->plot = cli_opt_value(a, "--plot");
   j->sd_path = cli_opt_value(a, "--sd");
@@ -90,9 +90,11 @@ static int parse_job(const cli_args *a, mon_job *j) {
       (rc = cli_opt_nonneg(a, "--cusum-h", "-", 0.0, &j->cusum_h)) ||
       (rc = cli_opt_nonneg(a, "--cusum-k", "-", 0.0, &j->cusum_k)))
     return rc;
-  if (cli_opt_value(a, "--relinearise") && (rc = cli_opt_count(a, "--relinearise", 1, &relin)))
-    return rc;
-  j->relinearise = relin;
+  if ((rc = cli_opt_nonneg(a, "--relinearise", "iterations", 0.0, &relin))) return rc;
+  if (relin != floor(relin) || relin > 100)
+    return cli_usage(a->cmd, "option --relinearise expects a whole number 0..100, got '%s'",
+                     cli_opt_value(a, "--relinearise"));
+  j->relinearise = (size_t)relin;
   if (cli_opt_value(a, "--alpha") && !(j->alpha > 0.0 && j->alpha < 1.0))
     return cli_usage(a->cmd, "option --alpha expects a probability 0 < A < 1, got '%s'",
                      cli_opt_value(a, "--alpha"));
