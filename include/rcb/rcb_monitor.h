@@ -46,6 +46,12 @@
  *    opts.relinearise > 0 the step is refined by chord iterations that
  *    re-evaluate the model at the new value (the fit's preallocated FRF
  *    object, no allocation).
+ *  - Noise after a change. With opts.reweight the covariance of r is
+ *    rebuilt at every update from the update's own noise (proportional
+ *    noise follows the new response, whose peaks may have moved), C =
+ *    Q^T D Q in the rank space, and every statistic above is taken in the
+ *    metric C^-1 (generalised least squares): T stays chi-square(k - k_t)
+ *    when only tracked parameters changed, however far.
  *  - Sequential detector. A two-sided CUSUM per tracked parameter on its
  *    standardised change z = (value - baseline) / stderr:
  *    S+ = max(0, S+ + z - k), S- = max(0, S- - z - k), alarm when either
@@ -111,6 +117,15 @@ typedef struct rcb_monitor_opts {
   size_t top;        /**< candidates ranked in each result, 0: RCB_MONITOR_TOP */
   size_t relinearise; /**< chord iterations refining the tracked estimates per
                            update by re-evaluating the model (0: linear only) */
+  int reweight;      /**< 1: take each update's noise from the update itself
+                          (eq. 19 on its own values, or the sd passed to
+                          rcb_monitor_update) and apply the statistics in that
+                          covariance (generalised least squares in the rank
+                          space, O(n k^2) per update); 0 (default): the noise of
+                          the commissioning values, exact while the machine is
+                          near them (O(n k) per update). Proportional noise
+                          grows with the response: after a large change (a
+                          resonance moved) only 1 keeps T chi-square */
 } rcb_monitor_opts;
 
 /** @brief One ranked candidate effect in a result. */
@@ -192,9 +207,10 @@ RCB_API const char *rcb_monitor_errmsg(const rcb_monitor *mon);
  * @param values rcb_monitor_point_count values, the set-up's layout:
  * channel-major (values[c * npoints + i]), each in its channel's kind, SI
  * @param sd standard deviation of each of Re and Im at each point for this
- * measurement (same layout, SI), or NULL for the noise given at create. With
- * sd the statistics are taken under that covariance (sandwich form), which
- * costs O(n k^2) instead of O(n k)
+ * measurement (same layout, SI), or NULL for the noise given at create (or,
+ * with opts.reweight, eq. 19 on these values). With sd the statistics are
+ * taken under that covariance as with opts.reweight, O(n k^2) instead of
+ * O(n k)
  * @param res output
  * @return RCB_ERR_ARG for a NaN/infinite value or a negative/NaN sd, naming
  * the channel and point (the monitor's state is left unchanged)

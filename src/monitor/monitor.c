@@ -22,6 +22,10 @@ void rcb_monitor_destroy(rcb_monitor *mon) {
   rcb_free(&mon->alloc, mon->cand);
   rcb_free(&mon->alloc, mon->test);
   rcb_free(&mon->alloc, mon->Q);
+  rcb_free(&mon->alloc, mon->G);
+  rcb_free(&mon->alloc, mon->C);
+  rcb_free(&mon->alloc, mon->sw.A);
+  rcb_free(&mon->alloc, mon->sw.work);
   rcb_free(&mon->alloc, mon->y);
   rcb_fit_destroy(mon->fit);
   rcb_model_destroy(mon->model);
@@ -35,14 +39,14 @@ const char *rcb_monitor_errmsg(const rcb_monitor *mon) { return mon ? mon->errms
 
 static int ready(const rcb_monitor *mon) { return mon && mon->k > 0 && mon->y; }
 
-/* out = Q^T r (k values). */
+/* out = Q^T r (k values; Q row-major, read once). */
 static void to_rank(const rcb_monitor *mon, const double *r, double *out) {
-  size_t a, i, n = mon->n;
-  for (a = 0; a < mon->k; a++) {
-    const double *q = mon->Q + n * a;
-    double s = 0;
-    for (i = 0; i < n; i++) s += q[i] * r[i];
-    out[a] = s;
+  size_t a, i, n = mon->n, k = mon->k;
+  memset(out, 0, k * sizeof *out);
+  for (i = 0; i < n; i++) {
+    const double *q = mon->Q + k * i;
+    double ri = r[i];
+    for (a = 0; a < k; a++) out[a] += q[a] * ri;
   }
 }
 
@@ -73,12 +77,14 @@ static rcb_status model_change(rcb_monitor *mon, const double *theta) {
   size_t k, p;
   rcb_status st = RCB_OK;
   for (k = 0; !st && k < mon->nt; k++)
-    st = rcb_model_set_param(mon->model, mon->tname[k], mon->t0[k] + theta[k]);
-  if (!st) st = rcb_fit_residuals(mon->fit, mon->rm);
+    if ((st = rcb_model_set_param(mon->model, mon->tname[k], mon->t0[k] + theta[k])))
+      rcb_mon_fail(mon, st, "re-linearising at %s = %g: %s", mon->tname[k],
+                   mon->t0[k] + theta[k], rcb_model_errmsg(mon->model));
+  if (!st && (st = rcb_fit_residuals(mon->fit, mon->rm)))
+    rcb_mon_fail(mon, st, "re-linearising at the tracked estimate: %s", rcb_fit_errmsg(mon->fit));
   if (st) {
     for (k = 0; k < mon->nt; k++) rcb_model_set_param(mon->model, mon->tname[k], mon->t0[k]);
-    return rcb_mon_fail(mon, st, "re-linearising at the tracked estimate: %s",
-                        rcb_fit_errmsg(mon->fit));
+    return st;
   }
   for (p = 0; p < mon->npt; p++) {
     double complex g = conj(mon->u[p]) * CMPLX(mon->rm[2 * p] - mon->rbase[2 * p],
@@ -93,11 +99,14 @@ static rcb_status model_change(rcb_monitor *mon, const double *theta) {
 /* The tracked step theta (linear, then chord iterations re-evaluating the
  * model: theta += E (y - ym(theta)), E the linear estimator); on return
  * mon->y holds the change the tracked parameters do not explain. */
-static rcb_status tracked_step(rcb_monitor *mon, double *theta) {
+static rcb_status tracked_step(rcb_monitor *mon, double *theta, int gls) {
   size_t a, it, i, k = mon->k, nt = mon->nt;
   rcb_status st;
   for (a = 0; a < nt; a++) theta[a] = dot(mon->test + a * k, mon->y, k);
-  if (!mon->relin || !nt) return RCB_OK;
+  if (!mon->relin || !nt) {
+    if (gls) memset(theta, 0, nt * sizeof *theta); /* the whole step is the GLS one */
+    return RCB_OK;
+  }
   for (it = 0; it < mon->relin; it++) {
     if ((st = model_change(mon, theta))) return st;
     for (i = 0; i < k; i++) mon->ym[i] = mon->y[i] - mon->ym[i];
@@ -105,19 +114,21 @@ static rcb_status tracked_step(rcb_monitor *mon, double *theta) {
   }
   if ((st = model_change(mon, theta))) return st;
   for (i = 0; i < k; i++) mon->y[i] -= mon->ym[i];
-  /* what is left along the tracked directions is re-expressed in them */
-  for (a = 0; a < nt; a++) theta[a] += dot(mon->test + a * k, mon->y, k);
+  /* what is left along the tracked directions is re-expressed in them
+   * (by the GLS step on the reweighted path) */
+  for (a = 0; !gls && a < nt; a++) theta[a] += dot(mon->test + a * k, mon->y, k);
   for (a = 0; a < nt; a++) rcb_model_set_param(mon->model, mon->tname[a], mon->t0[a]);
   return RCB_OK;
 }
 
-static void tracked_result(rcb_monitor *mon, const double *theta, rcb_monitor_result *res) {
+static void tracked_result(rcb_monitor *mon, const double *theta, const double *sev,
+                           rcb_monitor_result *res) {
   size_t a;
   res->ntracked = mon->nt;
   res->cusum_alarm = 0;
   for (a = 0; a < mon->nt; a++) {
     rcb_monitor_tracked *t = &res->tracked[a];
-    double se = mon->tse[a], z = theta[a] / se;
+    double se = sev[a], z = theta[a] / se;
     t->value = mon->t0[a] + theta[a];
     t->stderr_ = se;
     t->ci_lo = t->value - MON_Z95 * se, t->ci_hi = t->value + MON_Z95 * se;
@@ -141,14 +152,16 @@ static int before(const rcb_monitor *mon, size_t a, size_t b) {
          (cb->score_now - (double)cb->dof) / sqrt(2.0 * (double)cb->dof);
 }
 
-static void candidates(rcb_monitor *mon, rcb_monitor_result *res) {
+/* Scores (and, on the reweighted path, sizes) were left in the
+ * candidates by the caller when gls != 0. */
+static void candidates(rcb_monitor *mon, int gls, rcb_monitor_result *res) {
   size_t j, a, k = mon->k, nsc = 0, t;
   for (j = 0; j < mon->ncand; j++) {
     mon_cand *c = &mon->cand[j];
     if (!c->dof) continue;
-    c->score_now = 0;
-    for (a = 0; a < c->dof; a++) {
+    for (a = 0; !gls && a < c->dof; a++) {
       double z = dot(c->dir + a * k, mon->y, k);
+      if (!a) c->score_now = 0;
       c->score_now += z * z;
     }
     mon->pscore[j] = rcb_chi2_sf(c->score_now, (double)c->dof);
@@ -175,9 +188,10 @@ static void candidates(rcb_monitor *mon, rcb_monitor_result *res) {
     o->dof = c->dof;
     o->p_value = mon->pscore[mon->order[t]];
     for (a = 0; a < c->np; a++) {
-      o->size[a] = dot(c->est + a * k, mon->y, k);
-      o->ci_lo[a] = o->size[a] - MON_Z95 * c->se[a];
-      o->ci_hi[a] = o->size[a] + MON_Z95 * c->se[a];
+      double se = gls ? c->se_now[a] : c->se[a];
+      o->size[a] = gls ? c->size_now[a] : dot(c->est + a * k, mon->y, k);
+      o->ci_lo[a] = o->size[a] - MON_Z95 * se;
+      o->ci_hi[a] = o->size[a] + MON_Z95 * se;
     }
   }
 }
@@ -199,8 +213,9 @@ static void errors(const rcb_monitor *mon, const rcb_complex *v, rcb_monitor_res
 
 rcb_status rcb_monitor_update(rcb_monitor *mon, const rcb_complex *values, const double *sd,
                               rcb_monitor_result *res) {
-  double theta[RCB_MONITOR_MAX_TRACKED], T;
+  double theta[RCB_MONITOR_MAX_TRACKED], se[RCB_MONITOR_MAX_TRACKED], T;
   size_t p, a;
+  int gls;
   rcb_status st;
   if (!mon) return RCB_ERR_ARG;
   if (!values || !res) return rcb_mon_fail(mon, RCB_ERR_ARG, "rcb_monitor_update: values and "
@@ -208,34 +223,37 @@ rcb_status rcb_monitor_update(rcb_monitor *mon, const rcb_complex *values, const
   if (!ready(mon))
     return rcb_mon_fail(mon, RCB_ERR_STATE, "rcb_monitor_update: the monitor was not created "
                         "successfully");
-  if (sd)
-    return rcb_mon_fail(mon, RCB_ERR_UNSUPPORTED, "rcb_monitor_update: per-update sd is not "
-                        "implemented yet; give the noise at create (opts.sd / beta)");
   if ((st = check_input(mon, values, sd))) return st;
-  memset(res, 0, sizeof *res);
+  gls = mon->reweight || sd;
   for (p = 0; p < mon->npt; p++) {
     double complex g = conj(mon->u[p]) * (values[p] - mon->e0[p]);
     mon->r[2 * p] = creal(g) * mon->winv[2 * p];
     mon->r[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
   }
   to_rank(mon, mon->r, mon->y);
-  if ((st = tracked_step(mon, theta))) return st;
+  if ((st = tracked_step(mon, theta, gls))) return st;
+  if (gls) {
+    if ((st = rcb_mon_gls(mon, values, sd, theta, se, &T))) return st;
+  } else {
+    memcpy(se, mon->tse, sizeof se);
+    /* instant test: the part of y beyond the tracked directions */
+    T = dot(mon->y, mon->y, mon->k);
+    for (a = 0; a < mon->nt; a++) {
+      double z = dot(mon->tdir + a * mon->k, mon->y, mon->k);
+      T -= z * z;
+    }
+  }
+  memset(res, 0, sizeof *res);
   mon->updates++;
   res->update = mon->updates;
   errors(mon, values, res);
-  tracked_result(mon, theta, res);
-  /* instant test: the part of y beyond the tracked directions */
-  T = dot(mon->y, mon->y, mon->k);
-  for (a = 0; a < mon->nt; a++) {
-    double z = dot(mon->tdir + a * mon->k, mon->y, mon->k);
-    T -= z * z;
-  }
+  tracked_result(mon, theta, se, res);
   res->T = fmax(T, 0.0);
   res->dof = mon->k - mon->nt;
   res->threshold = mon->threshold;
   res->p_value = res->dof ? rcb_chi2_sf(res->T, (double)res->dof) : 1.0;
   res->alarm = res->dof && res->T > mon->threshold;
-  candidates(mon, res);
+  candidates(mon, gls, res);
   return RCB_OK;
 }
 

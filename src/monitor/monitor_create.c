@@ -90,6 +90,9 @@ static rcb_status noise(rcb_monitor *mon, const rcb_monitor_opts *o) {
   double navg = o->setup_averages > 0 ? o->setup_averages : 1.0;
   double f0 = isinf(navg) ? 1.0 : 1.0 + 1.0 / navg; /* new + commissioning variance */
   size_t c, i;
+  mon->navg_inv = isinf(navg) ? 0.0 : 1.0 / navg;
+  mon->beta_a = o->beta_a, mon->beta_s = o->beta_s;
+  mon->have_sd0 = o->sd != NULL;
   if (navg < 1.0)
     return rcb_mon_fail(mon, RCB_ERR_ARG, "setup_averages = %g: expected >= 1 (measurements "
                         "averaged into the commissioning values)", navg);
@@ -125,6 +128,8 @@ static rcb_status noise(rcb_monitor *mon, const rcb_monitor_opts *o) {
                             "deviation (commissioning value 0 and beta_s = 0); give beta_s > 0 "
                             "or opts.sd", c + 1, i + 1);
       mon->sd_new_rad[p] = sqrt(vr);
+      mon->var0[2 * p] = vr, mon->var0[2 * p + 1] = vt;
+      if (o->sd) mon->sd0[p] = o->sd[p];
       mon->winv[2 * p] = 1.0 / sqrt(vr * f0);
       mon->winv[2 * p + 1] = 1.0 / sqrt(vt * f0);
     }
@@ -303,13 +308,13 @@ void rcb_mon_whiten(const rcb_monitor *mon, const rcb_complex *dv, double *r) {
 
 /* ---- rank space ---- */
 
-/* Thin QR of A (k x p, column-major, overwritten by Qa) with R (p x p,
+/* Thin QR of w->A (k x p, column-major, overwritten by Qa) with R (p x p,
  * column-major) and its inverse Ri; *ok = 0 when a diagonal of R falls
  * below MON_RANK_TOL of its column's norm (a dependent column). */
-static rcb_status small_qr(rcb_monitor *mon, double *A, size_t k, size_t p, double *R,
-                           double *Ri, double *tau, double *work, size_t lwork, int *ok) {
+rcb_status rcb_mon_small_qr(rcb_monitor *mon, mon_small *w, size_t k, size_t p, int *ok) {
   size_t i, j;
   double norm[RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP];
+  double *A = w->A, *R = w->R, *Ri = w->Ri;
   lapack_int info;
   *ok = p <= k;
   if (!*ok || !p) return RCB_OK;
@@ -319,14 +324,14 @@ static rcb_status small_qr(rcb_monitor *mon, double *A, size_t k, size_t p, doub
     norm[j] = sqrt(s);
   }
   info = LAPACKE_dgeqrf_work(LAPACK_COL_MAJOR, (lapack_int)k, (lapack_int)p, A, (lapack_int)k,
-                             tau, work, (lapack_int)lwork);
+                             w->tau, w->work, (lapack_int)w->lwork);
   for (j = 0; !info && j < p; j++)
     for (i = 0; i < p; i++) R[i + p * j] = i <= j ? A[i + k * j] : 0.0;
   for (j = 0; j < p; j++)
     if (!(fabs(R[j + p * j]) > MON_RANK_TOL * norm[j])) *ok = 0;
   if (!info)
     info = LAPACKE_dorgqr_work(LAPACK_COL_MAJOR, (lapack_int)k, (lapack_int)p, (lapack_int)p, A,
-                               (lapack_int)k, tau, work, (lapack_int)lwork);
+                               (lapack_int)k, w->tau, w->work, (lapack_int)w->lwork);
   if (!info && *ok) {
     memcpy(Ri, R, p * p * sizeof *Ri);
     info = LAPACKE_dtrtri_work(LAPACK_COL_MAJOR, 'U', 'N', (lapack_int)p, Ri, (lapack_int)p);
@@ -354,18 +359,13 @@ static void estimator(const double *Qa, const double *Ri, size_t k, size_t p, si
   }
 }
 
-typedef struct rank_ws {
-  double *A, *R, *Ri, *tau, *work;
-  size_t lwork;
-} rank_ws;
-
-static rcb_status tracked_space(rcb_monitor *mon, const double *G, rank_ws *w) {
+static rcb_status tracked_space(rcb_monitor *mon, const double *G, mon_small *w) {
   size_t k = mon->k, nt = mon->nt, i, a;
   int ok;
   rcb_status st;
   if (!nt) return RCB_OK;
   memcpy(w->A, G, k * nt * sizeof *w->A);
-  if ((st = small_qr(mon, w->A, k, nt, w->R, w->Ri, w->tau, w->work, w->lwork, &ok))) return st;
+  if ((st = rcb_mon_small_qr(mon, w, k, nt, &ok))) return st;
   if (!ok)
     return rcb_mon_fail(mon, RCB_ERR_ARG, "the tracked parameters cannot all be told apart on "
                         "this set-up (their sensitivity columns are dependent): track fewer, or "
@@ -377,7 +377,7 @@ static rcb_status tracked_space(rcb_monitor *mon, const double *G, rank_ws *w) {
 }
 
 static rcb_status cand_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
-                             const double *G, rank_ws *w) {
+                             const double *G, mon_small *w) {
   size_t k = mon->k, nt = mon->nt, j, a, i;
   rcb_status st;
   for (j = 0; j < pl->ncand; j++) {
@@ -391,10 +391,11 @@ static rcb_status cand_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
     snprintf(mc->desc, sizeof mc->desc, "%s", c.desc);
     snprintf(mc->params, sizeof mc->params, "%s", c.params);
     mc->np = c.np;
+    mc->col = pl->col[j];
     p = nt + c.np;
     memcpy(w->A, G, k * nt * sizeof *w->A);
     memcpy(w->A + k * nt, G + k * pl->col[j], k * c.np * sizeof *w->A);
-    if ((st = small_qr(mon, w->A, k, p, w->R, w->Ri, w->tau, w->work, w->lwork, &ok))) return st;
+    if ((st = rcb_mon_small_qr(mon, w, k, p, &ok))) return st;
     if (!ok) continue; /* explained by the tracked parameters or itself dependent: not scored */
     mc->est = mon_alloc(mon, 2 * c.np * k, sizeof *mc->est);
     if (!mc->est) return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (candidates)");
@@ -453,41 +454,51 @@ static rcb_status factor(rcb_monitor *mon, rcb_diag *d, const double *J, size_t 
   return RCB_OK;
 }
 
+/* Q (column-major from the QR) to row-major: the update reads it residual
+ * by residual. */
+static rcb_status transpose_q(rcb_monitor *mon) {
+  size_t n = mon->n, k = mon->k, i, a;
+  double *Qr = mon_alloc(mon, n * k, sizeof *Qr);
+  if (!Qr) return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (Q)");
+  for (a = 0; a < k; a++)
+    for (i = 0; i < n; i++) Qr[k * i + a] = mon->Q[i + n * a];
+  rcb_free(&mon->alloc, mon->Q);
+  mon->Q = Qr;
+  return RCB_OK;
+}
+
 static rcb_status rank_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
                              const double *J) {
-  size_t k = mon->k, pmax = mon->nt + RCB_MONITOR_MAXP, lw;
-  double *G = mon_alloc(mon, k * pl->ncol, sizeof *G), q1 = 0, q2 = 0;
-  rank_ws w;
+  size_t k = mon->k, nt = mon->nt, pmax = nt + RCB_MONITOR_MAXP, lw;
+  double q1 = 0, q2 = 0;
+  mon_small *w = &mon->sw;
   rcb_status st;
-  memset(&w, 0, sizeof w);
-  w.A = mon_alloc(mon, k * pmax + 3 * pmax * pmax + pmax, sizeof *w.A);
-  mon->test = mon_alloc(mon, 2 * (mon->nt ? mon->nt : 1) * k, sizeof *mon->test);
+  mon->G = mon_alloc(mon, k * (pl->ncol ? pl->ncol : 1), sizeof *mon->G);
+  w->A = mon_alloc(mon, k * pmax + 3 * pmax * pmax + pmax, sizeof *w->A);
+  mon->test = mon_alloc(mon, 2 * (nt ? nt : 1) * k, sizeof *mon->test);
   mon->cand = mon_alloc(mon, pl->ncand ? pl->ncand : 1, sizeof *mon->cand);
-  if (!G || !w.A || !mon->test || !mon->cand) {
-    rcb_free(&mon->alloc, G);
-    rcb_free(&mon->alloc, w.A);
+  /* the reweighted path: C, z, U^-T G_t, two rows, the channels' amplitudes */
+  mon->C = mon_alloc(mon, k * k + k + k * (nt ? nt : 1) + 2 * k + mon->nch, sizeof *mon->C);
+  if (!mon->G || !w->A || !mon->test || !mon->cand || !mon->C)
     return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (rank space)");
-  }
+  mon->z = mon->C + k * k, mon->Atw = mon->z + k, mon->b1 = mon->Atw + k * (nt ? nt : 1);
+  mon->achan = mon->b1 + 2 * k;
+  mon->ncol = pl->ncol;
   mon->ncand = pl->ncand;
-  mon->tdir = mon->test + (mon->nt ? mon->nt : 1) * k;
-  w.R = w.A + k * pmax, w.Ri = w.R + pmax * pmax, w.tau = w.Ri + pmax * pmax;
-  LAPACKE_dgeqrf_work(LAPACK_COL_MAJOR, (lapack_int)k, (lapack_int)pmax, w.A, (lapack_int)k,
-                      w.tau, &q1, -1);
-  LAPACKE_dorgqr_work(LAPACK_COL_MAJOR, (lapack_int)k, (lapack_int)pmax, (lapack_int)pmax, w.A,
-                      (lapack_int)k, w.tau, &q2, -1);
+  mon->tdir = mon->test + (nt ? nt : 1) * k;
+  w->R = w->A + k * pmax, w->Ri = w->R + pmax * pmax, w->tau = w->Ri + pmax * pmax;
+  LAPACKE_dgeqrf_work(LAPACK_COL_MAJOR, (lapack_int)k, (lapack_int)pmax, w->A, (lapack_int)k,
+                      w->tau, &q1, -1);
+  LAPACKE_dorgqr_work(LAPACK_COL_MAJOR, (lapack_int)k, (lapack_int)pmax, (lapack_int)pmax, w->A,
+                      (lapack_int)k, w->tau, &q2, -1);
   lw = (size_t)fmax(fmax(q1, q2), (double)pmax);
-  w.work = mon_alloc(mon, lw, sizeof *w.work);
-  w.lwork = lw;
-  if (!w.work) st = rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (rank space)");
-  else {
-    project(mon, J, pl->ncol, G);
-    st = tracked_space(mon, G, &w);
-    if (!st) st = cand_space(mon, d, pl, G, &w);
-  }
-  rcb_free(&mon->alloc, w.work);
-  rcb_free(&mon->alloc, w.A);
-  rcb_free(&mon->alloc, G);
-  return st;
+  if (!(w->work = mon_alloc(mon, lw, sizeof *w->work)))
+    return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (rank space)");
+  w->lwork = lw;
+  project(mon, J, pl->ncol, mon->G);
+  if ((st = tracked_space(mon, mon->G, w)) || (st = cand_space(mon, d, pl, mon->G, w)))
+    return st;
+  return transpose_q(mon);
 }
 
 /* ---- create ---- */
@@ -495,7 +506,7 @@ static rcb_status rank_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
 static rcb_status buffers(rcb_monitor *mon) {
   size_t npt = mon->npt, n = mon->n;
   mon->e0 = mon_alloc(mon, 2 * npt, sizeof *mon->e0);
-  mon->h0abs = mon_alloc(mon, 2 * npt + 3 * n, sizeof *mon->h0abs);
+  mon->h0abs = mon_alloc(mon, 3 * npt + 5 * n, sizeof *mon->h0abs);
   if (!mon->e0 || !mon->h0abs) return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (set-up)");
   mon->u = mon->e0 + npt;
   mon->sd_new_rad = mon->h0abs + npt;
@@ -503,6 +514,8 @@ static rcb_status buffers(rcb_monitor *mon) {
   mon->rbase = mon->winv + n;
   mon->r = mon->rbase + n;
   mon->rm = mon->r + n;
+  mon->var0 = mon->rm + n;
+  mon->sd0 = mon->var0 + n;
   return RCB_OK;
 }
 
@@ -512,6 +525,7 @@ static rcb_status settings(rcb_monitor *mon, const rcb_monitor_opts *o) {
   mon->cusum_h = o->cusum_h > 0 ? o->cusum_h : 8.0;
   mon->top = o->top ? o->top : RCB_MONITOR_TOP;
   mon->relin = o->relinearise;
+  mon->reweight = o->reweight != 0;
   mon->nt = o->ntracked;
   if (!(mon->alpha < 1) || !isfinite(mon->cusum_k) || !isfinite(mon->cusum_h) ||
       o->alpha < 0 || o->cusum_k < 0 || o->cusum_h < 0)

@@ -29,8 +29,17 @@ typedef struct mon_cand {
   double *est;     /* np x k row-major: its parameters' step = est y */
   double *dir;     /* dof x k row-major: orthonormal, score = ||dir y||^2 */
   double se[RCB_MONITOR_MAXP]; /* standard errors, parameter units */
+  size_t col;        /* its first column in G */
   double score_now;  /* this update's score */
+  double size_now[RCB_MONITOR_MAXP], se_now[RCB_MONITOR_MAXP]; /* this update's
+                        estimate and standard error (reweighted path) */
 } mon_cand;
+
+/* Workspace of the small QRs in the rank space (k x p, p <= nt + MAXP). */
+typedef struct mon_small {
+  double *A, *R, *Ri, *tau, *work;
+  size_t lwork;
+} mon_small;
 
 struct rcb_monitor {
   rcb_allocator user;  /* the caller's hooks */
@@ -63,7 +72,9 @@ struct rcb_monitor {
 
   /* rank space */
   size_t k;            /* rank of all columns */
-  double *Q;           /* n x k column-major, orthonormal */
+  double *Q;           /* n x k row-major (residual i: Q + k i), orthonormal columns */
+  double *G;           /* Q^T J, k x ncol column-major (tracked columns first) */
+  size_t ncol;
   mon_cand *cand;
   size_t ncand;
 
@@ -75,6 +86,16 @@ struct rcb_monitor {
   rcb_fit *fit;
   double *rbase;       /* n */
 
+  /* noise of the reweighted path */
+  int reweight, have_sd0;
+  double beta_a, beta_s, navg_inv;
+  double *var0;        /* 2 per point: radial, tangential variance of one
+                          measurement at the commissioning values */
+  double *sd0;         /* opts.sd copied (have_sd0), npt */
+  double *C, *z, *Atw, *b1; /* k x k, k, k x nt, 2 k */
+  double *achan;       /* nch: eq. 19 additive amplitude of this update */
+  mon_small sw;
+
   /* update workspace */
   double *r, *rm;      /* n each */
   double *y, *ym;      /* k each */
@@ -85,7 +106,14 @@ struct rcb_monitor {
 
 #define rcb_mon_fail(mon, st, ...) rcb_fail((mon), (st), __VA_ARGS__)
 
-/* monitor_create.c's pieces used by monitor.c */
+/* monitor_create.c's pieces used by the update */
 void rcb_mon_whiten(const rcb_monitor *mon, const rcb_complex *d, double *r);
+/* Thin QR of A (k x p, column-major, overwritten by its Q) with R and R^-1
+ * (p x p); *ok = 0 for a dependent column. No allocation. */
+rcb_status rcb_mon_small_qr(rcb_monitor *mon, mon_small *w, size_t k, size_t p, int *ok);
+/* monitor_gls.c: the statistics in the update's own covariance. theta holds
+ * the re-linearised tracked step (0 without), y the change it leaves. */
+rcb_status rcb_mon_gls(rcb_monitor *mon, const rcb_complex *v, const double *sd,
+                       double *theta, double *se, double *T);
 
 #endif
