@@ -19,6 +19,7 @@ const char cli_help_monitor[] =
     "usage: rcbtool monitor BASELINE.ini DIR|MEAS... --params NAME[:LO:HI],...\n"
     "                       [--noise A,S | --sd STATS.csv|DIR] [--commission N]\n"
     "                       [--alpha A] [--cusum-h H] [--cusum-k K] [--relinearise N]\n"
+    "                       [--reweight]\n"
     "                       [--map NODE=STATION,...] [--rpm R] [--log OUT.json|OUT.csv]\n"
     "                       [--plot TREND.png] [--json] [-o FILE] [--progress]\n"
     "\n"
@@ -49,6 +50,10 @@ const char cli_help_monitor[] =
     "  --cusum-h H     CUSUM decision threshold, standard deviations (default: the\n"
     "                  library's); --cusum-k K its reference value\n"
     "  --relinearise N chord iterations re-evaluating the model per update (0)\n"
+    "  --reweight      each update's noise from its own values (eq. 19 on them, or\n"
+    "                  its --sd file), statistics by generalised least squares: T\n"
+    "                  stays chi-square after a large change of the tracked\n"
+    "                  parameters (a moved resonance); slower per update\n"
     "  --log FILE      every update as JSON (.json) or CSV (.csv), atomically\n"
     "  --plot FILE     the trend (.png, .pdf or .svg): tracked parameters with\n"
     "                  their 95 % bands, T/thr with the alarm line, alarms marked;\n"
@@ -95,6 +100,7 @@ static int parse_job(const cli_args *a, mon_job *j) {
     return cli_usage(a->cmd, "option --relinearise expects a whole number 0..100, got '%s'",
                      cli_opt_value(a, "--relinearise"));
   j->relinearise = (size_t)relin;
+  j->reweight = cli_opt_value(a, "--reweight") != NULL;
   if (cli_opt_value(a, "--alpha") && !(j->alpha > 0.0 && j->alpha < 1.0))
     return cli_usage(a->cmd, "option --alpha expects a probability 0 < A < 1, got '%s'",
                      cli_opt_value(a, "--alpha"));
@@ -270,6 +276,7 @@ int cmd_monitor(int argc, char **argv) {
                     {"--cusum-h", "H", NULL},
                     {"--cusum-k", "K", NULL},
                     {"--relinearise", "N", NULL},
+                    {"--reweight", NULL, NULL},
                     {"--map", "NODE=STATION,...", NULL},
                     {"--rpm", "R", NULL},
                     {"--log", "FILE", NULL},

@@ -20,6 +20,7 @@ typedef struct mon_job {
   int have_params;
   size_t commission;  /**< files averaged into the reference (>= 1) */
   size_t relinearise; /**< chord iterations per update */
+  int reweight;       /**< --reweight: each update's noise from its own values */
   double alpha, cusum_h, cusum_k; /**< 0: the library's defaults */
   double beta_a, beta_s;          /**< --noise, % */
   const char *sd_path;            /**< --sd FILE or DIR, NULL */

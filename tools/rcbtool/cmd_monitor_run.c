@@ -222,6 +222,7 @@ static int create_monitor(mon_ctx *x, rcb_monitor **mon) {
   o.sd = x->have_sd ? x->sd : NULL;
   o.setup_averages = (double)x->j->commission;
   o.relinearise = x->j->relinearise;
+  o.reweight = x->j->reweight;
   if (x->j->commission > 1 && (rc = averaged_setup(x, &avg))) return rc;
   st = rcb_monitor_create(mon, x->m, avg ? avg : x->setup, &o, NULL);
   rcb_meas_destroy(avg);

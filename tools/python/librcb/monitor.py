@@ -43,13 +43,15 @@ class Monitor(Handle):
     _errmsg = "rcb_monitor_errmsg"
 
     def __init__(self, model, setup, params, noise=None, sd=None, alpha=None, cusum_h=None,
-                 cusum_k=None, setup_averages=1, relinearise=0):
+                 cusum_k=None, setup_averages=1, relinearise=0, reweight=False):
         """model: the fitted baseline (a Model); setup: the commissioning
         measurement (a Meas: channels, grid and the reference values); params:
         tracked parameter names or {name: (lo, hi)}; noise: eq. 19 (beta_a,
         beta_s) in %, or sd: standard deviations of Re and Im per (channel,
         point), shape (channels, points), SI; alpha, cusum_h, cusum_k: None for
-        the library's defaults; setup_averages: measurements averaged into setup."""
+        the library's defaults; setup_averages: measurements averaged into setup;
+        reweight: each update's noise from its own values (generalised least
+        squares: T stays chi-square after large changes; O(n k^2) per update)."""
         super().__init__()
         self._names = [r if ref is None else f"{r}/{ref}" for r, ref, _ in setup.channels]
         self._shape = (len(self._names), setup.n_points)
@@ -68,6 +70,7 @@ class Monitor(Handle):
             o.sd = self._sd0.ctypes.data
         o.setup_averages = float(setup_averages)
         o.relinearise = int(relinearise)
+        o.reweight = int(bool(reweight))
         self._create("rcb_monitor_create", model.handle, setup.handle, ctypes.byref(o), None)
         self.tracked = [self._tracked_info(k) for k in range(len(tp))]
 
