@@ -16,10 +16,11 @@ this script itself) and writes
 The second reads the JSON of `rcbtool monitor --json` (or its --log .json;
 rcbtool monitor --plot OUT runs this script itself) and writes the trend OUT
 (FORMAT png, pdf or svg; by default from OUT's extension): each tracked
-parameter with its 95 % band against the update, the instant test statistic
-over its threshold (log axis) with the alarm line at 1, and the moments of
-change marked: the first TEST alarm (with the effect and place named) and the
-first CUSUM alarm, as vertical lines on every panel.
+parameter with its 95 % band against the update (CUSUM alarms as dots), the
+instant test statistic over its threshold (log axis) with the alarm line at 1
+(TEST alarms as dots), and the moments of change marked as vertical lines: the
+first update of every run of two or more alarmed updates, with the effect and
+place the TEST named (a lone alarm, as a false alarm looks, is a dot only).
 Exit codes: 0 written, 2 usage, 3 matplotlib missing, 4 bad JSON, 5 not written.
 """
 
@@ -185,8 +186,23 @@ def residual_map(plt, d, path):
     plt.close(fig)
 
 
-def _first(updates, key):
-    return next((u["update"] for u in updates if u[key]), None)
+def _changes(ups):
+    """The moments of change: the first update of every run of two or more
+    consecutive alarmed updates (TEST or CUSUM; a lone alarm is drawn as a dot
+    only, as a false alarm at the rate asked for looks), with what it was."""
+    out, run = [], []
+    for u in ups + [None]:
+        if u is not None and (u["alarm"] or u["cusum_alarm"]):
+            run.append(u)
+            continue
+        if len(run) >= 2:
+            first = run[0]
+            what = "CUSUM" if not first["alarm"] else "TEST"
+            t = next((v for v in run if v["alarm"] and v["top"]), None)
+            name = f": {t['top'][0]['effect']} at {t['top'][0]['place']}" if t else ""
+            out.append((first["update"], what + name))
+        run = []
+    return out
 
 
 def trend(plt, d, path, fmt=None):
@@ -196,7 +212,7 @@ def trend(plt, d, path, fmt=None):
     fig, axes = plt.subplots(len(names) + 1, 1, figsize=(9, 2.4 * (len(names) + 1) + 0.6),
                              sharex=True, squeeze=False)
     axes = axes[:, 0]
-    t_alarm, c_alarm = _first(ups, "alarm"), _first(ups, "cusum_alarm")
+    changes = _changes(ups)
     for k, (ax, name) in enumerate(zip(axes, names)):
         v = [u["tracked"][k]["value"] for u in ups]
         lo = [u["tracked"][k]["ci_lo"] for u in ups]
@@ -204,6 +220,9 @@ def trend(plt, d, path, fmt=None):
         ax.fill_between(x, lo, hi, color="tab:blue", alpha=0.25, lw=0, label="95 % interval")
         ax.plot(x, v, color="tab:blue", lw=1.0, label="estimate")
         ax.axhline(d["tracked"][k]["baseline"], color="k", ls="--", lw=0.8, label="baseline")
+        cu = [(xi, vi) for xi, vi, u in zip(x, v, ups) if u["tracked"][k]["cusum_alarm"]]
+        if cu:
+            ax.plot(*zip(*cu), ".", color="tab:orange", ms=4, label="CUSUM alarm")
         ax.set_ylabel(name, fontsize=8)
         ax.grid(True, alpha=0.3)
         ax.tick_params(labelsize=7)
@@ -221,19 +240,15 @@ def trend(plt, d, path, fmt=None):
     ax.grid(True, alpha=0.3, which="both")
     ax.tick_params(labelsize=7)
     for a in axes:
-        if t_alarm is not None:
-            a.axvline(t_alarm, color="tab:red", ls=":", lw=1.2,
-                      label=f"first TEST alarm (update {t_alarm})")
-        if c_alarm is not None:
-            a.axvline(c_alarm, color="tab:orange", ls="-.", lw=1.2,
-                      label=f"first CUSUM alarm (update {c_alarm})")
+        for k, (at, what) in enumerate(changes):
+            a.axvline(at, color="tab:red", ls=":", lw=1.2,
+                      label=f"change at update {at} ({what})" if a is axes[-1] else
+                      ("change" if k == 0 else None))
         a.legend(fontsize=6, loc="best")
-    title = f"{d['model']}: {len(ups)} updates"
-    if t_alarm is not None:
-        u = next(u for u in ups if u["alarm"])
-        if u["top"]:
-            title += f"; first TEST alarm: {u['top'][0]['effect']} at {u['top'][0]['place']}"
-    axes[0].set_title(title, fontsize=9)
+    model = str(d["model"]).rsplit("/", 1)[-1]
+    n_alarm = sum(1 for u in ups if u["alarm"])
+    axes[0].set_title(f"{model}: {len(ups)} updates, {n_alarm} TEST alarms, "
+                      f"{len(changes)} change(s) marked", fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=110, format=fmt)
     plt.close(fig)

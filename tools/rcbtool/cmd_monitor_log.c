@@ -3,6 +3,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "cmd_monitor.h"
 
@@ -196,6 +197,13 @@ static void print_csv(FILE *fp, const mon_state *s) {
   for (k = 0; k < s->nrec; k++) csv_row(fp, s, k);
 }
 
+/* The mode a plain fopen would have given (0666 & ~umask): mkstemp made 0600. */
+static void plain_mode(const char *path) {
+  mode_t mask = umask(0);
+  umask(mask);
+  (void)chmod(path, (mode_t)(0666 & ~mask));
+}
+
 /* Write a temporary for @p path with @p fn; 0 or exit 5 (the temporary removed). */
 static int write_tmp(cli_tmpfile *t, const char *path, const mon_state *s,
                      void (*fn)(FILE *, const mon_state *)) {
@@ -206,6 +214,7 @@ static int write_tmp(cli_tmpfile *t, const char *path, const mon_state *s,
     cli_tmpfile_close(t, 0);
     return cli_fail(CLI_EXIT_IO, "cannot write output file '%s'", path);
   }
+  plain_mode(t->write_path);
   fn(fp, s);
   bad = ferror(fp) != 0;
   if (fclose(fp) != 0) bad = 1;
@@ -250,7 +259,9 @@ int mon_write_outputs(const mon_state *s) {
     free(json_name);
   }
   if (have_pic) {
-    int r2 = cli_tmpfile_close(&pic, !rc);
+    int r2;
+    if (!rc) plain_mode(pic.write_path);
+    r2 = cli_tmpfile_close(&pic, !rc);
     if (!rc) rc = r2;
   }
   if (have_log) {
