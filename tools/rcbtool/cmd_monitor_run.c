@@ -275,7 +275,7 @@ static void print_line(FILE *fp, const mon_state *s, const mon_record *rec) {
     const rcb_monitor_candidate *c = &r->top[0];
     rcb_monitor_candidate_info ci;
     if (rcb_monitor_candidate_info_get(s->mon, c->index, &ci) == RCB_OK)
-      fprintf(fp, "  -> %s at %s: %s %.4g [%.4g, %.4g]", rcb_effect_name(ci.effect), ci.place,
+      fprintf(fp, "  -> %s at %s: %s %.6g [%.6g, %.6g]", rcb_effect_name(ci.effect), ci.place,
               ci.params, c->size[0], c->ci_lo[0], c->ci_hi[0]);
   }
   fputc('\n', fp);
