@@ -146,6 +146,7 @@ static rcb_status baseline(rcb_monitor *mon, const rcb_model *base, const rcb_mo
   if (st) return rcb_mon_fail(mon, st, "baseline model: %s",
                               mon->model ? rcb_model_errmsg(mon->model) : rcb_status_str(st));
   if ((st = rcb_fit_create(&mon->fit, mon->model, mon->setup, &mon->alloc)) ||
+      (st = rcb_fit_set_solver(mon->fit, RCB_SOLVER_BANDED)) ||
       (st = rcb_fit_set_scale(mon->fit, RCB_SCALE_COMPLEX)) ||
       (st = rcb_fit_set_uncertainty(mon->fit, 0)))
     return rcb_mon_fail(mon, st, "set-up against the baseline: %s",
@@ -192,6 +193,7 @@ static rcb_status cand_fit(rcb_monitor *mon, rcb_model *cm, const rcb_diag_cand_
                            rcb_fit **out) {
   rcb_status st = rcb_fit_create(out, cm, mon->setup, &mon->alloc);
   size_t k;
+  if (!st) st = rcb_fit_set_solver(*out, RCB_SOLVER_BANDED); /* no KLU: every byte via the hooks */
   if (!st) st = rcb_fit_set_scale(*out, RCB_SCALE_COMPLEX);
   if (!st) st = rcb_fit_set_uncertainty(*out, 0);
   for (k = 0; !st && k < c->np; k++) st = rcb_fit_add_param(*out, c->pname[k], c->lo[k], c->hi[k], 0);
