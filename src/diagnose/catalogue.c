@@ -507,6 +507,7 @@ rcb_status rcb_diag_catalogue_get(const rcb_diag *d, size_t i, rcb_diag_cand_des
     out->lo[k] = c->lo[k], out->hi[k] = c->hi[k], out->logp[k] = c->logp[k];
   }
   out->refit_only = c->refit_only;
+  out->adds_dofs = c->edit == EDIT_ADD_PEDESTAL;
   return RCB_OK;
 }
 

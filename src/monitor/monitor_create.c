@@ -146,6 +146,7 @@ static rcb_status baseline(rcb_monitor *mon, const rcb_model *base, const rcb_mo
   if (st) return rcb_mon_fail(mon, st, "baseline model: %s",
                               mon->model ? rcb_model_errmsg(mon->model) : rcb_status_str(st));
   if ((st = rcb_fit_create(&mon->fit, mon->model, mon->setup, &mon->alloc)) ||
+      (st = rcb_fit_set_solver(mon->fit, RCB_SOLVER_BANDED)) ||
       (st = rcb_fit_set_scale(mon->fit, RCB_SCALE_COMPLEX)) ||
       (st = rcb_fit_set_uncertainty(mon->fit, 0)))
     return rcb_mon_fail(mon, st, "set-up against the baseline: %s",
@@ -192,6 +193,7 @@ static rcb_status cand_fit(rcb_monitor *mon, rcb_model *cm, const rcb_diag_cand_
                            rcb_fit **out) {
   rcb_status st = rcb_fit_create(out, cm, mon->setup, &mon->alloc);
   size_t k;
+  if (!st) st = rcb_fit_set_solver(*out, RCB_SOLVER_BANDED); /* no KLU: every byte via the hooks */
   if (!st) st = rcb_fit_set_scale(*out, RCB_SCALE_COMPLEX);
   if (!st) st = rcb_fit_set_uncertainty(*out, 0);
   for (k = 0; !st && k < c->np; k++) st = rcb_fit_add_param(*out, c->pname[k], c->lo[k], c->hi[k], 0);
@@ -218,7 +220,9 @@ static rcb_status cand_columns(rcb_monitor *mon, rcb_diag *d, const col_plan *pl
       break;
     }
     st = cand_fit(mon, cm, &c, &cf);
-    pl->own[j] = rcb_model_dof_count(cm) != ndof;
+    if (!st && pl->own[j] == (rcb_model_dof_count(cm) == ndof))
+      st = rcb_mon_fail(mon, RCB_ERR_STATE, "%s: its model's DOFs are not as the catalogue "
+                        "states", c.desc);
     if (!st && !pl->own[j]) {
       if ((st = rcb_fit_dz_get(cf, &mon->alloc, dz + ndz)))
         rcb_mon_fail(mon, st, "%s: %s", c.desc, rcb_fit_errmsg(cf));
@@ -244,42 +248,25 @@ static rcb_status cand_columns(rcb_monitor *mon, rcb_diag *d, const col_plan *pl
   return st;
 }
 
-/* Which candidates, their columns: the batched (same DOFs) ones first. The
- * DOF test needs the candidate's model, so it is made twice (cheap). */
+/* Which candidates, their columns: the batched (same DOFs) ones first. */
 static rcb_status plan(rcb_monitor *mon, rcb_diag *d, unsigned mask, col_plan *pl) {
-  size_t nc = rcb_diag_catalogue_count(d), i, pass, ndof = rcb_model_dof_count(mon->model);
-  rcb_status st;
-  int *same = mon_alloc(mon, nc ? nc : 1, sizeof *same);
+  size_t nc = rcb_diag_catalogue_count(d), i, pass;
   pl->cand = mon_alloc(mon, nc ? nc : 1, sizeof *pl->cand);
   pl->col = mon_alloc(mon, nc ? nc : 1, sizeof *pl->col);
   pl->own = mon_alloc(mon, nc ? nc : 1, sizeof *pl->own);
-  if (!same || !pl->cand || !pl->col || !pl->own) {
-    rcb_free(&mon->alloc, same);
+  if (!pl->cand || !pl->col || !pl->own)
     return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (catalogue)");
-  }
-  for (i = 0; i < nc; i++) {
-    rcb_diag_cand_desc c;
-    rcb_model *cm = NULL;
-    rcb_diag_catalogue_get(d, i, &c);
-    if (!wanted(&c, mask)) continue;
-    if ((st = rcb_diag_catalogue_model(d, i, mon->model, &cm))) {
-      rcb_free(&mon->alloc, same);
-      return rcb_mon_fail(mon, st, "%s", rcb_diag_errmsg(d));
-    }
-    same[i] = 1 + (rcb_model_dof_count(cm) == ndof);
-    rcb_model_destroy(cm);
-  }
   pl->ncol = mon->nt;
-  for (pass = 2; pass >= 1; pass--)
+  for (pass = 0; pass < 2; pass++)
     for (i = 0; i < nc; i++) {
       rcb_diag_cand_desc c;
-      if (same[i] != (int)pass) continue;
       rcb_diag_catalogue_get(d, i, &c);
+      if (!wanted(&c, mask) || c.adds_dofs != (int)pass) continue;
+      pl->own[pl->ncand] = c.adds_dofs;
       pl->cand[pl->ncand] = i;
       pl->col[pl->ncand++] = pl->ncol;
       pl->ncol += c.np;
     }
-  rcb_free(&mon->alloc, same);
   return RCB_OK;
 }
 
@@ -456,19 +443,16 @@ static rcb_status factor(rcb_monitor *mon, rcb_diag *d, const double *J, size_t 
 
 /* Q (column-major from the QR) to row-major: the update reads it residual
  * by residual. */
-static rcb_status transpose_q(rcb_monitor *mon) {
+static void transpose_q(rcb_monitor *mon, double *Qr) {
   size_t n = mon->n, k = mon->k, i, a;
-  double *Qr = mon_alloc(mon, n * k, sizeof *Qr);
-  if (!Qr) return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (Q)");
   for (a = 0; a < k; a++)
     for (i = 0; i < n; i++) Qr[k * i + a] = mon->Q[i + n * a];
   rcb_free(&mon->alloc, mon->Q);
   mon->Q = Qr;
-  return RCB_OK;
 }
 
-static rcb_status rank_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
-                             const double *J) {
+/* J (n x ncol >= n x k) is used up: Q moves into its block. */
+static rcb_status rank_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl, double *J) {
   size_t k = mon->k, nt = mon->nt, pmax = nt + RCB_MONITOR_MAXP, lw;
   double q1 = 0, q2 = 0;
   mon_small *w = &mon->sw;
@@ -498,7 +482,8 @@ static rcb_status rank_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
   project(mon, J, pl->ncol, mon->G);
   if ((st = tracked_space(mon, mon->G, w)) || (st = cand_space(mon, d, pl, mon->G, w)))
     return st;
-  return transpose_q(mon);
+  transpose_q(mon, J);
+  return RCB_OK;
 }
 
 /* ---- create ---- */
@@ -576,7 +561,7 @@ static rcb_status commission(rcb_monitor *mon, const rcb_model *base, const rcb_
     memset(mon->r, 0, mon->n * sizeof *mon->r);
     st = factor(mon, d, J, pl.ncol);
   }
-  if (!st) st = rank_space(mon, d, &pl, J);
+  if (!st && !(st = rank_space(mon, d, &pl, J))) J = NULL; /* now mon->Q */
   if (!st) {
     mon->y = mon_alloc(mon, 2 * mon->k + 2 * (mon->ncand ? mon->ncand : 1), sizeof *mon->y);
     if (!mon->y) st = rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (update workspace)");
