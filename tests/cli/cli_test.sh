@@ -782,6 +782,46 @@ for t, b in zip(u[0]["tracked"], d["tracked"]):
 assert u[1]["T"] > 0 and u[1]["threshold"] > 0 and u[1]["dof"] >= 1, u[1]
 PY
   [ "$(grep -c -v '^#' "$W/log.csv")" -eq 3 ] || fail "log.csv: expected a header and 2 rows" ;;
+monitor_sd)
+  # per-point sds: one --sd file for every update, or a directory of STEM_stats.csv
+  # (each update's own sds); the same sds both ways must give the same statistics
+  # (the library's per-update GLS path against its commissioning-noise path)
+  mkdir "$W/s" "$W/sd"
+  for k in 1 2 3 4; do
+    run simulate "$MODEL" --frf --out C.A.x,C.A.y,C.B.x,C.B.y --in DA.x --fmin 100 --fmax 400 \
+      --points 61 --rpm 10000 --kind inertance --noise 10,1 --seed $k -o "$W/s/d$k.csv"; expect_rc 0
+  done
+  python3 - "$W" <<'PY' || fail "could not write the stats files"
+import csv, math, sys
+w = sys.argv[1]
+rows = [r for r in csv.reader(open(f"{w}/s/d1.csv")) if r and not r[0].startswith("#")]
+head, data = rows[0], rows[1:]
+names = [h[:-3] for h in head[1::2]]
+with open(f"{w}/sd.csv", "w") as f:
+    f.write("freq_hz," + ",".join(f"{n} sd" for n in names) + "\n")
+    for r in data:
+        v = [float(x) for x in r[1:]]
+        sd = [0.06 * math.hypot(v[2 * c], v[2 * c + 1]) for c in range(len(names))]
+        f.write(r[0] + "," + ",".join(repr(x) for x in sd) + "\n")
+PY
+  for k in 1 2 3 4; do cp "$W/sd.csv" "$W/sd/d${k}_stats.csv"; done
+  run monitor "$MODEL" "$W/s" --params coupling.C.kt --sd "$W/sd.csv" --json; expect_rc 0
+  cp "$W/out" "$W/file.json"
+  run monitor "$MODEL" "$W/s" --params coupling.C.kt --sd "$W/sd" --json; expect_rc 0
+  python3 - "$W/file.json" "$W/out" <<'PY' || fail "--sd FILE and --sd DIR disagree"
+import json, sys
+a, b = (json.load(open(p))["updates"] for p in sys.argv[1:])
+assert len(a) == len(b) == 3
+for x, y in zip(a, b):
+    assert abs(x["T"] - y["T"]) <= 1e-6 * abs(x["T"]) + 1e-9, (x["T"], y["T"])
+    tx, ty = x["tracked"][0], y["tracked"][0]
+    assert abs(tx["value"] - ty["value"]) <= 1e-9 * abs(tx["value"]), (tx, ty)
+    assert abs(tx["stderr"] - ty["stderr"]) <= 1e-6 * tx["stderr"], (tx, ty)
+PY
+  rm "$W/sd/d3_stats.csv"
+  run monitor "$MODEL" "$W/s" --params coupling.C.kt --sd "$W/sd"; expect_rc 3; err_has "d3_stats.csv"
+  usage monitor "$MODEL" "$W/s" --params coupling.C.kt --sd "$W/sd.csv" --noise 10,1
+  err_has "exclude each other" ;;
 monitor_dir_order)
   # DIR is read sorted by name, whatever the order the files were made in
   mkdir "$W/s"
