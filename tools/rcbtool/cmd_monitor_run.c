@@ -89,26 +89,6 @@ static int sd_is_dir(const char *path) {
   return path && stat(path, &st) == 0 && S_ISDIR(st.st_mode);
 }
 
-/* The sds of file @p path (read as @p ms) in the set-up's order, NULL without --sd
- * DIR; 0 or an exit code. */
-static int file_sd(const mon_job *j, const rcb_meas *ms, const char *path, const size_t *perm,
-                   double *out, int *have) {
-  size_t n = rcb_meas_point_count(ms), nc = rcb_meas_channel_count(ms), c;
-  double *sd = NULL;
-  char *f;
-  int rc;
-  *have = 0;
-  if (!sd_is_dir(j->sd_path)) return 0;
-  if (!(f = sd_file_for(j->sd_path, path))) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
-  rc = cli_sd_values(f, ms, &sd);
-  free(f);
-  if (rc) return rc;
-  for (c = 0; c < nc; c++) memcpy(out + c * n, sd + perm[c] * n, n * sizeof *out);
-  free(sd);
-  *have = 1;
-  return 0;
-}
-
 typedef struct mon_ctx {
   const cli_args *a;
   const mon_job *j;
@@ -119,6 +99,27 @@ typedef struct mon_ctx {
   double *sd;
   int have_sd;
 } mon_ctx;
+
+/* --sd DIR: the sds of file @p path (read as @p ms, the set-up's layout) into
+ * x->sd in the set-up's order; *have 0 without --sd DIR. 0 or an exit code. */
+static int file_sd(mon_ctx *x, const rcb_meas *ms, const char *path, int *have) {
+  size_t c;
+  double *sd = NULL;
+  char *f;
+  int rc;
+  *have = 0;
+  if (!sd_is_dir(x->j->sd_path)) return 0;
+  if (!(f = sd_file_for(x->j->sd_path, path)))
+    return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  rc = cli_sd_values(f, ms, &sd); /* ms has x->nc channels of x->n points (matched) */
+  free(f);
+  if (rc) return rc;
+  for (c = 0; c < x->nc; c++)
+    memcpy(x->sd + c * x->n, sd + x->perm[c] * x->n, x->n * sizeof *x->sd);
+  free(sd);
+  *have = 1;
+  return 0;
+}
 
 static int read_file(mon_ctx *x, size_t k, rcb_meas **out) {
   const char *path = x->j->series.files[k];
@@ -141,9 +142,9 @@ static int commission(mon_ctx *x) {
   x->n = rcb_meas_point_count(x->setup);
   x->nc = rcb_meas_channel_count(x->setup);
   nv = x->n * x->nc;
-  x->perm = malloc((x->nc ? x->nc : 1) * sizeof *x->perm);
-  x->values = malloc((nv ? nv : 1) * sizeof *x->values);
-  x->sd = malloc((nv ? nv : 1) * sizeof *x->sd);
+  x->perm = calloc(x->nc ? x->nc : 1, sizeof *x->perm);
+  x->values = calloc(nv ? nv : 1, sizeof *x->values);
+  x->sd = calloc(nv ? nv : 1, sizeof *x->sd);
   if (!x->perm || !x->values || !x->sd) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   for (k = 0; k < x->nc; k++) x->perm[k] = k;
   if (x->j->sd_path && !sd_is_dir(x->j->sd_path)) { /* one file for every update */
@@ -152,8 +153,7 @@ static int commission(mon_ctx *x) {
     memcpy(x->sd, sd, nv * sizeof *sd);
     free(sd);
     x->have_sd = 1;
-  } else if ((rc = file_sd(x->j, x->setup, x->j->series.files[0], x->perm, x->sd,
-                           &x->have_sd))) {
+  } else if ((rc = file_sd(x, x->setup, x->j->series.files[0], &x->have_sd))) {
     return rc;
   }
   if (x->j->commission == 1) return 0;
@@ -302,7 +302,7 @@ static int one_update(mon_ctx *x, mon_state *s, rcb_monitor *mon, size_t k) {
   int rc, have_sd = 0;
   if ((rc = read_file(x, k, &ms))) return rc;
   gather(ms, x->perm, x->nc, x->n, x->values);
-  rc = file_sd(x->j, ms, x->j->series.files[k], x->perm, x->sd, &have_sd);
+  rc = file_sd(x, ms, x->j->series.files[k], &have_sd);
   rcb_meas_destroy(ms);
   if (rc) return rc;
   if ((st = rcb_monitor_update(mon, x->values, have_sd ? x->sd : NULL, &r)))
