@@ -12,6 +12,8 @@
  *    tolerance of the chi-square mean, the tracked parameter's z with mean
  *    0 and variance 1, its 95 % interval covering the truth as often as
  *    the binomial 99 % interval of 0.95 allows, and no CUSUM alarm;
+ *  - the same with per-point standard deviations (Gaussian noise) passed
+ *    at create and with each update;
  *  - known changes, made by evaluating a model (a unit test of the linear
  *    algebra: the series generated with ROSS belong to the CLI's tests):
  *    kt scaled by 0.92 (the tracked interval covers it, the CUSUM falls,
@@ -249,6 +251,50 @@ static void null_case(fixture *f, int reweight) {
 static void test_null(void **state) { null_case(*state, 0); }
 static void test_null_reweighted(void **state) { null_case(*state, 1); }
 
+/* Per-point standard deviations (as #15's estimators give), circular
+ * Gaussian noise drawn here by Box-Muller, passed at create and with every
+ * update (the reweighted path): the mean of T is the chi-square mean. */
+static void test_null_sd(void **state) {
+  fixture *f = *state;
+  rcb_monitor_param tp;
+  rcb_monitor_opts o = opts_kt(&tp, f->kt);
+  rcb_monitor *mon = NULL;
+  rcb_monitor_result r;
+  double *sd = malloc(NPT * sizeof *sd), sumT = 0, tol, amax = 0;
+  const size_t N = 200;
+  size_t u, i, alarms = 0, lo, hi;
+  uint64_t seed = 99;
+  for (i = 0; i < NPT; i++) amax = fmax(amax, cabs(f->fs[i]));
+  for (i = 0; i < NPT; i++) sd[i] = 0.01 * cabs(f->fs[i]) + 1e-3 * amax;
+  o.sd = sd;
+  o.beta_a = o.beta_s = 0;
+  o.alpha = 0.02;
+  o.setup_averages = HUGE_VAL;
+  assert_int_equal(rcb_monitor_create(&mon, f->base, f->setup, &o, NULL), RCB_OK);
+  for (u = 0; u < N; u++) {
+    for (i = 0; i < NPT; i++) {
+      double u1 = 1 - rng_uniform(&seed), u2 = rng_uniform(&seed), g = sqrt(-2 * log(u1));
+      double ph = 2 * 3.14159265358979323846 * u2;
+      f->v[i] = f->fs[i] + sd[i] * g * (cos(ph) + CMPLX(0.0, sin(ph)));
+    }
+    assert_int_equal(rcb_monitor_update(mon, f->v, sd, &r), RCB_OK);
+    sumT += r.T;
+    alarms += (size_t)r.alarm;
+  }
+  tol = 4 * sqrt(2.0 * (double)r.dof / (double)N);
+  binom99(N, o.alpha, &lo, &hi);
+  print_message("null with per-point sd: mean T %.2f (dof %zu, tolerance %.2f), %zu alarms "
+                "(99 %% interval [%zu, %zu])\n", sumT / (double)N, r.dof, tol, alarms, lo, hi);
+  assert_true(fabs(sumT / (double)N - (double)r.dof) < tol);
+  assert_true(alarms >= lo && alarms <= hi);
+  /* a bad sd in an update is refused, naming the point */
+  sd[5] = -1;
+  assert_int_equal(rcb_monitor_update(mon, f->v, sd, &r), RCB_ERR_ARG);
+  assert_non_null(strstr(rcb_monitor_errmsg(mon), "channel 1 point 6"));
+  rcb_monitor_destroy(mon);
+  free(sd);
+}
+
 /* kt scaled by 0.92 in the machine: a tracked drift. The machine is the
  * baseline model itself here: with 6400 residuals at 2 % noise the
  * interval is ~2e-5 kt wide, and the fixture's 5 % bias of bearing B3
@@ -458,6 +504,7 @@ int main(void) {
       cmocka_unit_test(test_chi2),
       cmocka_unit_test(test_null),
       cmocka_unit_test(test_null_reweighted),
+      cmocka_unit_test(test_null_sd),
       cmocka_unit_test(test_kt_change),
       cmocka_unit_test(test_cross_coupling),
       cmocka_unit_test(test_no_alloc_in_update),

@@ -113,18 +113,21 @@ static rcb_status candidates_gls(rcb_monitor *mon) {
       c->score_now = 0;
       memset(c->size_now, 0, sizeof c->size_now);
       memcpy(c->se_now, c->se, sizeof c->se_now);
+      memset(c->th_now, 0, sizeof c->th_now);
+      memcpy(c->set_now, c->se_t, sizeof c->set_now);
       continue;
     }
     c->score_now = explained(&mon->sw, mon->z, k, nt, nt + c->np, qz);
     step(&mon->sw, qz, nt + c->np, nt, c->np, c->size_now, c->se_now);
+    step(&mon->sw, qz, nt + c->np, 0, nt, c->th_now, c->set_now);
   }
   return RCB_OK;
 }
 
 rcb_status rcb_mon_gls(rcb_monitor *mon, const rcb_complex *v, const double *sd,
-                       double *theta, double *se, double *T) {
+                       double *dtheta, double *se, double *T) {
   size_t k = mon->k, nt = mon->nt, a;
-  double qz[RCB_MONITOR_MAX_TRACKED], dth[RCB_MONITOR_MAX_TRACKED];
+  double qz[RCB_MONITOR_MAX_TRACKED];
   lapack_int info;
   int ok = 1;
   rcb_status st;
@@ -147,8 +150,7 @@ rcb_status rcb_mon_gls(rcb_monitor *mon, const rcb_complex *v, const double *sd,
       return rcb_mon_fail(mon, RCB_ERR_SINGULAR, "reweighted update %zu: the tracked parameters "
                           "are not told apart in this update's noise", mon->updates + 1);
     *T -= explained(&mon->sw, mon->z, k, 0, nt, qz);
-    step(&mon->sw, qz, nt, 0, nt, dth, se);
-    for (a = 0; a < nt; a++) theta[a] += dth[a];
+    step(&mon->sw, qz, nt, 0, nt, dtheta, se);
   }
   return candidates_gls(mon);
 }
