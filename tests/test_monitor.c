@@ -37,6 +37,7 @@
 #include <string.h>
 #include <cmocka.h>
 
+#include "monitor/monitor_internal.h" /* rcb_mon_chi2_logsf */
 #include "rcb/rcb.h"
 #include "rcb_test_util.h"
 
@@ -150,6 +151,12 @@ static void test_chi2(void **state) {
    * chi-square(10) 0.99 quantile 23.209 (Abramowitz & Stegun table 26.8) */
   assert_true(rcb_test_close(rcb_chi2_quantile(0.99, 10), 23.2093, 1e-5, 0));
   assert_true(isnan(rcb_chi2_quantile(1.0, 3)) && isnan(rcb_chi2_sf(-1, 3)));
+  /* the log tail where the tail underflows (ranking of strong effects):
+   * chi-square(2): log P(X > x) = -x / 2; chi-square(4): -x/2 + log(1 + x/2) */
+  assert_true(rcb_chi2_sf(3000, 2) == 0.0);
+  assert_true(rcb_test_close(rcb_mon_chi2_logsf(3000, 2), -1500, 1e-12, 0));
+  assert_true(rcb_test_close(rcb_mon_chi2_logsf(3000, 4), -1500 + log(1501.0), 1e-12, 0));
+  assert_true(rcb_test_close(rcb_mon_chi2_logsf(3, 4), log(exp(-1.5) * 2.5), 1e-12, 0));
   /* Siegmund's approximation against the exact one-sided CUSUM ARL0 on
    * N(0,1) data (Montgomery, Introduction to SQC, table 9.3: k = 0.5,
    * h = 4: 336; h = 5: 930), within the approximation's ~1 % */

@@ -138,14 +138,12 @@ static void tracked_result(rcb_monitor *mon, const double *theta, const double *
   }
 }
 
-/* a ranks before b: smaller p-value; where both underflow, larger
- * standardised score. */
+/* a ranks before b: smaller p-value, compared as logarithms (the p-values
+ * of strong effects underflow to 0 together); then the larger score. */
 static int before(const rcb_monitor *mon, size_t a, size_t b) {
-  const mon_cand *ca = &mon->cand[a], *cb = &mon->cand[b];
   double pa = mon->pscore[a], pb = mon->pscore[b];
   if (pa != pb) return pa < pb;
-  return (ca->score_now - (double)ca->dof) / sqrt(2.0 * (double)ca->dof) >
-         (cb->score_now - (double)cb->dof) / sqrt(2.0 * (double)cb->dof);
+  return mon->cand[a].score_now > mon->cand[b].score_now;
 }
 
 /* Scores (and, on the reweighted path, sizes) were left in the
@@ -160,7 +158,7 @@ static void candidates(rcb_monitor *mon, int gls, rcb_monitor_result *res) {
       if (!a) c->score_now = 0;
       c->score_now += z * z;
     }
-    mon->pscore[j] = rcb_chi2_sf(c->score_now, (double)c->dof);
+    mon->pscore[j] = rcb_mon_chi2_logsf(c->score_now, (double)c->dof);
     mon->order[nsc++] = j;
   }
   /* partial selection sort: the best mon->top first */
@@ -182,7 +180,7 @@ static void candidates(rcb_monitor *mon, int gls, rcb_monitor_result *res) {
     o->np = c->np;
     o->score = c->score_now;
     o->dof = c->dof;
-    o->p_value = mon->pscore[mon->order[t]];
+    o->p_value = exp(mon->pscore[mon->order[t]]);
     for (a = 0; a < c->np; a++) {
       double se = gls ? c->se_now[a] : c->se[a];
       o->size[a] = gls ? c->size_now[a] : dot(c->est + a * k, mon->y, k);

@@ -103,12 +103,15 @@ struct rcb_monitor {
   /* update workspace */
   double *r, *rm;      /* n each */
   double *y, *ym;      /* k each */
-  double *pscore;      /* ncand */
+  double *pscore;      /* ncand: log p-value of each candidate's score */
   size_t *order;       /* ncand */
   size_t updates;
 };
 
 #define rcb_mon_fail(mon, st, ...) rcb_fail((mon), (st), __VA_ARGS__)
+
+/* chi2.c: log P(X > x) of chi-square(dof), finite where the tail underflows. */
+double rcb_mon_chi2_logsf(double x, double dof);
 
 /* monitor_create.c's pieces used by the update */
 void rcb_mon_whiten(const rcb_monitor *mon, const rcb_complex *d, double *r);
