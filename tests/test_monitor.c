@@ -41,8 +41,8 @@
 #include "rcb/rcb.h"
 #include "rcb_test_util.h"
 
-#define NCH 8
-#define NPTS 400
+#define NCH ((size_t)8)
+#define NPTS ((size_t)400)
 #define NPT (NCH * NPTS)
 #define BETA_A 2.0 /* %, eq. 19 */
 #define BETA_S 2.0 /* %, eq. 19 */
@@ -70,7 +70,7 @@ static void eq19(const rcb_complex *fs, rcb_complex *fe, uint64_t *seed) {
     const rcb_complex *s = fs + c * NPTS;
     double s2 = 0, a;
     for (i = 0; i < NPTS; i++) s2 += creal(s[i] * conj(s[i]));
-    a = sqrt(s2) / NPTS * BETA_S / 100.0;
+    a = sqrt(s2) / (double)NPTS * BETA_S / 100.0;
     for (i = 0; i < NPTS; i++) {
       double r1 = 2 * rng_uniform(seed) - 1, r2 = 2 * rng_uniform(seed) - 1;
       double ph = 2 * 3.14159265358979323846 * rng_uniform(seed);
@@ -131,21 +131,27 @@ static rcb_monitor_opts opts_kt(rcb_monitor_param *tp, double kt) {
 /* ---- closed forms ---- */
 
 static void test_chi2(void **state) {
-  double a;
+  int i;
   (void)state;
   /* chi-square(2) is exponential with mean 2: the quantile is -2 ln(1 - p) */
-  for (a = 1e-6; a < 0.5; a *= 7)
+  for (i = 0; i < 8; i++) {
+    double a = 1e-6 * pow(7, i);
     assert_true(rcb_test_close(rcb_chi2_quantile(1 - a, 2), -2 * log(a), 1e-10, 0));
+  }
   /* chi-square(1): P(X > x) = erfc(sqrt(x / 2)) */
-  for (a = 0.01; a < 40; a *= 1.7)
-    assert_true(rcb_test_close(rcb_chi2_sf(a, 1), erfc(sqrt(a / 2)), 1e-10, 1e-300));
+  for (i = 0; i < 14; i++) {
+    double x = 0.01 * pow(1.7, i);
+    assert_true(rcb_test_close(rcb_chi2_sf(x, 1), erfc(sqrt(x / 2)), 1e-10, 1e-300));
+  }
   /* chi-square(4): P(X > x) = exp(-x/2) (1 + x/2) */
-  for (a = 0.01; a < 200; a *= 1.9)
-    assert_true(rcb_test_close(rcb_chi2_sf(a, 4), exp(-a / 2) * (1 + a / 2), 1e-10, 1e-300));
+  for (i = 0; i < 15; i++) {
+    double x = 0.01 * pow(1.9, i);
+    assert_true(rcb_test_close(rcb_chi2_sf(x, 4), exp(-x / 2) * (1 + x / 2), 1e-10, 1e-300));
+  }
   /* the quantile inverts the tail at many degrees of freedom */
-  for (a = 1; a < 500; a *= 2.3) {
-    double x = rcb_chi2_quantile(1 - 1e-3, a);
-    assert_true(rcb_test_close(rcb_chi2_sf(x, a), 1e-3, 1e-9, 0));
+  for (i = 0; i < 8; i++) {
+    double dof = pow(2.3, i), x = rcb_chi2_quantile(1 - 1e-3, dof);
+    assert_true(rcb_test_close(rcb_chi2_sf(x, dof), 1e-3, 1e-9, 0));
   }
   /* published: chi-square(82) 0.999 quantile 126.78... no table at hand;
    * chi-square(10) 0.99 quantile 23.209 (Abramowitz & Stegun table 26.8) */
