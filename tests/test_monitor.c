@@ -12,6 +12,8 @@
  *    tolerance of the chi-square mean, the tracked parameter's z with mean
  *    0 and variance 1, its 95 % interval covering the truth as often as
  *    the binomial 99 % interval of 0.95 allows, and no CUSUM alarm;
+ *  - the same with per-point standard deviations (Gaussian noise) passed
+ *    at create and with each update;
  *  - known changes, made by evaluating a model (a unit test of the linear
  *    algebra: the series generated with ROSS belong to the CLI's tests):
  *    kt scaled by 0.92 (the tracked interval covers it, the CUSUM falls,
@@ -35,11 +37,12 @@
 #include <string.h>
 #include <cmocka.h>
 
+#include "monitor/monitor_internal.h" /* rcb_mon_chi2_logsf */
 #include "rcb/rcb.h"
 #include "rcb_test_util.h"
 
-#define NCH 8
-#define NPTS 400
+#define NCH ((size_t)8)
+#define NPTS ((size_t)400)
 #define NPT (NCH * NPTS)
 #define BETA_A 2.0 /* %, eq. 19 */
 #define BETA_S 2.0 /* %, eq. 19 */
@@ -67,7 +70,7 @@ static void eq19(const rcb_complex *fs, rcb_complex *fe, uint64_t *seed) {
     const rcb_complex *s = fs + c * NPTS;
     double s2 = 0, a;
     for (i = 0; i < NPTS; i++) s2 += creal(s[i] * conj(s[i]));
-    a = sqrt(s2) / NPTS * BETA_S / 100.0;
+    a = sqrt(s2) / (double)NPTS * BETA_S / 100.0;
     for (i = 0; i < NPTS; i++) {
       double r1 = 2 * rng_uniform(seed) - 1, r2 = 2 * rng_uniform(seed) - 1;
       double ph = 2 * 3.14159265358979323846 * rng_uniform(seed);
@@ -128,26 +131,38 @@ static rcb_monitor_opts opts_kt(rcb_monitor_param *tp, double kt) {
 /* ---- closed forms ---- */
 
 static void test_chi2(void **state) {
-  double a;
+  int i;
   (void)state;
   /* chi-square(2) is exponential with mean 2: the quantile is -2 ln(1 - p) */
-  for (a = 1e-6; a < 0.5; a *= 7)
+  for (i = 0; i < 8; i++) {
+    double a = 1e-6 * pow(7, i);
     assert_true(rcb_test_close(rcb_chi2_quantile(1 - a, 2), -2 * log(a), 1e-10, 0));
+  }
   /* chi-square(1): P(X > x) = erfc(sqrt(x / 2)) */
-  for (a = 0.01; a < 40; a *= 1.7)
-    assert_true(rcb_test_close(rcb_chi2_sf(a, 1), erfc(sqrt(a / 2)), 1e-10, 1e-300));
+  for (i = 0; i < 14; i++) {
+    double x = 0.01 * pow(1.7, i);
+    assert_true(rcb_test_close(rcb_chi2_sf(x, 1), erfc(sqrt(x / 2)), 1e-10, 1e-300));
+  }
   /* chi-square(4): P(X > x) = exp(-x/2) (1 + x/2) */
-  for (a = 0.01; a < 200; a *= 1.9)
-    assert_true(rcb_test_close(rcb_chi2_sf(a, 4), exp(-a / 2) * (1 + a / 2), 1e-10, 1e-300));
+  for (i = 0; i < 15; i++) {
+    double x = 0.01 * pow(1.9, i);
+    assert_true(rcb_test_close(rcb_chi2_sf(x, 4), exp(-x / 2) * (1 + x / 2), 1e-10, 1e-300));
+  }
   /* the quantile inverts the tail at many degrees of freedom */
-  for (a = 1; a < 500; a *= 2.3) {
-    double x = rcb_chi2_quantile(1 - 1e-3, a);
-    assert_true(rcb_test_close(rcb_chi2_sf(x, a), 1e-3, 1e-9, 0));
+  for (i = 0; i < 8; i++) {
+    double dof = pow(2.3, i), x = rcb_chi2_quantile(1 - 1e-3, dof);
+    assert_true(rcb_test_close(rcb_chi2_sf(x, dof), 1e-3, 1e-9, 0));
   }
   /* published: chi-square(82) 0.999 quantile 126.78... no table at hand;
    * chi-square(10) 0.99 quantile 23.209 (Abramowitz & Stegun table 26.8) */
   assert_true(rcb_test_close(rcb_chi2_quantile(0.99, 10), 23.2093, 1e-5, 0));
   assert_true(isnan(rcb_chi2_quantile(1.0, 3)) && isnan(rcb_chi2_sf(-1, 3)));
+  /* the log tail where the tail underflows (ranking of strong effects):
+   * chi-square(2): log P(X > x) = -x / 2; chi-square(4): -x/2 + log(1 + x/2) */
+  assert_true(rcb_chi2_sf(3000, 2) == 0.0);
+  assert_true(rcb_test_close(rcb_mon_chi2_logsf(3000, 2), -1500, 1e-12, 0));
+  assert_true(rcb_test_close(rcb_mon_chi2_logsf(3000, 4), -1500 + log(1501.0), 1e-12, 0));
+  assert_true(rcb_test_close(rcb_mon_chi2_logsf(3, 4), log(exp(-1.5) * 2.5), 1e-12, 0));
   /* Siegmund's approximation against the exact one-sided CUSUM ARL0 on
    * N(0,1) data (Montgomery, Introduction to SQC, table 9.3: k = 0.5,
    * h = 4: 336; h = 5: 930), within the approximation's ~1 % */
@@ -248,6 +263,50 @@ static void null_case(fixture *f, int reweight) {
 
 static void test_null(void **state) { null_case(*state, 0); }
 static void test_null_reweighted(void **state) { null_case(*state, 1); }
+
+/* Per-point standard deviations (as #15's estimators give), circular
+ * Gaussian noise drawn here by Box-Muller, passed at create and with every
+ * update (the reweighted path): the mean of T is the chi-square mean. */
+static void test_null_sd(void **state) {
+  fixture *f = *state;
+  rcb_monitor_param tp;
+  rcb_monitor_opts o = opts_kt(&tp, f->kt);
+  rcb_monitor *mon = NULL;
+  rcb_monitor_result r;
+  double *sd = malloc(NPT * sizeof *sd), sumT = 0, tol, amax = 0;
+  const size_t N = 200;
+  size_t u, i, alarms = 0, lo, hi;
+  uint64_t seed = 99;
+  for (i = 0; i < NPT; i++) amax = fmax(amax, cabs(f->fs[i]));
+  for (i = 0; i < NPT; i++) sd[i] = 0.01 * cabs(f->fs[i]) + 1e-3 * amax;
+  o.sd = sd;
+  o.beta_a = o.beta_s = 0;
+  o.alpha = 0.02;
+  o.setup_averages = HUGE_VAL;
+  assert_int_equal(rcb_monitor_create(&mon, f->base, f->setup, &o, NULL), RCB_OK);
+  for (u = 0; u < N; u++) {
+    for (i = 0; i < NPT; i++) {
+      double u1 = 1 - rng_uniform(&seed), u2 = rng_uniform(&seed), g = sqrt(-2 * log(u1));
+      double ph = 2 * 3.14159265358979323846 * u2;
+      f->v[i] = f->fs[i] + sd[i] * g * (cos(ph) + CMPLX(0.0, sin(ph)));
+    }
+    assert_int_equal(rcb_monitor_update(mon, f->v, sd, &r), RCB_OK);
+    sumT += r.T;
+    alarms += (size_t)r.alarm;
+  }
+  tol = 4 * sqrt(2.0 * (double)r.dof / (double)N);
+  binom99(N, o.alpha, &lo, &hi);
+  print_message("null with per-point sd: mean T %.2f (dof %zu, tolerance %.2f), %zu alarms "
+                "(99 %% interval [%zu, %zu])\n", sumT / (double)N, r.dof, tol, alarms, lo, hi);
+  assert_true(fabs(sumT / (double)N - (double)r.dof) < tol);
+  assert_true(alarms >= lo && alarms <= hi);
+  /* a bad sd in an update is refused, naming the point */
+  sd[5] = -1;
+  assert_int_equal(rcb_monitor_update(mon, f->v, sd, &r), RCB_ERR_ARG);
+  assert_non_null(strstr(rcb_monitor_errmsg(mon), "channel 1 point 6"));
+  rcb_monitor_destroy(mon);
+  free(sd);
+}
 
 /* kt scaled by 0.92 in the machine: a tracked drift. The machine is the
  * baseline model itself here: with 6400 residuals at 2 % noise the
@@ -458,6 +517,7 @@ int main(void) {
       cmocka_unit_test(test_chi2),
       cmocka_unit_test(test_null),
       cmocka_unit_test(test_null_reweighted),
+      cmocka_unit_test(test_null_sd),
       cmocka_unit_test(test_kt_change),
       cmocka_unit_test(test_cross_coupling),
       cmocka_unit_test(test_no_alloc_in_update),

@@ -88,7 +88,7 @@ static const char MODEL_INI[] =
 
 #define NOUT 4
 #define NFREQ 120
-#define NPT (NOUT * NFREQ)
+#define NPT ((size_t)NOUT * NFREQ)
 #define RPM 10000.0      /* operating speed during the daily test */
 #define DAYS 365
 #define WEAR_START 60

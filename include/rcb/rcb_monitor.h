@@ -42,7 +42,8 @@
  *    together, with 95 % intervals from (J^T W J)^-1 (the noise is known:
  *    no sigma^2 factor).
  *  - Trend. Tracked parameters: the same step with the tracked parameters
- *    alone, value = baseline + step, 95 % interval. With
+ *    alone (jointly with the best candidate while the instant test fires),
+ *    value = baseline + step, 95 % interval. With
  *    opts.relinearise > 0 the step is refined by chord iterations that
  *    re-evaluate the model at the new value (the fit's preallocated FRF
  *    object, no allocation).
@@ -144,7 +145,9 @@ typedef struct rcb_monitor_candidate {
   double p_value;     /**< upper-tail probability of score (-) */
 } rcb_monitor_candidate;
 
-/** @brief One tracked parameter in a result. */
+/** @brief One tracked parameter in a result. While the instant test fires,
+ * the estimate is fitted jointly with the best-ranked candidate (a new
+ * effect left out of the fit would bias the trend). */
 typedef struct rcb_monitor_tracked {
   double value;        /**< estimate, parameter units */
   double ci_lo, ci_hi; /**< 95 % interval, parameter units */

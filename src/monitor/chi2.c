@@ -28,8 +28,14 @@ static double gamma_p_series(double a, double x) {
   return sum * exp(-x + a * log(x) - lgamma(a));
 }
 
+/* log Q(a, x) by the continued fraction, x >= a + 1: finite where Q
+ * itself underflows (the ranking of strong effects). */
+static double gamma_logq_cf(double a, double x);
+
 /* Upper regularised Q(a, x) by its continued fraction, x >= a + 1. */
-static double gamma_q_cf(double a, double x) {
+static double gamma_q_cf(double a, double x) { return exp(gamma_logq_cf(a, x)); }
+
+static double gamma_logq_cf(double a, double x) {
   double b = x + 1.0 - a, c = 1.0 / DBL_MIN, d = 1.0 / b, h = d;
   int i;
   for (i = 1; i < RCB_GAMMA_ITER; i++) {
@@ -44,7 +50,14 @@ static double gamma_q_cf(double a, double x) {
     h *= del;
     if (fabs(del - 1.0) < RCB_GAMMA_EPS) break;
   }
-  return exp(-x + a * log(x) - lgamma(a)) * h;
+  return -x + a * log(x) - lgamma(a) + log(h);
+}
+
+double rcb_mon_chi2_logsf(double x, double dof) {
+  double a = 0.5 * dof, h = 0.5 * x;
+  if (!(dof >= 1.0) || !(x >= 0.0)) return (double)NAN;
+  if (h < a + 1.0) return log(rcb_chi2_sf(x, dof));
+  return gamma_logq_cf(a, h);
 }
 
 double rcb_chi2_sf(double x, double dof) {

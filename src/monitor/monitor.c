@@ -96,17 +96,16 @@ static rcb_status model_change(rcb_monitor *mon, const double *theta) {
   return RCB_OK;
 }
 
-/* The tracked step theta (linear, then chord iterations re-evaluating the
- * model: theta += E (y - ym(theta)), E the linear estimator); on return
- * mon->y holds the change the tracked parameters do not explain. */
-static rcb_status tracked_step(rcb_monitor *mon, double *theta, int gls) {
+/* The re-linearised tracked step theta (chord iterations re-evaluating the
+ * model: theta += E (y - ym(theta)), E the linear estimator; 0 without
+ * re-linearisation); on return mon->y holds the change the model at
+ * baseline + theta does not explain (y itself without). */
+static rcb_status tracked_step(rcb_monitor *mon, double *theta) {
   size_t a, it, i, k = mon->k, nt = mon->nt;
   rcb_status st;
+  memset(theta, 0, sizeof(double) * RCB_MONITOR_MAX_TRACKED);
+  if (!mon->relin || !nt) return RCB_OK;
   for (a = 0; a < nt; a++) theta[a] = dot(mon->test + a * k, mon->y, k);
-  if (!mon->relin || !nt) {
-    if (gls) memset(theta, 0, nt * sizeof *theta); /* the whole step is the GLS one */
-    return RCB_OK;
-  }
   for (it = 0; it < mon->relin; it++) {
     if ((st = model_change(mon, theta))) return st;
     for (i = 0; i < k; i++) mon->ym[i] = mon->y[i] - mon->ym[i];
@@ -114,9 +113,6 @@ static rcb_status tracked_step(rcb_monitor *mon, double *theta, int gls) {
   }
   if ((st = model_change(mon, theta))) return st;
   for (i = 0; i < k; i++) mon->y[i] -= mon->ym[i];
-  /* what is left along the tracked directions is re-expressed in them
-   * (by the GLS step on the reweighted path) */
-  for (a = 0; !gls && a < nt; a++) theta[a] += dot(mon->test + a * k, mon->y, k);
   for (a = 0; a < nt; a++) rcb_model_set_param(mon->model, mon->tname[a], mon->t0[a]);
   return RCB_OK;
 }
@@ -142,14 +138,12 @@ static void tracked_result(rcb_monitor *mon, const double *theta, const double *
   }
 }
 
-/* a ranks before b: smaller p-value; where both underflow, larger
- * standardised score. */
+/* a ranks before b: smaller p-value, compared as logarithms (the p-values
+ * of strong effects underflow to 0 together); then the larger score. */
 static int before(const rcb_monitor *mon, size_t a, size_t b) {
-  const mon_cand *ca = &mon->cand[a], *cb = &mon->cand[b];
   double pa = mon->pscore[a], pb = mon->pscore[b];
   if (pa != pb) return pa < pb;
-  return (ca->score_now - (double)ca->dof) / sqrt(2.0 * (double)ca->dof) >
-         (cb->score_now - (double)cb->dof) / sqrt(2.0 * (double)cb->dof);
+  return mon->cand[a].score_now > mon->cand[b].score_now;
 }
 
 /* Scores (and, on the reweighted path, sizes) were left in the
@@ -164,7 +158,7 @@ static void candidates(rcb_monitor *mon, int gls, rcb_monitor_result *res) {
       if (!a) c->score_now = 0;
       c->score_now += z * z;
     }
-    mon->pscore[j] = rcb_chi2_sf(c->score_now, (double)c->dof);
+    mon->pscore[j] = rcb_mon_chi2_logsf(c->score_now, (double)c->dof);
     mon->order[nsc++] = j;
   }
   /* partial selection sort: the best mon->top first */
@@ -186,7 +180,7 @@ static void candidates(rcb_monitor *mon, int gls, rcb_monitor_result *res) {
     o->np = c->np;
     o->score = c->score_now;
     o->dof = c->dof;
-    o->p_value = mon->pscore[mon->order[t]];
+    o->p_value = exp(mon->pscore[mon->order[t]]);
     for (a = 0; a < c->np; a++) {
       double se = gls ? c->se_now[a] : c->se[a];
       o->size[a] = gls ? c->size_now[a] : dot(c->est + a * k, mon->y, k);
@@ -211,9 +205,24 @@ static void errors(const rcb_monitor *mon, const rcb_complex *v, rcb_monitor_res
   res->floor_pct = 100.0 * sqrt(fl) / ee;
 }
 
+/* The tracked step beyond the re-linearised one, and its standard errors:
+ * alone, or, once the instant test has fired, fitted jointly with the best
+ * candidate (a new effect left out would bias the trend). */
+static void tracked_rest(const rcb_monitor *mon, int gls, const rcb_monitor_result *res,
+                         double *dth, double *se) {
+  const mon_cand *c = res->alarm && res->ntop ? &mon->cand[res->top[0].index] : NULL;
+  size_t a, k = mon->k;
+  for (a = 0; a < mon->nt; a++) {
+    if (c && gls) dth[a] = c->th_now[a], se[a] = c->set_now[a];
+    else if (c) dth[a] = dot(c->test_t + a * k, mon->y, k), se[a] = c->se_t[a];
+    else if (!gls) dth[a] = dot(mon->test + a * k, mon->y, k), se[a] = mon->tse[a];
+  }
+}
+
 rcb_status rcb_monitor_update(rcb_monitor *mon, const rcb_complex *values, const double *sd,
                               rcb_monitor_result *res) {
-  double theta[RCB_MONITOR_MAX_TRACKED], se[RCB_MONITOR_MAX_TRACKED], T;
+  double theta[RCB_MONITOR_MAX_TRACKED], dth[RCB_MONITOR_MAX_TRACKED] = {0},
+      se[RCB_MONITOR_MAX_TRACKED] = {0}, T;
   size_t p, a;
   int gls;
   rcb_status st;
@@ -231,11 +240,10 @@ rcb_status rcb_monitor_update(rcb_monitor *mon, const rcb_complex *values, const
     mon->r[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
   }
   to_rank(mon, mon->r, mon->y);
-  if ((st = tracked_step(mon, theta, gls))) return st;
+  if ((st = tracked_step(mon, theta))) return st;
   if (gls) {
-    if ((st = rcb_mon_gls(mon, values, sd, theta, se, &T))) return st;
+    if ((st = rcb_mon_gls(mon, values, sd, dth, se, &T))) return st;
   } else {
-    memcpy(se, mon->tse, sizeof se);
     /* instant test: the part of y beyond the tracked directions */
     T = dot(mon->y, mon->y, mon->k);
     for (a = 0; a < mon->nt; a++) {
@@ -247,13 +255,15 @@ rcb_status rcb_monitor_update(rcb_monitor *mon, const rcb_complex *values, const
   mon->updates++;
   res->update = mon->updates;
   errors(mon, values, res);
-  tracked_result(mon, theta, se, res);
   res->T = fmax(T, 0.0);
   res->dof = mon->k - mon->nt;
   res->threshold = mon->threshold;
   res->p_value = res->dof ? rcb_chi2_sf(res->T, (double)res->dof) : 1.0;
   res->alarm = res->dof && res->T > mon->threshold;
   candidates(mon, gls, res);
+  tracked_rest(mon, gls, res, dth, se);
+  for (a = 0; a < mon->nt; a++) theta[a] += dth[a];
+  tracked_result(mon, theta, se, res);
   return RCB_OK;
 }
 

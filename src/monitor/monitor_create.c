@@ -384,11 +384,13 @@ static rcb_status cand_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
     memcpy(w->A + k * nt, G + k * pl->col[j], k * c.np * sizeof *w->A);
     if ((st = rcb_mon_small_qr(mon, w, k, p, &ok))) return st;
     if (!ok) continue; /* explained by the tracked parameters or itself dependent: not scored */
-    mc->est = mon_alloc(mon, 2 * c.np * k, sizeof *mc->est);
+    mc->est = mon_alloc(mon, (2 * c.np + nt) * k, sizeof *mc->est);
     if (!mc->est) return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (candidates)");
     mc->dir = mc->est + c.np * k;
+    mc->test_t = mc->dir + c.np * k;
     mc->dof = c.np;
     estimator(w->A, w->Ri, k, p, nt, c.np, mc->est, mc->se);
+    estimator(w->A, w->Ri, k, p, 0, nt, mc->test_t, mc->se_t);
     for (a = 0; a < c.np; a++)
       for (i = 0; i < k; i++) mc->dir[a * k + i] = w->A[i + k * (nt + a)];
   }

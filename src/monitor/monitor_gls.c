@@ -20,13 +20,13 @@
 /* The 2 x 2 covariance of point p's (radial, tangential) residual, whitened:
  * this update's noise plus the commissioning values' share. */
 static void point_cov(const rcb_monitor *mon, const rcb_complex *v, const double *sd, size_t p,
-                      double *d11, double *d12, double *d22) {
+                      double a, double *d11, double *d12, double *d22) {
   double s11, s12 = 0, s22, w1 = mon->winv[2 * p], w2 = mon->winv[2 * p + 1];
   if (sd || mon->have_sd0) {
     double s = sd ? sd[p] : mon->sd0[p];
     s11 = s22 = s * s;
   } else {
-    double av = cabs(v[p]), a = mon->achan[p / mon->npts], sp = mon->beta_a / 100.0 * av;
+    double av = cabs(v[p]), sp = mon->beta_a / 100.0 * av;
     double complex w = av > 0 ? conj(mon->u[p]) * v[p] / av : 1.0;
     double c = creal(w), s = cimag(w), vp = sp * sp / 3.0, va = a * a / 6.0;
     s11 = vp * c * c + va, s12 = vp * c * s, s22 = vp * s * s + va;
@@ -38,7 +38,7 @@ static void point_cov(const rcb_monitor *mon, const rcb_complex *v, const double
 
 /* C = Q^T D Q (upper triangle), D = L L^T per point. */
 static void build_c(rcb_monitor *mon, const rcb_complex *v, const double *sd) {
-  size_t k = mon->k, p, a, b, c;
+  size_t k = mon->k, p, a, b, c = 0;
   double *b1 = mon->b1, *b2 = mon->b1 + k;
   if (!sd && !mon->have_sd0)
     for (c = 0; c < mon->nch; c++) { /* eq. 19 additive amplitude of this update */
@@ -50,7 +50,8 @@ static void build_c(rcb_monitor *mon, const rcb_complex *v, const double *sd) {
   for (p = 0; p < mon->npt; p++) {
     const double *q1 = mon->Q + k * (2 * p), *q2 = q1 + k;
     double d11, d12, d22, l11, l21, l22;
-    point_cov(mon, v, sd, p, &d11, &d12, &d22);
+    if (p && p == (c + 1) * mon->npts) c++; /* the channel of point p */
+    point_cov(mon, v, sd, p, mon->achan[c], &d11, &d12, &d22);
     l11 = sqrt(d11), l21 = d12 / l11, l22 = sqrt(fmax(d22 - l21 * l21, 0.0));
     for (a = 0; a < k; a++) b1[a] = l11 * q1[a] + l21 * q2[a], b2[a] = l22 * q2[a];
     for (b = 0; b < k; b++) {
@@ -113,18 +114,21 @@ static rcb_status candidates_gls(rcb_monitor *mon) {
       c->score_now = 0;
       memset(c->size_now, 0, sizeof c->size_now);
       memcpy(c->se_now, c->se, sizeof c->se_now);
+      memset(c->th_now, 0, sizeof c->th_now);
+      memcpy(c->set_now, c->se_t, sizeof c->set_now);
       continue;
     }
     c->score_now = explained(&mon->sw, mon->z, k, nt, nt + c->np, qz);
     step(&mon->sw, qz, nt + c->np, nt, c->np, c->size_now, c->se_now);
+    step(&mon->sw, qz, nt + c->np, 0, nt, c->th_now, c->set_now);
   }
   return RCB_OK;
 }
 
 rcb_status rcb_mon_gls(rcb_monitor *mon, const rcb_complex *v, const double *sd,
-                       double *theta, double *se, double *T) {
+                       double *dtheta, double *se, double *T) {
   size_t k = mon->k, nt = mon->nt, a;
-  double qz[RCB_MONITOR_MAX_TRACKED], dth[RCB_MONITOR_MAX_TRACKED];
+  double qz[RCB_MONITOR_MAX_TRACKED];
   lapack_int info;
   int ok = 1;
   rcb_status st;
@@ -147,8 +151,7 @@ rcb_status rcb_mon_gls(rcb_monitor *mon, const rcb_complex *v, const double *sd,
       return rcb_mon_fail(mon, RCB_ERR_SINGULAR, "reweighted update %zu: the tracked parameters "
                           "are not told apart in this update's noise", mon->updates + 1);
     *T -= explained(&mon->sw, mon->z, k, 0, nt, qz);
-    step(&mon->sw, qz, nt, 0, nt, dth, se);
-    for (a = 0; a < nt; a++) theta[a] += dth[a];
+    step(&mon->sw, qz, nt, 0, nt, dtheta, se);
   }
   return candidates_gls(mon);
 }

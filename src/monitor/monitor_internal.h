@@ -27,6 +27,10 @@ typedef struct mon_cand {
   size_t np;       /* its parameters */
   size_t dof;      /* directions beyond the tracked ones; 0: not scored */
   double *est;     /* np x k row-major: its parameters' step = est y */
+  double *test_t;  /* nt x k row-major: the tracked step fitted jointly with it */
+  double se_t[RCB_MONITOR_MAX_TRACKED]; /* and its standard errors */
+  double th_now[RCB_MONITOR_MAX_TRACKED], set_now[RCB_MONITOR_MAX_TRACKED]; /* the
+                        same on the reweighted path, this update */
   double *dir;     /* dof x k row-major: orthonormal, score = ||dir y||^2 */
   double se[RCB_MONITOR_MAXP]; /* standard errors, parameter units */
   size_t col;        /* its first column in G */
@@ -99,21 +103,26 @@ struct rcb_monitor {
   /* update workspace */
   double *r, *rm;      /* n each */
   double *y, *ym;      /* k each */
-  double *pscore;      /* ncand */
+  double *pscore;      /* ncand: log p-value of each candidate's score */
   size_t *order;       /* ncand */
   size_t updates;
 };
 
 #define rcb_mon_fail(mon, st, ...) rcb_fail((mon), (st), __VA_ARGS__)
 
+/* chi2.c: log P(X > x) of chi-square(dof), finite where the tail underflows. */
+double rcb_mon_chi2_logsf(double x, double dof);
+
 /* monitor_create.c's pieces used by the update */
 void rcb_mon_whiten(const rcb_monitor *mon, const rcb_complex *d, double *r);
 /* Thin QR of A (k x p, column-major, overwritten by its Q) with R and R^-1
  * (p x p); *ok = 0 for a dependent column. No allocation. */
 rcb_status rcb_mon_small_qr(rcb_monitor *mon, mon_small *w, size_t k, size_t p, int *ok);
-/* monitor_gls.c: the statistics in the update's own covariance. theta holds
- * the re-linearised tracked step (0 without), y the change it leaves. */
+/* monitor_gls.c: the statistics in the update's own covariance, on y (the
+ * change the re-linearised tracked step leaves): the tracked step dtheta
+ * beyond the re-linearised one and its standard errors, T, and every
+ * candidate's score and estimates. */
 rcb_status rcb_mon_gls(rcb_monitor *mon, const rcb_complex *v, const double *sd,
-                       double *theta, double *se, double *T);
+                       double *dtheta, double *se, double *T);
 
 #endif

@@ -19,8 +19,8 @@
 
 #include "rcb/rcb.h"
 
-#define NCH 8
-#define NPTS 400
+#define NCH ((size_t)8)
+#define NPTS ((size_t)400)
 #define NNOISY 16
 #define PI 3.14159265358979323846
 
@@ -173,14 +173,20 @@ int main(int argc, char **argv) {
     fprintf(stderr, "could not evaluate the set-up's FRFs\n");
     return 1;
   }
-  for (s = 0; s < NNOISY; s++) {
+  memset(noisy, 0, sizeof noisy);
+  for (s = 0; s < NNOISY && !rc; s++) {
     noisy[s] = malloc(NCH * NPTS * sizeof *noisy[s]);
     ms = setup_of(m);
-    if (!noisy[s] || !ms || rcb_meas_add_noise(ms, 2, 2, 1000 + s)) return 1;
-    values(ms, noisy[s]);
+    if (!noisy[s] || !ms || rcb_meas_add_noise(ms, 2, 2, 1000 + s)) {
+      fprintf(stderr, "noisy measurement %zu failed\n", s);
+      rc = 1;
+    } else {
+      values(ms, noisy[s]);
+    }
     rcb_meas_destroy(ms);
   }
-  printf("paper system, %d channels x %d frequencies, kt tracked, eq. 19 noise 2 %% + 2 %%\n",
+  if (rc) goto done;
+  printf("paper system, %zu channels x %zu frequencies, kt tracked, eq. 19 noise 2 %% + 2 %%\n",
          NCH, NPTS);
   rc |= run(m, setup, noisy, "linear", 0, 0, 400, 0);
   rc |= run(m, setup, noisy, "reweighted", 0, 1, 100, 0);
@@ -189,6 +195,7 @@ int main(int argc, char **argv) {
   printf("bearing and coupling effects only (opts.effects):\n");
   rc |= run(m, setup, noisy, "linear", 0, 0, 400, bearings_coupling);
   rc |= run(m, setup, noisy, "reweighted", 0, 1, 100, bearings_coupling);
+done:
   for (s = 0; s < NNOISY; s++) free(noisy[s]);
   rcb_meas_destroy(setup);
   rcb_model_destroy(m);
