@@ -117,7 +117,9 @@ typedef struct rcb_monitor_opts {
                           diagnosis, has no neutral value and is left out) */
   size_t top;        /**< candidates ranked in each result, 0: RCB_MONITOR_TOP */
   size_t relinearise; /**< chord iterations refining the tracked estimates per
-                           update by re-evaluating the model (0: linear only) */
+                           update by re-evaluating the model (0: linear only;
+                           each costs one sweep of the set-up with the banded
+                           LAPACK solver, which allocates nothing) */
   int reweight;      /**< 1: take each update's noise from the update itself
                           (eq. 19 on its own values, or the sd passed to
                           rcb_monitor_update) and apply the statistics in that
@@ -187,7 +189,11 @@ typedef struct rcb_monitor rcb_monitor;
  * @p alloc here (an embedded host passes its arena; rcb_monitor_memory says
  * how much was kept); rcb_monitor_update never allocates. There is no
  * two-call sizing: the size depends on how many candidates the catalogue
- * lays out on this model, known only once it has been built.
+ * lays out on this model, known only once it has been built. The model
+ * evaluations (here and with opts.relinearise) use the banded LAPACK solver,
+ * never KLU, whose factors would bypass the hooks. A bump allocator that
+ * never frees needs every temporary of create (tools/bench/bench_monitor
+ * prints both that and the bytes kept).
  * @param baseline fitted, finalized model (copied: the caller may destroy it)
  * @param setup channels and abscissa (FRF: frequencies, rad/s, at the test
  * speed; 1X unbalance response: rotor speeds, rad/s) and, as its values, the

@@ -47,6 +47,7 @@ static void build_c(rcb_monitor *mon, const rcb_complex *v, const double *sd) {
       mon->achan[c] = mon->beta_s / 100.0 * sqrt(s2) / (double)mon->npts;
     }
   memset(mon->C, 0, k * k * sizeof *mon->C);
+  c = 0;
   for (p = 0; p < mon->npt; p++) {
     const double *q1 = mon->Q + k * (2 * p), *q2 = q1 + k;
     double d11, d12, d22, l11, l21, l22;
