@@ -318,8 +318,8 @@ def main_monitor(a):
         if a.figure:
             days = len(list(machines[0].glob("day_*.uff")))
             throughput_figure(rates, a.figure, f"{len(machines)} machines x {days} days, "
-                              f"8 channels x 151 frequencies; {os.cpu_count()} cores, "
-                              f"load average {load:.1f} before the run")
+                              f"8 channels x 151 frequencies\n{os.cpu_count()} cores, "
+                              f"load average {load:.1f} before the run (other work)")
             print(f"wrote {a.figure}")
         return 0
     t0 = time.perf_counter()
