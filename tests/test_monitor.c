@@ -13,7 +13,7 @@
  *    0 and variance 1, its 95 % interval covering the truth as often as
  *    the binomial 99 % interval of 0.95 allows, and no CUSUM alarm;
  *  - the same with per-point standard deviations (Gaussian noise) passed
- *    at create and with each update;
+ *    at create and with each update, and with 1X unbalance responses;
  *  - known changes, made by evaluating a model (a unit test of the linear
  *    algebra: the series generated with ROSS belong to the CLI's tests):
  *    kt scaled by 0.92 (the tracked interval covers it, the CUSUM falls,
@@ -63,20 +63,26 @@ static uint64_t rng_next(uint64_t *s) {
 static double rng_uniform(uint64_t *s) { return (double)(rng_next(s) >> 11) * 0x1.0p-53; }
 
 /* f_e = f_s (1 + beta_a/100 r1) + (sqrt(sum_j |f_sj|^2)/n)(beta_s/100) r2 e^{i phi},
- * per channel, r1, r2 uniform on [-1, 1], phi uniform on [0, 2 pi). */
-static void eq19(const rcb_complex *fs, rcb_complex *fe, uint64_t *seed) {
+ * per channel (nch of npts values), r1, r2 uniform on [-1, 1], phi uniform
+ * on [0, 2 pi). */
+static void eq19n(const rcb_complex *fs, rcb_complex *fe, size_t nch, size_t npts,
+                  uint64_t *seed) {
   size_t c, i;
-  for (c = 0; c < NCH; c++) {
-    const rcb_complex *s = fs + c * NPTS;
+  for (c = 0; c < nch; c++) {
+    const rcb_complex *s = fs + c * npts;
     double s2 = 0, a;
-    for (i = 0; i < NPTS; i++) s2 += creal(s[i] * conj(s[i]));
-    a = sqrt(s2) / (double)NPTS * BETA_S / 100.0;
-    for (i = 0; i < NPTS; i++) {
+    for (i = 0; i < npts; i++) s2 += creal(s[i] * conj(s[i]));
+    a = sqrt(s2) / (double)npts * BETA_S / 100.0;
+    for (i = 0; i < npts; i++) {
       double r1 = 2 * rng_uniform(seed) - 1, r2 = 2 * rng_uniform(seed) - 1;
       double ph = 2 * 3.14159265358979323846 * rng_uniform(seed);
-      fe[c * NPTS + i] = s[i] * (1 + BETA_A / 100.0 * r1) + a * r2 * (cos(ph) + CMPLX(0.0, sin(ph)));
+      fe[c * npts + i] = s[i] * (1 + BETA_A / 100.0 * r1) + a * r2 * (cos(ph) + CMPLX(0.0, sin(ph)));
     }
   }
+}
+
+static void eq19(const rcb_complex *fs, rcb_complex *fe, uint64_t *seed) {
+  eq19n(fs, fe, NCH, NPTS, seed);
 }
 
 /* The noise-free FRFs of model m on the set-up grid (channel-major values). */
@@ -390,6 +396,43 @@ static void test_cross_coupling(void **state) {
   free(fs2);
 }
 
+/* 1X unbalance responses (4 probes, 60 speeds 1000-12000 rpm) as the
+ * set-up: the null case's mean T, and kt's interval coverage. */
+static void test_unbalance_null(void **state) {
+  fixture *f = *state;
+  const char *const outs[4] = {"DA.x", "DA.y", "DB.x", "DB.y"};
+  rcb_meas *ms = rcb_test_unbalance_meas(f->truth, outs, 4, 1000.0, 12000.0, 60);
+  rcb_complex *fs = malloc(240 * sizeof *fs), *v = malloc(240 * sizeof *v);
+  rcb_monitor_param tp;
+  rcb_monitor_opts o = opts_kt(&tp, f->kt);
+  rcb_monitor *mon = NULL;
+  rcb_monitor_result r;
+  const size_t N = 300;
+  size_t u, cover = 0, lo, hi;
+  double sumT = 0, tol;
+  uint64_t seed = 5;
+  values_of(ms, fs);
+  o.setup_averages = HUGE_VAL;
+  assert_int_equal(rcb_monitor_create(&mon, f->base, ms, &o, NULL), RCB_OK);
+  assert_int_equal(rcb_monitor_point_count(mon), 240);
+  for (u = 0; u < N; u++) {
+    eq19n(fs, v, 4, 60, &seed);
+    assert_int_equal(rcb_monitor_update(mon, v, NULL, &r), RCB_OK);
+    sumT += r.T;
+    cover += r.tracked[0].ci_lo <= f->kt && f->kt <= r.tracked[0].ci_hi;
+  }
+  tol = 4 * sqrt(2.0 * (double)r.dof / (double)N);
+  binom99(N, 0.95, &lo, &hi);
+  print_message("1X null: mean T %.2f (dof %zu, tolerance %.2f); kt covered %zu of %zu\n",
+                sumT / (double)N, r.dof, tol, cover, N);
+  assert_true(fabs(sumT / (double)N - (double)r.dof) < tol);
+  assert_true(cover >= lo && cover <= hi);
+  rcb_monitor_destroy(mon);
+  rcb_meas_destroy(ms);
+  free(fs);
+  free(v);
+}
+
 /* ---- memory ---- */
 
 static void test_no_alloc_in_update(void **state) {
@@ -518,6 +561,7 @@ int main(void) {
       cmocka_unit_test(test_null),
       cmocka_unit_test(test_null_reweighted),
       cmocka_unit_test(test_null_sd),
+      cmocka_unit_test(test_unbalance_null),
       cmocka_unit_test(test_kt_change),
       cmocka_unit_test(test_cross_coupling),
       cmocka_unit_test(test_no_alloc_in_update),

@@ -113,6 +113,22 @@ struct rcb_monitor {
 /* chi2.c: log P(X > x) of chi-square(dof), finite where the tail underflows. */
 double rcb_mon_chi2_logsf(double x, double dof);
 
+/* monitor_create.c: allocation through the monitor's counting hooks. */
+void *rcb_mon_alloc(rcb_monitor *mon, size_t count, size_t size);
+
+/* The candidates kept for the monitor and their first columns in J. */
+typedef struct col_plan {
+  size_t *cand;   /* catalogue index of each kept candidate */
+  size_t *col;    /* its first column */
+  int *own;       /* 1: its model has other DOFs (its own sweep) */
+  size_t ncand, ncol;
+} col_plan;
+
+/* monitor_rank.c: the QR of the whitened columns J (n x ncol; the basis
+ * made explicit in mon->Q), then the rank space; J's block becomes mon->Q. */
+rcb_status rcb_mon_factor(rcb_monitor *mon, rcb_diag *d, const double *J, size_t ncol);
+rcb_status rcb_mon_rank_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl, double *J);
+
 /* monitor_create.c's pieces used by the update */
 void rcb_mon_whiten(const rcb_monitor *mon, const rcb_complex *d, double *r);
 /* Thin QR of A (k x p, column-major, overwritten by its Q) with R and R^-1
