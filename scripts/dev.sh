@@ -13,6 +13,7 @@
 #   ./scripts/dev.sh core       build + ctest with every optional backend OFF (build-core/)
 #   ./scripts/dev.sh sanitize   AddressSanitizer + UBSan build and ctest (build-asan/)
 #   ./scripts/dev.sh bench      FRF sweep benchmark (C dense/banded; SciPy and ROSS if .venv)
+#                               and the monitor's update (tools/bench/bench_monitor)
 #   ./scripts/dev.sh bench-fit  identification benchmark (issue #3, Table 3 data, 20 seeds):
 #                               rcbtool fit per method vs SciPy least_squares (needs .venv);
 #                               extra arguments go to tools/bench/bench_fit.py
@@ -367,6 +368,8 @@ cmd_bench() {
   OPENBLAS_NUM_THREADS=1 "$bench" "$MODEL"
   say "where the banded time goes: zgbsv against an inline band LU"
   OPENBLAS_NUM_THREADS=1 "$BUILD_DIR/tools/bench/bench_band_lu" "$MODEL"
+  say "condition monitoring (rcb_monitor): create, arena, ms per update, 8 x 400"
+  OPENBLAS_NUM_THREADS=1 "$BUILD_DIR/tools/bench/bench_monitor" "$MODEL"
   if [[ -x $VENV/bin/python ]]; then
     say "reference: SciPy solve loop and ROSS run_freq_response on the same model"
     OPENBLAS_NUM_THREADS=1 "$VENV/bin/python" tools/bench/bench_frf_ref.py \

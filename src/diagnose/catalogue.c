@@ -488,3 +488,31 @@ rcb_status rcb_diag_candidate_model(rcb_diag *d, const diag_cand *c, const rcb_m
   *out = m;
   return RCB_OK;
 }
+
+/* ---- the catalogue for other folders (diagnose/diagnose.h) ---- */
+
+size_t rcb_diag_catalogue_count(const rcb_diag *d) { return d ? d->ncand : 0; }
+
+rcb_status rcb_diag_catalogue_get(const rcb_diag *d, size_t i, rcb_diag_cand_desc *out) {
+  const diag_cand *c;
+  size_t k;
+  if (!d || !out || i >= d->ncand) return RCB_ERR_ARG;
+  c = &d->cand[i];
+  memset(out, 0, sizeof *out);
+  out->effect = c->effect;
+  out->place = c->place, out->desc = c->desc, out->params = c->params;
+  out->np = c->np;
+  for (k = 0; k < c->np; k++) {
+    out->pname[k] = c->pname[k];
+    out->lo[k] = c->lo[k], out->hi[k] = c->hi[k], out->logp[k] = c->logp[k];
+  }
+  out->refit_only = c->refit_only;
+  out->adds_dofs = c->edit == EDIT_ADD_PEDESTAL;
+  return RCB_OK;
+}
+
+rcb_status rcb_diag_catalogue_model(rcb_diag *d, size_t i, const rcb_model *from,
+                                    rcb_model **out) {
+  if (!d || !out || i >= d->ncand) return RCB_ERR_ARG;
+  return rcb_diag_candidate_model(d, &d->cand[i], from, out);
+}

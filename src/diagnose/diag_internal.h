@@ -11,8 +11,8 @@
 #define RCB_DIAG_INTERNAL_H
 
 #include "core/rcb_internal.h"
+#include "diagnose/diagnose.h" /* the interface other folders use */
 
-#define RCB_DIAG_MAXP 3
 #define RCB_DIAG_NAME 128
 
 typedef enum diag_edit {
@@ -89,28 +89,7 @@ struct rcb_diag {
 /* The error message of rcb_diag (core/rcb_internal.h, rcb_fail). */
 #define rcb_diag_fail(d, st, ...) rcb_fail((d), (st), __VA_ARGS__)
 
-/* The score test (score_qr.c): the fitted parameters' columns J0 (n x nb,
- * d r / d p) factored once by LAPACK QR with the weighted residual r
- * projected on it, then per candidate the reduction of F = r^T r its
- * columns J (n x np, np <= RCB_DIAG_MAXP, overwritten) can explain beyond
- * J0: || Q_c^T r ||^2, Q_c orthonormal on the part of span(J) orthogonal to
- * span(J0). Columns within 1e-10 (relative) of the span of those before
- * them are dropped. */
-typedef struct diag_basis {
-  size_t n, rank;     /* residuals; columns of J0 kept */
-  double *qr, *tau;   /* Householder QR of J0's kept unit columns (dgeqrf layout) */
-  double *rt;         /* Q0^T r, n */
-  double *r2, *tau_c; /* a candidate's: its part of rt, its reflectors' scalars */
-  double *work;       /* LAPACK work, lwork */
-  size_t lwork;
-} diag_basis;
-rcb_status rcb_diag_basis_init(rcb_diag *d, diag_basis *b, const double *J0, size_t n,
-                               size_t nb, const double *r);
-rcb_status rcb_diag_explained(rcb_diag *d, diag_basis *b, double *J, size_t np, double *pred);
-void rcb_diag_basis_free(rcb_diag *d, diag_basis *b);
 
-/* Lay out every candidate effect of the (fitted) model m. */
-rcb_status rcb_diag_catalogue(rcb_diag *d, const rcb_model *m);
 /* Before a refit of candidate c on its model m (fit f, base parameters
  * fitted): move the candidate's parameters to a better start where the
  * neutral start sees nothing (a pedestal: a scan of its mass and stiffness). */

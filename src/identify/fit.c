@@ -27,6 +27,33 @@ static rcb_status resolve_channels(rcb_fit *f, rcb_dof *outs, rcb_dof *ins) {
   return RCB_OK;
 }
 
+/* The FRF object of f with solver s (fit_setup: RCB_SOLVER_AUTO). */
+static rcb_status make_frf(rcb_fit *f, rcb_dof *outs, rcb_dof *ins, rcb_solver_kind s) {
+  rcb_status st = rcb_frf_create(&f->frf, f->m, f->nout, outs, f->nin, ins, s, &f->alloc);
+  if (st) return rcb_fit_fail(f, st, "FRF workspace: %s", rcb_status_str(st));
+  /* the iterations run without the condition check; the final
+   * evaluation has it (rcb_fit_run) */
+  rcb_frf_set_condition_check(f->frf, RCB_COND_OFF, RCB_RCOND_WARN);
+  return RCB_OK;
+}
+
+rcb_status rcb_fit_set_solver(rcb_fit *f, rcb_solver_kind s) {
+  rcb_dof *outs, *ins;
+  rcb_status st;
+  if (!f || !f->frf) return RCB_ERR_ARG;
+  outs = rcb_alloc(&f->alloc, f->nch * sizeof *outs);
+  ins = rcb_alloc(&f->alloc, f->nch * sizeof *ins);
+  if (!outs || !ins) st = rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory");
+  else if (!(st = resolve_channels(f, outs, ins))) {
+    rcb_frf_destroy(f->frf);
+    f->frf = NULL;
+    st = make_frf(f, outs, ins, s);
+  }
+  rcb_free(&f->alloc, outs);
+  rcb_free(&f->alloc, ins);
+  return st;
+}
+
 static rcb_status fit_setup(rcb_fit *f) {
   size_t nch = f->nch;
   rcb_dof *outs = rcb_alloc(&f->alloc, nch * sizeof *outs);
@@ -39,11 +66,7 @@ static rcb_status fit_setup(rcb_fit *f) {
   if (!outs || !ins || !f->ch_out || !f->ch_in || !f->ch_kind || !f->Hmod)
     st = rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory setting up the fit");
   else if (!(st = resolve_channels(f, outs, ins))) {
-    st = rcb_frf_create(&f->frf, f->m, f->nout, outs, f->nin, ins, RCB_SOLVER_AUTO, &f->alloc);
-    if (st) rcb_fit_fail(f, st, "FRF workspace: %s", rcb_status_str(st));
-    /* the iterations run without the condition check; the final
-     * evaluation has it (rcb_fit_run) */
-    if (!st) rcb_frf_set_condition_check(f->frf, RCB_COND_OFF, RCB_RCOND_WARN);
+    st = make_frf(f, outs, ins, RCB_SOLVER_AUTO);
     f->Hwork = rcb_alloc(&f->alloc, f->nout * (f->nin ? f->nin : 1) * sizeof *f->Hwork);
     if (!st && !f->Hwork) st = rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory");
   }

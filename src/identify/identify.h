@@ -19,6 +19,12 @@ size_t rcb_fit_sweeps(const rcb_fit *f);
  * with a message when no point is left, RCB_ERR_NOMEM. */
 rcb_status rcb_fit_prepare(rcb_fit *f);
 
+/* Evaluate the model with solver s instead of RCB_SOLVER_AUTO (the FRF
+ * workspace made anew, before any run): a caller that needs every byte
+ * through its allocator hooks (the monitor) asks for RCB_SOLVER_BANDED,
+ * as KLU allocates its factors itself (rcb_analysis.h). */
+rcb_status rcb_fit_set_solver(rcb_fit *f, rcb_solver_kind s);
+
 /* The paper's error % of the model values of f's last evaluation (as
  * rcb_fit_error, without another sweep). */
 double rcb_fit_error_pct(const rcb_fit *f);

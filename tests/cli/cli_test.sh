@@ -719,6 +719,122 @@ bad_fit_params)
   err_has "coupling.C.nope"
   [ "$(cat "$W/f.ini")" = old ] || fail "a refused fit overwrote the output"
   cmp -s "$MODEL" "$W/model.ini" || fail "the model was modified" ;;
+# ---- rcbtool monitor (issue #16): the series and its refusals ----
+bad_monitor_series)
+  M="--params coupling.C.kt --noise 10,1"; O=C.A.x,C.A.y,C.B.x,C.B.y
+  # (4 channels x 61 points: more residuals than the catalogue has columns)
+  # shellcheck disable=SC2086 # $M is split into options on purpose
+  { run monitor "$MODEL" "$W/no_such_dir" $M --log "$W/log.json"; expect_rc 3; err_has "no_such_dir"
+    mkdir "$W/empty"; echo x >"$W/empty/notes.txt"
+    run monitor "$MODEL" "$W/empty" $M --log "$W/log.json"; expect_rc 3
+    err_has "'$W/empty' holds no measurement file"
+    mkdir "$W/s"
+    for k in 0 1 2; do
+      run simulate "$MODEL" --frf --out $O --in DA.x --fmin 100 --fmax 400 --points 61 \
+        --rpm 10000 --kind inertance --noise 10,1 --seed $((k + 1)) -o "$W/s/m$k.csv"; expect_rc 0
+    done
+    # a file with other frequencies, then one with another channel, then another speed
+    run simulate "$MODEL" --frf --out $O --in DA.x --fmin 100 --fmax 400 --points 31 \
+      --rpm 10000 --kind inertance -o "$W/s/m3.csv"; expect_rc 0
+    run monitor "$MODEL" "$W/s" $M --log "$W/log.json" -o "$W/lines.txt"; expect_rc 3
+    err_has "m3.csv' has 4 channels x 31 points, the commissioning file"; err_has "m0.csv"
+    [ ! -e "$W/log.json" ] && [ ! -e "$W/lines.txt" ] || fail "partial log or output left"
+    ls "$W" | grep -q 'log.json.' && fail "temporary log left behind"
+    run simulate "$MODEL" --frf --out C.A.x,C.A.y,C.B.x,DB.y --in DA.x --fmin 100 --fmax 400 \
+      --points 61 --rpm 10000 --kind inertance -o "$W/s/m3.csv"; expect_rc 0
+    run monitor "$MODEL" "$W/s" $M --log "$W/log.json"; expect_rc 3
+    err_has "m3.csv' has no channel C.B.y/DA.x"
+    run simulate "$MODEL" --frf --out $O --in DA.x --fmin 100 --fmax 400 --points 61 \
+      --rpm 9000 --kind inertance -o "$W/s/m3.csv"; expect_rc 0
+    run monitor "$MODEL" "$W/s" $M --log "$W/log.json"; expect_rc 3
+    err_has "m3.csv' was measured at 9000 rpm, the commissioning file"
+    [ ! -e "$W/log.json" ] || fail "partial log left"
+    rm "$W/s/m3.csv"
+    # usage: no noise, nothing left after commissioning, a log of an unknown kind
+    usage monitor "$MODEL" "$W/s" --params coupling.C.kt; err_has "--noise A,S"
+    usage monitor "$MODEL" "$W/s" $M --commission 3; err_has "none is left to monitor"
+    usage monitor "$MODEL" "$W/s" $M --log "$W/log.txt"; err_has ".json or .csv"
+    usage monitor "$MODEL" $M; err_has "missing the measurements"
+    # an output that is one of the inputs
+    cp "$W/s/m2.csv" "$W/m2.orig"
+    run monitor "$MODEL" "$W/s" $M --log "$W/s/m2.csv"; expect_rc 5; err_has "refusing"
+    cmp -s "$W/s/m2.csv" "$W/m2.orig" || fail "an input was overwritten"
+    run monitor "$MODEL" "$W/s" --params coupling.C.nope --noise 10,1; expect_rc 3
+    err_has "coupling.C.nope"; } ;;
+monitor_identical)
+  # an update identical to the commissioning file: no change, T = 0 and every
+  # tracked parameter at its baseline with z = 0 (closed form: d = 0)
+  run simulate "$MODEL" --frf --out C.A.x,C.A.y,C.B.x,C.B.y --in DA.x --fmin 100 --fmax 400 \
+    --points 61 --rpm 10000 --kind inertance --noise 10,1 --seed 3 -o "$W/a.csv"; expect_rc 0
+  run simulate "$MODEL" --frf --out C.A.x,C.A.y,C.B.x,C.B.y --in DA.x --fmin 100 --fmax 400 \
+    --points 61 --rpm 10000 --kind inertance --noise 10,1 --seed 4 -o "$W/b.csv"; expect_rc 0
+  run monitor "$MODEL" "$W/a.csv" "$W/a.csv" "$W/b.csv" --params coupling.C.kt,coupling.C.ct \
+    --noise 10,1 --log "$W/log.csv" --json; expect_rc 0; json_ok
+  python3 - "$W/out" <<'PY' || fail "identical update not at T = 0, or the log is wrong"
+import json, sys
+d = json.load(open(sys.argv[1]))
+u = d["updates"]
+assert [x["file"] for x in u] == ["a.csv", "b.csv"], u
+assert u[0]["T"] == 0 and not u[0]["alarm"], u[0]
+for t, b in zip(u[0]["tracked"], d["tracked"]):
+    assert abs(t["value"] - b["baseline"]) <= 1e-12 * abs(b["baseline"]) and t["z"] == 0, t
+# a new noise draw moves T off zero, and the threshold is the chi-square quantile
+assert u[1]["T"] > 0 and u[1]["threshold"] > 0 and u[1]["dof"] >= 1, u[1]
+PY
+  [ "$(grep -c -v '^#' "$W/log.csv")" -eq 3 ] || fail "log.csv: expected a header and 2 rows" ;;
+monitor_sd)
+  # per-point sds: one --sd file for every update, or a directory of STEM_stats.csv
+  # (each update's own sds); the same sds both ways must give the same statistics
+  # (the library's per-update GLS path against its commissioning-noise path)
+  mkdir "$W/s" "$W/sd"
+  for k in 1 2 3 4; do
+    run simulate "$MODEL" --frf --out C.A.x,C.A.y,C.B.x,C.B.y --in DA.x --fmin 100 --fmax 400 \
+      --points 61 --rpm 10000 --kind inertance --noise 10,1 --seed $k -o "$W/s/d$k.csv"; expect_rc 0
+  done
+  python3 - "$W" <<'PY' || fail "could not write the stats files"
+import csv, math, sys
+w = sys.argv[1]
+rows = [r for r in csv.reader(open(f"{w}/s/d1.csv")) if r and not r[0].startswith("#")]
+head, data = rows[0], rows[1:]
+names = [h[:-3] for h in head[1::2]]
+with open(f"{w}/sd.csv", "w") as f:
+    f.write("freq_hz," + ",".join(f"{n} sd" for n in names) + "\n")
+    for r in data:
+        v = [float(x) for x in r[1:]]
+        sd = [0.06 * math.hypot(v[2 * c], v[2 * c + 1]) for c in range(len(names))]
+        f.write(r[0] + "," + ",".join(repr(x) for x in sd) + "\n")
+PY
+  for k in 1 2 3 4; do cp "$W/sd.csv" "$W/sd/d${k}_stats.csv"; done
+  run monitor "$MODEL" "$W/s" --params coupling.C.kt --sd "$W/sd.csv" --json; expect_rc 0
+  cp "$W/out" "$W/file.json"
+  run monitor "$MODEL" "$W/s" --params coupling.C.kt --sd "$W/sd" --json; expect_rc 0
+  python3 - "$W/file.json" "$W/out" <<'PY' || fail "--sd FILE and --sd DIR disagree"
+import json, sys
+a, b = (json.load(open(p))["updates"] for p in sys.argv[1:])
+assert len(a) == len(b) == 3
+for x, y in zip(a, b):
+    assert abs(x["T"] - y["T"]) <= 1e-6 * abs(x["T"]) + 1e-9, (x["T"], y["T"])
+    tx, ty = x["tracked"][0], y["tracked"][0]
+    assert abs(tx["value"] - ty["value"]) <= 1e-9 * abs(tx["value"]), (tx, ty)
+    assert abs(tx["stderr"] - ty["stderr"]) <= 1e-6 * tx["stderr"], (tx, ty)
+PY
+  rm "$W/sd/d3_stats.csv"
+  run monitor "$MODEL" "$W/s" --params coupling.C.kt --sd "$W/sd"; expect_rc 3; err_has "d3_stats.csv"
+  usage monitor "$MODEL" "$W/s" --params coupling.C.kt --sd "$W/sd.csv" --noise 10,1
+  err_has "exclude each other" ;;
+monitor_dir_order)
+  # DIR is read sorted by name, whatever the order the files were made in
+  mkdir "$W/s"
+  for k in 3 1 2; do
+    run simulate "$MODEL" --frf --out C.A.x,C.A.y,C.B.x,C.B.y --in DA.x --fmin 100 --fmax 400 \
+      --points 61 \
+      --rpm 10000 --kind inertance --noise 10,1 --seed $k -o "$W/s/day$k.csv"; expect_rc 0
+  done
+  echo "not a measurement" >"$W/s/README.txt"
+  run monitor "$MODEL" "$W/s" --params coupling.C.kt --noise 10,1; expect_rc 0
+  out_has "commissioned on $W/s/day1.csv"
+  awk '!/^#/ && NR > 2 {print $2}' "$W/out" | tr '\n' ' ' | grep -q "^day2.csv day3.csv $" ||
+    fail "updates not in name order: $(awk '!/^#/ && NR > 2 {print $2}' "$W/out" | tr '\n' ' ')" ;;
 # ---- issue #17: never lose or spoil a user's file ----
 guard_output_is_input)
   # one guard on every output path: an output may not be an input of the same run
@@ -871,7 +987,7 @@ help_examples)
   mkdir "$W/x"; ln -s "$EX" "$W/x/examples"
   n=0
   for c in check matrices frf unbalance modes campbell simulate convert fit sensitivity compare \
-           diagnose history transient order estimate timecheck; do
+           diagnose history monitor transient order estimate timecheck; do
     # order reads the run-up that transient's example writes (a build with SUNDIALS)
     [ "$c" = order ] && [ ! -e "$W/x/runup.csv" ] && continue
     run "$c" --help; expect_rc 0
@@ -888,7 +1004,7 @@ help_examples)
   # docs/rcbtool.md's synopsis lists every command
   doc="$EX/../docs/rcbtool.md"
   for c in check matrices frf unbalance modes campbell simulate convert fit sensitivity compare \
-           diagnose history transient timecheck; do
+           diagnose history monitor transient timecheck; do
     sed -n '/^## Synopsis/,/^## /p' "$doc" | grep -q "rcbtool $c " || fail "synopsis lacks $c"
   done ;;
 # ==== end of the bad-input catalogue ====

@@ -163,3 +163,33 @@ def test_estimate_plot_failure_writes_nothing(tmp_path, test_signals):
              "--plot", run, env={"RCB_PYTHON": sys.executable, "RCB_PLOTS": str(SCRIPT)})
     assert r.returncode == 5, r.stderr
     assert run.read_bytes() == before and not (tmp_path / "1x.csv").exists()
+
+@pytest.mark.parametrize("ext", ["png", "svg"])
+def test_monitor_trend_plot(tmp_path, ext):
+    """rcbtool monitor --plot: the trend picture (png rendered and not blank; svg
+    in its format); a plot that cannot be drawn leaves no log and no picture."""
+    days = tmp_path / "days"
+    days.mkdir()
+    for k in range(5):
+        res = _run("simulate", MODEL, "--frf", "--out", "C.A.x,C.A.y,C.B.x,C.B.y", "--in", "DA.x",
+                   "--fmin", 100, "--fmax", 400, "--points", 61, "--rpm", 10000, "--kind",
+                   "inertance", "--noise", "10,1", "--seed", k + 1, "-o", days / f"d{k}.csv")
+        assert res.returncode == 0, res.stderr
+    env = {"RCB_PYTHON": sys.executable}
+    pic, log = tmp_path / "out" / f"trend.{ext}", tmp_path / "log.json"
+    res = _run("monitor", MODEL, days, "--params", "coupling.C.kt", "--noise", "10,1",
+               "--commission", 2, "--log", log, "--plot", pic, env=env)
+    assert res.returncode == 0, res.stderr
+    assert log.is_file() and pic.is_file()
+    if ext == "png":
+        _not_blank(pic)
+    else:
+        assert pic.read_text().lstrip().startswith("<?xml") and "<svg" in pic.read_text()
+    assert not [p for p in pic.parent.iterdir() if p != pic], "temporaries left"
+    pic.unlink()
+    log.unlink()
+    res = _run("monitor", MODEL, days, "--params", "coupling.C.kt", "--noise", "10,1",
+               "--commission", 2, "--log", log, "--plot", pic,
+               env={"RCB_PYTHON": sys.executable, "RCB_PLOTS": str(tmp_path / "none.py")})
+    assert res.returncode == 5 and "plotting script" in res.stderr, res.stderr
+    assert not log.exists() and not pic.exists()

@@ -4,6 +4,7 @@
     rcb_plots.py compare COMPARE.json PREFIX
     rcb_plots.py estimate ESTIMATE.json FILE.png
     rcb_plots.py order ORDER.json FILE.png
+    rcb_plots.py monitor MONITOR.json OUT [FORMAT]
 
 reads the JSON of `rcbtool compare --json` (rcbtool compare --plot PREFIX runs
 this script itself) and writes
@@ -19,6 +20,15 @@ estimate and order kinds on their own JSON (written to a temporary file):
             of every FRF, its coherence below;
   order:    Bode plot (amplitude, phase against speed) and polar plot of the
             1X vectors of every channel.
+
+The monitor kind reads the JSON of `rcbtool monitor --json` (or its --log .json;
+rcbtool monitor --plot OUT runs this script itself) and writes the trend OUT
+(FORMAT png, pdf or svg; by default from OUT's extension): each tracked
+parameter with its 95 % band against the update (CUSUM alarms as dots), the
+instant test statistic over its threshold (log axis) with the alarm line at 1
+(TEST alarms as dots), and the moments of change marked as vertical lines: the
+first update of every run of two or more alarmed updates, with the effect and
+place the TEST named (a lone alarm, as a false alarm looks, is a dot only).
 Exit codes: 0 written, 2 usage, 3 matplotlib missing, 4 bad JSON, 5 not written.
 """
 
@@ -249,10 +259,117 @@ def order_plot(plt, d, path):
 KINDS = {"estimate": ("freq_hz", estimate_plot), "order": ("rpm", order_plot)}
 
 
+def _changes(ups):
+    """The moments of change: the first update of every run of two or more
+    consecutive alarmed updates (TEST or CUSUM; a lone alarm is drawn as a dot
+    only, as a false alarm at the rate asked for looks), with what it was."""
+    out, run = [], []
+    for u in ups + [None]:
+        if u is not None and (u["alarm"] or u["cusum_alarm"]):
+            run.append(u)
+            continue
+        if len(run) >= 2:
+            first = run[0]
+            what = "CUSUM" if not first["alarm"] else "TEST"
+            t = next((v for v in run if v["alarm"] and v["top"]), None)
+            name = f": {t['top'][0]['effect']} at {t['top'][0]['place']}" if t else ""
+            out.append((first["update"], what + name))
+        run = []
+    return out
+
+
+def trend(plt, d, path, fmt=None):
+    ups = d["updates"]
+    names = [t["name"] for t in d["tracked"]]
+    x = [u["update"] for u in ups]
+    fig, axes = plt.subplots(len(names) + 1, 1, figsize=(9, 2.4 * (len(names) + 1) + 0.6),
+                             sharex=True, squeeze=False)
+    axes = axes[:, 0]
+    changes = _changes(ups)
+    for k, (ax, name) in enumerate(zip(axes, names)):
+        v = [u["tracked"][k]["value"] for u in ups]
+        lo = [u["tracked"][k]["ci_lo"] for u in ups]
+        hi = [u["tracked"][k]["ci_hi"] for u in ups]
+        ax.fill_between(x, lo, hi, color="tab:blue", alpha=0.25, lw=0, label="95 % interval")
+        ax.plot(x, v, color="tab:blue", lw=1.0, label="estimate")
+        ax.axhline(d["tracked"][k]["baseline"], color="k", ls="--", lw=0.8, label="baseline")
+        cu = [(xi, vi) for xi, vi, u in zip(x, v, ups) if u["tracked"][k]["cusum_alarm"]]
+        if cu:
+            ax.plot(*zip(*cu), ".", color="tab:orange", ms=4, label="CUSUM alarm")
+        ax.set_ylabel(name, fontsize=8)
+        ax.grid(True, alpha=0.3)
+        ax.tick_params(labelsize=7)
+    ax = axes[-1]
+    ratio = [u["T"] / u["threshold"] if u["T"] is not None and u["threshold"] else math.nan
+             for u in ups]
+    ax.semilogy(x, [max(r, 1e-3) for r in ratio], ".-", color="tab:gray", lw=0.7, ms=3,
+                label="T / threshold")
+    al = [(xi, max(r, 1e-3)) for xi, r, u in zip(x, ratio, ups) if u["alarm"]]
+    if al:
+        ax.semilogy(*zip(*al), "o", color="tab:red", ms=4, label="TEST alarm")
+    ax.axhline(1.0, color="tab:red", lw=1.0, label=f"alarm line (alpha {d.get('alpha') or 0:.2g})")
+    ax.set_ylabel("T / threshold (-)", fontsize=8)
+    ax.set_xlabel("update", fontsize=8)
+    ax.grid(True, alpha=0.3, which="both")
+    ax.tick_params(labelsize=7)
+    for a in axes:
+        for k, (at, what) in enumerate(changes):
+            a.axvline(at, color="tab:red", ls=":", lw=1.2,
+                      label=f"change at update {at} ({what})" if a is axes[-1] else
+                      ("change" if k == 0 else None))
+        a.legend(fontsize=6, loc="best")
+    model = str(d["model"]).rsplit("/", 1)[-1]
+    n_alarm = sum(1 for u in ups if u["alarm"])
+    axes[0].set_title(f"{model}: {len(ups)} updates, {n_alarm} TEST alarms, "
+                      f"{len(changes)} change(s) marked", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110, format=fmt)
+    plt.close(fig)
+
+
+def _matplotlib():
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError as e:
+        print(f"rcb_plots.py: matplotlib is not available to {sys.executable}: {e}",
+              file=sys.stderr)
+        return None
+    return plt
+
+
+def main_monitor(argv):
+    plt = _matplotlib()
+    if plt is None:
+        return 3
+    try:
+        with open(argv[2]) as f:
+            d = json.load(f)
+        d["updates"][0]["tracked"]
+        d["tracked"]
+    except (OSError, ValueError, KeyError, IndexError) as e:
+        print(f"rcb_plots.py: cannot read {argv[2]} as rcbtool monitor JSON: {e}",
+              file=sys.stderr)
+        return 4
+    out = argv[3]
+    fmt = argv[4] if len(argv) > 4 else None
+    try:
+        trend(plt, d, out, fmt)
+    except OSError as e:
+        print(f"rcb_plots.py: cannot write the picture: {e}", file=sys.stderr)
+        return 5
+    return 0
+
+
 def main(argv):
+    if len(argv) in (4, 5) and argv[1] == "monitor":
+        return main_monitor(argv)
     if len(argv) != 4 or argv[1] not in ("compare", *KINDS):
         print("usage: rcb_plots.py compare COMPARE.json PREFIX\n"
-              "       rcb_plots.py estimate|order DATA.json FILE.png", file=sys.stderr)
+              "       rcb_plots.py estimate|order DATA.json FILE.png\n"
+              "       rcb_plots.py monitor MONITOR.json OUT [FORMAT]", file=sys.stderr)
         return 2
     try:
         import matplotlib

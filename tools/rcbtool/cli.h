@@ -327,8 +327,10 @@ int cli_params_add(const cli_args *a, rcb_fit *f, const rcb_model *m, const cli_
 /** Make the directories of a --plot path (mkdir -p of its dirname); 0 or exit 5. */
 int cli_plot_mkdir(const char *path);
 /** Run rcb_plots.py KIND JSON OUT (RCB_PYTHON, RCB_PLOTS; messages to stderr);
+ * [FORMAT] (the picture's format when OUT has no telling suffix, or NULL);
  * 0, or exit 5 with a message ending in @p kept (what became of the outputs). */
-int cli_plot_run(const char *kind, const char *json, const char *out, const char *kept);
+int cli_plot_run(const char *kind, const char *json, const char *out, const char *format,
+                 const char *kept);
 /** Before any work: --plot @p path is not empty and is none of the inputs. */
 int cli_plot_check(const cli_args *a, const char *path);
 typedef void (*cli_plot_json_fn)(FILE *fp, const void *ctx);
@@ -370,6 +372,7 @@ int cmd_timecheck(int argc, char **argv);
 int cmd_compare(int argc, char **argv);
 int cmd_diagnose(int argc, char **argv);
 int cmd_history(int argc, char **argv);
+int cmd_monitor(int argc, char **argv);
 
 extern const char cli_help_check[];
 extern const char cli_help_matrices[];
@@ -388,6 +391,7 @@ extern const char cli_help_timecheck[];
 extern const char cli_help_compare[];
 extern const char cli_help_diagnose[];
 extern const char cli_help_history[];
+extern const char cli_help_monitor[];
 
 /** Print a command's help text to stdout; returns 0 (or 5 if stdout fails). */
 int cli_print_help(const char *text);

@@ -119,6 +119,8 @@ static const char *const examples[][2] = {
                  "coupling.C.kt,coupling.C.kr,coupling.C.ct --log --noise 10,1 --history "
                  "session.jsonl"},
     {"history", "rcbtool history session.jsonl"},
+    {"monitor", "rcbtool monitor fitted.ini meas.csv meas.csv --params coupling.C.kt,coupling.C.kr "
+                "--noise 10,1 --log monitor.csv"},
     {"transient", "rcbtool transient examples/paper_system.ini --out DA.x,DB.x --rpm 3000 "
                   "--rpm-end 4500 --accel 3000 --dt 1e-4 --signals -o runup.csv"},
     {"order", "rcbtool order runup.csv --kp KP --outputs DA.x,DB.x --bin-rpm 300 "

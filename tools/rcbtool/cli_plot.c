@@ -1,4 +1,4 @@
-/* --plot of compare, estimate and order: the plotting script
+/* --plot of compare, estimate, order and monitor: the plotting script
  * tools/python/rcb_plots.py (installed to share/rcb) run on our JSON. */
 #include <errno.h>
 #include <stdio.h>
@@ -72,7 +72,8 @@ int cli_plot_mkdir(const char *prefix) {
   return rc;
 }
 
-int cli_plot_run(const char *kind, const char *json, const char *out, const char *kept) {
+int cli_plot_run(const char *kind, const char *json, const char *out, const char *format,
+                 const char *kept) {
   const char *py = getenv("RCB_PYTHON");
   char script[4096];
   pid_t pid;
@@ -86,7 +87,7 @@ int cli_plot_run(const char *kind, const char *json, const char *out, const char
   pid = fork();
   if (pid < 0) return cli_fail(CLI_EXIT_IO, "--plot: fork failed: %s", strerror(errno));
   if (pid == 0) {
-    execlp(py, py, script, kind, json, out, (char *)NULL);
+    execlp(py, py, script, kind, json, out, format, (char *)NULL);
     fprintf(stderr, "rcbtool: --plot: cannot run Python '%s': %s (install Python 3 with "
             "matplotlib, or set RCB_PYTHON to such an interpreter)\n", py, strerror(errno));
     _exit(127);
@@ -130,7 +131,7 @@ int cli_plot_write(const char *kind, const char *png, cli_plot_json_fn json, con
     cli_tmpfile_close(&jt, 0);
     return rc;
   }
-  rc = cli_plot_run(kind, jt.write_path, pt.write_path, kept);
+  rc = cli_plot_run(kind, jt.write_path, pt.write_path, NULL, kept);
   cli_tmpfile_close(&jt, 0); /* the data file is not kept */
   if (cli_tmpfile_close(&pt, rc == 0) && !rc) rc = CLI_EXIT_IO;
   return rc;

@@ -410,7 +410,8 @@ static int write_plots(const cli_args *a, const cmp_job *j, const rcb_meas *ms,
   pa.output = json;
   if (!rc && !(rc = cli_out_open(&o, &pa))) {
     print_json(o.fp, a, j, ms, c, ord);
-    if (!(rc = cli_out_flush(&o)) && !(rc = cli_plot_run("compare", o.tmp ? o.tmp : json, j->plot, NOTHING_KEPT)))
+    if (!(rc = cli_out_flush(&o)) &&
+        !(rc = cli_plot_run("compare", o.tmp ? o.tmp : json, j->plot, NULL, NOTHING_KEPT)))
       rc = cli_out_close(&o);
     else
       cli_out_abort(&o);

@@ -34,6 +34,8 @@ static const cli_command commands[] = {
      cli_help_diagnose, cmd_diagnose},
     {"history", "the steps of a session (fit, diagnose, apply) and the error falling",
      cli_help_history, cmd_history},
+    {"monitor", "condition monitoring of a series of measurements: alarms, effect, trend",
+     cli_help_monitor, cmd_monitor},
     {"transient", "time histories: constant speed, run-up, coast-down (SUNDIALS)",
      cli_help_transient, cmd_transient},
     {"timecheck", "unbalance response: frequency domain vs time integration, per speed",

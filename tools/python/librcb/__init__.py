@@ -9,6 +9,7 @@ A thin ctypes layer over the C library librcb.so (no physics in Python):
     cb = rcb.campbell(m, rpm=np.linspace(0, 20000, 81))
     meas = rcb.Meas.read("measured.uff", model=m)
     res = rcb.fit(m, meas, ["coupling.C.kt", "coupling.C.kr"], noise=(10, 1))
+    mon = rcb.Monitor(m, meas, ["coupling.C.kt"], noise=(10, 1)); mon.update(meas2)
 
 Units: SI for every value; frequencies in Hz and rotor speeds in rpm at this
 edge (rad/s inside the library). The shared library is found through
@@ -20,6 +21,7 @@ from .analyses import Campbell, Modes, campbell, export_uff, frf, modes, simulat
 from .identify import Diagnosis, FitResult, compare, diagnose, fit
 from .meas import Meas, read_meas
 from .model import Model
+from .monitor import Monitor
 
 __version__ = "0.1.0"
 
@@ -39,4 +41,4 @@ def library_path():
 
 __all__ = ["Model", "Meas", "read_meas", "frf", "unbalance", "modes", "campbell", "simulate",
            "export_uff", "fit", "diagnose", "compare", "Modes", "Campbell", "FitResult",
-           "Diagnosis", "RcbError", "LibraryNotFound", "library_version", "library_path"]
+           "Diagnosis", "Monitor", "RcbError", "LibraryNotFound", "library_version", "library_path"]

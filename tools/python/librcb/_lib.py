@@ -104,6 +104,50 @@ class CompareSummary(ctypes.Structure):
                 ("csf_mean", c_double)]
 
 
+# rcb_monitor.h (issue #16); the array sizes are RCB_MONITOR_MAX_TRACKED,
+# RCB_MONITOR_TOP and RCB_MONITOR_MAXP
+MONITOR_MAX_TRACKED, MONITOR_TOP, MONITOR_MAXP = 8, 8, 3
+
+
+class MonitorParam(ctypes.Structure):
+    _fields_ = [("name", c_char_p), ("lo", c_double), ("hi", c_double)]
+
+
+class MonitorOpts(ctypes.Structure):
+    _fields_ = [("ntracked", c_size_t), ("tracked", ctypes.POINTER(MonitorParam)),
+                ("alpha", c_double), ("cusum_k", c_double), ("cusum_h", c_double),
+                ("beta_a", c_double), ("beta_s", c_double), ("sd", c_void_p),
+                ("setup_averages", c_double), ("effects", ctypes.c_uint), ("top", c_size_t),
+                ("relinearise", c_size_t), ("reweight", c_int)]
+
+
+class MonitorCandidate(ctypes.Structure):
+    _fields_ = [("index", c_size_t), ("effect", c_int), ("np", c_size_t),
+                ("size", c_double * MONITOR_MAXP), ("ci_lo", c_double * MONITOR_MAXP),
+                ("ci_hi", c_double * MONITOR_MAXP), ("score", c_double), ("dof", c_size_t),
+                ("p_value", c_double)]
+
+
+class MonitorTracked(ctypes.Structure):
+    _fields_ = [("value", c_double), ("ci_lo", c_double), ("ci_hi", c_double),
+                ("stderr_", c_double), ("z", c_double), ("cusum_up", c_double),
+                ("cusum_down", c_double), ("cusum_alarm", c_int), ("out_of_range", c_int)]
+
+
+class MonitorResult(ctypes.Structure):
+    _fields_ = [("update", c_size_t), ("error_pct", c_double), ("change_pct", c_double),
+                ("floor_pct", c_double), ("T", c_double), ("dof", c_size_t),
+                ("threshold", c_double), ("p_value", c_double), ("alarm", c_int),
+                ("cusum_alarm", c_int), ("ntop", c_size_t),
+                ("top", MonitorCandidate * MONITOR_TOP), ("ntracked", c_size_t),
+                ("tracked", MonitorTracked * MONITOR_MAX_TRACKED)]
+
+
+class MonitorCandidateInfo(ctypes.Structure):
+    _fields_ = [("effect", c_int), ("place", c_char_p), ("description", c_char_p),
+                ("params", c_char_p), ("np", c_size_t)]
+
+
 PP = ctypes.POINTER(c_void_p)  # out-parameter for an opaque handle
 
 # name: (restype, argtypes); restype c_int is an rcb_status.
@@ -217,6 +261,23 @@ _PROTOTYPES = {
     "rcb_compare_get_summary": (c_int, [c_void_p, ctypes.POINTER(CompareSummary)]),
     "rcb_compare_point_count": (c_size_t, [c_void_p]),
     "rcb_compare_grid": (c_double_p, [c_void_p]),
+    # monitoring
+    "rcb_monitor_create": (c_int, [PP, c_void_p, c_void_p, ctypes.POINTER(MonitorOpts),
+                                   c_void_p]),
+    "rcb_monitor_destroy": (None, [c_void_p]),
+    "rcb_monitor_errmsg": (c_char_p, [c_void_p]),
+    "rcb_monitor_update": (c_int, [c_void_p, c_void_p, c_void_p,
+                                   ctypes.POINTER(MonitorResult)]),
+    "rcb_monitor_reset_cusum": (None, [c_void_p]),
+    "rcb_monitor_point_count": (c_size_t, [c_void_p]),
+    "rcb_monitor_memory": (c_size_t, [c_void_p]),
+    "rcb_monitor_candidate_count": (c_size_t, [c_void_p]),
+    "rcb_monitor_candidate_info_get": (c_int, [c_void_p, c_size_t,
+                                               ctypes.POINTER(MonitorCandidateInfo)]),
+    "rcb_monitor_tracked_info": (c_int, [c_void_p, c_size_t, ctypes.POINTER(c_char_p),
+                                         c_double_p]),
+    "rcb_chi2_sf": (c_double, [c_double, c_double]),
+    "rcb_chi2_quantile": (c_double, [c_double, c_double]),
 }
 
 

@@ -97,6 +97,22 @@ class Meas(Handle):
                      "rcb_meas_read_uff")
         return ms
 
+    @classmethod
+    def from_bytes(cls, data, suffix=".uff", uff_map=None, model=None):
+        """Read a measurement held in memory (the bytes of a UFF58 or CSV file,
+        e.g. sent to a Dask worker): written to a private temporary file that
+        the library reads, then removed. suffix: ".uff" or ".csv" (the format)."""
+        import os
+        import tempfile
+
+        fd, tmp = tempfile.mkstemp(suffix=suffix, prefix="librcb-meas-")
+        try:
+            with os.fdopen(fd, "wb") as f:
+                f.write(data)
+            return cls.read(tmp, uff_map=uff_map, model=model)
+        finally:
+            os.unlink(tmp)
+
     def write(self, path, uff_map=None, model=None, binary=False):
         """Write UFF58 (by extension .uff/.unv/.uf; binary 58b if asked) or CSV.
         Stations of the channels without a node number in uff_map (or the model's

@@ -1,0 +1,275 @@
+/**
+ * @file rcb_monitor.h
+ * @brief Model-based condition monitoring (issue #16): a fitted baseline
+ * model and its commissioning measurement, then one new measurement after
+ * another, each answered with "unchanged within the noise", the trend of the
+ * tracked parameters with confidence intervals, and, when a new effect
+ * appears, the effect and place that explain it best, with their size.
+ *
+ * Method (all sizing and allocation in rcb_monitor_create; rcb_monitor_update
+ * allocates nothing):
+ *  - Residual space. Every (channel, point) of the set-up gives two real
+ *    residuals, the change of the measured value since commissioning,
+ *    d = e_new - e_0 (SI units of the channel's kind), taken in the
+ *    (radial, tangential) frame of e_0 and divided by its standard deviation:
+ *    the eq. 19 noise model (beta_a along e_0 with variance
+ *    (beta_a/100)^2 |e_0|^2 / 3, beta_s circular with variance a^2 / 6 per
+ *    component, a = beta_s/100 sqrt(sum_j |e_0j|^2) / n) or per-point
+ *    standard deviations, for the new measurement and for the commissioning
+ *    one (divided by the number of measurements averaged into it). The
+ *    baseline model's own bias (model minus commissioning measurement) is
+ *    therefore never a change.
+ *  - Columns. The sensitivities of the tracked parameters (paper eq. 9,
+ *    analytic) and of every catalogue candidate's parameters at its neutral
+ *    value (the diagnosis catalogue of rcb_diagnose.h, issue #4), all at
+ *    the baseline and whitened the same way, are factored once by
+ *    Householder QR (columns dependent on earlier ones within 1e-10 dropped):
+ *    Q, of rank k.
+ *  - Instant test. y = Q^T r (r the whitened change); the tracked
+ *    parameters are free to drift (their drift is trended and watched by the
+ *    CUSUM below), so the test is on the part of y orthogonal to them:
+ *    T = ||y||^2 - ||P_t y||^2, chi-square with k - k_t degrees of freedom
+ *    when nothing but the tracked parameters changed; alarm when T exceeds
+ *    the chi-square quantile at 1 - alpha (rcb_chi2_quantile, written here:
+ *    regularised incomplete gamma by series / continued fraction, inverted
+ *    by safeguarded Newton; no LAPACK or SUNDIALS routine offers it).
+ *  - Ranking. Each candidate's score statistic: the reduction of ||r||^2
+ *    its columns explain beyond the tracked parameters' (the orthogonalised
+ *    score test of the diagnosis), chi-square with its rank under "absent";
+ *    candidates are ranked by its upper-tail p-value (so one- and
+ *    three-parameter effects compare fairly). Size: the linearised
+ *    Gauss-Newton step of the tracked parameters and the candidate's
+ *    together, with 95 % intervals from (J^T W J)^-1 (the noise is known:
+ *    no sigma^2 factor).
+ *  - Trend. Tracked parameters: the same step with the tracked parameters
+ *    alone (jointly with the best candidate while the instant test fires),
+ *    value = baseline + step, 95 % interval. With
+ *    opts.relinearise > 0 the step is refined by chord iterations that
+ *    re-evaluate the model at the new value (the fit's preallocated FRF
+ *    object, no allocation).
+ *  - Noise after a change. With opts.reweight the covariance of r is
+ *    rebuilt at every update from the update's own noise (proportional
+ *    noise follows the new response, whose peaks may have moved), C =
+ *    Q^T D Q in the rank space, and every statistic above is taken in the
+ *    metric C^-1 (generalised least squares): T stays chi-square(k - k_t)
+ *    when only tracked parameters changed, however far.
+ *  - Sequential detector. A two-sided CUSUM per tracked parameter on its
+ *    standardised change z = (value - baseline) / stderr:
+ *    S+ = max(0, S+ + z - k), S- = max(0, S- - z - k), alarm when either
+ *    exceeds h. With independent N(0,1) z the in-control average run
+ *    length of one side is Siegmund's
+ *    ARL0 = (exp(2 k b) - 2 k b - 1) / (2 k^2), b = h + 1.166
+ *    (rcb_cusum_arl0); both sides of n_t parameters alarm about
+ *    2 n_t times as often. The z of successive updates share the
+ *    commissioning measurement's noise: average enough measurements into it
+ *    (opts.setup_averages) that this common part is small.
+ */
+#ifndef RCB_MONITOR_H
+#define RCB_MONITOR_H
+
+#include "rcb/rcb_core.h"
+#include "rcb/rcb_diagnose.h"
+#include "rcb/rcb_measure.h"
+#include "rcb/rcb_model.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** @brief Most tracked parameters of one monitor. */
+#define RCB_MONITOR_MAX_TRACKED 8
+/** @brief Most ranked candidates in one result. */
+#define RCB_MONITOR_TOP 8
+/** @brief Most parameters of one candidate effect (as the diagnosis). */
+#define RCB_MONITOR_MAXP 3
+
+/** @brief A parameter to track (rcb_model_get_param names, e.g. "C.kt"). */
+typedef struct rcb_monitor_param {
+  const char *name; /**< parameter name, copied at create */
+  double lo, hi;    /**< plausible range, parameter units (lo < hi); an estimate
+                         outside it sets rcb_monitor_tracked.out_of_range */
+} rcb_monitor_param;
+
+/** @brief Monitor settings: zero-initialise, then set what you need (0 means
+ * the default stated on each field). */
+typedef struct rcb_monitor_opts {
+  size_t ntracked;                  /**< tracked parameters, 0 .. RCB_MONITOR_MAX_TRACKED */
+  const rcb_monitor_param *tracked; /**< ntracked entries */
+  double alpha;      /**< false-alarm probability of the instant test per update
+                          (-), 0 < alpha < 1; 0: 1e-3 */
+  double cusum_k;    /**< CUSUM reference value, standard deviations of z (-);
+                          0: 0.5 (tuned to a shift of 1 standard deviation) */
+  double cusum_h;    /**< CUSUM decision threshold (-); 0: 8 (one side's
+                          ARL0 ~ 1.9e4 updates) */
+  double beta_a;     /**< eq. 19 random (proportional) noise of one
+                          measurement, % (used when sd is NULL) */
+  double beta_s;     /**< eq. 19 systematic (additive) noise of one
+                          measurement, % (used when sd is NULL) */
+  const double *sd;  /**< standard deviation of each of Re and Im of one
+                          measurement at each (channel, point), channel-major
+                          (sd[c * npoints + i]), SI units of the channel
+                          (e.g. from rcb_spectral_frf); NULL: the eq. 19 model */
+  double setup_averages; /**< measurements averaged into the set-up values
+                              (>= 1); 0: 1; HUGE_VAL: a noise-free reference */
+  unsigned effects;  /**< candidate effects: bit (1u << rcb_effect) set for
+                          each one catalogued; 0: every effect the catalogue
+                          scores (the coupling model, refitted only by the
+                          diagnosis, has no neutral value and is left out) */
+  size_t top;        /**< candidates ranked in each result, 0: RCB_MONITOR_TOP */
+  size_t relinearise; /**< chord iterations refining the tracked estimates per
+                           update by re-evaluating the model (0: linear only;
+                           each costs one sweep of the set-up with the banded
+                           LAPACK solver, which allocates nothing) */
+  int reweight;      /**< 1: take each update's noise from the update itself
+                          (eq. 19 on its own values, or the sd passed to
+                          rcb_monitor_update) and apply the statistics in that
+                          covariance (generalised least squares in the rank
+                          space, O(n k^2) per update); 0 (default): the noise of
+                          the commissioning values, exact while the machine is
+                          near them (O(n k) per update). Proportional noise
+                          grows with the response: after a large change (a
+                          resonance moved) only 1 keeps T chi-square */
+} rcb_monitor_opts;
+
+/** @brief One ranked candidate effect in a result. */
+typedef struct rcb_monitor_candidate {
+  size_t index;       /**< candidate index, for rcb_monitor_candidate_info */
+  rcb_effect effect;  /**< the kind of effect */
+  size_t np;          /**< its parameters (<= RCB_MONITOR_MAXP) */
+  double size[RCB_MONITOR_MAXP];  /**< estimated change of each parameter
+                                       from its neutral value, parameter units
+                                       (e.g. N/m for a cross-coupled stiffness) */
+  double ci_lo[RCB_MONITOR_MAXP]; /**< 95 % interval, parameter units */
+  double ci_hi[RCB_MONITOR_MAXP];
+  double score;       /**< score statistic (-), chi-square(dof) if absent */
+  size_t dof;         /**< its degrees of freedom (rank of its columns beyond
+                           the tracked ones) */
+  double p_value;     /**< upper-tail probability of score (-) */
+} rcb_monitor_candidate;
+
+/** @brief One tracked parameter in a result. While the instant test fires,
+ * the estimate is fitted jointly with the best-ranked candidate (a new
+ * effect left out of the fit would bias the trend). */
+typedef struct rcb_monitor_tracked {
+  double value;        /**< estimate, parameter units */
+  double ci_lo, ci_hi; /**< 95 % interval, parameter units */
+  double stderr_;      /**< standard error, parameter units */
+  double z;            /**< (value - baseline) / stderr (-) */
+  double cusum_up;     /**< CUSUM S+ (-) */
+  double cusum_down;   /**< CUSUM S- (-) */
+  int cusum_alarm;     /**< +1: S+ > h (rising), -1: S- > h (falling), 0 */
+  int out_of_range;    /**< 1 when value lies outside [lo, hi] */
+} rcb_monitor_tracked;
+
+/** @brief What one update found. Plain value type, owns nothing. */
+typedef struct rcb_monitor_result {
+  size_t update;      /**< updates so far, this one included */
+  double error_pct;   /**< paper's error %, 100 ||(|m| - |e|)|| / || |e| ||, of
+                           the baseline model m against this measurement e */
+  double change_pct;  /**< the same of the commissioning values against e */
+  double floor_pct;   /**< error % the noise alone explains (-, %): the rms of
+                           the noise's radial standard deviation over || |e| || */
+  double T;           /**< instant test statistic (-) */
+  size_t dof;         /**< its degrees of freedom k - k_t */
+  double threshold;   /**< chi-square quantile at 1 - alpha (-) */
+  double p_value;     /**< upper-tail probability of T (-) */
+  int alarm;          /**< 1 when T > threshold */
+  int cusum_alarm;    /**< 1 when some tracked parameter's CUSUM is past h */
+  size_t ntop;        /**< ranked candidates written */
+  rcb_monitor_candidate top[RCB_MONITOR_TOP]; /**< best first (smallest p) */
+  size_t ntracked;    /**< tracked parameters */
+  rcb_monitor_tracked tracked[RCB_MONITOR_MAX_TRACKED];
+} rcb_monitor_result;
+
+typedef struct rcb_monitor rcb_monitor;
+
+/**
+ * @brief Commission a monitor: size everything, evaluate the baseline
+ * model's sensitivities and lay out the catalogue. All memory comes from
+ * @p alloc here (an embedded host passes its arena; rcb_monitor_memory says
+ * how much was kept); rcb_monitor_update never allocates. There is no
+ * two-call sizing: the size depends on how many candidates the catalogue
+ * lays out on this model, known only once it has been built. The model
+ * evaluations (here and with opts.relinearise) use the banded LAPACK solver,
+ * never KLU, whose factors would bypass the hooks. A bump allocator that
+ * never frees needs every temporary of create (tools/bench/bench_monitor
+ * prints both that and the bytes kept).
+ * @param baseline fitted, finalized model (copied: the caller may destroy it)
+ * @param setup channels and abscissa (FRF: frequencies, rad/s, at the test
+ * speed; 1X unbalance response: rotor speeds, rad/s) and, as its values, the
+ * commissioning measurement (copied)
+ * @param opts settings (NULL: every default; noise then must come from
+ * somewhere: RCB_ERR_ARG without beta_a, beta_s or sd)
+ * @param alloc allocator hooks, NULL for malloc
+ * @return RCB_OK; on failure *out may hold an object carrying the message
+ * (rcb_monitor_errmsg): destroy it in every case
+ */
+RCB_API rcb_status rcb_monitor_create(rcb_monitor **out, const rcb_model *baseline,
+                                      const rcb_meas *setup, const rcb_monitor_opts *opts,
+                                      const rcb_allocator *alloc);
+RCB_API void rcb_monitor_destroy(rcb_monitor *mon);
+/** @brief Last error, naming the channel and point where it applies. */
+RCB_API const char *rcb_monitor_errmsg(const rcb_monitor *mon);
+
+/**
+ * @brief One new measurement. Allocates nothing.
+ * @param values rcb_monitor_point_count values, the set-up's layout:
+ * channel-major (values[c * npoints + i]), each in its channel's kind, SI
+ * @param sd standard deviation of each of Re and Im at each point for this
+ * measurement (same layout, SI), or NULL for the noise given at create (or,
+ * with opts.reweight, eq. 19 on these values). With sd the statistics are
+ * taken under that covariance as with opts.reweight, O(n k^2) instead of
+ * O(n k)
+ * @param res output
+ * @return RCB_ERR_ARG for a NaN/infinite value or a negative/NaN sd, naming
+ * the channel and point (the monitor's state is left unchanged)
+ */
+RCB_API rcb_status rcb_monitor_update(rcb_monitor *mon, const rcb_complex *values,
+                                      const double *sd, rcb_monitor_result *res);
+
+/** @brief Forget the CUSUM sums (after maintenance, or once an alarm is
+ * acknowledged); the update count and the baseline stay. */
+RCB_API void rcb_monitor_reset_cusum(rcb_monitor *mon);
+
+/** @brief Values one update takes: channels x points of the set-up. */
+RCB_API size_t rcb_monitor_point_count(const rcb_monitor *mon);
+/** @brief Bytes the monitor holds (all from its allocator). */
+RCB_API size_t rcb_monitor_memory(const rcb_monitor *mon);
+/** @brief Rank k of all columns (tracked + candidates) and k_t of the tracked. */
+RCB_API rcb_status rcb_monitor_rank(const rcb_monitor *mon, size_t *k, size_t *k_tracked);
+
+/** @brief Static description of candidate @p i (strings owned by the monitor). */
+typedef struct rcb_monitor_candidate_info {
+  rcb_effect effect;       /**< kind of effect (rcb_effect_name) */
+  const char *place;       /**< "bearing B2", "coupling C", "station #7", ... */
+  const char *description; /**< an engineer's sentence */
+  const char *params;      /**< its parameter names, comma separated */
+  size_t np;               /**< parameters */
+} rcb_monitor_candidate_info;
+/** @brief Candidates laid out at create (scored or not). */
+RCB_API size_t rcb_monitor_candidate_count(const rcb_monitor *mon);
+/** @brief Description of candidate @p i (0-based, as rcb_monitor_candidate.index);
+ * no allocation. */
+RCB_API rcb_status rcb_monitor_candidate_info_get(const rcb_monitor *mon, size_t i,
+                                                  rcb_monitor_candidate_info *out);
+/** @brief Name and baseline value (parameter units) of tracked parameter @p k. */
+RCB_API rcb_status rcb_monitor_tracked_info(const rcb_monitor *mon, size_t k,
+                                            const char **name, double *baseline);
+
+/* ---- statistics used by the monitor, pure functions ---- */
+
+/** @brief Upper tail P(X > x) of the chi-square distribution with @p dof
+ * degrees of freedom (dof >= 1, x >= 0; NaN otherwise). */
+RCB_API double rcb_chi2_sf(double x, double dof);
+/** @brief Quantile x with P(X <= x) = p of chi-square(@p dof), 0 < p < 1
+ * (NaN otherwise); relative accuracy ~1e-12. */
+RCB_API double rcb_chi2_quantile(double p, double dof);
+/** @brief Siegmund's in-control average run length (updates) of a one-sided
+ * CUSUM with reference @p k > 0 and threshold @p h > 0 on N(0,1) data. */
+RCB_API double rcb_cusum_arl0(double k, double h);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* RCB_MONITOR_H */

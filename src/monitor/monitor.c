@@ -1,0 +1,307 @@
+/*
+ * rcb_monitor: the update (allocation-free: every buffer was sized by
+ * rcb_monitor_create), the getters and destroy. The statistics are stated
+ * in rcb_monitor.h; here they are applied in the rank space of the
+ * whitened sensitivity columns (y = Q^T r, k values).
+ */
+#include <math.h>
+#include <string.h>
+
+#include "identify/identify.h"
+#include "monitor/monitor_internal.h"
+
+/* Two-sided 95 % normal quantile. */
+#define MON_Z95 1.959963984540054
+
+void rcb_monitor_destroy(rcb_monitor *mon) {
+  rcb_allocator a;
+  size_t j;
+  if (!mon) return;
+  a = mon->user;
+  for (j = 0; j < mon->ncand; j++) rcb_free(&mon->alloc, mon->cand[j].est);
+  rcb_free(&mon->alloc, mon->cand);
+  rcb_free(&mon->alloc, mon->test);
+  rcb_free(&mon->alloc, mon->Q);
+  rcb_free(&mon->alloc, mon->G);
+  rcb_free(&mon->alloc, mon->C);
+  rcb_free(&mon->alloc, mon->sw.A);
+  rcb_free(&mon->alloc, mon->sw.work);
+  rcb_free(&mon->alloc, mon->y);
+  rcb_fit_destroy(mon->fit);
+  rcb_model_destroy(mon->model);
+  rcb_meas_destroy(mon->setup);
+  rcb_free(&mon->alloc, mon->e0);
+  rcb_free(&mon->alloc, mon->h0abs);
+  rcb_free(&a, mon);
+}
+
+const char *rcb_monitor_errmsg(const rcb_monitor *mon) { return mon ? mon->errmsg : "no monitor"; }
+
+static int ready(const rcb_monitor *mon) { return mon && mon->k > 0 && mon->y; }
+
+/* out = Q^T r (k values; Q row-major, read once). */
+static void to_rank(const rcb_monitor *mon, const double *r, double *out) {
+  size_t a, i, n = mon->n, k = mon->k;
+  memset(out, 0, k * sizeof *out);
+  for (i = 0; i < n; i++) {
+    const double *q = mon->Q + k * i;
+    double ri = r[i];
+    for (a = 0; a < k; a++) out[a] += q[a] * ri;
+  }
+}
+
+static double dot(const double *a, const double *b, size_t n) {
+  double s = 0;
+  size_t i;
+  for (i = 0; i < n; i++) s += a[i] * b[i];
+  return s;
+}
+
+static rcb_status check_input(rcb_monitor *mon, const rcb_complex *v, const double *sd) {
+  size_t p;
+  for (p = 0; p < mon->npt; p++) {
+    if (!isfinite(creal(v[p])) || !isfinite(cimag(v[p])))
+      return rcb_mon_fail(mon, RCB_ERR_ARG, "update %zu: channel %zu point %zu is not finite "
+                          "(NaN or infinite value); the update was not taken", mon->updates + 1,
+                          p / mon->npts + 1, p % mon->npts + 1);
+    if (sd && (!(sd[p] > 0) || !isfinite(sd[p])))
+      return rcb_mon_fail(mon, RCB_ERR_ARG, "update %zu: channel %zu point %zu: sd = %g, "
+                          "expected finite > 0; the update was not taken", mon->updates + 1,
+                          p / mon->npts + 1, p % mon->npts + 1, sd[p]);
+  }
+  return RCB_OK;
+}
+
+/* ym = Q^T W (m(theta) - m(theta_0)) for tracked values t0 + theta. */
+static rcb_status model_change(rcb_monitor *mon, const double *theta) {
+  size_t k, p;
+  rcb_status st = RCB_OK;
+  for (k = 0; !st && k < mon->nt; k++)
+    if ((st = rcb_model_set_param(mon->model, mon->tname[k], mon->t0[k] + theta[k])))
+      rcb_mon_fail(mon, st, "re-linearising at %s = %g: %s", mon->tname[k],
+                   mon->t0[k] + theta[k], rcb_model_errmsg(mon->model));
+  if (!st && (st = rcb_fit_residuals(mon->fit, mon->rm)))
+    rcb_mon_fail(mon, st, "re-linearising at the tracked estimate: %s", rcb_fit_errmsg(mon->fit));
+  if (st) {
+    for (k = 0; k < mon->nt; k++) rcb_model_set_param(mon->model, mon->tname[k], mon->t0[k]);
+    return st;
+  }
+  for (p = 0; p < mon->npt; p++) {
+    double complex g = conj(mon->u[p]) * CMPLX(mon->rm[2 * p] - mon->rbase[2 * p],
+                                               mon->rm[2 * p + 1] - mon->rbase[2 * p + 1]);
+    mon->rm[2 * p] = creal(g) * mon->winv[2 * p];
+    mon->rm[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
+  }
+  to_rank(mon, mon->rm, mon->ym);
+  return RCB_OK;
+}
+
+/* The re-linearised tracked step theta (chord iterations re-evaluating the
+ * model: theta += E (y - ym(theta)), E the linear estimator; 0 without
+ * re-linearisation); on return mon->y holds the change the model at
+ * baseline + theta does not explain (y itself without). */
+static rcb_status tracked_step(rcb_monitor *mon, double *theta) {
+  size_t a, it, i, k = mon->k, nt = mon->nt;
+  rcb_status st;
+  memset(theta, 0, sizeof(double) * RCB_MONITOR_MAX_TRACKED);
+  if (!mon->relin || !nt) return RCB_OK;
+  for (a = 0; a < nt; a++) theta[a] = dot(mon->test + a * k, mon->y, k);
+  for (it = 0; it < mon->relin; it++) {
+    if ((st = model_change(mon, theta))) return st;
+    for (i = 0; i < k; i++) mon->ym[i] = mon->y[i] - mon->ym[i];
+    for (a = 0; a < nt; a++) theta[a] += dot(mon->test + a * k, mon->ym, k);
+  }
+  if ((st = model_change(mon, theta))) return st;
+  for (i = 0; i < k; i++) mon->y[i] -= mon->ym[i];
+  for (a = 0; a < nt; a++) rcb_model_set_param(mon->model, mon->tname[a], mon->t0[a]);
+  return RCB_OK;
+}
+
+static void tracked_result(rcb_monitor *mon, const double *theta, const double *sev,
+                           rcb_monitor_result *res) {
+  size_t a;
+  res->ntracked = mon->nt;
+  res->cusum_alarm = 0;
+  for (a = 0; a < mon->nt; a++) {
+    rcb_monitor_tracked *t = &res->tracked[a];
+    double se = sev[a], z = theta[a] / se;
+    t->value = mon->t0[a] + theta[a];
+    t->stderr_ = se;
+    t->ci_lo = t->value - MON_Z95 * se, t->ci_hi = t->value + MON_Z95 * se;
+    t->z = z;
+    mon->cus_up[a] = fmax(0.0, mon->cus_up[a] + z - mon->cusum_k);
+    mon->cus_dn[a] = fmax(0.0, mon->cus_dn[a] - z - mon->cusum_k);
+    t->cusum_up = mon->cus_up[a], t->cusum_down = mon->cus_dn[a];
+    t->cusum_alarm = t->cusum_up > mon->cusum_h ? 1 : t->cusum_down > mon->cusum_h ? -1 : 0;
+    t->out_of_range = t->value < mon->tlo[a] || t->value > mon->thi[a];
+    if (t->cusum_alarm) res->cusum_alarm = 1;
+  }
+}
+
+/* a ranks before b: smaller p-value, compared as logarithms (the p-values
+ * of strong effects underflow to 0 together); then the larger score. */
+static int before(const rcb_monitor *mon, size_t a, size_t b) {
+  double pa = mon->pscore[a], pb = mon->pscore[b];
+  if (pa != pb) return pa < pb;
+  return mon->cand[a].score_now > mon->cand[b].score_now;
+}
+
+/* Scores (and, on the reweighted path, sizes) were left in the
+ * candidates by the caller when gls != 0. */
+static void candidates(rcb_monitor *mon, int gls, rcb_monitor_result *res) {
+  size_t j, a, k = mon->k, nsc = 0, t;
+  for (j = 0; j < mon->ncand; j++) {
+    mon_cand *c = &mon->cand[j];
+    if (!c->dof) continue;
+    for (a = 0; !gls && a < c->dof; a++) {
+      double z = dot(c->dir + a * k, mon->y, k);
+      if (!a) c->score_now = 0;
+      c->score_now += z * z;
+    }
+    mon->pscore[j] = rcb_mon_chi2_logsf(c->score_now, (double)c->dof);
+    mon->order[nsc++] = j;
+  }
+  /* partial selection sort: the best mon->top first */
+  res->ntop = nsc < mon->top ? nsc : mon->top;
+  for (t = 0; t < res->ntop; t++) {
+    size_t best = t;
+    for (j = t + 1; j < nsc; j++)
+      if (before(mon, mon->order[j], mon->order[best])) best = j;
+    if (best != t) {
+      size_t s = mon->order[t];
+      mon->order[t] = mon->order[best], mon->order[best] = s;
+    }
+  }
+  for (t = 0; t < res->ntop; t++) {
+    const mon_cand *c = &mon->cand[mon->order[t]];
+    rcb_monitor_candidate *o = &res->top[t];
+    o->index = mon->order[t];
+    o->effect = c->effect;
+    o->np = c->np;
+    o->score = c->score_now;
+    o->dof = c->dof;
+    o->p_value = exp(mon->pscore[mon->order[t]]);
+    for (a = 0; a < c->np; a++) {
+      double se = gls ? c->se_now[a] : c->se[a];
+      o->size[a] = gls ? c->size_now[a] : dot(c->est + a * k, mon->y, k);
+      o->ci_lo[a] = o->size[a] - MON_Z95 * se;
+      o->ci_hi[a] = o->size[a] + MON_Z95 * se;
+    }
+  }
+}
+
+/* Paper's error %, change % and the noise floor % of this measurement. */
+static void errors(const rcb_monitor *mon, const rcb_complex *v, rcb_monitor_result *res) {
+  double em = 0, ec = 0, ee = 0, fl = 0;
+  size_t p;
+  for (p = 0; p < mon->npt; p++) {
+    double av = cabs(v[p]), dm = mon->h0abs[p] - av, dc = cabs(mon->e0[p]) - av;
+    em += dm * dm, ec += dc * dc, ee += av * av;
+    fl += mon->sd_new_rad[p] * mon->sd_new_rad[p];
+  }
+  ee = ee > 0 ? sqrt(ee) : 1.0;
+  res->error_pct = 100.0 * sqrt(em) / ee;
+  res->change_pct = 100.0 * sqrt(ec) / ee;
+  res->floor_pct = 100.0 * sqrt(fl) / ee;
+}
+
+/* The tracked step beyond the re-linearised one, and its standard errors:
+ * alone, or, once the instant test has fired, fitted jointly with the best
+ * candidate (a new effect left out would bias the trend). */
+static void tracked_rest(const rcb_monitor *mon, int gls, const rcb_monitor_result *res,
+                         double *dth, double *se) {
+  const mon_cand *c = res->alarm && res->ntop ? &mon->cand[res->top[0].index] : NULL;
+  size_t a, k = mon->k;
+  for (a = 0; a < mon->nt; a++) {
+    if (c && gls) dth[a] = c->th_now[a], se[a] = c->set_now[a];
+    else if (c) dth[a] = dot(c->test_t + a * k, mon->y, k), se[a] = c->se_t[a];
+    else if (!gls) dth[a] = dot(mon->test + a * k, mon->y, k), se[a] = mon->tse[a];
+  }
+}
+
+rcb_status rcb_monitor_update(rcb_monitor *mon, const rcb_complex *values, const double *sd,
+                              rcb_monitor_result *res) {
+  double theta[RCB_MONITOR_MAX_TRACKED], dth[RCB_MONITOR_MAX_TRACKED] = {0},
+      se[RCB_MONITOR_MAX_TRACKED] = {0}, T;
+  size_t p, a;
+  int gls;
+  rcb_status st;
+  if (!mon) return RCB_ERR_ARG;
+  if (!values || !res) return rcb_mon_fail(mon, RCB_ERR_ARG, "rcb_monitor_update: values and "
+                                           "result are required");
+  if (!ready(mon))
+    return rcb_mon_fail(mon, RCB_ERR_STATE, "rcb_monitor_update: the monitor was not created "
+                        "successfully");
+  if ((st = check_input(mon, values, sd))) return st;
+  gls = mon->reweight || sd;
+  for (p = 0; p < mon->npt; p++) {
+    double complex g = conj(mon->u[p]) * (values[p] - mon->e0[p]);
+    mon->r[2 * p] = creal(g) * mon->winv[2 * p];
+    mon->r[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
+  }
+  to_rank(mon, mon->r, mon->y);
+  if ((st = tracked_step(mon, theta))) return st;
+  if (gls) {
+    if ((st = rcb_mon_gls(mon, values, sd, dth, se, &T))) return st;
+  } else {
+    /* instant test: the part of y beyond the tracked directions */
+    T = dot(mon->y, mon->y, mon->k);
+    for (a = 0; a < mon->nt; a++) {
+      double z = dot(mon->tdir + a * mon->k, mon->y, mon->k);
+      T -= z * z;
+    }
+  }
+  memset(res, 0, sizeof *res);
+  mon->updates++;
+  res->update = mon->updates;
+  errors(mon, values, res);
+  res->T = fmax(T, 0.0);
+  res->dof = mon->k - mon->nt;
+  res->threshold = mon->threshold;
+  res->p_value = res->dof ? rcb_chi2_sf(res->T, (double)res->dof) : 1.0;
+  res->alarm = res->dof && res->T > mon->threshold;
+  candidates(mon, gls, res);
+  tracked_rest(mon, gls, res, dth, se);
+  for (a = 0; a < mon->nt; a++) theta[a] += dth[a];
+  tracked_result(mon, theta, se, res);
+  return RCB_OK;
+}
+
+void rcb_monitor_reset_cusum(rcb_monitor *mon) {
+  if (!mon) return;
+  memset(mon->cus_up, 0, sizeof mon->cus_up);
+  memset(mon->cus_dn, 0, sizeof mon->cus_dn);
+}
+
+size_t rcb_monitor_point_count(const rcb_monitor *mon) { return ready(mon) ? mon->npt : 0; }
+size_t rcb_monitor_memory(const rcb_monitor *mon) { return mon ? mon->held : 0; }
+
+rcb_status rcb_monitor_rank(const rcb_monitor *mon, size_t *k, size_t *k_tracked) {
+  if (!ready(mon)) return RCB_ERR_STATE;
+  if (k) *k = mon->k;
+  if (k_tracked) *k_tracked = mon->nt;
+  return RCB_OK;
+}
+
+size_t rcb_monitor_candidate_count(const rcb_monitor *mon) { return ready(mon) ? mon->ncand : 0; }
+
+rcb_status rcb_monitor_candidate_info_get(const rcb_monitor *mon, size_t i,
+                                          rcb_monitor_candidate_info *out) {
+  const mon_cand *c;
+  if (!ready(mon) || !out || i >= mon->ncand) return RCB_ERR_ARG;
+  c = &mon->cand[i];
+  out->effect = c->effect;
+  out->place = c->place;
+  out->description = c->desc;
+  out->params = c->params;
+  out->np = c->np;
+  return RCB_OK;
+}
+
+rcb_status rcb_monitor_tracked_info(const rcb_monitor *mon, size_t k, const char **name,
+                                    double *baseline) {
+  if (!ready(mon) || k >= mon->nt) return RCB_ERR_ARG;
+  if (name) *name = mon->tname[k];
+  if (baseline) *baseline = mon->t0[k];
+  return RCB_OK;
+}

@@ -1,0 +1,406 @@
+/*
+ * Commissioning a monitor (rcb_monitor.h): the set-up and the baseline model
+ * copied, the noise of every residual, the sensitivity columns of the
+ * tracked parameters (identify/, eq. 9) and of the diagnosis catalogue's
+ * candidates at their neutral values (diagnose/diagnose.h, fit_score.c's
+ * batched adjoint columns), all whitened and factored once by the score
+ * test's QR (diagnose/score_qr.c), and the small rank-space matrices the
+ * update applies (monitor_rank.c). Everything is allocated here; nothing in
+ * the update.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "diagnose/diagnose.h"
+#include "identify/identify.h"
+#include "monitor/monitor_internal.h"
+
+
+/* ---- the counting allocator: every byte the monitor's objects hold ---- */
+
+#define MON_HDR 16u /* keeps the caller's 16-byte alignment */
+
+static void *count_alloc(void *user, size_t size) {
+  rcb_monitor *mon = user;
+  unsigned char *p;
+  if (size > (size_t)-1 - MON_HDR) return NULL;
+  p = rcb_alloc(&mon->user, size + MON_HDR);
+  if (!p) return NULL;
+  memcpy(p, &size, sizeof size);
+  mon->held += size;
+  return p + MON_HDR;
+}
+
+static void count_free(void *user, void *ptr) {
+  rcb_monitor *mon = user;
+  unsigned char *p = (unsigned char *)ptr - MON_HDR;
+  size_t size;
+  memcpy(&size, p, sizeof size);
+  mon->held -= size;
+  rcb_free(&mon->user, p);
+}
+
+void *rcb_mon_alloc(rcb_monitor *mon, size_t count, size_t size) {
+  if (count && size > (size_t)-1 / count) return NULL;
+  return rcb_alloc(&mon->alloc, count * size);
+}
+
+/* ---- set-up: a copy of the commissioning measurement ---- */
+
+static rcb_status copy_setup(rcb_monitor *mon, const rcb_meas *setup) {
+  size_t c, i;
+  rcb_status st;
+  mon->nch = rcb_meas_channel_count(setup);
+  mon->npts = rcb_meas_point_count(setup);
+  if (!mon->nch || !mon->npts)
+    return rcb_mon_fail(mon, RCB_ERR_ARG, "set-up: no channel or no point (%zu channels x %zu "
+                        "points); give the commissioning measurement", mon->nch, mon->npts);
+  mon->npt = mon->nch * mon->npts;
+  mon->n = 2 * mon->npt;
+  if ((st = rcb_meas_create(&mon->setup, &mon->alloc)) ||
+      (st = rcb_meas_set_grid(mon->setup, rcb_meas_get_type(setup), mon->npts,
+                              rcb_meas_grid(setup), rcb_meas_speed(setup))))
+    return rcb_mon_fail(mon, st, "set-up: %s", mon->setup ? rcb_meas_errmsg(mon->setup) : "");
+  for (c = 0; c < mon->nch; c++) {
+    rcb_meas_channel_info ci;
+    rcb_meas_channel(setup, c, &ci);
+    for (i = 0; i < mon->npts; i++)
+      if (!isfinite(creal(ci.data[i])) || !isfinite(cimag(ci.data[i])))
+        return rcb_mon_fail(mon, RCB_ERR_ARG, "set-up: channel %zu (%s) point %zu: the "
+                            "commissioning value is not finite", c + 1, ci.response, i + 1);
+    if ((st = rcb_meas_add_channel(mon->setup, ci.response, ci.reference, ci.kind, ci.data)))
+      return rcb_mon_fail(mon, st, "set-up: %s", rcb_meas_errmsg(mon->setup));
+  }
+  return RCB_OK;
+}
+
+/* ---- noise: the standard deviation of every residual ---- */
+
+/* Radial and tangential sd of one measurement at each point: eq. 19
+ * (proportional part along e_0, variance (beta_a/100)^2 |e_0|^2 / 3 from
+ * r1 uniform on [-1, 1]; additive part circular, a^2 / 3 split over two
+ * components) or the caller's sd (circular). */
+static rcb_status noise(rcb_monitor *mon, const rcb_monitor_opts *o) {
+  double navg = o->setup_averages > 0 ? o->setup_averages : 1.0;
+  double f0 = isinf(navg) ? 1.0 : 1.0 + 1.0 / navg; /* new + commissioning variance */
+  size_t c, i;
+  mon->navg_inv = isinf(navg) ? 0.0 : 1.0 / navg;
+  mon->beta_a = o->beta_a, mon->beta_s = o->beta_s;
+  mon->have_sd0 = o->sd != NULL;
+  if (navg < 1.0)
+    return rcb_mon_fail(mon, RCB_ERR_ARG, "setup_averages = %g: expected >= 1 (measurements "
+                        "averaged into the commissioning values)", navg);
+  if (!o->sd && !(o->beta_a > 0 || o->beta_s > 0))
+    return rcb_mon_fail(mon, RCB_ERR_ARG, "no noise: give beta_a/beta_s (eq. 19, %%) or per-point "
+                        "standard deviations (opts.sd)");
+  if (!o->sd && (!(o->beta_a >= 0) || !(o->beta_s >= 0) || !isfinite(o->beta_a + o->beta_s)))
+    return rcb_mon_fail(mon, RCB_ERR_ARG, "noise: beta_a = %g, beta_s = %g %%: expected finite "
+                        ">= 0", o->beta_a, o->beta_s);
+  for (c = 0; c < mon->nch; c++) {
+    const rcb_complex *e = mon->e0 + c * mon->npts;
+    double s2 = 0.0, a;
+    for (i = 0; i < mon->npts; i++) s2 += creal(e[i] * conj(e[i]));
+    mon->e0norm2 += s2;
+    a = o->beta_s / 100.0 * sqrt(s2) / (double)mon->npts; /* eq. 19 additive amplitude */
+    for (i = 0; i < mon->npts; i++) {
+      size_t p = c * mon->npts + i;
+      double ae = cabs(e[i]), vr, vt;
+      mon->u[p] = ae > 0 ? e[i] / ae : 1.0;
+      if (o->sd) {
+        double s = o->sd[p];
+        if (!(s > 0) || !isfinite(s))
+          return rcb_mon_fail(mon, RCB_ERR_ARG, "opts.sd: channel %zu point %zu: sd = %g, "
+                              "expected finite > 0", c + 1, i + 1, s);
+        vr = vt = s * s;
+      } else {
+        double pa = o->beta_a / 100.0 * ae;
+        vt = a * a / 6.0;
+        vr = pa * pa / 3.0 + vt;
+      }
+      if (!(vr > 0) || !(vt > 0))
+        return rcb_mon_fail(mon, RCB_ERR_ARG, "noise: channel %zu point %zu has zero standard "
+                            "deviation (commissioning value 0 and beta_s = 0); give beta_s > 0 "
+                            "or opts.sd", c + 1, i + 1);
+      mon->sd_new_rad[p] = sqrt(vr);
+      mon->var0[2 * p] = vr, mon->var0[2 * p + 1] = vt;
+      if (o->sd) mon->sd0[p] = o->sd[p];
+      mon->winv[2 * p] = 1.0 / sqrt(vr * f0);
+      mon->winv[2 * p + 1] = 1.0 / sqrt(vt * f0);
+    }
+  }
+  return RCB_OK;
+}
+
+/* ---- the baseline model, its fit of the tracked parameters ---- */
+
+static rcb_status baseline(rcb_monitor *mon, const rcb_model *base, const rcb_monitor_opts *o) {
+  rcb_status st = rcb_model_clone(&mon->model, base, &mon->alloc);
+  size_t k, p;
+  if (!st) st = rcb_model_finalize(mon->model);
+  if (st) return rcb_mon_fail(mon, st, "baseline model: %s",
+                              mon->model ? rcb_model_errmsg(mon->model) : rcb_status_str(st));
+  if ((st = rcb_fit_create(&mon->fit, mon->model, mon->setup, &mon->alloc)) ||
+      (st = rcb_fit_set_solver(mon->fit, RCB_SOLVER_BANDED)) ||
+      (st = rcb_fit_set_scale(mon->fit, RCB_SCALE_COMPLEX)) ||
+      (st = rcb_fit_set_uncertainty(mon->fit, 0)))
+    return rcb_mon_fail(mon, st, "set-up against the baseline: %s",
+                        mon->fit ? rcb_fit_errmsg(mon->fit) : rcb_status_str(st));
+  for (k = 0; k < mon->nt; k++) {
+    const rcb_monitor_param *t = &o->tracked[k];
+    if (!t->name || strlen(t->name) >= RCB_MONITOR_NAME)
+      return rcb_mon_fail(mon, RCB_ERR_ARG, "tracked parameter %zu: no name or too long", k + 1);
+    snprintf(mon->tname[k], sizeof mon->tname[k], "%s", t->name);
+    mon->tlo[k] = t->lo, mon->thi[k] = t->hi;
+    if ((st = rcb_model_get_param(mon->model, t->name, &mon->t0[k])))
+      return rcb_mon_fail(mon, st, "tracked parameter '%s': %s", t->name,
+                          rcb_model_errmsg(mon->model));
+    if ((st = rcb_fit_add_param(mon->fit, t->name, t->lo, t->hi, 0)))
+      return rcb_mon_fail(mon, st, "tracked parameter '%s': %s", t->name,
+                          rcb_fit_errmsg(mon->fit));
+  }
+  if ((st = rcb_fit_residuals(mon->fit, mon->rbase)))
+    return rcb_mon_fail(mon, st, "baseline model on the set-up: %s", rcb_fit_errmsg(mon->fit));
+  if (rcb_fit_residual_count(mon->fit) != mon->n)
+    return rcb_mon_fail(mon, RCB_ERR_STATE, "residual layout: %zu, expected %zu",
+                        rcb_fit_residual_count(mon->fit), mon->n);
+  for (p = 0; p < mon->npt; p++)
+    mon->h0abs[p] = cabs(mon->e0[p] + CMPLX(mon->rbase[2 * p], mon->rbase[2 * p + 1]));
+  return RCB_OK;
+}
+
+/* ---- columns ---- */
+
+
+static int wanted(const rcb_diag_cand_desc *c, unsigned mask) {
+  if (c->refit_only || !c->np) return 0;
+  return mask ? (mask >> (unsigned)c->effect) & 1u : 1;
+}
+
+/* A fit of candidate model cm with its parameters (complex scale, as the base). */
+static rcb_status cand_fit(rcb_monitor *mon, rcb_model *cm, const rcb_diag_cand_desc *c,
+                           rcb_fit **out) {
+  rcb_status st = rcb_fit_create(out, cm, mon->setup, &mon->alloc);
+  size_t k;
+  if (!st) st = rcb_fit_set_solver(*out, RCB_SOLVER_BANDED); /* no KLU: every byte via the hooks */
+  if (!st) st = rcb_fit_set_scale(*out, RCB_SCALE_COMPLEX);
+  if (!st) st = rcb_fit_set_uncertainty(*out, 0);
+  for (k = 0; !st && k < c->np; k++) st = rcb_fit_add_param(*out, c->pname[k], c->lo[k], c->hi[k], 0);
+  if (st)
+    return rcb_mon_fail(mon, st, "%s: %s", c->desc, *out ? rcb_fit_errmsg(*out) : "no memory");
+  return RCB_OK;
+}
+
+/* The candidates' columns into J (n x ncol, after the tracked ones): one
+ * batched adjoint sweep of the base model for those with its DOFs, a sweep
+ * of their own model for the others (a pedestal). */
+static rcb_status cand_columns(rcb_monitor *mon, rcb_diag *d, const col_plan *pl, double *J) {
+  size_t ndz = 0, j, ndof = rcb_model_dof_count(mon->model), batch = 0;
+  rcb_fit_dz *dz = rcb_mon_alloc(mon, pl->ncol ? pl->ncol : 1, sizeof *dz);
+  rcb_status st = RCB_OK;
+  if (!dz) return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (candidate columns)");
+  for (j = 0; !st && j < pl->ncand; j++) {
+    rcb_diag_cand_desc c;
+    rcb_model *cm = NULL;
+    rcb_fit *cf = NULL;
+    rcb_diag_catalogue_get(d, pl->cand[j], &c);
+    if ((st = rcb_diag_catalogue_model(d, pl->cand[j], mon->model, &cm))) {
+      rcb_mon_fail(mon, st, "%s", rcb_diag_errmsg(d));
+      break;
+    }
+    st = cand_fit(mon, cm, &c, &cf);
+    if (!st && pl->own[j] == (rcb_model_dof_count(cm) == ndof))
+      st = rcb_mon_fail(mon, RCB_ERR_STATE, "%s: its model's DOFs are not as the catalogue "
+                        "states", c.desc);
+    if (!st && !pl->own[j]) {
+      if ((st = rcb_fit_dz_get(cf, &mon->alloc, dz + ndz)))
+        rcb_mon_fail(mon, st, "%s: %s", c.desc, rcb_fit_errmsg(cf));
+      else
+        ndz += c.np, batch++;
+    } else if (!st) {
+      if ((st = rcb_fit_jacobian(cf, 1, J + mon->n * pl->col[j])))
+        rcb_mon_fail(mon, st, "%s: %s", c.desc, rcb_fit_errmsg(cf));
+      else if (rcb_fit_residual_count(cf) != mon->n)
+        st = rcb_mon_fail(mon, RCB_ERR_STATE, "%s: residual layout differs", c.desc);
+    }
+    rcb_fit_destroy(cf);
+    rcb_model_destroy(cm);
+  }
+  if (!st && ndz) {
+    /* the batch's columns are contiguous after the tracked ones (plan order) */
+    if ((st = rcb_fit_jacobian_dz(mon->fit, dz, ndz, J + mon->n * mon->nt)))
+      rcb_mon_fail(mon, st, "candidate columns: %s", rcb_fit_errmsg(mon->fit));
+  }
+  (void)batch;
+  rcb_fit_dz_free(&mon->alloc, dz, ndz);
+  rcb_free(&mon->alloc, dz);
+  return st;
+}
+
+/* Which candidates, their columns: the batched (same DOFs) ones first. */
+static rcb_status plan(rcb_monitor *mon, rcb_diag *d, unsigned mask, col_plan *pl) {
+  size_t nc = rcb_diag_catalogue_count(d), i, pass;
+  pl->cand = rcb_mon_alloc(mon, nc ? nc : 1, sizeof *pl->cand);
+  pl->col = rcb_mon_alloc(mon, nc ? nc : 1, sizeof *pl->col);
+  pl->own = rcb_mon_alloc(mon, nc ? nc : 1, sizeof *pl->own);
+  if (!pl->cand || !pl->col || !pl->own)
+    return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (catalogue)");
+  pl->ncol = mon->nt;
+  for (pass = 0; pass < 2; pass++)
+    for (i = 0; i < nc; i++) {
+      rcb_diag_cand_desc c;
+      rcb_diag_catalogue_get(d, i, &c);
+      if (!wanted(&c, mask) || c.adds_dofs != (int)pass) continue;
+      pl->own[pl->ncand] = c.adds_dofs;
+      pl->cand[pl->ncand] = i;
+      pl->col[pl->ncand++] = pl->ncol;
+      pl->ncol += c.np;
+    }
+  return RCB_OK;
+}
+
+/* Whiten every column of J (the fit's Re/Im layout) into the radial /
+ * tangential frame. */
+static void whiten_columns(const rcb_monitor *mon, double *J, size_t ncol) {
+  size_t j, p;
+  for (j = 0; j < ncol; j++) {
+    double *c = J + mon->n * j;
+    for (p = 0; p < mon->npt; p++) {
+      double complex g = conj(mon->u[p]) * CMPLX(c[2 * p], c[2 * p + 1]);
+      c[2 * p] = creal(g) * mon->winv[2 * p];
+      c[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
+    }
+  }
+}
+
+void rcb_mon_whiten(const rcb_monitor *mon, const rcb_complex *dv, double *r) {
+  size_t p;
+  for (p = 0; p < mon->npt; p++) {
+    double complex g = conj(mon->u[p]) * dv[p];
+    r[2 * p] = creal(g) * mon->winv[2 * p];
+    r[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
+  }
+}
+
+/* ---- create ---- */
+
+static rcb_status buffers(rcb_monitor *mon) {
+  size_t npt = mon->npt, n = mon->n;
+  mon->e0 = rcb_mon_alloc(mon, 2 * npt, sizeof *mon->e0);
+  mon->h0abs = rcb_mon_alloc(mon, 3 * npt + 5 * n, sizeof *mon->h0abs);
+  if (!mon->e0 || !mon->h0abs) return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (set-up)");
+  mon->u = mon->e0 + npt;
+  mon->sd_new_rad = mon->h0abs + npt;
+  mon->winv = mon->sd_new_rad + npt;
+  mon->rbase = mon->winv + n;
+  mon->r = mon->rbase + n;
+  mon->rm = mon->r + n;
+  mon->var0 = mon->rm + n;
+  mon->sd0 = mon->var0 + n;
+  return RCB_OK;
+}
+
+static rcb_status settings(rcb_monitor *mon, const rcb_monitor_opts *o) {
+  mon->alpha = o->alpha > 0 ? o->alpha : 1e-3;
+  mon->cusum_k = o->cusum_k > 0 ? o->cusum_k : 0.5;
+  mon->cusum_h = o->cusum_h > 0 ? o->cusum_h : 8.0;
+  mon->top = o->top ? o->top : RCB_MONITOR_TOP;
+  mon->relin = o->relinearise;
+  mon->reweight = o->reweight != 0;
+  mon->nt = o->ntracked;
+  if (!(mon->alpha < 1) || !isfinite(mon->cusum_k) || !isfinite(mon->cusum_h) ||
+      o->alpha < 0 || o->cusum_k < 0 || o->cusum_h < 0)
+    return rcb_mon_fail(mon, RCB_ERR_ARG, "options: alpha = %g (0 < alpha < 1), cusum_k = %g, "
+                        "cusum_h = %g (finite >= 0, 0: default)", o->alpha, o->cusum_k,
+                        o->cusum_h);
+  if (mon->top > RCB_MONITOR_TOP)
+    return rcb_mon_fail(mon, RCB_ERR_ARG, "options: top = %zu, at most %d", mon->top,
+                        RCB_MONITOR_TOP);
+  if (mon->nt > RCB_MONITOR_MAX_TRACKED || (mon->nt && !o->tracked))
+    return rcb_mon_fail(mon, RCB_ERR_ARG, "options: %zu tracked parameters (at most %d, and "
+                        "opts.tracked must list them)", mon->nt, RCB_MONITOR_MAX_TRACKED);
+  return RCB_OK;
+}
+
+static rcb_status commission(rcb_monitor *mon, const rcb_model *base, const rcb_meas *setup,
+                             const rcb_monitor_opts *o) {
+  rcb_diag *d = NULL;
+  col_plan pl;
+  double *J = NULL;
+  size_t c, k;
+  rcb_status st;
+  memset(&pl, 0, sizeof pl);
+  if ((st = settings(mon, o)) || (st = copy_setup(mon, setup)) || (st = buffers(mon)))
+    return st;
+  for (c = 0; c < mon->nch; c++) {
+    rcb_meas_channel_info ci;
+    rcb_meas_channel(mon->setup, c, &ci);
+    memcpy(mon->e0 + c * mon->npts, ci.data, mon->npts * sizeof *mon->e0);
+  }
+  if ((st = noise(mon, o)) || (st = baseline(mon, base, o))) return st;
+  if ((st = rcb_diag_create(&d, mon->model, mon->setup, &mon->alloc)))
+    st = rcb_mon_fail(mon, st, "catalogue: %s", d ? rcb_diag_errmsg(d) : "out of memory");
+  for (k = 0; !st && k < mon->nt; k++)
+    if ((st = rcb_diag_add_fitted_param(d, mon->tname[k], mon->tlo[k], mon->thi[k], 0)))
+      rcb_mon_fail(mon, st, "catalogue: %s", rcb_diag_errmsg(d));
+  if (!st && (st = rcb_diag_catalogue(d, mon->model)))
+    rcb_mon_fail(mon, st, "catalogue: %s", rcb_diag_errmsg(d));
+  if (!st) st = plan(mon, d, o->effects, &pl);
+  if (!st && !(J = rcb_mon_alloc(mon, mon->n * (pl.ncol ? pl.ncol : 1), sizeof *J)))
+    st = rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (%zu x %zu sensitivity columns)",
+                      mon->n, pl.ncol);
+  if (!st && mon->nt && (st = rcb_fit_jacobian(mon->fit, 1, J)))
+    rcb_mon_fail(mon, st, "tracked parameters' sensitivities: %s", rcb_fit_errmsg(mon->fit));
+  if (!st) st = cand_columns(mon, d, &pl, J);
+  if (!st) {
+    whiten_columns(mon, J, pl.ncol);
+    memset(mon->r, 0, mon->n * sizeof *mon->r);
+    st = rcb_mon_factor(mon, d, J, pl.ncol);
+  }
+  if (!st && !(st = rcb_mon_rank_space(mon, d, &pl, J))) J = NULL; /* now mon->Q */
+  if (!st) {
+    mon->y = rcb_mon_alloc(mon, 2 * mon->k + 2 * (mon->ncand ? mon->ncand : 1), sizeof *mon->y);
+    if (!mon->y) st = rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (update workspace)");
+    else {
+      mon->ym = mon->y + mon->k;
+      mon->pscore = mon->ym + mon->k;
+      mon->order = (size_t *)(void *)(mon->pscore + (mon->ncand ? mon->ncand : 1));
+    }
+  }
+  if (!st) {
+    size_t dof = mon->k > mon->nt ? mon->k - mon->nt : 0;
+    mon->threshold = dof ? rcb_chi2_quantile(1.0 - mon->alpha, (double)dof) : (double)INFINITY;
+  }
+  rcb_free(&mon->alloc, J);
+  rcb_free(&mon->alloc, pl.cand);
+  rcb_free(&mon->alloc, pl.col);
+  rcb_free(&mon->alloc, pl.own);
+  rcb_diag_destroy(d);
+  return st;
+}
+
+rcb_status rcb_monitor_create(rcb_monitor **out, const rcb_model *baseline_model,
+                              const rcb_meas *setup, const rcb_monitor_opts *opts,
+                              const rcb_allocator *alloc) {
+  rcb_allocator a;
+  rcb_monitor_opts o0;
+  rcb_monitor *mon;
+  if (!out) return RCB_ERR_ARG;
+  *out = NULL;
+  rcb_allocator_init(&a, alloc);
+  if (!(mon = rcb_alloc(&a, sizeof *mon))) return RCB_ERR_NOMEM;
+  mon->user = a;
+  mon->alloc.alloc = count_alloc, mon->alloc.free = count_free, mon->alloc.user = mon;
+  mon->held = sizeof *mon;
+  *out = mon;
+  if (!baseline_model || !setup)
+    return rcb_mon_fail(mon, RCB_ERR_ARG, "rcb_monitor_create: baseline model and set-up "
+                        "measurement are required");
+  if (rcb_model_dof_count(baseline_model) == 0)
+    return rcb_mon_fail(mon, RCB_ERR_STATE, "baseline model not finalized (rcb_model_finalize)");
+  if (!opts) {
+    memset(&o0, 0, sizeof o0);
+    opts = &o0;
+  }
+  return commission(mon, baseline_model, setup, opts);
+}

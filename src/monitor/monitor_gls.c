@@ -1,0 +1,158 @@
+/*
+ * The reweighted update (opts.reweight, or an sd passed to the update):
+ * the covariance of the whitened change r is rebuilt from this update's
+ * noise, D (2 x 2 per point: the proportional eq. 19 noise lies along the
+ * new value, not along e_0), and taken to the rank space, C = Q^T D Q
+ * (k x k, accumulated point by point: O(n k^2)). With C = U^T U
+ * (Cholesky), every statistic is the least-squares one in the metric
+ * C^-1: z = U^-T y, the tracked columns A_t = U^-T G_t, a candidate's
+ * A_c = U^-T G_c; T = ||z||^2 - ||P_{A_t} z||^2, the score
+ * ||P_{[A_t A_c]} z||^2 - ||P_{A_t} z||^2, the estimates and their
+ * standard errors from the QR of [A_t A_c]. All memory was sized by
+ * rcb_monitor_create (mon->C, mon->sw).
+ */
+#include <lapacke.h>
+#include <math.h>
+#include <string.h>
+
+#include "monitor/monitor_internal.h"
+
+/* The 2 x 2 covariance of point p's (radial, tangential) residual, whitened:
+ * this update's noise plus the commissioning values' share. */
+static void point_cov(const rcb_monitor *mon, const rcb_complex *v, const double *sd, size_t p,
+                      double a, double *d11, double *d12, double *d22) {
+  double s11, s12 = 0, s22, w1 = mon->winv[2 * p], w2 = mon->winv[2 * p + 1];
+  if (sd || mon->have_sd0) {
+    double s = sd ? sd[p] : mon->sd0[p];
+    s11 = s22 = s * s;
+  } else {
+    double av = cabs(v[p]), sp = mon->beta_a / 100.0 * av;
+    double complex w = av > 0 ? conj(mon->u[p]) * v[p] / av : 1.0;
+    double c = creal(w), s = cimag(w), vp = sp * sp / 3.0, va = a * a / 6.0;
+    s11 = vp * c * c + va, s12 = vp * c * s, s22 = vp * s * s + va;
+  }
+  s11 += mon->var0[2 * p] * mon->navg_inv;
+  s22 += mon->var0[2 * p + 1] * mon->navg_inv;
+  *d11 = s11 * w1 * w1, *d12 = s12 * w1 * w2, *d22 = s22 * w2 * w2;
+}
+
+/* C = Q^T D Q (upper triangle), D = L L^T per point. */
+static void build_c(rcb_monitor *mon, const rcb_complex *v, const double *sd) {
+  size_t k = mon->k, p, a, b, c = 0;
+  double *b1 = mon->b1, *b2 = mon->b1 + k;
+  if (!sd && !mon->have_sd0)
+    for (c = 0; c < mon->nch; c++) { /* eq. 19 additive amplitude of this update */
+      double s2 = 0;
+      for (p = c * mon->npts; p < (c + 1) * mon->npts; p++) s2 += creal(v[p] * conj(v[p]));
+      mon->achan[c] = mon->beta_s / 100.0 * sqrt(s2) / (double)mon->npts;
+    }
+  memset(mon->C, 0, k * k * sizeof *mon->C);
+  c = 0;
+  for (p = 0; p < mon->npt; p++) {
+    const double *q1 = mon->Q + k * (2 * p), *q2 = q1 + k;
+    double d11, d12, d22, l11, l21, l22;
+    if (p && p == (c + 1) * mon->npts) c++; /* the channel of point p */
+    point_cov(mon, v, sd, p, mon->achan[c], &d11, &d12, &d22);
+    l11 = sqrt(d11), l21 = d12 / l11, l22 = sqrt(fmax(d22 - l21 * l21, 0.0));
+    for (a = 0; a < k; a++) b1[a] = l11 * q1[a] + l21 * q2[a], b2[a] = l22 * q2[a];
+    for (b = 0; b < k; b++) {
+      double *cb = mon->C + k * b, x1 = b1[b], x2 = b2[b];
+      for (a = 0; a <= b; a++) cb[a] += b1[a] * x1 + b2[a] * x2;
+    }
+  }
+}
+
+/* X (k x m) <- U^-T X. */
+static lapack_int solve_ut(const rcb_monitor *mon, double *X, size_t m) {
+  return LAPACKE_dtrtrs_work(LAPACK_COL_MAJOR, 'U', 'T', 'N', (lapack_int)mon->k,
+                             (lapack_int)m, mon->C, (lapack_int)mon->k, X, (lapack_int)mon->k);
+}
+
+/* With w->A = Qa (k x p) and w->Ri from rcb_mon_small_qr: qz = Qa^T z, and
+ * the explained part of rows first .. p. */
+static double explained(const mon_small *w, const double *z, size_t k, size_t first, size_t p,
+                        double *qz) {
+  size_t j, i;
+  double s = 0;
+  for (j = 0; j < p; j++) {
+    double v = 0;
+    for (i = 0; i < k; i++) v += w->A[i + k * j] * z[i];
+    qz[j] = v;
+    if (j >= first) s += v * v;
+  }
+  return s;
+}
+
+/* Rows first .. first + q of Ri qz, and their standard errors. */
+static void step(const mon_small *w, const double *qz, size_t p, size_t first, size_t q,
+                 double *x, double *se) {
+  size_t a, b;
+  for (a = 0; a < q; a++) {
+    size_t row = first + a;
+    double v = 0, s = 0;
+    for (b = row; b < p; b++) {
+      v += w->Ri[row + p * b] * qz[b];
+      s += w->Ri[row + p * b] * w->Ri[row + p * b];
+    }
+    x[a] = v, se[a] = sqrt(s);
+  }
+}
+
+static rcb_status candidates_gls(rcb_monitor *mon) {
+  size_t k = mon->k, nt = mon->nt, j;
+  double qz[RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP];
+  rcb_status st;
+  for (j = 0; j < mon->ncand; j++) {
+    mon_cand *c = &mon->cand[j];
+    int ok;
+    if (!c->dof) continue;
+    memcpy(mon->sw.A, mon->Atw, k * nt * sizeof *mon->sw.A);
+    memcpy(mon->sw.A + k * nt, mon->G + k * c->col, k * c->np * sizeof *mon->sw.A);
+    if (solve_ut(mon, mon->sw.A + k * nt, c->np))
+      return rcb_mon_fail(mon, RCB_ERR_LAPACK, "reweighted update: triangular solve failed");
+    if ((st = rcb_mon_small_qr(mon, &mon->sw, k, nt + c->np, &ok))) return st;
+    if (!ok) { /* dependent in this metric: no evidence */
+      c->score_now = 0;
+      memset(c->size_now, 0, sizeof c->size_now);
+      memcpy(c->se_now, c->se, sizeof c->se_now);
+      memset(c->th_now, 0, sizeof c->th_now);
+      memcpy(c->set_now, c->se_t, sizeof c->set_now);
+      continue;
+    }
+    c->score_now = explained(&mon->sw, mon->z, k, nt, nt + c->np, qz);
+    step(&mon->sw, qz, nt + c->np, nt, c->np, c->size_now, c->se_now);
+    step(&mon->sw, qz, nt + c->np, 0, nt, c->th_now, c->set_now);
+  }
+  return RCB_OK;
+}
+
+rcb_status rcb_mon_gls(rcb_monitor *mon, const rcb_complex *v, const double *sd,
+                       double *dtheta, double *se, double *T) {
+  size_t k = mon->k, nt = mon->nt, a;
+  double qz[RCB_MONITOR_MAX_TRACKED];
+  lapack_int info;
+  int ok = 1;
+  rcb_status st;
+  build_c(mon, v, sd);
+  info = LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'U', (lapack_int)k, mon->C, (lapack_int)k);
+  if (info)
+    return rcb_mon_fail(mon, RCB_ERR_SINGULAR, "reweighted update %zu: the noise covariance in "
+                        "the rank space is not positive definite (LAPACK info %d)",
+                        mon->updates + 1, (int)info);
+  memcpy(mon->z, mon->y, k * sizeof *mon->z);
+  memcpy(mon->Atw, mon->G, k * nt * sizeof *mon->Atw);
+  if (solve_ut(mon, mon->z, 1) || (nt && solve_ut(mon, mon->Atw, nt)))
+    return rcb_mon_fail(mon, RCB_ERR_LAPACK, "reweighted update: triangular solve failed");
+  *T = 0;
+  for (a = 0; a < k; a++) *T += mon->z[a] * mon->z[a];
+  if (nt) {
+    memcpy(mon->sw.A, mon->Atw, k * nt * sizeof *mon->sw.A);
+    if ((st = rcb_mon_small_qr(mon, &mon->sw, k, nt, &ok))) return st;
+    if (!ok)
+      return rcb_mon_fail(mon, RCB_ERR_SINGULAR, "reweighted update %zu: the tracked parameters "
+                          "are not told apart in this update's noise", mon->updates + 1);
+    *T -= explained(&mon->sw, mon->z, k, 0, nt, qz);
+    step(&mon->sw, qz, nt, 0, nt, dtheta, se);
+  }
+  return candidates_gls(mon);
+}

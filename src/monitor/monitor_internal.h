@@ -1,0 +1,144 @@
+/*
+ * The monitor object (rcb_monitor.h), private to monitor/: commissioning in
+ * monitor_create.c, the allocation-free update in monitor.c, the chi-square
+ * distribution in chi2.c. monitor/ comes after diagnose/ in the data flow
+ * and uses the public API and the documented internal interfaces only
+ * (identify/identify.h, diagnose/diagnose.h, core).
+ *
+ * Residual layout: point p = c * npts + i of the set-up gives the two real
+ * residuals 2 p (radial: along the commissioning value e_0) and 2 p + 1
+ * (tangential), each divided by its standard deviation ("whitened").
+ */
+#ifndef RCB_MONITOR_INTERNAL_H
+#define RCB_MONITOR_INTERNAL_H
+
+#include "core/rcb_internal.h"
+#include "rcb/rcb_monitor.h"
+
+#define RCB_MONITOR_NAME 128
+
+/* A candidate in the rank space (dimension k): its estimate rows and the
+ * orthonormal directions it adds beyond the tracked parameters. */
+typedef struct mon_cand {
+  rcb_effect effect;
+  char place[RCB_MONITOR_NAME];
+  char desc[2 * RCB_MONITOR_NAME];
+  char params[RCB_MONITOR_MAXP * RCB_MONITOR_NAME];
+  size_t np;       /* its parameters */
+  size_t dof;      /* directions beyond the tracked ones; 0: not scored */
+  double *est;     /* np x k row-major: its parameters' step = est y */
+  double *test_t;  /* nt x k row-major: the tracked step fitted jointly with it */
+  double se_t[RCB_MONITOR_MAX_TRACKED]; /* and its standard errors */
+  double th_now[RCB_MONITOR_MAX_TRACKED], set_now[RCB_MONITOR_MAX_TRACKED]; /* the
+                        same on the reweighted path, this update */
+  double *dir;     /* dof x k row-major: orthonormal, score = ||dir y||^2 */
+  double se[RCB_MONITOR_MAXP]; /* standard errors, parameter units */
+  size_t col;        /* its first column in G */
+  double score_now;  /* this update's score */
+  double size_now[RCB_MONITOR_MAXP], se_now[RCB_MONITOR_MAXP]; /* this update's
+                        estimate and standard error (reweighted path) */
+} mon_cand;
+
+/* Workspace of the small QRs in the rank space (k x p, p <= nt + MAXP). */
+typedef struct mon_small {
+  double *A, *R, *Ri, *tau, *work;
+  size_t lwork;
+} mon_small;
+
+struct rcb_monitor {
+  rcb_allocator user;  /* the caller's hooks */
+  rcb_allocator alloc; /* the same, counting live bytes into held */
+  size_t held;
+  char errmsg[RCB_ERRMSG_MAX];
+
+  /* set-up */
+  size_t nch, npts, npt, n; /* channels, points per channel, npt = nch * npts, n = 2 npt */
+  rcb_complex *e0;     /* commissioning values, npt */
+  double *h0abs;       /* |baseline model|, npt */
+  rcb_complex *u;      /* unit direction of e_0 per point (radial frame) */
+  double *winv;        /* 2 per point: 1 / sd of the radial, tangential residual */
+  double *sd_new_rad;  /* radial sd of one new measurement per point (floor %) */
+  double e0norm2;      /* sum |e_0|^2 */
+
+  /* settings */
+  double alpha, cusum_k, cusum_h, threshold;
+  size_t top, relin;
+
+  /* tracked parameters */
+  size_t nt;
+  char tname[RCB_MONITOR_MAX_TRACKED][RCB_MONITOR_NAME];
+  double tlo[RCB_MONITOR_MAX_TRACKED], thi[RCB_MONITOR_MAX_TRACKED];
+  double t0[RCB_MONITOR_MAX_TRACKED];   /* baseline values */
+  double tse[RCB_MONITOR_MAX_TRACKED];  /* standard errors */
+  double *test;        /* nt x k row-major: tracked step = test y */
+  double *tdir;        /* nt x k row-major: orthonormal basis of the tracked columns */
+  double cus_up[RCB_MONITOR_MAX_TRACKED], cus_dn[RCB_MONITOR_MAX_TRACKED];
+
+  /* rank space */
+  size_t k;            /* rank of all columns */
+  double *Q;           /* n x k row-major (residual i: Q + k i), orthonormal columns */
+  double *G;           /* Q^T J, k x ncol column-major (tracked columns first) */
+  size_t ncol;
+  mon_cand *cand;
+  size_t ncand;
+
+  /* re-linearisation: the baseline model (owned copy) and a fit of the
+   * tracked parameters on the commissioning values, its residuals at the
+   * baseline (model minus e_0, the fit's Re/Im layout) */
+  rcb_model *model;
+  rcb_meas *setup;
+  rcb_fit *fit;
+  double *rbase;       /* n */
+
+  /* noise of the reweighted path */
+  int reweight, have_sd0;
+  double beta_a, beta_s, navg_inv;
+  double *var0;        /* 2 per point: radial, tangential variance of one
+                          measurement at the commissioning values */
+  double *sd0;         /* opts.sd copied (have_sd0), npt */
+  double *C, *z, *Atw, *b1; /* k x k, k, k x nt, 2 k */
+  double *achan;       /* nch: eq. 19 additive amplitude of this update */
+  mon_small sw;
+
+  /* update workspace */
+  double *r, *rm;      /* n each */
+  double *y, *ym;      /* k each */
+  double *pscore;      /* ncand: log p-value of each candidate's score */
+  size_t *order;       /* ncand */
+  size_t updates;
+};
+
+#define rcb_mon_fail(mon, st, ...) rcb_fail((mon), (st), __VA_ARGS__)
+
+/* chi2.c: log P(X > x) of chi-square(dof), finite where the tail underflows. */
+double rcb_mon_chi2_logsf(double x, double dof);
+
+/* monitor_create.c: allocation through the monitor's counting hooks. */
+void *rcb_mon_alloc(rcb_monitor *mon, size_t count, size_t size);
+
+/* The candidates kept for the monitor and their first columns in J. */
+typedef struct col_plan {
+  size_t *cand;   /* catalogue index of each kept candidate */
+  size_t *col;    /* its first column */
+  int *own;       /* 1: its model has other DOFs (its own sweep) */
+  size_t ncand, ncol;
+} col_plan;
+
+/* monitor_rank.c: the QR of the whitened columns J (n x ncol; the basis
+ * made explicit in mon->Q), then the rank space; J's block becomes mon->Q. */
+rcb_status rcb_mon_factor(rcb_monitor *mon, rcb_diag *d, const double *J, size_t ncol);
+rcb_status rcb_mon_rank_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl, double *J);
+
+/* monitor_create.c's pieces used by the update */
+void rcb_mon_whiten(const rcb_monitor *mon, const rcb_complex *d, double *r);
+/* Thin QR of A (k x p, column-major, overwritten by its Q) with R and R^-1
+ * (p x p); *ok = 0 for a dependent column. No allocation. */
+rcb_status rcb_mon_small_qr(rcb_monitor *mon, mon_small *w, size_t k, size_t p, int *ok);
+/* monitor_gls.c: the statistics in the update's own covariance, on y (the
+ * change the re-linearised tracked step leaves): the tracked step dtheta
+ * beyond the re-linearised one and its standard errors, T, and every
+ * candidate's score and estimates. */
+rcb_status rcb_mon_gls(rcb_monitor *mon, const rcb_complex *v, const double *sd,
+                       double *dtheta, double *se, double *T);
+
+#endif

@@ -1,0 +1,85 @@
+"""librcb.Monitor (the ctypes layer over rcb_monitor, issue #16).
+
+* An update identical to the commissioning measurement: T = 0 and every
+  tracked parameter at its baseline with z = 0 (closed form: no change).
+* The same series through the package and through `rcbtool monitor` (the
+  other front end, reading the files the package wrote): the same T,
+  threshold, tracked values and intervals, and the same candidates' order
+  and sizes. The layout of the result struct (8 tracked, 8 candidates of 3
+  parameters) is what the ctypes mirror must get right.
+* Meas.from_bytes reads what Meas.write wrote.
+"""
+
+import json
+import os
+import subprocess
+
+import numpy as np
+import pytest
+
+from pkg_helpers import PAPER, rcb  # noqa: F401  (fixture)
+
+OUTS = ["DA.x", "DA.y", "C.A.x", "C.A.y", "C.B.x", "C.B.y", "DB.x", "DB.y"]
+UFF_MAP = {3: "DA", 10: "C.A", 11: "C.B", 16: "DB"}
+PARAMS = ["coupling.C.kt", "coupling.C.ct"]
+
+
+def _series(rcb, tmp_path, n=4):
+    f = np.linspace(100, 400, 121)
+    paths = []
+    with rcb.Model.from_ini(PAPER) as m:
+        for k in range(n):
+            if k == n - 1:  # the last day: a cross-coupled B3
+                m.set("bearing.B3.kcross", 1.5e7)
+            with rcb.simulate(m, OUTS, ["DA.x"], f, rpm=10000, kind="inertance",
+                              noise=(10, 1), seed=11 + k) as ms:
+                p = tmp_path / f"day{k}.uff"
+                ms.write(p, uff_map=UFF_MAP)
+                paths.append(p)
+    return paths
+
+
+def test_identical_update_is_no_change(rcb, tmp_path):
+    p = _series(rcb, tmp_path, 1)[0]
+    with rcb.Model.from_ini(PAPER) as m, rcb.Meas.read(p, uff_map=UFF_MAP) as ms, \
+            rcb.Monitor(m, ms, PARAMS, noise=(10, 1)) as mon:
+        r = mon.update(ms)
+        assert r["T"] == 0.0 and not r["alarm"] and r["update"] == 1
+        for t, base in zip(r["tracked"], mon.tracked):
+            assert t["value"] == pytest.approx(base["baseline"], rel=1e-12) and t["z"] == 0.0
+        assert mon.memory > 0
+
+
+def test_package_and_rcbtool_agree(rcb, tmp_path):
+    exe = os.environ.get("RCBTOOL")
+    if not exe:
+        pytest.skip("RCBTOOL is not set")
+    paths = _series(rcb, tmp_path)
+    ini = tmp_path / "model.ini"
+    ini.write_text(PAPER.read_text() + "\n[uff]\nmap = " +
+                   ", ".join(f"{k} {v}" for k, v in UFF_MAP.items()) + "\n")
+    res = subprocess.run([exe, "monitor", str(ini), *map(str, paths), "--params",
+                          ",".join(PARAMS), "--noise", "10,1", "--alpha", "0.01", "--json"],
+                         capture_output=True, text=True, timeout=300)
+    assert res.returncode == 0, res.stderr
+    cli = json.loads(res.stdout)["updates"]
+    with rcb.Model.from_ini(ini) as m, rcb.Meas.from_bytes(paths[0].read_bytes(),
+                                                            uff_map=UFF_MAP) as setup, \
+            rcb.Monitor(m, setup, PARAMS, noise=(10, 1), alpha=0.01) as mon:
+        py = []
+        for p in paths[1:]:
+            with rcb.Meas.from_bytes(p.read_bytes(), uff_map=UFF_MAP) as ms:
+                py.append(mon.update(ms))
+    assert len(py) == len(cli) == 3
+    for a, b in zip(py, cli):
+        for key in ("T", "threshold", "p_value", "error_pct", "floor_pct"):
+            assert a[key] == pytest.approx(b[key], rel=1e-12, abs=1e-300), key
+        assert (a["alarm"], a["dof"]) == (b["alarm"], b["dof"])
+        for ta, tb in zip(a["tracked"], b["tracked"]):
+            for key in ("value", "ci_lo", "ci_hi", "z", "cusum_up", "cusum_down"):
+                assert ta[key] == pytest.approx(tb[key], rel=1e-12, abs=1e-12), key
+        assert [(c["effect"], c["place"]) for c in a["top"]] == \
+            [(c["effect"], c["place"]) for c in b["top"]]
+        for ca, cb in zip(a["top"], b["top"]):
+            assert ca["size"] == pytest.approx(cb["size"], rel=1e-12)
+    assert py[-1]["alarm"]  # the cross-coupled day is a change

@@ -1,0 +1,572 @@
+/*
+ * rcb_monitor (issue #16): the statistics of the condition monitor on the
+ * paper system (examples/paper_system.ini), 8 response channels x 400
+ * frequencies, noise drawn here from the closed form of the paper's eq. 19
+ * with the test's own seeded generator (not the library's noise routine):
+ *  - the chi-square quantile, upper tail and Siegmund's CUSUM run length
+ *    against closed forms and published values;
+ *  - the null case: a commissioning measurement from a "truth" that differs
+ *    from the baseline model (a model bias, which is not a change), then
+ *    400 updates of fresh noise: the instant test's false alarms within the
+ *    binomial 99 % interval of alpha, the mean of T within its derived
+ *    tolerance of the chi-square mean, the tracked parameter's z with mean
+ *    0 and variance 1, its 95 % interval covering the truth as often as
+ *    the binomial 99 % interval of 0.95 allows, and no CUSUM alarm;
+ *  - the same with per-point standard deviations (Gaussian noise) passed
+ *    at create and with each update, and with 1X unbalance responses;
+ *  - known changes, made by evaluating a model (a unit test of the linear
+ *    algebra: the series generated with ROSS belong to the CLI's tests):
+ *    kt scaled by 0.92 (the tracked interval covers it, the CUSUM falls,
+ *    the instant test stays quiet because a tracked drift is not a new
+ *    effect) and a cross-coupled stiffness appearing at bearing B2 (the
+ *    instant test fires and names it first, its interval covering the truth);
+ *  - no allocation in rcb_monitor_update (counting allocator), with and
+ *    without re-linearisation;
+ *  - an allocation-failure walk over rcb_monitor_create (small set-up);
+ *  - bad input: NaN values, bad sd, unknown tracked parameter, no noise,
+ *    empty set-up: clear status and message, state unchanged.
+ */
+#include <complex.h>
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <cmocka.h>
+
+#include "monitor/monitor_internal.h" /* rcb_mon_chi2_logsf */
+#include "rcb/rcb.h"
+#include "rcb_test_util.h"
+
+#define NCH ((size_t)8)
+#define NPTS ((size_t)400)
+#define NPT (NCH * NPTS)
+#define BETA_A 2.0 /* %, eq. 19 */
+#define BETA_S 2.0 /* %, eq. 19 */
+#define KT_NAME "coupling.C.kt"
+
+static const char *const OUTS[NCH] = {"DA.x", "DA.y", "C.A.x", "C.A.y",
+                                      "C.B.x", "C.B.y", "DB.x", "DB.y"};
+static const char *const INS[1] = {"DA.x"};
+
+/* ---- the test's own noise: splitmix64 and eq. 19 in closed form ---- */
+
+static uint64_t rng_next(uint64_t *s) {
+  uint64_t z = (*s += 0x9E3779B97F4A7C15ull);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+static double rng_uniform(uint64_t *s) { return (double)(rng_next(s) >> 11) * 0x1.0p-53; }
+
+/* f_e = f_s (1 + beta_a/100 r1) + (sqrt(sum_j |f_sj|^2)/n)(beta_s/100) r2 e^{i phi},
+ * per channel (nch of npts values), r1, r2 uniform on [-1, 1], phi uniform
+ * on [0, 2 pi). */
+static void eq19n(const rcb_complex *fs, rcb_complex *fe, size_t nch, size_t npts,
+                  uint64_t *seed) {
+  size_t c, i;
+  for (c = 0; c < nch; c++) {
+    const rcb_complex *s = fs + c * npts;
+    double s2 = 0, a;
+    for (i = 0; i < npts; i++) s2 += creal(s[i] * conj(s[i]));
+    a = sqrt(s2) / (double)npts * BETA_S / 100.0;
+    for (i = 0; i < npts; i++) {
+      double r1 = 2 * rng_uniform(seed) - 1, r2 = 2 * rng_uniform(seed) - 1;
+      double ph = 2 * 3.14159265358979323846 * rng_uniform(seed);
+      fe[c * npts + i] = s[i] * (1 + BETA_A / 100.0 * r1) + a * r2 * (cos(ph) + CMPLX(0.0, sin(ph)));
+    }
+  }
+}
+
+static void eq19(const rcb_complex *fs, rcb_complex *fe, uint64_t *seed) {
+  eq19n(fs, fe, NCH, NPTS, seed);
+}
+
+/* The noise-free FRFs of model m on the set-up grid (channel-major values). */
+static rcb_meas *frf_of(const rcb_model *m) {
+  return rcb_test_frf_meas(m, OUTS, NCH, INS, 1, 20.0, 400.0, NPTS, 10000.0, RCB_RECEPTANCE);
+}
+
+static void values_of(const rcb_meas *ms, rcb_complex *v) {
+  size_t c;
+  for (c = 0; c < rcb_meas_channel_count(ms); c++) {
+    rcb_meas_channel_info ci;
+    assert_int_equal(rcb_meas_channel(ms, c, &ci), RCB_OK);
+    memcpy(v + c * rcb_meas_point_count(ms), ci.data, rcb_meas_point_count(ms) * sizeof *v);
+  }
+}
+
+/* A finalized copy of m with parameter name set to value. */
+static rcb_model *edited(const rcb_model *m, const char *name, double value) {
+  rcb_model *c = NULL;
+  assert_int_equal(rcb_model_clone(&c, m, NULL), RCB_OK);
+  assert_int_equal(rcb_model_finalize(c), RCB_OK);
+  assert_int_equal(rcb_model_set_param(c, name, value), RCB_OK);
+  return c;
+}
+
+/* Binomial(n, p) central interval holding at least 99 %: [lo, hi]. */
+static void binom99(size_t n, double p, size_t *lo, size_t *hi) {
+  double pk = pow(1 - p, (double)n), cdf = 0;
+  size_t k;
+  *lo = 0, *hi = n;
+  for (k = 0; k <= n; k++) {
+    double prev = cdf;
+    cdf += pk;
+    if (prev < 0.005 && cdf >= 0.005) *lo = k;
+    if (prev < 0.995 && cdf >= 0.995) {
+      *hi = k;
+      break;
+    }
+    pk *= (double)(n - k) / (double)(k + 1) * p / (1 - p);
+  }
+}
+
+static rcb_monitor_opts opts_kt(rcb_monitor_param *tp, double kt) {
+  rcb_monitor_opts o;
+  memset(&o, 0, sizeof o);
+  tp->name = KT_NAME, tp->lo = 0.5 * kt, tp->hi = 1.5 * kt;
+  o.ntracked = 1, o.tracked = tp;
+  o.beta_a = BETA_A, o.beta_s = BETA_S;
+  return o;
+}
+
+/* ---- closed forms ---- */
+
+static void test_chi2(void **state) {
+  int i;
+  (void)state;
+  /* chi-square(2) is exponential with mean 2: the quantile is -2 ln(1 - p) */
+  for (i = 0; i < 8; i++) {
+    double a = 1e-6 * pow(7, i);
+    assert_true(rcb_test_close(rcb_chi2_quantile(1 - a, 2), -2 * log(a), 1e-10, 0));
+  }
+  /* chi-square(1): P(X > x) = erfc(sqrt(x / 2)) */
+  for (i = 0; i < 14; i++) {
+    double x = 0.01 * pow(1.7, i);
+    assert_true(rcb_test_close(rcb_chi2_sf(x, 1), erfc(sqrt(x / 2)), 1e-10, 1e-300));
+  }
+  /* chi-square(4): P(X > x) = exp(-x/2) (1 + x/2) */
+  for (i = 0; i < 15; i++) {
+    double x = 0.01 * pow(1.9, i);
+    assert_true(rcb_test_close(rcb_chi2_sf(x, 4), exp(-x / 2) * (1 + x / 2), 1e-10, 1e-300));
+  }
+  /* the quantile inverts the tail at many degrees of freedom */
+  for (i = 0; i < 8; i++) {
+    double dof = pow(2.3, i), x = rcb_chi2_quantile(1 - 1e-3, dof);
+    assert_true(rcb_test_close(rcb_chi2_sf(x, dof), 1e-3, 1e-9, 0));
+  }
+  /* published: chi-square(82) 0.999 quantile 126.78... no table at hand;
+   * chi-square(10) 0.99 quantile 23.209 (Abramowitz & Stegun table 26.8) */
+  assert_true(rcb_test_close(rcb_chi2_quantile(0.99, 10), 23.2093, 1e-5, 0));
+  assert_true(isnan(rcb_chi2_quantile(1.0, 3)) && isnan(rcb_chi2_sf(-1, 3)));
+  /* the log tail where the tail underflows (ranking of strong effects):
+   * chi-square(2): log P(X > x) = -x / 2; chi-square(4): -x/2 + log(1 + x/2) */
+  assert_true(rcb_chi2_sf(3000, 2) == 0.0);
+  assert_true(rcb_test_close(rcb_mon_chi2_logsf(3000, 2), -1500, 1e-12, 0));
+  assert_true(rcb_test_close(rcb_mon_chi2_logsf(3000, 4), -1500 + log(1501.0), 1e-12, 0));
+  assert_true(rcb_test_close(rcb_mon_chi2_logsf(3, 4), log(exp(-1.5) * 2.5), 1e-12, 0));
+  /* Siegmund's approximation against the exact one-sided CUSUM ARL0 on
+   * N(0,1) data (Montgomery, Introduction to SQC, table 9.3: k = 0.5,
+   * h = 4: 336; h = 5: 930), within the approximation's ~1 % */
+  assert_true(rcb_test_close(rcb_cusum_arl0(0.5, 4), 336, 0.015, 0));
+  assert_true(rcb_test_close(rcb_cusum_arl0(0.5, 5), 930, 0.015, 0));
+}
+
+/* ---- the null case and its statistics ---- */
+
+typedef struct fixture {
+  rcb_model *base, *truth;
+  rcb_meas *setup;
+  rcb_complex *fs, *v;
+  double kt;
+} fixture;
+
+static int fixture_setup(void **state) {
+  fixture *f = calloc(1, sizeof *f);
+  rcb_meas *mt;
+  double kxx;
+  f->base = rcb_test_model_from_example("paper_system.ini");
+  assert_int_equal(rcb_model_get_param(f->base, KT_NAME, &f->kt), RCB_OK);
+  /* the machine is not quite the model: bearing B3 5 % stiffer in x */
+  assert_int_equal(rcb_model_get_param(f->base, "bearing.B3.kxx", &kxx), RCB_OK);
+  f->truth = edited(f->base, "bearing.B3.kxx", 1.05 * kxx);
+  f->fs = malloc(NPT * sizeof *f->fs);
+  f->v = malloc(NPT * sizeof *f->v);
+  mt = frf_of(f->truth);
+  values_of(mt, f->fs);
+  rcb_meas_destroy(mt);
+  /* set-up: the truth's FRFs as a commissioning measurement averaged so
+   * long that its noise is negligible (setup_averages = HUGE_VAL below) */
+  f->setup = frf_of(f->truth);
+  *state = f;
+  return 0;
+}
+
+static int fixture_teardown(void **state) {
+  fixture *f = *state;
+  rcb_model_destroy(f->base);
+  rcb_model_destroy(f->truth);
+  rcb_meas_destroy(f->setup);
+  free(f->fs);
+  free(f->v);
+  free(f);
+  return 0;
+}
+
+static void null_case(fixture *f, int reweight) {
+  rcb_monitor_param tp;
+  rcb_monitor_opts o = opts_kt(&tp, f->kt);
+  rcb_monitor *mon = NULL;
+  rcb_monitor_result r;
+  const size_t N = 400;
+  size_t u, alarms = 0, cover = 0, cusum = 0, lo, hi, k, kt;
+  double sumT = 0, sumz = 0, sumz2 = 0, tol, ch2 = 0, fl2 = 0;
+  uint64_t seed = 20261125;
+  o.alpha = 0.02; /* enough alarms in 400 updates to test the rate */
+  o.setup_averages = HUGE_VAL;
+  o.reweight = reweight;
+  assert_int_equal(rcb_monitor_create(&mon, f->base, f->setup, &o, NULL), RCB_OK);
+  assert_int_equal(rcb_monitor_rank(mon, &k, &kt), RCB_OK);
+  assert_int_equal(kt, 1);
+  assert_true(k > 10);
+  for (u = 0; u < N; u++) {
+    eq19(f->fs, f->v, &seed);
+    assert_int_equal(rcb_monitor_update(mon, f->v, NULL, &r), RCB_OK);
+    assert_int_equal(r.update, u + 1);
+    alarms += (size_t)r.alarm;
+    cusum += (size_t)r.cusum_alarm;
+    sumT += r.T;
+    sumz += r.tracked[0].z, sumz2 += r.tracked[0].z * r.tracked[0].z;
+    cover += r.tracked[0].ci_lo <= f->kt && f->kt <= r.tracked[0].ci_hi;
+    /* the commissioning values are noise-free here: the change is the noise
+     * alone, whose radial sd the floor states (|e| - |e_0| ~ radial noise) */
+    ch2 += r.change_pct * r.change_pct, fl2 += r.floor_pct * r.floor_pct;
+  }
+  /* mean square change against the floor's: a few peak points dominate
+   * both sums, so only the mean over the updates is close */
+  assert_true(fabs(ch2 / fl2 - 1) < 0.1);
+  binom99(N, o.alpha, &lo, &hi);
+  print_message("null (reweight %d): %zu alarms in %zu updates (alpha %g: 99 %% interval [%zu, %zu]); "
+                "mean T %.2f (dof %zu); z mean %.3f var %.3f; CI cover %zu\n", reweight,
+                alarms, N, o.alpha, lo, hi, sumT / (double)N, r.dof, sumz / (double)N,
+                sumz2 / (double)N - (sumz / (double)N) * (sumz / (double)N), cover);
+  assert_true(alarms >= lo && alarms <= hi);
+  /* mean of chi-square(dof): sd of the mean sqrt(2 dof / N), 4 of them */
+  tol = 4 * sqrt(2.0 * (double)r.dof / (double)N);
+  assert_true(fabs(sumT / (double)N - (double)r.dof) < tol);
+  /* z ~ N(0, 1): mean within 4 / sqrt(N), variance within 4 sqrt(2 / N) */
+  assert_true(fabs(sumz / (double)N) < 4 / sqrt((double)N));
+  assert_true(fabs(sumz2 / (double)N - 1) < 4 * sqrt(2.0 / (double)N));
+  binom99(N, 0.95, &lo, &hi);
+  assert_true(cover >= lo && cover <= hi);
+  assert_int_equal(cusum, 0);
+  rcb_monitor_destroy(mon);
+}
+
+static void test_null(void **state) { null_case(*state, 0); }
+static void test_null_reweighted(void **state) { null_case(*state, 1); }
+
+/* Per-point standard deviations (as #15's estimators give), circular
+ * Gaussian noise drawn here by Box-Muller, passed at create and with every
+ * update (the reweighted path): the mean of T is the chi-square mean. */
+static void test_null_sd(void **state) {
+  fixture *f = *state;
+  rcb_monitor_param tp;
+  rcb_monitor_opts o = opts_kt(&tp, f->kt);
+  rcb_monitor *mon = NULL;
+  rcb_monitor_result r;
+  double *sd = malloc(NPT * sizeof *sd), sumT = 0, tol, amax = 0;
+  const size_t N = 200;
+  size_t u, i, alarms = 0, lo, hi;
+  uint64_t seed = 99;
+  for (i = 0; i < NPT; i++) amax = fmax(amax, cabs(f->fs[i]));
+  for (i = 0; i < NPT; i++) sd[i] = 0.01 * cabs(f->fs[i]) + 1e-3 * amax;
+  o.sd = sd;
+  o.beta_a = o.beta_s = 0;
+  o.alpha = 0.02;
+  o.setup_averages = HUGE_VAL;
+  assert_int_equal(rcb_monitor_create(&mon, f->base, f->setup, &o, NULL), RCB_OK);
+  for (u = 0; u < N; u++) {
+    for (i = 0; i < NPT; i++) {
+      double u1 = 1 - rng_uniform(&seed), u2 = rng_uniform(&seed), g = sqrt(-2 * log(u1));
+      double ph = 2 * 3.14159265358979323846 * u2;
+      f->v[i] = f->fs[i] + sd[i] * g * (cos(ph) + CMPLX(0.0, sin(ph)));
+    }
+    assert_int_equal(rcb_monitor_update(mon, f->v, sd, &r), RCB_OK);
+    sumT += r.T;
+    alarms += (size_t)r.alarm;
+  }
+  tol = 4 * sqrt(2.0 * (double)r.dof / (double)N);
+  binom99(N, o.alpha, &lo, &hi);
+  print_message("null with per-point sd: mean T %.2f (dof %zu, tolerance %.2f), %zu alarms "
+                "(99 %% interval [%zu, %zu])\n", sumT / (double)N, r.dof, tol, alarms, lo, hi);
+  assert_true(fabs(sumT / (double)N - (double)r.dof) < tol);
+  assert_true(alarms >= lo && alarms <= hi);
+  /* a bad sd in an update is refused, naming the point */
+  sd[5] = -1;
+  assert_int_equal(rcb_monitor_update(mon, f->v, sd, &r), RCB_ERR_ARG);
+  assert_non_null(strstr(rcb_monitor_errmsg(mon), "channel 1 point 6"));
+  rcb_monitor_destroy(mon);
+  free(sd);
+}
+
+/* kt scaled by 0.92 in the machine: a tracked drift. The machine is the
+ * baseline model itself here: with 6400 residuals at 2 % noise the
+ * interval is ~2e-5 kt wide, and the fixture's 5 % bias of bearing B3
+ * changes d H / d kt by more than that over an 8 % step (the instant test
+ * then fires on the mismatch: docs/monitoring.md, limits). */
+static void test_kt_change(void **state) {
+  fixture *f = *state;
+  rcb_monitor_param tp;
+  rcb_monitor_opts o = opts_kt(&tp, f->kt);
+  rcb_monitor *mon = NULL;
+  rcb_monitor_result r;
+  rcb_model *m2 = edited(f->base, KT_NAME, 0.92 * f->kt);
+  rcb_meas *ms = frf_of(m2), *setup = frf_of(f->base);
+  rcb_complex *fs2 = malloc(NPT * sizeof *fs2);
+  uint64_t seed = 7;
+  size_t u, cover = 0, instant = 0;
+  const size_t N = 20;
+  o.setup_averages = HUGE_VAL;
+  o.relinearise = 3;
+  o.reweight = 1; /* the proportional noise follows the moved resonances */
+  values_of(ms, fs2);
+  assert_int_equal(rcb_monitor_create(&mon, f->base, setup, &o, NULL), RCB_OK);
+  for (u = 0; u < N; u++) {
+    eq19(fs2, f->v, &seed);
+    assert_int_equal(rcb_monitor_update(mon, f->v, NULL, &r), RCB_OK);
+    cover += r.tracked[0].ci_lo <= 0.92 * f->kt && 0.92 * f->kt <= r.tracked[0].ci_hi;
+    instant += (size_t)r.alarm;
+    assert_int_equal(r.tracked[0].cusum_alarm, -1); /* falling, from the first update */
+  }
+  print_message("kt x 0.92: last %.1f [%.1f, %.1f] N/m, truth %.1f; covered %zu/%zu; "
+                "instant alarms %zu\n", r.tracked[0].value, r.tracked[0].ci_lo,
+                r.tracked[0].ci_hi, 0.92 * f->kt, cover, N, instant);
+  assert_true(cover >= 16);  /* binomial(20, 0.95): P(X < 16) < 0.3 % */
+  assert_true(instant <= 2); /* alpha = 1e-3: a tracked drift is not a new effect */
+  rcb_monitor_destroy(mon);
+  rcb_meas_destroy(setup);
+  rcb_meas_destroy(ms);
+  rcb_model_destroy(m2);
+  free(fs2);
+}
+
+/* A cross-coupled stiffness appears at bearing B2. */
+static void test_cross_coupling(void **state) {
+  fixture *f = *state;
+  rcb_monitor_param tp;
+  rcb_monitor_opts o = opts_kt(&tp, f->kt);
+  rcb_monitor *mon = NULL;
+  rcb_monitor_result r;
+  rcb_monitor_candidate_info ci;
+  const double kc = 1e5; /* N/m */
+  rcb_model *m2 = edited(f->truth, "bearing.B2.kcross", kc);
+  rcb_meas *ms = frf_of(m2);
+  rcb_complex *fs2 = malloc(NPT * sizeof *fs2);
+  uint64_t seed = 11;
+  size_t u, named = 0, cover = 0;
+  const size_t N = 20;
+  o.setup_averages = HUGE_VAL;
+  values_of(ms, fs2);
+  assert_int_equal(rcb_monitor_create(&mon, f->base, f->setup, &o, NULL), RCB_OK);
+  for (u = 0; u < N; u++) {
+    eq19(fs2, f->v, &seed);
+    assert_int_equal(rcb_monitor_update(mon, f->v, NULL, &r), RCB_OK);
+    assert_int_equal(r.alarm, 1);
+    assert_true(r.ntop >= 1);
+    assert_int_equal(rcb_monitor_candidate_info_get(mon, r.top[0].index, &ci), RCB_OK);
+    if (r.top[0].effect == RCB_EFFECT_BEARING_CROSS_COUPLING && strcmp(ci.place, "bearing B2") == 0) {
+      named++;
+      cover += r.top[0].ci_lo[0] <= kc && kc <= r.top[0].ci_hi[0];
+    }
+  }
+  print_message("kcross %g N/m at B2: named %zu/%zu, covered %zu; last %s at %s: %.0f "
+                "[%.0f, %.0f], T %.0f (threshold %.1f)\n", kc, named, N, cover,
+                ci.description, ci.place, r.top[0].size[0], r.top[0].ci_lo[0],
+                r.top[0].ci_hi[0], r.T, r.threshold);
+  assert_int_equal(named, N);
+  assert_true(cover >= 16);
+  rcb_monitor_destroy(mon);
+  rcb_meas_destroy(ms);
+  rcb_model_destroy(m2);
+  free(fs2);
+}
+
+/* 1X unbalance responses (4 probes, 60 speeds 1000-12000 rpm) as the
+ * set-up: the null case's mean T, and kt's interval coverage. */
+static void test_unbalance_null(void **state) {
+  fixture *f = *state;
+  const char *const outs[4] = {"DA.x", "DA.y", "DB.x", "DB.y"};
+  rcb_meas *ms = rcb_test_unbalance_meas(f->truth, outs, 4, 1000.0, 12000.0, 60);
+  rcb_complex *fs = malloc(240 * sizeof *fs), *v = malloc(240 * sizeof *v);
+  rcb_monitor_param tp;
+  rcb_monitor_opts o = opts_kt(&tp, f->kt);
+  rcb_monitor *mon = NULL;
+  rcb_monitor_result r;
+  const size_t N = 300;
+  size_t u, cover = 0, lo, hi;
+  double sumT = 0, tol;
+  uint64_t seed = 5;
+  values_of(ms, fs);
+  o.setup_averages = HUGE_VAL;
+  assert_int_equal(rcb_monitor_create(&mon, f->base, ms, &o, NULL), RCB_OK);
+  assert_int_equal(rcb_monitor_point_count(mon), 240);
+  for (u = 0; u < N; u++) {
+    eq19n(fs, v, 4, 60, &seed);
+    assert_int_equal(rcb_monitor_update(mon, v, NULL, &r), RCB_OK);
+    sumT += r.T;
+    cover += r.tracked[0].ci_lo <= f->kt && f->kt <= r.tracked[0].ci_hi;
+  }
+  tol = 4 * sqrt(2.0 * (double)r.dof / (double)N);
+  binom99(N, 0.95, &lo, &hi);
+  print_message("1X null: mean T %.2f (dof %zu, tolerance %.2f); kt covered %zu of %zu\n",
+                sumT / (double)N, r.dof, tol, cover, N);
+  assert_true(fabs(sumT / (double)N - (double)r.dof) < tol);
+  assert_true(cover >= lo && cover <= hi);
+  rcb_monitor_destroy(mon);
+  rcb_meas_destroy(ms);
+  free(fs);
+  free(v);
+}
+
+/* ---- memory ---- */
+
+static void test_no_alloc_in_update(void **state) {
+  fixture *f = *state;
+  rcb_monitor_param tp;
+  rcb_monitor_opts o = opts_kt(&tp, f->kt);
+  rcb_test_counter cnt = {0, 0};
+  rcb_allocator a = rcb_test_counting_allocator(&cnt);
+  rcb_monitor *mon = NULL;
+  rcb_monitor_result r;
+  uint64_t seed = 3;
+  size_t u, before;
+  int relin;
+  for (relin = 0; relin <= 2; relin += 2) {
+    o.relinearise = (size_t)relin;
+    assert_int_equal(rcb_monitor_create(&mon, f->base, f->setup, &o, &a), RCB_OK);
+    before = cnt.allocs;
+    assert_true(before > 0 && rcb_monitor_memory(mon) > 0);
+    for (u = 0; u < 10; u++) {
+      rcb_status st;
+      eq19(f->fs, f->v, &seed);
+      st = rcb_monitor_update(mon, f->v, NULL, &r);
+      if (st) print_message("%s\n", rcb_monitor_errmsg(mon));
+      assert_int_equal(st, RCB_OK);
+    }
+    assert_int_equal(cnt.allocs, before);
+    rcb_monitor_destroy(mon);
+    assert_int_equal(cnt.allocs, cnt.frees);
+  }
+}
+
+/* Allocation-failure walk over create on a small set-up (2 channels x 24
+ * points, bearing effects only): every failing site gives an error, a
+ * message, and frees all it took. */
+static void test_alloc_walk(void **state) {
+  fixture *f = *state;
+  const char *const outs[2] = {"DA.x", "DB.y"};
+  rcb_meas *small = rcb_test_frf_meas(f->truth, outs, 2, INS, 1, 50.0, 300.0, 24, 10000.0,
+                                      RCB_RECEPTANCE);
+  rcb_monitor_param tp;
+  rcb_monitor_opts o = opts_kt(&tp, f->kt);
+  size_t k;
+  o.effects = (1u << RCB_EFFECT_BEARING_CROSS_COUPLING) | (1u << RCB_EFFECT_BEARING_STIFFNESS) |
+              (1u << RCB_EFFECT_FLEXIBLE_SUPPORT);
+  for (k = 1;; k++) {
+    rcb_test_failing fl;
+    rcb_allocator a;
+    rcb_monitor *mon = NULL;
+    rcb_status st;
+    memset(&fl, 0, sizeof fl);
+    fl.fail_at = k;
+    a = rcb_test_failing_allocator(&fl);
+    st = rcb_monitor_create(&mon, f->base, small, &o, &a);
+    if (!fl.hit) {
+      assert_int_equal(st, RCB_OK);
+      assert_true(rcb_monitor_candidate_count(mon) > 0);
+      rcb_monitor_destroy(mon);
+      assert_int_equal(fl.live, 0);
+      break;
+    }
+    assert_true(st < 0);
+    assert_true(mon == NULL || strlen(rcb_monitor_errmsg(mon)) > 0);
+    rcb_monitor_destroy(mon);
+    assert_int_equal(fl.live, 0);
+  }
+  print_message("allocation walk over create: %zu sites\n", k - 1);
+  rcb_meas_destroy(small);
+}
+
+/* ---- bad input ---- */
+
+static void test_bad_input(void **state) {
+  fixture *f = *state;
+  rcb_monitor_param tp;
+  rcb_monitor_opts o = opts_kt(&tp, f->kt);
+  rcb_monitor *mon = NULL;
+  rcb_monitor_result r;
+  double *sd = malloc(NPT * sizeof *sd);
+  rcb_meas *empty = NULL;
+  size_t i;
+  /* unknown tracked parameter: named */
+  tp.name = "coupling.C.kz";
+  assert_int_equal(rcb_monitor_create(&mon, f->base, f->setup, &o, NULL), RCB_ERR_NOT_FOUND);
+  assert_non_null(strstr(rcb_monitor_errmsg(mon), "coupling.C.kz"));
+  rcb_monitor_destroy(mon);
+  tp.name = KT_NAME;
+  /* no noise given */
+  o.beta_a = o.beta_s = 0;
+  assert_int_equal(rcb_monitor_create(&mon, f->base, f->setup, &o, NULL), RCB_ERR_ARG);
+  assert_non_null(strstr(rcb_monitor_errmsg(mon), "noise"));
+  rcb_monitor_destroy(mon);
+  /* per-point sd with a zero */
+  for (i = 0; i < NPT; i++) sd[i] = 1e-9;
+  sd[NPTS + 4] = 0;
+  o.sd = sd;
+  assert_int_equal(rcb_monitor_create(&mon, f->base, f->setup, &o, NULL), RCB_ERR_ARG);
+  assert_non_null(strstr(rcb_monitor_errmsg(mon), "channel 2 point 5"));
+  rcb_monitor_destroy(mon);
+  o.sd = NULL, o.beta_a = BETA_A, o.beta_s = BETA_S;
+  /* an empty set-up */
+  assert_int_equal(rcb_meas_create(&empty, NULL), RCB_OK);
+  assert_int_equal(rcb_monitor_create(&mon, f->base, empty, &o, NULL), RCB_ERR_ARG);
+  assert_non_null(strstr(rcb_monitor_errmsg(mon), "no channel"));
+  rcb_monitor_destroy(mon);
+  rcb_meas_destroy(empty);
+  /* NaN in an update: refused, named, and the update is not counted */
+  assert_int_equal(rcb_monitor_create(&mon, f->base, f->setup, &o, NULL), RCB_OK);
+  assert_int_equal(rcb_monitor_point_count(mon), NPT);
+  memcpy(f->v, f->fs, NPT * sizeof *f->v);
+  f->v[2 * NPTS + 6] = NAN;
+  assert_int_equal(rcb_monitor_update(mon, f->v, NULL, &r), RCB_ERR_ARG);
+  assert_non_null(strstr(rcb_monitor_errmsg(mon), "channel 3 point 7"));
+  f->v[2 * NPTS + 6] = f->fs[2 * NPTS + 6];
+  assert_int_equal(rcb_monitor_update(mon, f->v, NULL, &r), RCB_OK);
+  assert_int_equal(r.update, 1);
+  assert_int_equal(r.alarm, 0);
+  assert_true(r.T < 1e-6); /* the commissioning values themselves: no change */
+  assert_int_equal(rcb_monitor_update(mon, NULL, NULL, &r), RCB_ERR_ARG);
+  rcb_monitor_destroy(mon);
+  free(sd);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_chi2),
+      cmocka_unit_test(test_null),
+      cmocka_unit_test(test_null_reweighted),
+      cmocka_unit_test(test_null_sd),
+      cmocka_unit_test(test_unbalance_null),
+      cmocka_unit_test(test_kt_change),
+      cmocka_unit_test(test_cross_coupling),
+      cmocka_unit_test(test_no_alloc_in_update),
+      cmocka_unit_test(test_alloc_walk),
+      cmocka_unit_test(test_bad_input),
+  };
+  return cmocka_run_group_tests(tests, fixture_setup, fixture_teardown);
+}

@@ -1,0 +1,152 @@
+"""Monitor: model-based condition monitoring (an rcb_monitor handle, issue #16).
+
+    mon = rcb.Monitor(model, commissioning_meas, ["coupling.C.kt"], noise=(10, 1))
+    for meas in later_measurements:
+        r = mon.update(meas)       # a dict: error_pct, floor_pct, T, threshold,
+                                   # alarm, cusum_alarm, tracked [...], top [...]
+
+The library does the statistics (docs/monitoring.md); this layer only lays the
+values out in the commissioning measurement's channel order and turns the
+result into plain data (dicts, lists, floats: picklable, for Dask).
+Units: SI; parameter values in their own units (N/m, N s/m, ...).
+"""
+
+import ctypes
+
+import numpy as np
+
+from . import _lib
+from .model import Handle
+
+
+def _tracked(model, params):
+    """[(name, lo, hi)]: params is a list of names ([v/1000, 1000 v] around the
+    model's value, as rcbtool) or a {name: (lo, hi)} mapping."""
+    out = []
+    items = params.items() if isinstance(params, dict) else ((p, None) for p in params)
+    for name, bounds in items:
+        if bounds is None:
+            v = model.get(name)
+            lo, hi = sorted((v / 1000.0, v * 1000.0)) if v != 0 else (-1.0, 1.0)
+        else:
+            lo, hi = bounds
+        out.append((name, float(lo), float(hi)))
+    if len(out) > _lib.MONITOR_MAX_TRACKED:
+        raise ValueError(f"{len(out)} tracked parameters, at most {_lib.MONITOR_MAX_TRACKED}")
+    return out
+
+
+class Monitor(Handle):
+    """A monitor commissioned on a fitted model and one measurement set-up."""
+
+    _destroy = "rcb_monitor_destroy"
+    _errmsg = "rcb_monitor_errmsg"
+
+    def __init__(self, model, setup, params, noise=None, sd=None, alpha=None, cusum_h=None,
+                 cusum_k=None, setup_averages=1, relinearise=0, reweight=False):
+        """model: the fitted baseline (a Model); setup: the commissioning
+        measurement (a Meas: channels, grid and the reference values); params:
+        tracked parameter names or {name: (lo, hi)}; noise: eq. 19 (beta_a,
+        beta_s) in %, or sd: standard deviations of Re and Im per (channel,
+        point), shape (channels, points), SI; alpha, cusum_h, cusum_k: None for
+        the library's defaults; setup_averages: measurements averaged into setup;
+        reweight: each update's noise from its own values (generalised least
+        squares: T stays chi-square after large changes; O(n k^2) per update)."""
+        super().__init__()
+        self._names = [r if ref is None else f"{r}/{ref}" for r, ref, _ in setup.channels]
+        self._shape = (len(self._names), setup.n_points)
+        tp = _tracked(model, params)
+        self._keep = [n.encode() for n, _, _ in tp]
+        arr = (_lib.MonitorParam * max(len(tp), 1))()
+        for i, ((_, lo, hi), nb) in enumerate(zip(tp, self._keep)):
+            arr[i].name, arr[i].lo, arr[i].hi = nb, lo, hi
+        o = _lib.MonitorOpts()
+        o.ntracked, o.tracked = len(tp), arr
+        o.alpha, o.cusum_h, o.cusum_k = alpha or 0.0, cusum_h or 0.0, cusum_k or 0.0
+        if noise is not None:
+            o.beta_a, o.beta_s = float(noise[0]), float(noise[1])
+        if sd is not None:
+            self._sd0 = self._layout_sd(sd)
+            o.sd = self._sd0.ctypes.data
+        o.setup_averages = float(setup_averages)
+        o.relinearise = int(relinearise)
+        o.reweight = int(bool(reweight))
+        self._create("rcb_monitor_create", model.handle, setup.handle, ctypes.byref(o), None)
+        self.tracked = [self._tracked_info(k) for k in range(len(tp))]
+
+    def _tracked_info(self, k):
+        name, base = ctypes.c_char_p(), ctypes.c_double()
+        self.check(_lib.lib().rcb_monitor_tracked_info(self.handle, k, ctypes.byref(name),
+                                                       ctypes.byref(base)))
+        return {"name": _lib.text(name.value), "baseline": base.value}
+
+    def _layout_sd(self, sd):
+        sd = np.ascontiguousarray(sd, dtype=float)
+        if sd.shape != self._shape:
+            raise ValueError(f"sd has shape {sd.shape}, expected {self._shape}")
+        return sd
+
+    def _values(self, meas):
+        """The set-up's channel order from meas (any order; names must match)."""
+        names = meas.names()
+        missing = [n for n in self._names if n not in names]
+        if missing or meas.n_points != self._shape[1]:
+            raise ValueError(f"the measurement does not match the set-up: channels "
+                             f"{missing or 'ok'}, {meas.n_points} points for "
+                             f"{self._shape[1]}")
+        data = meas.data
+        return np.ascontiguousarray([data[names.index(n)] for n in self._names],
+                                    dtype=np.complex128)
+
+    @property
+    def memory(self):
+        """Bytes the monitor holds (all from its allocator)."""
+        return int(_lib.lib().rcb_monitor_memory(self.handle))
+
+    def candidate(self, i):
+        info = _lib.MonitorCandidateInfo()
+        self.check(_lib.lib().rcb_monitor_candidate_info_get(self.handle, i,
+                                                             ctypes.byref(info)))
+        return {"effect": _lib.text(_lib.lib().rcb_effect_name(info.effect)),
+                "place": _lib.text(info.place), "description": _lib.text(info.description),
+                "params": _lib.text(info.params)}
+
+    def reset_cusum(self):
+        _lib.lib().rcb_monitor_reset_cusum(self.handle)
+
+    def update(self, meas, sd=None):
+        """One new measurement (a Meas with the set-up's channels and grid);
+        sd: its own standard deviations (channels, points), SI, or None."""
+        v = self._values(meas)
+        s = self._layout_sd(sd) if sd is not None else None
+        r = _lib.MonitorResult()
+        self.check(_lib.lib().rcb_monitor_update(self.handle, v.ctypes.data,
+                                                 None if s is None else s.ctypes.data,
+                                                 ctypes.byref(r)), "rcb_monitor_update")
+        return self._result(r)
+
+    def _result(self, r):
+        tracked = []
+        for k in range(r.ntracked):
+            t = r.tracked[k]
+            tracked.append({"name": self.tracked[k]["name"], "value": t.value,
+                            "ci_lo": t.ci_lo, "ci_hi": t.ci_hi, "stderr": t.stderr_,
+                            "z": t.z, "cusum_up": t.cusum_up, "cusum_down": t.cusum_down,
+                            "cusum_alarm": t.cusum_alarm, "out_of_range": bool(t.out_of_range)})
+        top = []
+        for k in range(r.ntop):
+            c = r.top[k]
+            d = self.candidate(c.index)
+            d.update({"size": list(c.size[:c.np]), "ci_lo": list(c.ci_lo[:c.np]),
+                      "ci_hi": list(c.ci_hi[:c.np]), "score": c.score, "dof": c.dof,
+                      "p_value": c.p_value})
+            top.append(d)
+        return {"update": r.update, "error_pct": r.error_pct, "change_pct": r.change_pct,
+                "floor_pct": r.floor_pct, "T": r.T, "dof": r.dof, "threshold": r.threshold,
+                "p_value": r.p_value, "alarm": bool(r.alarm),
+                "cusum_alarm": bool(r.cusum_alarm), "tracked": tracked, "top": top}
+
+    def __repr__(self):
+        if not self._h:
+            return "<librcb.Monitor closed>"
+        return f"<librcb.Monitor {self._shape[0]} channels x {self._shape[1]} points>"

@@ -1,0 +1,326 @@
+/* rcbtool monitor: model-based condition monitoring of a time-ordered series
+ * of measurement files (issue #16) through rcb_monitor: the first file(s)
+ * commission the reference, then one line per update (error, noise floor,
+ * test statistic against its threshold, alarms, the effect named, the tracked
+ * parameters with their intervals); --log writes JSON or CSV, --plot the
+ * trend through tools/python/rcb_plots.py. */
+#include <dirent.h>
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "cli.h"
+#include "cmd_monitor.h"
+
+const char cli_help_monitor[] =
+    "usage: rcbtool monitor BASELINE.ini DIR|MEAS... --params NAME[:LO:HI],...\n"
+    "                       [--noise A,S | --sd STATS.csv|DIR] [--commission N]\n"
+    "                       [--alpha A] [--cusum-h H] [--cusum-k K] [--relinearise N]\n"
+    "                       [--reweight] [--map NODE=STATION,...] [--rpm R]\n"
+    "                       [--log OUT.json|OUT.csv] [--plot TREND.png] [--json]\n"
+    "                       [-o FILE] [--progress]\n"
+    "\n"
+    "Condition monitoring against a fitted baseline model. The measurements are\n"
+    "taken in time order: the files of DIR sorted by name (.uff, .unv, .uf, .csv;\n"
+    "other files are skipped), or the MEAS files in the order given. The first\n"
+    "file (the first N with --commission N, averaged) commissions the reference:\n"
+    "later changes are measured against it, so the model's own misfit at\n"
+    "commissioning is never an alarm. Every later file is one update, printed on\n"
+    "one line: the error of the baseline model against it and the noise floor\n"
+    "(%), the instant test statistic T over its threshold (T/thr > 1 is an alarm:\n"
+    "a chi-square test, at false-alarm rate --alpha per update, that nothing but\n"
+    "the tracked parameters changed), the alarm flags (TEST: the instant test;\n"
+    "CUSUM-/CUSUM+: a tracked parameter's two-sided CUSUM passed --cusum-h,\n"
+    "falling or rising), the tracked parameters with their 95 % intervals, and on\n"
+    "a TEST alarm the effect and place of the catalogue (as rcbtool diagnose)\n"
+    "that explain the change best, with its size. See docs/monitoring.md.\n"
+    "  --params LIST   parameters to track (fitted at commissioning, e.g.\n"
+    "                  coupling.C.kt,coupling.C.ct); LO:HI their plausible range\n"
+    "                  (default [v/1000, 1000 v])\n"
+    "  --noise A,S     eq. 19 noise of one measurement (random A %, systematic S %)\n"
+    "  --sd PATH       per-point standard deviations instead (rcbtool estimate\n"
+    "                  --stats or order --stats): one file for every update, or a\n"
+    "                  directory holding STEM_stats.csv for each measurement STEM.*\n"
+    "  --commission N  files averaged into the reference (default 1)\n"
+    "  --alpha A       false-alarm probability of the instant test per update\n"
+    "                  (default: the library's, 1e-3)\n"
+    "  --cusum-h H     CUSUM decision threshold, standard deviations (default: the\n"
+    "                  library's); --cusum-k K its reference value\n"
+    "  --relinearise N chord iterations re-evaluating the model per update (0)\n"
+    "  --reweight      each update's noise from its own values (eq. 19 on them, or\n"
+    "                  its --sd file), statistics by generalised least squares: T\n"
+    "                  stays chi-square after a large change of the tracked\n"
+    "                  parameters (a moved resonance); slower per update\n"
+    "  --log FILE      every update as JSON (.json) or CSV (.csv), atomically\n"
+    "  --plot FILE     the trend (.png, .pdf or .svg): tracked parameters with\n"
+    "                  their 95 % bands, T/thr with the alarm line, alarms marked;\n"
+    "                  Python 3 with matplotlib (RCB_PYTHON, RCB_PLOTS as compare)\n"
+    "  --json          the log's JSON on standard output instead of the lines\n"
+    "Units: error, floor %; T and its threshold have no unit; parameters in SI\n"
+    "(N/m, N s/m, N m/rad, N m s/rad, kg). Exit codes: 0 ok (alarms or not), 2\n"
+    "usage, 3 bad input (a missing or empty DIR, a file whose channels, points or\n"
+    "speed differ from the commissioning file's), 4 numerical failure, 5 output\n"
+    "not written (no partial log or plot is ever left).\n";
+
+static int pair(const cli_args *a, const char *opt, double *x, double *y) {
+  const char *s = cli_opt_value(a, opt), *t = s ? strchr(s, ',') : NULL;
+  char *e1, *e2;
+  if (!t) return cli_usage(a->cmd, "option %s expects two numbers separated by ','", opt);
+  *x = strtod(s, &e1);
+  *y = strtod(t + 1, &e2);
+  if (e1 != t || *e2 || !(*x >= 0) || !(*y >= 0) || !isfinite(*x) || !isfinite(*y))
+    return cli_usage(a->cmd, "option %s expects two numbers >= 0 separated by ',', got '%s'",
+                     opt, s);
+  return 0;
+}
+
+static int parse_job(const cli_args *a, mon_job *j) {
+  int rc;
+  double relin = 0.0;
+  j->log = cli_opt_value(a, "--log");
+  j->plot = cli_opt_value(a, "--plot");
+  j->sd_path = cli_opt_value(a, "--sd");
+  if ((rc = cli_opt_require(a, "--params", "the parameters to track, e.g. coupling.C.kt")) ||
+      (rc = cli_params_parse(a, "--params", &j->params)))
+    return rc;
+  j->have_params = 1;
+  if (j->params.n > RCB_MONITOR_MAX_TRACKED)
+    return cli_usage(a->cmd, "--params: %zu parameters, at most %d can be tracked",
+                     j->params.n, RCB_MONITOR_MAX_TRACKED);
+  if ((rc = cli_opt_count(a, "--commission", 1, &j->commission)) ||
+      (rc = cli_opt_nonneg(a, "--alpha", "-", 0.0, &j->alpha)) ||
+      (rc = cli_opt_nonneg(a, "--cusum-h", "-", 0.0, &j->cusum_h)) ||
+      (rc = cli_opt_nonneg(a, "--cusum-k", "-", 0.0, &j->cusum_k)))
+    return rc;
+  if ((rc = cli_opt_nonneg(a, "--relinearise", "iterations", 0.0, &relin))) return rc;
+  if (relin != floor(relin) || relin > 100)
+    return cli_usage(a->cmd, "option --relinearise expects a whole number 0..100, got '%s'",
+                     cli_opt_value(a, "--relinearise"));
+  j->relinearise = (size_t)relin;
+  j->reweight = cli_opt_value(a, "--reweight") != NULL;
+  if (cli_opt_value(a, "--alpha") && !(j->alpha > 0.0 && j->alpha < 1.0))
+    return cli_usage(a->cmd, "option --alpha expects a probability 0 < A < 1, got '%s'",
+                     cli_opt_value(a, "--alpha"));
+  if ((cli_opt_value(a, "--cusum-h") && !(j->cusum_h > 0.0)) ||
+      (cli_opt_value(a, "--cusum-k") && !(j->cusum_k > 0.0)))
+    return cli_usage(a->cmd, "options --cusum-h and --cusum-k expect values > 0");
+  if (cli_opt_value(a, "--noise") && j->sd_path)
+    return cli_usage(a->cmd, "--noise and --sd exclude each other: give the eq. 19 model or "
+                     "the per-point standard deviations");
+  if (cli_opt_value(a, "--noise") && (rc = pair(a, "--noise", &j->beta_a, &j->beta_s)))
+    return rc;
+  if (!cli_opt_value(a, "--noise") && !j->sd_path)
+    return cli_usage(a->cmd, "the monitor needs the measurement noise: give --noise A,S (eq. "
+                     "19, e.g. --noise 10,1) or --sd STATS.csv|DIR");
+  if (j->log && !mon_log_is_csv(j->log) && !mon_has_ext(j->log, ".json"))
+    return cli_usage(a->cmd, "--log %s: expected a .json or .csv file name", j->log);
+  if (j->plot && !mon_plot_format(j->plot))
+    return cli_usage(a->cmd, "--plot %s: expected a .png, .pdf or .svg file name", j->plot);
+  return 0;
+}
+
+/* ---- the series: DIR sorted by name, or the files as given ---- */
+
+int mon_has_ext(const char *path, const char *ext) {
+  size_t n = strlen(path), k = strlen(ext), i;
+  if (n < k) return 0;
+  for (i = 0; i < k; i++) {
+    char c = path[n - k + i];
+    if (c >= 'A' && c <= 'Z') c = (char)(c - 'A' + 'a');
+    if (c != ext[i]) return 0;
+  }
+  return 1;
+}
+
+static int is_meas_name(const char *name) {
+  return name[0] != '.' && (mon_has_ext(name, ".uff") || mon_has_ext(name, ".unv") ||
+                            mon_has_ext(name, ".uf") || mon_has_ext(name, ".csv"));
+}
+
+static int add_file(mon_series *s, const char *dir, const char *name) {
+  char *p;
+  if (s->n == s->cap) {
+    size_t cap = s->cap ? 2 * s->cap : 64;
+    char **f = realloc(s->files, cap * sizeof *f);
+    if (!f) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+    s->files = f;
+    s->cap = cap;
+  }
+  p = malloc((dir ? strlen(dir) + 1 : 0) + strlen(name) + 1);
+  if (!p) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  if (dir) {
+    strcpy(p, dir);
+    if (p[0] && p[strlen(p) - 1] != '/') strcat(p, "/");
+    strcat(p, name);
+  } else {
+    strcpy(p, name);
+  }
+  s->files[s->n++] = p;
+  return 0;
+}
+
+static int by_name(const void *x, const void *y) {
+  return strcmp(*(char *const *)x, *(char *const *)y);
+}
+
+static int add_dir(const char *cmd, mon_series *s, const char *dir) {
+  DIR *d = opendir(dir);
+  struct dirent *e;
+  size_t first = s->n;
+  int rc = 0;
+  if (!d)
+    return cli_fail(CLI_EXIT_INPUT, "%s: cannot read the directory '%s': %s", cmd, dir,
+                    strerror(errno));
+  while (!rc && (e = readdir(d)) != NULL)
+    if (is_meas_name(e->d_name)) rc = add_file(s, dir, e->d_name);
+  closedir(d);
+  if (rc) return rc;
+  if (s->n == first)
+    return cli_fail(CLI_EXIT_INPUT, "%s: the directory '%s' holds no measurement file (.uff, "
+                    ".unv, .uf or .csv); give the directory of the series or its files", cmd,
+                    dir);
+  qsort(s->files + first, s->n - first, sizeof *s->files, by_name);
+  return 0;
+}
+
+int mon_series_add(const char *cmd, mon_series *s, const char *path) {
+  struct stat st;
+  if (stat(path, &st) != 0)
+    return cli_fail(CLI_EXIT_INPUT, "%s: cannot read '%s': %s", cmd, path, strerror(errno));
+  if (S_ISDIR(st.st_mode)) return add_dir(cmd, s, path);
+  return add_file(s, NULL, path);
+}
+
+void mon_series_free(mon_series *s) {
+  size_t i;
+  for (i = 0; i < s->n; i++) free(s->files[i]);
+  free(s->files);
+  memset(s, 0, sizeof *s);
+}
+
+/* cli_parse knows one positional (the model): the others are the series. */
+static int takes_value(const char *arg, const cli_opt *opts, size_t nopts) {
+  size_t i;
+  if (strchr(arg, '=')) return 0;
+  if (strcmp(arg, "-o") == 0 || strcmp(arg, "--output") == 0 ||
+      strcmp(arg, "--max-output") == 0)
+    return 1;
+  for (i = 0; i < nopts; i++)
+    if (opts[i].metavar && strcmp(arg, opts[i].name) == 0) return 1;
+  return 0;
+}
+
+static void split_series(int argc, char **argv, const cli_opt *opts, size_t nopts, char **args,
+                         int *nargs, const char **series, size_t *nseries) {
+  int k, npos = 0, only_pos = 0, n = 0;
+  *nseries = 0;
+  for (k = 0; k < argc; k++) {
+    const char *arg = argv[k];
+    int pos = k > 0 && (only_pos || arg[0] != '-' || arg[1] == '\0');
+    if (k > 0 && !only_pos && strcmp(arg, "--") == 0) only_pos = 1;
+    if (pos && ++npos >= 2) {
+      series[(*nseries)++] = arg;
+      continue;
+    }
+    args[n++] = argv[k];
+    if (k > 0 && !pos && !only_pos && takes_value(arg, opts, nopts) && k + 1 < argc)
+      args[n++] = argv[++k];
+  }
+  *nargs = n;
+}
+
+/* Every output (-o, --log, --plot) is checked against every input before any work. */
+static int guard_outputs(const cli_args *a, const mon_job *j) {
+  const char *outs[3];
+  size_t i, k;
+  struct stat so, si;
+  int rc;
+  outs[0] = a->output;
+  outs[1] = j->log;
+  outs[2] = j->plot;
+  cli_input_add(a->model, "model");
+  for (k = 0; k < 3; k++) {
+    if (!outs[k] || strcmp(outs[k], "-") == 0) continue;
+    if ((rc = cli_output_check(outs[k]))) return rc;
+    if (stat(outs[k], &so) != 0) continue;
+    for (i = 0; i < j->series.n; i++)
+      if (stat(j->series.files[i], &si) == 0 && si.st_dev == so.st_dev &&
+          si.st_ino == so.st_ino)
+        return cli_fail(CLI_EXIT_IO, "refusing to write the output '%s' over the measurement "
+                        "file '%s' (an input of this run); choose another output name",
+                        outs[k], j->series.files[i]);
+  }
+  for (k = 0; k < 3; k++)
+    for (i = k + 1; i < 3; i++)
+      if (outs[k] && outs[i] && strcmp(outs[k], outs[i]) == 0 && strcmp(outs[k], "-") != 0)
+        return cli_usage(a->cmd, "-o, --log and --plot name the same file '%s'", outs[k]);
+  if (j->sd_path && (j->log || j->plot || a->output)) {
+    for (k = 0; k < 3; k++)
+      if (outs[k] && stat(outs[k], &so) == 0 && stat(j->sd_path, &si) == 0 &&
+          so.st_dev == si.st_dev && so.st_ino == si.st_ino)
+        return cli_fail(CLI_EXIT_IO, "refusing to write the output '%s' over the --sd file",
+                        outs[k]);
+  }
+  return 0;
+}
+
+int cmd_monitor(int argc, char **argv) {
+  cli_opt opts[] = {{"--params", "NAME[:LO:HI],...", NULL},
+                    {"--noise", "BETA_A,BETA_S", NULL},
+                    {"--sd", "STATS.csv|DIR", NULL},
+                    {"--commission", "N", NULL},
+                    {"--alpha", "A", NULL},
+                    {"--cusum-h", "H", NULL},
+                    {"--cusum-k", "K", NULL},
+                    {"--relinearise", "N", NULL},
+                    {"--reweight", NULL, NULL},
+                    {"--map", "NODE=STATION,...", NULL},
+                    {"--rpm", "R", NULL},
+                    {"--log", "FILE", NULL},
+                    {"--plot", "FILE", NULL}};
+  size_t nopts = sizeof opts / sizeof opts[0], nseries = 0, k;
+  const char **series = NULL;
+  char **args = NULL;
+  int nargs = 0, rc = 0;
+  mon_job j;
+  cli_args a;
+  memset(&j, 0, sizeof j);
+  args = malloc(((size_t)argc + 1) * sizeof *args);
+  series = malloc(((size_t)argc + 1) * sizeof *series);
+  if (!args || !series) {
+    rc = cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+    goto done;
+  }
+  split_series(argc, argv, opts, nopts, args, &nargs, series, &nseries);
+  if ((rc = cli_parse(nargs, args, opts, nopts, &a))) goto done;
+  if (a.help) {
+    rc = cli_print_help(cli_help_monitor);
+    goto done;
+  }
+  if (!nseries) {
+    rc = cli_usage(a.cmd, "missing the measurements: expected 'rcbtool monitor BASELINE.ini "
+                   "DIR|MEAS...'");
+    goto done;
+  }
+  if ((rc = parse_job(&a, &j))) goto done;
+  for (k = 0; k < nseries && !rc; k++) rc = mon_series_add(a.cmd, &j.series, series[k]);
+  if (rc) goto done;
+  if (j.series.n <= j.commission) {
+    rc = cli_usage(a.cmd, "%zu measurement file%s: the first %zu commission%s the reference "
+                   "and none is left to monitor (--commission N takes the first N)",
+                   j.series.n, j.series.n == 1 ? "" : "s", j.commission,
+                   j.commission == 1 ? "s" : "");
+    goto done;
+  }
+  if ((rc = guard_outputs(&a, &j))) goto done;
+  rc = mon_run(&a, &j);
+done:
+  if (j.have_params) cli_params_free(&j.params);
+  mon_series_free(&j.series);
+  free(args);
+  free((void *)series);
+  return rc;
+}

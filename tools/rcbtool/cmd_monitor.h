@@ -1,0 +1,72 @@
+/**
+ * @file cmd_monitor.h
+ * @brief rcbtool monitor internals: the series of files (cmd_monitor.c), the
+ * run (cmd_monitor_run.c) and the log and plot (cmd_monitor_log.c).
+ */
+#ifndef RCBTOOL_CMD_MONITOR_H
+#define RCBTOOL_CMD_MONITOR_H
+
+#include "cli.h"
+
+/** The measurement files in time order (owned copies of the paths). */
+typedef struct mon_series {
+  char **files;
+  size_t n, cap;
+} mon_series;
+
+/** The command line of one run. */
+typedef struct mon_job {
+  cli_params params; /**< --params: the tracked parameters */
+  int have_params;
+  size_t commission;  /**< files averaged into the reference (>= 1) */
+  size_t relinearise; /**< chord iterations per update */
+  int reweight;       /**< --reweight: each update's noise from its own values */
+  double alpha, cusum_h, cusum_k; /**< 0: the library's defaults */
+  double beta_a, beta_s;          /**< --noise, % */
+  const char *sd_path;            /**< --sd FILE or DIR, NULL */
+  const char *log, *plot;         /**< --log, --plot, NULL */
+  mon_series series;
+} mon_job;
+
+/** One update as the log keeps it. */
+typedef struct mon_record {
+  size_t file; /**< index into the series */
+  rcb_monitor_result r;
+} mon_record;
+
+/** A finished (or interrupted) run: what the outputs are written from. */
+typedef struct mon_state {
+  const cli_args *a;
+  const mon_job *j;
+  const rcb_monitor *mon;
+  mon_record *rec;
+  size_t nrec, cap;
+  size_t memory;   /**< bytes the monitor holds */
+  size_t rank, rank_tracked, candidates;
+  double rpm;      /**< test speed of the series, rpm (NaN: unbalance data) */
+  const char *kind; /**< "frf" or "unbalance" */
+  size_t channels, points;
+} mon_state;
+
+/** Add a file, or every measurement file of a directory sorted by name
+ * (none: exit 3 naming it); exit code 0, 3 or 4. */
+int mon_series_add(const char *cmd, mon_series *s, const char *path);
+void mon_series_free(mon_series *s);
+/** Case-insensitive "does @p path end with @p ext" (".json"). */
+int mon_has_ext(const char *path, const char *ext);
+/** --log FILE is CSV (by its extension)? */
+int mon_log_is_csv(const char *path);
+/** matplotlib's format for --plot FILE ("png", "pdf", "svg"), NULL otherwise. */
+const char *mon_plot_format(const char *path);
+
+/** Commission, update over the series, print; then the log and the plot. */
+int mon_run(const cli_args *a, const mon_job *j);
+
+/** The alarm flags of an update: "-", "TEST", "CUSUM-", "TEST,CUSUM+", ... */
+void mon_flags(const rcb_monitor_result *r, char *buf, size_t size);
+/** The log as JSON (also --json on standard output). */
+void mon_print_json(FILE *fp, const mon_state *s);
+/** --log and --plot, written to temporaries and renamed together; 0 or an exit code. */
+int mon_write_outputs(const mon_state *s);
+
+#endif /* RCBTOOL_CMD_MONITOR_H */

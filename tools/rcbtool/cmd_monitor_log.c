@@ -1,0 +1,272 @@
+/* rcbtool monitor: the log (JSON or CSV) and the trend plot, each written to
+ * a temporary file and renamed only when all of them are complete. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "cmd_monitor.h"
+
+int mon_log_is_csv(const char *path) { return mon_has_ext(path, ".csv"); }
+
+const char *mon_plot_format(const char *path) {
+  static const char *const fmt[] = {"png", "pdf", "svg"};
+  static const char *const ext[] = {".png", ".pdf", ".svg"};
+  size_t i;
+  for (i = 0; i < 3; i++)
+    if (mon_has_ext(path, ext[i])) return fmt[i];
+  return NULL;
+}
+
+static const char *file_of(const mon_state *s, size_t k) {
+  const char *p = s->j->series.files[s->rec[k].file], *b = strrchr(p, '/');
+  return b ? b + 1 : p;
+}
+
+static void json_key_num(FILE *fp, const char *key, double x) {
+  fprintf(fp, ", \"%s\": ", key);
+  cli_json_num(fp, x);
+}
+
+static void json_candidate(FILE *fp, const mon_state *s, const rcb_monitor_candidate *c) {
+  rcb_monitor_candidate_info ci;
+  memset(&ci, 0, sizeof ci);
+  rcb_monitor_candidate_info_get(s->mon, c->index, &ci);
+  fputs("{\"effect\": ", fp);
+  cli_json_str(fp, rcb_effect_name(c->effect));
+  fputs(", \"place\": ", fp);
+  cli_json_str(fp, ci.place ? ci.place : "");
+  fputs(", \"description\": ", fp);
+  cli_json_str(fp, ci.description ? ci.description : "");
+  fputs(", \"params\": ", fp);
+  cli_json_str(fp, ci.params ? ci.params : "");
+  fputs(", \"size\": ", fp);
+  cli_json_nums(fp, c->size, c->np, 1);
+  fputs(", \"ci_lo\": ", fp);
+  cli_json_nums(fp, c->ci_lo, c->np, 1);
+  fputs(", \"ci_hi\": ", fp);
+  cli_json_nums(fp, c->ci_hi, c->np, 1);
+  json_key_num(fp, "score", c->score);
+  fprintf(fp, ", \"dof\": %zu", c->dof);
+  json_key_num(fp, "p_value", c->p_value);
+  fputc('}', fp);
+}
+
+static void json_tracked(FILE *fp, const rcb_monitor_tracked *t, const char *name) {
+  fputs("{\"name\": ", fp);
+  cli_json_str(fp, name);
+  json_key_num(fp, "value", t->value);
+  json_key_num(fp, "ci_lo", t->ci_lo);
+  json_key_num(fp, "ci_hi", t->ci_hi);
+  json_key_num(fp, "stderr", t->stderr_);
+  json_key_num(fp, "z", t->z);
+  json_key_num(fp, "cusum_up", t->cusum_up);
+  json_key_num(fp, "cusum_down", t->cusum_down);
+  fprintf(fp, ", \"cusum_alarm\": %d, \"out_of_range\": %s}", t->cusum_alarm,
+          t->out_of_range ? "true" : "false");
+}
+
+static void json_update(FILE *fp, const mon_state *s, size_t k) {
+  const rcb_monitor_result *r = &s->rec[k].r;
+  size_t i;
+  fprintf(fp, "  {\"update\": %zu, \"file\": ", r->update);
+  cli_json_str(fp, file_of(s, k));
+  json_key_num(fp, "error_pct", r->error_pct);
+  json_key_num(fp, "change_pct", r->change_pct);
+  json_key_num(fp, "floor_pct", r->floor_pct);
+  json_key_num(fp, "T", r->T);
+  json_key_num(fp, "threshold", r->threshold);
+  fprintf(fp, ", \"dof\": %zu", r->dof);
+  json_key_num(fp, "p_value", r->p_value);
+  fprintf(fp, ", \"alarm\": %s, \"cusum_alarm\": %s,\n   \"tracked\": [",
+          r->alarm ? "true" : "false", r->cusum_alarm ? "true" : "false");
+  for (i = 0; i < r->ntracked; i++) {
+    if (i) fputs(", ", fp);
+    json_tracked(fp, &r->tracked[i], s->j->params.items[i].name);
+  }
+  fputs("],\n   \"top\": [", fp);
+  for (i = 0; i < r->ntop; i++) {
+    if (i) fputs(",\n    ", fp);
+    json_candidate(fp, s, &r->top[i]);
+  }
+  fputs("]}", fp);
+}
+
+void mon_print_json(FILE *fp, const mon_state *s) {
+  size_t k;
+  double alpha = s->nrec ? rcb_chi2_sf(s->rec[0].r.threshold, (double)s->rec[0].r.dof)
+                         : (double)NAN;
+  fputs("{\"model\": ", fp);
+  cli_json_str(fp, s->a->model);
+  fputs(", \"commissioning\": [", fp);
+  for (k = 0; k < s->j->commission; k++) {
+    if (k) fputs(", ", fp);
+    cli_json_str(fp, s->j->series.files[k]);
+  }
+  fprintf(fp, "], \"type\": \"%s\"", s->kind);
+  json_key_num(fp, "rpm", s->rpm);
+  fprintf(fp, ", \"channels\": %zu, \"points\": %zu, \"candidates\": %zu, \"rank\": %zu, "
+          "\"rank_tracked\": %zu, \"memory_bytes\": %zu", s->channels, s->points,
+          s->candidates, s->rank, s->rank_tracked, s->memory);
+  json_key_num(fp, "alpha", alpha); /* the rate the threshold stands for */
+  json_key_num(fp, "cusum_h", s->j->cusum_h > 0 ? s->j->cusum_h : (double)NAN);
+  fputs(", \"noise\": ", fp);
+  if (s->j->sd_path)
+    cli_json_str(fp, s->j->sd_path);
+  else
+    fprintf(fp, "[%.17g, %.17g]", s->j->beta_a, s->j->beta_s);
+  fputs(",\n\"tracked\": [", fp);
+  for (k = 0; k < s->j->params.n; k++) {
+    const char *name = NULL;
+    double base = NAN;
+    rcb_monitor_tracked_info(s->mon, k, &name, &base);
+    fputs(k ? ", {\"name\": " : "{\"name\": ", fp);
+    cli_json_str(fp, s->j->params.items[k].name);
+    json_key_num(fp, "baseline", base);
+    fputc('}', fp);
+  }
+  fputs("],\n\"updates\": [\n", fp);
+  for (k = 0; k < s->nrec; k++) {
+    json_update(fp, s, k);
+    fputs(k + 1 < s->nrec ? ",\n" : "\n", fp);
+  }
+  fputs("]}\n", fp);
+}
+
+/* A CSV text field, quoted (the file and place names may hold commas). */
+static void csv_str(FILE *fp, const char *t) {
+  fputc('"', fp);
+  for (; *t; t++) {
+    if (*t == '"') fputc('"', fp);
+    fputc(*t, fp);
+  }
+  fputc('"', fp);
+}
+
+static void csv_row(FILE *fp, const mon_state *s, size_t k) {
+  const rcb_monitor_result *r = &s->rec[k].r;
+  const double v[] = {r->error_pct, r->change_pct, r->floor_pct, r->T, r->threshold,
+                      (double)r->dof, r->p_value};
+  char flags[32];
+  size_t i;
+  fprintf(fp, "%zu,", r->update);
+  csv_str(fp, file_of(s, k));
+  for (i = 0; i < sizeof v / sizeof v[0]; i++) {
+    fputc(',', fp);
+    cli_csv_num(fp, v[i]);
+  }
+  mon_flags(r, flags, sizeof flags);
+  fprintf(fp, ",%d,%d,", r->alarm, r->cusum_alarm);
+  csv_str(fp, flags);
+  for (i = 0; i < r->ntracked; i++) {
+    const rcb_monitor_tracked *t = &r->tracked[i];
+    const double tv[] = {t->value, t->ci_lo, t->ci_hi, t->z, t->cusum_down, t->cusum_up};
+    size_t q;
+    for (q = 0; q < 6; q++) {
+      fputc(',', fp);
+      cli_csv_num(fp, tv[q]);
+    }
+  }
+  fputc(',', fp);
+  if (r->ntop > 0) {
+    rcb_monitor_candidate_info ci;
+    memset(&ci, 0, sizeof ci);
+    rcb_monitor_candidate_info_get(s->mon, r->top[0].index, &ci);
+    csv_str(fp, rcb_effect_name(r->top[0].effect));
+    fputc(',', fp);
+    csv_str(fp, ci.place ? ci.place : "");
+    fputc(',', fp);
+    cli_csv_num(fp, r->top[0].p_value);
+  } else {
+    fputs("\"\",\"\",", fp);
+  }
+  fputc('\n', fp);
+}
+
+static void print_csv(FILE *fp, const mon_state *s) {
+  size_t k;
+  fprintf(fp, "# rcbtool monitor %s, commissioned on %s; SI units\n", s->a->model,
+          s->j->series.files[0]);
+  fputs("update,file,error_pct,change_pct,floor_pct,T,threshold,dof,p_value,alarm,"
+        "cusum_alarm,flags", fp);
+  for (k = 0; k < s->j->params.n; k++) {
+    const char *n = s->j->params.items[k].name;
+    fprintf(fp, ",%s,%s ci_lo,%s ci_hi,%s z,%s cusum_down,%s cusum_up", n, n, n, n, n, n);
+  }
+  fputs(",top_effect,top_place,top_p_value\n", fp);
+  for (k = 0; k < s->nrec; k++) csv_row(fp, s, k);
+}
+
+/* The mode a plain fopen would have given (0666 & ~umask): mkstemp made 0600. */
+static void plain_mode(const char *path) {
+  mode_t mask = umask(0);
+  umask(mask);
+  (void)chmod(path, (mode_t)(0666 & ~mask));
+}
+
+/* Write a temporary for @p path with @p fn; 0 or exit 5 (the temporary removed). */
+static int write_tmp(cli_tmpfile *t, const char *path, const mon_state *s,
+                     void (*fn)(FILE *, const mon_state *)) {
+  FILE *fp;
+  int rc = cli_tmpfile_open(t, path), bad;
+  if (rc) return rc;
+  if (!(fp = fopen(t->write_path, "w"))) {
+    cli_tmpfile_close(t, 0);
+    return cli_fail(CLI_EXIT_IO, "cannot write output file '%s'", path);
+  }
+  plain_mode(t->write_path);
+  fn(fp, s);
+  bad = ferror(fp) != 0;
+  if (fclose(fp) != 0) bad = 1;
+  if (bad) {
+    cli_tmpfile_close(t, 0);
+    return cli_fail(CLI_EXIT_IO, "cannot write output file '%s'", path);
+  }
+  return 0;
+}
+
+#define NOTHING_KEPT "no log, plot or output file was kept (run without --plot to get the rest)"
+
+static char *with_suffix(const char *path, const char *suffix) {
+  char *p = malloc(strlen(path) + strlen(suffix) + 1);
+  if (p) strcat(strcpy(p, path), suffix);
+  return p;
+}
+
+int mon_write_outputs(const mon_state *s) {
+  cli_tmpfile log, pic, pj;
+  char *json_name = NULL;
+  int rc = 0, have_log = 0, have_pic = 0;
+  memset(&log, 0, sizeof log);
+  if (s->j->log) {
+    if ((rc = write_tmp(&log, s->j->log, s, mon_log_is_csv(s->j->log) ? print_csv
+                                                                         : mon_print_json)))
+      return rc;
+    have_log = 1;
+  }
+  if (s->j->plot) {
+    /* the plotter reads the JSON from a temporary beside the picture (removed) */
+    if (!(json_name = with_suffix(s->j->plot, ".json"))) rc = cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+    if (!rc) rc = cli_plot_mkdir(s->j->plot);
+    if (!rc && !(rc = write_tmp(&pj, json_name, s, mon_print_json))) {
+      if (!(rc = cli_tmpfile_open(&pic, s->j->plot))) {
+        have_pic = 1;
+        rc = cli_plot_run("monitor", pj.write_path, pic.write_path,
+                             mon_plot_format(s->j->plot), NOTHING_KEPT);
+      }
+      cli_tmpfile_close(&pj, 0);
+    }
+    free(json_name);
+  }
+  if (have_pic) {
+    int r2;
+    if (!rc) plain_mode(pic.write_path);
+    r2 = cli_tmpfile_close(&pic, !rc);
+    if (!rc) rc = r2;
+  }
+  if (have_log) {
+    int r2 = cli_tmpfile_close(&log, !rc);
+    if (!rc) rc = r2;
+  }
+  return rc;
+}

@@ -1,0 +1,397 @@
+/* rcbtool monitor: commissioning, the updates and the lines printed. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "cmd_monitor.h"
+
+/* The file name without its directories (for the lines). */
+static const char *base_name(const char *path) {
+  const char *s = strrchr(path, '/');
+  return s ? s + 1 : path;
+}
+
+static int same_x(double x, double y) { return fabs(x - y) <= 1e-6 * fabs(y) + 1e-12; }
+
+/* The set-up's layout in @p ms (file @p path): the same type, points, speed
+ * and channels (in any order: perm[c] is the channel of ms holding the
+ * set-up's channel c). 0 or exit 3 naming the file. */
+static int match_layout(const char *cmd, const rcb_meas *ref, const char *ref_path,
+                        const rcb_meas *ms, const char *path, size_t *perm) {
+  size_t n = rcb_meas_point_count(ref), nc = rcb_meas_channel_count(ref), c, q, i;
+  int frf = rcb_meas_get_type(ref) == RCB_MEAS_FRF;
+  const double *x = rcb_meas_grid(ref), *y = rcb_meas_grid(ms);
+  double unit = frf ? CLI_HZ_TO_RAD_S : CLI_RPM_TO_RAD_S;
+  static const char fix[] = "every file of a series must have the commissioning file's "
+                            "channels, points and speed";
+  if (rcb_meas_get_type(ms) != rcb_meas_get_type(ref))
+    return cli_fail(CLI_EXIT_INPUT, "%s: '%s' holds %s, the commissioning file '%s' %s; %s",
+                    cmd, path, frf ? "unbalance responses" : "FRFs", ref_path,
+                    frf ? "FRFs" : "unbalance responses", fix);
+  if (rcb_meas_point_count(ms) != n || rcb_meas_channel_count(ms) != nc)
+    return cli_fail(CLI_EXIT_INPUT, "%s: '%s' has %zu channels x %zu points, the "
+                    "commissioning file '%s' %zu x %zu; %s", cmd, path,
+                    rcb_meas_channel_count(ms), rcb_meas_point_count(ms), ref_path, nc, n, fix);
+  for (i = 0; i < n; i++)
+    if (!same_x(y[i], x[i]))
+      return cli_fail(CLI_EXIT_INPUT, "%s: '%s': point %zu is at %.9g %s, in the commissioning "
+                      "file '%s' at %.9g; %s", cmd, path, i + 1, y[i] / unit, frf ? "Hz" : "rpm",
+                      ref_path, x[i] / unit, fix);
+  if (frf && !same_x(rcb_meas_speed(ms), rcb_meas_speed(ref)))
+    return cli_fail(CLI_EXIT_INPUT, "%s: '%s' was measured at %.6g rpm, the commissioning "
+                    "file '%s' at %.6g rpm; %s", cmd, path, rcb_meas_speed(ms) / CLI_RPM_TO_RAD_S,
+                    ref_path, rcb_meas_speed(ref) / CLI_RPM_TO_RAD_S, fix);
+  for (c = 0; c < nc; c++) {
+    rcb_meas_channel_info ri, mi;
+    rcb_meas_channel(ref, c, &ri);
+    for (q = 0; q < nc; q++) {
+      rcb_meas_channel(ms, q, &mi);
+      if (strcmp(mi.response, ri.response) == 0 &&
+          (ri.reference ? mi.reference && strcmp(mi.reference, ri.reference) == 0
+                        : !mi.reference))
+        break;
+    }
+    if (q == nc || mi.kind != ri.kind)
+      return cli_fail(CLI_EXIT_INPUT, "%s: '%s' has no channel %s%s%s%s (of the commissioning "
+                      "file '%s'); %s", cmd, path, ri.response, ri.reference ? "/" : "",
+                      ri.reference ? ri.reference : "", q == nc ? "" : " of the same kind",
+                      ref_path, fix);
+    perm[c] = q;
+  }
+  return 0;
+}
+
+/* values[c * n + i] (the set-up's order) from ms. */
+static void gather(const rcb_meas *ms, const size_t *perm, size_t nc, size_t n,
+                   rcb_complex *values) {
+  size_t c;
+  for (c = 0; c < nc; c++) {
+    rcb_meas_channel_info ci;
+    rcb_meas_channel(ms, perm[c], &ci);
+    memcpy(values + c * n, ci.data, n * sizeof *values);
+  }
+}
+
+/* --sd DIR: DIR/STEM_stats.csv of measurement DIR2/STEM.ext. */
+static char *sd_file_for(const char *dir, const char *meas) {
+  const char *b = base_name(meas), *dot = strrchr(b, '.');
+  size_t stem = dot ? (size_t)(dot - b) : strlen(b);
+  char *p = malloc(strlen(dir) + stem + sizeof "/_stats.csv");
+  if (!p) return NULL;
+  sprintf(p, "%s/%.*s_stats.csv", dir, (int)stem, b);
+  return p;
+}
+
+static int sd_is_dir(const char *path) {
+  struct stat st;
+  return path && stat(path, &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+typedef struct mon_ctx {
+  const cli_args *a;
+  const mon_job *j;
+  rcb_model *m;
+  rcb_meas *setup; /* the first commissioning file, its values the average */
+  size_t n, nc, *perm;
+  rcb_complex *values;
+  double *sd;
+  int have_sd;
+} mon_ctx;
+
+/* --sd DIR: the sds of file @p path (read as @p ms, the set-up's layout) into
+ * x->sd in the set-up's order; *have 0 without --sd DIR. 0 or an exit code. */
+static int file_sd(mon_ctx *x, const rcb_meas *ms, const char *path, int *have) {
+  size_t c;
+  double *sd = NULL;
+  char *f;
+  int rc;
+  *have = 0;
+  if (!sd_is_dir(x->j->sd_path)) return 0;
+  if (!(f = sd_file_for(x->j->sd_path, path)))
+    return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  rc = cli_sd_read(f, ms, &sd); /* ms has x->nc channels of x->n points (matched) */
+  free(f);
+  if (rc) return rc;
+  for (c = 0; c < x->nc; c++)
+    memcpy(x->sd + c * x->n, sd + x->perm[c] * x->n, x->n * sizeof *x->sd);
+  free(sd);
+  *have = 1;
+  return 0;
+}
+
+static int read_file(mon_ctx *x, size_t k, rcb_meas **out) {
+  const char *path = x->j->series.files[k];
+  int rc = cli_meas_read(x->a, path, x->m, out);
+  if (rc) return rc;
+  if (k > 0 &&
+      (rc = match_layout(x->a->cmd, x->setup, x->j->series.files[0], *out, path, x->perm))) {
+    rcb_meas_destroy(*out);
+    *out = NULL;
+  }
+  return rc;
+}
+
+/* The first --commission files: their average into the set-up's values. */
+static int commission(mon_ctx *x) {
+  size_t k, i, nv;
+  rcb_meas *ms = NULL;
+  int rc;
+  if ((rc = read_file(x, 0, &x->setup))) return rc;
+  x->n = rcb_meas_point_count(x->setup);
+  x->nc = rcb_meas_channel_count(x->setup);
+  nv = x->n * x->nc;
+  x->perm = calloc(x->nc ? x->nc : 1, sizeof *x->perm);
+  x->values = calloc(nv ? nv : 1, sizeof *x->values);
+  x->sd = calloc(nv ? nv : 1, sizeof *x->sd);
+  if (!x->perm || !x->values || !x->sd) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  for (k = 0; k < x->nc; k++) x->perm[k] = k;
+  if (x->j->sd_path && !sd_is_dir(x->j->sd_path)) { /* one file for every update */
+    double *sd;
+    if ((rc = cli_sd_read(x->j->sd_path, x->setup, &sd))) return rc;
+    memcpy(x->sd, sd, nv * sizeof *sd);
+    free(sd);
+    x->have_sd = 1;
+  } else if ((rc = file_sd(x, x->setup, x->j->series.files[0], &x->have_sd))) {
+    return rc;
+  }
+  if (x->j->commission == 1) return 0;
+  gather(x->setup, x->perm, x->nc, x->n, x->values);
+  for (k = 1; k < x->j->commission; k++) {
+    rcb_complex *v = x->values;
+    if ((rc = read_file(x, k, &ms))) return rc;
+    for (i = 0; i < x->nc; i++) {
+      rcb_meas_channel_info ci;
+      size_t p;
+      rcb_meas_channel(ms, x->perm[i], &ci);
+      for (p = 0; p < x->n; p++) v[i * x->n + p] += ci.data[p];
+    }
+    rcb_meas_destroy(ms);
+  }
+  for (i = 0; i < nv; i++) x->values[i] /= (double)x->j->commission;
+  return 0;
+}
+
+/* A set-up holding the averaged values: the first file's grid and channels. */
+static int averaged_setup(mon_ctx *x, rcb_meas **out) {
+  rcb_meas *ms = NULL;
+  size_t c;
+  rcb_status st = rcb_meas_create(&ms, NULL);
+  if (!st)
+    st = rcb_meas_set_grid(ms, rcb_meas_get_type(x->setup), x->n, rcb_meas_grid(x->setup),
+                           rcb_meas_speed(x->setup));
+  for (c = 0; c < x->nc && !st; c++) {
+    rcb_meas_channel_info ci;
+    rcb_meas_channel(x->setup, c, &ci);
+    st = rcb_meas_add_channel(ms, ci.response, ci.reference, ci.kind, x->values + c * x->n);
+  }
+  if (st) {
+    int rc = cli_fail(CLI_EXIT_NUMERIC, "%s: averaging the commissioning files: %s", x->a->cmd,
+                      cli_msg(ms ? rcb_meas_errmsg(ms) : NULL, st));
+    rcb_meas_destroy(ms);
+    return rc;
+  }
+  *out = ms;
+  return 0;
+}
+
+static int create_monitor(mon_ctx *x, rcb_monitor **mon) {
+  rcb_monitor_param tp[RCB_MONITOR_MAX_TRACKED];
+  rcb_monitor_opts o;
+  rcb_meas *avg = NULL;
+  rcb_status st;
+  size_t k;
+  int rc;
+  memset(&o, 0, sizeof o);
+  for (k = 0; k < x->j->params.n; k++) {
+    const cli_param_spec *p = &x->j->params.items[k];
+    double v;
+    if (rcb_model_get_param(x->m, p->name, &v))
+      return cli_fail(CLI_EXIT_INPUT, "%s: %s", x->a->cmd, rcb_model_errmsg(x->m));
+    tp[k].name = p->name;
+    if ((rc = cli_param_bounds(x->a, p, v, 0, &tp[k].lo, &tp[k].hi))) return rc;
+  }
+  o.ntracked = x->j->params.n;
+  o.tracked = tp;
+  o.alpha = x->j->alpha;
+  o.cusum_h = x->j->cusum_h;
+  o.cusum_k = x->j->cusum_k;
+  o.beta_a = x->j->beta_a;
+  o.beta_s = x->j->beta_s;
+  o.sd = x->have_sd ? x->sd : NULL;
+  o.setup_averages = (double)x->j->commission;
+  o.relinearise = x->j->relinearise;
+  o.reweight = x->j->reweight;
+  if (x->j->commission > 1 && (rc = averaged_setup(x, &avg))) return rc;
+  st = rcb_monitor_create(mon, x->m, avg ? avg : x->setup, &o, NULL);
+  rcb_meas_destroy(avg);
+  if (st)
+    return cli_fail(st == RCB_ERR_ARG || st == RCB_ERR_NOT_FOUND ? CLI_EXIT_INPUT
+                                                                  : cli_status_exit(st),
+                    "%s: commissioning on '%s': %s", x->a->cmd, x->j->series.files[0],
+                    cli_msg(*mon ? rcb_monitor_errmsg(*mon) : NULL, st));
+  return 0;
+}
+
+/* ---- the lines ---- */
+
+static void print_header(FILE *fp, const mon_state *s) {
+  size_t k;
+  fprintf(fp, "# commissioned on %s", s->j->series.files[0]);
+  if (s->j->commission > 1) fprintf(fp, " and the next %zu files (averaged)", s->j->commission - 1);
+  fprintf(fp, "; %zu channels x %zu points; %zu candidate effects; monitor memory %zu bytes\n",
+          s->channels, s->points, s->candidates, s->memory);
+  fprintf(fp, "%6s  %-24s %8s %8s %8s  %-12s", "update", "file", "error %", "floor %", "T/thr",
+          "alarms");
+  for (k = 0; k < s->j->params.n; k++) fprintf(fp, "  %s [95 %% CI]", s->j->params.items[k].name);
+  fputc('\n', fp);
+}
+
+void mon_flags(const rcb_monitor_result *r, char *buf, size_t size) {
+  size_t k;
+  int down = 0, up = 0;
+  for (k = 0; k < r->ntracked; k++) {
+    if (r->tracked[k].cusum_alarm < 0) down = 1;
+    if (r->tracked[k].cusum_alarm > 0) up = 1;
+  }
+  snprintf(buf, size, "%s%s%s%s", r->alarm ? "TEST" : "", r->alarm && (down || up) ? "," : "",
+           down ? (up ? "CUSUM-+" : "CUSUM-") : (up ? "CUSUM+" : ""),
+           !r->alarm && !down && !up ? "-" : "");
+}
+
+static void print_line(FILE *fp, const mon_state *s, const mon_record *rec) {
+  const rcb_monitor_result *r = &rec->r;
+  char flags[32];
+  size_t k;
+  mon_flags(r, flags, sizeof flags);
+  fprintf(fp, "%6zu  %-24s %8.3f %8.3f %8.3g  %-12s", r->update,
+          base_name(s->j->series.files[rec->file]), r->error_pct, r->floor_pct,
+          r->T / r->threshold, flags);
+  for (k = 0; k < r->ntracked; k++)
+    fprintf(fp, "  %.6g [%.6g, %.6g]", r->tracked[k].value, r->tracked[k].ci_lo,
+            r->tracked[k].ci_hi);
+  if (r->alarm && r->ntop > 0) {
+    const rcb_monitor_candidate *c = &r->top[0];
+    rcb_monitor_candidate_info ci;
+    if (rcb_monitor_candidate_info_get(s->mon, c->index, &ci) == RCB_OK)
+      fprintf(fp, "  -> %s at %s: %s %.6g [%.6g, %.6g]", rcb_effect_name(ci.effect), ci.place,
+              ci.params, c->size[0], c->ci_lo[0], c->ci_hi[0]);
+  }
+  fputc('\n', fp);
+}
+
+static int keep(mon_state *s, size_t file, const rcb_monitor_result *r) {
+  if (s->nrec == s->cap) {
+    size_t cap = s->cap ? 2 * s->cap : 64;
+    mon_record *p = realloc(s->rec, cap * sizeof *p);
+    if (!p) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+    s->rec = p;
+    s->cap = cap;
+  }
+  s->rec[s->nrec].file = file;
+  s->rec[s->nrec].r = *r;
+  s->nrec++;
+  return 0;
+}
+
+static int one_update(mon_ctx *x, mon_state *s, rcb_monitor *mon, size_t k) {
+  rcb_meas *ms = NULL;
+  rcb_monitor_result r;
+  rcb_status st;
+  int rc, have_sd = 0;
+  if ((rc = read_file(x, k, &ms))) return rc;
+  gather(ms, x->perm, x->nc, x->n, x->values);
+  rc = file_sd(x, ms, x->j->series.files[k], &have_sd);
+  rcb_meas_destroy(ms);
+  if (rc) return rc;
+  if ((st = rcb_monitor_update(mon, x->values, have_sd ? x->sd : NULL, &r)))
+    return cli_fail(st == RCB_ERR_ARG ? CLI_EXIT_INPUT : cli_status_exit(st), "%s: '%s': %s",
+                    x->a->cmd, x->j->series.files[k], cli_msg(rcb_monitor_errmsg(mon), st));
+  return keep(s, k, &r);
+}
+
+static void summary(FILE *fp, const mon_state *s) {
+  size_t i, nt = 0, ncu = 0, ft = 0, fc = 0;
+  for (i = 0; i < s->nrec; i++) {
+    const rcb_monitor_result *r = &s->rec[i].r;
+    if (r->alarm && !nt++) ft = r->update;
+    if (r->cusum_alarm && !ncu++) fc = r->update;
+  }
+  fprintf(fp, "# %zu updates: %zu with a TEST alarm", s->nrec, nt);
+  if (nt) fprintf(fp, " (first at update %zu)", ft);
+  fprintf(fp, ", %zu with a CUSUM alarm", ncu);
+  if (ncu) fprintf(fp, " (first at update %zu)", fc);
+  fputc('\n', fp);
+}
+
+static int updates(mon_ctx *x, mon_state *s, rcb_monitor *mon, cli_out *o) {
+  cli_progress p;
+  size_t k, total = x->j->series.n - x->j->commission;
+  int rc = 0;
+  memset(&p, 0, sizeof p);
+  /* on a terminal the lines are the progress: the counter only when they go elsewhere */
+  if (x->a->progress || x->a->json || o->fp != stdout || !isatty(fileno(stdout)))
+    cli_progress_start(&p, x->a, "monitor", "updates", total);
+  if (!x->a->json) print_header(o->fp, s);
+  for (k = x->j->commission; k < x->j->series.n && !rc; k++) {
+    if (!(rc = one_update(x, s, mon, k)) && !x->a->json) {
+      print_line(o->fp, s, &s->rec[s->nrec - 1]);
+      if (o->fp == stdout) fflush(stdout);
+    }
+    cli_progress_step(&p, k + 1 - x->j->commission);
+  }
+  cli_progress_end(&p);
+  if (!rc && !x->a->json) summary(o->fp, s);
+  return rc;
+}
+
+static void describe(mon_state *s, const mon_ctx *x, const rcb_monitor *mon) {
+  s->memory = rcb_monitor_memory(mon);
+  s->candidates = rcb_monitor_candidate_count(mon);
+  rcb_monitor_rank(mon, &s->rank, &s->rank_tracked);
+  s->channels = x->nc;
+  s->points = x->n;
+  s->kind = rcb_meas_get_type(x->setup) == RCB_MEAS_FRF ? "frf" : "unbalance";
+  s->rpm = rcb_meas_get_type(x->setup) == RCB_MEAS_FRF
+               ? rcb_meas_speed(x->setup) / CLI_RPM_TO_RAD_S
+               : (double)NAN;
+}
+
+int mon_run(const cli_args *a, const mon_job *j) {
+  mon_ctx x;
+  mon_state s;
+  rcb_monitor *mon = NULL;
+  cli_out o;
+  int rc;
+  memset(&x, 0, sizeof x);
+  memset(&s, 0, sizeof s);
+  memset(&o, 0, sizeof o);
+  x.a = s.a = a;
+  x.j = s.j = j;
+  if ((rc = cli_load_model(a, &x.m))) return rc;
+  if ((rc = commission(&x)) || (rc = create_monitor(&x, &mon))) goto done;
+  s.mon = mon;
+  describe(&s, &x, mon);
+  if ((rc = cli_out_open(&o, a))) goto done;
+  if ((rc = updates(&x, &s, mon, &o))) {
+    cli_out_abort(&o);
+    goto done;
+  }
+  if (a->json) mon_print_json(o.fp, &s);
+  /* the log and the plot first: -o is renamed into place only when they are written */
+  if ((rc = cli_out_flush(&o)) || (rc = mon_write_outputs(&s))) {
+    cli_out_abort(&o);
+    goto done;
+  }
+  rc = cli_out_close(&o);
+done:
+  rcb_monitor_destroy(mon);
+  rcb_meas_destroy(x.setup);
+  rcb_model_destroy(x.m);
+  free(x.perm);
+  free(x.values);
+  free(x.sd);
+  free(s.rec);
+  return rc;
+}
