@@ -42,6 +42,9 @@ typedef struct diag_cand {
   double predicted;                 /* score-test reduction of F */
   double predicted_nom;             /* the same at the nominal model (far baseline) */
   int from_fit, from_nom;           /* refitted from the fitted / the nominal base */
+  int prefitted;                    /* pre-fitted alone at the nominal model (far baseline) */
+  double pre_F;                     /* its objective there (HUGE_VAL: failed) */
+  double pre[RCB_DIAG_MAXP];        /* and its parameters, the start of the nominal refit */
   int refitted, significant;
   double F, err, dbic;
   char fitted[RCB_DIAG_MAXP * (RCB_DIAG_NAME + 32)];

@@ -459,6 +459,55 @@ static rcb_status polish(rcb_fit *f) {
   return st;
 }
 
+/* The pre-fit of a candidate when the baseline ran off (d->far): its own
+ * parameters alone, the base parameters held at their nominal values, on
+ * the subset w, at most RCB_DIAG_PREFIT_ITER iterations, from its neutral
+ * value (a pedestal: from the best point of its grid). A missing effect
+ * that shifts every resonance is judged there by what it really explains,
+ * not by the score test: when every model resonance sits beside its
+ * measured peak, the first-order score favours effects that flatten peaks
+ * (damping), and a joint fit from the neutral value lets the base
+ * parameters run off again before the effect's own parameter reaches its
+ * value. With 0.15 kg per hub hidden at coupling C (32 x 1101, seed 1) the
+ * hub mass scores 5.7 % of F at the nominal model (14th, behind every
+ * damping), and its joint fit from there ends with kt on its bound (error
+ * 26.6 %); alone it reaches 0.1500 kg and the floor in 15 sweeps, and the
+ * joint fit from that start stays there. The nominal refits
+ * (RCB_DIAG_NOM_REFITS) are the pre-fits with the lowest objective, and
+ * start where their pre-fit ended. */
+#define RCB_DIAG_PREFIT_ITER 15
+static rcb_status prefit(rcb_diag *d, diag_cand *c, const double *w) {
+  rcb_model *m = NULL;
+  rcb_fit *f = NULL;
+  rcb_status st = rcb_diag_candidate_model(d, c, d->nom_model, &m);
+  size_t it = 0, k, np;
+  double ftol = 0.0, xtol = 0.0;
+  c->prefitted = 1;
+  c->pre_F = HUGE_VAL;
+  if (!st) st = make_fit(d, m, 0, c, &f);
+  if (!st) st = rcb_diag_refit_start(d, c, m, f);
+  if (!st) st = rcb_fit_set_starts(f, 1, 1);
+  if (!st) st = rcb_fit_get_limits(f, &it, &ftol, &xtol);
+  if (!st) st = rcb_fit_set_limits(f, RCB_DIAG_PREFIT_ITER, ftol, xtol);
+  if (!st) st = rcb_fit_set_weights(f, w);
+  if (!st) st = rcb_fit_run(f);
+  if (!st) {
+    rcb_fit_report rep;
+    rcb_fit_get_report(f, &rep);
+    np = rcb_fit_param_count(f);
+    for (k = 0; k < c->np && k < np; k++) {
+      rcb_fit_param p;
+      rcb_fit_get_param(f, np - c->np + k, &p);
+      c->pre[k] = p.value;
+    }
+    if (np == c->np && isfinite(rep.objective)) c->pre_F = rep.objective;
+  }
+  drop_fit(d, f);
+  rcb_model_destroy(m);
+  if (st == RCB_ERR_NOMEM) return rcb_diag_fail(d, st, "pre-fitting %s: out of memory", c->desc);
+  return RCB_OK; /* a candidate that cannot be pre-fitted is not refitted from there */
+}
+
 /* BIC change and significance of a refitted candidate (F, err set). */
 static void judge(const rcb_diag *d, diag_cand *c, double k) {
   double N = (double)d->nres;
@@ -500,6 +549,10 @@ static rcb_status refit(rcb_diag *d, diag_cand *c, const double *w) {
   for (s = 0; s < 2; s++) {
     if (!(s ? c->from_nom : c->from_fit)) continue;
     st = refit_setup(d, c, s ? d->nom_model : d->base_model, &m[s], &f[s]);
+    if (!st && s && c->prefitted && c->pre_F < HUGE_VAL) { /* where its pre-fit ended */
+      size_t k;
+      for (k = 0; !st && k < c->np; k++) st = rcb_model_set_param(m[s], c->pname[k], c->pre[k]);
+    }
     if (st == RCB_ERR_NOMEM) break;
     if (st) { /* a candidate that cannot be built is reported, not fatal */
       if (!why[0]) snprintf(why, sizeof why, "not fitted: %.300s", d->errmsg);
@@ -570,9 +623,12 @@ static void sort_order(rcb_diag *d) {
     }
 }
 
-/* With the baseline run off, the candidates the score test ranks first at
- * the nominal model are refitted from there too (from both starts when
- * they are also among the best at the fitted model). */
+/* With the baseline run off, the RCB_DIAG_NOM_PREFITS candidates the score
+ * test ranks first at the nominal model are pre-fitted alone there
+ * (prefit), and the RCB_DIAG_NOM_REFITS best pre-fits are refitted jointly
+ * from where they ended (from both starts when they are also among the best
+ * at the fitted model). Sixteen: the hub of the 0.15 kg case scores 14th. */
+#define RCB_DIAG_NOM_PREFITS 16
 #define RCB_DIAG_NOM_REFITS 3
 
 static rcb_status refit_best(rcb_diag *d) {
@@ -586,12 +642,22 @@ static rcb_status refit_best(rcb_diag *d) {
     c->from_fit = c->refit_only || (todo < d->nrefit && c->predicted > 0);
     todo += !c->refit_only && c->from_fit;
   }
-  for (j = 0; d->far && j < RCB_DIAG_NOM_REFITS; j++) {
+  for (j = 0; !st && d->far && j < RCB_DIAG_NOM_PREFITS; j++) {
     diag_cand *c = NULL;
     for (k = 0; k < d->ncand; k++) {
       diag_cand *e = &d->cand[k];
-      if (!e->refit_only && !e->from_nom && e->predicted_nom > 0 &&
+      if (!e->refit_only && !e->prefitted && e->predicted_nom > 0 &&
           (!c || e->predicted_nom > c->predicted_nom))
+        c = e;
+    }
+    if (!c) break;
+    st = prefit(d, c, w);
+  }
+  for (j = 0; !st && d->far && j < RCB_DIAG_NOM_REFITS; j++) {
+    diag_cand *c = NULL;
+    for (k = 0; k < d->ncand; k++) {
+      diag_cand *e = &d->cand[k];
+      if (e->prefitted && !e->from_nom && e->pre_F < HUGE_VAL && (!c || e->pre_F < c->pre_F))
         c = e;
     }
     if (!c) break;
@@ -749,8 +815,8 @@ rcb_status rcb_diag_explain(const rcb_diag *d, char *buf, size_t size, size_t *n
     size_t n = strlen(text);
     snprintf(text + n, sizeof text - n,
              " The fit of the model as it is ran far from the nominal model (%s): a missing "
-             "effect pulls it there; the candidates were scored and refitted from the nominal "
-             "model too.",
+             "effect pulls it there; the candidates were also scored at the nominal model, the "
+             "best there fitted alone and refitted from where that ended.",
              d->drift);
   }
   return put_text(text, buf, size, needed);
