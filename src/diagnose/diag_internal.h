@@ -66,6 +66,7 @@ struct rcb_diag {
   double beta_a, beta_s, band_lo, band_hi;
   int have_band;
   size_t nrefit;
+  size_t nthreads;                  /* threads across candidates (parallel.c) */
   int (*progress)(void *user, size_t done, size_t total);
   void *progress_user;
   size_t progress_done;             /* steps reported: a count that only rises */
@@ -109,6 +110,17 @@ rcb_status rcb_diag_basis_init(rcb_diag *d, diag_basis *b, const double *J0, siz
                                size_t nb, const double *r);
 rcb_status rcb_diag_explained(rcb_diag *d, diag_basis *b, double *J, size_t np, double *pred);
 void rcb_diag_basis_free(rcb_diag *d, diag_basis *b);
+
+/* Jobs across candidates (parallel.c): job(d, i, ctx) for i in [0, n) on
+ * d->nthreads threads, each on its own shallow copy of d (its error message
+ * and counters, merged in job order), results bit for bit those of a serial
+ * run; after(d, i, ctx), when given, on the calling thread in job order (as
+ * each job ends when serial, once all have ended when threaded). The first
+ * failing job in job order decides the status and message. */
+typedef rcb_status (*rcb_diag_job)(rcb_diag *d, size_t i, void *ctx);
+typedef rcb_status (*rcb_diag_after)(rcb_diag *d, size_t i, void *ctx);
+rcb_status rcb_diag_for_each(rcb_diag *d, size_t n, rcb_diag_job job, void *ctx,
+                             rcb_diag_after after);
 
 /* Lay out every candidate effect of the (fitted) model m. */
 rcb_status rcb_diag_catalogue(rcb_diag *d, const rcb_model *m);

@@ -30,6 +30,7 @@ rcb_status rcb_diag_create(rcb_diag **out, const rcb_model *m, const rcb_meas *m
   d->meas = meas;
   d->scale = RCB_SCALE_LOG10;
   d->nrefit = 8;
+  d->nthreads = 1;
   *out = d;
   if (rcb_model_dof_count(m) == 0) return rcb_diag_fail(d, RCB_ERR_STATE, "model not finalized");
   return RCB_OK;
@@ -94,6 +95,12 @@ rcb_status rcb_diag_set_band(rcb_diag *d, double lo, double hi) {
 rcb_status rcb_diag_set_refits(rcb_diag *d, size_t n) {
   if (!d) return RCB_ERR_ARG;
   d->nrefit = n;
+  return RCB_OK;
+}
+
+rcb_status rcb_diag_set_threads(rcb_diag *d, size_t n) {
+  if (!d || n < 1 || n > RCB_DIAG_MAX_THREADS) return RCB_ERR_ARG;
+  d->nthreads = n;
   return RCB_OK;
 }
 
@@ -631,18 +638,40 @@ static void sort_order(rcb_diag *d) {
 #define RCB_DIAG_NOM_PREFITS 16
 #define RCB_DIAG_NOM_REFITS 3
 
-static rcb_status refit_best(rcb_diag *d) {
-  size_t k, j, done = 0, todo = 0;
-  double *w = NULL;
-  rcb_status st = subset(d, &w);
-  if (st) return st;
-  sort_order(d); /* by predicted reduction (nothing refitted yet) */
-  for (k = 0; k < d->ncand; k++) {
-    diag_cand *c = &d->cand[d->order[k]];
-    c->from_fit = c->refit_only || (todo < d->nrefit && c->predicted > 0);
-    todo += !c->refit_only && c->from_fit;
-  }
-  for (j = 0; !st && d->far && j < RCB_DIAG_NOM_PREFITS; j++) {
+/* The candidates a step fits, in order, for rcb_diag_for_each. */
+typedef struct cand_jobs {
+  diag_cand **c;
+  size_t n, todo; /* jobs; refits reported to the progress callback */
+  double *w;      /* the frequency subset, or NULL */
+} cand_jobs;
+
+static rcb_status prefit_job(rcb_diag *d, size_t i, void *ctx) {
+  cand_jobs *j = ctx;
+  return prefit(d, j->c[i], j->w);
+}
+
+static rcb_status refit_job(rcb_diag *d, size_t i, void *ctx) {
+  cand_jobs *j = ctx;
+  return refit(d, j->c[i], j->w);
+}
+
+/* After a refit: progress (scored candidates only; the count only rises). */
+static rcb_status refit_done(rcb_diag *d, size_t i, void *ctx) {
+  cand_jobs *j = ctx;
+  if (j->c[i]->refit_only) return RCB_OK;
+  if (d->progress_done < d->ncand) d->progress_done = d->ncand; /* refit-only ones */
+  if (d->progress && d->progress(d->progress_user, ++d->progress_done, d->ncand + j->todo))
+    return rcb_diag_fail(d, RCB_ERR_STATE, "stopped by the caller");
+  return RCB_OK;
+}
+
+/* With the baseline run off: the best RCB_DIAG_NOM_PREFITS at the nominal
+ * model pre-fitted alone there, the RCB_DIAG_NOM_REFITS best pre-fits
+ * marked for a refit from where they ended. */
+static rcb_status nominal_starts(rcb_diag *d, cand_jobs *j) {
+  size_t k, n;
+  rcb_status st;
+  for (j->n = 0; j->n < RCB_DIAG_NOM_PREFITS; j->n++) {
     diag_cand *c = NULL;
     for (k = 0; k < d->ncand; k++) {
       diag_cand *e = &d->cand[k];
@@ -651,9 +680,11 @@ static rcb_status refit_best(rcb_diag *d) {
         c = e;
     }
     if (!c) break;
-    st = prefit(d, c, w);
+    c->prefitted = 1;
+    j->c[j->n] = c;
   }
-  for (j = 0; !st && d->far && j < RCB_DIAG_NOM_REFITS; j++) {
+  if ((st = rcb_diag_for_each(d, j->n, prefit_job, j, NULL))) return st;
+  for (n = 0; n < RCB_DIAG_NOM_REFITS; n++) {
     diag_cand *c = NULL;
     for (k = 0; k < d->ncand; k++) {
       diag_cand *e = &d->cand[k];
@@ -661,23 +692,40 @@ static rcb_status refit_best(rcb_diag *d) {
         c = e;
     }
     if (!c) break;
-    todo += !c->from_fit;
+    j->todo += !c->from_fit;
     c->from_nom = 1;
   }
-  for (k = 0; !st && k < d->ncand; k++) {
-    diag_cand *c = &d->cand[d->order[k]];
-    if (c->refit_only || !(c->from_fit || c->from_nom)) continue;
-    st = refit(d, c, w);
-    done++;
-    if (d->progress_done < d->ncand) d->progress_done = d->ncand; /* refit-only ones */
-    if (!st && d->progress &&
-        d->progress(d->progress_user, ++d->progress_done, d->ncand + todo))
-      st = rcb_diag_fail(d, RCB_ERR_STATE, "stopped by the caller");
+  return RCB_OK;
+}
+
+static rcb_status refit_best(rcb_diag *d) {
+  size_t k;
+  cand_jobs j;
+  rcb_status st;
+  memset(&j, 0, sizeof j);
+  if ((st = subset(d, &j.w))) return st;
+  if (!(j.c = rcb_alloc(&d->alloc, (d->ncand ? d->ncand : 1) * sizeof *j.c))) {
+    rcb_free(&d->alloc, j.w);
+    return rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
   }
-  for (k = 0; !st && k < d->ncand; k++)
-    if (d->cand[k].refit_only) st = refit(d, &d->cand[k], w);
+  sort_order(d); /* by predicted reduction (nothing refitted yet) */
+  for (k = 0; k < d->ncand; k++) {
+    diag_cand *c = &d->cand[d->order[k]];
+    c->from_fit = c->refit_only || (j.todo < d->nrefit && c->predicted > 0);
+    j.todo += !c->refit_only && c->from_fit;
+  }
+  if (d->far) st = nominal_starts(d, &j);
+  /* the scored candidates in rank order, then those refitted only */
+  for (j.n = 0, k = 0; k < d->ncand; k++) {
+    diag_cand *c = &d->cand[d->order[k]];
+    if (!c->refit_only && (c->from_fit || c->from_nom)) j.c[j.n++] = c;
+  }
+  for (k = 0; k < d->ncand; k++)
+    if (d->cand[k].refit_only) j.c[j.n++] = &d->cand[k];
+  if (!st) st = rcb_diag_for_each(d, j.n, refit_job, &j, refit_done);
   if (!st) sort_order(d);
-  rcb_free(&d->alloc, w);
+  rcb_free(&d->alloc, j.w);
+  rcb_free(&d->alloc, j.c);
   return st;
 }
 
