@@ -650,25 +650,25 @@ static void sort_order(rcb_diag *d) {
 
 /* The candidates a step fits, in order, for rcb_diag_for_each. */
 typedef struct cand_jobs {
-  diag_cand **c;
+  size_t *k;      /* candidate indices */
   size_t n, todo; /* jobs; refits reported to the progress callback */
   double *w;      /* the frequency subset, or NULL */
 } cand_jobs;
 
 static rcb_status prefit_job(rcb_diag *d, size_t i, void *ctx) {
   cand_jobs *j = ctx;
-  return prefit(d, j->c[i], j->w);
+  return prefit(d, &d->cand[j->k[i]], j->w);
 }
 
 static rcb_status refit_job(rcb_diag *d, size_t i, void *ctx) {
   cand_jobs *j = ctx;
-  return refit(d, j->c[i], j->w);
+  return refit(d, &d->cand[j->k[i]], j->w);
 }
 
 /* After a refit: progress (scored candidates only; the count only rises). */
 static rcb_status refit_done(rcb_diag *d, size_t i, void *ctx) {
   cand_jobs *j = ctx;
-  if (j->c[i]->refit_only) return RCB_OK;
+  if (d->cand[j->k[i]].refit_only) return RCB_OK;
   if (d->progress_done < d->ncand) d->progress_done = d->ncand; /* refit-only ones */
   if (d->progress && d->progress(d->progress_user, ++d->progress_done, d->ncand + j->todo))
     return rcb_diag_fail(d, RCB_ERR_STATE, "stopped by the caller");
@@ -691,7 +691,7 @@ static rcb_status nominal_starts(rcb_diag *d, cand_jobs *j) {
     }
     if (!c) break;
     c->prefitted = 1;
-    j->c[j->n] = c;
+    j->k[j->n] = (size_t)(c - d->cand);
   }
   if ((st = rcb_diag_for_each(d, j->n, prefit_job, j, NULL))) return st;
   for (n = 0; n < RCB_DIAG_NOM_REFITS; n++) {
@@ -716,7 +716,7 @@ static rcb_status refit_best(rcb_diag *d) {
   rcb_status st;
   memset(&j, 0, sizeof j);
   if ((st = subset(d, &j.w))) return st;
-  if (!(j.c = rcb_alloc(&d->alloc, (d->ncand ? d->ncand : 1) * sizeof *j.c))) {
+  if (!(j.k = rcb_alloc(&d->alloc, (d->ncand ? d->ncand : 1) * sizeof *j.k))) {
     rcb_free(&d->alloc, j.w);
     return rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
   }
@@ -730,14 +730,14 @@ static rcb_status refit_best(rcb_diag *d) {
   /* the scored candidates in rank order, then those refitted only */
   for (j.n = 0, k = 0; k < d->ncand; k++) {
     diag_cand *c = &d->cand[d->order[k]];
-    if (!c->refit_only && (c->from_fit || c->from_nom)) j.c[j.n++] = c;
+    if (!c->refit_only && (c->from_fit || c->from_nom)) j.k[j.n++] = d->order[k];
   }
   for (k = 0; k < d->ncand; k++)
-    if (d->cand[k].refit_only) j.c[j.n++] = &d->cand[k];
+    if (d->cand[k].refit_only) j.k[j.n++] = k;
   if (!st) st = rcb_diag_for_each(d, j.n, refit_job, &j, refit_done);
   if (!st) sort_order(d);
   rcb_free(&d->alloc, j.w);
-  rcb_free(&d->alloc, j.c);
+  rcb_free(&d->alloc, j.k);
   return st;
 }
 
