@@ -195,6 +195,96 @@ static void test_hidden_speed(void **state) {
   hidden("speed.factor", 1.2, RCB_EFFECT_SPEED, "operating speed");
 }
 
+/* Run a diagnosis of ms on nthreads threads (paper model, coupling kt, kr,
+ * ct fitted). */
+static rcb_diag *run_on_threads(const rcb_model *m, const rcb_meas *ms, size_t nthreads) {
+  rcb_diag *d = NULL;
+  assert_int_equal(rcb_diag_create(&d, m, ms, NULL), RCB_OK);
+  assert_int_equal(rcb_diag_set_noise_model(d, 10.0, 1.0), RCB_OK);
+  assert_int_equal(rcb_diag_set_threads(d, nthreads), RCB_OK);
+  assert_int_equal(rcb_diag_add_fitted_param(d, "coupling.C.kt", 46.095, 46.095e6, 1), 0);
+  assert_int_equal(rcb_diag_add_fitted_param(d, "coupling.C.kr", 0.22076, 220760, 1), 0);
+  assert_int_equal(rcb_diag_add_fitted_param(d, "coupling.C.ct", 0.010949, 10949, 1), 0);
+  if (rcb_diag_run(d)) fail_msg("%s", rcb_diag_errmsg(d));
+  return d;
+}
+
+static void same_double(double a, double b, const char *what, size_t rank) {
+  if (memcmp(&a, &b, sizeof a) != 0)
+    fail_msg("rank %zu: %s %.17g (1 thread) vs %.17g (threads)", rank + 1, what, a, b);
+}
+
+/* Threads across candidates (rcb_diag_set_threads) give the results of one
+ * thread bit for bit: every candidate's rank, scores, refitted error,
+ * objective drop, BIC and fitted values, the work counters, the
+ * explanation and the applied model's parameters. The case is the hidden
+ * hub (0.07 kg), whose baseline fit runs off, so the pre-fits at the
+ * nominal model run on the threads too; 3 threads on 2 cores also
+ * exercises a thread taking jobs while another is descheduled. */
+static void test_threads_identical(void **state) {
+  rcb_model *truth = rcb_test_model_from_example("paper_system.ini");
+  rcb_model *m = rcb_test_model_from_example("paper_system.ini");
+  rcb_model *a1 = NULL, *a3 = NULL;
+  rcb_meas *ms;
+  rcb_diag *d1, *d3;
+  rcb_diag_stats s1, s3;
+  char t1[1536], t3[1536];
+  size_t k, n;
+  (void)state;
+  assert_int_equal(rcb_model_set_param(truth, "coupling.C.hub_mass", 0.07), RCB_OK);
+  ms = measure(truth, 1);
+  d1 = run_on_threads(m, ms, 1);
+  d3 = run_on_threads(m, ms, 3);
+  n = rcb_diag_candidate_count(d1);
+  assert_int_equal(rcb_diag_candidate_count(d3), n);
+  for (k = 0; k < n; k++) {
+    rcb_diag_candidate c1, c3;
+    assert_int_equal(rcb_diag_candidate_get(d1, k, &c1), RCB_OK);
+    assert_int_equal(rcb_diag_candidate_get(d3, k, &c3), RCB_OK);
+    assert_string_equal(c1.description, c3.description);
+    assert_int_equal(c1.refitted, c3.refitted);
+    assert_int_equal(c1.significant, c3.significant);
+    same_double(c1.predicted_pct, c3.predicted_pct, "score", k);
+    same_double(c1.error_pct, c3.error_pct, "error", k);
+    same_double(c1.objective_drop_pct, c3.objective_drop_pct, "objective drop", k);
+    same_double(c1.delta_bic, c3.delta_bic, "BIC", k);
+    assert_string_equal(c1.fitted, c3.fitted);
+  }
+  assert_int_equal(rcb_diag_get_stats(d1, &s1), RCB_OK);
+  assert_int_equal(rcb_diag_get_stats(d3, &s3), RCB_OK);
+  assert_int_equal(s1.evaluations, s3.evaluations);
+  assert_int_equal(s1.refits, s3.refits);
+  assert_int_equal(rcb_diag_explain(d1, t1, sizeof t1, NULL), RCB_OK);
+  assert_int_equal(rcb_diag_explain(d3, t3, sizeof t3, NULL), RCB_OK);
+  assert_string_equal(t1, t3);
+  assert_non_null(strstr(t1, "ran far from the nominal model")); /* the pre-fits ran */
+  {
+    rcb_diag_candidate c;
+    assert_int_equal(rcb_diag_candidate_get(d1, 0, &c), RCB_OK);
+    assert_int_equal(c.effect, RCB_EFFECT_COUPLING_HUB);
+  }
+  assert_int_equal(rcb_diag_apply_model(d1, 0, NULL, &a1), RCB_OK);
+  assert_int_equal(rcb_diag_apply_model(d3, 0, NULL, &a3), RCB_OK);
+  {
+    double v1, v3;
+    assert_int_equal(rcb_model_get_param(a1, "coupling.C.hub_mass", &v1), RCB_OK);
+    assert_int_equal(rcb_model_get_param(a3, "coupling.C.hub_mass", &v3), RCB_OK);
+    same_double(v1, v3, "applied hub mass", 0);
+    assert_int_equal(rcb_model_get_param(a1, "coupling.C.kt", &v1), RCB_OK);
+    assert_int_equal(rcb_model_get_param(a3, "coupling.C.kt", &v3), RCB_OK);
+    same_double(v1, v3, "applied kt", 0);
+  }
+  assert_int_equal(rcb_diag_set_threads(d1, 0), RCB_ERR_ARG);
+  assert_int_equal(rcb_diag_set_threads(d1, RCB_DIAG_MAX_THREADS + 1), RCB_ERR_ARG);
+  rcb_model_destroy(a1);
+  rcb_model_destroy(a3);
+  rcb_diag_destroy(d1);
+  rcb_diag_destroy(d3);
+  rcb_meas_destroy(ms);
+  rcb_model_destroy(m);
+  rcb_model_destroy(truth);
+}
+
 /* Nothing hidden: no candidate is significant. */
 static void test_null(void **state) {
   rcb_model *truth = rcb_test_model_from_example("paper_system.ini");
@@ -223,6 +313,7 @@ int main(void) {
       cmocka_unit_test(test_hidden_pedestal),
       cmocka_unit_test(test_hidden_speed),
       cmocka_unit_test(test_null),
+      cmocka_unit_test(test_threads_identical),
   };
   if (getenv("RCB_DIAG_ONLY")) cmocka_set_test_filter(getenv("RCB_DIAG_ONLY"));
   return cmocka_run_group_tests(tests, NULL, NULL);

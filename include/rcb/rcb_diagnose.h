@@ -87,6 +87,20 @@ RCB_API rcb_status rcb_diag_set_sd(rcb_diag *d, const double *sd, size_t n);
 RCB_API int rcb_diag_get_sd(const rcb_diag *d, double *sd, size_t n);
 /** @brief How many of the best-scored candidates to refit (default 8). */
 RCB_API rcb_status rcb_diag_set_refits(rcb_diag *d, size_t n);
+/** @brief At most this many threads across candidates. */
+#define RCB_DIAG_MAX_THREADS 64
+/**
+ * @brief Pre-fits and refits of the candidates on @p n POSIX threads (default
+ * 1; at most RCB_DIAG_MAX_THREADS). The results are the same bit for bit
+ * whatever @p n (each candidate is fitted on its own copy of the model);
+ * built without threads (RCB_WITH_THREADS=OFF) every candidate is fitted on
+ * the calling thread. The allocator hooks given to rcb_diag_create are then
+ * called from several threads at once: they must be thread-safe (NULL,
+ * malloc, is). The progress callback is called on the calling thread; the
+ * refits are reported once they have all ended.
+ * @return RCB_ERR_ARG when @p n is 0 or above RCB_DIAG_MAX_THREADS
+ */
+RCB_API rcb_status rcb_diag_set_threads(rcb_diag *d, size_t n);
 /** @brief Progress callback: called after each candidate is scored or refitted. */
 RCB_API rcb_status rcb_diag_set_progress(rcb_diag *d,
                                          int (*cb)(void *user, size_t done, size_t total),

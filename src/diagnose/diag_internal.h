@@ -42,6 +42,9 @@ typedef struct diag_cand {
   double predicted;                 /* score-test reduction of F */
   double predicted_nom;             /* the same at the nominal model (far baseline) */
   int from_fit, from_nom;           /* refitted from the fitted / the nominal base */
+  int prefitted;                    /* pre-fitted alone at the nominal model (far baseline) */
+  double pre_F;                     /* its objective there (HUGE_VAL: failed) */
+  double pre[RCB_DIAG_MAXP];        /* and its parameters, the start of the nominal refit */
   int refitted, significant;
   double F, err, dbic;
   char fitted[RCB_DIAG_MAXP * (RCB_DIAG_NAME + 32)];
@@ -65,6 +68,7 @@ struct rcb_diag {
   double *sd;                       /* known standard deviations (rcb_diag_set_sd), NULL:
                                        none; every fit weights by them */
   size_t nrefit;
+  size_t nthreads;                  /* threads across candidates (parallel.c) */
   int (*progress)(void *user, size_t done, size_t total);
   void *progress_user;
   size_t progress_done;             /* steps reported: a count that only rises */
@@ -89,6 +93,16 @@ struct rcb_diag {
 /* The error message of rcb_diag (core/rcb_internal.h, rcb_fail). */
 #define rcb_diag_fail(d, st, ...) rcb_fail((d), (st), __VA_ARGS__)
 
+/* Jobs across candidates (parallel.c): job(d, i, ctx) for i in [0, n) on
+ * d->nthreads threads, each on its own shallow copy of d (its error message
+ * and counters, merged in job order), results bit for bit those of a serial
+ * run; after(d, i, ctx), when given, on the calling thread in job order (as
+ * each job ends when serial, once all have ended when threaded). The first
+ * failing job in job order decides the status and message. */
+typedef rcb_status (*rcb_diag_job)(rcb_diag *d, size_t i, void *ctx);
+typedef rcb_status (*rcb_diag_after)(rcb_diag *d, size_t i, void *ctx);
+rcb_status rcb_diag_for_each(rcb_diag *d, size_t n, rcb_diag_job job, void *ctx,
+                             rcb_diag_after after);
 
 /* Before a refit of candidate c on its model m (fit f, base parameters
  * fitted): move the candidate's parameters to a better start where the

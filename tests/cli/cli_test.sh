@@ -1145,6 +1145,8 @@ diagnose_usage)
   usage diagnose "$MODEL"; err_has "missing the measurement"
   usage diagnose "$MODEL" "$W/m.csv" --apply 1; err_has "-o MODEL2.ini"
   run diagnose "$MODEL" "$W/m.csv" --params coupling.C.zz; expect_rc 3; err_has "coupling.C.zz"
+  usage diagnose "$MODEL" "$W/m.csv" --threads 0; err_has "--threads expects a whole number >= 1"
+  usage diagnose "$MODEL" "$W/m.csv" --threads 65; err_has "--threads 65: from 1 to 64"
   run history "$W/none.jsonl"; expect_rc 3; err_has "none.jsonl" ;;
 # ---- time integration (SUNDIALS; skipped when librcb is built without it) ----
 transient_csv)

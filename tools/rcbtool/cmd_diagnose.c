@@ -13,7 +13,7 @@ const char cli_help_diagnose[] =
     "                        [--log] [--scale linear|log10|db|complex] [--noise A,S|--sd FILE]\n"
     "                        [--band LO:HI] [--map NODE=STATION,...] [--rpm R] [--refits N]\n"
     "                        [--top N] [--apply K -o MODEL2.ini] [--history FILE]\n"
-    "                        [--json] [--progress]\n"
+    "                        [--threads N] [--json] [--progress]\n"
     "\n"
     "Fits the model as it is (the --params, e.g. the coupling's kt and kr), then\n"
     "scores every effect of the catalogue at every place it can occur: coupling\n"
@@ -36,6 +36,8 @@ const char cli_help_diagnose[] =
     "  --band LO:HI   use only this band: Hz for FRF data, rpm for unbalance data\n"
     "  --refits N     candidates refitted (default 8)\n"
     "  --top N        candidates to print (default 10)\n"
+    "  --threads N    fit the candidates on N threads (default 1); the same\n"
+    "                 numbers bit for bit\n"
     "  --apply K      with -o FILE: write the model with candidate K (1 = best)\n"
     "                 added and fitted, atomically; the input model is untouched\n"
     "  --history FILE record this step (rcbtool history FILE shows the steps)\n"
@@ -57,7 +59,7 @@ typedef struct diag_job {
   cli_params params;
   int have_params, log_all, scale, have_noise, have_band, have_sd;
   double beta_a, beta_s, band_lo, band_hi;
-  size_t refits, top, apply;
+  size_t refits, top, apply, threads;
   const char *history;
 } diag_job;
 
@@ -81,6 +83,7 @@ static int parse_job(const cli_args *a, diag_job *j) {
   if ((rc = cli_opt_choice(a, "--scale", scale_names, 4, RCB_SCALE_LOG10, &j->scale)) ||
       (rc = cli_opt_count(a, "--refits", 8, &j->refits)) ||
       (rc = cli_opt_count(a, "--top", 10, &j->top)) ||
+      (rc = cli_opt_count(a, "--threads", 1, &j->threads)) ||
       (rc = cli_opt_count(a, "--apply", 0, &j->apply)))
     return rc;
   if ((j->have_noise = cli_opt_value(a, "--noise") != NULL) &&
@@ -115,6 +118,8 @@ static int setup(const cli_args *a, const diag_job *j, const rcb_model *m, const
   if (!st && j->have_band) st = rcb_diag_set_band(d, j->band_lo * unit, j->band_hi * unit);
   if (!st) st = rcb_diag_set_refits(d, j->refits);
   if (st) return cli_usage(a->cmd, "invalid --noise, --band or --refits value");
+  if (rcb_diag_set_threads(d, j->threads))
+    return cli_usage(a->cmd, "--threads %zu: from 1 to %d", j->threads, RCB_DIAG_MAX_THREADS);
   for (k = 0; j->have_params && k < j->params.n; k++) {
     const cli_param_spec *p = &j->params.items[k];
     double v, lo = 0, hi = 0;
@@ -315,6 +320,7 @@ int cmd_diagnose(int argc, char **argv) {
                     {"--rpm", "R", NULL},
                     {"--refits", "N", NULL},
                     {"--top", "N", NULL},
+                    {"--threads", "N", NULL},
                     {"--apply", "K", NULL},
                     {"--history", "FILE", NULL}};
   size_t nopts = sizeof opts / sizeof opts[0];
