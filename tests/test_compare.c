@@ -3,6 +3,8 @@
  *  - a model compared with its own simulated data: error 0, FRAC 1, CSAC 1,
  *    CSF 1, zero log and phase errors, an empty residual map (FRFs of every
  *    kind, unbalance responses); every measured peak paired;
+ *  - with known standard deviations: chi-square per dof ~ 1 (4 with sds
+ *    halved) and the noise floor in closed form;
  *  - a pure frequency scaling (every stiffness x a, every damper x sqrt(a),
  *    mass unchanged, at rest: every eigenvalue x sqrt(a)) gives a peak
  *    frequency error of 100 (1/sqrt(a) - 1) % on every paired peak;
@@ -580,6 +582,88 @@ static void test_errors_and_allocator(void **state) {
   rcb_model_destroy(m);
 }
 
+/* Known standard deviations (issue #15, rcb_compare_set_sd): the measurement
+ * is the model plus complex Gaussian noise of sd 2 % of |H| on Re and Im
+ * (Box-Muller on the test's own LCG); the chi-square per degree of freedom
+ * is then chi2(2N)/(2N): mean 1, sd 1/sqrt(N), and 4 when the stated sds are
+ * half the true ones. The floor is the closed form 100 sqrt(sum sd^2 / sum
+ * |e|^2). A count that does not match the measurement is refused; NULL
+ * clears (NaN). */
+static double lcg_uniform(unsigned long long *s) {
+  *s = *s * 6364136223846793005ULL + 1442695040888963407ULL;
+  return ((double)(*s >> 11) + 0.5) / 9007199254740992.0;
+}
+
+static void test_known_sd(void **state) {
+  static const char *const outs[] = {"DA.x", "DB.x"};
+  static const char *const ins[] = {"DA.x", "DA.x"};
+  rcb_model *m = paper();
+  rcb_meas *clean = frf_meas(m, outs, ins, 2, 20.0, 400.0, 500, 3000.0, RCB_RECEPTANCE), *ms;
+  size_t n = 500, k, i;
+  double *sd = calloc(2 * n, sizeof *sd), *half = calloc(2 * n, sizeof *half), s2 = 0, e2 = 0;
+  rcb_complex *col = calloc(n, sizeof *col);
+  unsigned long long seed = 12345;
+  rcb_compare *c = NULL;
+  rcb_compare_summary s;
+  rcb_compare_channel ch;
+  (void)state;
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, n, rcb_meas_grid(clean), 3000.0 * RPM),
+                   RCB_OK);
+  for (k = 0; k < 2; k++) {
+    rcb_meas_channel_info ci;
+    rcb_meas_channel(clean, k, &ci);
+    for (i = 0; i < n; i++) {
+      double u1 = lcg_uniform(&seed), u2 = lcg_uniform(&seed), r = sqrt(-2.0 * log(u1));
+      double sdev = 0.02 * cabs(ci.data[i]);
+      col[i] = ci.data[i] + sdev * r * CMPLX(cos(TWO_PI * u2), sin(TWO_PI * u2));
+      sd[k * n + i] = sdev;
+      half[k * n + i] = 0.5 * sdev;
+      s2 += sdev * sdev;
+      e2 += creal(col[i] * conj(col[i]));
+    }
+    assert_int_equal(rcb_meas_add_channel(ms, ci.response, ci.reference, ci.kind, col), RCB_OK);
+  }
+  assert_int_equal(rcb_compare_create(&c, NULL), RCB_OK);
+  /* without sds: NaN */
+  assert_int_equal(rcb_compare_run(c, m, ms), RCB_OK);
+  assert_int_equal(rcb_compare_get_summary(c, &s), RCB_OK);
+  assert_true(isnan(s.floor_pct) && isnan(s.chi2_dof));
+  /* the true sds: chi2/dof within 4 of its sd 1/sqrt(2N) */
+  assert_int_equal(rcb_compare_set_sd(c, sd, 2 * n), RCB_OK);
+  assert_int_equal(rcb_compare_run(c, m, ms), RCB_OK);
+  assert_int_equal(rcb_compare_get_summary(c, &s), RCB_OK);
+  assert_true(fabs(s.chi2_dof - 1.0) < 4.0 / sqrt(2.0 * (double)n));
+  assert_true(fabs(s.floor_pct - 100.0 * sqrt(s2 / e2)) < 1e-9 * s.floor_pct);
+  for (k = 0; k < 2; k++) {
+    assert_int_equal(rcb_compare_get_channel(c, k, &ch), RCB_OK);
+    assert_true(fabs(ch.chi2_dof - 1.0) < 4.0 / sqrt((double)n));
+    assert_true(ch.floor_pct > 1.0 && ch.floor_pct < 3.0); /* 2 % of |e|, |e| noisy */
+  }
+  /* sds stated too small by 2: chi2/dof about 4 */
+  assert_int_equal(rcb_compare_set_sd(c, half, 2 * n), RCB_OK);
+  assert_int_equal(rcb_compare_run(c, m, ms), RCB_OK);
+  assert_int_equal(rcb_compare_get_summary(c, &s), RCB_OK);
+  assert_true(fabs(s.chi2_dof - 4.0) < 16.0 / sqrt(2.0 * (double)n));
+  /* refusals: a wrong count at run, a negative value at set; NULL clears */
+  assert_int_equal(rcb_compare_set_sd(c, sd, n), RCB_OK);
+  assert_int_equal(rcb_compare_run(c, m, ms), RCB_ERR_ARG);
+  assert_non_null(strstr(rcb_compare_errmsg(c), "2 channels x 500 points"));
+  half[3] = -1.0;
+  assert_int_equal(rcb_compare_set_sd(c, half, 2 * n), RCB_ERR_ARG);
+  assert_int_equal(rcb_compare_set_sd(c, NULL, 0), RCB_OK);
+  assert_int_equal(rcb_compare_run(c, m, ms), RCB_OK);
+  assert_int_equal(rcb_compare_get_summary(c, &s), RCB_OK);
+  assert_true(isnan(s.chi2_dof));
+  rcb_compare_destroy(c);
+  rcb_meas_destroy(ms);
+  rcb_meas_destroy(clean);
+  rcb_model_destroy(m);
+  free(sd);
+  free(half);
+  free(col);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_self_frf),
@@ -594,6 +678,7 @@ int main(void) {
       cmocka_unit_test(test_modal_fit_gyroscopic),
       cmocka_unit_test(test_known_values),
       cmocka_unit_test(test_errors_and_allocator),
+      cmocka_unit_test(test_known_sd),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -50,6 +50,20 @@ RCB_API rcb_status rcb_compare_set_bands(rcb_compare *c, size_t nbands);
 RCB_API rcb_status rcb_compare_set_peaks(rcb_compare *c, double prominence_db, double freq_tol);
 
 /**
+ * @brief Known standard deviations of the measured values (issue #15: from
+ * `rcbtool estimate --stats` / `order --stats`, as rcb_fit_set_sd): @p sd[k *
+ * npoints + i] is the standard deviation of Re and of Im of channel k at point
+ * i, in the measurement's SI unit (e.g. m/N); 0 or NaN leaves the point out
+ * of the chi-square. With them every run also reports the noise floor (the
+ * error % the sds alone explain) and the chi-square per degree of freedom of
+ * each channel (about 1 when the model and the measurement agree to within
+ * the noise). The values are copied; @p n must equal channels x points of the
+ * measurement of the next run (checked there). @p sd NULL (n 0) clears them.
+ * @return RCB_ERR_ARG for a negative or infinite value, RCB_ERR_NOMEM
+ */
+RCB_API rcb_status rcb_compare_set_sd(rcb_compare *c, const double *sd, size_t n);
+
+/**
  * @brief Compare model @p m (finalized) with measurement @p ms: evaluates the
  * model at every point (a point where the model matrix is singular, e.g. a
  * free rotor at 0 Hz, is left out as NaN), computes every result below.
@@ -71,6 +85,11 @@ typedef struct rcb_compare_channel {
   double phase_rms_deg;   /**< RMS of arg(m) - arg(e) wrapped to (-180, 180], deg */
   const rcb_complex *meas;  /**< measured values, rcb_compare_point_count of them */
   const rcb_complex *model; /**< model values, same kind and units (NaN where left out) */
+  double floor_pct;       /**< noise floor: 100 sqrt(sum sd^2 / sum |e|^2), % (NaN without
+                               rcb_compare_set_sd) */
+  double chi2_dof;        /**< sum |m - e|^2 / (2 sd^2) over the points with sd > 0, divided
+                               by 2 x their count (Re and Im): ~1 at the noise (NaN without
+                               sds) */
 } rcb_compare_channel;
 
 /** @brief Totals over every channel and point. */
@@ -81,6 +100,9 @@ typedef struct rcb_compare_summary {
   double phase_rms_deg; /**< RMS phase error over all points, deg */
   double csac_mean;     /**< mean CSAC over frequencies */
   double csf_mean;      /**< mean CSF over frequencies */
+  double floor_pct;     /**< noise floor % over all channels (NaN without sds) */
+  double chi2_dof;      /**< chi-square per degree of freedom over all channels (NaN
+                             without sds) */
 } rcb_compare_summary;
 
 RCB_API size_t rcb_compare_channel_count(const rcb_compare *c);

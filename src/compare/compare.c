@@ -30,7 +30,8 @@ static void free_results(rcb_compare *c) {
   const rcb_allocator *a = &c->alloc;
   void *ptrs[] = {c->grid, c->meas,  c->model, c->names, (void *)c->resp, (void *)c->ref,
                   c->kind, c->err,   c->frac,  c->lrms,  c->prms,         c->csac,
-                  c->csf,  c->map,   c->peaks, c->band_first, c->band_count};
+                  c->csf,  c->map,   c->peaks, c->band_first, c->band_count,
+                  c->floor, c->chi2};
   size_t k;
   for (k = 0; k < sizeof ptrs / sizeof ptrs[0]; k++) rcb_free(a, ptrs[k]);
   c->grid = NULL;
@@ -39,6 +40,7 @@ static void free_results(rcb_compare *c) {
   c->resp = c->ref = NULL;
   c->kind = NULL;
   c->err = c->frac = c->lrms = c->prms = c->csac = c->csf = c->map = NULL;
+  c->floor = c->chi2 = NULL;
   c->peaks = NULL;
   c->band_first = c->band_count = NULL;
   c->nch = c->npts = c->nbands = c->npeaks = 0;
@@ -50,6 +52,7 @@ void rcb_compare_destroy(rcb_compare *c) {
   if (!c) return;
   free_results(c);
   a = c->alloc;
+  rcb_free(&a, c->sd);
   rcb_free(&a, c);
 }
 
@@ -74,6 +77,25 @@ rcb_status rcb_compare_set_peaks(rcb_compare *c, double prominence_db, double fr
                         freq_tol);
   c->prom_db = prominence_db;
   c->tol = freq_tol;
+  return RCB_OK;
+}
+
+rcb_status rcb_compare_set_sd(rcb_compare *c, const double *sd, size_t n) {
+  double *copy = NULL;
+  size_t i;
+  if (!c) return RCB_ERR_ARG;
+  if (sd && n) {
+    for (i = 0; i < n; i++)
+      if (sd[i] < 0 || isinf(sd[i]))
+        return rcb_cmp_fail(c, RCB_ERR_ARG, "standard deviation %zu is %g: expected >= 0 "
+                            "and finite (0 or NaN leaves the point out)", i, sd[i]);
+    if (!(copy = rcb_alloc(&c->alloc, n * sizeof *copy)))
+      return rcb_cmp_fail(c, RCB_ERR_NOMEM, "out of memory");
+    memcpy(copy, sd, n * sizeof *copy);
+  }
+  rcb_free(&c->alloc, c->sd);
+  c->sd = copy;
+  c->nsd = copy ? n : 0;
   return RCB_OK;
 }
 
@@ -158,6 +180,8 @@ static rcb_status alloc_results(rcb_compare *c) {
   c->frac = rcb_alloc(a, nc * sizeof *c->frac);
   c->lrms = rcb_alloc(a, nc * sizeof *c->lrms);
   c->prms = rcb_alloc(a, nc * sizeof *c->prms);
+  c->floor = rcb_alloc(a, nc * sizeof *c->floor);
+  c->chi2 = rcb_alloc(a, nc * sizeof *c->chi2);
   c->csac = rcb_alloc(a, n * sizeof *c->csac);
   c->csf = rcb_alloc(a, n * sizeof *c->csf);
   c->map = rcb_alloc(a, nc * nb * sizeof *c->map);
@@ -165,7 +189,7 @@ static rcb_status alloc_results(rcb_compare *c) {
   c->band_count = rcb_alloc(a, nb * sizeof *c->band_count);
   if (!c->grid || !c->meas || !c->model || !c->resp || !c->ref || !c->kind || !c->err ||
       !c->frac || !c->lrms || !c->prms || !c->csac || !c->csf || !c->map || !c->band_first ||
-      !c->band_count)
+      !c->band_count || !c->floor || !c->chi2)
     return rcb_cmp_fail(c, RCB_ERR_NOMEM, "out of memory for the comparison results");
   return RCB_OK;
 }
@@ -245,6 +269,27 @@ static void add_point(sums *s, double complex e, double complex m) {
   }
 }
 
+/* Noise floor % and chi-square per degree of freedom of channel k (all
+ * channels for k == nch) from the known sds: NaN without them. */
+static void sd_metrics(const rcb_compare *c, size_t k, double *floor_pct, double *chi2) {
+  double s2 = 0.0, e2 = 0.0, x2 = 0.0;
+  size_t n = 0, k0 = k < c->nch ? k : 0, k1 = k < c->nch ? k + 1 : c->nch, i;
+  *floor_pct = *chi2 = (double)NAN;
+  if (!c->sd) return;
+  for (k = k0; k < k1; k++)
+    for (i = 0; i < c->npts; i++) {
+      rcb_complex e = c->meas[k * c->npts + i], m = c->model[k * c->npts + i], d = m - e;
+      double sd = c->sd[k * c->npts + i];
+      if (!usable(e, m) || !(sd > 0)) continue;
+      s2 += sd * sd;
+      e2 += creal(e * conj(e));
+      x2 += creal(d * conj(d)) / (sd * sd);
+      n++;
+    }
+  if (e2 > 0) *floor_pct = 100.0 * sqrt(s2 / e2);
+  if (n) *chi2 = x2 / (2.0 * (double)n);
+}
+
 static void channel_metrics(rcb_compare *c) {
   sums all;
   size_t k, i;
@@ -266,7 +311,9 @@ static void channel_metrics(rcb_compare *c) {
     c->lrms[k] = s.nl ? sqrt(s.l2 / (double)s.nl) : (double)NAN;
     c->prms[k] = s.np ? sqrt(s.p2 / (double)s.np) : (double)NAN;
     fsum += c->frac[k];
+    sd_metrics(c, k, &c->floor[k], &c->chi2[k]);
   }
+  sd_metrics(c, c->nch, &c->sum.floor_pct, &c->sum.chi2_dof);
   c->sum.error_pct = all.den > 0 ? 100.0 * sqrt(all.num / all.den) : (double)NAN;
   c->sum.frac_mean = fsum / (double)c->nch;
   c->sum.log_rms = all.nl ? sqrt(all.l2 / (double)all.nl) : (double)NAN;
@@ -360,6 +407,14 @@ rcb_status rcb_compare_run(rcb_compare *c, const rcb_model *m, const rcb_meas *m
                         "least one channel with one point", rcb_meas_point_count(ms),
                         rcb_meas_channel_count(ms));
   }
+  if (c->sd && c->nsd != c->nch * c->npts) {
+    size_t nsd = c->nsd, nch = c->nch, npts = c->npts;
+    c->npts = c->nch = 0;
+    return rcb_cmp_fail(c, RCB_ERR_ARG,
+                        "%zu standard deviations set (rcb_compare_set_sd) for a measurement "
+                        "of %zu channels x %zu points: expected %zu", nsd, nch, npts,
+                        nch * npts);
+  }
   c->nbands = c->nbands_req < c->npts ? c->nbands_req : c->npts;
   memset(&ev, 0, sizeof ev);
   ev.m = m;
@@ -406,6 +461,8 @@ rcb_status rcb_compare_get_channel(const rcb_compare *c, size_t i, rcb_compare_c
   out->frac = c->frac[i];
   out->log_rms = c->lrms[i];
   out->phase_rms_deg = c->prms[i];
+  out->floor_pct = c->floor[i];
+  out->chi2_dof = c->chi2[i];
   out->meas = c->meas + i * c->npts;
   out->model = c->model + i * c->npts;
   return RCB_OK;

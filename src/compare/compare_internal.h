@@ -12,6 +12,8 @@ struct rcb_compare {
   size_t nbands_req;   /* requested bands */
   double prom_db;      /* peak prominence, dB */
   double tol;          /* relative frequency tolerance of the pairing */
+  double *sd;          /* nsd known standard deviations (rcb_compare_set_sd), NULL: none */
+  size_t nsd;
   /* results */
   int done;
   rcb_meas_type type;
@@ -23,6 +25,7 @@ struct rcb_compare {
   const char **resp, **ref;    /* nch each, into names (ref NULL for unbalance) */
   rcb_frf_kind *kind;          /* nch */
   double *err, *frac, *lrms, *prms; /* nch */
+  double *floor, *chi2;        /* nch, NaN without sds */
   double *csac, *csf;          /* npts */
   size_t *band_first, *band_count; /* nbands */
   double *map;                 /* nch * nbands */

@@ -16,7 +16,7 @@
 const char cli_help_compare[] =
     "usage: rcbtool compare MODEL.ini MEAS.uff|MEAS.unv|MEAS.csv [--map NODE=STATION,...]\n"
     "                       [--rpm R] [--bands N] [--worst N] [--prominence DB] [--tol PCT]\n"
-    "                       [--plot PREFIX] [--json] [-o FILE]\n"
+    "                       [--sd STATS.csv] [--plot PREFIX] [--json] [-o FILE]\n"
     "\n"
     "Compares the model with a measurement (FRFs at a rotor speed, synchronous FRFs,\n"
     "or unbalance responses over speed): the model is evaluated at every measured\n"
@@ -25,6 +25,10 @@ const char cli_help_compare[] =
     "                   the model's [uff] map; nodes without one read as \"#N\" (warned)\n"
     "  --rpm R          rotor speed of an FRF test, rpm (default: the file's, else the\n"
     "                   model's [test] rpm, else 0 with a warning)\n"
+    "  --sd FILE        standard deviations of the measured values (the --stats file\n"
+    "                   of rcbtool estimate or order): adds each channel's noise floor\n"
+    "                   % and chi-square per degree of freedom (about 1 when the model\n"
+    "                   agrees with the measurement to within its noise)\n"
     "  --bands N        frequency bands of the residual map (default 10)\n"
     "  --worst N        bands listed as the worst (default 3)\n"
     "  --prominence DB  a measured resonance stands at least DB above the higher of\n"
@@ -50,7 +54,8 @@ const char cli_help_compare[] =
     "Abscissa on output: Hz for FRFs, rpm for unbalance responses.\n"
     "JSON: {\"type\", \"x_unit\", \"x\": [...], \"rpm\", \"summary\": {...}, \"channels\":\n"
     "[{\"response\", \"reference\", \"kind\", \"error_pct\", \"frac\", \"log_rms\",\n"
-    "\"phase_rms_deg\", \"meas_re\", \"meas_im\", \"model_re\", \"model_im\"}], \"csac\",\n"
+    "\"phase_rms_deg\", \"floor_pct\", \"chi2_dof\" (null without --sd), \"meas_re\",\n"
+    "\"meas_im\", \"model_re\", \"model_im\"}], \"csac\",\n"
     "\"csf\", \"bands\": [{\"lo\", \"hi\", \"first\", \"count\", \"rms\"}], \"residual_map\":\n"
     "[[per band] per channel], \"worst_bands\": [...], \"peaks\": [{\"match\", ...}]}\n"
     "Exit codes: 2 usage, 3 bad model or measurement (a channel the model does not\n"
@@ -136,14 +141,22 @@ static void print_channels(FILE *fp, const rcb_compare *c) {
           "RMS phase error %.3g deg, mean CSAC %.4f, mean CSF %.4f\n\n",
           s.error_pct, s.frac_mean, s.log_rms, pow(10.0, s.log_rms), s.phase_rms_deg,
           s.csac_mean, s.csf_mean);
-  fprintf(fp, "%-14s %-14s %-10s %10s %8s %9s %10s\n", "channel", "reference", "kind",
+  if (!isnan(s.chi2_dof))
+    fprintf(fp, "noise (--sd): floor %.3g %% (the error the standard deviations alone "
+            "explain), chi-square per degree of freedom %.4g (about 1 at the noise)\n\n",
+            s.floor_pct, s.chi2_dof);
+  fprintf(fp, "%-14s %-14s %-10s %10s %8s %9s %10s", "channel", "reference", "kind",
           "error_%", "FRAC", "log_rms", "phase_deg");
+  if (!isnan(s.chi2_dof)) fprintf(fp, " %9s %10s", "floor_%", "chi2/dof");
+  fputc('\n', fp);
   for (k = 0; k < nch; k++) {
     rcb_compare_channel ch;
     rcb_compare_get_channel(c, k, &ch);
-    fprintf(fp, "%-14s %-14s %-10s %10.4g %8.4f %9.4f %10.3g\n", ch.response,
+    fprintf(fp, "%-14s %-14s %-10s %10.4g %8.4f %9.4f %10.3g", ch.response,
             ch.reference ? ch.reference : "-", kind_name(ch.kind), ch.error_pct, ch.frac,
             ch.log_rms, ch.phase_rms_deg);
+    if (!isnan(s.chi2_dof)) fprintf(fp, " %9.4g %10.4g", ch.floor_pct, ch.chi2_dof);
+    fputc('\n', fp);
   }
 }
 
@@ -271,6 +284,8 @@ static void json_channels(FILE *fp, const rcb_compare *c) {
     json_key_num(fp, "frac", ch.frac, 1);
     json_key_num(fp, "log_rms", ch.log_rms, 1);
     json_key_num(fp, "phase_rms_deg", ch.phase_rms_deg, 1);
+    json_key_num(fp, "floor_pct", ch.floor_pct, 1);
+    json_key_num(fp, "chi2_dof", ch.chi2_dof, 1);
     fputs(",\n  \"meas_re\": ", fp);
     json_complex_parts(fp, ch.meas, n, 0);
     fputs(",\n  \"meas_im\": ", fp);
@@ -367,6 +382,8 @@ static void print_json(FILE *fp, const cli_args *a, const cmp_job *j, const rcb_
   json_key_num(fp, "phase_rms_deg", s.phase_rms_deg, 1);
   json_key_num(fp, "csac_mean", s.csac_mean, 1);
   json_key_num(fp, "csf_mean", s.csf_mean, 1);
+  json_key_num(fp, "floor_pct", s.floor_pct, 1);
+  json_key_num(fp, "chi2_dof", s.chi2_dof, 1);
   fputc('}', fp);
   json_channels(fp, c);
   fputs(",\n\"csac\": ", fp);
@@ -456,6 +473,16 @@ static int run(const cli_args *a, cmp_job *j) {
     rc = cli_fail(CLI_EXIT_NUMERIC, "out of memory");
     goto done;
   }
+  if (cli_opt_value(a, "--sd")) {
+    double *sd = NULL;
+    if ((rc = cli_sd_read(cli_opt_value(a, "--sd"), ms, &sd))) goto done;
+    st = rcb_compare_set_sd(c, sd, rcb_meas_channel_count(ms) * rcb_meas_point_count(ms));
+    free(sd);
+    if (st) {
+      rc = cli_fail(CLI_EXIT_INPUT, "%s: --sd: %s", a->cmd, rcb_compare_errmsg(c));
+      goto done;
+    }
+  }
   if ((st = rcb_compare_set_bands(c, j->bands)) ||
       (st = rcb_compare_set_peaks(c, j->prom_db, j->tol_pct / 100.0)) ||
       (st = rcb_compare_run(c, m, ms))) {
@@ -493,7 +520,8 @@ int cmd_compare(int argc, char **argv) {
   cli_opt opts[] = {{"--map", "NODE=STATION,...", NULL}, {"--rpm", "R", NULL},
                     {"--bands", "N", NULL},
                     {"--worst", "N", NULL},              {"--prominence", "DB", NULL},
-                    {"--tol", "PCT", NULL},              {"--plot", "PREFIX", NULL}};
+                    {"--tol", "PCT", NULL},              {"--plot", "PREFIX", NULL},
+                    {"--sd", "FILE", NULL}};
   size_t nopts = sizeof opts / sizeof opts[0];
   cmp_job j;
   cli_args a;

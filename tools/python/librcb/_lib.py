@@ -95,13 +95,14 @@ class DiagCandidate(ctypes.Structure):
 class CompareChannel(ctypes.Structure):
     _fields_ = [("response", c_char_p), ("reference", c_char_p), ("kind", c_int),
                 ("error_pct", c_double), ("frac", c_double), ("log_rms", c_double),
-                ("phase_rms_deg", c_double), ("meas", c_void_p), ("model", c_void_p)]
+                ("phase_rms_deg", c_double), ("meas", c_void_p), ("model", c_void_p),
+                ("floor_pct", c_double), ("chi2_dof", c_double)]
 
 
 class CompareSummary(ctypes.Structure):
     _fields_ = [("error_pct", c_double), ("frac_mean", c_double), ("log_rms", c_double),
                 ("phase_rms_deg", c_double), ("csac_mean", c_double),
-                ("csf_mean", c_double)]
+                ("csf_mean", c_double), ("floor_pct", c_double), ("chi2_dof", c_double)]
 
 
 # rcb_monitor.h (issue #16); the array sizes are RCB_MONITOR_MAX_TRACKED,
