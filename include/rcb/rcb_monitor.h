@@ -14,8 +14,9 @@
  *    (radial, tangential) frame of e_0 and divided by its standard deviation:
  *    the eq. 19 noise model (beta_a along e_0 with variance
  *    (beta_a/100)^2 |e_0|^2 / 3, beta_s circular with variance a^2 / 6 per
- *    component, a = beta_s/100 sqrt(sum_j |e_0j|^2) / n) or per-point
- *    standard deviations, for the new measurement and for the commissioning
+ *    component, a = beta_s/100 sqrt(sum_j |e_0j|^2) / n; with phase noise
+ *    +-phase_deg, uniform, (phase_deg pi/180)^2 |e_0|^2 / 3 more on the
+ *    tangential axis) or per-point standard deviations, for the new measurement and for the commissioning
  *    one (divided by the number of measurements averaged into it). The
  *    baseline model's own bias (model minus commissioning measurement) is
  *    therefore never a change.
@@ -129,6 +130,11 @@ typedef struct rcb_monitor_opts {
                           near them (O(n k) per update). Proportional noise
                           grows with the response: after a large change (a
                           resonance moved) only 1 keeps T chi-square */
+  double phase_deg;  /**< phase noise of one measurement, degrees: each point
+                          turned by an angle uniform in +-phase_deg (issue
+                          #14's noise), tangential variance
+                          |e|^2 (phase_deg pi/180)^2 / 3 added to the eq. 19
+                          model's (used when sd is NULL); 0: none */
 } rcb_monitor_opts;
 
 /** @brief One ranked candidate effect in a result. */

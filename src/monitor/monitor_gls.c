@@ -29,7 +29,9 @@ static void point_cov(const rcb_monitor *mon, const rcb_complex *v, const double
     double av = cabs(v[p]), sp = mon->beta_a / 100.0 * av;
     double complex w = av > 0 ? conj(mon->u[p]) * v[p] / av : 1.0;
     double c = creal(w), s = cimag(w), vp = sp * sp / 3.0, va = a * a / 6.0;
-    s11 = vp * c * c + va, s12 = vp * c * s, s22 = vp * s * s + va;
+    double vph = mon->phase_var * av * av; /* phase turn: across the new value */
+    s11 = vp * c * c + vph * s * s + va, s12 = (vp - vph) * c * s;
+    s22 = vp * s * s + vph * c * c + va;
   }
   s11 += mon->var0[2 * p] * mon->navg_inv;
   s22 += mon->var0[2 * p + 1] * mon->navg_inv;

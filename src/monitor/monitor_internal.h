@@ -16,6 +16,7 @@
 #include "rcb/rcb_monitor.h"
 
 #define RCB_MONITOR_NAME 128
+#define RCB_MON_DEG 0.017453292519943295 /* rad per degree */
 
 /* A candidate in the rank space (dimension k): its estimate rows and the
  * orthonormal directions it adds beyond the tracked parameters. */
@@ -93,6 +94,7 @@ struct rcb_monitor {
   /* noise of the reweighted path */
   int reweight, have_sd0;
   double beta_a, beta_s, navg_inv;
+  double phase_var;    /* variance of the phase turn, rad^2 (phase_deg^2 / 3) */
   double *var0;        /* 2 per point: radial, tangential variance of one
                           measurement at the commissioning values */
   double *sd0;         /* opts.sd copied (have_sd0), npt */

@@ -114,7 +114,7 @@ void mon_print_json(FILE *fp, const mon_state *s) {
   if (s->j->sd_path)
     cli_json_str(fp, s->j->sd_path);
   else
-    fprintf(fp, "[%.17g, %.17g]", s->j->beta_a, s->j->beta_s);
+    fprintf(fp, "[%.17g, %.17g, %.17g]", s->j->beta_a, s->j->beta_s, s->j->phase_deg);
   fputs(",\n\"tracked\": [", fp);
   for (k = 0; k < s->j->params.n; k++) {
     const char *name = NULL;

@@ -118,7 +118,7 @@ class MonitorOpts(ctypes.Structure):
                 ("alpha", c_double), ("cusum_k", c_double), ("cusum_h", c_double),
                 ("beta_a", c_double), ("beta_s", c_double), ("sd", c_void_p),
                 ("setup_averages", c_double), ("effects", ctypes.c_uint), ("top", c_size_t),
-                ("relinearise", c_size_t), ("reweight", c_int)]
+                ("relinearise", c_size_t), ("reweight", c_int), ("phase_deg", c_double)]
 
 
 class MonitorCandidate(ctypes.Structure):
