@@ -47,7 +47,13 @@
  *    value = baseline + step, 95 % interval. With
  *    opts.relinearise > 0 the step is refined by chord iterations that
  *    re-evaluate the model at the new value (the fit's preallocated FRF
- *    object, no allocation).
+ *    object, no allocation); T is taken on what that step leaves, but the
+ *    candidates (scores, sizes) and the joint fit while the test fires are
+ *    on the change from the baseline, linearised there: the re-linearised
+ *    step of the tracked parameters alone absorbs part of a new effect, and
+ *    the model's non-linear response at that wrong step is in no
+ *    candidate's columns (with opts.reweight it made a flexible support at
+ *    B1 of -1e7 kg explain B3's cross-coupling).
  *  - Noise after a change. With opts.reweight the covariance of r is
  *    rebuilt at every update from the update's own noise (proportional
  *    noise follows the new response, whose peaks may have moved), C =

@@ -154,7 +154,7 @@ static void candidates(rcb_monitor *mon, int gls, rcb_monitor_result *res) {
     mon_cand *c = &mon->cand[j];
     if (!c->dof) continue;
     for (a = 0; !gls && a < c->dof; a++) {
-      double z = dot(c->dir + a * k, mon->y, k);
+      double z = dot(c->dir + a * k, mon->y0, k);
       if (!a) c->score_now = 0;
       c->score_now += z * z;
     }
@@ -183,7 +183,7 @@ static void candidates(rcb_monitor *mon, int gls, rcb_monitor_result *res) {
     o->p_value = exp(mon->pscore[mon->order[t]]);
     for (a = 0; a < c->np; a++) {
       double se = gls ? c->se_now[a] : c->se[a];
-      o->size[a] = gls ? c->size_now[a] : dot(c->est + a * k, mon->y, k);
+      o->size[a] = gls ? c->size_now[a] : dot(c->est + a * k, mon->y0, k);
       o->ci_lo[a] = o->size[a] - MON_Z95 * se;
       o->ci_hi[a] = o->size[a] + MON_Z95 * se;
     }
@@ -209,12 +209,13 @@ static void errors(const rcb_monitor *mon, const rcb_complex *v, rcb_monitor_res
  * alone, or, once the instant test has fired, fitted jointly with the best
  * candidate (a new effect left out would bias the trend). */
 static void tracked_rest(const rcb_monitor *mon, int gls, const rcb_monitor_result *res,
-                         double *dth, double *se) {
+                         double *theta, double *dth, double *se) {
   const mon_cand *c = res->alarm && res->ntop ? &mon->cand[res->top[0].index] : NULL;
   size_t a, k = mon->k;
   for (a = 0; a < mon->nt; a++) {
+    if (c) theta[a] = 0; /* the joint fit is from the baseline, as the candidates' */
     if (c && gls) dth[a] = c->th_now[a], se[a] = c->set_now[a];
-    else if (c) dth[a] = dot(c->test_t + a * k, mon->y, k), se[a] = c->se_t[a];
+    else if (c) dth[a] = dot(c->test_t + a * k, mon->y0, k), se[a] = c->se_t[a];
     else if (!gls) dth[a] = dot(mon->test + a * k, mon->y, k), se[a] = mon->tse[a];
   }
 }
@@ -240,6 +241,7 @@ rcb_status rcb_monitor_update(rcb_monitor *mon, const rcb_complex *values, const
     mon->r[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
   }
   to_rank(mon, mon->r, mon->y);
+  memcpy(mon->y0, mon->y, mon->k * sizeof *mon->y0);
   if ((st = tracked_step(mon, theta))) return st;
   if (gls) {
     if ((st = rcb_mon_gls(mon, values, sd, dth, se, &T))) return st;
@@ -261,7 +263,7 @@ rcb_status rcb_monitor_update(rcb_monitor *mon, const rcb_complex *values, const
   res->p_value = res->dof ? rcb_chi2_sf(res->T, (double)res->dof) : 1.0;
   res->alarm = res->dof && res->T > mon->threshold;
   candidates(mon, gls, res);
-  tracked_rest(mon, gls, res, dth, se);
+  tracked_rest(mon, gls, res, theta, dth, se);
   for (a = 0; a < mon->nt; a++) theta[a] += dth[a];
   tracked_result(mon, theta, se, res);
   return RCB_OK;

@@ -121,7 +121,7 @@ static rcb_status candidates_gls(rcb_monitor *mon) {
       memcpy(c->set_now, c->se_t, sizeof c->set_now);
       continue;
     }
-    c->score_now = explained(&mon->sw, mon->z, k, nt, nt + c->np, qz);
+    c->score_now = explained(&mon->sw, mon->z0, k, nt, nt + c->np, qz);
     step(&mon->sw, qz, nt + c->np, nt, c->np, c->size_now, c->se_now);
     step(&mon->sw, qz, nt + c->np, 0, nt, c->th_now, c->set_now);
   }
@@ -142,8 +142,10 @@ rcb_status rcb_mon_gls(rcb_monitor *mon, const rcb_complex *v, const double *sd,
                         "the rank space is not positive definite (LAPACK info %d)",
                         mon->updates + 1, (int)info);
   memcpy(mon->z, mon->y, k * sizeof *mon->z);
+  memcpy(mon->z0, mon->y0, k * sizeof *mon->z0);
   memcpy(mon->Atw, mon->G, k * nt * sizeof *mon->Atw);
-  if (solve_ut(mon, mon->z, 1) || (nt && solve_ut(mon, mon->Atw, nt)))
+  if (solve_ut(mon, mon->z, 1) || solve_ut(mon, mon->z0, 1) ||
+      (nt && solve_ut(mon, mon->Atw, nt)))
     return rcb_mon_fail(mon, RCB_ERR_LAPACK, "reweighted update: triangular solve failed");
   *T = 0;
   for (a = 0; a < k; a++) *T += mon->z[a] * mon->z[a];

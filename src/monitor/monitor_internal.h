@@ -98,13 +98,15 @@ struct rcb_monitor {
   double *var0;        /* 2 per point: radial, tangential variance of one
                           measurement at the commissioning values */
   double *sd0;         /* opts.sd copied (have_sd0), npt */
-  double *C, *z, *Atw, *b1; /* k x k, k, k x nt, 2 k */
+  double *C, *z, *z0, *Atw, *b1; /* k x k, k, k, k x nt, 2 k */
   double *achan;       /* nch: eq. 19 additive amplitude of this update */
   mon_small sw;
 
   /* update workspace */
   double *r, *rm;      /* n each */
   double *y, *ym;      /* k each */
+  double *y0;          /* k: y before the re-linearised tracked step, the change
+                          from the baseline the candidates are scored on */
   double *pscore;      /* ncand: log p-value of each candidate's score */
   size_t *order;       /* ncand */
   size_t updates;

@@ -172,10 +172,6 @@ def test_cross_coupling_B3_detected(tool):
     assert 0 <= delay <= CROSS_DELAY, FIGURES["cross_B3 detection"]
 
 
-@pytest.mark.xfail(strict=True, reason="with --reweight the first candidate is a flexible "
-                   "support at B1 of absurd size (pedestal mass -1.1e7 kg); without "
-                   "--reweight B3's cross-coupling is named, but the kt wear then fires the "
-                   "instant test from its second update: no one option set passes both")
 def test_cross_coupling_B3_named(tool):
     log, truth, change, before, n_before, hi, after = _cross(tool)
     assert after, "no TEST alarm after the change"
