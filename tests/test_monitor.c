@@ -411,7 +411,7 @@ static void cross_case(fixture *f, int reweight, size_t relin, double kc /* N/m 
   rcb_meas *ms = frf_of(m2);
   rcb_complex *fs2 = malloc(NPT * sizeof *fs2);
   uint64_t seed = 11;
-  size_t u, named = 0, cover = 0;
+  size_t u, t, named = 0, cover = 0;
   const size_t N = 20;
   o.setup_averages = HUGE_VAL;
   o.reweight = reweight, o.relinearise = relin;
@@ -432,6 +432,9 @@ static void cross_case(fixture *f, int reweight, size_t relin, double kc /* N/m 
     assert_int_equal(rcb_monitor_update(mon, f->v, NULL, &r), RCB_OK);
     assert_int_equal(r.alarm, 1);
     assert_true(r.ntop >= 1);
+    /* the truth is possible; impossible sizes rank after every possible one */
+    assert_int_equal(r.top[0].implausible, 0);
+    for (t = 1; t < r.ntop; t++) assert_true(r.top[t].implausible >= r.top[t - 1].implausible);
     assert_int_equal(rcb_monitor_candidate_info_get(mon, r.top[0].index, &ci), RCB_OK);
     if (r.top[0].effect == RCB_EFFECT_BEARING_CROSS_COUPLING && strcmp(ci.place, "bearing B2") == 0) {
       named++;

@@ -38,7 +38,12 @@
  *    its columns explain beyond the tracked parameters' (the orthogonalised
  *    score test of the diagnosis), chi-square with its rank under "absent";
  *    candidates are ranked by its upper-tail p-value (so one- and
- *    three-parameter effects compare fairly). Size: the linearised
+ *    three-parameter effects compare fairly), except that a candidate whose
+ *    estimate is physically impossible (for some parameter the 95 %
+ *    interval of neutral value + size lies wholly outside the catalogue's
+ *    plausible range, e.g. a negative pedestal mass) ranks after every
+ *    possible one: a large score at an impossible size means its columns
+ *    fit a change of another kind. Size: the linearised
  *    Gauss-Newton step of the tracked parameters and the candidate's
  *    together, with 95 % intervals from (J^T W J)^-1 (the noise is known:
  *    no sigma^2 factor).
@@ -157,6 +162,11 @@ typedef struct rcb_monitor_candidate {
   size_t dof;         /**< its degrees of freedom (rank of its columns beyond
                            the tracked ones) */
   double p_value;     /**< upper-tail probability of score (-) */
+  int implausible;    /**< 1 when, for some parameter, the 95 % interval of
+                           neutral value + size lies wholly outside the
+                           catalogue's plausible range (e.g. a negative mass
+                           or stiffness); such candidates rank after every
+                           plausible one */
 } rcb_monitor_candidate;
 
 /** @brief One tracked parameter in a result. While the instant test fires,

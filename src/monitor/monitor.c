@@ -142,12 +142,24 @@ static void tracked_result(rcb_monitor *mon, const double *theta, const double *
  * of strong effects underflow to 0 together); then the larger score. */
 static int before(const rcb_monitor *mon, size_t a, size_t b) {
   double pa = mon->pscore[a], pb = mon->pscore[b];
+  if (mon->cand[a].implausible != mon->cand[b].implausible) return !mon->cand[a].implausible;
   if (pa != pb) return pa < pb;
   return mon->cand[a].score_now > mon->cand[b].score_now;
 }
 
-/* Scores (and, on the reweighted path, sizes) were left in the
- * candidates by the caller when gls != 0. */
+/* Is some parameter's 95 % interval, neutral + size +- 1.96 se, wholly
+ * outside the catalogue's plausible range? */
+static int implausible(const mon_cand *c) {
+  size_t a;
+  for (a = 0; a < c->np; a++) {
+    double v = c->neutral[a] + c->size_now[a], h = MON_Z95 * c->se_now[a];
+    if (v + h < c->lo[a] || v - h > c->hi[a]) return 1;
+  }
+  return 0;
+}
+
+/* Scores and sizes (on the reweighted path) were left in the candidates
+ * by the caller when gls != 0. */
 static void candidates(rcb_monitor *mon, int gls, rcb_monitor_result *res) {
   size_t j, a, k = mon->k, nsc = 0, t;
   for (j = 0; j < mon->ncand; j++) {
@@ -158,6 +170,9 @@ static void candidates(rcb_monitor *mon, int gls, rcb_monitor_result *res) {
       if (!a) c->score_now = 0;
       c->score_now += z * z;
     }
+    for (a = 0; !gls && a < c->np; a++)
+      c->size_now[a] = dot(c->est + a * k, mon->y0, k), c->se_now[a] = c->se[a];
+    c->implausible = implausible(c);
     mon->pscore[j] = rcb_mon_chi2_logsf(c->score_now, (double)c->dof);
     mon->order[nsc++] = j;
   }
@@ -181,9 +196,10 @@ static void candidates(rcb_monitor *mon, int gls, rcb_monitor_result *res) {
     o->score = c->score_now;
     o->dof = c->dof;
     o->p_value = exp(mon->pscore[mon->order[t]]);
+    o->implausible = c->implausible;
     for (a = 0; a < c->np; a++) {
-      double se = gls ? c->se_now[a] : c->se[a];
-      o->size[a] = gls ? c->size_now[a] : dot(c->est + a * k, mon->y0, k);
+      double se = c->se_now[a];
+      o->size[a] = c->size_now[a];
       o->ci_lo[a] = o->size[a] - MON_Z95 * se;
       o->ci_hi[a] = o->size[a] + MON_Z95 * se;
     }

@@ -202,7 +202,7 @@ static rcb_status cand_fit(rcb_monitor *mon, rcb_model *cm, const rcb_diag_cand_
  * batched adjoint sweep of the base model for those with its DOFs, a sweep
  * of their own model for the others (a pedestal). */
 static rcb_status cand_columns(rcb_monitor *mon, rcb_diag *d, const col_plan *pl, double *J) {
-  size_t ndz = 0, j, ndof = rcb_model_dof_count(mon->model), batch = 0;
+  size_t ndz = 0, j, k, ndof = rcb_model_dof_count(mon->model), batch = 0;
   rcb_fit_dz *dz = rcb_mon_alloc(mon, pl->ncol ? pl->ncol : 1, sizeof *dz);
   rcb_status st = RCB_OK;
   if (!dz) return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (candidate columns)");
@@ -216,6 +216,9 @@ static rcb_status cand_columns(rcb_monitor *mon, rcb_diag *d, const col_plan *pl
       break;
     }
     st = cand_fit(mon, cm, &c, &cf);
+    for (k = 0; !st && k < c.np; k++)
+      if ((st = rcb_model_get_param(cm, c.pname[k], pl->neutral + pl->col[j] + k)))
+        rcb_mon_fail(mon, st, "%s: %s", c.desc, rcb_model_errmsg(cm));
     if (!st && pl->own[j] == (rcb_model_dof_count(cm) == ndof))
       st = rcb_mon_fail(mon, RCB_ERR_STATE, "%s: its model's DOFs are not as the catalogue "
                         "states", c.desc);
@@ -263,6 +266,8 @@ static rcb_status plan(rcb_monitor *mon, rcb_diag *d, unsigned mask, col_plan *p
       pl->col[pl->ncand++] = pl->ncol;
       pl->ncol += c.np;
     }
+  if (!(pl->neutral = rcb_mon_alloc(mon, pl->ncol ? pl->ncol : 1, sizeof *pl->neutral)))
+    return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (catalogue)");
   return RCB_OK;
 }
 
@@ -383,6 +388,7 @@ static rcb_status commission(rcb_monitor *mon, const rcb_model *base, const rcb_
   rcb_free(&mon->alloc, pl.cand);
   rcb_free(&mon->alloc, pl.col);
   rcb_free(&mon->alloc, pl.own);
+  rcb_free(&mon->alloc, pl.neutral);
   rcb_diag_destroy(d);
   return st;
 }

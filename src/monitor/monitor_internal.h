@@ -37,7 +37,10 @@ typedef struct mon_cand {
   size_t col;        /* its first column in G */
   double score_now;  /* this update's score */
   double size_now[RCB_MONITOR_MAXP], se_now[RCB_MONITOR_MAXP]; /* this update's
-                        estimate and standard error (reweighted path) */
+                        estimate and standard error */
+  double neutral[RCB_MONITOR_MAXP]; /* the parameters' values the columns are at */
+  double lo[RCB_MONITOR_MAXP], hi[RCB_MONITOR_MAXP]; /* the catalogue's plausible range */
+  int implausible;   /* this update: some parameter's 95 % interval outside [lo, hi] */
 } mon_cand;
 
 /* Workspace of the small QRs in the rank space (k x p, p <= nt + MAXP). */
@@ -125,6 +128,7 @@ typedef struct col_plan {
   size_t *cand;   /* catalogue index of each kept candidate */
   size_t *col;    /* its first column */
   int *own;       /* 1: its model has other DOFs (its own sweep) */
+  double *neutral; /* ncol: each candidate column's parameter value in its model */
   size_t ncand, ncol;
 } col_plan;
 

@@ -102,6 +102,8 @@ static rcb_status cand_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
     snprintf(mc->params, sizeof mc->params, "%s", c.params);
     mc->np = c.np;
     mc->col = pl->col[j];
+    for (a = 0; a < c.np; a++)
+      mc->neutral[a] = pl->neutral[pl->col[j] + a], mc->lo[a] = c.lo[a], mc->hi[a] = c.hi[a];
     p = nt + c.np;
     memcpy(w->A, G, k * nt * sizeof *w->A);
     memcpy(w->A + k * nt, G + k * pl->col[j], k * c.np * sizeof *w->A);

@@ -185,6 +185,7 @@ def test_cross_coupling_B3_named(tool):
         f"after the change name it")
     assert top["effect"] == truth["effect"] and top["place"] == truth["place"], \
         FIGURES["cross_B3 naming"]
+    assert not top["implausible"], FIGURES["cross_B3 naming"]
 
 
 SLOW = pytest.mark.skipif(not os.environ.get("RCB_MONITOR_ALL"),

@@ -49,6 +49,7 @@ static void json_candidate(FILE *fp, const mon_state *s, const rcb_monitor_candi
   json_key_num(fp, "score", c->score);
   fprintf(fp, ", \"dof\": %zu", c->dof);
   json_key_num(fp, "p_value", c->p_value);
+  fprintf(fp, ", \"implausible\": %s", c->implausible ? "true" : "false");
   fputc('}', fp);
 }
 

@@ -125,7 +125,7 @@ class MonitorCandidate(ctypes.Structure):
     _fields_ = [("index", c_size_t), ("effect", c_int), ("np", c_size_t),
                 ("size", c_double * MONITOR_MAXP), ("ci_lo", c_double * MONITOR_MAXP),
                 ("ci_hi", c_double * MONITOR_MAXP), ("score", c_double), ("dof", c_size_t),
-                ("p_value", c_double)]
+                ("p_value", c_double), ("implausible", c_int)]
 
 
 class MonitorTracked(ctypes.Structure):

@@ -141,7 +141,7 @@ class Monitor(Handle):
             d = self.candidate(c.index)
             d.update({"size": list(c.size[:c.np]), "ci_lo": list(c.ci_lo[:c.np]),
                       "ci_hi": list(c.ci_hi[:c.np]), "score": c.score, "dof": c.dof,
-                      "p_value": c.p_value})
+                      "p_value": c.p_value, "implausible": bool(c.implausible)})
             top.append(d)
         return {"update": r.update, "error_pct": r.error_pct, "change_pct": r.change_pct,
                 "floor_pct": r.floor_pct, "T": r.T, "dof": r.dof, "threshold": r.threshold,
