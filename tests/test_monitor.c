@@ -85,6 +85,16 @@ static void eq19(const rcb_complex *fs, rcb_complex *fe, uint64_t *seed) {
   eq19n(fs, fe, NCH, NPTS, seed);
 }
 
+/* Issue #14's phase noise on top: every point turned by its own angle,
+ * uniform in [-deg, deg] degrees. */
+static void phase_noise(rcb_complex *fe, size_t n, double deg, uint64_t *seed) {
+  size_t i;
+  for (i = 0; i < n; i++) {
+    double th = (2 * rng_uniform(seed) - 1) * deg * 3.14159265358979323846 / 180.0;
+    fe[i] *= cos(th) + CMPLX(0.0, sin(th));
+  }
+}
+
 /* The noise-free FRFs of model m on the set-up grid (channel-major values). */
 static rcb_meas *frf_of(const rcb_model *m) {
   return rcb_test_frf_meas(m, OUTS, NCH, INS, 1, 20.0, 400.0, NPTS, 10000.0, RCB_RECEPTANCE);
@@ -97,6 +107,25 @@ static void values_of(const rcb_meas *ms, rcb_complex *v) {
     assert_int_equal(rcb_meas_channel(ms, c, &ci), RCB_OK);
     memcpy(v + c * rcb_meas_point_count(ms), ci.data, rcb_meas_point_count(ms) * sizeof *v);
   }
+}
+
+/* A copy of measurement ms with every value times s. */
+static rcb_meas *scaled(const rcb_meas *ms, double s) {
+  rcb_meas *out = NULL;
+  rcb_complex *v = malloc(rcb_meas_point_count(ms) * sizeof *v);
+  size_t c, i;
+  assert_non_null(v);
+  assert_int_equal(rcb_meas_create(&out, NULL), RCB_OK);
+  assert_int_equal(rcb_meas_set_grid(out, rcb_meas_get_type(ms), rcb_meas_point_count(ms),
+                                     rcb_meas_grid(ms), rcb_meas_speed(ms)), RCB_OK);
+  for (c = 0; c < rcb_meas_channel_count(ms); c++) {
+    rcb_meas_channel_info ci;
+    assert_int_equal(rcb_meas_channel(ms, c, &ci), RCB_OK);
+    for (i = 0; i < rcb_meas_point_count(ms); i++) v[i] = s * ci.data[i];
+    assert_int_equal(rcb_meas_add_channel(out, ci.response, ci.reference, ci.kind, v), RCB_OK);
+  }
+  free(v);
+  return out;
 }
 
 /* A finalized copy of m with parameter name set to value. */
@@ -217,24 +246,34 @@ static int fixture_teardown(void **state) {
   return 0;
 }
 
-static void null_case(fixture *f, int reweight) {
+static void null_case(fixture *f, int reweight, double phase_deg) {
   rcb_monitor_param tp;
   rcb_monitor_opts o = opts_kt(&tp, f->kt);
   rcb_monitor *mon = NULL;
+  rcb_meas *setup = f->setup;
   rcb_monitor_result r;
   const size_t N = 400;
   size_t u, alarms = 0, cover = 0, cusum = 0, lo, hi, k, kt;
   double sumT = 0, sumz = 0, sumz2 = 0, tol, ch2 = 0, fl2 = 0;
-  uint64_t seed = 20261125;
+  uint64_t seed = 20261125, pseed = 14;
   o.alpha = 0.02; /* enough alarms in 400 updates to test the rate */
   o.setup_averages = HUGE_VAL;
   o.reweight = reweight;
-  assert_int_equal(rcb_monitor_create(&mon, f->base, f->setup, &o, NULL), RCB_OK);
+  o.phase_deg = phase_deg;
+  if (phase_deg > 0) {
+    /* the commissioning values are taken with the same instrument: averaged
+     * long, a value e turned by theta uniform in +-d tends to
+     * E[e^{i theta}] e = e sin(d) / d (closed form) */
+    double d = phase_deg * 3.14159265358979323846 / 180.0;
+    setup = scaled(f->setup, sin(d) / d);
+  }
+  assert_int_equal(rcb_monitor_create(&mon, f->base, setup, &o, NULL), RCB_OK);
   assert_int_equal(rcb_monitor_rank(mon, &k, &kt), RCB_OK);
   assert_int_equal(kt, 1);
   assert_true(k > 10);
   for (u = 0; u < N; u++) {
     eq19(f->fs, f->v, &seed);
+    if (phase_deg > 0) phase_noise(f->v, NPT, phase_deg, &pseed);
     assert_int_equal(rcb_monitor_update(mon, f->v, NULL, &r), RCB_OK);
     assert_int_equal(r.update, u + 1);
     alarms += (size_t)r.alarm;
@@ -248,10 +287,11 @@ static void null_case(fixture *f, int reweight) {
   }
   /* mean square change against the floor's: a few peak points dominate
    * both sums, so only the mean over the updates is close */
-  assert_true(fabs(ch2 / fl2 - 1) < 0.1);
+  assert_true(phase_deg > 0 || fabs(ch2 / fl2 - 1) < 0.1); /* the floor is radial */
   binom99(N, o.alpha, &lo, &hi);
-  print_message("null (reweight %d): %zu alarms in %zu updates (alpha %g: 99 %% interval [%zu, %zu]); "
-                "mean T %.2f (dof %zu); z mean %.3f var %.3f; CI cover %zu\n", reweight,
+  print_message("null (reweight %d, phase +-%g deg): %zu alarms in %zu updates (alpha %g: 99 %% "
+                "interval [%zu, %zu]); mean T %.2f (dof %zu); z mean %.3f var %.3f; CI cover "
+                "%zu\n", reweight, phase_deg,
                 alarms, N, o.alpha, lo, hi, sumT / (double)N, r.dof, sumz / (double)N,
                 sumz2 / (double)N - (sumz / (double)N) * (sumz / (double)N), cover);
   assert_true(alarms >= lo && alarms <= hi);
@@ -265,10 +305,15 @@ static void null_case(fixture *f, int reweight) {
   assert_true(cover >= lo && cover <= hi);
   assert_int_equal(cusum, 0);
   rcb_monitor_destroy(mon);
+  if (setup != f->setup) rcb_meas_destroy(setup);
 }
 
-static void test_null(void **state) { null_case(*state, 0); }
-static void test_null_reweighted(void **state) { null_case(*state, 1); }
+static void test_null(void **state) { null_case(*state, 0, 0.0); }
+static void test_null_reweighted(void **state) { null_case(*state, 1, 0.0); }
+/* 3 degrees of phase noise (tangential sd 3.0 % of |e| against the radial
+ * 1.2 % of beta_a = 2 %): without opts.phase_deg T would be ~7 x dof. */
+static void test_null_phase(void **state) { null_case(*state, 0, 3.0); }
+static void test_null_phase_reweighted(void **state) { null_case(*state, 1, 3.0); }
 
 /* Per-point standard deviations (as #15's estimators give), circular
  * Gaussian noise drawn here by Box-Muller, passed at create and with every
@@ -356,21 +401,30 @@ static void test_kt_change(void **state) {
 }
 
 /* A cross-coupled stiffness appears at bearing B2. */
-static void test_cross_coupling(void **state) {
-  fixture *f = *state;
-  rcb_monitor_param tp;
-  rcb_monitor_opts o = opts_kt(&tp, f->kt);
+static void cross_case(fixture *f, int reweight, size_t relin, double kc /* N/m */) {
+  rcb_monitor_param tp[3];
+  rcb_monitor_opts o = opts_kt(tp, f->kt);
   rcb_monitor *mon = NULL;
   rcb_monitor_result r;
   rcb_monitor_candidate_info ci;
-  const double kc = 1e5; /* N/m */
   rcb_model *m2 = edited(f->truth, "bearing.B2.kcross", kc);
   rcb_meas *ms = frf_of(m2);
   rcb_complex *fs2 = malloc(NPT * sizeof *fs2);
   uint64_t seed = 11;
-  size_t u, named = 0, cover = 0;
+  size_t u, t, named = 0, cover = 0;
   const size_t N = 20;
   o.setup_averages = HUGE_VAL;
+  o.reweight = reweight, o.relinearise = relin;
+  if (relin) { /* the coupling's three coefficients tracked, as rcbtool monitor's users do */
+    double v;
+    size_t k;
+    tp[1].name = "coupling.C.kr", tp[2].name = "coupling.C.ct";
+    for (k = 1; k < 3; k++) {
+      assert_int_equal(rcb_model_get_param(f->base, tp[k].name, &v), RCB_OK);
+      tp[k].lo = 0.5 * v, tp[k].hi = 1.5 * v;
+    }
+    o.ntracked = 3;
+  }
   values_of(ms, fs2);
   assert_int_equal(rcb_monitor_create(&mon, f->base, f->setup, &o, NULL), RCB_OK);
   for (u = 0; u < N; u++) {
@@ -378,14 +432,18 @@ static void test_cross_coupling(void **state) {
     assert_int_equal(rcb_monitor_update(mon, f->v, NULL, &r), RCB_OK);
     assert_int_equal(r.alarm, 1);
     assert_true(r.ntop >= 1);
+    /* the truth is possible; impossible sizes rank after every possible one */
+    assert_int_equal(r.top[0].implausible, 0);
+    for (t = 1; t < r.ntop; t++) assert_true(r.top[t].implausible >= r.top[t - 1].implausible);
     assert_int_equal(rcb_monitor_candidate_info_get(mon, r.top[0].index, &ci), RCB_OK);
     if (r.top[0].effect == RCB_EFFECT_BEARING_CROSS_COUPLING && strcmp(ci.place, "bearing B2") == 0) {
       named++;
       cover += r.top[0].ci_lo[0] <= kc && kc <= r.top[0].ci_hi[0];
     }
   }
-  print_message("kcross %g N/m at B2: named %zu/%zu, covered %zu; last %s at %s: %.0f "
-                "[%.0f, %.0f], T %.0f (threshold %.1f)\n", kc, named, N, cover,
+  print_message("kcross %g N/m at B2 (reweight %d, relinearise %zu): named %zu/%zu, covered "
+                "%zu; last %s at %s: %.0f [%.0f, %.0f], T %.0f (threshold %.1f)\n", kc,
+                reweight, relin, named, N, cover,
                 ci.description, ci.place, r.top[0].size[0], r.top[0].ci_lo[0],
                 r.top[0].ci_hi[0], r.T, r.threshold);
   assert_int_equal(named, N);
@@ -395,6 +453,14 @@ static void test_cross_coupling(void **state) {
   rcb_model_destroy(m2);
   free(fs2);
 }
+
+static void test_cross_coupling(void **state) { cross_case(*state, 0, 0, 1e5); }
+/* Reweighted, the coupling's three coefficients tracked and re-linearised
+ * (rcbtool monitor's ROSS set-up): the re-linearised step of the tracked
+ * parameters alone absorbs part of the new effect; the candidates are
+ * scored on the change from the baseline. (With kcross 1e7 the sizes'
+ * linearisation bias, -3 %, exceeds their 95 % intervals.) */
+static void test_cross_coupling_relin(void **state) { cross_case(*state, 1, 2, 1e5); }
 
 /* 1X unbalance responses (4 probes, 60 speeds 1000-12000 rpm) as the
  * set-up: the null case's mean T, and kt's interval coverage. */
@@ -560,10 +626,13 @@ int main(void) {
       cmocka_unit_test(test_chi2),
       cmocka_unit_test(test_null),
       cmocka_unit_test(test_null_reweighted),
+      cmocka_unit_test(test_null_phase),
+      cmocka_unit_test(test_null_phase_reweighted),
       cmocka_unit_test(test_null_sd),
       cmocka_unit_test(test_unbalance_null),
       cmocka_unit_test(test_kt_change),
       cmocka_unit_test(test_cross_coupling),
+      cmocka_unit_test(test_cross_coupling_relin),
       cmocka_unit_test(test_no_alloc_in_update),
       cmocka_unit_test(test_alloc_walk),
       cmocka_unit_test(test_bad_input),

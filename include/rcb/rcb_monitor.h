@@ -14,8 +14,9 @@
  *    (radial, tangential) frame of e_0 and divided by its standard deviation:
  *    the eq. 19 noise model (beta_a along e_0 with variance
  *    (beta_a/100)^2 |e_0|^2 / 3, beta_s circular with variance a^2 / 6 per
- *    component, a = beta_s/100 sqrt(sum_j |e_0j|^2) / n) or per-point
- *    standard deviations, for the new measurement and for the commissioning
+ *    component, a = beta_s/100 sqrt(sum_j |e_0j|^2) / n; with phase noise
+ *    +-phase_deg, uniform, (phase_deg pi/180)^2 |e_0|^2 / 3 more on the
+ *    tangential axis) or per-point standard deviations, for the new measurement and for the commissioning
  *    one (divided by the number of measurements averaged into it). The
  *    baseline model's own bias (model minus commissioning measurement) is
  *    therefore never a change.
@@ -37,7 +38,12 @@
  *    its columns explain beyond the tracked parameters' (the orthogonalised
  *    score test of the diagnosis), chi-square with its rank under "absent";
  *    candidates are ranked by its upper-tail p-value (so one- and
- *    three-parameter effects compare fairly). Size: the linearised
+ *    three-parameter effects compare fairly), except that a candidate whose
+ *    estimate is physically impossible (for some parameter the 95 %
+ *    interval of neutral value + size lies wholly outside the catalogue's
+ *    plausible range, e.g. a negative pedestal mass) ranks after every
+ *    possible one: a large score at an impossible size means its columns
+ *    fit a change of another kind. Size: the linearised
  *    Gauss-Newton step of the tracked parameters and the candidate's
  *    together, with 95 % intervals from (J^T W J)^-1 (the noise is known:
  *    no sigma^2 factor).
@@ -46,7 +52,13 @@
  *    value = baseline + step, 95 % interval. With
  *    opts.relinearise > 0 the step is refined by chord iterations that
  *    re-evaluate the model at the new value (the fit's preallocated FRF
- *    object, no allocation).
+ *    object, no allocation); T is taken on what that step leaves, but the
+ *    candidates (scores, sizes) and the joint fit while the test fires are
+ *    on the change from the baseline, linearised there: the re-linearised
+ *    step of the tracked parameters alone absorbs part of a new effect, and
+ *    the model's non-linear response at that wrong step is in no
+ *    candidate's columns (with opts.reweight it made a flexible support at
+ *    B1 of -1e7 kg explain B3's cross-coupling).
  *  - Noise after a change. With opts.reweight the covariance of r is
  *    rebuilt at every update from the update's own noise (proportional
  *    noise follows the new response, whose peaks may have moved), C =
@@ -129,6 +141,11 @@ typedef struct rcb_monitor_opts {
                           near them (O(n k) per update). Proportional noise
                           grows with the response: after a large change (a
                           resonance moved) only 1 keeps T chi-square */
+  double phase_deg;  /**< phase noise of one measurement, degrees: each point
+                          turned by an angle uniform in +-phase_deg (issue
+                          #14's noise), tangential variance
+                          |e|^2 (phase_deg pi/180)^2 / 3 added to the eq. 19
+                          model's (used when sd is NULL); 0: none */
 } rcb_monitor_opts;
 
 /** @brief One ranked candidate effect in a result. */
@@ -145,6 +162,11 @@ typedef struct rcb_monitor_candidate {
   size_t dof;         /**< its degrees of freedom (rank of its columns beyond
                            the tracked ones) */
   double p_value;     /**< upper-tail probability of score (-) */
+  int implausible;    /**< 1 when, for some parameter, the 95 % interval of
+                           neutral value + size lies wholly outside the
+                           catalogue's plausible range (e.g. a negative mass
+                           or stiffness); such candidates rank after every
+                           plausible one */
 } rcb_monitor_candidate;
 
 /** @brief One tracked parameter in a result. While the instant test fires,

@@ -142,22 +142,37 @@ static void tracked_result(rcb_monitor *mon, const double *theta, const double *
  * of strong effects underflow to 0 together); then the larger score. */
 static int before(const rcb_monitor *mon, size_t a, size_t b) {
   double pa = mon->pscore[a], pb = mon->pscore[b];
+  if (mon->cand[a].implausible != mon->cand[b].implausible) return !mon->cand[a].implausible;
   if (pa != pb) return pa < pb;
   return mon->cand[a].score_now > mon->cand[b].score_now;
 }
 
-/* Scores (and, on the reweighted path, sizes) were left in the
- * candidates by the caller when gls != 0. */
+/* Is some parameter's 95 % interval, neutral + size +- 1.96 se, wholly
+ * outside the catalogue's plausible range? */
+static int implausible(const mon_cand *c) {
+  size_t a;
+  for (a = 0; a < c->np; a++) {
+    double v = c->neutral[a] + c->size_now[a], h = MON_Z95 * c->se_now[a];
+    if (v + h < c->lo[a] || v - h > c->hi[a]) return 1;
+  }
+  return 0;
+}
+
+/* Scores and sizes (on the reweighted path) were left in the candidates
+ * by the caller when gls != 0. */
 static void candidates(rcb_monitor *mon, int gls, rcb_monitor_result *res) {
   size_t j, a, k = mon->k, nsc = 0, t;
   for (j = 0; j < mon->ncand; j++) {
     mon_cand *c = &mon->cand[j];
     if (!c->dof) continue;
     for (a = 0; !gls && a < c->dof; a++) {
-      double z = dot(c->dir + a * k, mon->y, k);
+      double z = dot(c->dir + a * k, mon->y0, k);
       if (!a) c->score_now = 0;
       c->score_now += z * z;
     }
+    for (a = 0; !gls && a < c->np; a++)
+      c->size_now[a] = dot(c->est + a * k, mon->y0, k), c->se_now[a] = c->se[a];
+    c->implausible = implausible(c);
     mon->pscore[j] = rcb_mon_chi2_logsf(c->score_now, (double)c->dof);
     mon->order[nsc++] = j;
   }
@@ -181,9 +196,10 @@ static void candidates(rcb_monitor *mon, int gls, rcb_monitor_result *res) {
     o->score = c->score_now;
     o->dof = c->dof;
     o->p_value = exp(mon->pscore[mon->order[t]]);
+    o->implausible = c->implausible;
     for (a = 0; a < c->np; a++) {
-      double se = gls ? c->se_now[a] : c->se[a];
-      o->size[a] = gls ? c->size_now[a] : dot(c->est + a * k, mon->y, k);
+      double se = c->se_now[a];
+      o->size[a] = c->size_now[a];
       o->ci_lo[a] = o->size[a] - MON_Z95 * se;
       o->ci_hi[a] = o->size[a] + MON_Z95 * se;
     }
@@ -209,12 +225,13 @@ static void errors(const rcb_monitor *mon, const rcb_complex *v, rcb_monitor_res
  * alone, or, once the instant test has fired, fitted jointly with the best
  * candidate (a new effect left out would bias the trend). */
 static void tracked_rest(const rcb_monitor *mon, int gls, const rcb_monitor_result *res,
-                         double *dth, double *se) {
+                         double *theta, double *dth, double *se) {
   const mon_cand *c = res->alarm && res->ntop ? &mon->cand[res->top[0].index] : NULL;
   size_t a, k = mon->k;
   for (a = 0; a < mon->nt; a++) {
+    if (c) theta[a] = 0; /* the joint fit is from the baseline, as the candidates' */
     if (c && gls) dth[a] = c->th_now[a], se[a] = c->set_now[a];
-    else if (c) dth[a] = dot(c->test_t + a * k, mon->y, k), se[a] = c->se_t[a];
+    else if (c) dth[a] = dot(c->test_t + a * k, mon->y0, k), se[a] = c->se_t[a];
     else if (!gls) dth[a] = dot(mon->test + a * k, mon->y, k), se[a] = mon->tse[a];
   }
 }
@@ -240,6 +257,7 @@ rcb_status rcb_monitor_update(rcb_monitor *mon, const rcb_complex *values, const
     mon->r[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
   }
   to_rank(mon, mon->r, mon->y);
+  memcpy(mon->y0, mon->y, mon->k * sizeof *mon->y0);
   if ((st = tracked_step(mon, theta))) return st;
   if (gls) {
     if ((st = rcb_mon_gls(mon, values, sd, dth, se, &T))) return st;
@@ -261,7 +279,7 @@ rcb_status rcb_monitor_update(rcb_monitor *mon, const rcb_complex *values, const
   res->p_value = res->dof ? rcb_chi2_sf(res->T, (double)res->dof) : 1.0;
   res->alarm = res->dof && res->T > mon->threshold;
   candidates(mon, gls, res);
-  tracked_rest(mon, gls, res, dth, se);
+  tracked_rest(mon, gls, res, theta, dth, se);
   for (a = 0; a < mon->nt; a++) theta[a] += dth[a];
   tracked_result(mon, theta, se, res);
   return RCB_OK;

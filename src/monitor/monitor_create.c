@@ -80,7 +80,9 @@ static rcb_status copy_setup(rcb_monitor *mon, const rcb_meas *setup) {
 /* Radial and tangential sd of one measurement at each point: eq. 19
  * (proportional part along e_0, variance (beta_a/100)^2 |e_0|^2 / 3 from
  * r1 uniform on [-1, 1]; additive part circular, a^2 / 3 split over two
- * components) or the caller's sd (circular). */
+ * components; a phase turn uniform in +-phase_deg, to first order
+ * tangential, variance |e_0|^2 (phase_deg pi/180)^2 / 3) or the caller's
+ * sd (circular). */
 static rcb_status noise(rcb_monitor *mon, const rcb_monitor_opts *o) {
   double navg = o->setup_averages > 0 ? o->setup_averages : 1.0;
   double f0 = isinf(navg) ? 1.0 : 1.0 + 1.0 / navg; /* new + commissioning variance */
@@ -88,6 +90,7 @@ static rcb_status noise(rcb_monitor *mon, const rcb_monitor_opts *o) {
   mon->navg_inv = isinf(navg) ? 0.0 : 1.0 / navg;
   mon->beta_a = o->beta_a, mon->beta_s = o->beta_s;
   mon->have_sd0 = o->sd != NULL;
+  mon->phase_var = (o->phase_deg * RCB_MON_DEG) * (o->phase_deg * RCB_MON_DEG) / 3.0;
   if (navg < 1.0)
     return rcb_mon_fail(mon, RCB_ERR_ARG, "setup_averages = %g: expected >= 1 (measurements "
                         "averaged into the commissioning values)", navg);
@@ -97,6 +100,9 @@ static rcb_status noise(rcb_monitor *mon, const rcb_monitor_opts *o) {
   if (!o->sd && (!(o->beta_a >= 0) || !(o->beta_s >= 0) || !isfinite(o->beta_a + o->beta_s)))
     return rcb_mon_fail(mon, RCB_ERR_ARG, "noise: beta_a = %g, beta_s = %g %%: expected finite "
                         ">= 0", o->beta_a, o->beta_s);
+  if (!(o->phase_deg >= 0) || !(o->phase_deg < 90))
+    return rcb_mon_fail(mon, RCB_ERR_ARG, "noise: phase_deg = %g degrees: expected 0 <= "
+                        "phase_deg < 90", o->phase_deg);
   for (c = 0; c < mon->nch; c++) {
     const rcb_complex *e = mon->e0 + c * mon->npts;
     double s2 = 0.0, a;
@@ -117,6 +123,7 @@ static rcb_status noise(rcb_monitor *mon, const rcb_monitor_opts *o) {
         double pa = o->beta_a / 100.0 * ae;
         vt = a * a / 6.0;
         vr = pa * pa / 3.0 + vt;
+        vt += mon->phase_var * ae * ae; /* the phase turn moves e_0 tangentially */
       }
       if (!(vr > 0) || !(vt > 0))
         return rcb_mon_fail(mon, RCB_ERR_ARG, "noise: channel %zu point %zu has zero standard "
@@ -195,7 +202,7 @@ static rcb_status cand_fit(rcb_monitor *mon, rcb_model *cm, const rcb_diag_cand_
  * batched adjoint sweep of the base model for those with its DOFs, a sweep
  * of their own model for the others (a pedestal). */
 static rcb_status cand_columns(rcb_monitor *mon, rcb_diag *d, const col_plan *pl, double *J) {
-  size_t ndz = 0, j, ndof = rcb_model_dof_count(mon->model), batch = 0;
+  size_t ndz = 0, j, k, ndof = rcb_model_dof_count(mon->model), batch = 0;
   rcb_fit_dz *dz = rcb_mon_alloc(mon, pl->ncol ? pl->ncol : 1, sizeof *dz);
   rcb_status st = RCB_OK;
   if (!dz) return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (candidate columns)");
@@ -209,6 +216,9 @@ static rcb_status cand_columns(rcb_monitor *mon, rcb_diag *d, const col_plan *pl
       break;
     }
     st = cand_fit(mon, cm, &c, &cf);
+    for (k = 0; !st && k < c.np; k++)
+      if ((st = rcb_model_get_param(cm, c.pname[k], pl->neutral + pl->col[j] + k)))
+        rcb_mon_fail(mon, st, "%s: %s", c.desc, rcb_model_errmsg(cm));
     if (!st && pl->own[j] == (rcb_model_dof_count(cm) == ndof))
       st = rcb_mon_fail(mon, RCB_ERR_STATE, "%s: its model's DOFs are not as the catalogue "
                         "states", c.desc);
@@ -256,6 +266,8 @@ static rcb_status plan(rcb_monitor *mon, rcb_diag *d, unsigned mask, col_plan *p
       pl->col[pl->ncand++] = pl->ncol;
       pl->ncol += c.np;
     }
+  if (!(pl->neutral = rcb_mon_alloc(mon, pl->ncol ? pl->ncol : 1, sizeof *pl->neutral)))
+    return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (catalogue)");
   return RCB_OK;
 }
 
@@ -359,11 +371,12 @@ static rcb_status commission(rcb_monitor *mon, const rcb_model *base, const rcb_
   }
   if (!st && !(st = rcb_mon_rank_space(mon, d, &pl, J))) J = NULL; /* now mon->Q */
   if (!st) {
-    mon->y = rcb_mon_alloc(mon, 2 * mon->k + 2 * (mon->ncand ? mon->ncand : 1), sizeof *mon->y);
+    mon->y = rcb_mon_alloc(mon, 3 * mon->k + 2 * (mon->ncand ? mon->ncand : 1), sizeof *mon->y);
     if (!mon->y) st = rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (update workspace)");
     else {
       mon->ym = mon->y + mon->k;
-      mon->pscore = mon->ym + mon->k;
+      mon->y0 = mon->ym + mon->k;
+      mon->pscore = mon->y0 + mon->k;
       mon->order = (size_t *)(void *)(mon->pscore + (mon->ncand ? mon->ncand : 1));
     }
   }
@@ -375,6 +388,7 @@ static rcb_status commission(rcb_monitor *mon, const rcb_model *base, const rcb_
   rcb_free(&mon->alloc, pl.cand);
   rcb_free(&mon->alloc, pl.col);
   rcb_free(&mon->alloc, pl.own);
+  rcb_free(&mon->alloc, pl.neutral);
   rcb_diag_destroy(d);
   return st;
 }

@@ -29,7 +29,9 @@ static void point_cov(const rcb_monitor *mon, const rcb_complex *v, const double
     double av = cabs(v[p]), sp = mon->beta_a / 100.0 * av;
     double complex w = av > 0 ? conj(mon->u[p]) * v[p] / av : 1.0;
     double c = creal(w), s = cimag(w), vp = sp * sp / 3.0, va = a * a / 6.0;
-    s11 = vp * c * c + va, s12 = vp * c * s, s22 = vp * s * s + va;
+    double vph = mon->phase_var * av * av; /* phase turn: across the new value */
+    s11 = vp * c * c + vph * s * s + va, s12 = (vp - vph) * c * s;
+    s22 = vp * s * s + vph * c * c + va;
   }
   s11 += mon->var0[2 * p] * mon->navg_inv;
   s22 += mon->var0[2 * p + 1] * mon->navg_inv;
@@ -119,7 +121,7 @@ static rcb_status candidates_gls(rcb_monitor *mon) {
       memcpy(c->set_now, c->se_t, sizeof c->set_now);
       continue;
     }
-    c->score_now = explained(&mon->sw, mon->z, k, nt, nt + c->np, qz);
+    c->score_now = explained(&mon->sw, mon->z0, k, nt, nt + c->np, qz);
     step(&mon->sw, qz, nt + c->np, nt, c->np, c->size_now, c->se_now);
     step(&mon->sw, qz, nt + c->np, 0, nt, c->th_now, c->set_now);
   }
@@ -140,8 +142,10 @@ rcb_status rcb_mon_gls(rcb_monitor *mon, const rcb_complex *v, const double *sd,
                         "the rank space is not positive definite (LAPACK info %d)",
                         mon->updates + 1, (int)info);
   memcpy(mon->z, mon->y, k * sizeof *mon->z);
+  memcpy(mon->z0, mon->y0, k * sizeof *mon->z0);
   memcpy(mon->Atw, mon->G, k * nt * sizeof *mon->Atw);
-  if (solve_ut(mon, mon->z, 1) || (nt && solve_ut(mon, mon->Atw, nt)))
+  if (solve_ut(mon, mon->z, 1) || solve_ut(mon, mon->z0, 1) ||
+      (nt && solve_ut(mon, mon->Atw, nt)))
     return rcb_mon_fail(mon, RCB_ERR_LAPACK, "reweighted update: triangular solve failed");
   *T = 0;
   for (a = 0; a < k; a++) *T += mon->z[a] * mon->z[a];

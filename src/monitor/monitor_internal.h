@@ -16,6 +16,7 @@
 #include "rcb/rcb_monitor.h"
 
 #define RCB_MONITOR_NAME 128
+#define RCB_MON_DEG 0.017453292519943295 /* rad per degree */
 
 /* A candidate in the rank space (dimension k): its estimate rows and the
  * orthonormal directions it adds beyond the tracked parameters. */
@@ -36,7 +37,10 @@ typedef struct mon_cand {
   size_t col;        /* its first column in G */
   double score_now;  /* this update's score */
   double size_now[RCB_MONITOR_MAXP], se_now[RCB_MONITOR_MAXP]; /* this update's
-                        estimate and standard error (reweighted path) */
+                        estimate and standard error */
+  double neutral[RCB_MONITOR_MAXP]; /* the parameters' values the columns are at */
+  double lo[RCB_MONITOR_MAXP], hi[RCB_MONITOR_MAXP]; /* the catalogue's plausible range */
+  int implausible;   /* this update: some parameter's 95 % interval outside [lo, hi] */
 } mon_cand;
 
 /* Workspace of the small QRs in the rank space (k x p, p <= nt + MAXP). */
@@ -93,16 +97,19 @@ struct rcb_monitor {
   /* noise of the reweighted path */
   int reweight, have_sd0;
   double beta_a, beta_s, navg_inv;
+  double phase_var;    /* variance of the phase turn, rad^2 (phase_deg^2 / 3) */
   double *var0;        /* 2 per point: radial, tangential variance of one
                           measurement at the commissioning values */
   double *sd0;         /* opts.sd copied (have_sd0), npt */
-  double *C, *z, *Atw, *b1; /* k x k, k, k x nt, 2 k */
+  double *C, *z, *z0, *Atw, *b1; /* k x k, k, k, k x nt, 2 k */
   double *achan;       /* nch: eq. 19 additive amplitude of this update */
   mon_small sw;
 
   /* update workspace */
   double *r, *rm;      /* n each */
   double *y, *ym;      /* k each */
+  double *y0;          /* k: y before the re-linearised tracked step, the change
+                          from the baseline the candidates are scored on */
   double *pscore;      /* ncand: log p-value of each candidate's score */
   size_t *order;       /* ncand */
   size_t updates;
@@ -121,6 +128,7 @@ typedef struct col_plan {
   size_t *cand;   /* catalogue index of each kept candidate */
   size_t *col;    /* its first column */
   int *own;       /* 1: its model has other DOFs (its own sweep) */
+  double *neutral; /* ncol: each candidate column's parameter value in its model */
   size_t ncand, ncol;
 } col_plan;
 

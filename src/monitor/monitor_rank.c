@@ -102,6 +102,8 @@ static rcb_status cand_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
     snprintf(mc->params, sizeof mc->params, "%s", c.params);
     mc->np = c.np;
     mc->col = pl->col[j];
+    for (a = 0; a < c.np; a++)
+      mc->neutral[a] = pl->neutral[pl->col[j] + a], mc->lo[a] = c.lo[a], mc->hi[a] = c.hi[a];
     p = nt + c.np;
     memcpy(w->A, G, k * nt * sizeof *w->A);
     memcpy(w->A + k * nt, G + k * pl->col[j], k * c.np * sizeof *w->A);
@@ -186,11 +188,13 @@ rcb_status rcb_mon_rank_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
   w->A = rcb_mon_alloc(mon, k * pmax + 3 * pmax * pmax + pmax, sizeof *w->A);
   mon->test = rcb_mon_alloc(mon, 2 * (nt ? nt : 1) * k, sizeof *mon->test);
   mon->cand = rcb_mon_alloc(mon, pl->ncand ? pl->ncand : 1, sizeof *mon->cand);
-  /* the reweighted path: C, z, U^-T G_t, two rows, the channels' amplitudes */
-  mon->C = rcb_mon_alloc(mon, k * k + k + k * (nt ? nt : 1) + 2 * k + mon->nch, sizeof *mon->C);
+  /* the reweighted path: C, z, z0, U^-T G_t, two rows, the channels' amplitudes */
+  mon->C = rcb_mon_alloc(mon, k * k + 2 * k + k * (nt ? nt : 1) + 2 * k + mon->nch,
+                         sizeof *mon->C);
   if (!mon->G || !w->A || !mon->test || !mon->cand || !mon->C)
     return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (rank space)");
-  mon->z = mon->C + k * k, mon->Atw = mon->z + k, mon->b1 = mon->Atw + k * (nt ? nt : 1);
+  mon->z = mon->C + k * k, mon->z0 = mon->z + k, mon->Atw = mon->z0 + k;
+  mon->b1 = mon->Atw + k * (nt ? nt : 1);
   mon->achan = mon->b1 + 2 * k;
   mon->ncol = pl->ncol;
   mon->ncand = pl->ncand;

@@ -754,6 +754,7 @@ bad_monitor_series)
     usage monitor "$MODEL" "$W/s" --params coupling.C.kt; err_has "--noise A,S"
     usage monitor "$MODEL" "$W/s" $M --commission 3; err_has "none is left to monitor"
     usage monitor "$MODEL" "$W/s" $M --log "$W/log.txt"; err_has ".json or .csv"
+    usage monitor "$MODEL" "$W/s" --params coupling.C.kt --noise 10,1,90; err_has "0 <= P < 90"
     usage monitor "$MODEL" $M; err_has "missing the measurements"
     # an output that is one of the inputs
     cp "$W/s/m2.csv" "$W/m2.orig"

@@ -22,8 +22,8 @@ two chord re-linearisations of the tracked parameters).
   CROSS_DELAY updates of it, and the first candidate of the alarm is the
   cross-coupled stiffness at bearing B3;
 * null_phase (the null series with 2 degrees of phase noise per point, issue
-  #14's): xfail, strict: rcb_monitor's noise model has no phase term, so the
-  phase scatter reads as change (every update alarms).
+  #14's), monitored with --noise 10,1,2 (the phase term of rcb_monitor_opts):
+  false alarms as for null.
 * signals (issue #15's path, RCB_MONITOR_ALL=1: about 2 min): 9 tests of 24 s
   of white force on DA.x simulated outside librcb (test_signals_diagnose's
   SciPy discretisation of the truth's matrices), `rcbtool estimate` (H1, with
@@ -76,7 +76,8 @@ def monitor(tool, name, *extra):
 
 def _monitor(tool, name, *extra):
     d, truth, model = mc.series(name)
-    cmd = [tool, "monitor", str(model), str(d), "--params", PARAMS, "--noise", NOISE,
+    noise = NOISE + (f",{truth['phase_deg']:g}" if truth.get("phase_deg") else "")
+    cmd = [tool, "monitor", str(model), str(d), "--params", PARAMS, "--noise", noise,
            *map(str, MONITOR), *map(str, extra), "--json"]
     res = subprocess.run(cmd, capture_output=True, text=True, timeout=900,
                          env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
@@ -91,12 +92,8 @@ def _alarms(log, key="alarm", lo=0, hi=None):
     return [u for u in log["updates"] if u[key] and lo <= u["index"] < (hi or 10**9)]
 
 
-PHASE_XFAIL = pytest.param("null_phase", 0.01, marks=pytest.mark.xfail(
-    strict=True, reason="rcb_monitor has no phase-noise term: 2 degrees of phase scatter "
-    "read as change (requested from the library: opts.phase_deg)"))
-
-
-@pytest.mark.parametrize("name,alpha", [("null", 0.01), ("null", 0.05), PHASE_XFAIL])
+@pytest.mark.parametrize("name,alpha", [("null", 0.01), ("null", 0.05), ("null_phase", 0.01),
+                                        ("null_phase", 0.05)])
 def test_null_false_alarms(tool, name, alpha):
     log, truth = monitor(tool, name, "--alpha", alpha)
     n = len(log["updates"])
@@ -109,7 +106,21 @@ def test_null_false_alarms(tool, name, alpha):
     FIGURES[key] = (f"{count} TEST alarms in {n} updates (expected {n * alpha:.1f}, 99 % "
                     f"interval [{lo:.0f}, {hi:.0f}]); {cusum} with a CUSUM alarm")
     assert lo <= count <= hi, FIGURES[key]
-    assert cusum == 0, FIGURES[key]
+
+
+CUSUM_PHASE_XFAIL = pytest.param("null_phase", marks=pytest.mark.xfail(
+    strict=True, reason="kr's CUSUM- passes h = 8 on updates 155-171 (kr's z: mean -0.25 "
+    "over the series, the share of the 10 averaged commissioning files every update carries, "
+    "then a run of z ~ -0.9 from update 140): a chance run the CUSUM's ARL0, stated for "
+    "independent z, does not allow for"))
+
+
+@pytest.mark.parametrize("name", ["null", CUSUM_PHASE_XFAIL])
+def test_null_cusum_silent(tool, name):
+    log, truth = monitor(tool, name, "--alpha", 0.01)
+    cusum = [u["update"] for u in _alarms(log, "cusum_alarm")]
+    FIGURES[f"{name} CUSUM"] = f"CUSUM alarms at updates {cusum}"
+    assert not cusum, FIGURES[f"{name} CUSUM"]
 
 
 def test_kt_wear(tool):
@@ -161,10 +172,6 @@ def test_cross_coupling_B3_detected(tool):
     assert 0 <= delay <= CROSS_DELAY, FIGURES["cross_B3 detection"]
 
 
-@pytest.mark.xfail(strict=True, reason="with --reweight the first candidate is a flexible "
-                   "support at B1 of absurd size (pedestal mass -1.1e7 kg); without "
-                   "--reweight B3's cross-coupling is named, but the kt wear then fires the "
-                   "instant test from its second update: no one option set passes both")
 def test_cross_coupling_B3_named(tool):
     log, truth, change, before, n_before, hi, after = _cross(tool)
     assert after, "no TEST alarm after the change"
@@ -178,6 +185,7 @@ def test_cross_coupling_B3_named(tool):
         f"after the change name it")
     assert top["effect"] == truth["effect"] and top["place"] == truth["place"], \
         FIGURES["cross_B3 naming"]
+    assert not top["implausible"], FIGURES["cross_B3 naming"]
 
 
 SLOW = pytest.mark.skipif(not os.environ.get("RCB_MONITOR_ALL"),

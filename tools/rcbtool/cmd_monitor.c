@@ -17,7 +17,7 @@
 
 const char cli_help_monitor[] =
     "usage: rcbtool monitor BASELINE.ini DIR|MEAS... --params NAME[:LO:HI],...\n"
-    "                       [--noise A,S | --sd STATS.csv|DIR] [--commission N]\n"
+    "                       [--noise A,S[,P] | --sd STATS.csv|DIR] [--commission N]\n"
     "                       [--alpha A] [--cusum-h H] [--cusum-k K] [--relinearise N]\n"
     "                       [--reweight] [--map NODE=STATION,...] [--rpm R]\n"
     "                       [--log OUT.json|OUT.csv] [--plot TREND.png] [--json]\n"
@@ -40,7 +40,8 @@ const char cli_help_monitor[] =
     "  --params LIST   parameters to track (fitted at commissioning, e.g.\n"
     "                  coupling.C.kt,coupling.C.ct); LO:HI their plausible range\n"
     "                  (default [v/1000, 1000 v])\n"
-    "  --noise A,S     eq. 19 noise of one measurement (random A %, systematic S %)\n"
+    "  --noise A,S[,P] eq. 19 noise of one measurement (random A %, systematic S %)\n"
+    "                  and phase noise, uniform in +-P degrees per point (0)\n"
     "  --sd PATH       per-point standard deviations instead (rcbtool estimate\n"
     "                  --stats or order --stats): one file for every update, or a\n"
     "                  directory holding STEM_stats.csv for each measurement STEM.*\n"
@@ -65,15 +66,20 @@ const char cli_help_monitor[] =
     "speed differ from the commissioning file's), 4 numerical failure, 5 output\n"
     "not written (no partial log or plot is ever left).\n";
 
-static int pair(const cli_args *a, const char *opt, double *x, double *y) {
-  const char *s = cli_opt_value(a, opt), *t = s ? strchr(s, ',') : NULL;
-  char *e1, *e2;
-  if (!t) return cli_usage(a->cmd, "option %s expects two numbers separated by ','", opt);
+/* --noise A,S[,P]: eq. 19's two numbers, then the phase noise in degrees. */
+static int noise_opt(const cli_args *a, const char *opt, double *x, double *y, double *ph) {
+  const char *s = cli_opt_value(a, opt), *t = s ? strchr(s, ',') : NULL, *u;
+  char *e1, *e2, *e3 = NULL;
+  if (!t) return cli_usage(a->cmd, "option %s expects A,S or A,S,P (numbers separated by "
+                           "',')", opt);
+  u = strchr(t + 1, ',');
   *x = strtod(s, &e1);
   *y = strtod(t + 1, &e2);
-  if (e1 != t || *e2 || !(*x >= 0) || !(*y >= 0) || !isfinite(*x) || !isfinite(*y))
-    return cli_usage(a->cmd, "option %s expects two numbers >= 0 separated by ',', got '%s'",
-                     opt, s);
+  *ph = u ? strtod(u + 1, &e3) : 0.0;
+  if (e1 != t || (u ? e2 != u || *e3 : *e2 != 0) || !(*x >= 0) || !(*y >= 0) ||
+      !isfinite(*x) || !isfinite(*y) || !(*ph >= 0 && *ph < 90))
+    return cli_usage(a->cmd, "option %s expects A,S[,P]: A, S >= 0 (%%), P phase noise "
+                     "0 <= P < 90 (degrees), got '%s'", opt, s);
   return 0;
 }
 
@@ -110,7 +116,7 @@ static int parse_job(const cli_args *a, mon_job *j) {
   if (cli_opt_value(a, "--noise") && j->sd_path)
     return cli_usage(a->cmd, "--noise and --sd exclude each other: give the eq. 19 model or "
                      "the per-point standard deviations");
-  if (cli_opt_value(a, "--noise") && (rc = pair(a, "--noise", &j->beta_a, &j->beta_s)))
+  if (cli_opt_value(a, "--noise") && (rc = noise_opt(a, "--noise", &j->beta_a, &j->beta_s, &j->phase_deg)))
     return rc;
   if (!cli_opt_value(a, "--noise") && !j->sd_path)
     return cli_usage(a->cmd, "the monitor needs the measurement noise: give --noise A,S (eq. "
@@ -269,7 +275,7 @@ static int guard_outputs(const cli_args *a, const mon_job *j) {
 
 int cmd_monitor(int argc, char **argv) {
   cli_opt opts[] = {{"--params", "NAME[:LO:HI],...", NULL},
-                    {"--noise", "BETA_A,BETA_S", NULL},
+                    {"--noise", "BETA_A,BETA_S[,PHASE_DEG]", NULL},
                     {"--sd", "STATS.csv|DIR", NULL},
                     {"--commission", "N", NULL},
                     {"--alpha", "A", NULL},

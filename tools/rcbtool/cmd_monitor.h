@@ -23,6 +23,7 @@ typedef struct mon_job {
   int reweight;       /**< --reweight: each update's noise from its own values */
   double alpha, cusum_h, cusum_k; /**< 0: the library's defaults */
   double beta_a, beta_s;          /**< --noise, % */
+  double phase_deg;               /**< --noise's third number, degrees */
   const char *sd_path;            /**< --sd FILE or DIR, NULL */
   const char *log, *plot;         /**< --log, --plot, NULL */
   mon_series series;

@@ -49,6 +49,7 @@ static void json_candidate(FILE *fp, const mon_state *s, const rcb_monitor_candi
   json_key_num(fp, "score", c->score);
   fprintf(fp, ", \"dof\": %zu", c->dof);
   json_key_num(fp, "p_value", c->p_value);
+  fprintf(fp, ", \"implausible\": %s", c->implausible ? "true" : "false");
   fputc('}', fp);
 }
 
@@ -114,7 +115,7 @@ void mon_print_json(FILE *fp, const mon_state *s) {
   if (s->j->sd_path)
     cli_json_str(fp, s->j->sd_path);
   else
-    fprintf(fp, "[%.17g, %.17g]", s->j->beta_a, s->j->beta_s);
+    fprintf(fp, "[%.17g, %.17g, %.17g]", s->j->beta_a, s->j->beta_s, s->j->phase_deg);
   fputs(",\n\"tracked\": [", fp);
   for (k = 0; k < s->j->params.n; k++) {
     const char *name = NULL;

@@ -219,6 +219,7 @@ static int create_monitor(mon_ctx *x, rcb_monitor **mon) {
   o.cusum_k = x->j->cusum_k;
   o.beta_a = x->j->beta_a;
   o.beta_s = x->j->beta_s;
+  o.phase_deg = x->j->phase_deg;
   o.sd = x->have_sd ? x->sd : NULL;
   o.setup_averages = (double)x->j->commission;
   o.relinearise = x->j->relinearise;

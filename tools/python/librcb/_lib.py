@@ -119,14 +119,14 @@ class MonitorOpts(ctypes.Structure):
                 ("alpha", c_double), ("cusum_k", c_double), ("cusum_h", c_double),
                 ("beta_a", c_double), ("beta_s", c_double), ("sd", c_void_p),
                 ("setup_averages", c_double), ("effects", ctypes.c_uint), ("top", c_size_t),
-                ("relinearise", c_size_t), ("reweight", c_int)]
+                ("relinearise", c_size_t), ("reweight", c_int), ("phase_deg", c_double)]
 
 
 class MonitorCandidate(ctypes.Structure):
     _fields_ = [("index", c_size_t), ("effect", c_int), ("np", c_size_t),
                 ("size", c_double * MONITOR_MAXP), ("ci_lo", c_double * MONITOR_MAXP),
                 ("ci_hi", c_double * MONITOR_MAXP), ("score", c_double), ("dof", c_size_t),
-                ("p_value", c_double)]
+                ("p_value", c_double), ("implausible", c_int)]
 
 
 class MonitorTracked(ctypes.Structure):

@@ -47,7 +47,8 @@ class Monitor(Handle):
         """model: the fitted baseline (a Model); setup: the commissioning
         measurement (a Meas: channels, grid and the reference values); params:
         tracked parameter names or {name: (lo, hi)}; noise: eq. 19 (beta_a,
-        beta_s) in %, or sd: standard deviations of Re and Im per (channel,
+        beta_s) in % (and a third number: phase noise, uniform in +- that
+        many degrees per point), or sd: standard deviations of Re and Im per (channel,
         point), shape (channels, points), SI; alpha, cusum_h, cusum_k: None for
         the library's defaults; setup_averages: measurements averaged into setup;
         reweight: each update's noise from its own values (generalised least
@@ -65,6 +66,7 @@ class Monitor(Handle):
         o.alpha, o.cusum_h, o.cusum_k = alpha or 0.0, cusum_h or 0.0, cusum_k or 0.0
         if noise is not None:
             o.beta_a, o.beta_s = float(noise[0]), float(noise[1])
+            o.phase_deg = float(noise[2]) if len(noise) > 2 else 0.0
         if sd is not None:
             self._sd0 = self._layout_sd(sd)
             o.sd = self._sd0.ctypes.data
@@ -139,7 +141,7 @@ class Monitor(Handle):
             d = self.candidate(c.index)
             d.update({"size": list(c.size[:c.np]), "ci_lo": list(c.ci_lo[:c.np]),
                       "ci_hi": list(c.ci_hi[:c.np]), "score": c.score, "dof": c.dof,
-                      "p_value": c.p_value})
+                      "p_value": c.p_value, "implausible": bool(c.implausible)})
             top.append(d)
         return {"update": r.update, "error_pct": r.error_pct, "change_pct": r.change_pct,
                 "floor_pct": r.floor_pct, "T": r.T, "dof": r.dof, "threshold": r.threshold,
