@@ -44,7 +44,7 @@ static void free_results(rcb_diag *d) {
   rcb_model_destroy(d->base_model);
   rcb_model_destroy(d->nom_model);
   d->cand = NULL, d->order = NULL, d->base_model = NULL, d->nom_model = NULL;
-  d->far = 0, d->drift[0] = '\0';
+  d->far = 0, d->drift[0] = '\0', d->pre_best = HUGE_VAL;
   d->ncand = d->cap_cand = 0;
   d->ran = 0;
   memset(&d->stats, 0, sizeof d->stats);
@@ -567,6 +567,13 @@ static rcb_status polish(rcb_fit *f) {
  * (RCB_DIAG_NOM_REFITS) are the pre-fits with the lowest objective, and
  * start where their pre-fit ended. */
 #define RCB_DIAG_PREFIT_ITER 8
+/* On the subset (32 x 1101), a pre-fit is refitted only when its objective
+ * is within this factor of the best pre-fit's: on the 0.15 kg hub case the
+ * hub mass ends its pre-fit at F = 4528, the hub's inertia at 4.7e5 and the
+ * rest at 2e6-3e6; the inertia's joint refit took 3.1 s (352 sweeps) to end
+ * at 38 %, far behind. 8 x 151 refits the 3 best as before. A refit ending
+ * its screen that far behind is not polished (far_behind). */
+#define RCB_DIAG_PRE_RATIO 10.0
 /* On the subset (32 x 1101) 4: a candidate that explains the data gets
  * there in a few (the 0.15 kg hub mass: the same joint refit after 4 as
  * after 8), the rest crawl (dampings: 52-83 sweeps in 8); 8 x 151 keeps 8. */
@@ -627,6 +634,29 @@ static rcb_status evaluate_only(rcb_diag *d, diag_cand *c, rcb_model **m, rcb_fi
   return RCB_OK;
 }
 
+/* A screened refit whose objective on the subset ends more than
+ * RCB_DIAG_PRE_RATIO x above the best pre-fit's (d->pre_best, same subset
+ * and weights) is far behind: evaluated once on all points where the screen
+ * left it, not polished. Its error and BIC are then those of the screened
+ * point (an upper bound). On the hub cases the other coupling models end
+ * there (F 2.4e6-7.2e7 on all points against 3.4e4 for the hub mass). */
+static rcb_status far_behind(rcb_diag *d, diag_cand *c, rcb_model **m, rcb_fit *f) {
+  double *r = rcb_alloc(&d->alloc, d->nres * sizeof *r);
+  rcb_status st = r ? rcb_fit_set_weights(f, NULL) : RCB_ERR_NOMEM;
+  if (!st) st = objective(d, f, r, &c->F, &c->err);
+  rcb_free(&d->alloc, r);
+  if (st == RCB_ERR_NOMEM) return rcb_diag_fail(d, st, "refitting %s: out of memory", c->desc);
+  if (st) {
+    snprintf(c->fitted, sizeof c->fitted, "refit failed: %.300s", d->errmsg);
+    return RCB_OK;
+  }
+  c->refitted = 1;
+  judge(d, c, (double)c->np);
+  record_fit(c, f);
+  c->model = *m, *m = NULL;
+  return RCB_OK;
+}
+
 /* Refit candidate c with the base parameters, from the fitted base model
  * (c->from_fit) and from the nominal one (c->from_nom: the baseline fit ran
  * off, and c scores high at the nominal model): a missing effect that
@@ -677,6 +707,8 @@ static rcb_status refit(rcb_diag *d, diag_cand *c, const double *w) {
       st = evaluate_only(d, c, &m[b], f[b]);
     } else if (!(F[b] < HUGE_VAL)) {
       snprintf(c->fitted, sizeof c->fitted, "%s", why);
+    } else if (w && d->far && F[b] > RCB_DIAG_PRE_RATIO * d->pre_best) {
+      st = far_behind(d, c, &m[b], f[b]);
     } else if (w && (st = polish(f[b]))) {
       if (st == RCB_ERR_NOMEM)
         rcb_diag_fail(d, st, "refitting %s: %s", c->desc, rcb_fit_errmsg(f[b]));
@@ -726,12 +758,6 @@ static void sort_order(rcb_diag *d) {
  * at the fitted model). Sixteen: the hub of the 0.15 kg case scores 14th. */
 #define RCB_DIAG_NOM_PREFITS 16
 #define RCB_DIAG_NOM_REFITS 3
-/* On the subset (32 x 1101), a pre-fit is refitted only when its objective
- * is within this factor of the best pre-fit's: on the 0.15 kg hub case the
- * hub mass ends its pre-fit at F = 4528, the hub's inertia at 4.7e5 and the
- * rest at 2e6-3e6; the inertia's joint refit took 3.1 s (352 sweeps) to end
- * at 38 %, far behind. 8 x 151 refits the 3 best as before. */
-#define RCB_DIAG_PRE_RATIO 10.0
 
 /* The candidates a step fits, in order, for rcb_diag_for_each. */
 typedef struct cand_jobs {
@@ -766,6 +792,7 @@ static rcb_status refit_done(rcb_diag *d, size_t i, void *ctx) {
 static rcb_status nominal_starts(rcb_diag *d, cand_jobs *j) {
   size_t k, n;
   double best = HUGE_VAL;
+  d->pre_best = HUGE_VAL;
   rcb_status st;
   for (j->n = 0; j->n < RCB_DIAG_NOM_PREFITS; j->n++) {
     diag_cand *c = NULL;
@@ -788,7 +815,7 @@ static rcb_status nominal_starts(rcb_diag *d, cand_jobs *j) {
         c = e;
     }
     if (!c) break;
-    if (!n) best = c->pre_F;
+    if (!n) best = d->pre_best = c->pre_F;
     else if (j->w && !(c->pre_F <= RCB_DIAG_PRE_RATIO * best)) break;
     j->todo += !c->from_fit;
     c->from_nom = 1;
