@@ -80,6 +80,7 @@ struct rcb_diag {
   rcb_model *nom_model;             /* a finalized copy of the model as given, when
                                        the baseline fit ran off from it (owned) */
   int far;                          /* the baseline fit ran off from the nominal model */
+  double pre_best;                  /* the lowest pre-fit objective (far baseline), or HUGE_VAL */
   char drift[256];                  /* which parameter ran off, in words */
   double F0, err0, floor0;
   size_t nres;

@@ -290,6 +290,17 @@ def hub_mass_edit(mass):
     return edit
 
 
+def hub_inertia_edit(factor):
+    """model_edit: coupling C's hubs with factor x the diametral inertia (kg m^2) of
+    their geometry, mass and polar inertia kept."""
+
+    def edit(model):
+        m, idd, ip = _hub(model)
+        coupling_keys(drop=HUB_GEOMETRY, hub_mass=m, hub_id=factor * idd, hub_ip=ip)(model)
+
+    return edit
+
+
 def point_mass_edit(station_spec, mass):
     """model_edit: a point mass (kg; no inertia) at 'SHAFT z', a ROSS DiskElement."""
 
@@ -412,7 +423,9 @@ LARGE_CASES = [
     # as it is runs off (kt onto its bound) and the first-order score at the
     # nominal model ranks the hub 14th, behind every damping.
     Case("large_hub15_C", "coupling C hub mass 0.15 kg per station",
-         [(HUB, "coupling C")], "ross", model_edit=hub_mass_edit(0.15), grid="large"),
+         [(HUB, "coupling C")], "ross", model_edit=hub_mass_edit(0.15), grid="large"),    # The hub's diametral inertia alone (mass and polar inertia of the geometry kept).
+    Case("large_hubId_C", "coupling C hub diametral inertia x 20 per station (1.13e-4 kg m^2)",
+         [(HUB, "coupling C")], "ross", model_edit=hub_inertia_edit(20.0), grid="large"),
 ]
 
 
