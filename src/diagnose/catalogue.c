@@ -228,6 +228,9 @@ static rcb_status added_masses(rcb_diag *d, const rcb_model *m) {
       if (!(c = new_cand(d, RCB_EFFECT_ADDED_MASS, place))) return RCB_ERR_NOMEM;
       snprintf(c->desc, sizeof c->desc, "an added %s at %s", k ? "diametral inertia" : "mass",
                place);
+      c->node = i + 1;
+      c->inertia = (int)k;
+      c->shaft = nd->shaft;
       if (disk) {
         double lo, hi;
         int logp;

@@ -33,6 +33,9 @@ typedef struct diag_cand {
   char at[RCB_DIAG_NAME];           /* EDIT_ADD_DISK: its node, "#N" */
   double ped0[3];                   /* EDIT_ADD_PEDESTAL: kg, N/m, N s/m */
   int refit_only;                   /* no neutral value: refitted, not scored */
+  size_t node;                      /* an added mass or inertia: its node + 1 (0: other effects) */
+  int inertia;                      /* that candidate is a diametral inertia, not a mass */
+  size_t shaft;                     /* and the shaft of its node */
   size_t np;
   char pname[RCB_DIAG_MAXP][RCB_DIAG_NAME];
   double lo[RCB_DIAG_MAXP], hi[RCB_DIAG_MAXP];
