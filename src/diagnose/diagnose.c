@@ -577,7 +577,7 @@ static rcb_status polish(rcb_fit *f) {
 /* On the subset (32 x 1101) 4: a candidate that explains the data gets
  * there in a few (the 0.15 kg hub mass: the same joint refit after 4 as
  * after 8), the rest crawl (dampings: 52-83 sweeps in 8); 8 x 151 keeps 8. */
-#define RCB_DIAG_PREFIT_ITER_SUBSET 4
+#define RCB_DIAG_PREFIT_ITER_SUBSET 4 /* not for an added mass or inertia (place_search) */
 static rcb_status prefit(rcb_diag *d, diag_cand *c, const double *w) {
   rcb_model *m = NULL;
   rcb_fit *f = NULL;
@@ -591,7 +591,8 @@ static rcb_status prefit(rcb_diag *d, diag_cand *c, const double *w) {
   if (!st) st = rcb_fit_set_starts(f, 1, 1);
   if (!st) st = rcb_fit_get_limits(f, &it, &ftol, &xtol);
   if (!st)
-    st = rcb_fit_set_limits(f, w ? RCB_DIAG_PREFIT_ITER_SUBSET : RCB_DIAG_PREFIT_ITER, ftol, xtol);
+    st = rcb_fit_set_limits(f, w && !c->node ? RCB_DIAG_PREFIT_ITER_SUBSET : RCB_DIAG_PREFIT_ITER,
+                            ftol, xtol);
   if (!st) st = rcb_fit_set_weights(f, w);
   if (!st) st = rcb_fit_run(f);
   if (!st) {
