@@ -109,24 +109,27 @@ static void values_of(const rcb_meas *ms, rcb_complex *v) {
   }
 }
 
-/* A copy of measurement ms with every value times s. */
-static rcb_meas *scaled(const rcb_meas *ms, double s) {
+/* A copy of measurement ms with its values replaced by v (channel-major),
+ * or, with v NULL, its own values times s. */
+static rcb_meas *with_values(const rcb_meas *ms, const rcb_complex *v, double s) {
   rcb_meas *out = NULL;
-  rcb_complex *v = malloc(rcb_meas_point_count(ms) * sizeof *v);
-  size_t c, i;
-  assert_non_null(v);
+  rcb_complex *w = malloc(rcb_meas_point_count(ms) * sizeof *w);
+  size_t c, i, n = rcb_meas_point_count(ms);
+  assert_non_null(w);
   assert_int_equal(rcb_meas_create(&out, NULL), RCB_OK);
-  assert_int_equal(rcb_meas_set_grid(out, rcb_meas_get_type(ms), rcb_meas_point_count(ms),
-                                     rcb_meas_grid(ms), rcb_meas_speed(ms)), RCB_OK);
+  assert_int_equal(rcb_meas_set_grid(out, rcb_meas_get_type(ms), n, rcb_meas_grid(ms),
+                                     rcb_meas_speed(ms)), RCB_OK);
   for (c = 0; c < rcb_meas_channel_count(ms); c++) {
     rcb_meas_channel_info ci;
     assert_int_equal(rcb_meas_channel(ms, c, &ci), RCB_OK);
-    for (i = 0; i < rcb_meas_point_count(ms); i++) v[i] = s * ci.data[i];
-    assert_int_equal(rcb_meas_add_channel(out, ci.response, ci.reference, ci.kind, v), RCB_OK);
+    for (i = 0; i < n; i++) w[i] = v ? v[c * n + i] : s * ci.data[i];
+    assert_int_equal(rcb_meas_add_channel(out, ci.response, ci.reference, ci.kind, w), RCB_OK);
   }
-  free(v);
+  free(w);
   return out;
 }
+
+static rcb_meas *scaled(const rcb_meas *ms, double s) { return with_values(ms, NULL, s); }
 
 /* A finalized copy of m with parameter name set to value. */
 static rcb_model *edited(const rcb_model *m, const char *name, double value) {
@@ -357,6 +360,68 @@ static void test_null_sd(void **state) {
   assert_non_null(strstr(rcb_monitor_errmsg(mon), "channel 1 point 6"));
   rcb_monitor_destroy(mon);
   free(sd);
+}
+
+/* The self-starting CUSUM (rcb_monitor.h). The commissioning values are the
+ * average of NAVG noisy measurements, so every update's z carries the same
+ * commissioning noise; the CUSUM's input u must not: over a null series u
+ * has mean 0, variance 1 and no lag-1 correlation (each within 4 standard
+ * errors), and no CUSUM alarm. Then kt drifts linearly from update N0 at
+ * RATE standard errors per update (the data the model's change to first
+ * order, H(kt) = H0 + (kt - kt0) dH/dkt by a difference of two exact
+ * sweeps, so the linear path is exact): the falling CUSUM alarms within
+ * 20 updates of the start, and not before it. */
+static void test_self_starting_cusum(void **state) {
+  fixture *f = *state;
+  enum { NAVG = 10, N0 = 200, N = 300 };
+  const double RATE = 0.2, DK = 1e-3; /* -, relative kt step of the difference */
+  rcb_monitor_param tp;
+  rcb_monitor_opts o = opts_kt(&tp, f->kt);
+  rcb_monitor *mon = NULL;
+  rcb_monitor_result r;
+  rcb_model *m2 = edited(f->truth, KT_NAME, (1 + DK) * f->kt);
+  rcb_meas *ms = frf_of(m2), *setup;
+  rcb_complex *acc = calloc(NPT, sizeof *acc), *dh = malloc(NPT * sizeof *dh);
+  double su = 0, su2 = 0, sl = 0, sz = 0, uprev = 0, se = 0;
+  uint64_t seed = 4242;
+  size_t u, i, alarm_at = 0;
+  values_of(ms, dh);
+  for (i = 0; i < NPT; i++) dh[i] = (dh[i] - f->fs[i]) / (DK * f->kt); /* per N/m */
+  for (u = 0; u < NAVG; u++) {
+    eq19(f->fs, f->v, &seed);
+    for (i = 0; i < NPT; i++) acc[i] += f->v[i] / NAVG;
+  }
+  setup = with_values(f->setup, acc, 1.0);
+  o.setup_averages = NAVG;
+  assert_int_equal(rcb_monitor_create(&mon, f->base, setup, &o, NULL), RCB_OK);
+  for (u = 0; u < N; u++) {
+    double dkt = u < N0 ? 0.0 : -RATE * se * (double)(u - N0 + 1); /* N/m */
+    eq19(f->fs, f->v, &seed);
+    for (i = 0; i < NPT; i++) f->v[i] += dkt * dh[i];
+    assert_int_equal(rcb_monitor_update(mon, f->v, NULL, &r), RCB_OK);
+    if (!u) se = r.tracked[0].stderr_;
+    if (r.tracked[0].cusum_alarm && !alarm_at) alarm_at = u + 1;
+    if (u >= N0) continue;
+    su += r.tracked[0].u, su2 += r.tracked[0].u * r.tracked[0].u, sz += r.tracked[0].z;
+    if (u) sl += r.tracked[0].u * uprev;
+    uprev = r.tracked[0].u;
+  }
+  su /= N0, su2 = su2 / N0 - su * su, sl /= N0 - 1;
+  print_message("self-starting CUSUM, commissioning of %d averages: null u mean %.3f var %.3f "
+                "lag-1 %.3f (z mean %.3f); kt falling %.2f se per update from update %d: "
+                "CUSUM alarm at update %zu (%d into the drift)\n", (int)NAVG, su, su2, sl,
+                sz / N0, RATE, N0 + 1, alarm_at, (int)alarm_at - N0);
+  assert_true(fabs(su) < 4 / sqrt((double)N0));
+  assert_true(fabs(su2 - 1) < 4 * sqrt(2.0 / (double)N0));
+  assert_true(fabs(sl) < 4 / sqrt((double)N0));
+  assert_true(alarm_at > N0 && alarm_at <= N0 + 20);
+  assert_int_equal(r.tracked[0].cusum_alarm, -1);
+  rcb_monitor_destroy(mon);
+  rcb_meas_destroy(setup);
+  rcb_meas_destroy(ms);
+  rcb_model_destroy(m2);
+  free(acc);
+  free(dh);
 }
 
 /* kt scaled by 0.92 in the machine: a tracked drift. The machine is the
@@ -630,6 +695,7 @@ int main(void) {
       cmocka_unit_test(test_null_phase_reweighted),
       cmocka_unit_test(test_null_sd),
       cmocka_unit_test(test_unbalance_null),
+      cmocka_unit_test(test_self_starting_cusum),
       cmocka_unit_test(test_kt_change),
       cmocka_unit_test(test_cross_coupling),
       cmocka_unit_test(test_cross_coupling_relin),

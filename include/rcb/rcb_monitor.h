@@ -58,23 +58,48 @@
  *    step of the tracked parameters alone absorbs part of a new effect, and
  *    the model's non-linear response at that wrong step is in no
  *    candidate's columns (with opts.reweight it made a flexible support at
- *    B1 of -1e7 kg explain B3's cross-coupling).
+ *    B1 of -1e7 kg explain B3's cross-coupling). While the test fires, the
+ *    joint step of the tracked parameters and the best candidate is then
+ *    refined by opts.relinearise Gauss-Newton iterations whose columns are
+ *    re-evaluated at the estimate (forward differences of the model, 1 +
+ *    k_t + its parameters sweeps each), when the candidate's parameters are
+ *    the model's own (a bearing's or a disk's coefficients, not a pedestal
+ *    or a new mass): its size, the tracked values and all their standard
+ *    errors come from there. A large effect is not linear in its size:
+ *    linearised at the baseline, 1.5e7 N/m of cross-coupling at B3 came
+ *    out 5 % short, its interval missed the truth, and the unchanged
+ *    tracked parameters moved 17-68 standard errors.
  *  - Noise after a change. With opts.reweight the covariance of r is
  *    rebuilt at every update from the update's own noise (proportional
  *    noise follows the new response, whose peaks may have moved), C =
  *    Q^T D Q in the rank space, and every statistic above is taken in the
  *    metric C^-1 (generalised least squares): T stays chi-square(k - k_t)
  *    when only tracked parameters changed, however far.
- *  - Sequential detector. A two-sided CUSUM per tracked parameter on its
- *    standardised change z = (value - baseline) / stderr:
- *    S+ = max(0, S+ + z - k), S- = max(0, S- - z - k), alarm when either
- *    exceeds h. With independent N(0,1) z the in-control average run
- *    length of one side is Siegmund's
- *    ARL0 = (exp(2 k b) - 2 k b - 1) / (2 k^2), b = h + 1.166
- *    (rcb_cusum_arl0); both sides of n_t parameters alarm about
- *    2 n_t times as often. The z of successive updates share the
- *    commissioning measurement's noise: average enough measurements into it
- *    (opts.setup_averages) that this common part is small.
+ *  - Sequential detector. A two-sided self-starting CUSUM per tracked
+ *    parameter. Its input is not the change since commissioning,
+ *    z = (value - baseline) / stderr: every update's z carries the same
+ *    commissioning noise (the reference is one measurement, or the average
+ *    of N = opts.setup_averages), so successive z are correlated and a
+ *    CUSUM on them false-alarms far more often than its ARL0 says (with
+ *    N = 10: 15 alarms over 190 updates of a null ROSS series). The input is
+ *    the innovation u = (step - m) / sqrt(v + 1 / W): m the inverse-variance
+ *    weighted mean of the commissioning (step 0, variance
+ *    stderr^2 (1/N) / (1 + 1/N)) and of every earlier in-control update's
+ *    step (variance v = stderr^2 / (1 + 1/N), its own noise), W the sum of
+ *    those weights. The commissioning noise cancels in step - m, and under
+ *    "no change" with Gaussian noise the u of successive updates are
+ *    independent N(0, 1) (the innovations of a running mean). Then
+ *    S+ = max(0, S+ + u - k), S- = max(0, S- - u - k), alarm when either
+ *    exceeds h, and the in-control average run length of one side is
+ *    Siegmund's ARL0 = (exp(2 k b) - 2 k b - 1) / (2 k^2), b = h + 1.166
+ *    (rcb_cusum_arl0); both sides of n_t parameters alarm about 2 n_t times
+ *    as often. An update joins the reference only while neither the instant
+ *    test nor that parameter's CUSUM alarms; after a CUSUM alarm its
+ *    reference stays frozen until rcb_monitor_reset_cusum, which starts it
+ *    afresh from the next update (then the first update after the reset
+ *    only seeds it, u = 0). A drift is caught as a run of innovations of one
+ *    sign: the running mean trails a linear drift by half its length. With a
+ *    noise-free reference (setup_averages HUGE_VAL) m stays 0 and u = z.
  */
 #ifndef RCB_MONITOR_H
 #define RCB_MONITOR_H
@@ -109,7 +134,7 @@ typedef struct rcb_monitor_opts {
   const rcb_monitor_param *tracked; /**< ntracked entries */
   double alpha;      /**< false-alarm probability of the instant test per update
                           (-), 0 < alpha < 1; 0: 1e-3 */
-  double cusum_k;    /**< CUSUM reference value, standard deviations of z (-);
+  double cusum_k;    /**< CUSUM reference value, standard deviations of u (-);
                           0: 0.5 (tuned to a shift of 1 standard deviation) */
   double cusum_h;    /**< CUSUM decision threshold (-); 0: 8 (one side's
                           ARL0 ~ 1.9e4 updates) */
@@ -176,7 +201,11 @@ typedef struct rcb_monitor_tracked {
   double value;        /**< estimate, parameter units */
   double ci_lo, ci_hi; /**< 95 % interval, parameter units */
   double stderr_;      /**< standard error, parameter units */
-  double z;            /**< (value - baseline) / stderr (-) */
+  double z;            /**< (value - baseline) / stderr (-): the change since
+                            commissioning */
+  double u;            /**< the self-starting CUSUM's input (-): the step's
+                            innovation against the reference of the earlier
+                            in-control updates (see the method above) */
   double cusum_up;     /**< CUSUM S+ (-) */
   double cusum_down;   /**< CUSUM S- (-) */
   int cusum_alarm;     /**< +1: S+ > h (rising), -1: S- > h (falling), 0 */

@@ -65,14 +65,15 @@ static void build_c(rcb_monitor *mon, const rcb_complex *v, const double *sd) {
 }
 
 /* X (k x m) <- U^-T X. */
-static lapack_int solve_ut(const rcb_monitor *mon, double *X, size_t m) {
-  return LAPACKE_dtrtrs_work(LAPACK_COL_MAJOR, 'U', 'T', 'N', (lapack_int)mon->k,
-                             (lapack_int)m, mon->C, (lapack_int)mon->k, X, (lapack_int)mon->k);
+int rcb_mon_gls_solve(const rcb_monitor *mon, double *X, size_t m) {
+  return (int)LAPACKE_dtrtrs_work(LAPACK_COL_MAJOR, 'U', 'T', 'N', (lapack_int)mon->k,
+                                  (lapack_int)m, mon->C, (lapack_int)mon->k, X,
+                                  (lapack_int)mon->k);
 }
 
 /* With w->A = Qa (k x p) and w->Ri from rcb_mon_small_qr: qz = Qa^T z, and
  * the explained part of rows first .. p. */
-static double explained(const mon_small *w, const double *z, size_t k, size_t first, size_t p,
+double rcb_mon_gls_explained(const mon_small *w, const double *z, size_t k, size_t first, size_t p,
                         double *qz) {
   size_t j, i;
   double s = 0;
@@ -86,7 +87,7 @@ static double explained(const mon_small *w, const double *z, size_t k, size_t fi
 }
 
 /* Rows first .. first + q of Ri qz, and their standard errors. */
-static void step(const mon_small *w, const double *qz, size_t p, size_t first, size_t q,
+void rcb_mon_gls_step(const mon_small *w, const double *qz, size_t p, size_t first, size_t q,
                  double *x, double *se) {
   size_t a, b;
   for (a = 0; a < q; a++) {
@@ -110,7 +111,7 @@ static rcb_status candidates_gls(rcb_monitor *mon) {
     if (!c->dof) continue;
     memcpy(mon->sw.A, mon->Atw, k * nt * sizeof *mon->sw.A);
     memcpy(mon->sw.A + k * nt, mon->G + k * c->col, k * c->np * sizeof *mon->sw.A);
-    if (solve_ut(mon, mon->sw.A + k * nt, c->np))
+    if (rcb_mon_gls_solve(mon, mon->sw.A + k * nt, c->np))
       return rcb_mon_fail(mon, RCB_ERR_LAPACK, "reweighted update: triangular solve failed");
     if ((st = rcb_mon_small_qr(mon, &mon->sw, k, nt + c->np, &ok))) return st;
     if (!ok) { /* dependent in this metric: no evidence */
@@ -121,9 +122,9 @@ static rcb_status candidates_gls(rcb_monitor *mon) {
       memcpy(c->set_now, c->se_t, sizeof c->set_now);
       continue;
     }
-    c->score_now = explained(&mon->sw, mon->z0, k, nt, nt + c->np, qz);
-    step(&mon->sw, qz, nt + c->np, nt, c->np, c->size_now, c->se_now);
-    step(&mon->sw, qz, nt + c->np, 0, nt, c->th_now, c->set_now);
+    c->score_now = rcb_mon_gls_explained(&mon->sw, mon->z0, k, nt, nt + c->np, qz);
+    rcb_mon_gls_step(&mon->sw, qz, nt + c->np, nt, c->np, c->size_now, c->se_now);
+    rcb_mon_gls_step(&mon->sw, qz, nt + c->np, 0, nt, c->th_now, c->set_now);
   }
   return RCB_OK;
 }
@@ -144,8 +145,8 @@ rcb_status rcb_mon_gls(rcb_monitor *mon, const rcb_complex *v, const double *sd,
   memcpy(mon->z, mon->y, k * sizeof *mon->z);
   memcpy(mon->z0, mon->y0, k * sizeof *mon->z0);
   memcpy(mon->Atw, mon->G, k * nt * sizeof *mon->Atw);
-  if (solve_ut(mon, mon->z, 1) || solve_ut(mon, mon->z0, 1) ||
-      (nt && solve_ut(mon, mon->Atw, nt)))
+  if (rcb_mon_gls_solve(mon, mon->z, 1) || rcb_mon_gls_solve(mon, mon->z0, 1) ||
+      (nt && rcb_mon_gls_solve(mon, mon->Atw, nt)))
     return rcb_mon_fail(mon, RCB_ERR_LAPACK, "reweighted update: triangular solve failed");
   *T = 0;
   for (a = 0; a < k; a++) *T += mon->z[a] * mon->z[a];
@@ -155,8 +156,8 @@ rcb_status rcb_mon_gls(rcb_monitor *mon, const rcb_complex *v, const double *sd,
     if (!ok)
       return rcb_mon_fail(mon, RCB_ERR_SINGULAR, "reweighted update %zu: the tracked parameters "
                           "are not told apart in this update's noise", mon->updates + 1);
-    *T -= explained(&mon->sw, mon->z, k, 0, nt, qz);
-    step(&mon->sw, qz, nt, 0, nt, dtheta, se);
+    *T -= rcb_mon_gls_explained(&mon->sw, mon->z, k, 0, nt, qz);
+    rcb_mon_gls_step(&mon->sw, qz, nt, 0, nt, dtheta, se);
   }
   return candidates_gls(mon);
 }

@@ -41,6 +41,10 @@ typedef struct mon_cand {
   double neutral[RCB_MONITOR_MAXP]; /* the parameters' values the columns are at */
   double lo[RCB_MONITOR_MAXP], hi[RCB_MONITOR_MAXP]; /* the catalogue's plausible range */
   int implausible;   /* this update: some parameter's 95 % interval outside [lo, hi] */
+  int settable;      /* its parameters are the baseline model's own, at their
+                        neutral values (rcb_model_set_param on mon->model):
+                        the joint step can be re-linearised */
+  char pname[RCB_MONITOR_MAXP][RCB_MONITOR_NAME]; /* their names (settable) */
 } mon_cand;
 
 /* Workspace of the small QRs in the rank space (k x p, p <= nt + MAXP). */
@@ -77,6 +81,13 @@ struct rcb_monitor {
   double *test;        /* nt x k row-major: tracked step = test y */
   double *tdir;        /* nt x k row-major: orthonormal basis of the tracked columns */
   double cus_up[RCB_MONITOR_MAX_TRACKED], cus_dn[RCB_MONITOR_MAX_TRACKED];
+  /* the self-starting CUSUM's reference (rcb_monitor.h): the
+   * inverse-variance weighted mean of the commissioning (step 0) and of the
+   * in-control updates' steps, kept as sum(step / var) (1 / parameter
+   * units) and sum(1 / var) (1 / parameter units^2); ref_started: the
+   * commissioning's pseudo-observation is in (or a reset dropped it) */
+  double ref_sum[RCB_MONITOR_MAX_TRACKED], ref_w[RCB_MONITOR_MAX_TRACKED];
+  int ref_started, ref_frozen[RCB_MONITOR_MAX_TRACKED];
 
   /* rank space */
   size_t k;            /* rank of all columns */
@@ -103,6 +114,9 @@ struct rcb_monitor {
   double *sd0;         /* opts.sd copied (have_sd0), npt */
   double *C, *z, *z0, *Atw, *b1; /* k x k, k, k, k x nt, 2 k */
   double *achan;       /* nch: eq. 19 additive amplitude of this update */
+  double *Jx;          /* k x (nt + MAXP), column-major: the joint columns of the
+                          tracked parameters and the best candidate at the
+                          current estimate (monitor.c, joint_relin) */
   mon_small sw;
 
   /* update workspace */
@@ -148,5 +162,16 @@ rcb_status rcb_mon_small_qr(rcb_monitor *mon, mon_small *w, size_t k, size_t p, 
  * candidate's score and estimates. */
 rcb_status rcb_mon_gls(rcb_monitor *mon, const rcb_complex *v, const double *sd,
                        double *dtheta, double *se, double *T);
+/* Its pieces, for the joint re-linearisation of monitor.c (after
+ * rcb_mon_gls, whose Cholesky factor U stays in mon->C): X (k x m,
+ * column-major) <- U^-T X (0 or LAPACK's info); with w->A = Qa (k x p) and
+ * w->Ri from rcb_mon_small_qr, qz = Qa^T z and the sum of squares of its
+ * entries first .. p; rows first .. first + q of Ri qz and their standard
+ * errors. */
+int rcb_mon_gls_solve(const rcb_monitor *mon, double *X, size_t m);
+double rcb_mon_gls_explained(const mon_small *w, const double *z, size_t k, size_t first,
+                             size_t p, double *qz);
+void rcb_mon_gls_step(const mon_small *w, const double *qz, size_t p, size_t first, size_t q,
+                      double *x, double *se);
 
 #endif

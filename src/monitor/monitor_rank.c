@@ -104,6 +104,14 @@ static rcb_status cand_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
     mc->col = pl->col[j];
     for (a = 0; a < c.np; a++)
       mc->neutral[a] = pl->neutral[pl->col[j] + a], mc->lo[a] = c.lo[a], mc->hi[a] = c.hi[a];
+    mc->settable = !pl->own[j];
+    for (a = 0; mc->settable && a < c.np; a++) {
+      double v;
+      mc->settable = snprintf(mc->pname[a], sizeof mc->pname[a], "%s", c.pname[a]) <
+                         (int)sizeof mc->pname[a] &&
+                     rcb_model_get_param(mon->model, c.pname[a], &v) == RCB_OK &&
+                     v == mc->neutral[a];
+    }
     p = nt + c.np;
     memcpy(w->A, G, k * nt * sizeof *w->A);
     memcpy(w->A + k * nt, G + k * pl->col[j], k * c.np * sizeof *w->A);
@@ -189,13 +197,14 @@ rcb_status rcb_mon_rank_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
   mon->test = rcb_mon_alloc(mon, 2 * (nt ? nt : 1) * k, sizeof *mon->test);
   mon->cand = rcb_mon_alloc(mon, pl->ncand ? pl->ncand : 1, sizeof *mon->cand);
   /* the reweighted path: C, z, z0, U^-T G_t, two rows, the channels' amplitudes */
-  mon->C = rcb_mon_alloc(mon, k * k + 2 * k + k * (nt ? nt : 1) + 2 * k + mon->nch,
+  mon->C = rcb_mon_alloc(mon, k * k + 2 * k + k * (nt ? nt : 1) + 2 * k + mon->nch + k * pmax,
                          sizeof *mon->C);
   if (!mon->G || !w->A || !mon->test || !mon->cand || !mon->C)
     return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (rank space)");
   mon->z = mon->C + k * k, mon->z0 = mon->z + k, mon->Atw = mon->z0 + k;
   mon->b1 = mon->Atw + k * (nt ? nt : 1);
   mon->achan = mon->b1 + 2 * k;
+  mon->Jx = mon->achan + mon->nch;
   mon->ncol = pl->ncol;
   mon->ncand = pl->ncand;
   mon->tdir = mon->test + (nt ? nt : 1) * k;

@@ -61,6 +61,7 @@ static void json_tracked(FILE *fp, const rcb_monitor_tracked *t, const char *nam
   json_key_num(fp, "ci_hi", t->ci_hi);
   json_key_num(fp, "stderr", t->stderr_);
   json_key_num(fp, "z", t->z);
+  json_key_num(fp, "u", t->u);
   json_key_num(fp, "cusum_up", t->cusum_up);
   json_key_num(fp, "cusum_down", t->cusum_down);
   fprintf(fp, ", \"cusum_alarm\": %d, \"out_of_range\": %s}", t->cusum_alarm,
@@ -161,9 +162,9 @@ static void csv_row(FILE *fp, const mon_state *s, size_t k) {
   csv_str(fp, flags);
   for (i = 0; i < r->ntracked; i++) {
     const rcb_monitor_tracked *t = &r->tracked[i];
-    const double tv[] = {t->value, t->ci_lo, t->ci_hi, t->z, t->cusum_down, t->cusum_up};
+    const double tv[] = {t->value, t->ci_lo, t->ci_hi, t->z, t->u, t->cusum_down, t->cusum_up};
     size_t q;
-    for (q = 0; q < 6; q++) {
+    for (q = 0; q < sizeof tv / sizeof tv[0]; q++) {
       fputc(',', fp);
       cli_csv_num(fp, tv[q]);
     }
@@ -192,7 +193,8 @@ static void print_csv(FILE *fp, const mon_state *s) {
         "cusum_alarm,flags", fp);
   for (k = 0; k < s->j->params.n; k++) {
     const char *n = s->j->params.items[k].name;
-    fprintf(fp, ",%s,%s ci_lo,%s ci_hi,%s z,%s cusum_down,%s cusum_up", n, n, n, n, n, n);
+    fprintf(fp, ",%s,%s ci_lo,%s ci_hi,%s z,%s u,%s cusum_down,%s cusum_up", n, n, n, n, n, n,
+            n);
   }
   fputs(",top_effect,top_place,top_p_value\n", fp);
   for (k = 0; k < s->nrec; k++) csv_row(fp, s, k);

@@ -131,7 +131,8 @@ class MonitorCandidate(ctypes.Structure):
 
 class MonitorTracked(ctypes.Structure):
     _fields_ = [("value", c_double), ("ci_lo", c_double), ("ci_hi", c_double),
-                ("stderr_", c_double), ("z", c_double), ("cusum_up", c_double),
+                ("stderr_", c_double), ("z", c_double), ("u", c_double),
+                ("cusum_up", c_double),
                 ("cusum_down", c_double), ("cusum_alarm", c_int), ("out_of_range", c_int)]
 
 

@@ -133,7 +133,7 @@ class Monitor(Handle):
             t = r.tracked[k]
             tracked.append({"name": self.tracked[k]["name"], "value": t.value,
                             "ci_lo": t.ci_lo, "ci_hi": t.ci_hi, "stderr": t.stderr_,
-                            "z": t.z, "cusum_up": t.cusum_up, "cusum_down": t.cusum_down,
+                            "z": t.z, "u": t.u, "cusum_up": t.cusum_up, "cusum_down": t.cusum_down,
                             "cusum_alarm": t.cusum_alarm, "out_of_range": bool(t.out_of_range)})
         top = []
         for k in range(r.ntop):
