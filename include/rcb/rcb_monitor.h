@@ -156,7 +156,10 @@ typedef struct rcb_monitor_opts {
   size_t relinearise; /**< chord iterations refining the tracked estimates per
                            update by re-evaluating the model (0: linear only;
                            each costs one sweep of the set-up with the banded
-                           LAPACK solver, which allocates nothing) */
+                           LAPACK solver, which allocates nothing, or, where
+                           rcb_monitor_fast_relinearise says so, a small
+                           solve per frequency on the DOFs the tracked
+                           parameters touch) */
   int reweight;      /**< 1: take each update's noise from the update itself
                           (eq. 19 on its own values, or the sd passed to
                           rcb_monitor_update) and apply the statistics in that
@@ -286,6 +289,13 @@ RCB_API void rcb_monitor_reset_cusum(rcb_monitor *mon);
 RCB_API size_t rcb_monitor_point_count(const rcb_monitor *mon);
 /** @brief Bytes the monitor holds (all from its allocator). */
 RCB_API size_t rcb_monitor_memory(const rcb_monitor *mon);
+/** @brief 1 when opts.relinearise re-evaluates the model without a sweep:
+ * an FRF set-up whose tracked parameters enter the dynamic stiffness
+ * affinely (every stiffness, damping and inertia coefficient does), on the
+ * few DOFs they touch; each evaluation is then the Woodbury identity on
+ * those DOFs, checked against a sweep at create (relative 1e-7). 0: each
+ * re-linearisation sweeps the set-up (a 1X set-up, or no re-linearisation). */
+RCB_API int rcb_monitor_fast_relinearise(const rcb_monitor *mon);
 /** @brief Rank k of all columns (tracked + candidates) and k_t of the tracked. */
 RCB_API rcb_status rcb_monitor_rank(const rcb_monitor *mon, size_t *k, size_t *k_tracked);
 

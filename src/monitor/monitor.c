@@ -27,6 +27,7 @@ void rcb_monitor_destroy(rcb_monitor *mon) {
   rcb_free(&mon->alloc, mon->sw.A);
   rcb_free(&mon->alloc, mon->sw.work);
   rcb_free(&mon->alloc, mon->y);
+  rcb_mon_lowrank_free(mon, mon->lr);
   rcb_fit_destroy(mon->fit);
   rcb_model_destroy(mon->model);
   rcb_meas_destroy(mon->setup);
@@ -87,6 +88,17 @@ static rcb_status model_change(rcb_monitor *mon, const double *theta, const mon_
                                const double *s) {
   size_t k, p;
   rcb_status st = RCB_OK;
+  if (!c && mon->lr) { /* the tracked parameters alone: without a sweep */
+    rcb_complex *dm = mon->lr->dm;
+    if ((st = rcb_mon_lowrank_change(mon, theta, dm))) return st;
+    for (p = 0; p < mon->npt; p++) {
+      double complex g = conj(mon->u[p]) * dm[p];
+      mon->rm[2 * p] = creal(g) * mon->winv[2 * p];
+      mon->rm[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
+    }
+    to_rank(mon, mon->rm, mon->ym);
+    return RCB_OK;
+  }
   for (k = 0; !st && k < mon->nt; k++)
     if ((st = rcb_model_set_param(mon->model, mon->tname[k], mon->t0[k] + theta[k])))
       rcb_mon_fail(mon, st, "re-linearising at %s = %g: %s", mon->tname[k],
@@ -406,6 +418,7 @@ void rcb_monitor_reset_cusum(rcb_monitor *mon) {
 }
 
 size_t rcb_monitor_point_count(const rcb_monitor *mon) { return ready(mon) ? mon->npt : 0; }
+int rcb_monitor_fast_relinearise(const rcb_monitor *mon) { return ready(mon) && mon->lr; }
 size_t rcb_monitor_memory(const rcb_monitor *mon) { return mon ? mon->held : 0; }
 
 rcb_status rcb_monitor_rank(const rcb_monitor *mon, size_t *k, size_t *k_tracked) {

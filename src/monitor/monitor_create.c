@@ -380,6 +380,7 @@ static rcb_status commission(rcb_monitor *mon, const rcb_model *base, const rcb_
       mon->order = (size_t *)(void *)(mon->pscore + (mon->ncand ? mon->ncand : 1));
     }
   }
+  if (!st) st = rcb_mon_lowrank_init(mon);
   if (!st) {
     size_t dof = mon->k > mon->nt ? mon->k - mon->nt : 0;
     mon->threshold = dof ? rcb_chi2_quantile(1.0 - mon->alpha, (double)dof) : (double)INFINITY;

@@ -11,6 +11,7 @@
  * standard errors from the QR of [A_t A_c]. All memory was sized by
  * rcb_monitor_create (mon->C, mon->sw).
  */
+#include <cblas.h>
 #include <lapacke.h>
 #include <math.h>
 #include <string.h>
@@ -38,10 +39,12 @@ static void point_cov(const rcb_monitor *mon, const rcb_complex *v, const double
   *d11 = s11 * w1 * w1, *d12 = s12 * w1 * w2, *d22 = s22 * w2 * w2;
 }
 
-/* C = Q^T D Q (upper triangle), D = L L^T per point. */
+/* C = Q^T D Q (upper triangle), D = L L^T per point: the rows L^T Q of
+ * MON_SYRK_POINTS points at a time into B (k x 2 MON_SYRK_POINTS,
+ * column-major: one row per column), then C += B B^T (BLAS dsyrk). */
 static void build_c(rcb_monitor *mon, const rcb_complex *v, const double *sd) {
-  size_t k = mon->k, p, a, b, c = 0;
-  double *b1 = mon->b1, *b2 = mon->b1 + k;
+  size_t k = mon->k, p, a, c = 0, nb = 0;
+  double *B = mon->b1;
   if (!sd && !mon->have_sd0)
     for (c = 0; c < mon->nch; c++) { /* eq. 19 additive amplitude of this update */
       double s2 = 0;
@@ -52,14 +55,15 @@ static void build_c(rcb_monitor *mon, const rcb_complex *v, const double *sd) {
   c = 0;
   for (p = 0; p < mon->npt; p++) {
     const double *q1 = mon->Q + k * (2 * p), *q2 = q1 + k;
-    double d11, d12, d22, l11, l21, l22;
+    double d11, d12, d22, l11, l21, l22, *b1 = B + k * (2 * nb), *b2 = b1 + k;
     if (p && p == (c + 1) * mon->npts) c++; /* the channel of point p */
     point_cov(mon, v, sd, p, mon->achan[c], &d11, &d12, &d22);
     l11 = sqrt(d11), l21 = d12 / l11, l22 = sqrt(fmax(d22 - l21 * l21, 0.0));
     for (a = 0; a < k; a++) b1[a] = l11 * q1[a] + l21 * q2[a], b2[a] = l22 * q2[a];
-    for (b = 0; b < k; b++) {
-      double *cb = mon->C + k * b, x1 = b1[b], x2 = b2[b];
-      for (a = 0; a <= b; a++) cb[a] += b1[a] * x1 + b2[a] * x2;
+    if (++nb == MON_SYRK_POINTS || p + 1 == mon->npt) {
+      cblas_dsyrk(CblasColMajor, CblasUpper, CblasNoTrans, (blasint)k, (blasint)(2 * nb), 1.0,
+                  B, (blasint)k, 1.0, mon->C, (blasint)k);
+      nb = 0;
     }
   }
 }

@@ -17,6 +17,9 @@
 
 #define RCB_MONITOR_NAME 128
 #define RCB_MON_DEG 0.017453292519943295 /* rad per degree */
+/* Points per block of the reweighted covariance (monitor_gls.c: C += B B^T
+ * by BLAS dsyrk on 2 MON_SYRK_POINTS rows at a time) */
+#define MON_SYRK_POINTS 128
 
 /* A candidate in the rank space (dimension k): its estimate rows and the
  * orthonormal directions it adds beyond the tracked parameters. */
@@ -46,6 +49,29 @@ typedef struct mon_cand {
                         the joint step can be re-linearised */
   char pname[RCB_MONITOR_MAXP][RCB_MONITOR_NAME]; /* their names (settable) */
 } mon_cand;
+
+/* Most DOFs the tracked parameters may touch, and most channels, for the
+ * low-rank re-evaluation (monitor_lowrank.c). */
+#define MON_LOWRANK_MAXP 32
+#define RCB_MONITOR_LOWRANK_MAXCH 4096
+
+/* The re-linearisation's evaluations by the Woodbury identity
+ * (monitor_lowrank.c): P the DOFs the tracked parameters touch. */
+typedef struct mon_lowrank {
+  size_t np, nin;      /* |P|, distinct inputs of the set-up */
+  size_t *pdof;        /* P: matrix rows */
+  struct rcb_fit_dz *dz; /* nt: the tracked parameters' derivative matrices */
+  size_t *ep;          /* per derivative entry: its row's and column's place in P */
+  size_t *ch_in;       /* nch: each channel's input */
+  rcb_complex *a;      /* npt x np: H0_{o,P} in the channel's kind, per point */
+  rcb_complex *b;      /* npts x nin x np: H0_{P,i} (receptance) */
+  rcb_complex *hpp;    /* npts x np x np, column-major: H0_PP (receptance) */
+  rcb_complex *dZ, *M, *X; /* work: np x np, np x np, np x nin */
+  rcb_complex *dm;     /* npt: the change of the model values */
+  int *ipiv;           /* np */
+  const double *w;     /* the set-up's frequencies, rad/s (npts; its own copy's) */
+  double speed;        /* rotor speed, rad/s (negative: synchronous) */
+} mon_lowrank;
 
 /* Workspace of the small QRs in the rank space (k x p, p <= nt + MAXP). */
 typedef struct mon_small {
@@ -104,6 +130,7 @@ struct rcb_monitor {
   rcb_meas *setup;
   rcb_fit *fit;
   double *rbase;       /* n */
+  mon_lowrank *lr;     /* the evaluations without a sweep, NULL: by sweeps */
 
   /* noise of the reweighted path */
   int reweight, have_sd0;
@@ -112,7 +139,7 @@ struct rcb_monitor {
   double *var0;        /* 2 per point: radial, tangential variance of one
                           measurement at the commissioning values */
   double *sd0;         /* opts.sd copied (have_sd0), npt */
-  double *C, *z, *z0, *Atw, *b1; /* k x k, k, k, k x nt, 2 k */
+  double *C, *z, *z0, *Atw, *b1; /* k x k, k, k, k x nt, k x 2 MON_SYRK_POINTS */
   double *achan;       /* nch: eq. 19 additive amplitude of this update */
   double *Jx;          /* k x (nt + MAXP), column-major: the joint columns of the
                           tracked parameters and the best candidate at the
@@ -145,6 +172,13 @@ typedef struct col_plan {
   double *neutral; /* ncol: each candidate column's parameter value in its model */
   size_t ncand, ncol;
 } col_plan;
+
+/* monitor_lowrank.c: set up the low-rank re-evaluation where it applies
+ * and reproduces a sweep (an error only for memory); the change of every
+ * point's model value (SI, channel-major) for tracked steps theta; free. */
+rcb_status rcb_mon_lowrank_init(rcb_monitor *mon);
+rcb_status rcb_mon_lowrank_change(rcb_monitor *mon, const double *theta, rcb_complex *dm);
+void rcb_mon_lowrank_free(rcb_monitor *mon, mon_lowrank *lr);
 
 /* monitor_rank.c: the QR of the whitened columns J (n x ncol; the basis
  * made explicit in mon->Q), then the rank space; J's block becomes mon->Q. */

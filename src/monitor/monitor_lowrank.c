@@ -1,0 +1,260 @@
+/*
+ * The re-linearisation's model evaluations without a sweep (FRF set-ups).
+ * The tracked parameters are coefficients of the dynamic stiffness:
+ * Z(w; t0 + theta) = Z0(w) + sum_j theta_j D_j(w), D_j = dK_j - w^2 dM_j +
+ * i w (dC_j + Omega dG_j) (identify.h's rcb_fit_dz: the parameters'
+ * derivative matrices, constant when Z is affine in them), all on the few
+ * DOFs P they touch (a coupling's kt, kr, ct: the 8 DOFs of its two hubs).
+ * With H0 = Z0^-1, the Woodbury identity gives every channel's change
+ *   H_oi(theta) - H0_oi = -H0_oP (I + dZ H0_PP)^-1 dZ H0_Pi,  dZ = dZ_PP,
+ * one |P| x |P| solve per frequency (about 1 us) instead of the banded
+ * factorisation of the whole model (about 20 us). H0_oP (in each channel's
+ * kind), H0_PP and H0_Pi (receptances) are kept from create, where one
+ * evaluation is checked against a sweep of the model (rcb_mon_lowrank_init):
+ * a parameter that does not enter Z affinely (or a unbalance set-up) leaves
+ * the sweep in charge. All memory from the monitor's hooks at create.
+ */
+#include <lapacke.h>
+#include <math.h>
+#include <string.h>
+
+#include "identify/identify.h"
+#include "io/io.h"
+#include "monitor/monitor_internal.h"
+
+/* Largest relative difference, over the points, of the low-rank change
+ * against the sweep's (of the largest change) that create accepts. */
+#define LR_TOL 1e-7
+/* The check's step: this fraction of each tracked parameter's baseline. */
+#define LR_STEP 0.05
+
+/* Index of matrix row r in P (appending it if new; np capped by cap). */
+static size_t p_index(mon_lowrank *lr, size_t r, size_t cap) {
+  size_t q;
+  for (q = 0; q < lr->np; q++)
+    if (lr->pdof[q] == r) return q;
+  if (lr->np < cap) lr->pdof[lr->np++] = r;
+  return q;
+}
+
+/* The rcb_dof of matrix row r (a node's DOF; pedestal DOFs are not). */
+static int dof_of(const rcb_model *m, size_t r, rcb_dof *out) {
+  size_t n, d, idx, nn = rcb_model_node_count(m);
+  for (n = 0; n < nn; n++)
+    for (d = 0; d < 4; d++) {
+      rcb_dof x;
+      x.node = n, x.dir = (rcb_dir)d;
+      if (rcb_model_dof_index(m, x, &idx) == RCB_OK && idx == r) {
+        *out = x;
+        return 1;
+      }
+    }
+  return 0;
+}
+
+/* The blocks H0_oP, H0_PP, H0_Pi at every frequency of the set-up. */
+static rcb_status blocks(rcb_monitor *mon, mon_lowrank *lr, const rcb_meas_dofs *md,
+                         const rcb_frf_kind *kind) {
+  size_t np = lr->np, nout = md->nout + np, nin = md->nin + np, i, c, q, r, pass;
+  rcb_dof *outs = rcb_mon_alloc(mon, nout, sizeof *outs), *ins = rcb_mon_alloc(mon, nin,
+                                                                               sizeof *ins);
+  rcb_complex *H = rcb_mon_alloc(mon, nout * nin, sizeof *H);
+  rcb_frf *f = NULL;
+  rcb_status st = RCB_ERR_NOMEM;
+  if (!outs || !ins || !H) goto done;
+  memcpy(outs, md->outs, md->nout * sizeof *outs);
+  memcpy(ins, md->ins, md->nin * sizeof *ins);
+  for (q = 0; q < np; q++) {
+    st = RCB_ERR_UNSUPPORTED;
+    if (!dof_of(mon->model, lr->pdof[q], &outs[md->nout + q])) goto done;
+    ins[md->nin + q] = outs[md->nout + q];
+  }
+  if ((st = rcb_frf_create(&f, mon->model, nout, outs, nin, ins, RCB_SOLVER_BANDED,
+                           &mon->alloc)))
+    goto done;
+  for (i = 0; i < mon->npts; i++) {
+    double w = lr->w[i], W = lr->speed < 0 ? w : lr->speed;
+    /* pass 0: receptance (H0_PP, H0_Pi, and the receptance channels); then
+     * each other kind's channels */
+    for (pass = 0; pass < 3; pass++) {
+      int used = pass == 0;
+      for (c = 0; !used && c < mon->nch; c++) used = (int)kind[c] == (int)pass;
+      if (!used) continue;
+      if ((st = rcb_frf_eval(f, w, W, (rcb_frf_kind)pass, H))) goto done;
+      for (c = 0; c < mon->nch; c++)
+        if ((int)kind[c] == (int)pass)
+          for (q = 0; q < np; q++)
+            lr->a[(c * mon->npts + i) * np + q] = H[md->ch_out[c] + nout * (md->nin + q)];
+      if (pass) continue;
+      for (q = 0; q < np; q++) {
+        for (r = 0; r < np; r++)
+          lr->hpp[i * np * np + q + np * r] = H[md->nout + q + nout * (md->nin + r)];
+        for (r = 0; r < md->nin; r++) lr->b[(i * md->nin + r) * np + q] = H[md->nout + q + nout * r];
+      }
+    }
+  }
+done:
+  rcb_frf_destroy(f);
+  rcb_free(&mon->alloc, H);
+  rcb_free(&mon->alloc, ins);
+  rcb_free(&mon->alloc, outs);
+  return st;
+}
+
+rcb_status rcb_mon_lowrank_change(rcb_monitor *mon, const double *theta, rcb_complex *dm) {
+  mon_lowrank *lr = mon->lr;
+  size_t np = lr->np, nin = lr->nin, i, j, a, q, r, c;
+  for (i = 0; i < mon->npts; i++) {
+    double w = lr->w[i], W = lr->speed < 0 ? w : lr->speed;
+    const rcb_complex *hpp = lr->hpp + i * np * np, *b = lr->b + i * nin * np;
+    rcb_complex *dZ = lr->dZ, *M = lr->M, *X = lr->X;
+    size_t e = 0;
+    memset(dZ, 0, np * np * sizeof *dZ);
+    for (j = 0; j < mon->nt; j++)
+      for (a = 0; a < lr->dz[j].ne; a++, e++) {
+        const rcb_fit_dz_entry *d = &lr->dz[j].e[a];
+        dZ[lr->ep[2 * e] + np * lr->ep[2 * e + 1]] +=
+            theta[j] * CMPLX(d->k - w * w * d->m, w * (d->c + W * d->g));
+      }
+    for (r = 0; r < np; r++) /* M = I + dZ H0_PP, X = dZ H0_Pi */
+      for (q = 0; q < np; q++) {
+        rcb_complex s = q == r ? 1.0 : 0.0;
+        for (a = 0; a < np; a++) s += dZ[q + np * a] * hpp[a + np * r];
+        M[q + np * r] = s;
+      }
+    for (r = 0; r < nin; r++)
+      for (q = 0; q < np; q++) {
+        rcb_complex s = 0;
+        for (a = 0; a < np; a++) s += dZ[q + np * a] * b[r * np + a];
+        X[q + np * r] = s;
+      }
+    if (LAPACKE_zgesv_work(LAPACK_COL_MAJOR, (lapack_int)np, (lapack_int)nin, M, (lapack_int)np,
+                           lr->ipiv, X, (lapack_int)np))
+      return rcb_mon_fail(mon, RCB_ERR_SINGULAR, "re-linearising at %g rad/s: the changed "
+                          "model is singular", w);
+    for (c = 0; c < mon->nch; c++) {
+      const rcb_complex *ac = lr->a + (c * mon->npts + i) * np, *x = X + np * lr->ch_in[c];
+      rcb_complex s = 0;
+      for (q = 0; q < np; q++) s += ac[q] * x[q];
+      dm[c * mon->npts + i] = -s;
+    }
+  }
+  return RCB_OK;
+}
+
+/* Sizes, the tracked parameters' derivative matrices and P. */
+static rcb_status layout(rcb_monitor *mon, mon_lowrank *lr, size_t nin) {
+  size_t j, a, ne = 0, e = 0, cap;
+  rcb_status st;
+  lr->dz = rcb_mon_alloc(mon, mon->nt, sizeof *lr->dz);
+  if (!lr->dz) return RCB_ERR_NOMEM;
+  if ((st = rcb_fit_dz_get(mon->fit, &mon->alloc, lr->dz))) return st;
+  for (j = 0; j < mon->nt; j++) ne += lr->dz[j].ne;
+  cap = 2 * ne;
+  lr->ep = rcb_mon_alloc(mon, cap ? cap : 1, sizeof *lr->ep);
+  lr->pdof = rcb_mon_alloc(mon, cap ? cap : 1, sizeof *lr->pdof);
+  if (!lr->ep || !lr->pdof) return RCB_ERR_NOMEM;
+  for (j = 0; j < mon->nt; j++)
+    for (a = 0; a < lr->dz[j].ne; a++, e++) {
+      lr->ep[2 * e] = p_index(lr, lr->dz[j].e[a].row, cap);
+      lr->ep[2 * e + 1] = p_index(lr, lr->dz[j].e[a].col, cap);
+    }
+  if (!lr->np || lr->np > MON_LOWRANK_MAXP) return RCB_ERR_UNSUPPORTED;
+  lr->nin = nin;
+  lr->a = rcb_mon_alloc(mon, mon->npt * lr->np, sizeof *lr->a);
+  lr->hpp = rcb_mon_alloc(mon, mon->npts * lr->np * lr->np, sizeof *lr->hpp);
+  lr->b = rcb_mon_alloc(mon, mon->npts * nin * lr->np, sizeof *lr->b);
+  lr->dZ = rcb_mon_alloc(mon, 2 * lr->np * lr->np + lr->np * nin + mon->npt, sizeof *lr->dZ);
+  lr->ipiv = rcb_mon_alloc(mon, lr->np, sizeof *lr->ipiv);
+  lr->ch_in = rcb_mon_alloc(mon, mon->nch, sizeof *lr->ch_in);
+  if (!lr->a || !lr->hpp || !lr->b || !lr->dZ || !lr->ipiv || !lr->ch_in) return RCB_ERR_NOMEM;
+  lr->M = lr->dZ + lr->np * lr->np, lr->X = lr->M + lr->np * lr->np;
+  lr->dm = lr->X + lr->np * nin;
+  return RCB_OK;
+}
+
+/* Does the low-rank change equal the sweep's at theta = LR_STEP t0? */
+static rcb_status check(rcb_monitor *mon, int *ok) {
+  double theta[RCB_MONITOR_MAX_TRACKED], big = 0, diff = 0;
+  rcb_complex *dm = rcb_mon_alloc(mon, mon->npt, sizeof *dm);
+  size_t j, p;
+  rcb_status st = RCB_OK;
+  *ok = 0;
+  if (!dm) return RCB_ERR_NOMEM;
+  for (j = 0; j < mon->nt; j++) theta[j] = LR_STEP * mon->t0[j];
+  for (j = 0; !st && j < mon->nt; j++)
+    st = rcb_model_set_param(mon->model, mon->tname[j], mon->t0[j] + theta[j]);
+  if (!st) st = rcb_fit_residuals(mon->fit, mon->rm);
+  for (j = 0; j < mon->nt; j++) rcb_model_set_param(mon->model, mon->tname[j], mon->t0[j]);
+  if (!st) st = rcb_mon_lowrank_change(mon, theta, dm);
+  for (p = 0; !st && p < mon->npt; p++) {
+    rcb_complex s = CMPLX(mon->rm[2 * p] - mon->rbase[2 * p],
+                          mon->rm[2 * p + 1] - mon->rbase[2 * p + 1]);
+    big = fmax(big, cabs(s));
+    diff = fmax(diff, cabs(s - dm[p]));
+  }
+  rcb_free(&mon->alloc, dm);
+  *ok = !st && big > 0 && diff <= LR_TOL * big;
+  return st == RCB_ERR_NOMEM ? st : RCB_OK;
+}
+
+void rcb_mon_lowrank_free(rcb_monitor *mon, mon_lowrank *lr) {
+  if (!lr) return;
+  if (lr->dz) rcb_fit_dz_free(&mon->alloc, lr->dz, mon->nt);
+  rcb_free(&mon->alloc, lr->dz);
+  rcb_free(&mon->alloc, lr->ep);
+  rcb_free(&mon->alloc, lr->pdof);
+  rcb_free(&mon->alloc, lr->a);
+  rcb_free(&mon->alloc, lr->hpp);
+  rcb_free(&mon->alloc, lr->b);
+  rcb_free(&mon->alloc, lr->dZ);
+  rcb_free(&mon->alloc, lr->ipiv);
+  rcb_free(&mon->alloc, lr->ch_in);
+  rcb_free(&mon->alloc, lr);
+}
+
+/* The low-rank path when it applies (mon->lr), else none (mon->lr NULL):
+ * an error only for memory. */
+static rcb_status lowrank_try(rcb_monitor *mon, mon_lowrank *lr, rcb_meas_dofs *md) {
+  rcb_frf_kind kind[RCB_MONITOR_LOWRANK_MAXCH];
+  size_t c;
+  rcb_status st;
+  int ok;
+  if (rcb_meas_resolve_dofs(mon->setup, mon->model, md, NULL) != RCB_OK) return RCB_OK;
+  for (c = 0; c < mon->nch; c++) {
+    rcb_meas_channel_info ci;
+    if (rcb_meas_channel(mon->setup, c, &ci) != RCB_OK) return RCB_OK;
+    kind[c] = ci.kind;
+  }
+  lr->w = rcb_meas_grid(mon->setup);
+  lr->speed = rcb_meas_speed(mon->setup);
+  if ((st = layout(mon, lr, md->nin))) return st == RCB_ERR_NOMEM ? st : RCB_OK;
+  for (c = 0; c < mon->nch; c++) lr->ch_in[c] = md->ch_in[c];
+  if ((st = blocks(mon, lr, md, kind))) return st == RCB_ERR_NOMEM ? st : RCB_OK;
+  mon->lr = lr;
+  if ((st = check(mon, &ok)) || !ok) mon->lr = NULL;
+  return st;
+}
+
+rcb_status rcb_mon_lowrank_init(rcb_monitor *mon) {
+  mon_lowrank *lr;
+  rcb_meas_dofs md;
+  size_t nch = mon->nch;
+  rcb_status st;
+  if (!mon->nt || !mon->relin || rcb_meas_get_type(mon->setup) != RCB_MEAS_FRF ||
+      nch > RCB_MONITOR_LOWRANK_MAXCH)
+    return RCB_OK; /* the sweep re-evaluates */
+  memset(&md, 0, sizeof md);
+  lr = rcb_mon_alloc(mon, 1, sizeof *lr);
+  md.ch_out = rcb_mon_alloc(mon, 2 * nch, sizeof *md.ch_out);
+  md.outs = rcb_mon_alloc(mon, 2 * nch, sizeof *md.outs);
+  st = lr && md.ch_out && md.outs ? RCB_OK : RCB_ERR_NOMEM;
+  if (!st) {
+    md.ch_in = md.ch_out + nch, md.ins = md.outs + nch;
+    st = lowrank_try(mon, lr, &md);
+  }
+  rcb_free(&mon->alloc, md.outs);
+  rcb_free(&mon->alloc, md.ch_out);
+  if (!mon->lr) rcb_mon_lowrank_free(mon, lr); /* not applicable: the sweep re-evaluates */
+  return st ? rcb_mon_fail(mon, st, "out of memory (re-linearisation blocks)") : RCB_OK;
+}
