@@ -10,6 +10,9 @@
 #include "identify/identify.h"
 #include "monitor/monitor_internal.h"
 
+/* A re-linearisation's chord correction below this many standard errors
+ * of every tracked parameter ends the iterations (-). */
+#define MON_RELIN_TOL 0.05
 /* Two-sided 95 % normal quantile. */
 #define MON_Z95 1.959963984540054
 
@@ -28,6 +31,8 @@ void rcb_monitor_destroy(rcb_monitor *mon) {
   rcb_free(&mon->alloc, mon->sw.work);
   rcb_free(&mon->alloc, mon->y);
   rcb_mon_lowrank_free(mon, mon->lr);
+  if (mon->cdz) rcb_fit_dz_free(&mon->alloc, mon->cdz, mon->ncdz);
+  rcb_free(&mon->alloc, mon->cdz);
   rcb_fit_destroy(mon->fit);
   rcb_model_destroy(mon->model);
   rcb_meas_destroy(mon->setup);
@@ -88,9 +93,9 @@ static rcb_status model_change(rcb_monitor *mon, const double *theta, const mon_
                                const double *s) {
   size_t k, p;
   rcb_status st = RCB_OK;
-  if (!c && mon->lr) { /* the tracked parameters alone: without a sweep */
+  if (mon->lr && (!c || c->ep)) { /* without a sweep */
     rcb_complex *dm = mon->lr->dm;
-    if ((st = rcb_mon_lowrank_change(mon, theta, dm))) return st;
+    if ((st = rcb_mon_lowrank_change(mon, theta, c, s, dm))) return st;
     for (p = 0; p < mon->npt; p++) {
       double complex g = conj(mon->u[p]) * dm[p];
       mon->rm[2 * p] = creal(g) * mon->winv[2 * p];
@@ -125,21 +130,40 @@ static rcb_status model_change(rcb_monitor *mon, const double *theta, const mon_
 
 /* The re-linearised tracked step theta (chord iterations re-evaluating the
  * model: theta += E (y - ym(theta)), E the linear estimator; 0 without
- * re-linearisation); on return mon->y holds the change the model at
- * baseline + theta does not explain (y itself without). */
+ * re-linearisation), at most opts.relinearise of them, stopping once a
+ * correction is below MON_RELIN_TOL standard errors for every tracked
+ * parameter; on return mon->y holds the change the model at baseline +
+ * theta does not explain (y itself without): after a converged correction
+ * d, y - ym(theta) - G_t d (the baseline's columns carry so small a step
+ * exactly enough), else one more evaluation. */
 static rcb_status tracked_step(rcb_monitor *mon, double *theta) {
   size_t a, it, i, k = mon->k, nt = mon->nt;
+  double d[RCB_MONITOR_MAX_TRACKED];
   rcb_status st;
+  int small = 0;
   memset(theta, 0, sizeof(double) * RCB_MONITOR_MAX_TRACKED);
   if (!mon->relin || !nt) return RCB_OK;
   for (a = 0; a < nt; a++) theta[a] = dot(mon->test + a * k, mon->y, k);
-  for (it = 0; it < mon->relin; it++) {
+  for (it = 0; !small && it < mon->relin; it++) {
     if ((st = model_change(mon, theta, NULL, NULL))) return st;
     for (i = 0; i < k; i++) mon->ym[i] = mon->y[i] - mon->ym[i];
-    for (a = 0; a < nt; a++) theta[a] += dot(mon->test + a * k, mon->ym, k);
+    small = 1;
+    for (a = 0; a < nt; a++) {
+      d[a] = dot(mon->test + a * k, mon->ym, k);
+      theta[a] += d[a];
+      if (!(fabs(d[a]) < MON_RELIN_TOL * mon->tse[a])) small = 0;
+    }
   }
-  if ((st = model_change(mon, theta, NULL, NULL))) return st;
-  for (i = 0; i < k; i++) mon->y[i] -= mon->ym[i];
+  if (small) {
+    for (i = 0; i < k; i++) {
+      double s = mon->ym[i];
+      for (a = 0; a < nt; a++) s -= mon->G[i + k * a] * d[a];
+      mon->y[i] = s;
+    }
+  } else {
+    if ((st = model_change(mon, theta, NULL, NULL))) return st;
+    for (i = 0; i < k; i++) mon->y[i] -= mon->ym[i];
+  }
   model_restore(mon, NULL);
   return RCB_OK;
 }
@@ -292,7 +316,8 @@ static void tracked_rest(const rcb_monitor *mon, int gls, const rcb_monitor_resu
  * (steps of a tenth of each standard error, rank space), both taken to
  * this update's metric on the reweighted path (U^-T), then the small QR:
  * x += R^-1 Qa^T w, sd the row norms of R^-1. 1 + nt + np model sweeps.
- * *ok = 0 when the model refused a value or a column is dependent. */
+ * *ok = 0 when the model refused a value or a column is dependent, 2 when
+ * some step was MON_RELIN_TOL standard errors or more, else 1. */
 static rcb_status joint_gn(rcb_monitor *mon, const mon_cand *c, int gls, double *x, double *sd,
                            int *ok) {
   size_t a, i, k = mon->k, nt = mon->nt, p = nt + c->np;
@@ -318,13 +343,17 @@ static rcb_status joint_gn(rcb_monitor *mon, const mon_cand *c, int gls, double 
   if ((st = rcb_mon_small_qr(mon, &mon->sw, k, p, ok)) || !*ok) return st;
   (void)rcb_mon_gls_explained(&mon->sw, w, k, 0, p, qz);
   rcb_mon_gls_step(&mon->sw, qz, p, 0, p, dx, sd);
-  for (a = 0; a < p; a++) x[a] += dx[a];
+  for (a = 0; a < p; a++) {
+    x[a] += dx[a];
+    if (!(fabs(dx[a]) < MON_RELIN_TOL * sd[a])) *ok = 2; /* not converged yet */
+  }
   return RCB_OK;
 }
 
 /* With opts.relinearise and while the instant test fires: the joint step
  * of the tracked parameters and the best candidate, linearised at the
- * baseline, refined by as many Gauss-Newton iterations with the columns
+ * baseline, refined by up to as many Gauss-Newton iterations (until a
+ * step is below MON_RELIN_TOL standard errors) with the columns
  * re-evaluated at the estimate (joint_gn), when the candidate's
  * parameters are the model's own (c->settable); the standard errors are
  * then those of the last iteration's columns. A large new effect is not
@@ -344,7 +373,10 @@ static rcb_status joint_relin(rcb_monitor *mon, int gls, rcb_monitor_result *res
   if (!c || !mon->relin || !c->settable) return RCB_OK;
   for (a = 0; a < nt; a++) x[a] = dth[a], sd[a] = se[a];
   for (a = 0; a < c->np; a++) x[nt + a] = c->size_now[a], sd[nt + a] = c->se_now[a];
-  for (it = 0; ok && !st && it < mon->relin; it++) st = joint_gn(mon, c, gls, x, sd, &ok);
+  for (it = 0; ok == 1 && !st && it < mon->relin; it++) {
+    st = joint_gn(mon, c, gls, x, sd, &ok);
+    ok = ok == 2 ? 1 : ok ? 3 : 0; /* 3: converged */
+  }
   model_restore(mon, c);
   if (st || !ok) return st;
   for (a = 0; a < nt; a++) dth[a] = x[a], se[a] = sd[a];

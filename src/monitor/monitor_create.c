@@ -242,6 +242,10 @@ static rcb_status cand_columns(rcb_monitor *mon, rcb_diag *d, const col_plan *pl
       rcb_mon_fail(mon, st, "candidate columns: %s", rcb_fit_errmsg(mon->fit));
   }
   (void)batch;
+  if (!st && mon->relin && ndz) { /* kept for the low-rank joint re-linearisation */
+    mon->cdz = dz, mon->ncdz = ndz;
+    return RCB_OK;
+  }
   rcb_fit_dz_free(&mon->alloc, dz, ndz);
   rcb_free(&mon->alloc, dz);
   return st;

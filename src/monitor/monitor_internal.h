@@ -44,6 +44,10 @@ typedef struct mon_cand {
   double neutral[RCB_MONITOR_MAXP]; /* the parameters' values the columns are at */
   double lo[RCB_MONITOR_MAXP], hi[RCB_MONITOR_MAXP]; /* the catalogue's plausible range */
   int implausible;   /* this update: some parameter's 95 % interval outside [lo, hi] */
+  const struct rcb_fit_dz *dz; /* np: its derivative matrices (batched candidates
+                        with opts.relinearise; NULL otherwise) */
+  size_t *ep;        /* per entry of dz: row's and column's place in the
+                        low-rank P; NULL: not on the low-rank path */
   int settable;      /* its parameters are the baseline model's own, at their
                         neutral values (rcb_model_set_param on mon->model):
                         the joint step can be re-linearised */
@@ -53,12 +57,17 @@ typedef struct mon_cand {
 /* Most DOFs the tracked parameters may touch, and most channels, for the
  * low-rank re-evaluation (monitor_lowrank.c). */
 #define MON_LOWRANK_MAXP 32
+#define MON_LOWRANK_CAND 8 /* most DOFs one candidate adds to P */
 #define RCB_MONITOR_LOWRANK_MAXCH 4096
 
 /* The re-linearisation's evaluations by the Woodbury identity
  * (monitor_lowrank.c): P the DOFs the tracked parameters touch. */
 typedef struct mon_lowrank {
   size_t np, nin;      /* |P|, distinct inputs of the set-up */
+  size_t npt;          /* the tracked parameters' DOFs: the first npt of P; the
+                          rest are the settable candidates' */
+  size_t *act, *loc;   /* work (MON_LOWRANK_MAXP each): the places in P of an
+                          evaluation's DOFs, and each place's local index */
   size_t *pdof;        /* P: matrix rows */
   struct rcb_fit_dz *dz; /* nt: the tracked parameters' derivative matrices */
   size_t *ep;          /* per derivative entry: its row's and column's place in P */
@@ -131,6 +140,9 @@ struct rcb_monitor {
   rcb_fit *fit;
   double *rbase;       /* n */
   mon_lowrank *lr;     /* the evaluations without a sweep, NULL: by sweeps */
+  struct rcb_fit_dz *cdz; /* the batched candidates' derivative matrices, ncdz
+                          (kept with opts.relinearise) */
+  size_t ncdz;
 
   /* noise of the reweighted path */
   int reweight, have_sd0;
@@ -174,10 +186,13 @@ typedef struct col_plan {
 } col_plan;
 
 /* monitor_lowrank.c: set up the low-rank re-evaluation where it applies
- * and reproduces a sweep (an error only for memory); the change of every
- * point's model value (SI, channel-major) for tracked steps theta; free. */
+ * and reproduces a sweep (an error only for memory), after the rank space
+ * (it marks the candidates it takes: c->ep); the change of every point's
+ * model value (SI, channel-major) for tracked steps theta and, with c
+ * (c->ep set), candidate c's parameters at neutral + s; free. */
 rcb_status rcb_mon_lowrank_init(rcb_monitor *mon);
-rcb_status rcb_mon_lowrank_change(rcb_monitor *mon, const double *theta, rcb_complex *dm);
+rcb_status rcb_mon_lowrank_change(rcb_monitor *mon, const double *theta, const mon_cand *c,
+                                  const double *s, rcb_complex *dm);
 void rcb_mon_lowrank_free(rcb_monitor *mon, mon_lowrank *lr);
 
 /* monitor_rank.c: the QR of the whitened columns J (n x ncol; the basis

@@ -28,6 +28,12 @@
 /* The check's step: this fraction of each tracked parameter's baseline. */
 #define LR_STEP 0.05
 
+/* The tracked parameters back at their baseline values. */
+static void model_restore_tracked(rcb_monitor *mon) {
+  size_t j;
+  for (j = 0; j < mon->nt; j++) rcb_model_set_param(mon->model, mon->tname[j], mon->t0[j]);
+}
+
 /* Index of matrix row r in P (appending it if new; np capped by cap). */
 static size_t p_index(mon_lowrank *lr, size_t r, size_t cap) {
   size_t q;
@@ -101,65 +107,120 @@ done:
   return st;
 }
 
-rcb_status rcb_mon_lowrank_change(rcb_monitor *mon, const double *theta, rcb_complex *dm) {
+rcb_status rcb_mon_lowrank_change(rcb_monitor *mon, const double *theta, const mon_cand *c,
+                                  const double *s, rcb_complex *dm) {
   mon_lowrank *lr = mon->lr;
-  size_t np = lr->np, nin = lr->nin, i, j, a, q, r, c;
+  size_t nin = lr->nin, np = lr->np, na, i, j, a, q, r, ch, e0;
+  size_t *act = lr->act, *loc = lr->loc;
+  /* this evaluation's DOFs: the tracked parameters', then c's */
+  na = lr->npt;
+  for (q = 0; q < np; q++) loc[q] = q < na ? q : (size_t)-1, act[q] = q;
+  for (a = 0, e0 = 0; c && a < c->np; e0 += c->dz[a].ne, a++)
+    for (q = 0; q < 2 * c->dz[a].ne; q++) {
+      size_t pos = c->ep[2 * e0 + q];
+      if (loc[pos] == (size_t)-1) loc[pos] = na, act[na++] = pos;
+    }
   for (i = 0; i < mon->npts; i++) {
     double w = lr->w[i], W = lr->speed < 0 ? w : lr->speed;
     const rcb_complex *hpp = lr->hpp + i * np * np, *b = lr->b + i * nin * np;
     rcb_complex *dZ = lr->dZ, *M = lr->M, *X = lr->X;
     size_t e = 0;
-    memset(dZ, 0, np * np * sizeof *dZ);
+    memset(dZ, 0, na * na * sizeof *dZ);
     for (j = 0; j < mon->nt; j++)
       for (a = 0; a < lr->dz[j].ne; a++, e++) {
         const rcb_fit_dz_entry *d = &lr->dz[j].e[a];
-        dZ[lr->ep[2 * e] + np * lr->ep[2 * e + 1]] +=
+        dZ[loc[lr->ep[2 * e]] + na * loc[lr->ep[2 * e + 1]]] +=
             theta[j] * CMPLX(d->k - w * w * d->m, w * (d->c + W * d->g));
       }
-    for (r = 0; r < np; r++) /* M = I + dZ H0_PP, X = dZ H0_Pi */
-      for (q = 0; q < np; q++) {
-        rcb_complex s = q == r ? 1.0 : 0.0;
-        for (a = 0; a < np; a++) s += dZ[q + np * a] * hpp[a + np * r];
-        M[q + np * r] = s;
+    for (j = 0, e = 0; c && j < c->np; j++)
+      for (a = 0; a < c->dz[j].ne; a++, e++) {
+        const rcb_fit_dz_entry *d = &c->dz[j].e[a];
+        dZ[loc[c->ep[2 * e]] + na * loc[c->ep[2 * e + 1]]] +=
+            s[j] * CMPLX(d->k - w * w * d->m, w * (d->c + W * d->g));
+      }
+    for (r = 0; r < na; r++) /* M = I + dZ H0_PP, X = dZ H0_Pi (on the active DOFs) */
+      for (q = 0; q < na; q++) {
+        rcb_complex v = q == r ? 1.0 : 0.0;
+        for (a = 0; a < na; a++) v += dZ[q + na * a] * hpp[act[a] + np * act[r]];
+        M[q + na * r] = v;
       }
     for (r = 0; r < nin; r++)
-      for (q = 0; q < np; q++) {
-        rcb_complex s = 0;
-        for (a = 0; a < np; a++) s += dZ[q + np * a] * b[r * np + a];
-        X[q + np * r] = s;
+      for (q = 0; q < na; q++) {
+        rcb_complex v = 0;
+        for (a = 0; a < na; a++) v += dZ[q + na * a] * b[r * np + act[a]];
+        X[q + na * r] = v;
       }
-    if (LAPACKE_zgesv_work(LAPACK_COL_MAJOR, (lapack_int)np, (lapack_int)nin, M, (lapack_int)np,
-                           lr->ipiv, X, (lapack_int)np))
+    if (LAPACKE_zgesv_work(LAPACK_COL_MAJOR, (lapack_int)na, (lapack_int)nin, M, (lapack_int)na,
+                           lr->ipiv, X, (lapack_int)na))
       return rcb_mon_fail(mon, RCB_ERR_SINGULAR, "re-linearising at %g rad/s: the changed "
                           "model is singular", w);
-    for (c = 0; c < mon->nch; c++) {
-      const rcb_complex *ac = lr->a + (c * mon->npts + i) * np, *x = X + np * lr->ch_in[c];
-      rcb_complex s = 0;
-      for (q = 0; q < np; q++) s += ac[q] * x[q];
-      dm[c * mon->npts + i] = -s;
+    for (ch = 0; ch < mon->nch; ch++) {
+      const rcb_complex *ac = lr->a + (ch * mon->npts + i) * np, *x = X + na * lr->ch_in[ch];
+      rcb_complex v = 0;
+      for (q = 0; q < na; q++) v += ac[act[q]] * x[q];
+      dm[ch * mon->npts + i] = -v;
     }
   }
   return RCB_OK;
 }
 
-/* Sizes, the tracked parameters' derivative matrices and P. */
+/* Entries of derivative matrices dz[0 .. n). */
+static size_t entries(const rcb_fit_dz *dz, size_t n) {
+  size_t j, ne = 0;
+  for (j = 0; j < n; j++) ne += dz[j].ne;
+  return ne;
+}
+
+/* Places in P of the entries of dz[0 .. n) into ep (2 per entry), P grown
+ * as needed up to cap; 0 when P would pass cap (P and ep then as before). */
+static int places(mon_lowrank *lr, const rcb_fit_dz *dz, size_t n, size_t *ep, size_t cap) {
+  size_t j, a, e = 0, np0 = lr->np;
+  for (j = 0; j < n; j++)
+    for (a = 0; a < dz[j].ne; a++, e++) {
+      ep[2 * e] = p_index(lr, dz[j].e[a].row, cap);
+      ep[2 * e + 1] = p_index(lr, dz[j].e[a].col, cap);
+      if (ep[2 * e] >= cap || ep[2 * e + 1] >= cap) {
+        lr->np = np0;
+        return 0;
+      }
+    }
+  return 1;
+}
+
+/* Sizes, the tracked parameters' derivative matrices and P: the tracked
+ * parameters' DOFs first, then those of each settable candidate with
+ * derivative matrices while P stays within MON_LOWRANK_MAXP and the
+ * candidate's own DOFs within MON_LOWRANK_CAND (a distributed effect such
+ * as shaft damping stays on the sweep). */
 static rcb_status layout(rcb_monitor *mon, mon_lowrank *lr, size_t nin) {
-  size_t j, a, ne = 0, e = 0, cap;
+  size_t j, ne, cap = MON_LOWRANK_MAXP, used;
   rcb_status st;
   lr->dz = rcb_mon_alloc(mon, mon->nt, sizeof *lr->dz);
-  if (!lr->dz) return RCB_ERR_NOMEM;
+  lr->pdof = rcb_mon_alloc(mon, cap, sizeof *lr->pdof);
+  lr->act = rcb_mon_alloc(mon, 2 * cap, sizeof *lr->act);
+  if (!lr->dz || !lr->pdof || !lr->act) return RCB_ERR_NOMEM;
+  lr->loc = lr->act + cap;
   if ((st = rcb_fit_dz_get(mon->fit, &mon->alloc, lr->dz))) return st;
-  for (j = 0; j < mon->nt; j++) ne += lr->dz[j].ne;
-  cap = 2 * ne;
-  lr->ep = rcb_mon_alloc(mon, cap ? cap : 1, sizeof *lr->ep);
-  lr->pdof = rcb_mon_alloc(mon, cap ? cap : 1, sizeof *lr->pdof);
-  if (!lr->ep || !lr->pdof) return RCB_ERR_NOMEM;
-  for (j = 0; j < mon->nt; j++)
-    for (a = 0; a < lr->dz[j].ne; a++, e++) {
-      lr->ep[2 * e] = p_index(lr, lr->dz[j].e[a].row, cap);
-      lr->ep[2 * e + 1] = p_index(lr, lr->dz[j].e[a].col, cap);
+  ne = entries(lr->dz, mon->nt);
+  for (j = 0; j < mon->ncand; j++)
+    if (mon->cand[j].dz && mon->cand[j].settable && mon->cand[j].dof)
+      ne += entries(mon->cand[j].dz, mon->cand[j].np);
+  lr->ep = rcb_mon_alloc(mon, 2 * (ne ? ne : 1), sizeof *lr->ep);
+  if (!lr->ep) return RCB_ERR_NOMEM;
+  if (!places(lr, lr->dz, mon->nt, lr->ep, cap) || !lr->np) return RCB_ERR_UNSUPPORTED;
+  lr->npt = lr->np;
+  used = 2 * entries(lr->dz, mon->nt);
+  for (j = 0; j < mon->ncand; j++) {
+    mon_cand *c = &mon->cand[j];
+    size_t np0 = lr->np;
+    if (!c->dz || !c->settable || !c->dof) continue;
+    if (places(lr, c->dz, c->np, lr->ep + used, cap) && lr->np - np0 <= MON_LOWRANK_CAND) {
+      c->ep = lr->ep + used;
+      used += 2 * entries(c->dz, c->np);
+    } else {
+      lr->np = np0;
     }
-  if (!lr->np || lr->np > MON_LOWRANK_MAXP) return RCB_ERR_UNSUPPORTED;
+  }
   lr->nin = nin;
   lr->a = rcb_mon_alloc(mon, mon->npt * lr->np, sizeof *lr->a);
   lr->hpp = rcb_mon_alloc(mon, mon->npts * lr->np * lr->np, sizeof *lr->hpp);
@@ -173,37 +234,66 @@ static rcb_status layout(rcb_monitor *mon, mon_lowrank *lr, size_t nin) {
   return RCB_OK;
 }
 
-/* Does the low-rank change equal the sweep's at theta = LR_STEP t0? */
+/* Largest difference of the low-rank change against the sweep's (rm -
+ * rbase), over the largest change, for the model's current values. */
+static double mismatch(rcb_monitor *mon, const double *theta, const mon_cand *c,
+                       const double *s, rcb_complex *dm, rcb_status *st) {
+  double big = 0, diff = 0;
+  size_t p;
+  if ((*st = rcb_fit_residuals(mon->fit, mon->rm)) ||
+      (*st = rcb_mon_lowrank_change(mon, theta, c, s, dm)))
+    return HUGE_VAL;
+  for (p = 0; p < mon->npt; p++) {
+    rcb_complex v = CMPLX(mon->rm[2 * p] - mon->rbase[2 * p],
+                          mon->rm[2 * p + 1] - mon->rbase[2 * p + 1]);
+    big = fmax(big, cabs(v));
+    diff = fmax(diff, cabs(v - dm[p]));
+  }
+  return big > 0 ? diff / big : HUGE_VAL;
+}
+
+/* Does the low-rank change equal the sweep's, at theta = LR_STEP t0 for the
+ * tracked parameters (*ok), and at ten standard errors of each candidate
+ * taken (c->ep, reset for one that does not)? */
 static rcb_status check(rcb_monitor *mon, int *ok) {
-  double theta[RCB_MONITOR_MAX_TRACKED], big = 0, diff = 0;
+  double theta[RCB_MONITOR_MAX_TRACKED], zero[RCB_MONITOR_MAX_TRACKED] = {0}, s[RCB_MONITOR_MAXP];
   rcb_complex *dm = rcb_mon_alloc(mon, mon->npt, sizeof *dm);
-  size_t j, p;
+  size_t j, a;
   rcb_status st = RCB_OK;
   *ok = 0;
   if (!dm) return RCB_ERR_NOMEM;
   for (j = 0; j < mon->nt; j++) theta[j] = LR_STEP * mon->t0[j];
   for (j = 0; !st && j < mon->nt; j++)
     st = rcb_model_set_param(mon->model, mon->tname[j], mon->t0[j] + theta[j]);
-  if (!st) st = rcb_fit_residuals(mon->fit, mon->rm);
-  for (j = 0; j < mon->nt; j++) rcb_model_set_param(mon->model, mon->tname[j], mon->t0[j]);
-  if (!st) st = rcb_mon_lowrank_change(mon, theta, dm);
-  for (p = 0; !st && p < mon->npt; p++) {
-    rcb_complex s = CMPLX(mon->rm[2 * p] - mon->rbase[2 * p],
-                          mon->rm[2 * p + 1] - mon->rbase[2 * p + 1]);
-    big = fmax(big, cabs(s));
-    diff = fmax(diff, cabs(s - dm[p]));
+  *ok = !st && mismatch(mon, theta, NULL, NULL, dm, &st) <= LR_TOL;
+  model_restore_tracked(mon);
+  for (j = 0; *ok && !st && j < mon->ncand; j++) {
+    mon_cand *c = &mon->cand[j];
+    rcb_status sc = RCB_OK;
+    int good;
+    if (!c->ep) continue;
+    for (a = 0; !sc && a < c->np; a++) {
+      s[a] = 10.0 * c->se[a];
+      sc = rcb_model_set_param(mon->model, c->pname[a], c->neutral[a] + s[a]);
+    }
+    good = !sc && mismatch(mon, zero, c, s, dm, &sc) <= LR_TOL;
+    for (a = 0; a < c->np; a++) rcb_model_set_param(mon->model, c->pname[a], c->neutral[a]);
+    if (sc == RCB_ERR_NOMEM) st = sc;
+    if (!good) c->ep = NULL; /* not affine after all: by sweeps */
   }
   rcb_free(&mon->alloc, dm);
-  *ok = !st && big > 0 && diff <= LR_TOL * big;
   return st == RCB_ERR_NOMEM ? st : RCB_OK;
 }
 
 void rcb_mon_lowrank_free(rcb_monitor *mon, mon_lowrank *lr) {
+  size_t j;
   if (!lr) return;
+  for (j = 0; j < mon->ncand; j++) mon->cand[j].ep = NULL;
   if (lr->dz) rcb_fit_dz_free(&mon->alloc, lr->dz, mon->nt);
   rcb_free(&mon->alloc, lr->dz);
   rcb_free(&mon->alloc, lr->ep);
   rcb_free(&mon->alloc, lr->pdof);
+  rcb_free(&mon->alloc, lr->act);
   rcb_free(&mon->alloc, lr->a);
   rcb_free(&mon->alloc, lr->hpp);
   rcb_free(&mon->alloc, lr->b);

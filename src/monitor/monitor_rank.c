@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "diagnose/diagnose.h"
+#include "identify/identify.h"
 #include "monitor/monitor_internal.h"
 
 /* Relative size of a triangular factor's diagonal below which a column
@@ -88,7 +89,7 @@ static rcb_status tracked_space(rcb_monitor *mon, const double *G, mon_small *w)
 
 static rcb_status cand_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
                              const double *G, mon_small *w) {
-  size_t k = mon->k, nt = mon->nt, j, a, i;
+  size_t k = mon->k, nt = mon->nt, j, a, i, idz = 0;
   rcb_status st;
   for (j = 0; j < pl->ncand; j++) {
     mon_cand *mc = &mon->cand[j];
@@ -104,6 +105,10 @@ static rcb_status cand_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
     mc->col = pl->col[j];
     for (a = 0; a < c.np; a++)
       mc->neutral[a] = pl->neutral[pl->col[j] + a], mc->lo[a] = c.lo[a], mc->hi[a] = c.hi[a];
+    if (!pl->own[j]) { /* the batched candidates' derivative matrices, in plan order */
+      if (mon->cdz && idz + c.np <= mon->ncdz) mc->dz = mon->cdz + idz;
+      idz += c.np;
+    }
     mc->settable = !pl->own[j];
     for (a = 0; mc->settable && a < c.np; a++) {
       double v;
