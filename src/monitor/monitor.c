@@ -365,8 +365,8 @@ static rcb_status joint_gn(rcb_monitor *mon, const mon_cand *c, int gls, double 
 static rcb_status joint_relin(rcb_monitor *mon, int gls, rcb_monitor_result *res, double *dth,
                               double *se) {
   mon_cand *c = res->alarm && res->ntop ? &mon->cand[res->top[0].index] : NULL;
-  double x[RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP], sd[RCB_MONITOR_MAX_TRACKED +
-                                                           RCB_MONITOR_MAXP];
+  double x[RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP] = {0},
+         sd[RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP] = {0};
   size_t a, it, nt = mon->nt;
   rcb_status st = RCB_OK;
   int ok = 1;

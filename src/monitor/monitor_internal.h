@@ -54,11 +54,9 @@ typedef struct mon_cand {
   char pname[RCB_MONITOR_MAXP][RCB_MONITOR_NAME]; /* their names (settable) */
 } mon_cand;
 
-/* Most DOFs the tracked parameters may touch, and most channels, for the
- * low-rank re-evaluation (monitor_lowrank.c). */
+/* Most DOFs of P for the low-rank re-evaluation (monitor_lowrank.c). */
 #define MON_LOWRANK_MAXP 32
 #define MON_LOWRANK_CAND 8 /* most DOFs one candidate adds to P */
-#define RCB_MONITOR_LOWRANK_MAXCH 4096
 
 /* The re-linearisation's evaluations by the Woodbury identity
  * (monitor_lowrank.c): P the DOFs the tracked parameters touch. */

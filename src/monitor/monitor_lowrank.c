@@ -58,9 +58,14 @@ static int dof_of(const rcb_model *m, size_t r, rcb_dof *out) {
   return 0;
 }
 
+/* The kind of channel c of the set-up (rcb_frf_kind), -1 if unreadable. */
+static int channel_kind(const rcb_monitor *mon, size_t c) {
+  rcb_meas_channel_info ci;
+  return rcb_meas_channel(mon->setup, c, &ci) == RCB_OK ? (int)ci.kind : -1;
+}
+
 /* The blocks H0_oP, H0_PP, H0_Pi at every frequency of the set-up. */
-static rcb_status blocks(rcb_monitor *mon, mon_lowrank *lr, const rcb_meas_dofs *md,
-                         const rcb_frf_kind *kind) {
+static rcb_status blocks(rcb_monitor *mon, mon_lowrank *lr, const rcb_meas_dofs *md) {
   size_t np = lr->np, nout = md->nout + np, nin = md->nin + np, i, c, q, r, pass;
   rcb_dof *outs = rcb_mon_alloc(mon, nout, sizeof *outs), *ins = rcb_mon_alloc(mon, nin,
                                                                                sizeof *ins);
@@ -84,11 +89,11 @@ static rcb_status blocks(rcb_monitor *mon, mon_lowrank *lr, const rcb_meas_dofs 
      * each other kind's channels */
     for (pass = 0; pass < 3; pass++) {
       int used = pass == 0;
-      for (c = 0; !used && c < mon->nch; c++) used = (int)kind[c] == (int)pass;
+      for (c = 0; !used && c < mon->nch; c++) used = channel_kind(mon, c) == (int)pass;
       if (!used) continue;
       if ((st = rcb_frf_eval(f, w, W, (rcb_frf_kind)pass, H))) goto done;
       for (c = 0; c < mon->nch; c++)
-        if ((int)kind[c] == (int)pass)
+        if (channel_kind(mon, c) == (int)pass)
           for (q = 0; q < np; q++)
             lr->a[(c * mon->npts + i) * np + q] = H[md->ch_out[c] + nout * (md->nin + q)];
       if (pass) continue;
@@ -306,21 +311,17 @@ void rcb_mon_lowrank_free(rcb_monitor *mon, mon_lowrank *lr) {
 /* The low-rank path when it applies (mon->lr), else none (mon->lr NULL):
  * an error only for memory. */
 static rcb_status lowrank_try(rcb_monitor *mon, mon_lowrank *lr, rcb_meas_dofs *md) {
-  rcb_frf_kind kind[RCB_MONITOR_LOWRANK_MAXCH];
   size_t c;
   rcb_status st;
   int ok;
   if (rcb_meas_resolve_dofs(mon->setup, mon->model, md, NULL) != RCB_OK) return RCB_OK;
-  for (c = 0; c < mon->nch; c++) {
-    rcb_meas_channel_info ci;
-    if (rcb_meas_channel(mon->setup, c, &ci) != RCB_OK) return RCB_OK;
-    kind[c] = ci.kind;
-  }
+  for (c = 0; c < mon->nch; c++)
+    if (channel_kind(mon, c) < 0) return RCB_OK;
   lr->w = rcb_meas_grid(mon->setup);
   lr->speed = rcb_meas_speed(mon->setup);
   if ((st = layout(mon, lr, md->nin))) return st == RCB_ERR_NOMEM ? st : RCB_OK;
   for (c = 0; c < mon->nch; c++) lr->ch_in[c] = md->ch_in[c];
-  if ((st = blocks(mon, lr, md, kind))) return st == RCB_ERR_NOMEM ? st : RCB_OK;
+  if ((st = blocks(mon, lr, md))) return st == RCB_ERR_NOMEM ? st : RCB_OK;
   mon->lr = lr;
   if ((st = check(mon, &ok)) || !ok) mon->lr = NULL;
   return st;
@@ -331,8 +332,7 @@ rcb_status rcb_mon_lowrank_init(rcb_monitor *mon) {
   rcb_meas_dofs md;
   size_t nch = mon->nch;
   rcb_status st;
-  if (!mon->nt || !mon->relin || rcb_meas_get_type(mon->setup) != RCB_MEAS_FRF ||
-      nch > RCB_MONITOR_LOWRANK_MAXCH)
+  if (!mon->nt || !mon->relin || rcb_meas_get_type(mon->setup) != RCB_MEAS_FRF)
     return RCB_OK; /* the sweep re-evaluates */
   memset(&md, 0, sizeof md);
   lr = rcb_mon_alloc(mon, 1, sizeof *lr);
