@@ -174,10 +174,11 @@ static void test_known_coherence_and_biases(void **state) {
   printf("known coherence: mean %.4f, H1 inside its 95 %% band at %.1f %% of lines\n", mc,
          100.0 * inside);
   assert_true(inside > 0.90 && inside < 0.99);
-  /* and sd itself: |H1| sqrt((1 - coh) / (2 nd coh)), nd = 1999 segments over
-   * Hann's 50 % overlap factor 1 + 2 rho^2, rho = 1/6 (periodic Hann at N/2) */
-  assert_true(fabs(sd[10] - cabs(h1[10]) * sqrt((1 - coh[10]) * (1.0 + 2.0 / 36.0) /
-                                                (2 * 1999.0 * coh[10]))) < 1e-12);
+  /* and sd itself: |H1| sqrt((1 - coh) / (2 (nd - 1) coh)), nd = 1999 segments
+   * over Hann's 50 % overlap factor 1 + 2 rho^2, rho = 1/6 (periodic Hann at N/2) */
+  assert_true(fabs(sd[10] - cabs(h1[10]) * sqrt((1 - coh[10]) /
+                                                (2 * (1999.0 / (1.0 + 2.0 / 36.0) - 1.0) *
+                                                 coh[10]))) < 1e-12);
   done(&t);
 }
 

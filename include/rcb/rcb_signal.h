@@ -195,11 +195,15 @@ RCB_API rcb_status rcb_spectral_cross(const rcb_spectral *e, size_t a, size_t b,
  * @param coh ordinary coherence of the pair (one input) or the multiple
  * coherence of the output on all inputs
  * @param sd standard deviation of each of Re h and Im h (of |h|, and of
- * |h| times the phase in rad): sqrt((1 - coh) Gyy [Gxx^-1]_jj / (2 (nd - p + 1)))
- * (Bendat & Piersol, eq. 9.90 generalised; for one input
- * |h| sqrt((1 - coh) / (2 nd coh))), the same expression for H2 and Hv;
- * nd = segments / (1 + 2 sum_j rho_j^2), the independent averages the
- * overlapped segments are worth (rho_j: the window's overlap correlation)
+ * |h| times the phase in rad): sqrt((1 - coh) Gyy [Gxx^-1]_jj / (2 (nd - p)))
+ * (Bendat & Piersol, eq. 9.90 generalised, with the residual power over
+ * its nd - p degrees of freedom, so unbiased at a few averages: then
+ * |h - H|^2 / (2 sd^2) is F(2, 2 (nd - p)), Goodman 1963; for one input
+ * |h| sqrt((1 - coh) / (2 (nd - 1) coh))), the same expression for H2 and
+ * Hv; nd = segments / (1 + 2 sum_j rho_j^2), the independent averages the
+ * overlapped segments are worth (rho_j: the window's overlap correlation);
+ * NaN where nd <= p. Neighbouring lines' errors are correlated (Hann, H1 of
+ * random excitation: 0.45; two lines apart 0.03)
  * @return RCB_ERR_SINGULAR (with the line in the message) if Gxx is singular
  */
 RCB_API rcb_status rcb_spectral_frf(rcb_spectral *e, rcb_estimator est, size_t out,

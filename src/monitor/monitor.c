@@ -180,7 +180,10 @@ static rcb_status tracked_step(rcb_monitor *mon, double *theta) {
 static double innovation(rcb_monitor *mon, size_t a, double theta, double se, double *v) {
   double nu = mon->navg_inv, w;
   *v = se * se / (1.0 + nu);
-  if (!mon->ref_started) mon->ref_w[a] = nu > 0 ? 1.0 / (*v * nu) : (double)INFINITY, mon->ref_sum[a] = 0;
+  if (!mon->ref_started) {
+    mon->ref_w[a] = nu > 0 ? 1.0 / (*v * nu) : (double)INFINITY;
+    mon->ref_sum[a] = 0;
+  }
   w = mon->ref_w[a];
   if (!(w > 0)) return 0.0;
   return (theta - mon->ref_sum[a] / w) / sqrt(*v + 1.0 / w);

@@ -100,7 +100,8 @@ static rcb_status blocks(rcb_monitor *mon, mon_lowrank *lr, const rcb_meas_dofs 
       for (q = 0; q < np; q++) {
         for (r = 0; r < np; r++)
           lr->hpp[i * np * np + q + np * r] = H[md->nout + q + nout * (md->nin + r)];
-        for (r = 0; r < md->nin; r++) lr->b[(i * md->nin + r) * np + q] = H[md->nout + q + nout * r];
+        for (r = 0; r < md->nin; r++)
+          lr->b[(i * md->nin + r) * np + q] = H[md->nout + q + nout * r];
       }
     }
   }

@@ -4,10 +4,15 @@
  * Gyy / Gyx and Hv (total least squares, the eigenvector of the 2x2
  * spectral matrix [Gxx Gxy; Gyx Gyy]) for one input; ordinary (one input)
  * or multiple coherence; per-line standard deviation of Re h and Im h,
- * sigma^2 = (1 - coh) Gyy [Gxx^-1]_jj / (2 (nd - p + 1)), which for one
- * input is B&P's eps[|H|] = sqrt(1 - coh) / (sqrt(coh) sqrt(2 nd)) times |H|;
- * nd is the number of segments divided by the overlap factor (spectral.c),
- * the equivalent number of independent averages.
+ * sigma^2 = (1 - coh) Gyy [Gxx^-1]_jj / (2 (nd - p)): the residual power
+ * (1 - coh) Gyy of the least squares over nd averages with p inputs has
+ * the expectation sigma_n^2 (nd - p) / nd, so this is unbiased, and
+ * |h - H|^2 / (2 sigma^2) is then F(2, 2 (nd - p)) distributed (Goodman
+ * 1963); B&P's large-sample eps[|H|] = sqrt(1 - coh) / (sqrt(coh) sqrt(2 nd))
+ * divides by nd and under-states the scatter at a few averages (by 1.27 in
+ * variance at nd = 4.7). nd is the number of segments divided by the
+ * overlap factor (spectral.c), the equivalent number of independent
+ * averages; NaN for nd <= p (no scatter to estimate from).
  * Several inputs: Gxx is Hermitian positive definite unless two inputs are
  * fully coherent, so it is factored by LAPACK zpotrf (zpotrs, zpotri).
  */
@@ -38,7 +43,7 @@ static void frf_siso(rcb_estimator est, double gxx, rcb_complex gxy, double gyy,
   }
   if (c > 1.0) c = 1.0; /* rounding when the pair is exactly linear */
   *coh = c;
-  *sd = sqrt((1.0 - c) * gyy / (gxx * 2.0 * nd));
+  *sd = nd > 1.0 ? sqrt((1.0 - c) * gyy / (gxx * 2.0 * (nd - 1.0))) : (double)NAN;
 }
 
 /* Several inputs, line k: solve Gxx h = gxy (Cholesky); -1 if Gxx is singular. */
@@ -60,7 +65,7 @@ static int frf_miso(rcb_spectral *e, size_t k, size_t out, size_t in, rcb_comple
   *coh = gyy > 0.0 ? fmin(1.0, num / gyy) : (double)NAN;
   info = LAPACKE_zpotri_work(LAPACK_COL_MAJOR, 'L', n, (lapack_complex_double *)e->a, n);
   if (info) return -1;
-  nd = (double)e->nd / e->ovl - (double)p + 1.0;
+  nd = (double)e->nd / e->ovl - (double)p;
   *sd = nd > 0.0 ? sqrt(fmax(0.0, 1.0 - *coh) * gyy * creal(e->a[in * p + in]) / (2.0 * nd))
                  : (double)NAN;
   return 0;

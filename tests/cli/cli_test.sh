@@ -639,6 +639,29 @@ bad_uff_mislabelled)
   sed -e 's/^    58 /    5x /' "$W/s.uff" >"$W/u.uff"
   run convert "$W/u.uff" "$W/o.csv" --map 1=DA; expect_rc 3; err_has "u.uff:2:"; err_has "not a number"
   [ ! -e "$W/o.csv" ] || fail "output written from a mislabelled file" ;;
+estimate_every)
+  # --every 2 writes lines 1, 3, 5, ... of the full estimate, exactly (FRF and
+  # --stats), and refuses 0. Signals: a pseudo-random force and a filtered
+  # response with noise (awk's generator, seeded).
+  awk 'BEGIN { srand(7); y = 0; print "# units = N,m"; print "time_s,f,DA.x";
+               for (i = 0; i < 4096; i++) { f = rand() - 0.5; y = 0.6 * y + 1e-6 * f;
+                 printf "%.6f,%.9g,%.9g\n", i / 1024, f, y + 1e-8 * (rand() - 0.5) } }' \
+    >"$W/s.csv"
+  run estimate "$W/s.csv" --input f=DA.x --outputs DA.x --nseg 256 --stats "$W/st1.csv" \
+    -o "$W/h1.csv"; expect_rc 0
+  run estimate "$W/s.csv" --input f=DA.x --outputs DA.x --nseg 256 --stats "$W/st2.csv" \
+    --every 2 -o "$W/h2.csv"; expect_rc 0
+  python3 - "$W" <<'EOF' || fail "every second line"
+import sys
+w = sys.argv[1]
+def rows(p):
+    return [l for l in open(p).read().splitlines() if l and l[0].isdigit()]
+for a, b in (("h1.csv", "h2.csv"), ("st1.csv", "st2.csv")):
+    full, half = rows(f"{w}/{a}"), rows(f"{w}/{b}")
+    assert len(full) == 128 and half == full[::2], (a, len(full), len(half))
+EOF
+  run estimate "$W/s.csv" --input f=DA.x --outputs DA.x --nseg 256 --every 0 -o "$W/h3.csv"
+  expect_rc 2; err_has "--every"; [ ! -e "$W/h3.csv" ] || fail "output written" ;;
 bad_signal_units)
   # estimate: a force without a force unit, a response in an unknown unit
   printf '# units = V,mm\ntime_s,f,DA.x\n0,1,1\n0.001,2,1\n0.002,3,2\n' >"$W/s.csv"

@@ -93,12 +93,12 @@ def _nd(segments, nseg, overlap):
 
 def _coverage(h, s, ref, band, nd):
     """Share of lines where the reference lies inside the 95 % band: with
-    the per-component sd estimated from the coherence of nd averages, |dH|^2 /
-    (2 sd^2) is distributed as nd / (nd - 1) F(2, 2 (nd - 1)) (Goodman;
-    the normal-theory radius sqrt(-2 ln 0.05) sd = 2.45 sd holds for large nd
-    only: 2.92 sd at nd = 8, 2.54 sd at nd = 29)."""
+    the per-component sd estimated from the coherence of nd averages (the
+    residual power over nd - 1), |dH|^2 / (2 sd^2) is distributed as
+    F(2, 2 (nd - 1)) (Goodman; the normal-theory radius sqrt(-2 ln 0.05) sd =
+    2.45 sd holds for large nd only: 2.73 sd at nd = 8, 2.51 sd at nd = 29)."""
     worst = 1.0
-    k95 = np.sqrt(2 * nd / (nd - 1) * fdist.ppf(0.95, 2, 2 * (nd - 1)))
+    k95 = np.sqrt(2 * fdist.ppf(0.95, 2, 2 * (nd - 1)))
     for ch in OUTS:
         est = h[f"{ch}/DA.x re"] + 1j * h[f"{ch}/DA.x im"]
         r95 = k95 * s[f"{ch}/DA.x sd"]
