@@ -48,6 +48,7 @@ typedef struct diag_cand {
   int prefitted;                    /* pre-fitted alone at the nominal model (far baseline) */
   double pre_F;                     /* its objective there (HUGE_VAL: failed) */
   double pre[RCB_DIAG_MAXP];        /* and its parameters, the start of the nominal refit */
+  int pre_floor;                    /* its pre-fit ended at the noise floor */
   int refitted, significant;
   double F, err, dbic;
   char fitted[RCB_DIAG_MAXP * (RCB_DIAG_NAME + 32)];
