@@ -200,7 +200,8 @@ def monitor_machine(name, days, design_text, alpha=1e-3):
     with rcb.Model.from_ini(design_text, name="design.ini") as model, \
             _commissioning(rcb, days) as setup, \
             rcb.Monitor(model, setup, MON_PARAMS, noise=MON_NOISE, alpha=alpha,
-                        setup_averages=MON_COMMISSION) as mon:
+                        setup_averages=MON_COMMISSION, reweight=True,
+                        relinearise=8) as mon:  # as the ROSS series (docs/monitoring.md)
         for d, data in enumerate(days[MON_COMMISSION:], start=MON_COMMISSION):
             with rcb.Meas.from_bytes(data, uff_map=MON_MAP) as ms:
                 r = mon.update(ms)
