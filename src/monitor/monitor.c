@@ -21,6 +21,9 @@ void rcb_monitor_destroy(rcb_monitor *mon) {
   size_t j;
   if (!mon) return;
   a = mon->user;
+  rcb_mon_lowrank_free(mon, mon->lr); /* before the candidates: it resets their ep */
+  if (mon->cdz) rcb_fit_dz_free(&mon->alloc, mon->cdz, mon->ncdz);
+  rcb_free(&mon->alloc, mon->cdz);
   for (j = 0; j < mon->ncand; j++) rcb_free(&mon->alloc, mon->cand[j].est);
   rcb_free(&mon->alloc, mon->cand);
   rcb_free(&mon->alloc, mon->test);
@@ -30,9 +33,6 @@ void rcb_monitor_destroy(rcb_monitor *mon) {
   rcb_free(&mon->alloc, mon->sw.A);
   rcb_free(&mon->alloc, mon->sw.work);
   rcb_free(&mon->alloc, mon->y);
-  rcb_mon_lowrank_free(mon, mon->lr);
-  if (mon->cdz) rcb_fit_dz_free(&mon->alloc, mon->cdz, mon->ncdz);
-  rcb_free(&mon->alloc, mon->cdz);
   rcb_fit_destroy(mon->fit);
   rcb_model_destroy(mon->model);
   rcb_meas_destroy(mon->setup);
