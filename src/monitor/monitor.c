@@ -80,7 +80,7 @@ static rcb_status check_input(rcb_monitor *mon, const rcb_complex *v, const doub
 
 /* The tracked parameters back at their baseline values and candidate c's
  * (if any) at their neutral ones. */
-static void model_restore(rcb_monitor *mon, const mon_cand *c) {
+void rcb_mon_model_restore(rcb_monitor *mon, const mon_cand *c) {
   size_t k;
   for (k = 0; k < mon->nt; k++) rcb_model_set_param(mon->model, mon->tname[k], mon->t0[k]);
   for (k = 0; c && k < c->np; k++) rcb_model_set_param(mon->model, c->pname[k], c->neutral[k]);
@@ -88,7 +88,7 @@ static void model_restore(rcb_monitor *mon, const mon_cand *c) {
 
 /* ym = Q^T W (m(theta, s) - m(0, 0)) for tracked values t0 + theta and,
  * with c, candidate c's parameters at neutral + s (c->settable). The
- * parameters stay set: the caller restores them (model_restore). */
+ * parameters stay set: the caller restores them (rcb_mon_model_restore). */
 static rcb_status model_change(rcb_monitor *mon, const double *theta, const mon_cand *c,
                                const double *s) {
   size_t k, p;
@@ -115,7 +115,7 @@ static rcb_status model_change(rcb_monitor *mon, const double *theta, const mon_
   if (!st && (st = rcb_fit_residuals(mon->fit, mon->rm)))
     rcb_mon_fail(mon, st, "re-linearising at the tracked estimate: %s", rcb_fit_errmsg(mon->fit));
   if (st) {
-    model_restore(mon, c);
+    rcb_mon_model_restore(mon, c);
     return st;
   }
   for (p = 0; p < mon->npt; p++) {
@@ -164,7 +164,7 @@ static rcb_status tracked_step(rcb_monitor *mon, double *theta) {
     if ((st = model_change(mon, theta, NULL, NULL))) return st;
     for (i = 0; i < k; i++) mon->y[i] -= mon->ym[i];
   }
-  model_restore(mon, NULL);
+  rcb_mon_model_restore(mon, NULL);
   return RCB_OK;
 }
 
@@ -380,7 +380,7 @@ static rcb_status joint_relin(rcb_monitor *mon, int gls, rcb_monitor_result *res
     st = joint_gn(mon, c, gls, x, sd, &ok);
     ok = ok == 2 ? 1 : ok ? 3 : 0; /* 3: converged */
   }
-  model_restore(mon, c);
+  rcb_mon_model_restore(mon, c);
   if (st || !ok) return st;
   for (a = 0; a < nt; a++) dth[a] = x[a], se[a] = sd[a];
   for (a = 0; a < c->np; a++) {

@@ -183,6 +183,10 @@ typedef struct col_plan {
   size_t ncand, ncol;
 } col_plan;
 
+/* monitor.c: the tracked parameters of mon->model back at their baseline
+ * values and candidate c's (if any) at their neutral ones. */
+void rcb_mon_model_restore(rcb_monitor *mon, const mon_cand *c);
+
 /* monitor_lowrank.c: set up the low-rank re-evaluation where it applies
  * and reproduces a sweep (an error only for memory), after the rank space
  * (it marks the candidates it takes: c->ep); the change of every point's

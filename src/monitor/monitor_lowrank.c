@@ -28,11 +28,6 @@
 /* The check's step: this fraction of each tracked parameter's baseline. */
 #define LR_STEP 0.05
 
-/* The tracked parameters back at their baseline values. */
-static void model_restore_tracked(rcb_monitor *mon) {
-  size_t j;
-  for (j = 0; j < mon->nt; j++) rcb_model_set_param(mon->model, mon->tname[j], mon->t0[j]);
-}
 
 /* Index of matrix row r in P (appending it if new; np capped by cap). */
 static size_t p_index(mon_lowrank *lr, size_t r, size_t cap) {
@@ -272,7 +267,7 @@ static rcb_status check(rcb_monitor *mon, int *ok) {
   for (j = 0; !st && j < mon->nt; j++)
     st = rcb_model_set_param(mon->model, mon->tname[j], mon->t0[j] + theta[j]);
   *ok = !st && mismatch(mon, theta, NULL, NULL, dm, &st) <= LR_TOL;
-  model_restore_tracked(mon);
+  rcb_mon_model_restore(mon, NULL);
   for (j = 0; *ok && !st && j < mon->ncand; j++) {
     mon_cand *c = &mon->cand[j];
     rcb_status sc = RCB_OK;
@@ -283,7 +278,7 @@ static rcb_status check(rcb_monitor *mon, int *ok) {
       sc = rcb_model_set_param(mon->model, c->pname[a], c->neutral[a] + s[a]);
     }
     good = !sc && mismatch(mon, zero, c, s, dm, &sc) <= LR_TOL;
-    for (a = 0; a < c->np; a++) rcb_model_set_param(mon->model, c->pname[a], c->neutral[a]);
+    rcb_mon_model_restore(mon, c);
     if (sc == RCB_ERR_NOMEM) st = sc;
     if (!good) c->ep = NULL; /* not affine after all: by sweeps */
   }

@@ -343,13 +343,12 @@ static int write_stats(est_job *j, const est_out *r, const char *path) {
   return cli_out_close(&out);
 }
 
-static int write_spectra(est_job *j, const est_out *r, const char *path) {
+static int write_spectra(est_job *j, const char *path) {
   size_t nb = rcb_spectral_bin_count(j->e), k, a, b, nc = j->p + j->q;
   rcb_complex *g = malloc(nc * nc * nb * sizeof *g);
   double *w = malloc(nb * sizeof *w); /* every bin (r->w holds the written lines) */
   cli_out out;
   int rc;
-  (void)r;
   if (!g || !w) {
     free(g);
     free(w);
@@ -466,7 +465,7 @@ static int estimate(const cli_args *a) {
                         "no output file was written (run without --plot for the estimate alone)");
   }
   if (!rc && stats) rc = write_stats(&j, &r, stats);
-  if (!rc && spectra) rc = write_spectra(&j, &r, spectra);
+  if (!rc && spectra) rc = write_spectra(&j, spectra);
   if (!rc) rc = write_meas(&j, &r);
   if (j.e) rcb_spectral_release(j.e);
   free(j.work);
