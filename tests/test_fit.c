@@ -10,7 +10,8 @@
  *    with honest standard errors, and flags cR as not identifiable;
  *  - a fit that stays above the noise floor (a missing effect, or a local
  *    minimum of a local NLopt method) is reported as unsure, and restarts
- *    from random starts within the bounds reach the floor;
+ *    from random starts within the bounds reach the floor; the random
+ *    starts run alone (rcb_fit_set_first_start) are those of a whole run;
  *  - bad settings give clear errors.
  */
 #include <complex.h>
@@ -356,6 +357,46 @@ static void test_multistart_local_minimum(void **state) {
   assert_true(many.starts > 1);
   assert_true(many.error_pct < 1.05 * many.floor_pct);
 }
+
+/* rcb_fit_set_first_start(f, 1) tries the random starts alone, the same
+ * points a run from the model's start tries after it: the best of a run
+ * from the model's start alone and of one from the random starts alone is
+ * the run of them all, to the bit, with the starts counted in two parts. */
+static void test_random_starts_alone(void **state) {
+  rcb_fit_report rep[3]; /* all 8 starts, the model's alone, the random ones alone */
+  const size_t n[3] = {8, 1, 8}, first[3] = {0, 0, 1};
+  double x[3][3];
+  size_t r, k, alone;
+  (void)state;
+  for (r = 0; r < 3; r++) {
+    rcb_model *m;
+    rcb_meas *ms;
+    rcb_fit *f = noisy_setup(&m, &ms, "nelson_crandall_2");
+    assert_int_equal(rcb_fit_set_method(f, RCB_FIT_NLOPT, "bobyqa"), RCB_OK);
+    assert_int_equal(rcb_fit_set_starts(f, n[r], 3), RCB_OK);
+    assert_int_equal(rcb_fit_set_first_start(f, first[r]), RCB_OK);
+    assert_int_equal(rcb_fit_get_first_start(f), first[r]);
+    if (rcb_fit_run(f)) fail_msg("%s", rcb_fit_errmsg(f));
+    assert_int_equal(rcb_fit_get_report(f, &rep[r]), RCB_OK);
+    for (k = 0; k < 3; k++) {
+      rcb_fit_param p;
+      assert_int_equal(rcb_fit_get_param(f, k, &p), RCB_OK);
+      x[r][k] = p.value;
+    }
+    rcb_fit_destroy(f);
+    rcb_meas_destroy(ms);
+    rcb_model_destroy(m);
+  }
+  print_message("all starts: F %.9g in %zu starts; model's alone %.9g; random alone %.9g in "
+                "%zu\n",
+                rep[0].objective, rep[0].starts, rep[1].objective, rep[2].objective,
+                rep[2].starts);
+  assert_int_equal(rep[1].unsure, 1); /* so the run of all goes on to the random ones */
+  assert_int_equal(rep[0].starts, 1 + rep[2].starts);
+  alone = rep[2].objective < rep[1].objective ? 2 : 1;
+  assert_true(rep[0].objective == rep[alone].objective);
+  assert_memory_equal(x[0], x[alone], sizeof x[0]);
+}
 #endif
 
 static void test_bad_settings(void **state) {
@@ -373,6 +414,10 @@ static void test_bad_settings(void **state) {
   assert_int_equal(rcb_fit_add_param(f, "coupling.C.zz", 0, 1, 0), RCB_ERR_NOT_FOUND);
   assert_int_equal(rcb_fit_add_param(f, "coupling.C.kt", 1e3, 1e6, 0), RCB_OK);
   assert_int_equal(rcb_fit_add_param(f, "coupling.C.kt", 1e3, 1e6, 0), RCB_ERR_ARG);
+  assert_int_equal(rcb_fit_set_first_start(f, 1), RCB_OK); /* of 1 start: nothing to try */
+  assert_int_equal(rcb_fit_run(f), RCB_ERR_ARG);
+  assert_non_null(strstr(rcb_fit_errmsg(f), "nothing to try"));
+  assert_int_equal(rcb_fit_set_first_start(f, 0), RCB_OK);
   assert_int_equal(rcb_fit_set_band(f, 10, 5), RCB_ERR_ARG);
   assert_int_equal(rcb_fit_set_band(f, 0, 1), RCB_OK);
   assert_int_equal(rcb_fit_run(f), RCB_ERR_ARG); /* no point in the band */
@@ -392,6 +437,7 @@ int main(void) {
       cmocka_unit_test(test_complex_continuation),
 #if RCB_WITH_NLOPT
       cmocka_unit_test(test_multistart_local_minimum),
+      cmocka_unit_test(test_random_starts_alone),
 #endif
       cmocka_unit_test(test_bad_settings),
   };

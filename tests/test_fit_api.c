@@ -56,6 +56,7 @@ static void test_defaults(void **state) {
   assert_true(cb == NULL && user == NULL);
   assert_int_equal(rcb_fit_get_starts(f, &n, &seed), RCB_OK);
   assert_true(n == 1 && seed == 0);
+  assert_int_equal(rcb_fit_get_first_start(f), 0);
   assert_int_equal(rcb_fit_get_uncertainty(f), 1);
   assert_int_equal(rcb_fit_get_param_bounds(f, 0, &lo, &hi, NULL), RCB_ERR_ARG);
   rcb_fit_destroy(f);
@@ -111,6 +112,9 @@ static void test_set_then_get(void **state) {
   assert_int_equal(rcb_fit_set_starts(f, 5, 2024ul), RCB_OK);
   assert_int_equal(rcb_fit_get_starts(f, &n, &seed), RCB_OK);
   assert_true(n == 5 && seed == 2024ul);
+  assert_int_equal(rcb_fit_set_first_start(f, 1), RCB_OK);
+  assert_int_equal(rcb_fit_set_starts(f, 6, 7ul), RCB_OK); /* keeps the first start */
+  assert_int_equal(rcb_fit_get_first_start(f), 1);
   assert_int_equal(rcb_fit_set_uncertainty(f, 0), RCB_OK);
   assert_int_equal(rcb_fit_get_uncertainty(f), 0);
   rcb_fit_destroy(f);

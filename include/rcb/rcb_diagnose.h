@@ -122,6 +122,11 @@ typedef struct rcb_diag_candidate {
   double delta_bic;         /**< BIC change (negative is better; NaN if not refitted) */
   int significant;          /**< refitted, BIC falls by > 10 and the error falls */
   const char *fitted;       /**< "name = value, ..." of the refit (candidate's params) */
+  int screened_only;        /**< 1 when the refit was fitted on a frequency subset only
+                                 and evaluated on all points there, as it ended far behind
+                                 the best (32 x 1101: over 2 x its objective): error_pct,
+                                 objective_drop_pct and delta_bic are then bounds a fit on
+                                 all points would improve on */
 } rcb_diag_candidate;
 
 RCB_API size_t rcb_diag_candidate_count(const rcb_diag *d);
@@ -135,6 +140,9 @@ typedef struct rcb_diag_stats {
   size_t evaluations; /**< model sweeps over the measured points (a Jacobian counts one) */
   size_t scored;      /**< candidates scored by the score test */
   size_t refits;      /**< candidates refitted (or evaluated, with nothing to fit) */
+  size_t restarts;    /**< refits screened on a frequency subset that then tried their
+                           random starts (only when no refit's first screen reached
+                           the noise floor) */
 } rcb_diag_stats;
 RCB_API rcb_status rcb_diag_get_stats(const rcb_diag *d, rcb_diag_stats *out);
 /**

@@ -111,6 +111,15 @@ RCB_API rcb_status rcb_fit_set_progress(rcb_fit *f,
  * n = 1 (default) tries only the model's own start.
  */
 RCB_API rcb_status rcb_fit_set_starts(rcb_fit *f, size_t n, unsigned long seed);
+/**
+ * @brief The first of the n starting points of rcb_fit_set_starts that
+ * rcb_fit_run tries: 0 (default) the model's own start, then the random ones;
+ * 1 the random ones only, the same points a run from 0 tries after the
+ * model's start (for a caller that ran that start already and decides after
+ * it whether the further starts are worth their cost). Must be below n when
+ * the fit runs. Setting the starts again keeps it.
+ */
+RCB_API rcb_status rcb_fit_set_first_start(rcb_fit *f, size_t first);
 
 /**
  * @brief Whether rcb_fit_run ends with the uncertainty step (standard errors,
@@ -169,6 +178,8 @@ RCB_API rcb_status rcb_fit_get_progress(const rcb_fit *f,
                                         void **user);
 /** @brief Starting points (default 1) and the PRNG seed of the further ones (default 0). */
 RCB_API rcb_status rcb_fit_get_starts(const rcb_fit *f, size_t *n, unsigned long *seed);
+/** @brief The first starting point tried (default 0, see rcb_fit_set_first_start). */
+RCB_API size_t rcb_fit_get_first_start(const rcb_fit *f);
 /** @brief Whether rcb_fit_run computes the uncertainties (default 1). */
 RCB_API int rcb_fit_get_uncertainty(const rcb_fit *f);
 

@@ -49,7 +49,14 @@ typedef struct diag_cand {
   double pre_F;                     /* its objective there (HUGE_VAL: failed) */
   double pre[RCB_DIAG_MAXP];        /* and its parameters, the start of the nominal refit */
   int pre_floor;                    /* its pre-fit ended at the noise floor */
+  int screened;                     /* its refit was screened on the frequency subset
+                                       (model: where it ended), then evaluated on all
+                                       points there, and polished when near the best */
+  double screen_F;                  /* the screen's objective on the subset */
+  int screen_unsure, screen_floor;  /* it ended unsure; at the noise floor */
   int refitted, significant;
+  int polished;                     /* refitted on all points (0: evaluated where its
+                                       screen ended: F, err, dbic upper bounds) */
   double F, err, dbic;
   char fitted[RCB_DIAG_MAXP * (RCB_DIAG_NAME + 32)];
   rcb_model *model;                 /* refitted model (owned, finalized) */
@@ -85,6 +92,8 @@ struct rcb_diag {
                                        the baseline fit ran off from it (owned) */
   int far;                          /* the baseline fit ran off from the nominal model */
   double pre_best;                  /* the lowest pre-fit objective (far baseline), or HUGE_VAL */
+  double best_F;                    /* the lowest objective of the refits on all points */
+  int screen_floor;                 /* a refit's screen ended at the noise floor */
   char drift[256];                  /* which parameter ran off, in words */
   double F0, err0, floor0;
   size_t nres;

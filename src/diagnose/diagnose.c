@@ -517,6 +517,18 @@ static rcb_status refit_setup(rcb_diag *d, const diag_cand *c, const rcb_model *
   return st;
 }
 
+/* On the subset (32 x 1101) a refit's random starts come after every
+ * candidate's first start has been screened, and only when none of those
+ * screens reached the noise floor (refit_restart): once one did, a
+ * candidate explains the data, and random starts would only look for a
+ * rival, as the pedestals' grids did in the run-off screen (prefit_selected).
+ * Measured on the ROSS large_* sets, seed 1 (rcbtool diagnose, 8 refits):
+ * the random starts never gave the best point of a refit there and took
+ * 2/3 of the screen's sweeps of the candidates that ended far from the data
+ * (the added mass at DB on large_pedestal_B4: 625 of 640; the dampings at
+ * B1 and B4 on large_cr_C: 436 of 598). */
+#define RCB_DIAG_STARTS_SUBSET 1
+
 /* The screening fit on the frequency subset w (NULL: the fit on all points)
  * stops after cap iterations (RCB_DIAG_SCREEN_ITER): it ranks the starts and
  * brings the polish near its end, and a fit crawling along a bound (a
@@ -572,8 +584,7 @@ static rcb_status polish(rcb_fit *f) {
  * is within this factor of the best pre-fit's: on the 0.15 kg hub case the
  * hub mass ends its pre-fit at F = 4528, the hub's inertia at 4.7e5 and the
  * rest at 2e6-3e6; the inertia's joint refit took 3.1 s (352 sweeps) to end
- * at 38 %, far behind. 8 x 151 refits the 3 best as before. A refit ending
- * its screen that far behind is not polished (far_behind). */
+ * at 38 %, far behind. 8 x 151 refits the 3 best as before. */
 #define RCB_DIAG_PRE_RATIO 10.0
 /* On the subset (32 x 1101) 4: a candidate that explains the data gets
  * there in a few (the 0.15 kg hub mass: the same joint refit after 4 as
@@ -583,6 +594,9 @@ static rcb_status polish(rcb_fit *f) {
  * fit's own "unsure" limit) explains the data: nothing is left for a place
  * search to find (place_search). */
 #define RCB_DIAG_FLOOR_FACTOR 1.5
+static int at_floor(double err, double floor) {
+  return isfinite(floor) && err < RCB_DIAG_FLOOR_FACTOR * floor;
+}
 
 /* Note where pre-fit f of c ended: its parameters, objective and whether
  * its error is at the noise floor (the floor of the same points). */
@@ -590,7 +604,7 @@ static void prefit_note(diag_cand *c, const rcb_model *m, double F, double err, 
   size_t k;
   for (k = 0; k < c->np; k++) rcb_model_get_param(m, c->pname[k], &c->pre[k]);
   if (isfinite(F)) c->pre_F = F;
-  c->pre_floor = isfinite(floor) && err < RCB_DIAG_FLOOR_FACTOR * floor;
+  c->pre_floor = at_floor(err, floor);
 }
 
 /* A pedestal's pre-fit on the subset: the best point of its grid
@@ -674,43 +688,45 @@ static rcb_status evaluate_only(rcb_diag *d, diag_cand *c, rcb_model **m, rcb_fi
   rcb_free(&d->alloc, r);
   if (st) return st;
   c->refitted = 1;
+  c->polished = 1;
   judge(d, c, 0.0);
   snprintf(c->fitted, sizeof c->fitted, "no parameter");
   c->model = *m, *m = NULL; /* kept: --apply writes it */
   return RCB_OK;
 }
 
-/* A screened refit whose objective on the subset ends more than
- * RCB_DIAG_PRE_RATIO x above the best pre-fit's (d->pre_best, same subset
- * and weights) is far behind: evaluated once on all points where the screen
- * left it, not polished. Its error and BIC are then those of the screened
- * point (an upper bound). On the hub cases the other coupling models end
- * there (F 2.4e6-7.2e7 on all points against 3.4e4 for the hub mass). */
-static rcb_status far_behind(rcb_diag *d, diag_cand *c, rcb_model **m, rcb_fit *f) {
-  double *r = rcb_alloc(&d->alloc, d->nres * sizeof *r);
-  rcb_status st = r ? rcb_fit_set_weights(f, NULL) : RCB_ERR_NOMEM;
-  if (!st) st = objective(d, f, r, &c->F, &c->err);
-  rcb_free(&d->alloc, r);
-  if (st == RCB_ERR_NOMEM) return rcb_diag_fail(d, st, "refitting %s: out of memory", c->desc);
-  if (st) {
-    snprintf(c->fitted, sizeof c->fitted, "refit failed: %.300s", d->errmsg);
-    return RCB_OK;
-  }
+/* On the subset (32 x 1101) a refit is polished on all points only when,
+ * evaluated there where its screen ended, its objective is within this
+ * fraction of the lowest refit's; the others keep that evaluation, their
+ * figures upper bounds (rcb_diag_candidate.screened_only). A polish lowers
+ * a screened objective by little: on bench_diagnose --large (kcross at B2)
+ * by 0.001-1.7 % (34738.5 -> 34738.1 for the cross-coupling, the rest
+ * 5.8-390 x above it), while the six polishes behind it took 71 of the 78
+ * sweeps on all points, 2 s of the 3.6 s. */
+#define RCB_DIAG_POLISH_WITHIN 0.1
+
+/* A refit fitted or evaluated on all points: its figures. */
+static void refit_result(rcb_diag *d, diag_cand *c, rcb_model **m, rcb_fit *f, double F,
+                         double err, int polished) {
   c->refitted = 1;
+  c->polished = polished;
+  c->F = F, c->err = err;
   judge(d, c, (double)c->np);
   record_fit(c, f);
+  rcb_model_destroy(c->model);
   c->model = *m, *m = NULL;
-  return RCB_OK;
 }
 
-/* Refit candidate c with the base parameters, from the fitted base model
- * (c->from_fit) and from the nominal one (c->from_nom: the baseline fit ran
- * off, and c scores high at the nominal model): a missing effect that
- * pulled the base parameters far leaves the fitted point in a basin a joint
- * fit does not leave. With w (a subset of the frequencies, subset()) each
- * start is screened on the subset and only the best is polished on all
- * points, from where the subset left it. */
-static rcb_status refit(rcb_diag *d, diag_cand *c, const double *w) {
+/* The first step of the refit of candidate c with the base parameters, from
+ * the fitted base model (c->from_fit) and from the nominal one (c->from_nom:
+ * the baseline fit ran off, and c scores high at the nominal model): a
+ * missing effect that pulled the base parameters far leaves the fitted point
+ * in a basin a joint fit does not leave. With w (a subset of the
+ * frequencies, subset()) each start is screened on the subset and the best
+ * is kept in c->model (c->screened) for the steps that follow once every
+ * candidate's screen has ended (refit_restart, refit_evaluate,
+ * refit_polish); without, the fit on all points is the refit. */
+static rcb_status refit_screen(rcb_diag *d, diag_cand *c, const double *w) {
   rcb_model *m[2] = {NULL, NULL};
   rcb_fit *f[2] = {NULL, NULL};
   double F[2] = {HUGE_VAL, HUGE_VAL};
@@ -729,6 +745,7 @@ static rcb_status refit(rcb_diag *d, diag_cand *c, const double *w) {
     if (!(s ? c->from_nom : c->from_fit)) continue;
     from_pre = s && c->prefitted && c->pre_F < HUGE_VAL;
     st = refit_setup(d, c, s ? d->nom_model : d->base_model, from_pre, &m[s], &f[s]);
+    if (!st && w) st = rcb_fit_set_starts(f[s], RCB_DIAG_STARTS_SUBSET, 1); /* see refit_restart */
     if (!st && from_pre) { /* where its pre-fit ended */
       size_t k;
       for (k = 0; !st && k < c->np; k++) st = rcb_model_set_param(m[s], c->pname[k], c->pre[k]);
@@ -761,22 +778,16 @@ static rcb_status refit(rcb_diag *d, diag_cand *c, const double *w) {
       st = evaluate_only(d, c, &m[b], f[b]);
     } else if (!(F[b] < HUGE_VAL)) {
       snprintf(c->fitted, sizeof c->fitted, "%s", why);
-    } else if (w && d->far && F[b] > RCB_DIAG_PRE_RATIO * d->pre_best) {
-      st = far_behind(d, c, &m[b], f[b]);
-    } else if (w && (st = polish(f[b]))) {
-      if (st == RCB_ERR_NOMEM)
-        rcb_diag_fail(d, st, "refitting %s: %s", c->desc, rcb_fit_errmsg(f[b]));
-      else
-        snprintf(c->fitted, sizeof c->fitted, "refit failed: %.300s", rcb_fit_errmsg(f[b]));
-      st = st == RCB_ERR_NOMEM ? st : RCB_OK;
+    } else if (w) { /* kept for refit_restart and refit_evaluate */
+      rcb_fit_get_report(f[b], &rep);
+      c->screened = 1;
+      c->screen_F = F[b];
+      c->screen_unsure = rep.unsure;
+      c->screen_floor = at_floor(rep.error_pct, rep.floor_pct);
+      c->model = m[b], m[b] = NULL;
     } else {
       rcb_fit_get_report(f[b], &rep);
-      c->refitted = 1;
-      c->F = rep.objective;
-      c->err = rep.error_pct;
-      judge(d, c, (double)c->np);
-      record_fit(c, f[b]);
-      c->model = m[b], m[b] = NULL;
+      refit_result(d, c, &m[b], f[b], rep.objective, rep.error_pct, 1);
     }
   }
   for (s = 0; s < 2; s++) {
@@ -784,6 +795,85 @@ static rcb_status refit(rcb_diag *d, diag_cand *c, const double *w) {
     rcb_model_destroy(m[s]);
   }
   return st;
+}
+
+/* The second step of a screened refit (c->screened) whose screen ended
+ * unsure, when no candidate's screen reached the noise floor (d->screen_floor):
+ * the random starts of refit_starts the first step left out, screened on
+ * the subset w from the same points a run of them all would have drawn
+ * (rcb_fit_set_first_start); the lower of the two ends is kept. */
+static rcb_status refit_restart(rcb_diag *d, diag_cand *c, const double *w) {
+  rcb_model *m = NULL;
+  rcb_fit *f = NULL;
+  rcb_fit_report rep;
+  size_t n = refit_starts(d, c);
+  rcb_status st;
+  if (!c->screened || !c->screen_unsure || d->screen_floor || n <= RCB_DIAG_STARTS_SUBSET)
+    return RCB_OK;
+  d->stats.restarts++;
+  st = rcb_diag_copy_model(d, c->model, &m);
+  if (!st) st = make_fit(d, m, 1, c, &f);
+  if (!st) st = rcb_fit_set_starts(f, n, 1);
+  if (!st) st = rcb_fit_set_first_start(f, RCB_DIAG_STARTS_SUBSET);
+  if (!st) st = refit_tolerance(d, c, f);
+  if (!st) st = screen(f, w, RCB_DIAG_SCREEN_ITER);
+  if (!st) st = rcb_fit_get_report(f, &rep);
+  if (!st && rep.objective < c->screen_F) {
+    c->screen_F = rep.objective;
+    rcb_model_destroy(c->model);
+    c->model = m, m = NULL;
+  }
+  if (st == RCB_ERR_NOMEM)
+    rcb_diag_fail(d, st, "refitting %s: %s", c->desc, f ? rcb_fit_errmsg(f) : "out of memory");
+  drop_fit(d, f);
+  rcb_model_destroy(m);
+  return st == RCB_ERR_NOMEM ? st : RCB_OK; /* a failed restart leaves the first screen */
+}
+
+/* The third step of a screened refit (c->screened), once every screen has
+ * ended: evaluated on all points where its screen ended (its model in
+ * c->model). */
+static rcb_status refit_evaluate(rcb_diag *d, diag_cand *c) {
+  rcb_model *m = c->model;
+  rcb_fit *f = NULL;
+  double *r = NULL, F = 0.0, err = 0.0;
+  rcb_status st;
+  if (!c->screened) return RCB_OK;
+  c->model = NULL;
+  st = make_fit(d, m, 1, c, &f);
+  if (!st) st = (r = rcb_alloc(&d->alloc, d->nres * sizeof *r)) ? RCB_OK : RCB_ERR_NOMEM;
+  if (!st) st = objective(d, f, r, &F, &err);
+  if (!st) refit_result(d, c, &m, f, F, err, 0);
+  else if (st != RCB_ERR_NOMEM)
+    snprintf(c->fitted, sizeof c->fitted, "refit failed: %.300s", d->errmsg);
+  rcb_free(&d->alloc, r);
+  drop_fit(d, f);
+  rcb_model_destroy(m);
+  if (st == RCB_ERR_NOMEM) return rcb_diag_fail(d, st, "refitting %s: out of memory", c->desc);
+  return RCB_OK;
+}
+
+/* The fourth step: a screened refit within RCB_DIAG_POLISH_WITHIN of the
+ * lowest objective of all refits (d->best_F) polished on all points,
+ * on a copy of its model (a failed polish leaves the evaluation). */
+static rcb_status refit_polish(rcb_diag *d, diag_cand *c) {
+  rcb_model *m = NULL;
+  rcb_fit *f = NULL;
+  rcb_fit_report rep;
+  rcb_status st;
+  if (!c->screened || !c->refitted || !(c->F <= (1.0 + RCB_DIAG_POLISH_WITHIN) * d->best_F))
+    return RCB_OK;
+  st = rcb_diag_copy_model(d, c->model, &m);
+  if (!st) st = make_fit(d, m, 1, c, &f);
+  if (!st) st = refit_tolerance(d, c, f);
+  if (!st) st = polish(f);
+  if (!st) st = rcb_fit_get_report(f, &rep);
+  if (!st) refit_result(d, c, &m, f, rep.objective, rep.error_pct, 1);
+  else if (st == RCB_ERR_NOMEM)
+    rcb_diag_fail(d, st, "refitting %s: %s", c->desc, f ? rcb_fit_errmsg(f) : "out of memory");
+  drop_fit(d, f);
+  rcb_model_destroy(m);
+  return st == RCB_ERR_NOMEM ? st : RCB_OK;
 }
 
 /* Rank: refitted by BIC change, then the rest by predicted reduction. */
@@ -826,7 +916,38 @@ static rcb_status prefit_job(rcb_diag *d, size_t i, void *ctx) {
 
 static rcb_status refit_job(rcb_diag *d, size_t i, void *ctx) {
   cand_jobs *j = ctx;
-  return refit(d, &d->cand[j->k[i]], j->w);
+  return refit_screen(d, &d->cand[j->k[i]], j->w);
+}
+
+static rcb_status restart_job(rcb_diag *d, size_t i, void *ctx) {
+  cand_jobs *j = ctx;
+  return refit_restart(d, &d->cand[j->k[i]], j->w);
+}
+
+/* Whether a refit's screen ended at the noise floor: refit_restart. */
+static void screen_floor(rcb_diag *d) {
+  size_t k;
+  d->screen_floor = 0;
+  for (k = 0; k < d->ncand; k++) d->screen_floor |= d->cand[k].screened && d->cand[k].screen_floor;
+}
+
+static rcb_status evaluate_job(rcb_diag *d, size_t i, void *ctx) {
+  cand_jobs *j = ctx;
+  return refit_evaluate(d, &d->cand[j->k[i]]);
+}
+
+static rcb_status polish_job(rcb_diag *d, size_t i, void *ctx) {
+  cand_jobs *j = ctx;
+  return refit_polish(d, &d->cand[j->k[i]]);
+}
+
+/* The lowest objective on all points of the refits: what refit_polish
+ * measures from. */
+static void lowest_refit(rcb_diag *d) {
+  size_t k;
+  d->best_F = HUGE_VAL;
+  for (k = 0; k < d->ncand; k++)
+    if (d->cand[k].refitted && d->cand[k].F < d->best_F) d->best_F = d->cand[k].F;
 }
 
 /* After a refit: progress (scored candidates only; the count only rises). */
@@ -990,6 +1111,11 @@ static rcb_status refit_best(rcb_diag *d) {
   for (k = 0; k < d->ncand; k++)
     if (d->cand[k].refit_only) j.k[j.n++] = k;
   if (!st) st = rcb_diag_for_each(d, j.n, refit_job, &j, refit_done);
+  if (!st) screen_floor(d);
+  if (!st) st = rcb_diag_for_each(d, j.n, restart_job, &j, NULL);
+  if (!st) st = rcb_diag_for_each(d, j.n, evaluate_job, &j, NULL);
+  if (!st) lowest_refit(d);
+  if (!st) st = rcb_diag_for_each(d, j.n, polish_job, &j, NULL);
   if (!st) sort_order(d);
   rcb_free(&d->alloc, j.w);
   rcb_free(&d->alloc, j.k);
@@ -1046,6 +1172,7 @@ rcb_status rcb_diag_candidate_get(const rcb_diag *d, size_t rank, rcb_diag_candi
   out->delta_bic = c->dbic;
   out->significant = c->significant;
   out->fitted = c->fitted;
+  out->screened_only = c->refitted && !c->polished;
   return RCB_OK;
 }
 

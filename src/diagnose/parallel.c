@@ -94,6 +94,7 @@ static rcb_status run_threads(rcb_diag *d, size_t n, rcb_diag_job job, void *ctx
   for (t = 0; t < started; t++) {
     d->stats.evaluations += w[t].wk.stats.evaluations;
     d->stats.refits += w[t].wk.stats.refits;
+    d->stats.restarts += w[t].wk.stats.restarts;
     if (w[t].failed < first) {
       first = w[t].failed;
       memcpy(d->errmsg, w[t].msg, sizeof d->errmsg);

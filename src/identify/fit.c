@@ -385,6 +385,8 @@ rcb_status rcb_fit_get_starts(const rcb_fit *f, size_t *n, unsigned long *seed) 
   return RCB_OK;
 }
 
+size_t rcb_fit_get_first_start(const rcb_fit *f) { return f ? f->first_start : 0; }
+
 int rcb_fit_get_uncertainty(const rcb_fit *f) { return f ? !f->no_uncertainty : 1; }
 
 /* ---- run and results ---- */
@@ -394,6 +396,12 @@ rcb_status rcb_fit_set_starts(rcb_fit *f, size_t n, unsigned long seed) {
   f->nstarts = n;
   f->seed = seed;
   f->rng = (unsigned long long)seed * 0x9E3779B97F4A7C15ull + 1ull;
+  return RCB_OK;
+}
+
+rcb_status rcb_fit_set_first_start(rcb_fit *f, size_t first) {
+  if (!f) return RCB_ERR_ARG;
+  f->first_start = first;
   return RCB_OK;
 }
 
@@ -422,14 +430,15 @@ static int is_unsure(const rcb_fit *f, double err) {
   return !f->converged || (isfinite(floor_pct) && err > 1.5 * floor_pct);
 }
 
-/* Run the optimiser from the model's start, then from further random starts
- * while the result is unsure; keep the best point in x_best. */
+/* Run the optimiser from the model's start (unless the caller asked for the
+ * random starts only), then from further random starts while the result is
+ * unsure; keep the best point in x_best. */
 static rcb_status multistart(rcb_fit *f, double *x, double *x_best) {
   size_t s, it = 0, ev = 0, n = f->nstarts ? f->nstarts : 1;
   double best = HUGE_VAL;
   int conv = 0, stall = 0;
   rcb_status st = RCB_OK, first = RCB_OK;
-  for (s = 0; s < n; s++) {
+  for (s = f->first_start; s < n; s++) {
     double F;
     if (s > 0) {
       random_start(f, x);
@@ -439,9 +448,9 @@ static rcb_status multistart(rcb_fit *f, double *x, double *x_best) {
     f->stalled = 0;
     st = f->method == RCB_FIT_NLOPT ? rcb_fit_run_nlopt(f) : rcb_fit_run_paper(f);
     it += f->iterations, ev += f->evaluations;
-    f->starts_used = s + 1;
+    f->starts_used = s + 1 - f->first_start;
     if (st) {
-      if (s == 0) first = st;
+      if (s == f->first_start) first = st;
       continue;
     }
     if ((st = rcb_fit_eval(f, f->r))) break;
@@ -486,6 +495,9 @@ rcb_status rcb_fit_run(rcb_fit *f) {
   if (!f) return RCB_ERR_ARG;
   if (f->np == 0)
     return rcb_fit_fail(f, RCB_ERR_ARG, "no parameter to fit (add one with --params)");
+  if (f->first_start >= (f->nstarts ? f->nstarts : 1))
+    return rcb_fit_fail(f, RCB_ERR_ARG, "first start %zu of %zu starting points: nothing to try",
+                        f->first_start, f->nstarts ? f->nstarts : 1);
   for (k = 0; k < f->np; k++) {
     rcb_model_get_param(f->m, f->par[k].name, &f->par[k].start);
     f->par[k].value = f->par[k].start;

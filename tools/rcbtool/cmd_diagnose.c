@@ -27,6 +27,11 @@ const char cli_help_diagnose[] =
     "fitted parameters); the best N (--refits, default 8) and the other coupling\n"
     "models are refitted, and ranked by the change of BIC. A candidate is\n"
     "significant when BIC falls by more than 10 and the error itself falls.\n"
+    "On large sets (where a subset of the frequencies keeps at most half of\n"
+    "them) the refits are screened on that subset and only those within 2 x of\n"
+    "the best there are polished on all points; the others are evaluated on all\n"
+    "points where their screen ended, marked \"screened\" (\"screened_only\" in\n"
+    "JSON): their error and dBIC are upper bounds.\n"
     "  --noise A,S    the eq. 19 noise model (random A %, systematic S %): weights\n"
     "                 and the noise floor (strongly recommended)\n"
     "  --sd FILE      instead of --noise: weights and the noise floor from the\n"
@@ -42,7 +47,8 @@ const char cli_help_diagnose[] =
     "                 added and fitted, atomically; the input model is untouched\n"
     "  --history FILE record this step (rcbtool history FILE shows the steps)\n"
     "  --json         the ranking as JSON, with \"evaluations\" (model sweeps, a\n"
-    "                 Jacobian counting one), \"scored\" and \"refits\"\n"
+    "                 Jacobian counting one), \"scored\", \"refits\" and \"restarts\"\n"
+    "                 (refits that tried random starts after their screen)\n"
     "Units of the report: error % and the noise floor %: the relative error of\n"
     "the model against the data, in percent (the floor is predicted from --noise\n"
     "or --sd, not measured); score %: the part of that error the effect can\n"
@@ -166,7 +172,8 @@ static void print_text(FILE *fp, const diag_job *j, const rcb_diag *d, const cha
     fprintf(fp, "%-4zu %-5s %-58.58s %9.3g ", k + 1, c.significant ? "YES" : "no",
             c.description, c.predicted_pct);
     if (c.refitted)
-      fprintf(fp, "%9.4g %+10.1f  %s\n", c.error_pct, c.delta_bic, c.fitted);
+      fprintf(fp, "%9.4g %+10.1f  %s%s\n", c.error_pct, c.delta_bic, c.fitted,
+              c.screened_only ? " (screened: error and dBIC are upper bounds)" : "");
     else
       fprintf(fp, "%9s %10s  %s\n", "-", "-", c.fitted[0] ? c.fitted : "(not refitted)");
   }
@@ -183,8 +190,8 @@ static void print_json(FILE *fp, const diag_job *j, const rcb_diag *d, const cha
   fputs(", \"floor_pct\": ", fp);
   cli_json_num(fp, floor_pct);
   if (rcb_diag_get_stats(d, &stats) == RCB_OK) /* the work done: model sweeps, candidates */
-    fprintf(fp, ", \"evaluations\": %zu, \"scored\": %zu, \"refits\": %zu", stats.evaluations,
-            stats.scored, stats.refits);
+    fprintf(fp, ", \"evaluations\": %zu, \"scored\": %zu, \"refits\": %zu, \"restarts\": %zu",
+            stats.evaluations, stats.scored, stats.refits, stats.restarts);
   fputs(", \"explanation\": ", fp);
   cli_json_str(fp, explain);
   fputs(",\n\"candidates\": [", fp);
@@ -205,7 +212,8 @@ static void print_json(FILE *fp, const diag_job *j, const rcb_diag *d, const cha
     cli_json_num(fp, c.error_pct);
     fputs(", \"delta_bic\": ", fp);
     cli_json_num(fp, c.delta_bic);
-    fprintf(fp, ", \"significant\": %s, \"fitted\": ", c.significant ? "true" : "false");
+    fprintf(fp, ", \"significant\": %s, \"screened_only\": %s, \"fitted\": ",
+            c.significant ? "true" : "false", c.screened_only ? "true" : "false");
     cli_json_str(fp, c.fitted);
     fputs("}", fp);
   }

@@ -89,7 +89,8 @@ class DiagCandidate(ctypes.Structure):
     _fields_ = [("effect", c_int), ("place", c_char_p), ("description", c_char_p),
                 ("params", c_char_p), ("predicted_pct", c_double), ("refitted", c_int),
                 ("error_pct", c_double), ("objective_drop_pct", c_double),
-                ("delta_bic", c_double), ("significant", c_int), ("fitted", c_char_p)]
+                ("delta_bic", c_double), ("significant", c_int), ("fitted", c_char_p),
+                ("screened_only", c_int)]
 
 
 class CompareChannel(ctypes.Structure):

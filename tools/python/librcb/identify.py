@@ -155,7 +155,8 @@ class Diagnosis(Handle):
                 "params": _lib.text(c.params), "predicted_pct": c.predicted_pct,
                 "refitted": bool(c.refitted), "error_pct": c.error_pct,
                 "objective_drop_pct": c.objective_drop_pct, "delta_bic": c.delta_bic,
-                "significant": bool(c.significant), "fitted": _lib.text(c.fitted)})
+                "significant": bool(c.significant), "fitted": _lib.text(c.fitted),
+                "screened_only": bool(c.screened_only)})
         st, self.explanation = _lib.two_call_string(L.rcb_diag_explain, self.handle)
         self.check(st, "rcb_diag_explain")
 
