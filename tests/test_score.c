@@ -26,8 +26,8 @@
 #include <string.h>
 #include <cmocka.h>
 
-#include "diagnose/diag_internal.h"
-#include "identify/fit_internal.h" /* white-box: the adjoint choice, sums of squares */
+#include "diagnose/diagnose.h" /* the score test's QR (the internal interface) */
+#include "identify/identify.h" /* the adjoint choice (the internal interface) */
 #include "rcb_test_util.h"
 
 #define RPM (RCB_PI / 30.0)
@@ -56,6 +56,13 @@ static double rel_diff(const double *a, const double *b, size_t n) {
     s = fmax(s, fabs(b[j]));
   }
   return s > 0 ? d / s : d;
+}
+
+static double sumsq(const double *r, size_t n) {
+  double F = 0.0;
+  size_t i;
+  for (i = 0; i < n; i++) F += r[i] * r[i];
+  return F;
 }
 
 /* The Jacobian of all parameters at once (the adjoint path: few outputs,
@@ -210,12 +217,14 @@ static void test_batched_scores_equal_alone(void **state) {
   rcb_fit_dz dz[5];
   size_t k, off = 0, ndz = 0;
   double *J;
+  rcb_allocator a; /* malloc, as the dz's owner */
   (void)state;
+  rcb_allocator_init(&a, NULL);
   case_open(&sc);
   fb = fit_of(sc.m, sc.ms, base_names, NBASE);
   for (k = 0; k < NCAND; k++) {
     fc = fit_of(sc.m, sc.ms, cand_names[k], cand_np[k]);
-    assert_int_equal(rcb_fit_dz_get(fc, &sc.d->alloc, dz + ndz), RCB_OK);
+    assert_int_equal(rcb_fit_dz_get(fc, &a, dz + ndz), RCB_OK);
     ndz += cand_np[k];
     rcb_fit_destroy(fc);
   }
@@ -225,12 +234,12 @@ static void test_batched_scores_equal_alone(void **state) {
     double pb = predicted(&sc, sc.J0, NBASE, J + sc.n * off, cand_np[k], NULL);
     double pa = predicted(&sc, sc.J0, NBASE, sc.Jc[k], cand_np[k], NULL);
     print_message("  %-28s batched %.10g alone %.10g (F %.6g)\n", cand_names[k][0], pb, pa,
-                  rcb_fit_sumsq(sc.r, sc.n));
+                  sumsq(sc.r, sc.n));
     assert_true(pa > 0);
     assert_true(rcb_test_close(pb, pa, 1e-8, 0.0));
     off += cand_np[k];
   }
-  rcb_fit_dz_free(&sc.d->alloc, dz, ndz);
+  rcb_fit_dz_free(&a, dz, ndz);
   free(J);
   rcb_fit_destroy(fb);
   case_close(&sc);
@@ -305,7 +314,7 @@ static void test_score_rank(void **state) {
   pd = predicted(&sc, sc.J0, NBASE, Jin, 1, NULL);
   print_message("  J0 with a dependent fourth column: %.12g (rank %zu), without: %.12g\n",
                 predicted(&sc, J0d, NBASE + 1, sc.Jc[0], 1, NULL), rank, p);
-  print_message("  a candidate inside span(J0): %.3g (F %.6g)\n", pd, rcb_fit_sumsq(sc.r, n));
+  print_message("  a candidate inside span(J0): %.3g (F %.6g)\n", pd, sumsq(sc.r, n));
   assert_true(pd == 0.0);
   /* a candidate of two columns, the second 1e8 x the first: as the first */
   Jdup = malloc(2 * n * sizeof *Jdup);

@@ -27,7 +27,7 @@
 #include <cmocka.h>
 
 #include "analyses/frf_internal.h"
-#include "identify/fit_internal.h"
+#include "identify/identify.h"
 #include "rcb/rcb_config.h"
 #include "rcb_test_util.h"
 
@@ -402,7 +402,7 @@ static void test_fit_jacobian_sparse(void **state) {
     assert_int_equal(rcb_meas_add_channel(ms, outs[o], ins[0], RCB_RECEPTANCE, col), RCB_OK);
   }
   if (rcb_fit_create(&fit, m, ms, NULL)) fail_msg("%s", rcb_fit_errmsg(fit));
-  assert_int_equal(rcb_frf_solver(fit->frf), RCB_SOLVER_SPARSE);
+  assert_int_equal(rcb_fit_get_solver(fit), RCB_SOLVER_SPARSE);
   for (k = 0; k < 3; k++) {
     double p;
     assert_int_equal(rcb_model_get_param(m, names[k], &p), RCB_OK);

@@ -37,6 +37,10 @@ static rcb_status make_frf(rcb_fit *f, rcb_dof *outs, rcb_dof *ins, rcb_solver_k
   return RCB_OK;
 }
 
+rcb_solver_kind rcb_fit_get_solver(const rcb_fit *f) {
+  return f && f->frf ? rcb_frf_solver(f->frf) : RCB_SOLVER_AUTO;
+}
+
 rcb_status rcb_fit_set_solver(rcb_fit *f, rcb_solver_kind s) {
   rcb_dof *outs, *ins;
   rcb_status st;

@@ -131,10 +131,9 @@ rcb_status rcb_fit_derivative_matrices(rcb_fit *f);
 /* The same from f->dmat, f->dF (after rcb_fit_derivative_matrices). */
 rcb_status rcb_fit_dz_collect(rcb_fit *f, const rcb_allocator *a, rcb_fit_dz *dz);
 /* f's own Jacobian d r / d p by the adjoint (models values into Hmod, no
- * residuals), and whether that needs fewer solves per point than the direct
- * re-solve of jac_point. */
+ * residuals); whether that needs fewer solves per point than the direct
+ * re-solve of jac_point is rcb_fit_adjoint_cheaper (identify.h). */
 rcb_status rcb_fit_jac_adjoint(rcb_fit *f, double *Jp);
-int rcb_fit_adjoint_cheaper(const rcb_fit *f);
 
 /* fit_guard.c: after the run, why it stopped (converged, at a bound,
  * stalled, out of iterations) into f->stop; a non-finite objective as

@@ -24,6 +24,14 @@ rcb_status rcb_fit_prepare(rcb_fit *f);
  * through its allocator hooks (the monitor) asks for RCB_SOLVER_BANDED,
  * as KLU allocates its factors itself (rcb_analysis.h). */
 rcb_status rcb_fit_set_solver(rcb_fit *f, rcb_solver_kind s);
+/* The solver f's sweeps use (the one RCB_SOLVER_AUTO chose, or the one set);
+ * RCB_SOLVER_AUTO when f is NULL. */
+rcb_solver_kind rcb_fit_get_solver(const rcb_fit *f);
+
+/* Whether f's Jacobian goes by the adjoint (one transposed re-solve of the
+ * outputs per point, rcb_frf_solve_adjoint) rather than the direct re-solve
+ * (one per parameter and input): the adjoint needs fewer solves per point. */
+int rcb_fit_adjoint_cheaper(const rcb_fit *f);
 
 /* The paper's error % of the model values of f's last evaluation (as
  * rcb_fit_error, without another sweep). */
