@@ -4,7 +4,8 @@
  * reaching k, for each of: loading a model from an INI string, creating an
  * FRF object and sweeping it, a small fit (the paper's method, noise-free
  * data, 2 parameters; again with NLopt when built with it), a small
- * diagnosis (every candidate scored, one refit), and reading a CSV and a
+ * diagnosis (every candidate scored, one refit), the refits of one on a
+ * frequency subset (screen, random starts, evaluation, polish), and reading a CSV and a
  * UFF58 measurement. Every run must
  *  - return an error status when the failing allocation was reached (never
  *    RCB_OK with a silently missing piece), RCB_ERR_NOMEM or an error that
@@ -64,11 +65,11 @@ static size_t walk_stride(void) {
   return v > 1 ? (size_t)v : 1;
 }
 
-/* Walk k = 1.. until the scenario runs without reaching k; returns the
- * number of allocations of the complete run. */
-static size_t walk(const char *name, scenario run) {
-  size_t k, step = walk_stride();
-  for (k = 1;; k += step) {
+/* Walk k = from, from + 1, .. until the scenario runs without reaching k;
+ * returns the number of allocations of the complete run. */
+static size_t walk_from(const char *name, scenario run, size_t from, size_t step) {
+  size_t k;
+  for (k = from;; k += step) {
     failing f = {k, 0, 0, 0, 0};
     rcb_allocator a = hooks(&f);
     rcb_status st = run(&a, 0);
@@ -89,6 +90,9 @@ static size_t walk(const char *name, scenario run) {
     if (k > 100000) fail_msg("%s: no end to the walk", name);
   }
 }
+
+/* Walk k = 1.. (every site, or every RCB_ALLOC_WALK_STRIDE-th). */
+static size_t walk(const char *name, scenario run) { return walk_from(name, run, 1, walk_stride()); }
 
 /* ---- scenarios; each frees everything before returning ---- */
 
@@ -214,31 +218,37 @@ static rcb_status sc_uff(const rcb_allocator *a, int check) {
 }
 
 /* Noise-free FRF "measurement" of the model (plain malloc: not walked). */
-static rcb_meas *truth_meas(void) {
+static rcb_meas *truth_meas_n(size_t n, double f0, double df) {
   rcb_model *m = rcb_test_model_from_string(MODEL);
   rcb_meas *ms = NULL;
   rcb_frf *f = NULL;
   rcb_dof d[4];
-  double x[12];
-  rcb_complex H[4 * 12], col[12];
+  double *x = calloc(n, sizeof *x);
+  rcb_complex *H = calloc(4 * n, sizeof *H), *col = calloc(n, sizeof *col);
   size_t i, o;
   static const char *const outs[4] = {"C.A.x", "C.B.x", "C.A.ry", "C.B.ry"};
   for (o = 0; o < 4; o++) assert_int_equal(rcb_model_find_dof(m, outs[o], &d[o]), RCB_OK);
   assert_int_equal(rcb_frf_create(&f, m, 4, d, 1, d, RCB_SOLVER_AUTO, NULL), RCB_OK);
-  for (i = 0; i < 12; i++) {
-    x[i] = 2.0 * RCB_PI * (50.0 + 40.0 * (double)i);
+  for (i = 0; i < n; i++) {
+    x[i] = 2.0 * RCB_PI * (f0 + df * (double)i);
     assert_int_equal(rcb_frf_eval(f, x[i], 0.0, RCB_RECEPTANCE, H + 4 * i), RCB_OK);
   }
   assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
-  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, 12, x, 0.0), RCB_OK);
+  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, n, x, 0.0), RCB_OK);
   for (o = 0; o < 4; o++) {
-    for (i = 0; i < 12; i++) col[i] = H[4 * i + o];
+    for (i = 0; i < n; i++) col[i] = H[4 * i + o];
     assert_int_equal(rcb_meas_add_channel(ms, outs[o], "C.A.x", RCB_RECEPTANCE, col), RCB_OK);
   }
   rcb_frf_destroy(f);
   rcb_model_destroy(m);
+  free(x);
+  free(H);
+  free(col);
   return ms;
 }
+
+/* The truth's 12 points, 50-490 Hz. */
+static rcb_meas *truth_meas(void) { return truth_meas_n(12, 50.0, 40.0); }
 
 static rcb_meas *g_truth;
 
@@ -301,6 +311,62 @@ static rcb_status sc_diag(const rcb_allocator *a, int check) {
     print_message("diagnosis: first %s at %s (%s), error %.3g %%\n", rcb_effect_name(c.effect),
                   c.place, c.params, c.error_pct);
     assert_true(c.refitted);
+  }
+  rcb_diag_destroy(d);
+  rcb_model_destroy(m);
+  return st;
+}
+
+/* The diagnosis on a grid long enough for the screen on a frequency subset
+ * (301 points 50-650 Hz; the subset keeps 150 of them): the refits' screen,
+ * random starts (with a noise model far below the data's, so that no
+ * screen reaches the floor), evaluation on all points and polish. The walk
+ * starts where the refits do: the allocation count at the last report of
+ * the scores (a refit's first report jumps past the candidates refitted
+ * only), recorded by the progress callback on a complete run. */
+static size_t g_refits_from; /* allocations when the scores ended, 0: not known */
+
+typedef struct refit_mark {
+  const rcb_test_failing *f;
+  size_t last_done, last_allocs;
+} refit_mark;
+
+static int mark_refits(void *user, size_t done, size_t total) {
+  refit_mark *r = user;
+  (void)total;
+  if (!g_refits_from && r->last_done && done > r->last_done + 1) g_refits_from = r->last_allocs;
+  r->last_done = done, r->last_allocs = r->f->allocs;
+  return 0;
+}
+
+static rcb_status sc_diag_subset(const rcb_allocator *a, int check) {
+  rcb_model *m = NULL;
+  rcb_diag *d = NULL;
+  rcb_diag_stats stats;
+  refit_mark mark = {a->user, 0, 0};
+  rcb_status st = load(a, &m);
+  if (st) return st;
+  assert_int_equal(rcb_model_set_param(m, "coupling.C.kr", 1e3 / 3.0), RCB_OK);
+  st = rcb_diag_create(&d, m, g_truth, a);
+  if (!st) st = rcb_diag_add_fitted_param(d, "coupling.C.kt", 1e3, 1e7, 1);
+  if (!st) st = rcb_diag_set_scale(d, RCB_SCALE_LOG10);
+  if (!st) st = rcb_diag_set_noise_model(d, 0.1, 0.01);
+  if (!st) st = rcb_diag_set_refits(d, 1);
+  if (!st) st = rcb_diag_set_progress(d, mark_refits, &mark);
+  if (!st) st = rcb_diag_run(d);
+  if (st && d && rcb_diag_errmsg(d)[0] == '\0')
+    fail_msg("diagnosis: status %s without a message", rcb_status_str(st));
+  if (!st && check) {
+    rcb_diag_candidate c;
+    assert_int_equal(rcb_diag_candidate_get(d, 0, &c), RCB_OK);
+    assert_int_equal(rcb_diag_get_stats(d, &stats), RCB_OK);
+    print_message("diagnosis on the subset: first %s at %s, error %.3g %%, screened only %d; "
+                  "%zu refits, %zu with random starts, %zu sweeps\n",
+                  rcb_effect_name(c.effect), c.place, c.error_pct, c.screened_only,
+                  stats.refits, stats.restarts, stats.evaluations);
+    assert_true(c.refitted);
+    assert_int_equal(c.screened_only, 0);
+    assert_true(stats.restarts > 0);
   }
   rcb_diag_destroy(d);
   rcb_model_destroy(m);
@@ -458,6 +524,26 @@ static void test_diagnose(void **state) {
   walk_on_truth("diagnosis", sc_diag, NULL);
 }
 
+/* Every third site (each run of the walk re-runs the scores, 0.3-0.5 s on
+ * 301 points): at every site the first walk took 8 minutes. */
+#define RCB_SUBSET_WALK_STRIDE 3
+
+static void test_diagnose_subset(void **state) {
+  failing f = {0, 0, 0, 0, 0};
+  rcb_allocator a = hooks(&f);
+  size_t n, step = walk_stride() * RCB_SUBSET_WALK_STRIDE;
+  (void)state;
+  g_truth = truth_meas_n(301, 50.0, 2.0);
+  g_refits_from = 0;
+  assert_int_equal(sc_diag_subset(&a, 0), RCB_OK); /* where the refits start */
+  assert_true(g_refits_from > 0 && g_refits_from < f.allocs);
+  n = walk_from("diagnosis on the subset", sc_diag_subset, g_refits_from, step);
+  print_message("diagnosis on the subset: allocation sites %zu to %zu walked\n", g_refits_from,
+                n);
+  rcb_meas_destroy(g_truth);
+  g_truth = NULL;
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_load),
@@ -468,6 +554,7 @@ int main(void) {
       cmocka_unit_test(test_uff),
       cmocka_unit_test(test_fit_nlopt),
       cmocka_unit_test(test_diagnose),
+      cmocka_unit_test(test_diagnose_subset),
       cmocka_unit_test(test_fit),
   };
   return cmocka_run_group_tests(tests, rcb_test_setup_tmpdir, rcb_test_teardown_tmpdir);

@@ -123,10 +123,11 @@ typedef struct rcb_diag_candidate {
   int significant;          /**< refitted, BIC falls by > 10 and the error falls */
   const char *fitted;       /**< "name = value, ..." of the refit (candidate's params) */
   int screened_only;        /**< 1 when the refit was fitted on a frequency subset only
-                                 and evaluated on all points there, as it ended far behind
-                                 the best (32 x 1101: over 2 x its objective): error_pct,
-                                 objective_drop_pct and delta_bic are then bounds a fit on
-                                 all points would improve on */
+                                 and evaluated on all points where it ended there, as its
+                                 objective was over 10 % above the best refit's (large sets,
+                                 as 32 x 1101): delta_bic is then an upper bound and
+                                 objective_drop_pct a lower bound, which a fit on all points
+                                 would only improve; error_pct is the screened point's */
 } rcb_diag_candidate;
 
 RCB_API size_t rcb_diag_candidate_count(const rcb_diag *d);

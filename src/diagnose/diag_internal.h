@@ -56,7 +56,7 @@ typedef struct diag_cand {
   int screen_unsure, screen_floor;  /* it ended unsure; at the noise floor */
   int refitted, significant;
   int polished;                     /* refitted on all points (0: evaluated where its
-                                       screen ended: F, err, dbic upper bounds) */
+                                       screen ended: F and dbic upper bounds) */
   double F, err, dbic;
   char fitted[RCB_DIAG_MAXP * (RCB_DIAG_NAME + 32)];
   rcb_model *model;                 /* refitted model (owned, finalized) */

@@ -698,7 +698,7 @@ static rcb_status evaluate_only(rcb_diag *d, diag_cand *c, rcb_model **m, rcb_fi
 /* On the subset (32 x 1101) a refit is polished on all points only when,
  * evaluated there where its screen ended, its objective is within this
  * fraction of the lowest refit's; the others keep that evaluation, their
- * figures upper bounds (rcb_diag_candidate.screened_only). A polish lowers
+ * BIC an upper bound (rcb_diag_candidate.screened_only). A polish lowers
  * a screened objective by little: on bench_diagnose --large (kcross at B2)
  * by 0.001-1.7 % (34738.5 -> 34738.1 for the cross-coupling, the rest
  * 5.8-390 x above it), while the six polishes behind it took 71 of the 78
@@ -805,7 +805,7 @@ static rcb_status refit_screen(rcb_diag *d, diag_cand *c, const double *w) {
 static rcb_status refit_restart(rcb_diag *d, diag_cand *c, const double *w) {
   rcb_model *m = NULL;
   rcb_fit *f = NULL;
-  rcb_fit_report rep;
+  rcb_fit_report rep = {0};
   size_t n = refit_starts(d, c);
   rcb_status st;
   if (!c->screened || !c->screen_unsure || d->screen_floor || n <= RCB_DIAG_STARTS_SUBSET)
@@ -859,7 +859,7 @@ static rcb_status refit_evaluate(rcb_diag *d, diag_cand *c) {
 static rcb_status refit_polish(rcb_diag *d, diag_cand *c) {
   rcb_model *m = NULL;
   rcb_fit *f = NULL;
-  rcb_fit_report rep;
+  rcb_fit_report rep = {0};
   rcb_status st;
   if (!c->screened || !c->refitted || !(c->F <= (1.0 + RCB_DIAG_POLISH_WITHIN) * d->best_F))
     return RCB_OK;

@@ -453,6 +453,7 @@ static rcb_status multistart(rcb_fit *f, double *x, double *x_best) {
     st = f->method == RCB_FIT_NLOPT ? rcb_fit_run_nlopt(f) : rcb_fit_run_paper(f);
     it += f->iterations, ev += f->evaluations;
     f->starts_used = s + 1 - f->first_start;
+    if (st == RCB_ERR_NOMEM) break; /* not a start that failed: the run cannot go on */
     if (st) {
       if (s == f->first_start) first = st;
       continue;
@@ -469,6 +470,7 @@ static rcb_status multistart(rcb_fit *f, double *x, double *x_best) {
     if (!is_unsure(f, rcb_fit_error_pct(f))) break;
   }
   f->iterations = it, f->evaluations = ev, f->converged = conv, f->stalled = stall;
+  if (st == RCB_ERR_NOMEM) return st; /* even after a start that ended well */
   if (best == HUGE_VAL) return st ? st : first;
   return rcb_fit_set_x(f, x_best);
 }

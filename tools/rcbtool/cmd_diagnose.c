@@ -28,10 +28,10 @@ const char cli_help_diagnose[] =
     "models are refitted, and ranked by the change of BIC. A candidate is\n"
     "significant when BIC falls by more than 10 and the error itself falls.\n"
     "On large sets (where a subset of the frequencies keeps at most half of\n"
-    "them) the refits are screened on that subset and only those within 2 x of\n"
-    "the best there are polished on all points; the others are evaluated on all\n"
-    "points where their screen ended, marked \"screened\" (\"screened_only\" in\n"
-    "JSON): their error and dBIC are upper bounds.\n"
+    "them) the refits are screened on that subset and evaluated on all points\n"
+    "where their screen ended; only those within 10 % of the best objective are\n"
+    "polished on all points. The others are marked \"screened\" (\"screened_only\"\n"
+    "in JSON): their dBIC is an upper bound, their error the screened point's.\n"
     "  --noise A,S    the eq. 19 noise model (random A %, systematic S %): weights\n"
     "                 and the noise floor (strongly recommended)\n"
     "  --sd FILE      instead of --noise: weights and the noise floor from the\n"
@@ -173,7 +173,7 @@ static void print_text(FILE *fp, const diag_job *j, const rcb_diag *d, const cha
             c.description, c.predicted_pct);
     if (c.refitted)
       fprintf(fp, "%9.4g %+10.1f  %s%s\n", c.error_pct, c.delta_bic, c.fitted,
-              c.screened_only ? " (screened: error and dBIC are upper bounds)" : "");
+              c.screened_only ? " (screened: dBIC an upper bound)" : "");
     else
       fprintf(fp, "%9s %10s  %s\n", "-", "-", c.fitted[0] ? c.fitted : "(not refitted)");
   }
