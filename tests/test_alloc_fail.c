@@ -289,18 +289,28 @@ static rcb_status sc_fit(const rcb_allocator *a, int check) {
   return st;
 }
 
+/* The model (the truth's kr at 1/3) and a diagnosis of g_truth fitting kt,
+ * on log magnitudes, one refit (and the other coupling models); *m NULL
+ * when the model did not load. */
+static rcb_status diag_setup(const rcb_allocator *a, rcb_model **m, rcb_diag **d) {
+  rcb_status st = load(a, m);
+  *d = NULL;
+  if (st) return st;
+  assert_int_equal(rcb_model_set_param(*m, "coupling.C.kr", 1e3 / 3.0), RCB_OK);
+  st = rcb_diag_create(d, *m, g_truth, a);
+  if (!st) st = rcb_diag_add_fitted_param(*d, "coupling.C.kt", 1e3, 1e7, 1);
+  if (!st) st = rcb_diag_set_scale(*d, RCB_SCALE_LOG10);
+  if (!st) st = rcb_diag_set_refits(*d, 1);
+  return st;
+}
+
 /* The truth's kr is hidden at 1/3: the diagnosis fits kt, scores every
  * candidate, refits the best one (and the other coupling models). */
 static rcb_status sc_diag(const rcb_allocator *a, int check) {
   rcb_model *m = NULL;
   rcb_diag *d = NULL;
-  rcb_status st = load(a, &m);
-  if (st) return st;
-  assert_int_equal(rcb_model_set_param(m, "coupling.C.kr", 1e3 / 3.0), RCB_OK);
-  st = rcb_diag_create(&d, m, g_truth, a);
-  if (!st) st = rcb_diag_add_fitted_param(d, "coupling.C.kt", 1e3, 1e7, 1);
-  if (!st) st = rcb_diag_set_scale(d, RCB_SCALE_LOG10);
-  if (!st) st = rcb_diag_set_refits(d, 1);
+  rcb_status st = diag_setup(a, &m, &d);
+  if (!m) return st;
   if (!st) st = rcb_diag_run(d);
   if (st && d && rcb_diag_errmsg(d)[0] == '\0')
     fail_msg("diagnosis: status %s without a message", rcb_status_str(st));
@@ -344,14 +354,9 @@ static rcb_status sc_diag_subset(const rcb_allocator *a, int check) {
   rcb_diag *d = NULL;
   rcb_diag_stats stats;
   refit_mark mark = {a->user, 0, 0};
-  rcb_status st = load(a, &m);
-  if (st) return st;
-  assert_int_equal(rcb_model_set_param(m, "coupling.C.kr", 1e3 / 3.0), RCB_OK);
-  st = rcb_diag_create(&d, m, g_truth, a);
-  if (!st) st = rcb_diag_add_fitted_param(d, "coupling.C.kt", 1e3, 1e7, 1);
-  if (!st) st = rcb_diag_set_scale(d, RCB_SCALE_LOG10);
+  rcb_status st = diag_setup(a, &m, &d);
+  if (!m) return st;
   if (!st) st = rcb_diag_set_noise_model(d, 0.1, 0.01);
-  if (!st) st = rcb_diag_set_refits(d, 1);
   if (!st) st = rcb_diag_set_progress(d, mark_refits, &mark);
   if (!st) st = rcb_diag_run(d);
   if (st && d && rcb_diag_errmsg(d)[0] == '\0')
