@@ -617,6 +617,7 @@ static rcb_status polish(rcb_fit *f) {
  * fit's own "unsure" limit) explains the data: nothing is left for a place
  * search to find (place_search). */
 #define RCB_DIAG_FLOOR_FACTOR 1.5
+
 static int at_floor(double err, double floor) {
   return isfinite(floor) && err < RCB_DIAG_FLOOR_FACTOR * floor;
 }
@@ -967,8 +968,9 @@ static rcb_status restart_job(rcb_diag *d, size_t i, void *ctx) {
   return refit_restart(d, &d->cand[j->k[i]], j->w);
 }
 
-/* Whether a refit's screen ended at the noise floor: refit_restart. */
-static void screen_floor(rcb_diag *d) {
+/* Whether a refit's screen ended at the noise floor (d->screen_floor, read by
+ * refit_restart). */
+static void any_screen_at_floor(rcb_diag *d) {
   size_t k;
   d->screen_floor = 0;
   for (k = 0; k < d->ncand; k++) d->screen_floor |= d->cand[k].screened && d->cand[k].screen_floor;
@@ -1154,7 +1156,7 @@ static rcb_status refit_best(rcb_diag *d) {
   for (k = 0; k < d->ncand; k++)
     if (d->cand[k].refit_only) j.k[j.n++] = k;
   if (!st) st = rcb_diag_for_each(d, j.n, refit_job, &j, refit_done);
-  if (!st) screen_floor(d);
+  if (!st) any_screen_at_floor(d);
   if (!st) st = rcb_diag_for_each(d, j.n, restart_job, &j, NULL);
   if (!st) st = rcb_diag_for_each(d, j.n, evaluate_job, &j, NULL);
   if (!st) lowest_refit(d);
