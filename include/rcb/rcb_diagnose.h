@@ -40,7 +40,13 @@ typedef enum rcb_effect {
   RCB_EFFECT_ADDED_MASS = 9,                     /**< mass and inertia at a station */
   RCB_EFFECT_FLEXIBLE_SUPPORT = 10,              /**< a pedestal under a bearing */
   RCB_EFFECT_SPEED = 11,                         /**< operating speed (speed.factor) */
-  RCB_EFFECT_COUNT = 12
+  RCB_EFFECT_ELEMENT_STIFFNESS = 12,             /**< one shaft element's bending stiffness
+                                                      (a crack, wear, a loose fit) */
+  RCB_EFFECT_ELEMENT_MASS = 13,                  /**< one shaft element's mass and inertia */
+  RCB_EFFECT_SENSOR_GAIN = 14,                   /**< a response sensor's gain (and phase) */
+  RCB_EFFECT_SENSOR_SIGN = 15,                   /**< a response sensor's sign flipped */
+  RCB_EFFECT_SENSOR_SWAP = 16,                   /**< two probes (x, y) swapped */
+  RCB_EFFECT_COUNT = 17
 } rcb_effect;
 
 /** @brief Short English name of an effect. */

@@ -17,7 +17,10 @@ static const char *const effect_names[RCB_EFFECT_COUNT] = {
     "coupling hub mass and inertia",  "bearing stiffness (anisotropy)",
     "bearing cross-coupled stiffness", "bearing damping",
     "shaft material damping",         "added mass and inertia",
-    "flexible support",               "operating speed"};
+    "flexible support",               "operating speed",
+    "shaft element stiffness",        "shaft element mass",
+    "sensor gain and phase",          "sensor sign",
+    "swapped sensors"};
 
 const char *rcb_effect_name(rcb_effect e) {
   return (int)e >= 0 && e < RCB_EFFECT_COUNT ? effect_names[e] : "?";
