@@ -57,6 +57,37 @@ static rcb_meas *measure(const rcb_model *truth, unsigned seed) {
   return measure_grid(truth, seed, 151, 100.0, 400.0);
 }
 
+/* The one rule (issue #23): every candidate's claim is rcb_evidence_claim of
+ * its own figures; the ranking puts what may be said first; the explanation
+ * says "explains" exactly when the first candidate's claim does, and "No
+ * candidate is significant" exactly when none is. */
+static void claims_consistent(const rcb_diag *d, const char *text) {
+  size_t k, n = rcb_diag_candidate_count(d), nsig = 0;
+  double err0;
+  rcb_claim prev = RCB_CLAIM_EXPLAINS, first = RCB_CLAIM_NONE;
+  assert_int_equal(rcb_diag_baseline(d, &err0, NULL, NULL), RCB_OK);
+  for (k = 0; k < n; k++) {
+    rcb_diag_candidate c;
+    rcb_evidence e;
+    assert_int_equal(rcb_diag_candidate_get(d, k, &c), RCB_OK);
+    if (!c.refitted) {
+      assert_int_equal(c.claim, RCB_CLAIM_NONE);
+      continue;
+    }
+    e.delta_bic = c.delta_bic, e.error_before_pct = err0, e.error_after_pct = c.error_pct;
+    e.chi2 = c.chi2, e.chi2_limit = c.chi2_limit;
+    assert_int_equal(c.claim, rcb_evidence_claim(&e));
+    assert_int_equal(c.significant, rcb_evidence_significant(&e));
+    assert_int_equal(c.significant, c.claim != RCB_CLAIM_NONE);
+    assert_true(c.claim <= prev); /* ranked by claim first */
+    prev = c.claim;
+    if (k == 0) first = c.claim;
+    nsig += c.significant;
+  }
+  assert_int_equal(strstr(text, "explains") != NULL, first == RCB_CLAIM_EXPLAINS);
+  assert_int_equal(strstr(text, "No candidate is significant") != NULL, nsig == 0);
+}
+
 /* Diagnose the paper model (its coupling kt, kr, ct fitted) against data
  * from a truth with one extra effect; return the best candidate. */
 static void diagnose(rcb_model *truth, unsigned seed, rcb_diag_candidate *best,
@@ -64,7 +95,7 @@ static void diagnose(rcb_model *truth, unsigned seed, rcb_diag_candidate *best,
   rcb_model *m = rcb_test_model_from_example("paper_system.ini");
   rcb_meas *ms = measure(truth, seed);
   rcb_diag *d = NULL;
-  char text[1024];
+  char text[4096];
   size_t need;
   assert_int_equal(rcb_diag_create(&d, m, ms, NULL), RCB_OK);
   assert_int_equal(rcb_diag_set_noise_model(d, 10.0, 1.0), RCB_OK);
@@ -77,6 +108,7 @@ static void diagnose(rcb_model *truth, unsigned seed, rcb_diag_candidate *best,
   assert_int_equal(rcb_diag_baseline(d, err0, NULL, floor0), RCB_OK);
   assert_int_equal(rcb_diag_explain(d, text, sizeof text, &need), RCB_OK);
   print_message("  %s\n", text);
+  claims_consistent(d, text);
   if (getenv("RCB_DIAG_VERBOSE")) {
     size_t k;
     for (k = 0; k < rcb_diag_candidate_count(d) &&
@@ -133,6 +165,7 @@ static void hidden_in(rcb_model *truth, const char *what, rcb_effect want, const
     assert_int_equal(best.effect, want);
     assert_non_null(strstr(best.place, place));
     assert_true(best.significant);
+    assert_int_equal(best.claim, RCB_CLAIM_EXPLAINS); /* and the adequacy test agrees */
     apply_reaches_floor(d, floor0);
     rcb_diag_destroy(d);
   }
@@ -273,7 +306,7 @@ static void test_threads_identical(void **state) {
   rcb_model *a1 = NULL, *a3 = NULL;
   rcb_meas *ms;
   rcb_diag *d1, *d3;
-  char t1[1536];
+  char t1[4096];
   (void)state;
   assert_int_equal(rcb_model_set_param(truth, "coupling.C.hub_mass", 0.07), RCB_OK);
   ms = measure(truth, 1);
@@ -371,7 +404,7 @@ static void test_large_screen(void **state) {
   rcb_diag *d, *d2;
   rcb_diag_candidate first;
   rcb_diag_stats st;
-  char text[1536];
+  char text[4096];
   size_t k, checked = 0;
   double F1;
   (void)state;
@@ -427,6 +460,11 @@ static void test_null(void **state) {
                 best.description, best.delta_bic, err0, floor0);
   assert_false(best.significant);
   assert_true(err0 < 1.1 * floor0);
+  {
+    rcb_fit_adequacy a;
+    assert_int_equal(rcb_diag_adequacy(d, &a), RCB_OK);
+    assert_true(a.known && a.adequate); /* nothing is missing, and the test says so */
+  }
   rcb_diag_destroy(d);
   rcb_model_destroy(truth);
 }

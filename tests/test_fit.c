@@ -399,6 +399,121 @@ static void test_random_starts_alone(void **state) {
 }
 #endif
 
+/* The adequacy test's null distribution (issue #23) against the noise it
+ * stands for: data = the model's FRFs with eq. 19 noise (rcb_meas_add_noise,
+ * 60 seeds), the model itself evaluated (no parameter fitted): F's mean
+ * within 4 standard errors of the predicted mean, its spread within 35 % of
+ * the predicted sd (the sd of a sample sd of 60 is 9 %), and the 1 % test
+ * rejecting at most 4 of 60 (binomial p = 0.01: P(X >= 5) = 3e-3). On the
+ * log10 and the complex scales, whose squares are far from chi-square (uniform
+ * r1: the variance of a square is 0.8, not 2). */
+static void adequacy_null(rcb_fit_scale scale) {
+  rcb_model *m = rcb_test_model_from_example("paper_system.ini");
+  const char *outs[] = {"DA.x", "C.A.y", "C.B.x", "DB.y"}, *ins[] = {"DA.x"};
+  double sum = 0.0, sum2 = 0.0, expected = 0.0, sd = 0.0;
+  size_t seed, rejected = 0, nseed = 60;
+  for (seed = 1; seed <= nseed; seed++) {
+    rcb_meas *ms = rcb_test_frf_meas(m, outs, 4, ins, 1, 100, 400, 151, 10000, RCB_INERTANCE);
+    rcb_fit *f = NULL;
+    rcb_fit_adequacy a;
+    assert_int_equal(rcb_meas_add_noise(ms, 10.0, 1.0, 1000u + seed), RCB_OK);
+    assert_int_equal(rcb_fit_create(&f, m, ms, NULL), RCB_OK);
+    assert_int_equal(rcb_fit_set_scale(f, scale), RCB_OK);
+    assert_int_equal(rcb_fit_set_noise_model(f, 10.0, 1.0), RCB_OK);
+    assert_int_equal(rcb_fit_get_adequacy(f, &a, NULL, NULL, NULL), RCB_OK);
+    assert_int_equal(a.known, 1);
+    sum += a.chi2, sum2 += a.chi2 * a.chi2;
+    expected = a.expected, sd = a.sd; /* the same model: the same figures each seed */
+    rejected += !a.adequate;
+    rcb_fit_destroy(f);
+    rcb_meas_destroy(ms);
+  }
+  {
+    double mean = sum / (double)nseed;
+    double s = sqrt((sum2 - (double)nseed * mean * mean) / (double)(nseed - 1));
+    print_message("adequacy null (scale %d): F mean %.2f (predicted %.2f), sd %.2f (predicted "
+                  "%.2f), %zu of %zu rejected\n", (int)scale, mean, expected, s, sd, rejected,
+                  nseed);
+    assert_true(fabs(mean - expected) < 4.0 * sd / sqrt((double)nseed));
+    assert_true(s > 0.65 * sd && s < 1.35 * sd);
+    assert_true(rejected <= 4);
+  }
+  rcb_model_destroy(m);
+}
+
+static void test_adequacy_null_log10(void **state) {
+  (void)state;
+  adequacy_null(RCB_SCALE_LOG10);
+}
+
+static void test_adequacy_null_complex(void **state) {
+  (void)state;
+  adequacy_null(RCB_SCALE_COMPLEX);
+}
+
+/* Known standard deviations: each weighted residual N(0, 1), so F is a
+ * chi-square of N - np degrees of freedom (mean N - np, sd sqrt(2 (N - np)))
+ * exactly as stated; Gaussian noise of that sd added here (Box-Muller on a
+ * fixed LCG), and a model that lacks the coupling damping fails the test
+ * while the truth passes it. */
+static void test_adequacy_known_sd(void **state) {
+  rcb_model *m = rcb_test_model_from_example("paper_system.ini");
+  rcb_model *lacking = rcb_test_model_from_example("paper_system.ini");
+  const char *outs[] = {"C.A.x", "C.B.y"}, *ins[] = {"DA.x"};
+  rcb_meas *clean = rcb_test_frf_meas(m, outs, 2, ins, 1, 100, 400, 151, 10000, RCB_INERTANCE);
+  rcb_meas *ms = NULL;
+  size_t n = 2 * 151, i, c;
+  double *sd = malloc(n * sizeof *sd);
+  rcb_complex y[151];
+  unsigned long long x = 12345u;
+  rcb_fit *f = NULL;
+  rcb_fit_adequacy a;
+  (void)state;
+  assert_non_null(sd);
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, 151, rcb_meas_grid(clean),
+                                     rcb_meas_speed(clean)),
+                   RCB_OK);
+  for (c = 0; c < 2; c++) {
+    rcb_meas_channel_info ci;
+    rcb_meas_channel(clean, c, &ci);
+    for (i = 0; i < 151; i++) {
+      double u1, u2, r;
+      x = x * 6364136223846793005ull + 1442695040888963407ull;
+      u1 = ((double)(x >> 11) + 0.5) * 0x1.0p-53;
+      x = x * 6364136223846793005ull + 1442695040888963407ull;
+      u2 = (double)(x >> 11) * 0x1.0p-53;
+      r = sqrt(-2 * log(u1));
+      sd[c * 151 + i] = 0.03 * cabs(ci.data[i]);
+      y[i] = ci.data[i] + sd[c * 151 + i] * r * CMPLX(cos(2 * RCB_PI * u2), sin(2 * RCB_PI * u2));
+    }
+    assert_int_equal(rcb_meas_add_channel(ms, ci.response, ci.reference, ci.kind, y), RCB_OK);
+  }
+  assert_int_equal(rcb_fit_create(&f, m, ms, NULL), RCB_OK);
+  assert_int_equal(rcb_fit_set_scale(f, RCB_SCALE_COMPLEX), RCB_OK);
+  assert_int_equal(rcb_fit_set_sd(f, sd), RCB_OK);
+  assert_int_equal(rcb_fit_get_adequacy(f, &a, NULL, NULL, NULL), RCB_OK);
+  assert_true(a.known);
+  assert_true(fabs(a.expected - 2.0 * (double)n) < 1e-9);
+  assert_true(fabs(a.sd - sqrt(4.0 * (double)n)) < 1e-9);
+  print_message("known sd: F %.1f, limit %.1f\n", a.chi2, a.limit);
+  assert_true(a.adequate); /* the truth: F a chi-square of 604, the 1 % limit */
+  rcb_fit_destroy(f);
+  assert_int_equal(rcb_model_set_param(lacking, "coupling.C.ct", 0.0), RCB_OK);
+  assert_int_equal(rcb_fit_create(&f, lacking, ms, NULL), RCB_OK);
+  assert_int_equal(rcb_fit_set_scale(f, RCB_SCALE_COMPLEX), RCB_OK);
+  assert_int_equal(rcb_fit_set_sd(f, sd), RCB_OK);
+  assert_int_equal(rcb_fit_get_adequacy(f, &a, NULL, NULL, NULL), RCB_OK);
+  print_message("known sd, no coupling damping: F %.1f, limit %.1f\n", a.chi2, a.limit);
+  assert_false(a.adequate);
+  rcb_fit_destroy(f);
+  rcb_model_destroy(lacking);
+  rcb_meas_destroy(ms);
+  rcb_meas_destroy(clean);
+  rcb_model_destroy(m);
+  free(sd);
+}
+
 static void test_bad_settings(void **state) {
   rcb_model *m = rcb_test_model_from_example("paper_system.ini");
   const char *outs[] = {"C.A.x"}, *ins[] = {"DA.x"};
@@ -439,6 +554,9 @@ int main(void) {
       cmocka_unit_test(test_multistart_local_minimum),
       cmocka_unit_test(test_random_starts_alone),
 #endif
+      cmocka_unit_test(test_adequacy_null_log10),
+      cmocka_unit_test(test_adequacy_null_complex),
+      cmocka_unit_test(test_adequacy_known_sd),
       cmocka_unit_test(test_bad_settings),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -20,9 +20,11 @@
 #define RCB_ADEQ_DRAWS 16
 #define RCB_ADEQ_SEED UINT64_C(0x23ADE9)
 
-/* Mean and variance of the square of one standardized residual j (and of
- * its Im part j + 1 when the point has two: both drawn from the same noisy
- * value). a: the channel's additive amplitude. Returns the parts used. */
+/* Mean of the square of one standardized residual j (and of its Im part
+ * j + 1 when the point has two: both drawn from the same noisy value), and
+ * the variance of the point's sum of squares (its parts are correlated: the
+ * weight of both comes from the one noisy value). a: the channel's additive
+ * amplitude. Returns the parts used. */
 static size_t draw_point(const rcb_fit *f, size_t j, double a, rcb_rng *rng, double *mean,
                          double *var) {
   size_t parts = (j + 1 < f->nres && f->res_part[j + 1] == 1 && f->res_pt[j + 1] == f->res_pt[j] &&
@@ -31,21 +33,20 @@ static size_t draw_point(const rcb_fit *f, size_t j, double a, rcb_rng *rng, dou
                      : 1;
   double complex h = f->Hmod[f->res_ch[j] * f->npts + f->res_pt[j]];
   double wu = f->wuser ? f->wuser[f->res_ch[j] * f->npts + f->res_pt[j]] : 1.0;
-  double s1[2] = {0, 0}, s2[2] = {0, 0};
+  double s1[2] = {0, 0}, t1 = 0.0, t2 = 0.0;
   size_t k, p;
   for (k = 0; k < RCB_ADEQ_DRAWS; k++) {
     double complex e = rcb_noise_draw(rng, h, f->beta_a, a);
+    double t = 0.0;
     for (p = 0; p < parts; p++) {
       double z = rcb_fit_on_scale(f, e, (int)p) - rcb_fit_on_scale(f, h, (int)p);
       double q = wu * z * z / rcb_fit_noise_var(f, e, a, (int)p);
-      s1[p] += q, s2[p] += q * q;
+      s1[p] += q, t += q;
     }
+    t1 += t, t2 += t * t;
   }
-  for (p = 0; p < parts; p++) {
-    double m = s1[p] / RCB_ADEQ_DRAWS;
-    mean[p] = m;
-    var[p] = (s2[p] - RCB_ADEQ_DRAWS * m * m) / (RCB_ADEQ_DRAWS - 1);
-  }
+  for (p = 0; p < parts; p++) mean[p] = s1[p] / RCB_ADEQ_DRAWS;
+  *var = (t2 - t1 * t1 / RCB_ADEQ_DRAWS) / (RCB_ADEQ_DRAWS - 1);
   return parts;
 }
 
@@ -75,16 +76,17 @@ rcb_status rcb_fit_get_adequacy(rcb_fit *f, rcb_fit_adequacy *out, double *chi2_
   out->known = rcb_fit_chi2(f);
   rcb_rng_seed(&rng, RCB_ADEQ_SEED);
   for (j = 0; j < f->nres;) {
-    double m[2] = {1.0, 1.0}, v[2] = {2.0, 2.0};
+    double m[2] = {1.0, 1.0}, v = 2.0; /* N(0, 1): a square's mean 1, variance 2 */
     size_t parts = 1, p;
     c = f->res_ch[j];
-    if (out->known && !f->sd) parts = draw_point(f, j, level[c], &rng, m, v);
+    if (out->known && !f->sd) parts = draw_point(f, j, level[c], &rng, m, &v);
+    var += v;
+    if (sd_ch) sd_ch[c] += v;
     for (p = 0; p < parts; p++, j++) {
       F += r[j] * r[j];
-      mean += m[p], var += v[p];
+      mean += m[p];
       if (chi2_ch) chi2_ch[c] += r[j] * r[j];
       if (expected_ch) expected_ch[c] += m[p];
-      if (sd_ch) sd_ch[c] += v[p];
     }
   }
   out->chi2 = F;

@@ -976,13 +976,18 @@ diagnose_progress_and_warnings)
   run fit "$M2" "$W/meas.csv" --params coupling.C.kt --history "$W/h.jsonl"; expect_rc 0
   run diagnose "$M2" "$W/meas.csv" --params coupling.C.kt,coupling.C.kr --log --noise 10,1 \
     --progress --apply 1 -o "$W/m2.ini" --history "$W/h.jsonl"
-  expect_rc 0
+  expect_rc 3; [ ! -e "$W/m2.ini" ] || fail "a refused --apply wrote the model"
+  err_has "is not significant"; err_has "add --force"
   grep -o '[0-9]*/[0-9]* steps' "$W/err" | cut -d/ -f1 >"$W/counts"
   [ "$(wc -l <"$W/counts")" -ge 2 ] || fail "no progress lines"
   sort -n -c "$W/counts" 2>/dev/null && [ -z "$(uniq -d "$W/counts")" ] ||
     fail "progress counts not rising: $(tr '\n' ' ' <"$W/counts")"
   out_has "predicted by the --noise model"
-  grep -q '"significant": true' "$W/out" && fail "null case: a candidate came out significant"
+  out_has "none is needed"; out_has "within the 1 % limit"
+  grep -q '^1 *explains\|^1 *improves' "$W/out" && fail "null case: a candidate came out significant"
+  run diagnose "$M2" "$W/meas.csv" --params coupling.C.kt,coupling.C.kr --log --noise 10,1 \
+    --apply 1 --force -o "$W/m2.ini" --history "$W/h.jsonl"
+  expect_rc 0; [ -s "$W/m2.ini" ] || fail "--force wrote no model"
   err_has "is not significant"
   run history "$W/h.jsonl"; expect_rc 0; out_has "the_model_file.ini"; out_has "predicted" ;;
 diagnose_progress_tty)
@@ -1157,7 +1162,13 @@ d = json.load(open(sys.argv[1]))
 c = d["candidates"][0]
 assert c["place"] == "bearing B2" and "cross-coupled" in c["effect"], c
 assert c["significant"] and c["error_pct"] < 1.1 * d["floor_pct"], c
-assert "bearing B2" in d["explanation"]
+assert c["claim"] == "explains" and c["adequate"] is True and c["chi2"] <= c["chi2_limit"], c
+assert d["adequacy"]["known"] and not d["adequacy"]["adequate"], d["adequacy"]
+assert d["adequacy"]["chi2"] > d["adequacy"]["limit"], d["adequacy"]
+assert "bearing B2" in d["explanation"] and "explains" in d["explanation"]
+assert {s["response"] for s in d["misfit"]["sensors"]} == {
+    "DA.x", "DA.y", "C.A.x", "C.A.y", "C.B.x", "C.B.y", "DB.x", "DB.y"}
+assert not any(s["concentrated"] for s in d["misfit"]["sensors"]), d["misfit"]
 PY
   cmp -s "$MODEL" "$W/model.ini" || fail "the input model was modified"
   run check "$W/model2.ini"; expect_rc 0

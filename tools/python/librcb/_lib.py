@@ -90,7 +90,24 @@ class DiagCandidate(ctypes.Structure):
                 ("params", c_char_p), ("predicted_pct", c_double), ("refitted", c_int),
                 ("error_pct", c_double), ("objective_drop_pct", c_double),
                 ("delta_bic", c_double), ("significant", c_int), ("fitted", c_char_p),
-                ("screened_only", c_int)]
+                ("claim", c_int), ("adequate", c_int), ("chi2", c_double),
+                ("chi2_limit", c_double), ("chain", c_int), ("screened_only", c_int)]
+
+
+class FitAdequacy(ctypes.Structure):
+    _fields_ = [("known", c_int), ("chi2", c_double), ("dof", c_double),
+                ("expected", c_double), ("sd", c_double), ("limit", c_double),
+                ("adequate", c_int)]
+
+
+class DiagMisfit(ctypes.Structure):
+    _fields_ = [("sensor", c_char_p), ("chi2", c_double), ("expected", c_double),
+                ("sd", c_double), ("excess_pct", c_double), ("concentrated", c_int)]
+
+
+class Evidence(ctypes.Structure):
+    _fields_ = [("delta_bic", c_double), ("error_before_pct", c_double),
+                ("error_after_pct", c_double), ("chi2", c_double), ("chi2_limit", c_double)]
 
 
 class CompareChannel(ctypes.Structure):
@@ -254,6 +271,13 @@ _PROTOTYPES = {
     "rcb_diag_baseline": (c_int, [c_void_p, c_double_p, c_double_p, c_double_p]),
     "rcb_diag_apply_model": (c_int, [c_void_p, c_size_t, c_void_p, PP]),
     "rcb_diag_explain": (c_int, [c_void_p, c_char_p, c_size_t, c_size_t_p]),
+    "rcb_diag_adequacy": (c_int, [c_void_p, ctypes.POINTER(FitAdequacy)]),
+    "rcb_diag_misfit_count": (c_size_t, [c_void_p]),
+    "rcb_diag_misfit_get": (c_int, [c_void_p, c_size_t, ctypes.POINTER(DiagMisfit)]),
+    "rcb_evidence_claim": (c_int, [ctypes.POINTER(Evidence)]),
+    "rcb_evidence_significant": (c_int, [ctypes.POINTER(Evidence)]),
+    "rcb_evidence_adequate": (c_int, [ctypes.POINTER(Evidence)]),
+    "rcb_claim_str": (c_char_p, [c_int]),
     # comparison
     "rcb_compare_create": (c_int, [PP, c_void_p]),
     "rcb_compare_destroy": (None, [c_void_p]),

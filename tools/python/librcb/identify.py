@@ -139,6 +139,7 @@ class Diagnosis(Handle):
         self.model, self.meas = model, meas
         self._create("rcb_diag_create", model.handle, meas.handle, None)
         self.candidates, self.baseline, self.explanation = [], {}, ""
+        self.adequacy, self.misfit = {}, []
 
     def _collect(self):
         L = _lib.lib()
@@ -156,14 +157,31 @@ class Diagnosis(Handle):
                 "refitted": bool(c.refitted), "error_pct": c.error_pct,
                 "objective_drop_pct": c.objective_drop_pct, "delta_bic": c.delta_bic,
                 "significant": bool(c.significant), "fitted": _lib.text(c.fitted),
+                "claim": _lib.text(L.rcb_claim_str(c.claim)),
+                "adequate": None if c.adequate < 0 else bool(c.adequate),
+                "chi2": c.chi2, "chi2_limit": c.chi2_limit, "chain": bool(c.chain),
                 "screened_only": bool(c.screened_only)})
+        a = _lib.FitAdequacy()
+        self.check(L.rcb_diag_adequacy(self.handle, ctypes.byref(a)), "rcb_diag_adequacy")
+        self.adequacy = {"known": bool(a.known), "chi2": a.chi2, "dof": a.dof,
+                         "expected": a.expected if a.known else float("nan"),
+                         "sd": a.sd if a.known else float("nan"), "limit": a.limit,
+                         "adequate": bool(a.adequate) if a.known else None}
+        m = _lib.DiagMisfit()
+        self.misfit = []
+        for k in range(L.rcb_diag_misfit_count(self.handle)):
+            self.check(L.rcb_diag_misfit_get(self.handle, k, ctypes.byref(m)))
+            self.misfit.append({"response": _lib.text(m.sensor), "chi2": m.chi2,
+                                "expected": m.expected, "excess_pct": m.excess_pct,
+                                "concentrated": bool(m.concentrated)})
         st, self.explanation = _lib.two_call_string(L.rcb_diag_explain, self.handle)
         self.check(st, "rcb_diag_explain")
 
     @property
     def best(self):
-        """The best significant candidate, or None."""
-        return next((c for c in self.candidates if c["significant"]), None)
+        """The best significant candidate (claim "explains" or "improves", the
+        library's one rule), or None."""
+        return next((c for c in self.candidates if c["claim"] != "none"), None)
 
     def apply(self, rank=0):
         """The model with candidate rank added and fitted (a new Model)."""
@@ -235,3 +253,15 @@ def compare(model, meas):
     x = grid / (2 * math.pi if meas.type == "frf" else RPM)
     return {"x": x, "summary": {k: getattr(s, k) for k, _ in _lib.CompareSummary._fields_},
             "channels": chans}
+
+
+def claim(delta_bic, error_before_pct, error_after_pct, chi2=float("nan"),
+          chi2_limit=float("nan")):
+    """What the evidence lets one say of an edit of a model: "explains",
+    "improves" or "none". The library's one rule (rcb_evidence_claim), called,
+    not restated: significant when BIC falls by more than 10 and the error by
+    2 % of itself; "explains" only when also adequate (chi2 <= chi2_limit)."""
+    L = _lib.lib()
+    e = _lib.Evidence(float(delta_bic), float(error_before_pct), float(error_after_pct),
+                      float(chi2), float(chi2_limit))
+    return _lib.text(L.rcb_claim_str(L.rcb_evidence_claim(ctypes.byref(e))))
