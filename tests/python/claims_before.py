@@ -32,9 +32,8 @@ import diag_cases as dc  # noqa: E402
 def on_grid(case, grid):
     if grid == case.grid:
         return case
-    after = dc.probe_edit("DB.y", dc.PROBE_GAIN, grid) if case.kind == "probe" else None
     return dc.ClaimCase(case.name, case.what, case.expect, case.kind, case.model_edit, grid=grid,
-                        after_noise=after)
+                        after_noise=case.after_noise)
 
 
 def run(tool, case, workdir, starts):
@@ -50,12 +49,9 @@ def run(tool, case, workdir, starts):
     params = dc.FIT_PARAMS
     for r in range(rounds):
         n0 = len(tool.times)
-        step = dc.claim_round(tool, workdir, meas, model, params, tag=f"r{r + 1}")
+        step = dc.claim_round(tool, workdir, meas, model, params, tag=f"r{r + 1}", starts=starts)
         d, c0 = step["diag"], step["diag"]["candidates"][0]
-        fit = None
-        if step["applied"] is not None:  # again, with the starts asked for
-            fit = tool.json("fit", step["applied"], meas, "--params", step["params"], "--noise",
-                            "10,1", "--starts", starts)
+        fit = step["fit"]
         fit_times = [t for t in tool.times[n0:] if t[0] == "fit"]
         out["rounds"].append({
             "first": {k: c0[k] for k in ("effect", "place", "fitted", "error_pct", "delta_bic",
