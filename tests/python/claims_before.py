@@ -8,7 +8,9 @@ both (the grid choice).
 
 Per case and grid: the first candidate, its words (the `explanation` JSON
 field), E0, the error after `diagnose --apply 1` + `rcbtool fit` of the
-applied model (fit with --starts N, default 8 as the CLI), the floor, the CPU
+applied model (fit with --starts N, default 1: it starts at the
+candidate's refit; 8 starts, the CLI's default, took over 600 s of wall on
+the shared machine for the large hub), the floor, the CPU
 and wall seconds of diagnose and of fit (user + sys of the child, as
 /usr/bin/time); two rounds for claim_two; on claim_probe_DBy the per-channel
 error % of `rcbtool compare` of the model as it is. One JSON file per run in
@@ -99,7 +101,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--cases", default=",".join(c.name for c in dc.CLAIM_CASES))
     ap.add_argument("--grids", default="")
-    ap.add_argument("--starts", type=int, default=8)
+    ap.add_argument("--starts", type=int, default=1)
     ap.add_argument("--out", default="out/claims_before")
     ap.add_argument("--table-only", action="store_true")
     a = ap.parse_args()

@@ -206,11 +206,15 @@ def test_large_hub(tool, claims, tmp_path):
 
 def test_bad_probe(tool, claims, tmp_path):
     """The channel named (a sensor's gain and phase at DB.y first, or the
-    misfit concentrated on DB.y), and no edit of the model claims to explain."""
+    misfit concentrated on DB.y), no edit of the model claims to explain, and
+    the model as it is is not called adequate. On the small grid the error
+    of the model as it is, 5.39 %, is under the floor (5.77 %): only a test
+    against the noise model can see the probe (one channel in eight 20 % low
+    where the random noise is +-10 %)."""
     case = CASES["claim_probe_DBy"]
     (s,) = _rounds(tool, tmp_path, case)
     d = s["diag"]
-    assert d["error0_pct"] > dc.AT_FLOOR * d["floor_pct"], d  # the probe is visible
+    assert not d["adequacy"]["adequate"], d["adequacy"]
     c0 = d["candidates"][0]
     sensors = d.get("misfit", {}).get("sensors", [])
     assert _is(c0, dc.SENSOR, "DB.y") or (sensors and sensors[0]["response"] == "DB.y"), \
