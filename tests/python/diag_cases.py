@@ -686,7 +686,7 @@ CLAIM_CASES = [
               [(ELEMENT, "shaft B")], "crack", model_edit=CRACK_B),
     ClaimCase("claim_hub25_C", "coupling C hubs 0.25 kg, Id 4.95e-5, Ip 5.90e-5 kg m^2 per side "
               "(steel ring 40/17 mm x 31 mm)", [(HUB, "coupling C")], "hub",
-              model_edit=hub_ring_edit(*HUB25)),
+              model_edit=hub_ring_edit(*HUB25), grid="small"),
     ClaimCase("claim_probe_DBy", "the model as it is; probe DB.y reads 0.8 exp(-i 4 deg)",
               [(SENSOR, "DB.y")], "probe", after_noise=probe_edit("DB.y", PROBE_GAIN),
               grid="small"),

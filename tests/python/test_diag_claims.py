@@ -130,22 +130,32 @@ def _explains(d):
     return [c for c in d["candidates"] if c["claim"] == "explains"]
 
 
-_Z = re.compile(r"z\s*=\s*([0-9.]+)(?:\s*(?:-|to|\.\.)\s*([0-9.]+))?")
+_POS = re.compile(r"(\d+\.\d+)(?:\s*(?:-|to|\.\.)\s*(\d+\.\d+))?\s*m\b")
+_NODE = re.compile(r"#(\d+)")
+SPAN_NODES = (14, 17)  # B3 is node #14, DB node #17 (shaft A holds #0-#10)
 
 
 def _in_span(text, span=dc.CRACK_SPAN):
-    """TEXT names shaft B and a place (z = a m, or a span z = a-b m) inside
-    B3-DB (0.67-0.82 m), or names B3 and DB."""
+    """TEXT names shaft B and, between B3 and DB (0.67-0.82 m), a span in m
+    ("0.72-0.77 m", within the ends) or a position ("z = 0.72 m", strictly
+    inside: a point at B3 itself is not the span), or nodes (#15-#16 within
+    #14-#17, one node strictly inside); or names B3 and DB."""
     shaft, lo, hi = span
     if f"shaft {shaft}" not in text:
         return False
     if "B3" in text and "DB" in text:
         return True
-    for a, b in _Z.findall(text):
-        zs = [float(a)] + ([float(b)] if b else [])
-        if all(lo - 1e-6 <= z <= hi + 1e-6 for z in zs):
+    eps = 1e-6
+    for a, b in _POS.findall(text):
+        if b and lo - eps <= float(a) <= hi + eps and lo - eps <= float(b) <= hi + eps:
             return True
-    return False
+        if not b and lo + eps < float(a) < hi - eps:
+            return True
+    nodes = [int(n) for n in _NODE.findall(text)]
+    a, b = SPAN_NODES
+    if len(nodes) == 1:
+        return a < nodes[0] < b
+    return len(nodes) > 1 and all(a <= n <= b for n in nodes)
 
 
 def _is(c, effect, place):
