@@ -95,9 +95,10 @@ def _rounds(tool, tmp_path, case, rounds=1):
         s["meas"] = meas
         d = s["diag"]
         c0 = d["candidates"][0] if d["candidates"] else {}
+        e1 = c0.get("error_pct")
         print(f"\n{case.name} round {r + 1} ({case.grid}): {c0.get('effect')} at "
               f"{c0.get('place')} [{c0.get('claim')}] error {d['error0_pct']:.2f} -> "
-              f"{c0.get('error_pct', math.nan):.2f} % (floor {d['floor_pct']:.2f}); "
+              f"{math.nan if e1 is None else e1:.2f} % (floor {d['floor_pct']:.2f}); "
               f"adequacy {d.get('adequacy')}; diagnose {s['cpu_s']:.1f} s CPU\n"
               f"  {d['explanation']}")
         _rule(tool, case, s)
