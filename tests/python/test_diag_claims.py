@@ -188,6 +188,25 @@ def test_hub25_moves_the_modes():
     assert (m, round(idd, 8), round(ip, 8)) == (0.25, 4.954e-5, 5.903e-5)
 
 
+def test_truth_edits():
+    """The crack is one ROSS element and nothing else (factor 1 gives the
+    model's inertances bit for bit; 0.6 changes them), and the probe edit
+    touches the DB.y rows only, on either grid."""
+    base = dc.ross_inertance(dc.BASE_INI, check=False)
+    same = dc.ross_inertance(dc.BASE_INI, dc._element_stiffness_edit("B", 4, 1.0), check=False)
+    assert np.array_equal(same, base)
+    crack = dc.ross_inertance(dc.BASE_INI, dc.CRACK_B)  # checked against transfer_matrix
+    assert np.linalg.norm(crack - base) > 0.1 * np.linalg.norm(base)
+    edit = dc.probe_edit("DB.y", dc.PROBE_GAIN)
+    for nin in (1, len(dc.LARGE_INS)):
+        data = np.ones((nin * len(dc.OUTS), 3), dtype=complex)
+        got = edit(data)
+        rows = [q * len(dc.OUTS) + dc.OUTS.index("DB.y") for q in range(nin)]
+        assert np.all(got[rows] == dc.PROBE_GAIN)
+        assert np.all(np.delete(got, rows, axis=0) == 1.0)
+        assert np.all(data == 1.0)  # a copy
+
+
 def test_crack_in_shaft_B(tool, claims, tmp_path):
     """Named as an element stiffness of shaft B between B3 and DB, or honestly
     not explained, with the span named."""
