@@ -203,6 +203,8 @@ def noisy(case, H, seed):
     out = add_noise(H, *NOISE, seed)
     if case.grid == "large":
         out = add_phase_noise(out, PHASE_DEG, seed)
+    if getattr(case, "after_noise", None):  # the measurement chain (a sensor reads last)
+        out = case.after_noise(out)
     return out
 
 
@@ -228,6 +230,8 @@ def ross_inertance(text, model_edit=None, check=True, freq=None, ins=(IN,)):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         rmod = rm.RossModel(model, speed=speed)
+        for rotor_edit in getattr(model, "rotor_edits", ()):  # edits of the ROSS rotor itself
+            rotor_edit(rmod)
         rot = rmod.rotor
         M, C, K, G = rot.M(frequency=speed), rot.C(frequency=speed), rot.K(frequency=speed), rot.G()
     jin = [rmod.station_dof(i) for i in ins]
@@ -563,3 +567,199 @@ def found(step, want):
 
 def at_floor(step):
     return step["error_pct"] < AT_FLOOR * step["floor_pct"]
+
+
+# --------------------------------------------------------------------------
+# Issue #23: what the diagnosis may claim (test_diag_claims.py)
+# --------------------------------------------------------------------------
+#
+# Truth by ROSS again. Two effects the catalogue of issue #4 did not hold (one
+# element of shaft B with a lower E and G: a crack, a weld, a local loss of
+# section; a probe reading low and late) and a hub far heavier than the
+# model's, where the diagnosis of the issue named an effect that is not there
+# and called it an explanation.
+
+ELEMENT = "shaft element stiffness"
+SENSOR = "sensor gain and phase"
+
+
+def _element_stiffness_edit(shaft, k, factor):
+    """model_edit: element k (0-based, along the shaft) of shaft SHAFT with E
+    and G x factor in ROSS: the rotor is rebuilt with that ShaftElement given
+    its own Material (density and Poisson's ratio kept, so G = E/2(1 + nu)
+    scales with E and the shear factor phi, which holds E/G, is unchanged).
+    Local to this file: ross_models.py is getting an element_stiffness_edit
+    of its own on another branch."""
+
+    def rotor_edit(rmod):
+        import ross as rs
+
+        sh = rmod.model._shaft[shaft]
+        n = rmod.node_of[(shaft, k)]
+        rot = rmod.rotor
+        els = list(rot.shaft_elements)
+        (i,) = [j for j, e in enumerate(els) if e.n == n and type(e) is rs.ShaftElement]
+        old = els[i]
+        rho, E, nu = rmod.model.materials[sh.material]
+        mat = rs.Material(name=f"rcb_{shaft}_el{k}_x{factor:g}".replace(".", "p"), rho=rho,
+                          E=factor * E, Poisson=nu)
+        L, od, idd = sh.elements[k]
+        el = rs.ShaftElement(L=L, idl=idd, odl=od, material=mat, n=n,
+                             shear_effects=sh.kappa > 0, rotary_inertia=True, gyroscopic=True,
+                             alpha=sh.alpha, beta=sh.beta)
+        if sh.kappa > 0:  # as the bridge does: the INI's shear factor
+            el.kappa = sh.kappa
+            el.phi = 12 * mat.E * el.Ie / (mat.G_s * sh.kappa * el.A * el.L**2)
+        assert abs(el.phi - old.phi) <= 1e-12 * abs(old.phi)
+        els[i] = el
+        rmod.rotor = rs.Rotor(els, rot.disk_elements, rot.bearing_elements,
+                              rot.point_mass_elements, tag=rot.tag)
+
+    def edit(model):
+        if not hasattr(model, "rotor_edits"):
+            model.rotor_edits = []
+        model.rotor_edits.append(rotor_edit)
+
+    return edit
+
+
+# The large hub: a steel ring (7850 kg/m^3) 40 mm outside, 17 mm inside, 31 mm
+# long per side: rm.annulus gives 0.2506 kg, Id = m (3 (ro^2 + ri^2) + L^2)/12
+# = 4.96e-5 kg m^2, Ip = m (ro^2 + ri^2)/2 = 5.92e-5 kg m^2. The model's hubs
+# (2758 kg/m^3, 34/12 mm, 21.6 mm) are 0.0473 kg, Id 5.67e-6, Ip 7.68e-6.
+# The truth is 0.25 kg with the ring's Id and Ip scaled to 0.25 kg: Id =
+# 4.954e-5, Ip = 5.903e-5 kg m^2 (HUB25). ROSS's modes at 3000 rpm
+# (test_diag_claims.py::test_hub25_moves_the_modes): the pairs at 150.3/161.6 Hz
+# move to 120.3/133.4 Hz (the issue says 158/168 -> 120/133 Hz; ROSS and rcbtool
+# modes agree on 150/162 Hz for the model).
+def _ring(mass, od=0.040, idd=0.017, length=0.031, rho=7850.0):
+    m, idd_, ip = rm.annulus(rho, od, idd, length)
+    return mass, idd_ * mass / m, ip * mass / m
+
+
+HUB25 = _ring(0.25)  # (kg, kg m^2, kg m^2) per hub side
+
+
+def hub_ring_edit(mass, idd, ip):
+    """model_edit: coupling C's hubs with this mass (kg), Id and Ip (kg m^2) per side."""
+    return coupling_keys(drop=HUB_GEOMETRY, hub_mass=mass, hub_id=idd, hub_ip=ip)
+
+
+PROBE_GAIN = 0.8 * np.exp(-1j * math.radians(4.0))  # reads 20 % low, 4 degrees late
+
+
+def probe_edit(response, gain):
+    """after_noise: every channel whose response is RESPONSE (each input's
+    block of OUTS, on either grid) multiplied by gain: the sensor reads what
+    the structure did, noise and all."""
+
+    def edit(data):
+        data = np.array(data, dtype=complex)
+        rows = [q * len(OUTS) + OUTS.index(response) for q in range(data.shape[0] // len(OUTS))]
+        data[rows] *= gain
+        return data
+
+    return edit
+
+
+class ClaimCase(Case):
+    """A case of issue #23. kind: what the test asserts (crack, hub, probe, two,
+    weak, null); after_noise: the measurement chain's edit of the noisy data."""
+
+    def __init__(self, name, what, expect, kind, model_edit=None, grid="large",
+                 after_noise=None):
+        super().__init__(name, what, expect, "ross", model_edit=model_edit, grid=grid)
+        self.kind = kind
+        self.after_noise = after_noise
+
+
+CRACK_B = _element_stiffness_edit("B", 4, 0.6)  # B 0.72-0.77 m (nodes #15-#16): B3 0.67, DB 0.82
+CRACK_SPAN = ("B", 0.67, 0.82)  # shaft, z from, z to (m): between B3 and DB
+# Near the detection limit, on the small grid: kcross 1e6 N/m at B3 gives dBIC
+# -18.8, 1.5e6 -48.2 (both not significant: the error falls under 2 %), 2e6
+# -97.6 (significant), 4e6 -626 (seed 1). On the large grid the same dBIC
+# needs 2.5e5 N/m (-53.2); there 3e6 N/m gives dBIC -11880, fitted 2.998e6,
+# and is still not significant (E0 5.63 % is under the floor, 5.77 %).
+WEAK_KCROSS = 1.5e6  # N/m
+
+CLAIM_CASES = [
+    ClaimCase("claim_crack_B", "shaft B element B 0.72-0.77 m (between B3 and DB): E, G x 0.6",
+              [(ELEMENT, "shaft B")], "crack", model_edit=CRACK_B),
+    ClaimCase("claim_hub25_C", "coupling C hubs 0.25 kg, Id 4.95e-5, Ip 5.90e-5 kg m^2 per side "
+              "(steel ring 40/17 mm x 31 mm)", [(HUB, "coupling C")], "hub",
+              model_edit=hub_ring_edit(*HUB25), grid="small"),
+    ClaimCase("claim_probe_DBy", "the model as it is; probe DB.y reads 0.8 exp(-i 4 deg)",
+              [(SENSOR, "DB.y")], "probe", after_noise=probe_edit("DB.y", PROBE_GAIN),
+              grid="small"),
+    ClaimCase("claim_two", "the crack of claim_crack_B and kxy = -kyx = 2e7 N/m at B2",
+              [(ELEMENT, "shaft B"), (CROSS, "bearing B2")], "two",
+              model_edit=both(CRACK_B, bearing_keys("B2", kxy=2e7, kyx=-2e7))),
+    ClaimCase("claim_weak", f"kxy = -kyx = {WEAK_KCROSS:g} N/m at B3", [(CROSS, "bearing B3")],
+              "weak", model_edit=bearing_keys("B3", kxy=WEAK_KCROSS, kyx=-WEAK_KCROSS),
+              grid="small"),
+    ClaimCase("claim_null", "nothing hidden", [], "null", grid="small"),
+]
+
+
+class TimedRcbtool(Rcbtool):
+    """Rcbtool that keeps the CPU (user + sys of the child, what /usr/bin/time
+    reports) and wall seconds of every run in self.times [(command, cpu, wall)]."""
+
+    def __init__(self, exe):
+        super().__init__(exe)
+        self.times = []
+
+    def run(self, *args, check=True):
+        import resource
+        import time
+
+        r0, w0 = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
+        try:
+            return super().run(*args, check=check)
+        finally:
+            r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+            cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
+            self.times.append((str(args[0]), cpu, time.perf_counter() - w0))
+
+
+def claim_measurement(case, workdir, seed=1):
+    """The case's noisy measurement (its grid; the sensor edit after the
+    noise) as UFF 58 in workdir; returns the path."""
+    meas = Path(workdir) / f"{case.name}.uff"
+    write_case_uff(meas, case, truth_clean(case), seed)
+    return meas
+
+
+def log_flag(params):
+    """["--log"] unless a bound is negative (--log needs bounds > 0)."""
+    return ["--log"] if not re.search(r":-", params) else []
+
+
+def claim_round(tool, workdir, meas, model, params=FIT_PARAMS, top=10, tag="r1", fit=True,
+                starts=None):
+    """One round: diagnose (with --apply 1 when the first candidate edits the
+    model) and, with fit, `rcbtool fit` of the applied model (--starts starts;
+    None: the CLI's default). Returns {"diag": the JSON, "fit": the fit's JSON
+    or None, "applied": the applied INI or None, "params": the fitted
+    parameters of the next round, "cpu_s", "wall_s": of diagnose}."""
+    workdir = Path(workdir)
+    nxt = workdir / f"{tag}_applied.ini"
+    noise = f"{NOISE[0]:g},{NOISE[1]:g}"
+    log = log_flag(params)
+    base = ["diagnose", model, meas, "--params", params, *log, "--noise", noise, "--top", top]
+    n0 = len(getattr(tool, "times", []))
+    res = tool.run(*base, "--apply", 1, "-o", nxt, "--json", check=False)
+    if res.returncode != 0:  # a candidate of the measurement chain: nothing to apply
+        res = tool.run(*base, "--json")
+        nxt = None
+    d = json.loads(res.stdout)
+    times = getattr(tool, "times", [])[n0:]
+    out = {"diag": d, "fit": None, "applied": nxt, "params": params,
+           "cpu_s": sum(t[1] for t in times), "wall_s": sum(t[2] for t in times)}
+    if nxt is not None and d["candidates"]:
+        out["params"] = params + "," + _bounded(d["candidates"][0]["fitted"])
+    if fit and nxt is not None and d["candidates"]:
+        more = [] if starts is None else ["--starts", starts]
+        out["fit"] = tool.json("fit", nxt, meas, "--params", out["params"], "--noise", noise,
+                               *more)
+    return out
