@@ -37,6 +37,9 @@ typedef struct diag_cand {
   int variant;                      /* which parameter of the family (mass 0, inertia 1) */
   size_t shaft;                     /* and the shaft of its node */
   size_t np;
+  size_t nlead;                     /* its pre-fit moves the first nlead parameters only,
+                                       the refit all from there (0: all): continuation
+                                       in the effect's size */
   char pname[RCB_DIAG_MAXP][RCB_DIAG_NAME];
   double lo[RCB_DIAG_MAXP], hi[RCB_DIAG_MAXP];
   int logp[RCB_DIAG_MAXP];

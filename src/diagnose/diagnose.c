@@ -158,11 +158,13 @@ rcb_status rcb_diag_set_progress(rcb_diag *d, int (*cb)(void *user, size_t done,
 
 /* A fit of m with the diagnosis settings, the base parameters (with_base)
  * and the candidate's parameters (c, may be NULL). */
-static rcb_status make_fit(rcb_diag *d, rcb_model *m, int with_base, const diag_cand *c,
+#define FIT_BASE 1u /* make_fit: the base parameters too */
+#define FIT_LEAD 2u /* make_fit: the candidate's first nlead parameters only (pre-fit) */
+static rcb_status make_fit(rcb_diag *d, rcb_model *m, unsigned with_base, const diag_cand *c,
                            rcb_fit **out) {
   rcb_fit *f = NULL;
   rcb_status st = rcb_fit_create(&f, m, d->meas, &d->alloc);
-  size_t k;
+  size_t k, npc = !c ? 0 : (with_base & FIT_LEAD) && c->nlead ? c->nlead : c->np;
   if (!st) st = rcb_fit_set_uncertainty(f, 0); /* intervals are not part of a diagnosis */
   if (!st) st = rcb_fit_set_scale(f, d->scale);
   if (!st && (d->beta_a > 0 || d->beta_s > 0))
@@ -170,7 +172,7 @@ static rcb_status make_fit(rcb_diag *d, rcb_model *m, int with_base, const diag_
   /* the fit's subset masks (screening, pedestal scan) multiply these */
   if (!st && d->sd) st = rcb_fit_set_sd(f, d->sd);
   if (!st && d->have_band) st = rcb_fit_set_band(f, d->band_lo, d->band_hi);
-  for (k = 0; !st && with_base && k < d->nbase; k++) {
+  for (k = 0; !st && (with_base & FIT_BASE) && k < d->nbase; k++) {
     double v;
     size_t j;
     int dup = 0;
@@ -179,7 +181,7 @@ static rcb_status make_fit(rcb_diag *d, rcb_model *m, int with_base, const diag_
     if (dup || rcb_model_get_param(m, d->base[k].name, &v)) continue;
     st = rcb_fit_add_param(f, d->base[k].name, d->base[k].lo, d->base[k].hi, d->base[k].logp);
   }
-  for (k = 0; !st && c && k < c->np; k++)
+  for (k = 0; !st && k < npc; k++)
     st = rcb_fit_add_param(f, c->pname[k], c->lo[k], c->hi[k], c->logp[k]);
   if (!st && c && c->fam->fit_setup) st = c->fam->fit_setup(c, f);
   if (st) {
@@ -794,7 +796,7 @@ static rcb_status prefit(rcb_diag *d, diag_cand *c, const double *w) {
   c->prefitted = 1;
   c->pre_F = HUGE_VAL;
   c->pre_floor = 0;
-  if (!st) st = make_fit(d, m, 0, c, &f);
+  if (!st) st = make_fit(d, m, FIT_LEAD, c, &f);
   if (!st) st = rcb_diag_refit_start(d, c, m, f);
   if (!st) st = rcb_fit_set_weights(f, w);
   if (!st)
