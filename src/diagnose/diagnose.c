@@ -1462,6 +1462,34 @@ static size_t say_where(const rcb_diag *d, char *text, size_t size, size_t n) {
   return n < size ? n : size - 1;
 }
 
+/* Where along a shaft the local candidates point (appended to text at n):
+ * the significant candidates that sit at nodes (DIAG_FAM_PLACE_WALK) among
+ * the first RCB_DIAG_SPAN_RANKS ranks, on the shaft of the best of them, as
+ * a span of z. Nothing when none is significant. */
+#define RCB_DIAG_SPAN_RANKS 6
+static size_t say_span(const rcb_diag *d, char *text, size_t size, size_t n) {
+  const rcb_model *m = d->base_model;
+  size_t k, shaft = 0, lo = 0, hi = 0, found = 0;
+  for (k = 0; k < d->ncand && k < RCB_DIAG_SPAN_RANKS; k++) {
+    const diag_cand *c = &d->cand[d->order[k]];
+    if (!(c->fam->flags & DIAG_FAM_PLACE_WALK) || !c->node || !c->refitted ||
+        c->claim == RCB_CLAIM_NONE || c->node > m->n_nodes)
+      continue;
+    if (!found) shaft = c->shaft, lo = hi = c->node - 1;
+    if (c->shaft != shaft) continue;
+    if (c->node - 1 < lo) lo = c->node - 1;
+    if (c->node - 1 > hi) hi = c->node - 1;
+    found++;
+  }
+  if (!found || n >= size) return n;
+  n += (size_t)snprintf(text + n, size - n,
+                        " The local candidates point to shaft %s between z = %.3g and %.3g m "
+                        "(nodes #%zu-#%zu): an effect there that the catalogue lacks is "
+                        "possible.",
+                        m->shafts[shaft].name, m->nodes[lo].z, m->nodes[hi].z, lo, hi);
+  return n < size ? n : size - 1;
+}
+
 /* The adequacy test's figures in words: "chi-square F above the limit L". */
 static void say_test(char *t, size_t size, double F, double limit) {
   snprintf(t, size, "chi-square %.6g %s the adequacy limit %.6g at 1 %%", F,
@@ -1528,8 +1556,10 @@ rcb_status rcb_diag_explain(const rcb_diag *d, char *buf, size_t size, size_t *n
   }
   n = strlen(text);
   if (!(c && c->refitted && c->claim == RCB_CLAIM_EXPLAINS) &&
-      !(d->adeq0.known && d->adeq0.adequate))
+      !(d->adeq0.known && d->adeq0.adequate)) {
     n = say_where(d, text, sizeof text, n);
+    n = say_span(d, text, sizeof text, n);
+  }
   if (d->far) /* the run-off baseline is a finding of its own */
     snprintf(text + n, sizeof text - n,
              " The fit of the model as it is ran far from the nominal model (%s): a missing "

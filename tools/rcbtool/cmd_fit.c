@@ -62,10 +62,14 @@ const char cli_help_fit[] =
     "in % at the start (E0) and the end (E1) (linear |H|, unweighted: the figure of\n"
     "rcbtool compare), the objective F the fit minimises (on --scale, --noise\n"
     "weights: E can rise while F falls), iterations, model evaluations, starting\n"
-    "points, residuals used, convergence and the parameter correlation matrix. Progress per\n"
+    "points, residuals used, convergence, the adequacy test (with --noise or --sd: is\n"
+    "the fitted model's chi-square within the 1 % limit of what the noise alone\n"
+    "leaves? the one rule of rcbtool diagnose) and the parameter correlation matrix.\n"
+    "Progress per\n"
     "iteration goes to stderr (on a terminal, or with --progress).\n"
     "JSON: {\"params\": [{\"name\", \"start\", \"fitted\", \"stderr\", \"ci95\": [lo, hi],\n"
     "\"lo\", \"hi\", \"log\", \"identifiable\"}], \"error0_pct\", \"error_pct\",\n"
+    "\"floor_pct\", \"adequacy\": {\"chi2\", \"limit\", \"adequate\" (null: noise unknown)},\n"
     "\"iterations\", \"evaluations\", \"starts\", \"starts_max\", \"residuals\", \"converged\",\n"
     "\"objective0\", "
     "\"objective\", \"sigma\", \"correlation\": [[...]], \"notes\": [...], \"output\"}\n"
@@ -369,6 +373,7 @@ typedef struct fit_result {
   rcb_fit_stop stop;      /* why the run stopped */
   size_t stop_param;      /* the parameter at its bound (RCB_FIT_STOP_AT_BOUND) */
   rcb_frf_condition cond; /* condition of the final evaluation's solves */
+  rcb_fit_adequacy adeq;  /* the adequacy test of the fitted model (issue #23) */
 } fit_result;
 
 static int collect(rcb_fit *f, fit_result *r) {
@@ -380,6 +385,7 @@ static int collect(rcb_fit *f, fit_result *r) {
   rcb_fit_get_report(f, &r->rep);
   r->stop = rcb_fit_stop_reason(f, &r->stop_param);
   if (rcb_fit_get_condition(f, &r->cond)) r->cond.ill = 0;
+  if (rcb_fit_get_adequacy(f, &r->adeq, NULL, NULL, NULL)) r->adeq.known = 0;
   for (k = 0; k < r->np; k++) rcb_fit_get_param(f, k, &r->par[k]);
   if (rcb_fit_correlation(f, r->corr))
     for (k = 0; k < r->np * r->np; k++) r->corr[k] = NAN;
@@ -468,6 +474,16 @@ static void write_text(FILE *fp, const fit_result *r, const fit_job *j) {
   if (isfinite(r->rep.floor_pct))
     fprintf(fp, "noise floor (predicted by the --noise model or the --sd deviations; the "
             "error reached can be lower): %.6g %%\n", r->rep.floor_pct);
+  if (r->adeq.known)
+    fprintf(fp, "adequacy test: chi-square %.6g %s the 1 %% limit %.6g (the noise alone: "
+            "%.6g +- %.3g): the fitted model is %s\n",
+            r->adeq.chi2, r->adeq.adequate ? "within" : "ABOVE", r->adeq.limit,
+            r->adeq.expected, r->adeq.sd,
+            r->adeq.adequate ? "consistent with the data"
+                             : "not consistent with the data (an effect is missing, a local "
+                               "minimum, or a faulty sensor: rcbtool diagnose)");
+  else
+    fputs("adequacy test: none (the noise is unknown: give --noise or --sd)\n", fp);
   fprintf(fp, "iterations: %zu\nmodel evaluations: %zu\n", r->rep.iterations,
           r->rep.evaluations);
   write_text_starts(fp, r, j);
@@ -558,6 +574,12 @@ static void write_json(FILE *fp, const fit_result *r, const fit_job *j, const cl
   cli_json_num(fp, r->rep.error_pct);
   fputs(", \"floor_pct\": ", fp);
   cli_json_num(fp, r->rep.floor_pct);
+  fputs(", \"adequacy\": {\"chi2\": ", fp);
+  cli_json_num(fp, r->adeq.chi2);
+  fputs(", \"limit\": ", fp);
+  cli_json_num(fp, r->adeq.limit);
+  fprintf(fp, ", \"adequate\": %s}",
+          !r->adeq.known ? "null" : r->adeq.adequate ? "true" : "false");
   fprintf(fp, ", \"iterations\": %zu, \"evaluations\": %zu, \"starts\": %zu, "
           "\"starts_max\": %zu, "
           "\"residuals\": %zu, \"converged\": %s, \"unsure\": %s, \"stop\": \"%s\",\n"
