@@ -1060,6 +1060,40 @@ assert d["peaks"] and all(p["match"] != "measured_only" for p in d["peaks"]), d[
 EOF2
   run compare "$MODEL" "$W/self.csv"; expect_rc 0
   out_has "overall: error 0 %"; out_has "worst bands"; out_has "peaks (measured resonances vs model modes" ;;
+compare_outlier)
+  # issue #23: a probe reading 20 % low (DB.y scaled by 0.8 in the file) is named, with
+  # the others' range; the same data with the gain right name nothing
+  run simulate "$MODEL" --frf --out C.A.x,C.A.y,C.B.x,C.B.y,DA.x,DB.y --in DA.x --fmin 5 \
+    --fmax 400 --points 400 --rpm 3000 --kind inertance --noise 10,1 --seed 3 -o "$W/ok.csv"
+  [ "$RC" -eq 0 ] || { [ "$RC" -eq 2 ] && grep -q "unknown command" "$W/err" && exit 77; fail "simulate failed"; }
+  awk -F, 'BEGIN { OFS = ","; CONVFMT = "%.17g"; OFMT = "%.17g" }
+    /^#/ || /^freq/ { print; next } { $12 *= 0.8; $13 *= 0.8; print }' "$W/ok.csv" >"$W/low.csv"
+  run compare "$MODEL" "$W/low.csv"; expect_rc 0
+  grep -q '^DB.y: [0-9.]* % where the other sensors are [0-9.]*-[0-9.]* %: check this sensor (gain, phase, mounting) before the model$' "$W/out" ||
+    fail "DB.y not named"
+  [ "$(grep -c 'check this' "$W/out")" -eq 1 ] || fail "more than one outlier named"
+  run compare "$MODEL" "$W/low.csv" --json; expect_rc 0; json_ok
+  python3 - "$W/out" <<'EOF2' || fail "outliers JSON wrong"
+import json, statistics, sys
+d = json.load(open(sys.argv[1]))
+o = d["outliers"]
+assert len(o) == 1 and o[0]["response"] == "DB.y" and o[0]["reference"] is None, o
+err = {c["response"]: c["error_pct"] for c in d["channels"]}
+others = [v for k, v in err.items() if k != "DB.y"]
+assert abs(o[0]["error_pct"] - err["DB.y"]) < 1e-9 * err["DB.y"]
+assert o[0]["others_lo"] == min(others) and o[0]["others_hi"] == max(others)
+med = statistics.median(others)
+mad = statistics.median(abs(v - med) for v in others)
+thr = max(2 * med, med + 6 * 1.4826 * mad)
+assert abs(o[0]["threshold"] - thr) < 1e-9 * thr and err["DB.y"] > thr, (thr, o)
+assert o[0]["by_chi2"] is False and o[0]["chi2_dof"] is None
+EOF2
+  run compare "$MODEL" "$W/ok.csv" --json; expect_rc 0
+  python3 -c 'import json,sys; assert json.load(open(sys.argv[1]))["outliers"] == []' "$W/out" ||
+    fail "an outlier named in the null case"
+  run compare "$MODEL" "$W/ok.csv"; expect_rc 0
+  grep -q 'check this' "$W/out" && fail "an outlier named in the null case"
+  : ;;
 compare_shift)
   # a model with the coupling's kt at 20e3 instead of 46.095e3 vs noisy data of the true
   # system (UFF): errors show, the peak near 160 Hz (a shoulder of the 150 Hz one: found
