@@ -23,6 +23,7 @@
 
 #include "core/rcb_internal.h"
 #include "rcb/rcb.h"
+#include "rcb/rcb_config.h"
 #include "rcb_test_util.h"
 
 /* A shaft (0.8 m, d 30 mm, 8 elements) with a 20 kg disk D in the middle on
