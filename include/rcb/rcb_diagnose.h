@@ -264,6 +264,11 @@ typedef struct rcb_plan_candidate {
   double speed;          /**< rotor speed, rad/s */
   double gain;           /**< rise of the separating chi-square with this channel added */
   double chi2_after;     /**< chi2_sep + gain */
+  double level_db;       /**< its RMS magnitude against the strongest present channel's,
+                              dB: eq. 19 scales a channel's additive noise with its own
+                              RMS, so a weak channel (x per y) ranks as if measured as
+                              cleanly as a strong one; check it would stand above your
+                              instruments' floor */
 } rcb_plan_candidate;
 RCB_API rcb_status rcb_plan_get_candidate(const rcb_plan *p, size_t rank,
                                           rcb_plan_candidate *out);

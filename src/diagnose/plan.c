@@ -35,7 +35,7 @@ typedef struct plan_par {
 
 typedef struct plan_cand {
   char resp[PLAN_NAME_MAX], ref[PLAN_NAME_MAX];
-  double speed, gain;
+  double speed, gain, rms;
 } plan_cand;
 
 struct rcb_plan {
@@ -46,6 +46,8 @@ struct rcb_plan {
   plan_par *par;
   size_t np, cap_par;
   double beta_a, beta_s, size;
+  double rms_ref; /* RMS magnitude of the strongest present channel */
+  double floor_a; /* eq. 19 additive amplitude of the strongest present channel */
   int noise;
   double *speeds;
   size_t nspeeds, cap_sp;
@@ -201,8 +203,8 @@ done:
 
 /* Weighted Jacobian of every plan parameter on measurement ms: *J (nres x
  * np, allocated) and, when ch is not NULL, each row's channel (*ch). */
-static rcb_status jacobian(rcb_plan *p, const rcb_meas *ms, double **J, size_t **ch,
-                           size_t *nres) {
+static rcb_status jacobian(rcb_plan *p, const rcb_meas *ms, const double *w, double **J,
+                           size_t **ch, size_t *nres) {
   rcb_fit *f = NULL;
   rcb_status st;
   size_t k;
@@ -214,9 +216,10 @@ static rcb_status jacobian(rcb_plan *p, const rcb_meas *ms, double **J, size_t *
     return st;
   }
   st = rcb_fit_set_noise_model(f, p->beta_a, p->beta_s);
+  if (!st && w) st = rcb_fit_set_weights(f, w);
   for (k = 0; k < p->np && !st; k++) {
-    double v = p->par[k].value, w = (fabs(v) + 1.0) * 1e6;
-    st = rcb_fit_add_param(f, p->par[k].name, v - w, v + w, 0);
+    double v = p->par[k].value, half = (fabs(v) + 1.0) * 1e6; /* bounds never reached */
+    st = rcb_fit_add_param(f, p->par[k].name, v - half, v + half, 0);
   }
   if (!st) st = rcb_fit_prepare(f);
   if (!st) {
@@ -440,6 +443,16 @@ done:
   return st;
 }
 
+/* RMS magnitude of channel k of ms. */
+static double channel_rms(const rcb_meas *ms, size_t k) {
+  rcb_meas_channel_info ci;
+  size_t i, n = rcb_meas_point_count(ms);
+  double s = 0.0;
+  rcb_meas_channel(ms, k, &ci);
+  for (i = 0; i < n; i++) s += creal(ci.data[i] * conj(ci.data[i]));
+  return n ? sqrt(s / (double)n) : 0.0;
+}
+
 static rcb_status present(rcb_plan *p, plan_basis *b) {
   size_t nch = rcb_meas_channel_count(p->meas), k, n = 0;
   const char **outs = rcb_alloc(&p->alloc, 2 * nch * sizeof *outs), **ins = outs + nch;
@@ -453,8 +466,11 @@ static rcb_status present(rcb_plan *p, plan_basis *b) {
     outs[k] = ci.response;
     ins[k] = ci.reference;
   }
-  if (!(st = simulate(p, outs, ins, nch, 0, rcb_meas_speed(p->meas), &ms)) &&
-      !(st = jacobian(p, ms, &J, NULL, &n)) && !(st = column_scales(p, J, n, b->scale)))
+  if (!(st = simulate(p, outs, ins, nch, 0, rcb_meas_speed(p->meas), &ms)))
+    for (k = 0, p->rms_ref = 0.0; k < nch; k++) p->rms_ref = fmax(p->rms_ref, channel_rms(ms, k));
+  p->floor_a = p->beta_s / 100.0 * p->rms_ref / sqrt((double)rcb_meas_point_count(p->meas));
+  if (!st &&
+      !(st = jacobian(p, ms, NULL, &J, NULL, &n)) && !(st = column_scales(p, J, n, b->scale)))
     st = separate(p, J, n, b);
   rcb_free(&p->alloc, J);
   rcb_meas_destroy(ms);
@@ -573,7 +589,7 @@ static rcb_status gain_of(rcb_plan *p, const plan_basis *b, const double *J, con
 }
 
 static rcb_status add_cand(rcb_plan *p, const char *resp, const char *ref, double speed,
-                           double gain) {
+                           double gain, double rms) {
   plan_cand *c;
   if (rcb_grow(&p->alloc, (void **)&p->cand, &p->cap_cand, p->ncand + 1, sizeof *p->cand))
     return plan_fail(p, RCB_ERR_NOMEM, "out of memory");
@@ -582,7 +598,33 @@ static rcb_status add_cand(rcb_plan *p, const char *resp, const char *ref, doubl
   snprintf(c->ref, sizeof c->ref, "%s", ref);
   c->speed = speed;
   c->gain = gain;
+  c->rms = rms;
   return RCB_OK;
+}
+
+/* Weights that turn the fit's eq. 19 variances (each channel's additive
+ * amplitude a_c = beta_s/100 sqrt(sum |e|^2)/n from its own values) into
+ * ones with the strongest present channel's amplitude A for every candidate:
+ * var = (beta_a/100)^2 |e|^2/3 + a^2/6 on |e| (the log10 factor cancels in the
+ * ratio), and points under 2 A are at the test's floor (weight 0). Without
+ * this a weak channel (x per y, -80 dB) would be ranked as if measured as
+ * cleanly, relative to its size, as the strongest one. Returns the points
+ * kept. */
+static size_t floor_weights(const rcb_plan *p, const rcb_meas *ms, double *w) {
+  size_t n = rcb_meas_point_count(ms), k, i, kept = 0;
+  double ba = p->beta_a / 100.0, A = p->floor_a;
+  for (k = 0; k < rcb_meas_channel_count(ms); k++) {
+    rcb_meas_channel_info ci;
+    double ac = p->beta_s / 100.0 * channel_rms(ms, k) / sqrt((double)n);
+    rcb_meas_channel(ms, k, &ci);
+    for (i = 0; i < n; i++) {
+      double m2 = creal(ci.data[i] * conj(ci.data[i]));
+      double vc = ba * ba * m2 / 3.0 + ac * ac / 6.0, v = ba * ba * m2 / 3.0 + A * A / 6.0;
+      w[k * n + i] = sqrt(m2) >= 2.0 * A && v > 0 ? vc / v : 0.0;
+      kept += w[k * n + i] > 0;
+    }
+  }
+  return kept;
 }
 
 /* Every response DOF per excitation e at speed w0. */
@@ -591,12 +633,17 @@ static rcb_status candidates_at(rcb_plan *p, const plan_basis *b, const plan_dof
   rcb_meas *ms = NULL;
   double *J = NULL, g;
   size_t *ch = NULL, nres = 0, r;
+  double *w = NULL;
   plan_ls ls;
   rcb_status st;
   memset(&ls, 0, sizeof ls);
-  if ((st = simulate(p, d->ptr, d->ptr + e, d->n, 1, w0, &ms)) ||
-      (st = jacobian(p, ms, &J, &ch, &nres)))
+  if ((st = simulate(p, d->ptr, d->ptr + e, d->n, 1, w0, &ms))) goto done;
+  if (!(w = rcb_alloc(&p->alloc, d->n * rcb_meas_point_count(ms) * sizeof *w))) {
+    st = plan_fail(p, RCB_ERR_NOMEM, "out of memory");
     goto done;
+  }
+  if (!floor_weights(p, ms, w)) goto done; /* all under the test's floor: nothing to add */
+  if ((st = jacobian(p, ms, w, &J, &ch, &nres))) goto done;
   ls.M = rcb_alloc(&p->alloc, (b->pb + nres) * b->pb * sizeof *ls.M);
   ls.rhs = rcb_alloc(&p->alloc, (b->pb + nres) * sizeof *ls.rhs);
   ls.row = rcb_alloc(&p->alloc, (b->pb + 1) * sizeof *ls.row);
@@ -606,10 +653,11 @@ static rcb_status candidates_at(rcb_plan *p, const plan_basis *b, const plan_dof
   }
   for (r = 0; r < d->n && !st; r++) {
     if (test_speed && is_present(p, d->row[r], d->row[e])) continue;
-    if (!(st = gain_of(p, b, J, ch, nres, r, &ls, &g))) st = add_cand(p, d->ptr[r], d->ptr[e],
-                                                                      w0, g);
+    if (!(st = gain_of(p, b, J, ch, nres, r, &ls, &g)))
+      st = add_cand(p, d->ptr[r], d->ptr[e], w0, g, channel_rms(ms, r));
   }
 done:
+  rcb_free(&p->alloc, w);
   rcb_free(&p->alloc, ls.M);
   rcb_free(&p->alloc, ls.rhs);
   rcb_free(&p->alloc, ls.row);
@@ -690,5 +738,8 @@ rcb_status rcb_plan_get_candidate(const rcb_plan *p, size_t rank, rcb_plan_candi
   out->speed = p->cand[rank].speed;
   out->gain = p->cand[rank].gain;
   out->chi2_after = p->res.chi2_sep + p->cand[rank].gain;
+  out->level_db = p->rms_ref > 0 && p->cand[rank].rms > 0
+                      ? 20.0 * log10(p->cand[rank].rms / p->rms_ref)
+                      : -HUGE_VAL;
   return RCB_OK;
 }
