@@ -114,6 +114,17 @@ static const char *verdict(const rcb_plan_result *r) {
                       : "these data cannot separate them";
 }
 
+/* Whether a rival's change exceeds 30 % of its (nonzero) value. */
+static int large_change(const rcb_plan *p) {
+  size_t k;
+  for (k = 0; k < rcb_plan_param_count(p); k++) {
+    rcb_plan_param q;
+    rcb_plan_get_param(p, k, &q);
+    if (q.value != 0 && fabs(q.change) > 0.3 * fabs(q.value)) return 1;
+  }
+  return 0;
+}
+
 static void print_params(FILE *fp, const rcb_plan *p, int side) {
   size_t k;
   for (k = 0; k < rcb_plan_param_count(p); k++) {
@@ -131,9 +142,9 @@ static void print_text(FILE *fp, const cli_args *a, const plan_job *j, const rcb
   rcb_plan_result r;
   size_t i;
   rcb_plan_get_result(p, &r);
-  fprintf(fp, "# rcbtool plan: %s vs the layout of %s (%zu channels x %zu points, %.6g to "
+  fprintf(fp, "# rcbtool plan: %s vs the layout of %s (%zu channel%s x %zu points, %.6g to "
           "%.6g Hz, %.6g rpm)\n", a->model, j->meas_path, rcb_meas_channel_count(ms),
-          rcb_meas_point_count(ms), rcb_meas_grid(ms)[0] / CLI_HZ_TO_RAD_S,
+          rcb_meas_channel_count(ms) == 1 ? "" : "s", rcb_meas_point_count(ms), rcb_meas_grid(ms)[0] / CLI_HZ_TO_RAD_S,
           rcb_meas_grid(ms)[rcb_meas_point_count(ms) - 1] / CLI_HZ_TO_RAD_S,
           rcb_meas_speed(ms) / CLI_RPM_TO_RAD_S);
   fprintf(fp, "present channels: principal angle %.4g deg between the rivals' weighted "
@@ -145,6 +156,10 @@ static void print_text(FILE *fp, const cli_args *a, const plan_job *j, const rcb
   print_params(fp, p, 1);
   fprintf(fp, "separating chi-square %.4g (threshold %g): %s\n", r.chi2_sep,
           RCB_PLAN_SEPARATE_CHI2, verdict(&r));
+  if (large_change(p))
+    fprintf(fp, "note: a change above 30 %% of its value: the figures are linear at the "
+            "model's values and extrapolate that far (the ranking stands; a smaller --size "
+            "keeps them local)\n");
   fprintf(fp, "\ncandidate channels (same grid and noise model) by gain in the separating "
           "chi-square:\n");
   fprintf(fp, "%-5s %-14s %-14s %9s %12s %12s %9s\n", "rank", "response", "excitation", "rpm",
