@@ -455,11 +455,12 @@ static double channel_rms(const rcb_meas *ms, size_t k) {
 
 static rcb_status present(rcb_plan *p, plan_basis *b) {
   size_t nch = rcb_meas_channel_count(p->meas), k, n = 0;
-  const char **outs = rcb_alloc(&p->alloc, 2 * nch * sizeof *outs), **ins = outs + nch;
+  const char **outs = rcb_alloc(&p->alloc, 2 * nch * sizeof *outs), **ins;
   rcb_meas *ms = NULL;
   double *J = NULL;
   rcb_status st;
   if (!outs) return plan_fail(p, RCB_ERR_NOMEM, "out of memory");
+  ins = outs + nch;
   for (k = 0; k < nch; k++) {
     rcb_meas_channel_info ci;
     rcb_meas_channel(p->meas, k, &ci);

@@ -75,7 +75,7 @@ static int rpm_list(const cli_args *a, plan_job *j) {
   const char *q;
   if (!s) return 0;
   for (q = s; *q; q++) n += *q == ',';
-  if (!(j->rpms = malloc(n * sizeof *j->rpms))) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  if (!(j->rpms = calloc(n, sizeof *j->rpms))) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   for (q = s; j->nrpm < n; j->nrpm++) {
     char *e;
     double v = strtod(q, &e);
@@ -144,7 +144,8 @@ static void print_text(FILE *fp, const cli_args *a, const plan_job *j, const rcb
   rcb_plan_get_result(p, &r);
   fprintf(fp, "# rcbtool plan: %s vs the layout of %s (%zu channel%s x %zu points, %.6g to "
           "%.6g Hz, %.6g rpm)\n", a->model, j->meas_path, rcb_meas_channel_count(ms),
-          rcb_meas_channel_count(ms) == 1 ? "" : "s", rcb_meas_point_count(ms), rcb_meas_grid(ms)[0] / CLI_HZ_TO_RAD_S,
+          rcb_meas_channel_count(ms) == 1 ? "" : "s", rcb_meas_point_count(ms),
+          rcb_meas_grid(ms)[0] / CLI_HZ_TO_RAD_S,
           rcb_meas_grid(ms)[rcb_meas_point_count(ms) - 1] / CLI_HZ_TO_RAD_S,
           rcb_meas_speed(ms) / CLI_RPM_TO_RAD_S);
   fprintf(fp, "present channels: principal angle %.4g deg between the rivals' weighted "
@@ -204,8 +205,9 @@ static void print_json(FILE *fp, const cli_args *a, const plan_job *j, const rcb
   cli_json_num(fp, r.chi2_sep);
   fputs(", \"threshold\": ", fp);
   cli_json_num(fp, RCB_PLAN_SEPARATE_CHI2);
-  fprintf(fp, ", \"separable\": %s, \"verdict\": \"%s\", \"residuals\": %zu,\n\"candidates\": [",
+  fprintf(fp, ", \"separable\": %s, \"verdict\": \"%s\", \"residuals\": %zu,\n",
           r.separable ? "true" : "false", verdict(&r), r.residuals);
+  fputs("\"candidates\": [", fp);
   for (i = 0; i < r.candidates && i < j->top; i++) {
     rcb_plan_candidate c;
     rcb_plan_get_candidate(p, i, &c);
