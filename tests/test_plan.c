@@ -2,7 +2,8 @@
  * Which test would tell them apart (rcb_plan, issue #23 item 6):
  *  - identity: the separating chi-square S sin^2(theta) equals the objective
  *    at which rcb_fit leaves rival B fitted to A's noise-free data (A moved
- *    by the plan's dA), and B's fitted change equals the plan's dB;
+ *    by the plan's dA), and B's fitted change equals the plan's dB, for one
+ *    parameter a side and for two;
  *  - a symmetric rotor measured at its midspan disk only: the two bearings'
  *    y stiffnesses have the same sensitivities there (angle 0, chi-square 0:
  *    "cannot separate"); the plan ranks a y channel at a bearing first, and
@@ -54,62 +55,93 @@ static rcb_plan *plan_of(const rcb_model *m, const rcb_meas *ms, const char *a, 
   return p;
 }
 
-/* The plan's chi-square against a brute-force fit of B to A's data. */
-static void test_identity(void **state) {
+/* The plan's chi-square against a brute-force fit of B to A's data: rivals
+ * a[0 .. na) and b[0 .. nb) on the paper system. */
+static void identity_case(const rcb_model *m, const rcb_meas *layout, const char *const *a,
+                          size_t na, const char *const *b, size_t nb) {
   static const char *const outs[] = {"C.A.x", "C.B.x", "DA.x", "DB.y"};
   static const char *const ins[] = {"DA.x"};
-  rcb_model *m, *truth = NULL;
-  rcb_meas *layout, *data;
-  rcb_plan_param pa, pb;
+  rcb_model *truth = NULL, *start = NULL;
+  rcb_meas *data;
   rcb_plan_result r;
   rcb_fit_report rep;
   rcb_fit *f = NULL;
-  double kxx;
-  rcb_plan *p;
-  (void)state;
-#if !RCB_WITH_NLOPT
-  skip(); /* the brute force needs NLopt (below) */
-#endif
-  m = finalized(rcb_test_model_from_example("paper_system.ini"));
-  layout = rcb_test_frf_meas(m, outs, 4, ins, 1, 100.0, 400.0, 151, 3000.0, RCB_INERTANCE);
+  rcb_plan *p = NULL;
+  size_t k;
+  assert_int_equal(rcb_plan_create(&p, m, layout, NULL), RCB_OK);
+  for (k = 0; k < na; k++) assert_int_equal(rcb_plan_add_param(p, 0, a[k]), RCB_OK);
+  for (k = 0; k < nb; k++) assert_int_equal(rcb_plan_add_param(p, 1, b[k]), RCB_OK);
+  assert_int_equal(rcb_plan_set_noise_model(p, 10.0, 1.0), RCB_OK);
   /* a small size: the linearisation's own error is O(dA / A) (1.6e-4 at
-   * S = 1e-3, 5e-4 at S = 1e-2: it falls as sqrt(S)) */
-  p = plan_of(m, layout, "coupling.C.kt", "bearing.B2.kxx", 1e-3);
+   * S = 1e-3, 5e-4 at S = 1e-2 for one parameter each: it falls as sqrt(S)) */
+  assert_int_equal(rcb_plan_set_size(p, 1e-3), RCB_OK);
+  if (rcb_plan_run(p)) fail_msg("plan: %s", rcb_plan_errmsg(p));
   assert_int_equal(rcb_plan_get_result(p, &r), RCB_OK);
-  assert_int_equal(rcb_plan_get_param(p, 0, &pa), RCB_OK);
-  assert_int_equal(rcb_plan_get_param(p, 1, &pb), RCB_OK);
   assert_true(r.angle_deg > 1.0 && r.angle_deg < 89.0);
   assert_true(fabs(r.chi2_sep - 1e-3 * pow(sin(r.angle_deg * RCB_PI / 180.0), 2)) <
               1e-9 * r.chi2_sep);
-  /* A's data: the model with kt moved by dA, noise-free */
+  /* A's data: the model with A's parameters moved by dA, noise-free */
   assert_int_equal(rcb_model_clone(&truth, m, NULL), RCB_OK);
   assert_int_equal(rcb_model_finalize(truth), RCB_OK);
-  assert_int_equal(rcb_model_set_param(truth, "coupling.C.kt", pa.value + pa.change), RCB_OK);
+  assert_int_equal(rcb_model_clone(&start, m, NULL), RCB_OK);
+  assert_int_equal(rcb_model_finalize(start), RCB_OK);
+  for (k = 0; k < na; k++) {
+    rcb_plan_param q;
+    assert_int_equal(rcb_plan_get_param(p, k, &q), RCB_OK);
+    assert_int_equal(rcb_model_set_param(truth, q.name, q.value + q.change), RCB_OK);
+  }
   data = rcb_test_frf_meas(truth, outs, 4, ins, 1, 100.0, 400.0, 151, 3000.0, RCB_INERTANCE);
-  /* B fitted to them from the model's value */
-  assert_int_equal(rcb_fit_create(&f, m, data, NULL), RCB_OK);
+  /* B fitted to them from the model's values */
+  assert_int_equal(rcb_fit_create(&f, start, data, NULL), RCB_OK);
   assert_int_equal(rcb_fit_set_noise_model(f, 10.0, 1.0), RCB_OK);
-  assert_int_equal(rcb_fit_add_param(f, "bearing.B2.kxx", pb.value / 10, pb.value * 10, 0),
-                   RCB_OK);
+  for (k = 0; k < nb; k++) {
+    rcb_plan_param q;
+    assert_int_equal(rcb_plan_get_param(p, na + k, &q), RCB_OK);
+    assert_int_equal(rcb_fit_add_param(f, q.name, q.value / 10, q.value * 10, 0), RCB_OK);
+  }
   assert_int_equal(rcb_fit_set_starts(f, 1, 1), RCB_OK);
   /* NLopt's BOBYQA to the precision asked: the paper's method stops at a gain
-   * under 0.01 of a chi-square unit, and F here is 0.01 in all */
+   * under 0.01 of a chi-square unit, and F here is 0.001 in all */
   assert_int_equal(rcb_fit_set_method(f, RCB_FIT_NLOPT, "LN_BOBYQA"), RCB_OK);
-  assert_int_equal(rcb_fit_set_limits(f, 200, 1e-15, 1e-15), RCB_OK);
+  assert_int_equal(rcb_fit_set_limits(f, 400, 1e-15, 1e-15), RCB_OK);
   assert_int_equal(rcb_fit_run(f), RCB_OK);
   assert_int_equal(rcb_fit_get_report(f, &rep), RCB_OK);
-  assert_int_equal(rcb_model_get_param(m, "bearing.B2.kxx", &kxx), RCB_OK);
-  print_message("plan: angle %.6g deg, chi2_sep %.10g, dA %.6g, dB %.6g; fit: F0 %.10g, "
-                "F %.10g, dB %.6g\n", r.angle_deg, r.chi2_sep, pa.change, pb.change,
-                rep.objective0, rep.objective, kxx - pb.value);
+  print_message("%zu + %zu parameters: angle %.6g deg, chi2_sep %.10g; fit: F0 %.10g, F %.10g\n",
+                na, nb, r.angle_deg, r.chi2_sep, rep.objective0, rep.objective);
   assert_true(fabs(rep.objective0 - 1e-3) < 1e-3 * 1e-3); /* ||J_A dA||^2 = S */
   assert_true(fabs(rep.objective - r.chi2_sep) < 1e-3 * r.chi2_sep);
-  assert_true(fabs((kxx - pb.value) - pb.change) < 1e-3 * fabs(pb.change));
+  for (k = 0; k < nb; k++) { /* B's fitted change is the plan's dB */
+    rcb_plan_param q;
+    double v;
+    assert_int_equal(rcb_plan_get_param(p, na + k, &q), RCB_OK);
+    assert_int_equal(rcb_model_get_param(start, q.name, &v), RCB_OK);
+    print_message("  %s: plan %.8g, fit %.8g\n", q.name, q.change, v - q.value);
+    assert_true(fabs((v - q.value) - q.change) < 2e-3 * fabs(q.change));
+  }
   rcb_fit_destroy(f);
   rcb_plan_destroy(p);
   rcb_meas_destroy(data);
-  rcb_meas_destroy(layout);
   rcb_model_destroy(truth);
+  rcb_model_destroy(start);
+}
+
+static void test_identity(void **state) {
+  static const char *const outs[] = {"C.A.x", "C.B.x", "DA.x", "DB.y"};
+  static const char *const ins[] = {"DA.x"};
+  static const char *const a1[] = {"coupling.C.kt"}, *const b1[] = {"bearing.B2.kxx"};
+  static const char *const a2[] = {"coupling.C.kt", "coupling.C.kr"};
+  static const char *const b2[] = {"bearing.B2.kxx", "bearing.B3.kxx"};
+  rcb_model *m;
+  rcb_meas *layout;
+  (void)state;
+#if !RCB_WITH_NLOPT
+  skip(); /* the brute force needs NLopt (identity_case) */
+#endif
+  m = finalized(rcb_test_model_from_example("paper_system.ini"));
+  layout = rcb_test_frf_meas(m, outs, 4, ins, 1, 100.0, 400.0, 151, 3000.0, RCB_INERTANCE);
+  identity_case(m, layout, a1, 1, b1, 1);
+  identity_case(m, layout, a2, 2, b2, 2);
+  rcb_meas_destroy(layout);
   rcb_model_destroy(m);
 }
 
