@@ -13,7 +13,8 @@
  *  - a resonance added to the data that the model lacks is listed as a
  *    measured peak without counterpart, at its frequency and damping;
  *  - the outlier rule in closed form; a sensor reading 20 % low named (error %
- *    and chi2/dof), nothing named in the null case;
+ *    and chi2/dof), nothing named in the null case; with two references, one
+ *    low channel named as a channel, a low sensor as the sensor;
  *  - known values of FRAC / CSF for a scaled measurement, channel errors,
  *    allocator balance.
  */
@@ -761,6 +762,62 @@ static void test_outlier_sensor(void **state) {
   rcb_model_destroy(m);
 }
 
+/* Six sensors per two references (DA.x, DB.y; channel 2 s + r), Gaussian
+ * noise of sd 2 % of |e|; channels whose bit is set in @p low read 20 % low. */
+static rcb_meas *two_refs(const rcb_model *m, unsigned low) {
+  static const char *const outs[] = {"C.A.x", "C.A.x", "C.A.y", "C.A.y", "C.B.x", "C.B.x",
+                                     "C.B.y", "C.B.y", "DA.x",  "DA.x",  "DB.y",  "DB.y"};
+  static const char *const ins[] = {"DA.x", "DB.y", "DA.x", "DB.y", "DA.x", "DB.y",
+                                    "DA.x", "DB.y", "DA.x", "DB.y", "DA.x", "DB.y"};
+  size_t n = 300, k, i;
+  rcb_meas *clean = frf_meas(m, outs, ins, 12, 5.0, 400.0, n, 3000.0, RCB_INERTANCE), *ms;
+  rcb_complex *col = calloc(n, sizeof *col);
+  unsigned long long seed = 99;
+  assert_non_null(col);
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, n, rcb_meas_grid(clean), 3000.0 * RPM),
+                   RCB_OK);
+  for (k = 0; k < 12; k++) {
+    rcb_meas_channel_info ci;
+    rcb_meas_channel(clean, k, &ci);
+    for (i = 0; i < n; i++) {
+      double u1 = lcg_uniform(&seed), u2 = lcg_uniform(&seed), r = sqrt(-2.0 * log(u1));
+      col[i] = ci.data[i] + 0.02 * cabs(ci.data[i]) * r * CMPLX(cos(TWO_PI * u2),
+                                                               sin(TWO_PI * u2));
+      if (low >> k & 1u) col[i] *= 0.8;
+    }
+    assert_int_equal(rcb_meas_add_channel(ms, ci.response, ci.reference, ci.kind, col), RCB_OK);
+  }
+  rcb_meas_destroy(clean);
+  free(col);
+  return ms;
+}
+
+/* With two references: DB.y low on both channels names the sensor; low on
+ * its DA.x channel alone names that channel, not the sensor. */
+static void test_outlier_channel(void **state) {
+  rcb_model *m = paper();
+  rcb_meas *both = two_refs(m, 3u << 10), *one = two_refs(m, 1u << 10);
+  rcb_compare *c = run(m, both);
+  rcb_compare_outlier o;
+  (void)state;
+  assert_int_equal(rcb_compare_outlier_count(c), 1);
+  assert_int_equal(rcb_compare_get_outlier(c, 0, &o), RCB_OK);
+  assert_string_equal(o.response, "DB.y");
+  assert_null(o.reference);
+  assert_int_equal(rcb_compare_run(c, m, one), RCB_OK);
+  assert_int_equal(rcb_compare_outlier_count(c), 1);
+  assert_int_equal(rcb_compare_get_outlier(c, 0, &o), RCB_OK);
+  assert_string_equal(o.response, "DB.y");
+  assert_non_null(o.reference);
+  assert_string_equal(o.reference, "DA.x");
+  assert_true(o.error_pct > 15.0 && o.others_hi < 4.0);
+  rcb_compare_destroy(c);
+  rcb_meas_destroy(both);
+  rcb_meas_destroy(one);
+  rcb_model_destroy(m);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_self_frf),
@@ -778,6 +835,7 @@ int main(void) {
       cmocka_unit_test(test_known_sd),
       cmocka_unit_test(test_outlier_rule),
       cmocka_unit_test(test_outlier_sensor),
+      cmocka_unit_test(test_outlier_channel),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

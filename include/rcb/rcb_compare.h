@@ -174,9 +174,11 @@ RCB_API double rcb_compare_chi2_limit(size_t dof);
  * before the model. Error %: a sensor's is 100 ||(|m| - |e|)|| / || |e| ||
  * over all its channels' points; a sensor is named when it exceeds the rule
  * against the other sensors (at least 4 sensors) and is at least 1 % (a gain
- * within calibration tolerance is not a fault). A channel is named against
- * the other channels only when its sensor has several channels and is not
- * named itself (one reference's cable, not the sensor). With known sds
+ * within calibration tolerance is not a fault), unless it has several
+ * channels and only one of them stands out among the channels: a gain, phase
+ * or mounting fault shows on every channel of the sensor, one channel alone
+ * is its cable, connector or reference, and that channel is named instead
+ * (against the other channels). With known sds
  * (rcb_compare_set_sd) on every channel, chi2/dof replaces error %: named
  * when it exceeds both the rule (ratio 4) and its own limit
  * rcb_compare_chi2_limit(2 x points).

@@ -129,6 +129,7 @@ typedef struct outl_work {
   size_t *sens;        /* nch: sensor index of each channel */
   size_t *nchan;       /* nsens: channels of each sensor */
   int *named;          /* nsens: the sensor is an outlier */
+  int *chan_out;       /* nch: the channel stands out among the channels */
   unit_sums *su, *cu;  /* nsens, nch */
   double *buf;         /* 5 nch: err, chi, oth, work for the sets */
   size_t *nx;          /* nch */
@@ -138,6 +139,7 @@ static void work_free(rcb_compare *c, outl_work *w) {
   rcb_free(&c->alloc, w->sens);
   rcb_free(&c->alloc, w->nchan);
   rcb_free(&c->alloc, w->named);
+  rcb_free(&c->alloc, w->chan_out);
   rcb_free(&c->alloc, w->su);
   rcb_free(&c->alloc, w->cu);
   rcb_free(&c->alloc, w->buf);
@@ -150,12 +152,13 @@ static rcb_status work_alloc(rcb_compare *c, outl_work *w) {
   w->sens = rcb_alloc(&c->alloc, n * sizeof *w->sens);
   w->nchan = rcb_alloc(&c->alloc, n * sizeof *w->nchan);
   w->named = rcb_alloc(&c->alloc, n * sizeof *w->named);
+  w->chan_out = rcb_alloc(&c->alloc, n * sizeof *w->chan_out);
   w->su = rcb_alloc(&c->alloc, n * sizeof *w->su);
   w->cu = rcb_alloc(&c->alloc, n * sizeof *w->cu);
   w->buf = rcb_alloc(&c->alloc, 4 * n * sizeof *w->buf);
   w->nx = rcb_alloc(&c->alloc, n * sizeof *w->nx);
   c->outl = rcb_alloc(&c->alloc, n * sizeof *c->outl);
-  if (!w->sens || !w->nchan || !w->named || !w->su || !w->cu || !w->buf || !w->nx || !c->outl)
+  if (!w->sens || !w->nchan || !w->named || !w->chan_out || !w->su || !w->cu || !w->buf || !w->nx || !c->outl)
     return rcb_cmp_fail(c, RCB_ERR_NOMEM, "out of memory for the outlier summary");
   return RCB_OK;
 }
@@ -183,9 +186,58 @@ static unit_set make_set(outl_work *w, size_t n) {
   return s;
 }
 
+/* Which channels stand out among all channels (w->chan_out). */
+static void flag_channels(const rcb_compare *c, outl_work *w, int by_chi2) {
+  unit_set s = make_set(w, c->nch);
+  rcb_compare_outlier scratch;
+  size_t k;
+  set_figures(&s, w->cu);
+  for (k = 0; k < c->nch; k++) w->chan_out[k] = judge(&s, k, by_chi2, &scratch);
+}
+
+/* Sensors named: the rule against the other sensors, unless the sensor has
+ * several channels and only one of them stands out among the channels (a
+ * gain, phase or mounting fault shows on every channel of the sensor; one
+ * channel alone is its cable, connector or reference: named as a channel). */
+static void name_sensors(rcb_compare *c, outl_work *w, size_t ns, int by_chi2) {
+  unit_set s = make_set(w, ns);
+  size_t k, j, first, nout;
+  set_figures(&s, w->su);
+  for (k = 0; k < ns; k++) {
+    rcb_compare_outlier *o = &c->outl[c->noutl];
+    if (!(w->named[k] = judge(&s, k, by_chi2, o))) continue;
+    for (j = 0, first = c->nch, nout = 0; j < c->nch; j++) {
+      if (w->sens[j] != k) continue;
+      if (first == c->nch) first = j;
+      nout += w->chan_out[j] != 0;
+    }
+    if (w->nchan[k] >= 2 && nout == 1) {
+      w->named[k] = 0;
+      continue;
+    }
+    o->response = c->resp[first];
+    c->noutl++;
+  }
+}
+
+/* Channels named: standing out among the channels, of a sensor with several
+ * channels that is not named itself. */
+static void name_channels(rcb_compare *c, outl_work *w, int by_chi2) {
+  unit_set s = make_set(w, c->nch);
+  size_t k;
+  set_figures(&s, w->cu);
+  for (k = 0; k < c->nch && c->noutl < c->nch; k++) {
+    rcb_compare_outlier *o = &c->outl[c->noutl];
+    if (!w->chan_out[k] || w->nchan[w->sens[k]] < 2 || w->named[w->sens[k]]) continue;
+    judge(&s, k, by_chi2, o); /* fills o (it stands out: flag_channels) */
+    o->response = c->resp[k];
+    o->reference = c->ref[k];
+    c->noutl++;
+  }
+}
+
 rcb_status rcb_cmp_outliers(rcb_compare *c) {
   outl_work w;
-  unit_set s;
   size_t k, ns;
   int by_chi2 = c->sd != NULL;
   rcb_status st;
@@ -202,26 +254,9 @@ rcb_status rcb_cmp_outliers(rcb_compare *c) {
     su->x2 += w.cu[k].x2, su->nx += w.cu[k].nx;
     if (!w.cu[k].nx) by_chi2 = 0; /* chi2/dof only when every channel has sds */
   }
-  s = make_set(&w, ns);
-  set_figures(&s, w.su);
-  for (k = 0; k < ns; k++) {
-    rcb_compare_outlier *o = &c->outl[c->noutl];
-    size_t j;
-    if (!(w.named[k] = judge(&s, k, by_chi2, o))) continue;
-    for (j = 0; w.sens[j] != k; j++) {
-    }
-    o->response = c->resp[j];
-    c->noutl++;
-  }
-  s = make_set(&w, c->nch);
-  set_figures(&s, w.cu);
-  for (k = 0; k < c->nch && c->noutl < c->nch; k++) {
-    rcb_compare_outlier *o = &c->outl[c->noutl];
-    if (w.nchan[w.sens[k]] < 2 || w.named[w.sens[k]] || !judge(&s, k, by_chi2, o)) continue;
-    o->response = c->resp[k];
-    o->reference = c->ref[k];
-    c->noutl++;
-  }
+  flag_channels(c, &w, by_chi2);
+  name_sensors(c, &w, ns, by_chi2);
+  name_channels(c, &w, by_chi2);
   work_free(c, &w);
   return RCB_OK;
 }
