@@ -158,7 +158,8 @@ static rcb_status work_alloc(rcb_compare *c, outl_work *w) {
   w->buf = rcb_alloc(&c->alloc, 4 * n * sizeof *w->buf);
   w->nx = rcb_alloc(&c->alloc, n * sizeof *w->nx);
   c->outl = rcb_alloc(&c->alloc, n * sizeof *c->outl);
-  if (!w->sens || !w->nchan || !w->named || !w->chan_out || !w->su || !w->cu || !w->buf || !w->nx || !c->outl)
+  if (!w->sens || !w->nchan || !w->named || !w->chan_out || !w->su || !w->cu || !w->buf ||
+      !w->nx || !c->outl)
     return rcb_cmp_fail(c, RCB_ERR_NOMEM, "out of memory for the outlier summary");
   return RCB_OK;
 }
