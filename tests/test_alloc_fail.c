@@ -5,8 +5,8 @@
  * FRF object and sweeping it, a small fit (the paper's method, noise-free
  * data, 2 parameters; again with NLopt when built with it), a small
  * diagnosis (every candidate scored, one refit), the refits of one on a
- * frequency subset (screen, random starts, evaluation, polish), and reading a CSV and a
- * UFF58 measurement. Every run must
+ * frequency subset (screen, random starts, evaluation, polish), a plan
+ * (rcb_plan), a comparison, and reading a CSV and a UFF58 measurement. Every run must
  *  - return an error status when the failing allocation was reached (never
  *    RCB_OK with a silently missing piece), RCB_ERR_NOMEM or an error that
  *    propagated from it, with a message;
@@ -492,6 +492,67 @@ static size_t walk_on_truth(const char *name, scenario run, const char *method) 
   return n;
 }
 
+/* The plan (issue #23 item 6): the coupling's kt against bearing B1's kxx,
+ * every station's x and y as candidates. */
+static rcb_status sc_plan(const rcb_allocator *a, int check) {
+  rcb_model *m = NULL;
+  rcb_plan *p = NULL;
+  rcb_status st = load(a, &m);
+  if (st) return st;
+  if (!(st = rcb_model_finalize(m))) st = rcb_plan_create(&p, m, g_truth, a);
+  if (!st) st = rcb_plan_add_param(p, 0, "coupling.C.kt");
+  if (!st) st = rcb_plan_add_param(p, 1, "bearing.B1.kxx");
+  if (!st) st = rcb_plan_set_noise_model(p, 10.0, 1.0);
+  if (!st) st = rcb_plan_run(p);
+  if (st && p) assert_true(rcb_plan_errmsg(p)[0] != '\0');
+  if (!st && check) {
+    rcb_plan_result r;
+    assert_int_equal(rcb_plan_get_result(p, &r), RCB_OK);
+    print_message("plan: angle %.6g deg, chi2 %.6g, %zu candidates\n", r.angle_deg,
+                  r.chi2_sep, r.candidates);
+    assert_true(r.candidates > 0 && r.angle_deg > 0);
+  }
+  rcb_plan_destroy(p);
+  rcb_model_destroy(m);
+  return st;
+}
+
+/* The comparison with its outlier summary (one channel scaled). */
+static rcb_status sc_compare(const rcb_allocator *a, int check) {
+  rcb_model *m = NULL;
+  rcb_compare *c = NULL;
+  rcb_status st = load(a, &m);
+  if (st) return st;
+  if (!(st = rcb_model_finalize(m))) st = rcb_compare_create(&c, a);
+  if (!st) st = rcb_compare_run(c, m, g_truth);
+  if (st && c) assert_true(rcb_compare_errmsg(c)[0] != '\0');
+  if (!st && check) assert_int_equal(rcb_compare_outlier_count(c), 0);
+  rcb_compare_destroy(c);
+  rcb_model_destroy(m);
+  return st;
+}
+
+/* Every seventh site: the candidates repeat one pattern per excitation (a
+ * model-made measurement, a fit, its Jacobian, the least squares), and a
+ * stride prime to its length meets each of its sites on some excitation;
+ * every site took 7.8 min for ~7400 sites (with a second speed). */
+#define RCB_PLAN_WALK_STRIDE 7
+
+static void test_plan(void **state) {
+  size_t n;
+  (void)state;
+  g_truth = truth_meas();
+  n = walk_from("plan", sc_plan, 1, walk_stride() * RCB_PLAN_WALK_STRIDE);
+  print_message("plan: %zu allocation sites, every %d-th walked\n", n, RCB_PLAN_WALK_STRIDE);
+  rcb_meas_destroy(g_truth);
+  g_truth = NULL;
+}
+
+static void test_compare(void **state) {
+  (void)state;
+  walk_on_truth("compare", sc_compare, NULL);
+}
+
 static void test_fit(void **state) {
   (void)state;
   walk_on_truth("fit (paper method)", sc_fit, NULL);
@@ -561,6 +622,8 @@ int main(void) {
       cmocka_unit_test(test_diagnose),
       cmocka_unit_test(test_diagnose_subset),
       cmocka_unit_test(test_fit),
+      cmocka_unit_test(test_plan),
+      cmocka_unit_test(test_compare),
   };
   return cmocka_run_group_tests(tests, rcb_test_setup_tmpdir, rcb_test_teardown_tmpdir);
 }

@@ -12,6 +12,9 @@
  *    damping ratio within 5 %;
  *  - a resonance added to the data that the model lacks is listed as a
  *    measured peak without counterpart, at its frequency and damping;
+ *  - the outlier rule in closed form; a sensor reading 20 % low named (error %
+ *    and chi2/dof), nothing named in the null case; with two references, one
+ *    low channel named as a channel, a low sensor as the sensor;
  *  - known values of FRAC / CSF for a scaled measurement, channel errors,
  *    allocator balance.
  */
@@ -664,6 +667,157 @@ static void test_known_sd(void **state) {
   free(col);
 }
 
+/* The outlier rule in closed form: others {1, 2, 3, 4, 100}: median 3, the
+ * absolute deviations {2, 1, 0, 1, 97} have median 1, so the threshold is
+ * max(2 x 3, 3 + 6 x 1.4826 x 1) = 11.8956; fewer than 3 finite others: NaN.
+ * The chi-square limit: the 0.999 quantile of chi2(100) is 149.449 (tables),
+ * of chi2(1000) 1143.917. */
+static void test_outlier_rule(void **state) {
+  const double others[] = {4.0, 100.0, 1.0, NAN, 3.0, 2.0}, two[] = {1.0, NAN, 2.0};
+  double work[6];
+  (void)state;
+  assert_true(fabs(rcb_compare_outlier_threshold(others, 6, 2.0, work) - 11.8956) < 1e-12);
+  assert_true(fabs(rcb_compare_outlier_threshold(others, 6, 5.0, work) - 15.0) < 1e-12);
+  assert_true(isnan(rcb_compare_outlier_threshold(two, 3, 2.0, work)));
+  assert_true(fabs(rcb_compare_chi2_limit(100) - 1.49449) < 2e-3);
+  assert_true(fabs(rcb_compare_chi2_limit(1000) - 1.143917) < 1e-3);
+  assert_true(isnan(rcb_compare_chi2_limit(0)));
+}
+
+/* Model-made FRFs of six sensors (paper system, input DA.x) with complex
+ * Gaussian noise of sd 2 % of |e| on Re and Im; sensor DB.y's values scaled by
+ * @p gain (a probe reading low). */
+static rcb_meas *six_sensors(const rcb_model *m, double gain, double **sd_out) {
+  static const char *const outs[] = {"C.A.x", "C.A.y", "C.B.x", "C.B.y", "DA.x", "DB.y"};
+  static const char *const ins[] = {"DA.x", "DA.x", "DA.x", "DA.x", "DA.x", "DA.x"};
+  size_t n = 400, k, i;
+  rcb_meas *clean = frf_meas(m, outs, ins, 6, 5.0, 400.0, n, 3000.0, RCB_INERTANCE), *ms;
+  rcb_complex *col = calloc(n, sizeof *col);
+  double *sd = calloc(6 * n, sizeof *sd);
+  unsigned long long seed = 777;
+  assert_non_null(col);
+  assert_non_null(sd);
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, n, rcb_meas_grid(clean), 3000.0 * RPM),
+                   RCB_OK);
+  for (k = 0; k < 6; k++) {
+    rcb_meas_channel_info ci;
+    rcb_meas_channel(clean, k, &ci);
+    for (i = 0; i < n; i++) {
+      double u1 = lcg_uniform(&seed), u2 = lcg_uniform(&seed), r = sqrt(-2.0 * log(u1));
+      double sdev = 0.02 * cabs(ci.data[i]);
+      col[i] = ci.data[i] + sdev * r * CMPLX(cos(TWO_PI * u2), sin(TWO_PI * u2));
+      if (k == 5) col[i] *= gain;
+      sd[k * n + i] = sdev;
+    }
+    assert_int_equal(rcb_meas_add_channel(ms, ci.response, ci.reference, ci.kind, col), RCB_OK);
+  }
+  rcb_meas_destroy(clean);
+  free(col);
+  *sd_out = sd;
+  return ms;
+}
+
+/* A probe reading 20 % low is named (its error % about 20 against about 2
+ * on the others; with sds, its chi2/dof about 0.2^2/(2 x 0.02^2) = 50 against
+ * about 1); with the gain right nothing is named. */
+static void test_outlier_sensor(void **state) {
+  rcb_model *m = paper();
+  double *sd = NULL;
+  rcb_meas *bad = six_sensors(m, 0.8, &sd), *good;
+  rcb_compare *c = run(m, bad);
+  rcb_compare_outlier o;
+  (void)state;
+  assert_int_equal(rcb_compare_outlier_count(c), 1);
+  assert_int_equal(rcb_compare_get_outlier(c, 0, &o), RCB_OK);
+  assert_string_equal(o.response, "DB.y");
+  assert_null(o.reference);
+  assert_int_equal(o.by_chi2, 0);
+  assert_true(o.error_pct > 15.0 && o.error_pct < 25.0);
+  assert_true(o.others_lo > 0.5 && o.others_hi < 4.0);
+  assert_true(o.error_pct > o.threshold && o.threshold >= 2.0 * o.others_lo);
+  assert_int_equal(rcb_compare_get_outlier(c, 1, &o), RCB_ERR_ARG);
+  /* with the sds: chi2/dof */
+  assert_int_equal(rcb_compare_set_sd(c, sd, 6 * 400), RCB_OK);
+  assert_int_equal(rcb_compare_run(c, m, bad), RCB_OK);
+  assert_int_equal(rcb_compare_outlier_count(c), 1);
+  assert_int_equal(rcb_compare_get_outlier(c, 0, &o), RCB_OK);
+  assert_string_equal(o.response, "DB.y");
+  assert_int_equal(o.by_chi2, 1);
+  assert_true(o.chi2_dof > 30.0 && o.chi2_dof < 70.0);
+  assert_true(o.chi2_lo > 0.8 && o.chi2_hi < 1.2);
+  rcb_compare_destroy(c);
+  free(sd);
+  /* the null case, with and without sds */
+  good = six_sensors(m, 1.0, &sd);
+  c = run(m, good);
+  assert_int_equal(rcb_compare_outlier_count(c), 0);
+  assert_int_equal(rcb_compare_set_sd(c, sd, 6 * 400), RCB_OK);
+  assert_int_equal(rcb_compare_run(c, m, good), RCB_OK);
+  assert_int_equal(rcb_compare_outlier_count(c), 0);
+  rcb_compare_destroy(c);
+  free(sd);
+  rcb_meas_destroy(good);
+  rcb_meas_destroy(bad);
+  rcb_model_destroy(m);
+}
+
+/* Six sensors per two references (DA.x, DB.y; channel 2 s + r), Gaussian
+ * noise of sd 2 % of |e|; channels whose bit is set in @p low read 20 % low. */
+static rcb_meas *two_refs(const rcb_model *m, unsigned low) {
+  static const char *const outs[] = {"C.A.x", "C.A.x", "C.A.y", "C.A.y", "C.B.x", "C.B.x",
+                                     "C.B.y", "C.B.y", "DA.x",  "DA.x",  "DB.y",  "DB.y"};
+  static const char *const ins[] = {"DA.x", "DB.y", "DA.x", "DB.y", "DA.x", "DB.y",
+                                    "DA.x", "DB.y", "DA.x", "DB.y", "DA.x", "DB.y"};
+  size_t n = 300, k, i;
+  rcb_meas *clean = frf_meas(m, outs, ins, 12, 5.0, 400.0, n, 3000.0, RCB_INERTANCE), *ms;
+  rcb_complex *col = calloc(n, sizeof *col);
+  unsigned long long seed = 99;
+  assert_non_null(col);
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, n, rcb_meas_grid(clean), 3000.0 * RPM),
+                   RCB_OK);
+  for (k = 0; k < 12; k++) {
+    rcb_meas_channel_info ci;
+    rcb_meas_channel(clean, k, &ci);
+    for (i = 0; i < n; i++) {
+      double u1 = lcg_uniform(&seed), u2 = lcg_uniform(&seed), r = sqrt(-2.0 * log(u1));
+      col[i] = ci.data[i] + 0.02 * cabs(ci.data[i]) * r * CMPLX(cos(TWO_PI * u2),
+                                                               sin(TWO_PI * u2));
+      if (low >> k & 1u) col[i] *= 0.8;
+    }
+    assert_int_equal(rcb_meas_add_channel(ms, ci.response, ci.reference, ci.kind, col), RCB_OK);
+  }
+  rcb_meas_destroy(clean);
+  free(col);
+  return ms;
+}
+
+/* With two references: DB.y low on both channels names the sensor; low on
+ * its DA.x channel alone names that channel, not the sensor. */
+static void test_outlier_channel(void **state) {
+  rcb_model *m = paper();
+  rcb_meas *both = two_refs(m, 3u << 10), *one = two_refs(m, 1u << 10);
+  rcb_compare *c = run(m, both);
+  rcb_compare_outlier o;
+  (void)state;
+  assert_int_equal(rcb_compare_outlier_count(c), 1);
+  assert_int_equal(rcb_compare_get_outlier(c, 0, &o), RCB_OK);
+  assert_string_equal(o.response, "DB.y");
+  assert_null(o.reference);
+  assert_int_equal(rcb_compare_run(c, m, one), RCB_OK);
+  assert_int_equal(rcb_compare_outlier_count(c), 1);
+  assert_int_equal(rcb_compare_get_outlier(c, 0, &o), RCB_OK);
+  assert_string_equal(o.response, "DB.y");
+  assert_non_null(o.reference);
+  assert_string_equal(o.reference, "DA.x");
+  assert_true(o.error_pct > 15.0 && o.others_hi < 4.0);
+  rcb_compare_destroy(c);
+  rcb_meas_destroy(both);
+  rcb_meas_destroy(one);
+  rcb_model_destroy(m);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_self_frf),
@@ -679,6 +833,9 @@ int main(void) {
       cmocka_unit_test(test_known_values),
       cmocka_unit_test(test_errors_and_allocator),
       cmocka_unit_test(test_known_sd),
+      cmocka_unit_test(test_outlier_rule),
+      cmocka_unit_test(test_outlier_sensor),
+      cmocka_unit_test(test_outlier_channel),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -137,6 +137,69 @@ RCB_API rcb_status rcb_compare_band(const rcb_compare *c, size_t b, double *lo, 
  */
 RCB_API const double *rcb_compare_residual_map(const rcb_compare *c);
 
+/**
+ * @brief The outlier rule of the per-sensor summary (issue #23), in one
+ * place: a value is an outlier among @p n others when it exceeds
+ *
+ *     max(ratio x median(others), median(others) + 6 x 1.4826 x MAD(others))
+ *
+ * (MAD the median absolute deviation; 1.4826 MAD estimates a standard
+ * deviation of normal data robustly). Both terms must be passed: the ratio
+ * alone would name the top of a widely spread set, the MAD term alone
+ * anything beyond a tight set (MAD near 0). A sensor whose gain is off by g
+ * adds about |1 - g| of its own to its error, while a model error moves the
+ * sensors that see a mode together: error % takes ratio 2 (the sensor misfits
+ * twice as much as the typical one), chi2/dof ratio 4 (= 2^2, as chi-square
+ * grows with the square of the misfit).
+ * @param others the others' values (NaN ones left out), @p n of them
+ * @param ratio the factor over the median (2 for error %, 4 for chi2/dof)
+ * @param work scratch of @p n doubles (no allocation)
+ * @return the threshold, or NaN when fewer than 3 others are finite (no
+ * judgement is possible)
+ */
+RCB_API double rcb_compare_outlier_threshold(const double *others, size_t n, double ratio,
+                                             double *work);
+
+/**
+ * @brief Upper limit of chi2/dof for @p dof degrees of freedom at the
+ * noise: the 0.999 quantile of chi-square(dof)/dof (Wilson-Hilferty cube
+ * approximation, within 1 % for dof >= 10), NaN for dof 0.
+ */
+RCB_API double rcb_compare_chi2_limit(size_t dof);
+
+/**
+ * @brief A sensor (a response name over all its references) or a channel
+ * whose misfit stands out from the others' (rcb_compare_outlier_threshold):
+ * the sign of a measurement chain fault (gain, phase, mounting) to check
+ * before the model. Error %: a sensor's is 100 ||(|m| - |e|)|| / || |e| ||
+ * over all its channels' points; a sensor is named when it exceeds the rule
+ * against the other sensors (at least 4 sensors) and is at least 1 % (a gain
+ * within calibration tolerance is not a fault), unless it has several
+ * channels and only one of them stands out among the channels: a gain, phase
+ * or mounting fault shows on every channel of the sensor, one channel alone
+ * is its cable, connector or reference, and that channel is named instead
+ * (against the other channels). With known sds
+ * (rcb_compare_set_sd) on every channel, chi2/dof replaces error %: named
+ * when it exceeds both the rule (ratio 4) and its own limit
+ * rcb_compare_chi2_limit(2 x points).
+ */
+typedef struct rcb_compare_outlier {
+  const char *response;  /**< the sensor, e.g. "DB.y" */
+  const char *reference; /**< NULL: the sensor over all references; else the one channel's */
+  double error_pct;      /**< its error %, % */
+  double others_lo;      /**< lowest error % of the others (sensors or channels), % */
+  double others_hi;      /**< highest error % of the others, % */
+  int by_chi2;           /**< 1: judged on chi2/dof (sds known), 0: on error % */
+  double chi2_dof;       /**< its chi2/dof (NaN without sds) */
+  double chi2_lo;        /**< lowest chi2/dof of the others (NaN without sds) */
+  double chi2_hi;        /**< highest chi2/dof of the others (NaN without sds) */
+  double threshold;      /**< the threshold it exceeded (error % or chi2/dof) */
+} rcb_compare_outlier;
+
+RCB_API size_t rcb_compare_outlier_count(const rcb_compare *c);
+RCB_API rcb_status rcb_compare_get_outlier(const rcb_compare *c, size_t i,
+                                           rcb_compare_outlier *out);
+
 /** @brief How a row of the peak table is paired. */
 typedef enum rcb_peak_match {
   RCB_PEAK_MATCHED = 0,       /**< measured peak with a model mode */

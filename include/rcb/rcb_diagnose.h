@@ -241,6 +241,110 @@ RCB_API rcb_status rcb_diag_apply_model(const rcb_diag *d, size_t rank,
  */
 RCB_API rcb_status rcb_diag_explain(const rcb_diag *d, char *buf, size_t size, size_t *needed);
 
+/* ---- Which test would tell them apart (issue #23 item 6) ---- */
+
+/**
+ * @brief The chi-square below which a plan says "these data cannot separate
+ * them": the diagnosis' BIC threshold (a candidate is significant when its
+ * BIC falls by more than 10).
+ */
+#define RCB_PLAN_SEPARATE_CHI2 10.0
+
+/**
+ * Two rival effects A and B (each one or more model parameters) that fit the
+ * data about equally, and the measurement that would tell them apart. Every
+ * figure is linear in the parameters at the model's values, on the fit's
+ * objective F (log10 scale, eq. 19 noise-model weights) over the model's own
+ * noise-free values at the measurement's channels, grid and speed:
+ *
+ * - J_A, J_B the weighted sensitivity columns (rcb_fit_jacobian) of A's and
+ *   B's parameters on the present channels; the principal angle theta is the
+ *   smallest angle between span(J_A) and span(J_B);
+ * - "A's data" is A's parameters moved along the direction of span(J_A)
+ *   closest to span(J_B) (the hardest to tell apart) by the size S that moves
+ *   F by S on its own (default 25): ||J_A dA||^2 = S;
+ * - the separating chi-square is the F by which the best-fitting B misses
+ *   A's data, min_dB ||J_A dA - J_B dB||^2 = S sin^2(theta); below
+ *   RCB_PLAN_SEPARATE_CHI2 the data cannot separate them;
+ * - a candidate channel (a response DOF, x or y of a station, per an
+ *   excitation at a station, x or y, at the test speed or another speed,
+ *   on the same frequency grid and noise model) is ranked by its gain: the
+ *   rise of the separating chi-square when its rows join the present ones,
+ *   dA kept (Fisher information along the separating direction).
+ */
+typedef struct rcb_plan rcb_plan;
+
+/**
+ * @brief Prepare a plan for model @p m (finalized; copied) against the
+ * layout of @p meas (FRFs at a fixed speed: its channels, references, kinds,
+ * frequency grid and speed; its values are not used). @p meas must stay
+ * valid until rcb_plan_run. On failure *out may hold an object with the
+ * message; destroy it.
+ */
+RCB_API rcb_status rcb_plan_create(rcb_plan **out, const rcb_model *m, const rcb_meas *meas,
+                                   const rcb_allocator *alloc);
+RCB_API void rcb_plan_destroy(rcb_plan *p);
+RCB_API const char *rcb_plan_errmsg(const rcb_plan *p);
+/**
+ * @brief Add parameter @p name (rcb_model_get_param names) to rival @p side
+ * (0: A, whose data are made; 1: B, fitted to them).
+ * @return RCB_ERR_NOT_FOUND for an unknown name, RCB_ERR_ARG for a name on
+ * both sides or given twice
+ */
+RCB_API rcb_status rcb_plan_add_param(rcb_plan *p, int side, const char *name);
+/** @brief The eq. 19 noise model, % (needed: it makes F a chi-square). */
+RCB_API rcb_status rcb_plan_set_noise_model(rcb_plan *p, double beta_a, double beta_s);
+/** @brief The size S of A's effect: the chi-square it moves F by on its own (default 25). */
+RCB_API rcb_status rcb_plan_set_size(rcb_plan *p, double chi2);
+/** @brief Another rotor speed for the candidates, rad/s (>= 0; the test speed is always one). */
+RCB_API rcb_status rcb_plan_add_speed(rcb_plan *p, double speed);
+/**
+ * @brief Compute the separability of the present data and rank the
+ * candidates. Errors: RCB_ERR_ARG (no parameter on a side, no noise model,
+ * not an FRF measurement at a fixed speed, a parameter without effect on the
+ * present channels, a rival's parameters dependent on them), RCB_ERR_NOMEM,
+ * RCB_ERR_LAPACK, and the fit's errors.
+ */
+RCB_API rcb_status rcb_plan_run(rcb_plan *p);
+
+/** @brief The separability of the present data. */
+typedef struct rcb_plan_result {
+  double angle_deg;  /**< smallest principal angle between span(J_A) and span(J_B), deg */
+  double size;       /**< S: the chi-square A's data move F by on their own */
+  double chi2_sep;   /**< S sin^2(angle): F by which the best B misses A's data */
+  int separable;     /**< chi2_sep >= RCB_PLAN_SEPARATE_CHI2 */
+  size_t residuals;  /**< residuals of the present channels */
+  size_t candidates; /**< candidate channels ranked */
+} rcb_plan_result;
+RCB_API rcb_status rcb_plan_get_result(const rcb_plan *p, rcb_plan_result *out);
+
+/** @brief One parameter of the plan, in the order added. */
+typedef struct rcb_plan_param {
+  const char *name;
+  int side;      /**< 0: A, 1: B */
+  double value;  /**< the model's value, parameter units */
+  double change; /**< A: its part of A's data (dA); B: B's best fit to them (dB); units of
+                      the parameter */
+} rcb_plan_param;
+RCB_API size_t rcb_plan_param_count(const rcb_plan *p);
+RCB_API rcb_status rcb_plan_get_param(const rcb_plan *p, size_t k, rcb_plan_param *out);
+
+/** @brief One candidate channel, by falling gain (rank 0 the best). */
+typedef struct rcb_plan_candidate {
+  const char *response;  /**< "B1.y" */
+  const char *reference; /**< the excitation, "DA.x" */
+  double speed;          /**< rotor speed, rad/s */
+  double gain;           /**< rise of the separating chi-square with this channel added */
+  double chi2_after;     /**< chi2_sep + gain */
+  double level_db;       /**< its RMS magnitude against the strongest present channel's,
+                              dB: eq. 19 scales a channel's additive noise with its own
+                              RMS, so a weak channel (x per y) ranks as if measured as
+                              cleanly as a strong one; check it would stand above your
+                              instruments' floor */
+} rcb_plan_candidate;
+RCB_API rcb_status rcb_plan_get_candidate(const rcb_plan *p, size_t rank,
+                                          rcb_plan_candidate *out);
+
 #ifdef __cplusplus
 }
 #endif

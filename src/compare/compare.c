@@ -31,7 +31,7 @@ static void free_results(rcb_compare *c) {
   void *ptrs[] = {c->grid, c->meas,  c->model, c->names, (void *)c->resp, (void *)c->ref,
                   c->kind, c->err,   c->frac,  c->lrms,  c->prms,         c->csac,
                   c->csf,  c->map,   c->peaks, c->band_first, c->band_count,
-                  c->floor, c->chi2};
+                  c->floor, c->chi2, c->outl};
   size_t k;
   for (k = 0; k < sizeof ptrs / sizeof ptrs[0]; k++) rcb_free(a, ptrs[k]);
   c->grid = NULL;
@@ -42,6 +42,8 @@ static void free_results(rcb_compare *c) {
   c->err = c->frac = c->lrms = c->prms = c->csac = c->csf = c->map = NULL;
   c->floor = c->chi2 = NULL;
   c->peaks = NULL;
+  c->outl = NULL;
+  c->noutl = 0;
   c->band_first = c->band_count = NULL;
   c->nch = c->npts = c->nbands = c->npeaks = 0;
   c->done = 0;
@@ -422,7 +424,7 @@ rcb_status rcb_compare_run(rcb_compare *c, const rcb_model *m, const rcb_meas *m
     channel_metrics(c);
     point_metrics(c);
     band_map(c);
-    st = rcb_cmp_peaks(c, &ev);
+    if (!(st = rcb_cmp_outliers(c))) st = rcb_cmp_peaks(c, &ev);
   }
   eval_free(c, &ev);
   if (st) {

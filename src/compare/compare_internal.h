@@ -30,6 +30,8 @@ struct rcb_compare {
   size_t *band_first, *band_count; /* nbands */
   double *map;                 /* nch * nbands */
   rcb_compare_peak *peaks;     /* npeaks */
+  rcb_compare_outlier *outl;   /* noutl (compare_outliers.c) */
+  size_t noutl;
   rcb_compare_summary sum;
 };
 
@@ -63,6 +65,9 @@ rcb_status rcb_cmp_modal_fit(rcb_compare *c, const double *w, const rcb_complex 
 rcb_status rcb_cmp_modal_fit_multi(rcb_compare *c, const double *w, const rcb_complex *h,
                                    size_t nch, size_t n, double wref, size_t nmodes,
                                    double *wn, double *zeta, size_t *nfound);
+
+/* Name the sensors and channels whose misfit stands out (compare_outliers.c). */
+rcb_status rcb_cmp_outliers(rcb_compare *c);
 
 /* Build the peak table (compare_peaks.c). */
 rcb_status rcb_cmp_peaks(rcb_compare *c, rcb_cmp_eval *ev);

@@ -231,6 +231,13 @@ rcb_status rcb_fit_eval(rcb_fit *f, double *r) {
   return RCB_OK;
 }
 
+rcb_status rcb_fit_residual_channels(const rcb_fit *f, size_t *ch) {
+  if (!f || !ch) return RCB_ERR_ARG;
+  if (!f->res_ch && f->nres) return RCB_ERR_STATE;
+  if (f->nres) memcpy(ch, f->res_ch, f->nres * sizeof *ch);
+  return RCB_OK;
+}
+
 double rcb_fit_error_pct(const rcb_fit *f) {
   double num = 0.0, den = 0.0;
   size_t j;

@@ -37,6 +37,11 @@ int rcb_fit_adjoint_cheaper(const rcb_fit *f);
  * rcb_fit_error, without another sweep). */
 double rcb_fit_error_pct(const rcb_fit *f);
 
+/* The channel (measurement channel index) of each residual of f's layout
+ * (rcb_fit_prepare or any evaluation first): ch[j] for j < nres, rows of
+ * rcb_fit_jacobian and rcb_fit_residuals (the plan of issue #23 sums each
+ * candidate channel's rows). RCB_ERR_STATE before a layout exists. */
+rcb_status rcb_fit_residual_channels(const rcb_fit *f, size_t *ch);
 /* One parameter's derivatives at a model: dM, dC, dG, dK over their
  * non-zero entries (DOF row, column; the units of M, C, G, K per unit of
  * the parameter) and dF/dp at unit speed (NULL when the force does not

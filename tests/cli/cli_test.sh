@@ -1018,7 +1018,7 @@ help_examples)
   mkdir "$W/x"; ln -s "$EX" "$W/x/examples"
   n=0
   for c in check matrices frf unbalance modes campbell simulate convert fit sensitivity compare \
-           diagnose history monitor transient order estimate timecheck; do
+           diagnose plan history monitor transient order estimate timecheck; do
     # order reads the run-up that transient's example writes (a build with SUNDIALS)
     [ "$c" = order ] && [ ! -e "$W/x/runup.csv" ] && continue
     run "$c" --help; expect_rc 0
@@ -1035,7 +1035,7 @@ help_examples)
   # docs/rcbtool.md's synopsis lists every command
   doc="$EX/../docs/rcbtool.md"
   for c in check matrices frf unbalance modes campbell simulate convert fit sensitivity compare \
-           diagnose history monitor transient timecheck; do
+           diagnose plan history monitor transient timecheck; do
     sed -n '/^## Synopsis/,/^## /p' "$doc" | grep -q "rcbtool $c " || fail "synopsis lacks $c"
   done ;;
 # ==== end of the bad-input catalogue ====
@@ -1065,6 +1065,40 @@ assert d["peaks"] and all(p["match"] != "measured_only" for p in d["peaks"]), d[
 EOF2
   run compare "$MODEL" "$W/self.csv"; expect_rc 0
   out_has "overall: error 0 %"; out_has "worst bands"; out_has "peaks (measured resonances vs model modes" ;;
+compare_outlier)
+  # issue #23: a probe reading 20 % low (DB.y scaled by 0.8 in the file) is named, with
+  # the others' range; the same data with the gain right name nothing
+  run simulate "$MODEL" --frf --out C.A.x,C.A.y,C.B.x,C.B.y,DA.x,DB.y --in DA.x --fmin 5 \
+    --fmax 400 --points 400 --rpm 3000 --kind inertance --noise 10,1 --seed 3 -o "$W/ok.csv"
+  [ "$RC" -eq 0 ] || { [ "$RC" -eq 2 ] && grep -q "unknown command" "$W/err" && exit 77; fail "simulate failed"; }
+  awk -F, 'BEGIN { OFS = ","; CONVFMT = "%.17g"; OFMT = "%.17g" }
+    /^#/ || /^freq/ { print; next } { $12 *= 0.8; $13 *= 0.8; print }' "$W/ok.csv" >"$W/low.csv"
+  run compare "$MODEL" "$W/low.csv"; expect_rc 0
+  grep -q '^DB.y: [0-9.]* % where the other sensors are [0-9.]*-[0-9.]* %: check this sensor (gain, phase, mounting) before the model$' "$W/out" ||
+    fail "DB.y not named"
+  [ "$(grep -c 'check this' "$W/out")" -eq 1 ] || fail "more than one outlier named"
+  run compare "$MODEL" "$W/low.csv" --json; expect_rc 0; json_ok
+  python3 - "$W/out" <<'EOF2' || fail "outliers JSON wrong"
+import json, statistics, sys
+d = json.load(open(sys.argv[1]))
+o = d["outliers"]
+assert len(o) == 1 and o[0]["response"] == "DB.y" and o[0]["reference"] is None, o
+err = {c["response"]: c["error_pct"] for c in d["channels"]}
+others = [v for k, v in err.items() if k != "DB.y"]
+assert abs(o[0]["error_pct"] - err["DB.y"]) < 1e-9 * err["DB.y"]
+assert o[0]["others_lo"] == min(others) and o[0]["others_hi"] == max(others)
+med = statistics.median(others)
+mad = statistics.median(abs(v - med) for v in others)
+thr = max(2 * med, med + 6 * 1.4826 * mad)
+assert abs(o[0]["threshold"] - thr) < 1e-9 * thr and err["DB.y"] > thr, (thr, o)
+assert o[0]["by_chi2"] is False and o[0]["chi2_dof"] is None
+EOF2
+  run compare "$MODEL" "$W/ok.csv" --json; expect_rc 0
+  python3 -c 'import json,sys; assert json.load(open(sys.argv[1]))["outliers"] == []' "$W/out" ||
+    fail "an outlier named in the null case"
+  run compare "$MODEL" "$W/ok.csv"; expect_rc 0
+  grep -q 'check this' "$W/out" && fail "an outlier named in the null case"
+  : ;;
 compare_shift)
   # a model with the coupling's kt at 20e3 instead of 46.095e3 vs noisy data of the true
   # system (UFF): errors show, the peak near 160 Hz (a shoulder of the 150 Hz one: found
@@ -1177,6 +1211,61 @@ PY
   expect_rc 0; out_has "bearing.B2.kcross"
   run history "$W/h.jsonl"; expect_rc 0; out_has "apply"; out_has "error % by step"
   [ "$(wc -l <"$W/h.jsonl")" -eq 3 ] || fail "history should hold 3 steps" ;;
+plan_separate)
+  # issue #23 item 6: the separability figure and the ranking, checked against their
+  # definitions from the JSON: chi2_sep = size sin^2(angle), the verdict at 10, the
+  # candidates by falling gain with chi2_after = chi2_sep + gain, no present channel
+  run simulate "$MODEL" --frf --out C.A.x,C.A.y,C.B.x,C.B.y --in DA.x --fmin 200 --fmax 400 \
+    --points 101 --rpm 10000 --kind inertance -o "$W/layout.csv"
+  [ "$RC" -eq 0 ] || { [ "$RC" -eq 2 ] && grep -q "unknown command" "$W/err" && exit 77; fail "simulate failed"; }
+  run plan "$MODEL" "$W/layout.csv" --between bearing.B2.kyy coupling.C.kr --noise 10,1 \
+    --rpm-list 6000 --top 500 --json
+  expect_rc 0; json_ok
+  python3 - "$W/out" <<'EOF2' || fail "plan JSON wrong"
+import json, math, sys
+d = json.load(open(sys.argv[1]))
+assert d["size"] == 25 and d["threshold"] == 10 and d["rpm"] == 10000
+assert abs(d["chi2_sep"] - 25 * math.sin(math.radians(d["angle_deg"])) ** 2) < 1e-6 * d["chi2_sep"]
+assert d["separable"] == (d["chi2_sep"] >= 10)
+assert [p["side"] for p in d["params"]] == ["A", "B"]
+c = d["candidates"]
+assert len(c) > 20 and {round(x["rpm"], 6) for x in c} == {10000, 6000}
+assert all(a["gain"] >= b["gain"] >= 0 for a, b in zip(c, c[1:]))
+assert all(abs(x["chi2_after"] - d["chi2_sep"] - x["gain"]) < 1e-9 * x["chi2_after"] for x in c)
+present = {("C.A.x", "DA.x"), ("C.A.y", "DA.x"), ("C.B.x", "DA.x"), ("C.B.y", "DA.x")}
+assert not any((x["response"], x["reference"]) in present and abs(x["rpm"] - 10000) < 1e-6 for x in c)
+EOF2
+  run plan "$MODEL" "$W/layout.csv" --between bearing.B2.kyy --and coupling.C.kr --noise 10,1
+  expect_rc 0
+  out_has "principal angle"; out_has "separating chi-square"
+  [ "$(grep -c '^[0-9]' "$W/out")" -eq 10 ] || fail "--top defaults to 10 rows" ;;
+plan_cannot_separate)
+  # a symmetric rotor measured at its midspan disk only (D.y per D.y, at rest): the two
+  # bearings' y stiffnesses look the same there; a y channel at a bearing tells them apart
+  printf '%s\n' "[material steel]" "density = 7800" "young = 2.1e11" "poisson = 0.3" \
+    "[shaft A]" "material = steel" "shear_factor = 0.9" "segment = 0.8 0.03 0.0 8" \
+    "[disk D]" "at = A 0.40" "mass = 20" "Id = 0.1" "Ip = 0.2" \
+    "[bearing B1]" "at = A 0.0" "kxx = 2e7" "kyy = 2e7" "cxx = 500" "cyy = 500" \
+    "[bearing B2]" "at = A 0.8" "kxx = 2e7" "kyy = 2e7" "cxx = 500" "cyy = 500" >"$W/sym.ini"
+  run simulate "$W/sym.ini" --frf --out D.y --in D.y --fmin 10 --fmax 300 --points 150 \
+    --rpm 0 -o "$W/mid.csv"
+  [ "$RC" -eq 0 ] || { [ "$RC" -eq 2 ] && grep -q "unknown command" "$W/err" && exit 77; fail "simulate failed"; }
+  run plan "$W/sym.ini" "$W/mid.csv" --between bearing.B1.kyy bearing.B2.kyy --noise 10,1
+  expect_rc 0
+  out_has "these data cannot separate them"
+  grep -q '^1  *B[12]\.y  *[A-Z0-9.]*y ' "$W/out" || grep -q '^1  *[A-Z0-9.]*y  *B[12]\.y ' "$W/out" ||
+    fail "the first candidate is not a y channel at a bearing"
+  grep -q '^1 .*separates$' "$W/out" || fail "the first candidate does not separate them" ;;
+plan_usage)
+  printf '# kind = inertance\n# rpm = 10000\nfreq_hz,C.A.x/DA.x re,C.A.x/DA.x im\n200,1,2\n300,1,3\n' >"$W/m.csv"
+  run plan --help; expect_rc 0; out_has "usage: rcbtool plan"; out_has "--between A"
+  usage plan "$MODEL" "$W/m.csv" --noise 10,1; err_has "--between"
+  usage plan "$MODEL" "$W/m.csv" --between coupling.C.kt coupling.C.kr; err_has "--noise"
+  usage plan "$MODEL" "$W/m.csv" --between coupling.C.kt coupling.C.kr --noise 10
+  run plan "$MODEL" "$W/m.csv" --between coupling.C.kt coupling.C.zz --noise 10,1
+  expect_rc 3; err_has "coupling.C.zz"; out_empty
+  run plan "$MODEL" "$W/m.csv" --between coupling.C.kt coupling.C.kt --noise 10,1
+  expect_rc 3; err_has "both sides" ;;
 diagnose_usage)
   printf '# kind = inertance\n# rpm = 10000\nfreq_hz,C.A.x/DA.x re,C.A.x/DA.x im\n200,1,2\n300,1,3\n' >"$W/m.csv"
   usage diagnose "$MODEL"; err_has "missing the measurement"

@@ -233,3 +233,23 @@ def test_handles_close_once(rcb):
     m.close()  # twice: no-op
     with pytest.raises(ValueError, match="closed"):
         m.dofs
+
+
+def test_compare_names_a_low_sensor(rcb, paper):
+    """Issue #23: a probe reading 20 % low (DB.y x 0.8) is named in "outliers",
+    with the others' range; the same data with the gain right name nothing."""
+    outs = ["C.A.x", "C.A.y", "C.B.x", "C.B.y", "DA.x", "DB.y"]
+    f = np.linspace(5, 400, 300)
+    ok = rcb.simulate(paper, outs, ["DA.x"], f, rpm=3000, kind="inertance", noise=(10, 1),
+                      seed=3)
+    data = ok.data.copy()
+    data[5] *= 0.8
+    low = rcb.Meas.from_arrays(f, data, outs, ["DA.x"] * 6, kind="inertance", rpm=3000)
+    c = rcb.compare(paper, low)
+    assert [o["response"] for o in c["outliers"]] == ["DB.y"]
+    o = c["outliers"][0]
+    err = [ch["error_pct"] for ch in c["channels"]]
+    assert o["reference"] is None and not o["by_chi2"]
+    assert o["error_pct"] == pytest.approx(err[5])
+    assert o["others_lo"] == min(err[:5]) and o["others_hi"] == max(err[:5])
+    assert rcb.compare(paper, ok)["outliers"] == []

@@ -371,6 +371,7 @@ int cmd_transient(int argc, char **argv);
 int cmd_timecheck(int argc, char **argv);
 int cmd_compare(int argc, char **argv);
 int cmd_diagnose(int argc, char **argv);
+int cmd_plan(int argc, char **argv);
 int cmd_history(int argc, char **argv);
 int cmd_monitor(int argc, char **argv);
 
@@ -390,6 +391,7 @@ extern const char cli_help_transient[];
 extern const char cli_help_timecheck[];
 extern const char cli_help_compare[];
 extern const char cli_help_diagnose[];
+extern const char cli_help_plan[];
 extern const char cli_help_history[];
 extern const char cli_help_monitor[];
 

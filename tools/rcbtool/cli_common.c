@@ -118,6 +118,8 @@ static const char *const examples[][2] = {
     {"diagnose", "rcbtool diagnose fitted.ini meas.csv --params "
                  "coupling.C.kt,coupling.C.kr,coupling.C.ct --log --noise 10,1 --history "
                  "session.jsonl"},
+    {"plan", "rcbtool plan fitted.ini meas.csv --between bearing.B2.kyy coupling.C.kr "
+             "--noise 10,1 --rpm-list 6000 --top 5"},
     {"history", "rcbtool history session.jsonl"},
     {"monitor", "rcbtool monitor fitted.ini meas.csv meas.csv --params coupling.C.kt,coupling.C.kr "
                 "--noise 10,1 --log monitor.csv"},

@@ -51,11 +51,20 @@ const char cli_help_compare[] =
     "and synchronous FRFs): frequency error % (mode wd and the model's own peak),\n"
     "damping error %, measured/model amplitude ratio; measured peaks without a model\n"
     "mode and model modes without a measured peak are named as such.\n"
+    "A sensor (a response over all its references) whose error % exceeds\n"
+    "max(2 x the median of the other sensors', median + 6 x 1.4826 x their MAD) and\n"
+    "1 % is named with a line \"check this sensor (gain, phase, mounting) before the\n"
+    "model\" (at least 4 sensors); with --sd, its chi2/dof against 4 x the median,\n"
+    "the MAD term and its own 0.999 chi-square limit. A sensor with several\n"
+    "references that stands out on one channel only has that channel named instead\n"
+    "(against the other channels: its cable, connector or reference).\n"
     "Abscissa on output: Hz for FRFs, rpm for unbalance responses.\n"
     "JSON: {\"type\", \"x_unit\", \"x\": [...], \"rpm\", \"summary\": {...}, \"channels\":\n"
     "[{\"response\", \"reference\", \"kind\", \"error_pct\", \"frac\", \"log_rms\",\n"
     "\"phase_rms_deg\", \"floor_pct\", \"chi2_dof\" (null without --sd), \"meas_re\",\n"
-    "\"meas_im\", \"model_re\", \"model_im\"}], \"csac\",\n"
+    "\"meas_im\", \"model_re\", \"model_im\"}], \"outliers\": [{\"response\", \"reference\",\n"
+    "\"error_pct\", \"others_lo\", \"others_hi\", \"by_chi2\", \"chi2_dof\", \"chi2_lo\",\n"
+    "\"chi2_hi\", \"threshold\"}], \"csac\",\n"
     "\"csf\", \"bands\": [{\"lo\", \"hi\", \"first\", \"count\", \"rms\"}], \"residual_map\":\n"
     "[[per band] per channel], \"worst_bands\": [...], \"peaks\": [{\"match\", ...}]}\n"
     "Exit codes: 2 usage, 3 bad model or measurement (a channel the model does not\n"
@@ -160,6 +169,30 @@ static void print_channels(FILE *fp, const rcb_compare *c) {
   }
 }
 
+/* One line per sensor or channel whose misfit stands out (rcb_compare_outlier). */
+static void print_outliers(FILE *fp, const rcb_compare *c) {
+  size_t i, n = rcb_compare_outlier_count(c);
+  for (i = 0; i < n; i++) {
+    rcb_compare_outlier o;
+    rcb_compare_get_outlier(c, i, &o);
+    fputs(i ? "" : "\n", fp);
+    if (o.reference)
+      fprintf(fp, "%s/%s: ", o.response, o.reference);
+    else
+      fprintf(fp, "%s: ", o.response);
+    if (o.by_chi2)
+      fprintf(fp, "chi2/dof %.3g where the other %s are %.3g-%.3g (error %.3g %%, the others "
+              "%.3g-%.3g %%)", o.chi2_dof, o.reference ? "channels" : "sensors", o.chi2_lo,
+              o.chi2_hi, o.error_pct, o.others_lo, o.others_hi);
+    else
+      fprintf(fp, "%.3g %% where the other %s are %.3g-%.3g %%", o.error_pct,
+              o.reference ? "channels" : "sensors", o.others_lo, o.others_hi);
+    fprintf(fp, ": check this %s before the model\n",
+            o.reference ? "channel (cable, connector, reference)"
+                        : "sensor (gain, phase, mounting)");
+  }
+}
+
 static void print_bands(FILE *fp, const rcb_compare *c, const cmp_job *j, const size_t *ord) {
   size_t nb = rcb_compare_band_count(c), nch = rcb_compare_channel_count(c), r, k;
   const double *map = rcb_compare_residual_map(c);
@@ -244,6 +277,7 @@ static void print_text(FILE *fp, const cli_args *a, const cmp_job *j, const rcb_
           rcb_compare_point_count(c), rcb_compare_grid(c)[0] * j->xscale,
           rcb_compare_grid(c)[rcb_compare_point_count(c) - 1] * j->xscale, j->xunit);
   print_channels(fp, c);
+  print_outliers(fp, c);
   print_bands(fp, c, j, ord);
   print_peaks(fp, c, j);
 }
@@ -297,6 +331,32 @@ static void json_channels(FILE *fp, const rcb_compare *c) {
     fputc('}', fp);
   }
   fputs("]", fp);
+}
+
+static void json_outliers(FILE *fp, const rcb_compare *c) {
+  size_t i, n = rcb_compare_outlier_count(c);
+  fputs(",\n\"outliers\": [", fp);
+  for (i = 0; i < n; i++) {
+    rcb_compare_outlier o;
+    rcb_compare_get_outlier(c, i, &o);
+    fputs(i ? ",\n {\"response\": " : "\n {\"response\": ", fp);
+    cli_json_str(fp, o.response);
+    fputs(", \"reference\": ", fp);
+    if (o.reference)
+      cli_json_str(fp, o.reference);
+    else
+      fputs("null", fp);
+    json_key_num(fp, "error_pct", o.error_pct, 1);
+    json_key_num(fp, "others_lo", o.others_lo, 1);
+    json_key_num(fp, "others_hi", o.others_hi, 1);
+    fprintf(fp, ", \"by_chi2\": %s", o.by_chi2 ? "true" : "false");
+    json_key_num(fp, "chi2_dof", o.chi2_dof, 1);
+    json_key_num(fp, "chi2_lo", o.chi2_lo, 1);
+    json_key_num(fp, "chi2_hi", o.chi2_hi, 1);
+    json_key_num(fp, "threshold", o.threshold, 1);
+    fputc('}', fp);
+  }
+  fputc(']', fp);
 }
 
 static void json_bands(FILE *fp, const rcb_compare *c, const cmp_job *j, const size_t *ord) {
@@ -386,6 +446,7 @@ static void print_json(FILE *fp, const cli_args *a, const cmp_job *j, const rcb_
   json_key_num(fp, "chi2_dof", s.chi2_dof, 1);
   fputc('}', fp);
   json_channels(fp, c);
+  json_outliers(fp, c);
   fputs(",\n\"csac\": ", fp);
   cli_json_nums(fp, rcb_compare_csac(c), n, 1);
   fputs(",\n\"csf\": ", fp);

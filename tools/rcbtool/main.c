@@ -32,6 +32,8 @@ static const cli_command commands[] = {
      cli_help_compare, cmd_compare},
     {"diagnose", "which physical effect is missing, and where; --apply adds it (fitted)",
      cli_help_diagnose, cmd_diagnose},
+    {"plan", "which added channel (or speed) would tell two rival effects apart",
+     cli_help_plan, cmd_plan},
     {"history", "the steps of a session (fit, diagnose, apply) and the error falling",
      cli_help_history, cmd_history},
     {"monitor", "condition monitoring of a series of measurements: alarms, effect, trend",

@@ -117,6 +117,13 @@ class CompareChannel(ctypes.Structure):
                 ("floor_pct", c_double), ("chi2_dof", c_double)]
 
 
+class CompareOutlier(ctypes.Structure):
+    _fields_ = [("response", c_char_p), ("reference", c_char_p), ("error_pct", c_double),
+                ("others_lo", c_double), ("others_hi", c_double), ("by_chi2", c_int),
+                ("chi2_dof", c_double), ("chi2_lo", c_double), ("chi2_hi", c_double),
+                ("threshold", c_double)]
+
+
 class CompareSummary(ctypes.Structure):
     _fields_ = [("error_pct", c_double), ("frac_mean", c_double), ("log_rms", c_double),
                 ("phase_rms_deg", c_double), ("csac_mean", c_double),
@@ -287,6 +294,8 @@ _PROTOTYPES = {
     "rcb_compare_get_channel": (c_int, [c_void_p, c_size_t, ctypes.POINTER(CompareChannel)]),
     "rcb_compare_get_summary": (c_int, [c_void_p, ctypes.POINTER(CompareSummary)]),
     "rcb_compare_point_count": (c_size_t, [c_void_p]),
+    "rcb_compare_outlier_count": (c_size_t, [c_void_p]),
+    "rcb_compare_get_outlier": (c_int, [c_void_p, c_size_t, ctypes.POINTER(CompareOutlier)]),
     "rcb_compare_grid": (c_double_p, [c_void_p]),
     # monitoring
     "rcb_monitor_create": (c_int, [PP, c_void_p, c_void_p, ctypes.POINTER(MonitorOpts),

@@ -232,7 +232,9 @@ class _Compare(Handle):
 
 def compare(model, meas):
     """Model vs measurement: summary (error %, FRAC, CSAC...) and per-channel
-    measures with both value arrays, as plain dicts and numpy arrays."""
+    measures with both value arrays, as plain dicts and numpy arrays; "outliers":
+    the sensors (and channels) whose error stands out from the others'
+    (rcb_compare_outlier: check them before the model)."""
     L = _lib.lib()
     with _Compare() as c:
         c.check(L.rcb_compare_run(c.handle, model.handle, meas.handle), "rcb_compare_run")
@@ -250,9 +252,16 @@ def compare(model, meas):
                           "reference": _lib.text(ch.reference), "error_pct": ch.error_pct,
                           "frac": ch.frac, "log_rms": ch.log_rms,
                           "phase_rms_deg": ch.phase_rms_deg, "meas": arr[0], "model": arr[1]})
+        outliers = []
+        o = _lib.CompareOutlier()
+        for i in range(L.rcb_compare_outlier_count(c.handle)):
+            c.check(L.rcb_compare_get_outlier(c.handle, i, ctypes.byref(o)))
+            outliers.append({k: (_lib.text(getattr(o, k)) if k in ("response", "reference")
+                                 else bool(o.by_chi2) if k == "by_chi2" else getattr(o, k))
+                             for k, _ in _lib.CompareOutlier._fields_})
     x = grid / (2 * math.pi if meas.type == "frf" else RPM)
     return {"x": x, "summary": {k: getattr(s, k) for k, _ in _lib.CompareSummary._fields_},
-            "channels": chans}
+            "channels": chans, "outliers": outliers}
 
 
 def claim(delta_bic, error_before_pct, error_after_pct, chi2=float("nan"),
