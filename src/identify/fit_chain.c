@@ -273,6 +273,21 @@ rcb_status rcb_fit_get_sensor(const rcb_fit *f, const char *response, double *ga
   return RCB_OK;
 }
 
+rcb_status rcb_fit_set_chain_value(rcb_fit *f, const char *name, double v) {
+  size_t k;
+  if (!f || !name) return RCB_ERR_ARG;
+  for (k = 0; k < f->np; k++) {
+    rcb_fit_par *p = &f->par[k];
+    if (!p->chain || strcmp(p->name, name) != 0) continue;
+    if (!(v >= p->lo && v <= p->hi))
+      return rcb_fit_fail(f, RCB_ERR_ARG, "%s = %g: outside its bounds [%g, %g]", name, v,
+                          p->lo, p->hi);
+    p->start = p->value = v; /* as rcb_fit_add_param reads a model parameter's */
+    return rcb_fit_par_set(f, k, v);
+  }
+  return rcb_fit_fail(f, RCB_ERR_ARG, "%s: not a sensor parameter of this fit", name);
+}
+
 size_t rcb_fit_sensor_count(const rcb_fit *f) { return f ? f->nsens : 0; }
 
 const char *rcb_fit_sensor_response(const rcb_fit *f, size_t k) {

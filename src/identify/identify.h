@@ -77,5 +77,11 @@ int rcb_fit_param_is_chain(const char *name);
  * (owned by the measurement), NULL past the end. */
 size_t rcb_fit_sensor_count(const rcb_fit *f);
 const char *rcb_fit_sensor_response(const rcb_fit *f, size_t k);
+/* Move chain parameter name, already added to f, to value v (its units,
+ * within its bounds): where a chain parameter lives between fits, as a
+ * model parameter lives in the model (the diagnosis keeps a candidate's
+ * fitted gain from its screen to its polish). RCB_ERR_ARG when name is not
+ * a chain parameter of f or v is outside its bounds. */
+rcb_status rcb_fit_set_chain_value(rcb_fit *f, const char *name, double v);
 
 #endif /* RCB_IDENTIFY_INTERNAL_API_H */
