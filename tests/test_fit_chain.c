@@ -442,6 +442,23 @@ static void test_chain_errors(void **state) {
   /* a chain parameter has no dZ/dp */
   assert_int_equal(rcb_fit_dz_get(f, NULL, dz), RCB_ERR_ARG);
   assert_non_null(strstr(rcb_fit_errmsg(f), "measurement chain"));
+  /* its value moved between fits (rcb_fit_set_chain_value): the fitted gain
+   * 0.9 on the fixed -1 reads as the fixed edit -0.9 does */
+  assert_int_equal(rcb_fit_set_sensor(f, "DB.y", -1.0, 0.0), RCB_OK);
+  assert_int_equal(rcb_fit_set_chain_value(f, "sensor.DB.y.gain", 20.0), RCB_ERR_ARG);
+  assert_int_equal(rcb_fit_set_chain_value(f, "sensor.DB.x.gain", 0.9), RCB_ERR_ARG);
+  assert_int_equal(rcb_fit_set_chain_value(f, "coupling.C.kt", 0.9), RCB_ERR_ARG);
+  assert_int_equal(rcb_fit_set_chain_value(f, "sensor.DB.y.gain", 0.9), RCB_OK);
+  {
+    rcb_fit_param p;
+    double F1 = objective(f), F2;
+    assert_int_equal(rcb_fit_get_param(f, 0, &p), RCB_OK);
+    assert_true(p.value == 0.9 && p.start == 0.9);
+    assert_int_equal(rcb_fit_set_chain_value(f, "sensor.DB.y.gain", 1.0), RCB_OK);
+    assert_int_equal(rcb_fit_set_sensor(f, "DB.y", -0.9, 0.0), RCB_OK);
+    F2 = objective(f);
+    if (!rcb_test_close(F1, F2, 1e-12, 0)) fail_msg("fitted 0.9: F %.17g, fixed: %.17g", F1, F2);
+  }
   rcb_fit_destroy(f);
 
   assert_int_equal(rcb_fit_create(&f, m, ms_part, NULL), RCB_OK);
