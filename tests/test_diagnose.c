@@ -396,7 +396,11 @@ static void test_large_screen(void **state) {
     rcb_diag_candidate c;
     double F, Fp;
     assert_int_equal(rcb_diag_candidate_get(d, k, &c), RCB_OK);
-    if (!c.refitted || !c.screened_only) continue;
+    /* a fault of the measurement chain has no model to apply (the two
+     * probes of a station swapped) */
+    if (!c.refitted || !c.screened_only ||
+        (c.effect >= RCB_EFFECT_SENSOR_GAIN && c.effect <= RCB_EFFECT_SENSOR_SWAP))
+      continue;
     F = candidate_F(d, &c);
     Fp = polished_F(d, ms, k);
     print_message("  screened only: %s: F %.6g, polished %.6g (the first %.6g)\n",
