@@ -52,6 +52,45 @@ typedef enum rcb_effect {
 /** @brief Short English name of an effect. */
 RCB_API const char *rcb_effect_name(rcb_effect e);
 
+/**
+ * @brief What the data let a tool say of an edit of a model (issue #23): the
+ * one rule behind every word ("significant", "explains", "at the floor") in
+ * the library's explanation, rcbtool's text, table, JSON, --apply and
+ * history, and the Python package, which all call these functions.
+ *
+ * - significant: BIC falls by more than 10 ("strong" evidence, Kass &
+ *   Raftery) and the error % falls by at least 2 % of itself;
+ * - adequate: the model with the edit passes the adequacy test of
+ *   rcb_fit_get_adequacy (chi2 <= chi2_limit, 1 % false rejections); unknown
+ *   when the noise is unknown (chi2_limit NaN);
+ * - the claim: RCB_CLAIM_EXPLAINS when significant and adequate,
+ *   RCB_CLAIM_IMPROVES when significant only (it lowers the misfit, and
+ *   something is still missing, or the noise is unknown), else
+ *   RCB_CLAIM_NONE.
+ */
+typedef enum rcb_claim {
+  RCB_CLAIM_NONE = 0,     /**< not significant: nothing may be said of it */
+  RCB_CLAIM_IMPROVES = 1, /**< significant, but not shown consistent with the data */
+  RCB_CLAIM_EXPLAINS = 2  /**< significant, and consistent with the data */
+} rcb_claim;
+typedef struct rcb_evidence {
+  double delta_bic;        /**< BIC change of the edit (-; negative is better) */
+  double error_before_pct; /**< error % without the edit */
+  double error_after_pct;  /**< error % with it */
+  double chi2;             /**< F with the edit (-) */
+  double chi2_limit;       /**< the adequacy test's limit (-); NaN: the noise is unknown */
+} rcb_evidence;
+#define RCB_BIC_SIGNIFICANT (-10.0) /**< dBIC below this is significant */
+#define RCB_ERROR_FALL 0.98         /**< and the error below this fraction of the one before */
+/** @brief 1 when significant, else 0. */
+RCB_API int rcb_evidence_significant(const rcb_evidence *e);
+/** @brief 1 adequate, 0 not, -1 unknown (no noise model, no standard deviations). */
+RCB_API int rcb_evidence_adequate(const rcb_evidence *e);
+/** @brief The claim the evidence supports. */
+RCB_API rcb_claim rcb_evidence_claim(const rcb_evidence *e);
+/** @brief "explains", "improves" or "none" (the JSON and Python spelling). */
+RCB_API const char *rcb_claim_str(rcb_claim c);
+
 typedef struct rcb_diag rcb_diag;
 
 /**
@@ -128,6 +167,12 @@ typedef struct rcb_diag_candidate {
   double delta_bic;         /**< BIC change (negative is better; NaN if not refitted) */
   int significant;          /**< refitted, BIC falls by > 10 and the error falls */
   const char *fitted;       /**< "name = value, ..." of the refit (candidate's params) */
+  rcb_claim claim;          /**< what may be said of it (rcb_evidence_claim) */
+  int adequate;             /**< 1: the model with it passes the adequacy test, 0: not,
+                                 -1: unknown (no noise known, or not refitted) */
+  double chi2, chi2_limit;  /**< its F and the adequacy limit (NaN: unknown) */
+  int chain;                /**< 1: a fault of the measurement chain (a sensor), not of
+                                 the model: --apply refuses, the model is not changed */
   int screened_only;        /**< 1 when the refit was fitted on a frequency subset only
                                  and evaluated on all points where it ended there, as its
                                  objective was over 10 % above the best refit's (large sets,
@@ -142,6 +187,33 @@ RCB_API rcb_status rcb_diag_candidate_get(const rcb_diag *d, size_t rank,
 /** @brief Error % and objective of the model as it is, after fitting its own parameters. */
 RCB_API rcb_status rcb_diag_baseline(const rcb_diag *d, double *error_pct, double *objective,
                                      double *floor_pct);
+/**
+ * @brief The adequacy test of the model as it is, after fitting its own
+ * parameters (rcb_fit_get_adequacy; known = 0 without a noise model or
+ * standard deviations).
+ */
+RCB_API rcb_status rcb_diag_adequacy(const rcb_diag *d, rcb_fit_adequacy *out);
+/** @brief Where the misfit of the model as it is concentrates: one response sensor. */
+typedef struct rcb_diag_misfit {
+  const char *sensor;   /**< the response (station.direction), over all its references */
+  double chi2;          /**< its part of F (-) */
+  double expected, sd;  /**< what the noise alone leaves there: mean, sd (-) */
+  double excess_pct;    /**< its share of F's excess over the expectation, % */
+  int concentrated;     /**< 1: its excess is above the others' by the rule of
+                             rcb_diag_misfit_get (a sensor to check first) */
+} rcb_diag_misfit;
+/** @brief Sensors of the measurement (0 before a run or without a known noise). */
+RCB_API size_t rcb_diag_misfit_count(const rcb_diag *d);
+/**
+ * @brief Sensor @p k, the largest excess first. The misfit concentrates on
+ * one sensor, or on two (a swapped pair), when they hold at least 80 % of
+ * F's excess over the noise, each fails its own adequacy test beyond a
+ * Bonferroni limit over the sensors (z = (chi2 - expected) / sd above the
+ * normal quantile of 0.01 / sensors) and its chi2 / expected is at least
+ * 3 x the median of the other sensors' (a fault of a sensor, not an effect
+ * every sensor sees).
+ */
+RCB_API rcb_status rcb_diag_misfit_get(const rcb_diag *d, size_t k, rcb_diag_misfit *out);
 /** @brief Work done by the last rcb_diag_run (for benchmarks and progress reports). */
 typedef struct rcb_diag_stats {
   size_t evaluations; /**< model sweeps over the measured points (a Jacobian counts one) */

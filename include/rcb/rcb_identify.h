@@ -251,6 +251,41 @@ typedef struct rcb_fit_report {
 RCB_API rcb_status rcb_fit_get_report(const rcb_fit *f, rcb_fit_report *out);
 
 /**
+ * @brief The adequacy test of a model (issue #23): is what the fit leaves
+ * what the noise alone would leave? With known standard deviations
+ * (rcb_fit_set_sd) every weighted residual is N(0, 1) and F a chi-square of
+ * N - np degrees of freedom; with the eq. 19 noise model F's null
+ * distribution is calibrated by drawing that noise (io/noise.c, its own
+ * generator and a fixed seed: the same figures every run) on the model's
+ * values at every residual, 16 draws each, weighted as the fit weights the
+ * data. The residuals are independent, so F's mean and variance are the
+ * sums of theirs (a relative error of about 1/sqrt(16 N) on 32 x 1101). The
+ * model is adequate when F <= limit = mean - np + 2.326 sd: 1 % of
+ * adequate models are rejected (F is a sum of N terms: normal to a good
+ * approximation). Without either (known = 0) nothing is tested: the noise is
+ * unknown.
+ */
+typedef struct rcb_fit_adequacy {
+  int known;       /**< 1: the noise is known (a noise model or standard deviations) */
+  double chi2;     /**< F, the weighted objective at the model's current values (-) */
+  double dof;      /**< residuals less fitted parameters (-) */
+  double expected; /**< F's mean under the noise alone, less np (-) */
+  double sd;       /**< F's standard deviation under the noise alone (-) */
+  double limit;    /**< expected + RCB_ADEQUACY_Z sd (-); NaN when not known */
+  int adequate;    /**< known and chi2 <= limit */
+} rcb_fit_adequacy;
+/** One-sided normal quantile of the adequacy test: 1 % false rejections. */
+#define RCB_ADEQUACY_Z 2.3263478740408408
+/**
+ * @brief The adequacy test at the model's current values (one sweep).
+ * @param chi2_ch, expected_ch, sd_ch: when not NULL, per channel
+ * (rcb_meas_channel_count entries): its part of F, of the mean and the sd
+ * (channels are independent: where the misfit concentrates).
+ */
+RCB_API rcb_status rcb_fit_get_adequacy(rcb_fit *f, rcb_fit_adequacy *out, double *chi2_ch,
+                                        double *expected_ch, double *sd_ch);
+
+/**
  * @brief Why the last run stopped. Anything but RCB_FIT_STOP_CONVERGED makes
  * the report unsure. (A non-finite objective is not a stop reason: rcb_fit_run
  * fails with RCB_ERR_NOT_CONVERGED, naming where it appeared.)

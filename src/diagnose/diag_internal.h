@@ -60,6 +60,9 @@ typedef struct diag_cand {
   double screen_F;                  /* the screen's objective on the subset */
   int screen_unsure, screen_floor;  /* it ended unsure; at the noise floor */
   int refitted, significant;
+  rcb_claim claim;                  /* rcb_evidence_claim of its refit */
+  int adequate;                     /* rcb_evidence_adequate (-1: unknown) */
+  double chi2_limit;                /* the adequacy limit of its refit (NaN: unknown) */
   int polished;                     /* refitted on all points (0: evaluated where its
                                        screen ended: F and dbic upper bounds) */
   double F, err, dbic;
@@ -101,6 +104,12 @@ struct rcb_diag {
   int screen_floor;                 /* a refit's screen ended at the noise floor */
   char drift[256];                  /* which parameter ran off, in words */
   double F0, err0, floor0;
+  rcb_fit_adequacy adeq0;           /* the adequacy test of the model as it is */
+  double adeq_mean, adeq_sd;        /* F's mean (no parameter fitted) and sd under the
+                                       noise alone: every refit's limit comes from them */
+  size_t nbase_fit;                 /* parameters the baseline fitted */
+  rcb_diag_misfit *mis;             /* per response sensor, the largest excess first */
+  size_t nmis;
   size_t nres;
   diag_cand *cand;
   size_t ncand, cap_cand;

@@ -13,8 +13,6 @@
 #include "diagnose/diag_internal.h"
 #include "identify/identify.h"
 
-#define RCB_DIAG_BIC_MIN (-10.0) /* "strong" evidence (Kass & Raftery) */
-#define RCB_DIAG_ERR_FALL 0.98   /* the error must fall by at least 2 % of itself */
 
 rcb_status rcb_diag_create(rcb_diag **out, const rcb_model *m, const rcb_meas *meas,
                            const rcb_allocator *alloc) {
@@ -43,6 +41,9 @@ static void free_results(rcb_diag *d) {
   rcb_free(&d->alloc, d->order);
   rcb_model_destroy(d->base_model);
   rcb_model_destroy(d->nom_model);
+  rcb_free(&d->alloc, d->mis);
+  d->mis = NULL, d->nmis = 0;
+  memset(&d->adeq0, 0, sizeof d->adeq0);
   d->cand = NULL, d->order = NULL, d->base_model = NULL, d->nom_model = NULL;
   d->far = 0, d->drift[0] = '\0', d->pre_best = HUGE_VAL;
   d->ncand = d->cap_cand = 0;
@@ -296,6 +297,113 @@ static rcb_status baseline_screen(rcb_diag *d, rcb_fit *f, const double *w) {
   return st;
 }
 
+/* The median of the n values v (sorted in place). */
+static double median(double *v, size_t n) {
+  size_t i, j;
+  for (i = 1; i < n; i++)
+    for (j = i; j > 0 && v[j] < v[j - 1]; j--) {
+      double t = v[j];
+      v[j] = v[j - 1];
+      v[j - 1] = t;
+    }
+  return n == 0 ? (double)NAN : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/* The upper normal quantile of p: z with P(Z > z) = 0.5 erfc(z / sqrt 2) = p
+ * (bisection to double precision; p in (0, 0.5]). */
+static double z_upper(double p) {
+  double lo = 0.0, hi = 40.0;
+  int it;
+  for (it = 0; it < 200; it++) { /* bisection on 0.5 erfc(z / sqrt 2) = p */
+    double mid = 0.5 * (lo + hi);
+    if (0.5 * erfc(mid / sqrt(2.0)) > p) lo = mid;
+    else hi = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+/* Which sensors concentrate the misfit (rcb_diag_misfit_get states the
+ * rule): the per-channel parts of the adequacy test summed per response. */
+#define RCB_DIAG_MISFIT_SHARE 80.0 /* % of the excess on one sensor or a pair */
+#define RCB_DIAG_MISFIT_RATIO 3.0
+static rcb_status misfit_sensors(rcb_diag *d, const double *chi2, const double *mean,
+                                 const double *var) {
+  size_t nch = rcb_meas_channel_count(d->meas), c, k, i, m;
+  double excess = 0.0, *ratio, zlim;
+  if (!(d->mis = rcb_alloc(&d->alloc, (nch ? nch : 1) * sizeof *d->mis)) ||
+      !(ratio = rcb_alloc(&d->alloc, (nch ? nch : 1) * sizeof *ratio)))
+    return rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
+  for (c = 0; c < nch; c++) {
+    rcb_meas_channel_info ci;
+    rcb_meas_channel(d->meas, c, &ci);
+    for (k = 0; k < d->nmis && strcmp(d->mis[k].sensor, ci.response) != 0; k++) continue;
+    if (k == d->nmis) {
+      memset(&d->mis[k], 0, sizeof d->mis[k]);
+      d->mis[d->nmis++].sensor = ci.response;
+    }
+    d->mis[k].chi2 += chi2[c], d->mis[k].expected += mean[c], d->mis[k].sd += var[c];
+  }
+  for (k = 0; k < d->nmis; k++) {
+    d->mis[k].sd = sqrt(d->mis[k].sd);
+    excess += fmax(d->mis[k].chi2 - d->mis[k].expected, 0.0);
+  }
+  for (k = 0; k < d->nmis; k++)
+    d->mis[k].excess_pct =
+        excess > 0 ? 100.0 * fmax(d->mis[k].chi2 - d->mis[k].expected, 0.0) / excess : 0.0;
+  for (k = 1; k < d->nmis; k++) /* the largest excess first (stable) */
+    for (i = k; i > 0 && d->mis[i].excess_pct > d->mis[i - 1].excess_pct; i--) {
+      rcb_diag_misfit t = d->mis[i];
+      d->mis[i] = d->mis[i - 1];
+      d->mis[i - 1] = t;
+    }
+  /* one sensor, or two (a swapped pair), holding RCB_DIAG_MISFIT_SHARE of
+   * the excess, each failing its own test beyond the Bonferroni limit and
+   * RCB_DIAG_MISFIT_RATIO x the median chi2 / expected of the rest */
+  zlim = z_upper(0.01 / (double)(d->nmis ? d->nmis : 1));
+  for (m = 1; m <= 2 && m < d->nmis; m++) {
+    double share = 0.0, med;
+    size_t n = 0;
+    for (k = 0; k < m; k++) share += d->mis[k].excess_pct;
+    if (share < RCB_DIAG_MISFIT_SHARE) continue;
+    for (i = m; i < d->nmis; i++)
+      if (d->mis[i].expected > 0) ratio[n++] = d->mis[i].chi2 / d->mis[i].expected;
+    med = median(ratio, n);
+    for (k = 0; k < m; k++) {
+      rcb_diag_misfit *s = &d->mis[k];
+      s->concentrated = n > 0 && s->expected > 0 && s->sd > 0 &&
+                        (s->chi2 - s->expected) / s->sd > zlim &&
+                        s->chi2 / s->expected >= RCB_DIAG_MISFIT_RATIO * med;
+    }
+    break;
+  }
+  rcb_free(&d->alloc, ratio);
+  return RCB_OK;
+}
+
+/* The adequacy test of the fitted model as it is (fit f), the null
+ * distribution every refit's limit comes from, and where the misfit
+ * concentrates. */
+static rcb_status baseline_adequacy(rcb_diag *d, rcb_fit *f) {
+  size_t nch = rcb_meas_channel_count(d->meas);
+  double *w = rcb_alloc(&d->alloc, 3 * (nch ? nch : 1) * sizeof *w);
+  rcb_status st;
+  size_t c;
+  if (!w) return rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
+  st = rcb_fit_get_adequacy(f, &d->adeq0, w, w + nch, w + 2 * nch);
+  if (st) {
+    rcb_free(&d->alloc, w);
+    return rcb_diag_fail(d, st, "the adequacy test of the model as it is: %s",
+                         rcb_fit_errmsg(f));
+  }
+  d->nbase_fit = rcb_fit_param_count(f);
+  d->adeq_mean = d->adeq0.expected + (double)d->nbase_fit;
+  d->adeq_sd = d->adeq0.sd;
+  for (c = 0; c < nch; c++) w[2 * nch + c] *= w[2 * nch + c]; /* variances */
+  if (d->adeq0.known) st = misfit_sensors(d, w, w + nch, w + 2 * nch);
+  rcb_free(&d->alloc, w);
+  return st;
+}
+
 /* Fit the model as it is, on a copy: the base model, F0, error, floor,
  * residual count; whether the fit ran off from the nominal model. */
 static rcb_status baseline(rcb_diag *d) {
@@ -326,6 +434,7 @@ static rcb_status baseline(rcb_diag *d) {
     st = r ? objective(d, f, r, &d->F0, &d->err0) : RCB_ERR_NOMEM;
     rcb_free(&d->alloc, r);
   }
+  if (!st) st = baseline_adequacy(d, f);
   drop_fit(d, f);
   if (!st) d->base_model = m; /* the fitted values stay in it */
   else rcb_model_destroy(m);
@@ -718,14 +827,24 @@ static rcb_status prefit(rcb_diag *d, diag_cand *c, const double *w) {
   return RCB_OK; /* a candidate that cannot be pre-fitted is not refitted from there */
 }
 
-/* BIC change and significance of a refitted candidate (F, err set). */
+/* BIC change, adequacy limit and claim of a refitted candidate (F, err set;
+ * k: its own parameters, refitted with the base's). */
 static void judge(const rcb_diag *d, diag_cand *c, double k) {
   double N = (double)d->nres;
+  rcb_evidence e;
   /* with noise-aware weights or known standard deviations F is a
    * chi-square: BIC = F + k ln N; else the Gaussian likelihood with the
    * variance estimated */
   c->dbic = chi2(d) ? (c->F - d->F0) + k * log(N) : N * log(c->F / d->F0) + k * log(N);
-  c->significant = c->dbic < RCB_DIAG_BIC_MIN && c->err < RCB_DIAG_ERR_FALL * d->err0;
+  c->chi2_limit = d->adeq0.known ? d->adeq_mean - ((double)d->nbase_fit + k) +
+                                       RCB_ADEQUACY_Z * d->adeq_sd
+                                 : (double)NAN;
+  e.delta_bic = c->dbic;
+  e.error_before_pct = d->err0, e.error_after_pct = c->err;
+  e.chi2 = c->F, e.chi2_limit = c->chi2_limit;
+  c->significant = rcb_evidence_significant(&e);
+  c->adequate = rcb_evidence_adequate(&e);
+  c->claim = rcb_evidence_claim(&e);
 }
 
 /* A refit with nothing to fit (kramer_1, rigid): the model evaluated. */
@@ -952,6 +1071,10 @@ static rcb_status refit_polish(rcb_diag *d, diag_cand *c) {
 /* Rank: refitted by BIC change, then the rest by predicted reduction. */
 static int better(const diag_cand *a, const diag_cand *b) {
   if (a->refitted != b->refitted) return a->refitted;
+  /* what may be said first: a candidate that explains, then one that is
+   * significant, then the rest; each by BIC (the text's first candidate is
+   * the table's, and --apply 1 applies it) */
+  if (a->refitted && a->claim != b->claim) return a->claim > b->claim;
   if (a->refitted) return a->dbic < b->dbic;
   return a->predicted > b->predicted;
 }
@@ -1259,8 +1382,28 @@ rcb_status rcb_diag_candidate_get(const rcb_diag *d, size_t rank, rcb_diag_candi
   out->objective_drop_pct = c->refitted ? 100.0 * (d->F0 - c->F) / d->F0 : (double)NAN;
   out->delta_bic = c->dbic;
   out->significant = c->significant;
+  out->claim = c->refitted ? c->claim : RCB_CLAIM_NONE;
+  out->adequate = c->refitted ? c->adequate : -1;
+  out->chi2 = c->refitted ? c->F : (double)NAN;
+  out->chi2_limit = c->refitted ? c->chi2_limit : (double)NAN;
+  out->chain = (c->fam->flags & DIAG_FAM_CHAIN) != 0;
   out->fitted = c->fitted;
   out->screened_only = c->refitted && !c->polished;
+  return RCB_OK;
+}
+
+rcb_status rcb_diag_adequacy(const rcb_diag *d, rcb_fit_adequacy *out) {
+  if (!d || !out) return RCB_ERR_ARG;
+  if (!d->ran) return RCB_ERR_STATE;
+  *out = d->adeq0;
+  return RCB_OK;
+}
+
+size_t rcb_diag_misfit_count(const rcb_diag *d) { return d && d->ran ? d->nmis : 0; }
+
+rcb_status rcb_diag_misfit_get(const rcb_diag *d, size_t k, rcb_diag_misfit *out) {
+  if (!d || !out || !d->ran || k >= d->nmis) return RCB_ERR_ARG;
+  *out = d->mis[k];
   return RCB_OK;
 }
 
@@ -1321,38 +1464,102 @@ rcb_status rcb_diag_apply_model(const rcb_diag *d, size_t rank, const rcb_alloca
   return RCB_OK;
 }
 
+/* Where the misfit of the model as it is concentrates, in words (appended
+ * to text at n; nothing without a known noise). */
+static size_t say_where(const rcb_diag *d, char *text, size_t size, size_t n) {
+  size_t k, shown = 0;
+  if (!d->nmis || n >= size) return n;
+  if (d->mis[0].concentrated) {
+    const rcb_diag_misfit *s = &d->mis[0];
+    n += (size_t)snprintf(text + n, size - n,
+                          " The misfit concentrates on sensor %s (chi-square %.3g x what the "
+                          "noise leaves there, %.0f %% of the excess): check this sensor (gain, "
+                          "phase, sign, direction, mounting) before the model.",
+                          s->sensor, s->chi2 / s->expected, s->excess_pct);
+    return n < size ? n : size - 1;
+  }
+  n += (size_t)snprintf(text + n, size - n, " The misfit is spread over the sensors; the "
+                        "largest excesses over the noise:");
+  for (k = 0; k < d->nmis && shown < 3 && n < size; k++, shown++)
+    n += (size_t)snprintf(text + n, size - n, "%s %s (%.0f %%)", shown ? "," : "",
+                          d->mis[k].sensor, d->mis[k].excess_pct);
+  if (n < size) n += (size_t)snprintf(text + n, size - n, ".");
+  return n < size ? n : size - 1;
+}
+
+/* The adequacy test's figures in words: "chi-square F above the limit L". */
+static void say_test(char *t, size_t size, double F, double limit) {
+  snprintf(t, size, "chi-square %.6g %s the adequacy limit %.6g at 1 %%", F,
+           F <= limit ? "within" : "above", limit);
+}
+
 rcb_status rcb_diag_explain(const rcb_diag *d, char *buf, size_t size, size_t *needed) {
-  char text[1536];
+  char text[3072], test[160], floor_txt[96] = "";
   const diag_cand *c;
+  size_t n;
   if (!d || !d->ran) return RCB_ERR_STATE;
   c = d->ncand ? &d->cand[d->order[0]] : NULL;
-  if (!c || !c->significant) {
+  if (isfinite(d->floor0))
+    snprintf(floor_txt, sizeof floor_txt, " (noise floor %.3g %%)", d->floor0);
+  if (c && c->refitted && c->claim == RCB_CLAIM_EXPLAINS) {
+    say_test(test, sizeof test, c->F, c->chi2_limit);
+    if (c->fam->flags & DIAG_FAM_CHAIN)
+      snprintf(text, sizeof text,
+               "The measurement chain, not the model: %s (%s). Read through it, the data fit "
+               "the model as it is: the error falls from %.3g %% to %.3g %%%s, BIC %+.1f, %s. "
+               "Check or recalibrate this sensor; the model is not changed.",
+               c->desc, c->fitted, d->err0, c->err, floor_txt, c->dbic, test);
+    else
+      snprintf(text, sizeof text,
+               "Missing: %s. Adding it (%s) explains the misfit: the error falls from %.3g %% "
+               "to %.3g %%%s, BIC %+.1f, and the model with it passes the adequacy test (%s).",
+               c->desc, c->fitted, d->err0, c->err, floor_txt, c->dbic, test);
+  } else if (c && c->refitted && c->claim == RCB_CLAIM_IMPROVES) {
+    if (isfinite(c->chi2_limit)) {
+      say_test(test, sizeof test, c->F, c->chi2_limit);
+      snprintf(text, sizeof text,
+               "The best candidate, %s (%s), accounts for %.1f %% of the misfit but leaves "
+               "%.1f %%: the error falls from %.3g %% to %.3g %%, %.2g x the noise floor of "
+               "%.3g %% (%s). Another effect is missing, possibly outside the catalogue.",
+               c->desc, c->fitted, 100.0 * (d->F0 - c->F) / d->F0, 100.0 * c->F / d->F0,
+               d->err0, c->err, c->err / d->floor0, d->floor0, test);
+    } else {
+      snprintf(text, sizeof text,
+               "The best candidate, %s (%s), lowers the misfit by %.1f %%: the error falls "
+               "from %.3g %% to %.3g %%, BIC %+.1f. Whether the model then explains the data "
+               "cannot be tested: the noise is unknown (give --noise or --sd).",
+               c->desc, c->fitted, 100.0 * (d->F0 - c->F) / d->F0, d->err0, c->err, c->dbic);
+    }
+  } else if (d->adeq0.known && d->adeq0.adequate) {
+    say_test(test, sizeof test, d->adeq0.chi2, d->adeq0.limit);
     snprintf(text, sizeof text,
-             "No candidate is significant: the model as it is leaves an error of %.3g %%%s; "
-             "no effect of the catalogue lowers BIC by more than %g while lowering the error.",
-             d->err0,
-             isfinite(d->floor0) ? (d->err0 < 1.5 * d->floor0
-                                        ? " (at the noise floor)"
-                                        : " (above the noise floor: the missing effect may "
-                                          "not be in the catalogue)")
-                                 : "",
-             -RCB_DIAG_BIC_MIN);
+             "No candidate is significant, and none is needed: the model as it is passes the "
+             "adequacy test (%s; error %.3g %%%s).",
+             test, d->err0, floor_txt);
+  } else if (d->adeq0.known) {
+    say_test(test, sizeof test, d->adeq0.chi2, d->adeq0.limit);
+    snprintf(text, sizeof text,
+             "No candidate is significant: the model as it is leaves an error of %.3g %%%s "
+             "(%s), and no effect of the catalogue lowers BIC by more than %g while lowering "
+             "the error: the missing effect may not be in the catalogue, or a sensor is at "
+             "fault.",
+             d->err0, floor_txt, test, -RCB_BIC_SIGNIFICANT);
   } else {
-    char floor_txt[64] = "";
-    if (isfinite(d->floor0)) snprintf(floor_txt, sizeof floor_txt, " (noise floor %.3g %%)", d->floor0);
     snprintf(text, sizeof text,
-             "Missing: %s. Adding it (%s) explains %.1f %% of the remaining misfit: the error "
-             "falls from %.3g %% to %.3g %%%s, BIC %+.1f.",
-             c->desc, c->fitted, 100.0 * (d->F0 - c->F) / d->F0, d->err0, c->err, floor_txt,
-             c->dbic);
+             "No candidate is significant: no effect of the catalogue lowers BIC by more than "
+             "%g while lowering the error (%.3g %%). Whether the model as it is explains the "
+             "data cannot be tested: the noise is unknown (give --noise or --sd).",
+             -RCB_BIC_SIGNIFICANT, d->err0);
   }
-  if (d->far) { /* the run-off baseline is a finding of its own */
-    size_t n = strlen(text);
+  n = strlen(text);
+  if (!(c && c->refitted && c->claim == RCB_CLAIM_EXPLAINS) &&
+      !(d->adeq0.known && d->adeq0.adequate))
+    n = say_where(d, text, sizeof text, n);
+  if (d->far) /* the run-off baseline is a finding of its own */
     snprintf(text + n, sizeof text - n,
              " The fit of the model as it is ran far from the nominal model (%s): a missing "
              "effect pulls it there; the candidates were also scored at the nominal model, the "
              "best there fitted alone and refitted from where that ended.",
              d->drift);
-  }
   return put_text(text, buf, size, needed);
 }

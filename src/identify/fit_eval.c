@@ -493,3 +493,13 @@ rcb_status rcb_fit_objective(rcb_fit *f, const double *x, double *F, double *gra
   *F = rcb_fit_sumsq(f->r, f->nres);
   return RCB_OK;
 }
+
+/* For the adequacy test (adequacy.c): a value on the fit's scale, and the
+ * variance of a measured value under the eq. 19 noise model (additive
+ * amplitude a, the measurement's units). */
+double rcb_fit_on_scale(const rcb_fit *f, double complex h, int part) {
+  return on_scale(f->scale, h, part);
+}
+double rcb_fit_noise_var(const rcb_fit *f, double complex e, double a, int part) {
+  return noise_var(f, e, a, part);
+}

@@ -163,6 +163,11 @@ double rcb_fit_floor_pct(const rcb_fit *f);
 /* 1 when the weights are inverse variances (noise model or known sds): the
  * objective is then a chi-square. */
 int rcb_fit_chi2(const rcb_fit *f);
+/* A value on the fit's scale (part: 0 Re or the magnitude, 1 Im), and the
+ * variance of a measured value e under the eq. 19 noise model with additive
+ * amplitude a (fit_eval.c; adequacy.c draws its null distribution). */
+double rcb_fit_on_scale(const rcb_fit *f, double complex h, int part);
+double rcb_fit_noise_var(const rcb_fit *f, double complex e, double a, int part);
 
 /* Pieces of the analytic Jacobian (fit_eval.c) for fit_score.c: the model
  * solve at point i (factors and solutions left in the FRF workspace); the

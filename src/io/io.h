@@ -7,6 +7,8 @@
 #ifndef RCB_IO_H
 #define RCB_IO_H
 
+#include <stdint.h>
+
 #include "core/rcb_internal.h"
 
 /* A measurement's channels as the outputs and inputs of an rcb_frf: the
@@ -27,5 +29,20 @@ typedef struct rcb_meas_dofs {
  * one resolver of the fit and the comparison (io/channels.c). */
 rcb_status rcb_meas_resolve_dofs(const rcb_meas *ms, const rcb_model *m, rcb_meas_dofs *d,
                                  char *errmsg);
+
+/* The paper's eq. 19 noise (io/noise.c), for rcb_meas_add_noise and for
+ * the adequacy test's calibration (identify/adequacy.c): one generator,
+ * xoshiro256** seeded through splitmix64 (the same numbers on every
+ * platform), one draw. */
+typedef struct rcb_rng {
+  uint64_t s[4];
+} rcb_rng;
+void rcb_rng_seed(rcb_rng *r, uint64_t seed);
+/* The additive amplitude of a channel of n values f: ||f||_2 / n beta_s/100
+ * (the measurement's units). */
+double rcb_noise_level(const rcb_complex *f, size_t n, double beta_s);
+/* One noisy value: fs (1 + beta_a/100 r1) + level r2 e^{i phi}; r1, r2
+ * uniform in [-1, 1], phi in [0, 2 pi), drawn in that order. */
+rcb_complex rcb_noise_draw(rcb_rng *r, rcb_complex fs, double beta_a, double level);
 
 #endif /* RCB_IO_H */

@@ -12,11 +12,10 @@
 #include <math.h>
 #include <stdint.h>
 
+#include "io/io.h"
 #include "io/meas_internal.h"
 
-typedef struct rng {
-  uint64_t s[4];
-} rng;
+typedef rcb_rng rng;
 
 static uint64_t splitmix64(uint64_t *x) {
   uint64_t z = (*x += UINT64_C(0x9E3779B97F4A7C15));
@@ -40,10 +39,12 @@ static uint64_t next(rng *r) {
   return result;
 }
 
-static void seed_rng(rng *r, uint64_t seed) {
+void rcb_rng_seed(rng *r, uint64_t seed) {
   int i;
   for (i = 0; i < 4; i++) r->s[i] = splitmix64(&seed);
 }
+
+#define seed_rng rcb_rng_seed
 
 /* Uniform in [0, 1): the top 53 bits, exact in a double. */
 static double uniform01(rng *r) { return (double)(next(r) >> 11) * 0x1.0p-53; }
@@ -53,6 +54,18 @@ static double uniform_pm1(rng *r) {
   uint64_t k = next(r) >> 10; /* 0 .. 2^54 - 1 */
   k %= (UINT64_C(1) << 53) + 1;
   return (double)k * 0x1.0p-52 - 1.0;
+}
+
+double rcb_noise_level(const rcb_complex *f, size_t n, double beta_s) {
+  double sum = 0.0;
+  size_t i;
+  for (i = 0; i < n; i++) sum += creal(f[i]) * creal(f[i]) + cimag(f[i]) * cimag(f[i]);
+  return n ? sqrt(sum) / (double)n * (beta_s / 100.0) : 0.0;
+}
+
+rcb_complex rcb_noise_draw(rng *r, rcb_complex fs, double beta_a, double level) {
+  double r1 = uniform_pm1(r), r2 = uniform_pm1(r), phi = 2.0 * RCB_PI * uniform01(r);
+  return fs * (1.0 + beta_a / 100.0 * r1) + level * r2 * CMPLX(cos(phi), sin(phi));
 }
 
 rcb_status rcb_meas_add_noise(rcb_meas *ms, double beta_a, double beta_s, uint64_t seed) {
@@ -65,13 +78,8 @@ rcb_status rcb_meas_add_noise(rcb_meas *ms, double beta_a, double beta_s, uint64
   seed_rng(&r, seed);
   for (c = 0; c < ms->nch; c++) {
     rcb_complex *f = ms->ch[c].data;
-    double sum = 0.0, level;
-    for (i = 0; i < ms->n; i++) sum += creal(f[i]) * creal(f[i]) + cimag(f[i]) * cimag(f[i]);
-    level = sqrt(sum) / (double)ms->n * (beta_s / 100.0);
-    for (i = 0; i < ms->n; i++) {
-      double r1 = uniform_pm1(&r), r2 = uniform_pm1(&r), phi = 2.0 * RCB_PI * uniform01(&r);
-      f[i] = f[i] * (1.0 + beta_a / 100.0 * r1) + level * r2 * CMPLX(cos(phi), sin(phi));
-    }
+    double level = rcb_noise_level(f, ms->n, beta_s);
+    for (i = 0; i < ms->n; i++) f[i] = rcb_noise_draw(&r, f[i], beta_a, level);
   }
   return RCB_OK;
 }

@@ -12,7 +12,8 @@ const char cli_help_diagnose[] =
     "usage: rcbtool diagnose MODEL.ini MEAS.uff|MEAS.csv [--params NAME[:LO:HI],...]\n"
     "                        [--log] [--scale linear|log10|db|complex] [--noise A,S|--sd FILE]\n"
     "                        [--band LO:HI] [--map NODE=STATION,...] [--rpm R] [--refits N]\n"
-    "                        [--top N] [--apply K -o MODEL2.ini] [--history FILE]\n"
+    "                        [--top N] [--apply K [--force] -o MODEL2.ini]\n"
+    "                        [--history FILE]\n"
     "                        [--threads N] [--json] [--progress]\n"
     "\n"
     "Fits the model as it is (the --params, e.g. the coupling's kt and kr), then\n"
@@ -25,8 +26,18 @@ const char cli_help_diagnose[] =
     "speed other than the stated one. The score is the error reduction the\n"
     "effect can explain (score test on the weighted objective, orthogonal to the\n"
     "fitted parameters); the best N (--refits, default 8) and the other coupling\n"
-    "models are refitted, and ranked by the change of BIC. A candidate is\n"
-    "significant when BIC falls by more than 10 and the error itself falls.\n"
+    "models are refitted. What may be said of a candidate follows one rule\n"
+    "(rcb_evidence_claim): it is significant when BIC falls by more than 10 and\n"
+    "the error by at least 2 % of itself; it \"explains\" the data only when it is\n"
+    "significant and the model with it passes the adequacy test (its chi-square\n"
+    "within the 1 % limit of what the noise alone leaves: --noise or --sd needed);\n"
+    "a significant one that fails the test \"improves\": another effect is still\n"
+    "missing. Candidates are ranked by that claim (explains, improves, none), then\n"
+    "by the change of BIC. When nothing explains the data, the report says where\n"
+    "the misfit concentrates (per response sensor), and a sensor whose misfit\n"
+    "stands out is named to be checked first. The catalogue also holds faults of\n"
+    "the measurement chain (a sensor's gain, sign, two swapped probes): they\n"
+    "never change the model, and --apply refuses them.\n"
     "On large sets (where a subset of the frequencies keeps at most half of\n"
     "them) the refits are screened on that subset and evaluated on all points\n"
     "where their screen ended; only those within 10 % of the best objective are\n"
@@ -44,16 +55,25 @@ const char cli_help_diagnose[] =
     "  --threads N    fit the candidates on N threads (default 1); the same\n"
     "                 numbers bit for bit\n"
     "  --apply K      with -o FILE: write the model with candidate K (1 = best)\n"
-    "                 added and fitted, atomically; the input model is untouched\n"
+    "                 added and fitted, atomically; the input model is untouched.\n"
+    "                 A candidate that is not significant is refused (exit 3)\n"
+    "  --force        with --apply: write a candidate that is not significant\n"
+    "                 all the same (a warning says so)\n"
     "  --history FILE record this step (rcbtool history FILE shows the steps)\n"
-    "  --json         the ranking as JSON, with \"evaluations\" (model sweeps, a\n"
+    "  --json         the ranking as JSON: per candidate \"claim\" (explains,\n"
+    "                 improves, none), \"significant\", \"adequate\" (null when\n"
+    "                 unknown), \"chi2\", \"chi2_limit\", \"chain\"; \"adequacy\" of\n"
+    "                 the model as it is (chi2, dof, expected, sd, limit,\n"
+    "                 adequate); \"misfit\": per sensor chi2, expected, excess_pct,\n"
+    "                 concentrated; and \"evaluations\" (model sweeps, a\n"
     "                 Jacobian counting one), \"scored\", \"refits\" and \"restarts\"\n"
     "                 (refits that tried random starts after their screen)\n"
     "Units of the report: error % and the noise floor %: the relative error of\n"
     "the model against the data, in percent (the floor is predicted from --noise\n"
     "or --sd, not measured); score %: the part of that error the effect can\n"
     "explain, in percent; dBIC: change of the Bayesian information criterion (no unit;\n"
-    "below -10 with a falling error is significant); fitted: values in SI units\n"
+    "below -10 with a falling error is significant); chi-square: the weighted\n"
+    "objective (no unit); fitted: values in SI units\n"
     "(N/m, N s/m, N m/rad, N m s/rad, kg, kg m^2).\n"
     "Other options as for rcbtool fit. Exit codes: 0 ok, 2 usage, 3 bad input,\n"
     "4 numerical failure, 5 output error.\n";
@@ -66,6 +86,7 @@ typedef struct diag_job {
   int have_params, log_all, scale, have_noise, have_band, have_sd;
   double beta_a, beta_s, band_lo, band_hi;
   size_t refits, top, apply, threads;
+  int force;
   const char *history;
 } diag_job;
 
@@ -86,6 +107,7 @@ static int parse_job(const cli_args *a, diag_job *j) {
   j->log_all = cli_opt_value(a, "--log") != NULL;
   j->history = cli_opt_value(a, "--history");
   j->have_sd = cli_opt_value(a, "--sd") != NULL;
+  j->force = cli_opt_value(a, "--force") != NULL;
   if ((rc = cli_opt_choice(a, "--scale", scale_names, 4, RCB_SCALE_LOG10, &j->scale)) ||
       (rc = cli_opt_count(a, "--refits", 8, &j->refits)) ||
       (rc = cli_opt_count(a, "--top", 10, &j->top)) ||
@@ -100,6 +122,7 @@ static int parse_job(const cli_args *a, diag_job *j) {
     return rc;
   if (j->apply && !a->output)
     return cli_usage(a->cmd, "--apply K writes a model: give -o MODEL2.ini");
+  if (j->force && !j->apply) return cli_usage(a->cmd, "--force goes with --apply K");
   if ((j->have_params = cli_opt_value(a, "--params") != NULL) &&
       (rc = cli_params_parse(a, "--params", &j->params)))
     return rc;
@@ -155,6 +178,30 @@ static int progress_cb(void *user, size_t done, size_t total) {
   return 0;
 }
 
+/* The adequacy test of the model as it is, and the sensors by misfit. */
+static void print_adequacy(FILE *fp, const rcb_diag *d) {
+  rcb_fit_adequacy t;
+  size_t k, n = rcb_diag_misfit_count(d);
+  if (rcb_diag_adequacy(d, &t) || !t.known) {
+    fputs("adequacy test: none (the noise is unknown: give --noise or --sd)\n\n", fp);
+    return;
+  }
+  fprintf(fp, "adequacy test of the model as it is: chi-square %.6g, %s the 1 %% limit %.6g "
+          "(the noise alone: %.6g +- %.3g; %.0f degrees of freedom)\n",
+          t.chi2, t.adequate ? "within" : "ABOVE", t.limit, t.expected, t.sd, t.dof);
+  if (!t.adequate && n) {
+    fprintf(fp, "%-14s %12s %12s %9s  %s\n", "sensor", "chi-square", "noise alone",
+            "excess %", "");
+    for (k = 0; k < n && k < 8; k++) {
+      rcb_diag_misfit s;
+      rcb_diag_misfit_get(d, k, &s);
+      fprintf(fp, "%-14s %12.6g %12.6g %9.1f  %s\n", s.sensor, s.chi2, s.expected,
+              s.excess_pct, s.concentrated ? "<- check this sensor" : "");
+    }
+  }
+  fputc('\n', fp);
+}
+
 static void print_text(FILE *fp, const diag_job *j, const rcb_diag *d, const char *explain) {
   double e0, floor_pct;
   size_t k, n = rcb_diag_candidate_count(d);
@@ -164,13 +211,14 @@ static void print_text(FILE *fp, const diag_job *j, const rcb_diag *d, const cha
     fprintf(fp, " (noise floor %.4g %%, predicted by the %s; the error reached can be lower)",
             floor_pct, j->have_sd ? "--sd deviations" : "--noise model");
   fprintf(fp, "; %zu candidates scored\n\n", n);
-  fprintf(fp, "%-4s %-5s %-58s %9s %9s %10s  %s\n", "rank", "sig", "candidate", "score %",
+  print_adequacy(fp, d);
+  fprintf(fp, "%-4s %-8s %-58s %9s %9s %10s  %s\n", "rank", "claim", "candidate", "score %",
           "error %", "dBIC", "fitted");
   for (k = 0; k < n && k < j->top; k++) {
     rcb_diag_candidate c;
     rcb_diag_candidate_get(d, k, &c);
-    fprintf(fp, "%-4zu %-5s %-58.58s %9.3g ", k + 1, c.significant ? "YES" : "no",
-            c.description, c.predicted_pct);
+    fprintf(fp, "%-4zu %-8s %-58.58s %9.3g ", k + 1, rcb_claim_str(c.claim), c.description,
+            c.predicted_pct);
     if (c.refitted)
       fprintf(fp, "%9.4g %+10.1f  %s%s\n", c.error_pct, c.delta_bic, c.fitted,
               c.screened_only ? " (screened: dBIC an upper bound)" : "");
@@ -178,6 +226,41 @@ static void print_text(FILE *fp, const diag_job *j, const rcb_diag *d, const cha
       fprintf(fp, "%9s %10s  %s\n", "-", "-", c.fitted[0] ? c.fitted : "(not refitted)");
   }
   fprintf(fp, "\n%s\n", explain);
+}
+
+/* "adequacy" and "misfit" (per sensor) of the model as it is. */
+static void json_adequacy(FILE *fp, const rcb_diag *d) {
+  rcb_fit_adequacy t;
+  size_t k, n = rcb_diag_misfit_count(d);
+  if (rcb_diag_adequacy(d, &t)) return;
+  fprintf(fp, ",\n\"adequacy\": {\"known\": %s, \"chi2\": ", t.known ? "true" : "false");
+  cli_json_num(fp, t.chi2);
+  fputs(", \"dof\": ", fp);
+  cli_json_num(fp, t.dof);
+  fputs(", \"expected\": ", fp);
+  cli_json_num(fp, t.known ? t.expected : (double)NAN);
+  fputs(", \"sd\": ", fp);
+  cli_json_num(fp, t.known ? t.sd : (double)NAN);
+  fputs(", \"limit\": ", fp);
+  cli_json_num(fp, t.limit);
+  fprintf(fp, ", \"adequate\": %s}", !t.known ? "null" : t.adequate ? "true" : "false");
+  fputs(",\n\"misfit\": {\"sensors\": [", fp);
+  for (k = 0; k < n; k++) {
+    rcb_diag_misfit s;
+    rcb_diag_misfit_get(d, k, &s);
+    fprintf(fp, "%s{\"response\": ", k ? ", " : "");
+    cli_json_str(fp, s.sensor);
+    fputs(", \"chi2\": ", fp);
+    cli_json_num(fp, s.chi2);
+    fputs(", \"expected\": ", fp);
+    cli_json_num(fp, s.expected);
+    fputs(", \"ratio\": ", fp);
+    cli_json_num(fp, s.expected > 0 ? s.chi2 / s.expected : (double)NAN);
+    fputs(", \"excess_pct\": ", fp);
+    cli_json_num(fp, s.excess_pct);
+    fprintf(fp, ", \"concentrated\": %s}", s.concentrated ? "true" : "false");
+  }
+  fputs("]}", fp);
 }
 
 static void print_json(FILE *fp, const diag_job *j, const rcb_diag *d, const char *explain) {
@@ -194,6 +277,7 @@ static void print_json(FILE *fp, const diag_job *j, const rcb_diag *d, const cha
             stats.evaluations, stats.scored, stats.refits, stats.restarts);
   fputs(", \"explanation\": ", fp);
   cli_json_str(fp, explain);
+  json_adequacy(fp, d);
   fputs(",\n\"candidates\": [", fp);
   for (k = 0; k < n && k < j->top; k++) {
     rcb_diag_candidate c;
@@ -212,8 +296,14 @@ static void print_json(FILE *fp, const diag_job *j, const rcb_diag *d, const cha
     cli_json_num(fp, c.error_pct);
     fputs(", \"delta_bic\": ", fp);
     cli_json_num(fp, c.delta_bic);
-    fprintf(fp, ", \"significant\": %s, \"screened_only\": %s, \"fitted\": ",
-            c.significant ? "true" : "false", c.screened_only ? "true" : "false");
+    fprintf(fp, ", \"claim\": \"%s\", \"significant\": %s, \"adequate\": %s, \"chi2\": ",
+            rcb_claim_str(c.claim), c.significant ? "true" : "false",
+            c.adequate < 0 ? "null" : c.adequate ? "true" : "false");
+    cli_json_num(fp, c.chi2);
+    fputs(", \"chi2_limit\": ", fp);
+    cli_json_num(fp, c.chi2_limit);
+    fprintf(fp, ", \"chain\": %s, \"screened_only\": %s, \"fitted\": ",
+            c.chain ? "true" : "false", c.screened_only ? "true" : "false");
     cli_json_str(fp, c.fitted);
     fputs("}", fp);
   }
@@ -231,17 +321,24 @@ static int apply(const cli_args *a, const diag_job *j, const rcb_diag *d) {
   if (j->apply > rcb_diag_candidate_count(d))
     return cli_usage(a->cmd, "--apply %zu: there are %zu candidates", j->apply,
                      rcb_diag_candidate_count(d));
-  if (rcb_diag_apply_model(d, j->apply - 1, NULL, &m))
-    return cli_fail(CLI_EXIT_INPUT, "%s: %s", a->cmd, rcb_diag_errmsg(d));
   {
     rcb_diag_candidate c;
-    if (rcb_diag_candidate_get(d, j->apply - 1, &c) == RCB_OK && !c.significant)
-      cli_warn("%s: --apply %zu: candidate %zu (%s) is not significant (dBIC %+.1f; "
-               "significant needs BIC to fall by more than 10 and the error to fall): the "
-               "model written may be fitting noise; prefer a significant candidate or more "
-               "data",
+    if (rcb_diag_candidate_get(d, j->apply - 1, &c) == RCB_OK && c.claim == RCB_CLAIM_NONE &&
+        !c.chain) {
+      if (!j->force)
+        return cli_fail(CLI_EXIT_INPUT,
+                        "%s: --apply %zu: candidate %zu (%s) is not significant (dBIC %+.1f; "
+                        "significant needs BIC to fall by more than 10 and the error by 2 %% "
+                        "of itself): the model would be fitting noise; nothing written. Apply "
+                        "a significant candidate, bring more data, or add --force",
+                        a->cmd, j->apply, j->apply, c.description, c.delta_bic);
+      cli_warn("%s: --apply %zu --force: candidate %zu (%s) is not significant (dBIC %+.1f): "
+               "the model written may be fitting noise",
                a->cmd, j->apply, j->apply, c.description, c.delta_bic);
+    }
   }
+  if (rcb_diag_apply_model(d, j->apply - 1, NULL, &m))
+    return cli_fail(CLI_EXIT_INPUT, "%s: %s", a->cmd, rcb_diag_errmsg(d));
   if (rcb_model_write_ini(m, NULL, 0, &need) != RCB_ERR_WORKSPACE) {
     rc = cli_fail(CLI_EXIT_NUMERIC, "%s: %s", a->cmd, rcb_model_errmsg(m));
     rcb_model_destroy(m);
@@ -265,10 +362,11 @@ static int apply(const cli_args *a, const diag_job *j, const rcb_diag *d) {
 static int record(const cli_args *a, const diag_job *j, const rcb_diag *d, const char *text) {
   double e0, floor_pct;
   rcb_diag_candidate c;
-  char note[700];
+  char note[800];
   rcb_diag_baseline(d, &e0, NULL, &floor_pct);
   if (j->apply && !rcb_diag_candidate_get(d, j->apply - 1, &c)) {
-    snprintf(note, sizeof note, "applied: %s (%s)", c.description, c.fitted);
+    snprintf(note, sizeof note, "applied: %s (%s); claim: %s", c.description, c.fitted,
+             rcb_claim_str(c.claim));
     return cli_history_append(j->history, "apply", a->output, c.error_pct, floor_pct,
                               (j->have_params ? j->params.n : 0) +
                                   (size_t)(strchr(c.params, ',') ? 2 : 1),
@@ -282,8 +380,8 @@ static int run(const cli_args *a, diag_job *j) {
   rcb_model *m = NULL;
   rcb_meas *ms = NULL;
   rcb_diag *d = NULL;
-  char text[1200];
-  size_t need;
+  char *text = NULL;
+  size_t need = 0;
   rcb_status st;
   prog_ctx pc;
   int rc;
@@ -306,11 +404,16 @@ static int run(const cli_args *a, diag_job *j) {
     goto done;
   }
   if (pc.started) cli_progress_end(&pc.p);
-  rcb_diag_explain(d, text, sizeof text, &need);
+  rcb_diag_explain(d, NULL, 0, &need); /* two-call sizing */
+  if (!(text = malloc(need ? need : 1)) || rcb_diag_explain(d, text, need, &need)) {
+    rc = cli_fail(CLI_EXIT_NUMERIC, "%s: out of memory", a->cmd);
+    goto done;
+  }
   (a->json ? print_json : print_text)(stdout, j, d, text);
   if (j->apply && (rc = apply(a, j, d))) goto done;
   if (j->history) rc = record(a, j, d, text);
 done:
+  free(text);
   rcb_diag_destroy(d);
   rcb_meas_destroy(ms);
   rcb_model_destroy(m);
@@ -330,6 +433,7 @@ int cmd_diagnose(int argc, char **argv) {
                     {"--top", "N", NULL},
                     {"--threads", "N", NULL},
                     {"--apply", "K", NULL},
+                    {"--force", NULL, NULL},
                     {"--history", "FILE", NULL}};
   size_t nopts = sizeof opts / sizeof opts[0];
   diag_job j;
