@@ -22,9 +22,11 @@
 static const char *const outs[] = {"DA.x", "DA.y", "C.A.x", "C.A.y",
                                    "C.B.x", "C.B.y", "DB.x", "DB.y"};
 
-/* Inertances outs / DA.x, n points f0-f1 Hz at 10000 rpm, with eq. 19 noise. */
-static rcb_meas *measure_grid(const rcb_model *truth, unsigned seed, size_t n, double f0,
-                              double f1) {
+/* Inertances outs / DA.x, n points f0-f1 Hz at 10000 rpm, with eq. 19 noise;
+ * the channel of response probe (NULL: none) read gain times its value (a
+ * probe reading off, before the noise). */
+static rcb_meas *measure_probe(const rcb_model *truth, unsigned seed, size_t n, double f0,
+                               double f1, const char *probe, double gain) {
   rcb_meas *ms = NULL;
   rcb_frf *fr = NULL;
   rcb_dof od[8], in;
@@ -41,7 +43,8 @@ static rcb_meas *measure_grid(const rcb_model *truth, unsigned seed, size_t n, d
   assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
   assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, n, x, 10000 * RPM), RCB_OK);
   for (o = 0; o < 8; o++) {
-    for (i = 0; i < n; i++) col[i] = H[8 * i + o];
+    double g = probe && strcmp(outs[o], probe) == 0 ? gain : 1.0;
+    for (i = 0; i < n; i++) col[i] = g * H[8 * i + o];
     assert_int_equal(rcb_meas_add_channel(ms, outs[o], "DA.x", RCB_INERTANCE, col), RCB_OK);
   }
   assert_int_equal(rcb_meas_add_noise(ms, 10.0, 1.0, seed), RCB_OK);
@@ -50,6 +53,11 @@ static rcb_meas *measure_grid(const rcb_model *truth, unsigned seed, size_t n, d
   free(H);
   free(col);
   return ms;
+}
+
+static rcb_meas *measure_grid(const rcb_model *truth, unsigned seed, size_t n, double f0,
+                              double f1) {
+  return measure_probe(truth, seed, n, f0, f1, NULL, 1.0);
 }
 
 /* The tests' grid: 151 points 100-400 Hz (2 Hz apart). */
@@ -421,7 +429,11 @@ static void test_large_screen(void **state) {
     rcb_diag_candidate c;
     double F, Fp;
     assert_int_equal(rcb_diag_candidate_get(d, k, &c), RCB_OK);
-    if (!c.refitted || !c.screened_only) continue;
+    /* a fault of the measurement chain has no model to apply (the two
+     * probes of a station swapped) */
+    if (!c.refitted || !c.screened_only ||
+        (c.effect >= RCB_EFFECT_SENSOR_GAIN && c.effect <= RCB_EFFECT_SENSOR_SWAP))
+      continue;
     F = candidate_F(d, &c);
     Fp = polished_F(d, ms, k);
     print_message("  screened only: %s: F %.6g, polished %.6g (the first %.6g)\n",
@@ -449,11 +461,82 @@ static void test_large_screen(void **state) {
 }
 
 /* Nothing hidden: no candidate is significant. */
+/* The measurement chain (issue #23, item 4): the DA.x probe reads 20 % low.
+ * The sensor's gain ranks first, significant, within 3 standard errors of
+ * 0.8 (the standard error of the same joint fit with its uncertainty: the
+ * diagnosis' refits skip that step); the fault is the chain's, so there is
+ * no model to apply. DA.x, the driving point, carries most of the paper's
+ * linear error %: with DB.y 20 % low instead the gain at DB.y also ranks
+ * first (BIC -1663, gain 0.797) but is not significant, as the error %,
+ * 5.39 before (floor 5.77), does not fall (5.44 %): the significance rule
+ * asks both. On 601 points the refits are screened on a subset of 150 and
+ * evaluated, polished on all points after: the gain must survive those
+ * steps (it lives in the fit's chain, not in the candidate's model). */
+static void sensor_gain_case(size_t npts) {
+  rcb_model *truth = rcb_test_model_from_example("paper_system.ini");
+  rcb_model *m = rcb_test_model_from_example("paper_system.ini");
+  rcb_meas *ms = measure_probe(truth, 1, npts, 100.0, 400.0, "DA.x", 0.8);
+  const char *names[] = {"coupling.C.kt", "coupling.C.kr", "coupling.C.ct"};
+  const double lo[] = {46.095, 0.22076, 0.010949}, hi[] = {46.095e6, 220760, 10949};
+  rcb_diag_candidate best, c;
+  rcb_diag *d = NULL;
+  rcb_fit *f = NULL;
+  rcb_fit_param p;
+  rcb_model *applied = NULL;
+  const char *at;
+  double g, err0, floor0;
+  size_t k;
+  assert_int_equal(rcb_diag_create(&d, m, ms, NULL), RCB_OK);
+  assert_int_equal(rcb_diag_set_noise_model(d, 10.0, 1.0), RCB_OK);
+  for (k = 0; k < 3; k++)
+    assert_int_equal(rcb_diag_add_fitted_param(d, names[k], lo[k], hi[k], 1), RCB_OK);
+  if (rcb_diag_run(d)) fail_msg("%s", rcb_diag_errmsg(d));
+  assert_int_equal(rcb_diag_candidate_get(d, 0, &best), RCB_OK);
+  assert_int_equal(rcb_diag_baseline(d, &err0, NULL, &floor0), RCB_OK);
+  print_message("  %zu points, DA.x reading 0.8: first '%s' (%s), BIC %+.1f, error %.3g -> "
+                "%.3g %% (floor %.3g), %s%s\n",
+                npts, best.description, best.place, best.delta_bic, err0, best.error_pct,
+                floor0, best.fitted, best.screened_only ? " (screened only)" : "");
+  assert_int_equal(best.effect, RCB_EFFECT_SENSOR_GAIN);
+  assert_non_null(strstr(best.place, "DA.x"));
+  assert_true(best.significant);
+  assert_non_null(at = strstr(best.fitted, "sensor.DA.x.gain = "));
+  g = strtod(at + strlen("sensor.DA.x.gain = "), NULL);
+  /* the same joint fit, with its standard errors */
+  assert_int_equal(rcb_fit_create(&f, m, ms, NULL), RCB_OK);
+  assert_int_equal(rcb_fit_set_scale(f, RCB_SCALE_LOG10), RCB_OK);
+  assert_int_equal(rcb_fit_set_noise_model(f, 10.0, 1.0), RCB_OK);
+  for (k = 0; k < 3; k++) assert_int_equal(rcb_fit_add_param(f, names[k], lo[k], hi[k], 1), 0);
+  assert_int_equal(rcb_fit_add_param(f, "sensor.DA.x.gain", 0.1, 10.0, 1), RCB_OK);
+  assert_int_equal(rcb_fit_run(f), RCB_OK);
+  assert_int_equal(rcb_fit_get_param(f, 3, &p), RCB_OK);
+  print_message("  diagnosis gain %.5g, joint fit %.5g +/- %.3g\n", g, p.value, p.stderr_);
+  if (!(fabs(g - 0.8) <= 3 * p.stderr_) || !(fabs(p.value - 0.8) <= 3 * p.stderr_))
+    fail_msg("gain %g (joint fit %g), se %g: not within 3 se of 0.8", g, p.value, p.stderr_);
+  /* the second candidate is no other sensor's gain: the fault is located */
+  assert_int_equal(rcb_diag_candidate_get(d, 1, &c), RCB_OK);
+  assert_false(c.significant && c.effect == RCB_EFFECT_SENSOR_GAIN);
+  assert_int_equal(rcb_diag_apply_model(d, 0, NULL, &applied), RCB_ERR_STATE);
+  assert_null(applied);
+  rcb_fit_destroy(f);
+  rcb_diag_destroy(d);
+  rcb_meas_destroy(ms);
+  rcb_model_destroy(m);
+  rcb_model_destroy(truth);
+}
+
+static void test_hidden_sensor_gain(void **state) {
+  (void)state;
+  sensor_gain_case(151);
+  sensor_gain_case(601); /* refits screened on a subset */
+}
+
 static void test_null(void **state) {
   rcb_model *truth = rcb_test_model_from_example("paper_system.ini");
   rcb_diag_candidate best;
   rcb_diag *d;
   double err0, floor0;
+  size_t k, nsensor = 0;
   (void)state;
   diagnose(truth, 3, &best, &err0, &floor0, &d);
   print_message("  null: first '%s', BIC %+.1f, error %.3g %% (floor %.3g)\n",
@@ -465,6 +548,14 @@ static void test_null(void **state) {
     assert_int_equal(rcb_diag_adequacy(d, &a), RCB_OK);
     assert_true(a.known && a.adequate); /* nothing is missing, and the test says so */
   }
+  for (k = 0; k < rcb_diag_candidate_count(d); k++) { /* no sensor found at fault */
+    rcb_diag_candidate c;
+    assert_int_equal(rcb_diag_candidate_get(d, k, &c), RCB_OK);
+    if (c.effect < RCB_EFFECT_SENSOR_GAIN || c.effect > RCB_EFFECT_SENSOR_SWAP) continue;
+    nsensor++;
+    if (c.significant) fail_msg("null: '%s' significant (BIC %+.1f)", c.description, c.delta_bic);
+  }
+  assert_int_equal(nsensor, 8 + 4); /* a gain per probe, a swap per station (log10 scale) */
   rcb_diag_destroy(d);
   rcb_model_destroy(truth);
 }
@@ -480,6 +571,7 @@ int main(void) {
       cmocka_unit_test(test_hidden_coupling_rotational_damping),
       cmocka_unit_test(test_hidden_pedestal),
       cmocka_unit_test(test_hidden_speed),
+      cmocka_unit_test(test_hidden_sensor_gain),
       cmocka_unit_test(test_null),
       cmocka_unit_test(test_threads_identical),
       cmocka_unit_test(test_large_screen),

@@ -211,10 +211,13 @@ static void diagnose(rcb_model *truth, uint64_t seed, rcb_diag_candidate *best, 
     fail_msg("F0 = %g, expected %g +- %g", F0, N - 3.0, 5.0 * sqrt(2.0 * N));
   for (k = 0; k < rcb_diag_candidate_count(d); k++) {
     rcb_diag_candidate c;
-    double np = 1.0, Fc;
+    double np, Fc;
     const char *p;
     assert_int_equal(rcb_diag_candidate_get(d, k, &c), RCB_OK);
     if (!c.refitted || strcmp(c.fitted, "no parameter") == 0) continue;
+    /* k: the candidate's own parameters (none for a sign flipped or two
+     * probes swapped: a fixed edit of the chain, the base refitted) */
+    np = c.params[0] ? 1.0 : 0.0;
     for (p = c.params; (p = strchr(p, ',')) != NULL; p++) np += 1.0;
     Fc = F0 * (1.0 - c.objective_drop_pct / 100.0);
     if (!(fabs(c.delta_bic - (Fc - F0 + np * log(N))) < 1e-6 * (fabs(c.delta_bic) + F0)))

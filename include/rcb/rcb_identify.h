@@ -51,11 +51,56 @@ RCB_API const char *rcb_fit_errmsg(const rcb_fit *f);
 
 /**
  * @brief Add a parameter to fit (see rcb_model_get_param for names).
+ *
+ * Besides the model's parameters, the measurement chain's: every measured
+ * channel whose response is R (the channel's response name, "DB.y") is
+ * predicted as g e^{i phi} H_model, with
+ * - "sensor.R.gain": g, dimensionless, neutral 1 (a probe reading 20 % low:
+ *   0.8), and
+ * - "sensor.R.phase": phi, rad, neutral 0, positive when the sensor leads.
+ * They start from their current values (1 and 0 until a run moves them) and
+ * multiply any fixed edit of rcb_fit_set_sensor. The phase is invisible on
+ * magnitude scales (LINEAR, LOG10, DB): fit it on RCB_SCALE_COMPLEX.
  * @param lo lower bound @param hi upper bound (lo < hi; the current value is the
  * start) @param log_param optimise log(p) instead of p (needs lo > 0)
+ * @return RCB_ERR_NOT_FOUND for an unknown model parameter, RCB_ERR_ARG for a
+ * sensor parameter whose response no measured channel has
  */
 RCB_API rcb_status rcb_fit_add_param(rcb_fit *f, const char *name, double lo, double hi,
                                      int log_param);
+
+/* ---- the measurement chain: fixed edits (not fitted) ---- */
+
+/**
+ * @brief A fixed edit of the sensor of measured response @p response ("DB.y"):
+ * every channel with that response is predicted as gain e^{i phase_rad} times
+ * the model's value (times any fitted sensor.<response>.gain, .phase). A sign
+ * flipped is gain -1; (1, 0) undoes the edit.
+ * @param gain dimensionless, finite and nonzero @param phase_rad rad, positive
+ * when the sensor leads
+ * @return RCB_ERR_ARG when no measured channel has that response
+ */
+RCB_API rcb_status rcb_fit_set_sensor(rcb_fit *f, const char *response, double gain,
+                                      double phase_rad);
+/**
+ * @brief Two probes swapped: channels whose response is @p a are predicted from
+ * the model's response at @p b and vice versa (each sensor's gain and phase
+ * stay with its own channels). @p b NULL (or equal to @p a) undoes a's swap.
+ * Swapping a pair already swapped is a no-op.
+ * @return RCB_ERR_ARG when a or b is not a measured response, when the two are
+ * not measured with the same references, or when either is swapped with a
+ * third already (undo that first)
+ */
+RCB_API rcb_status rcb_fit_swap_sensors(rcb_fit *f, const char *a, const char *b);
+/**
+ * @brief The fixed edit of a measured response's sensor, as set (default 1, 0,
+ * NULL). @param gain dimensionless @param phase_rad rad @param swapped_with the
+ * response it is swapped with (owned by the measurement), NULL when none. Any
+ * output may be NULL.
+ * @return RCB_ERR_ARG when no measured channel has that response
+ */
+RCB_API rcb_status rcb_fit_get_sensor(const rcb_fit *f, const char *response, double *gain,
+                                      double *phase_rad, const char **swapped_with);
 RCB_API rcb_status rcb_fit_set_scale(rcb_fit *f, rcb_fit_scale scale);
 /** @brief Keep only abscissa values in [lo, hi], rad/s. */
 RCB_API rcb_status rcb_fit_set_band(rcb_fit *f, double lo, double hi);
@@ -297,7 +342,8 @@ RCB_API rcb_status rcb_fit_error(rcb_fit *f, double *error_pct);
  * @brief Sensitivity of each measurement channel to each parameter (paper
  * Figs. 7 and 11): S[c + nch * k] = RMS over the channel's points of
  * p_k d s(H)/d p_k (the change on the fit's scale for a 100 % change of p_k,
- * weights not applied). Use a noise-free simulated measurement with many
+ * weights not applied; for a sensor's phase, neutral at 0, d s(H)/d phi per
+ * rad). Use a noise-free simulated measurement with many
  * candidate channels to pick the most sensitive ones.
  * @param S output, nch x np column-major (nch = rcb_meas_channel_count)
  */

@@ -31,6 +31,11 @@ typedef struct diag_cand {
   char at[RCB_DIAG_NAME];           /* its node, "#N" */
   double ped0[3];                   /* pedestal: kg, N/m, N s/m */
   double v0[4];                     /* other families' fixed values (a sensor's gain) */
+  /* where its chain parameters (sensor.<r>.gain, .phase: not in any model)
+   * ended in the fit whose model is kept in model: restored on every fit of
+   * it after that (make_fit), as the model carries the model's parameters */
+  double chain_v[RCB_DIAG_MAXP];
+  int chain_kept;
   int refit_only;                   /* no neutral value: refitted, not scored */
   /* a candidate at a node of a shaft (DIAG_FAM_PLACE_WALK) */
   size_t node;                      /* its node + 1 (0: other effects) */

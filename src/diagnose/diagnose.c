@@ -183,6 +183,9 @@ static rcb_status make_fit(rcb_diag *d, rcb_model *m, unsigned with_base, const 
   }
   for (k = 0; !st && k < npc; k++)
     st = rcb_fit_add_param(f, c->pname[k], c->lo[k], c->hi[k], c->logp[k]);
+  for (k = 0; !st && c && c->chain_kept && k < c->np; k++)
+    if (rcb_fit_param_is_chain(c->pname[k]))
+      st = rcb_fit_set_chain_value(f, c->pname[k], c->chain_v[k]);
   if (!st && c && c->fam->fit_setup) st = c->fam->fit_setup(c, f);
   if (st) {
     rcb_diag_fail(d, st, "%s", f ? rcb_fit_errmsg(f) : "out of memory");
@@ -191,6 +194,19 @@ static rcb_status make_fit(rcb_diag *d, rcb_model *m, unsigned with_base, const 
   }
   *out = f;
   return RCB_OK;
+}
+
+/* Where the chain parameters of c (the last c->np of fit f) ended, kept
+ * with the model of that fit (make_fit restores them). */
+static void keep_chain(diag_cand *c, const rcb_fit *f) {
+  size_t k, np = rcb_fit_param_count(f);
+  for (k = 0; k < c->np && np >= c->np; k++) {
+    rcb_fit_param p;
+    if (!rcb_fit_param_is_chain(c->pname[k]) || rcb_fit_get_param(f, np - c->np + k, &p))
+      continue;
+    c->chain_v[k] = p.value;
+    c->chain_kept = 1;
+  }
 }
 
 /* Destroy a fit, counting its model sweeps in the diagnosis' figures. */
@@ -736,9 +752,14 @@ static int at_floor(double err, double floor) {
 
 /* Note where pre-fit f of c ended: its parameters, objective and whether
  * its error is at the noise floor (the floor of the same points). */
-static void prefit_note(diag_cand *c, const rcb_model *m, double F, double err, double floor) {
-  size_t k;
-  for (k = 0; k < c->np; k++) rcb_model_get_param(m, c->pname[k], &c->pre[k]);
+static void prefit_note(diag_cand *c, const rcb_model *m, const rcb_fit *f, double F,
+                        double err, double floor) {
+  size_t k, np = rcb_fit_param_count(f);
+  for (k = 0; k < c->np; k++) {
+    rcb_fit_param p;
+    if (!rcb_fit_param_is_chain(c->pname[k])) rcb_model_get_param(m, c->pname[k], &c->pre[k]);
+    else if (np >= c->np && !rcb_fit_get_param(f, np - c->np + k, &p)) c->pre[k] = p.value;
+  }
   if (isfinite(F)) c->pre_F = F;
   c->pre_floor = at_floor(err, floor);
 }
@@ -756,7 +777,7 @@ static rcb_status prefit_grid(rcb_diag *d, diag_cand *c, const rcb_model *m, rcb
   rcb_status st = r ? rcb_fit_residuals(f, r) : RCB_ERR_NOMEM;
   for (i = 0; !st && i < n; i++) F += r[i] * r[i];
   if (!st) st = rcb_fit_get_report(f, &rep);
-  if (!st) prefit_note(c, m, F, rcb_fit_error_pct(f), rep.floor_pct);
+  if (!st) prefit_note(c, m, f, F, rcb_fit_error_pct(f), rep.floor_pct);
   rcb_free(&d->alloc, r);
   return st;
 }
@@ -785,7 +806,7 @@ static rcb_status prefit_run(diag_cand *c, const rcb_model *m, rcb_fit *f, const
                             crawl ? fmax(ftol, RCB_DIAG_PREFIT_FTOL) : ftol, xtol);
   if (!st) st = rcb_fit_run(f);
   if (!st) st = rcb_fit_get_report(f, &rep);
-  if (!st) prefit_note(c, m, rep.objective, rep.error_pct, rep.floor_pct);
+  if (!st) prefit_note(c, m, f, rep.objective, rep.error_pct, rep.floor_pct);
   return st;
 }
 
@@ -860,6 +881,7 @@ static void refit_result(rcb_diag *d, diag_cand *c, rcb_model **m, rcb_fit *f, d
   c->F = F, c->err = err;
   judge(d, c, (double)c->np);
   record_fit(c, f);
+  keep_chain(c, f);
   rcb_model_destroy(c->model);
   c->model = *m, *m = NULL;
 }
@@ -896,7 +918,10 @@ static rcb_status refit_screen(rcb_diag *d, diag_cand *c, const double *w) {
     if (!st && w) st = rcb_fit_set_starts(f[s], RCB_DIAG_STARTS_SUBSET, 1); /* see refit_restart */
     if (!st && from_pre) { /* where its pre-fit ended */
       size_t k;
-      for (k = 0; !st && k < c->np; k++) st = rcb_model_set_param(m[s], c->pname[k], c->pre[k]);
+      for (k = 0; !st && k < c->np; k++)
+        st = rcb_fit_param_is_chain(c->pname[k])
+                 ? rcb_fit_set_chain_value(f[s], c->pname[k], c->pre[k])
+                 : rcb_model_set_param(m[s], c->pname[k], c->pre[k]);
     }
     if (st == RCB_ERR_NOMEM) break;
     if (st) { /* a candidate that cannot be built is reported, not fatal */
@@ -932,6 +957,7 @@ static rcb_status refit_screen(rcb_diag *d, diag_cand *c, const double *w) {
       c->screen_F = F[b];
       c->screen_unsure = rep.unsure;
       c->screen_floor = at_floor(rep.error_pct, rep.floor_pct);
+      keep_chain(c, f[b]);
       c->model = m[b], m[b] = NULL;
     } else {
       rcb_fit_get_report(f[b], &rep);
@@ -968,6 +994,7 @@ static rcb_status refit_restart(rcb_diag *d, diag_cand *c, const double *w) {
   if (!st) st = rcb_fit_get_report(f, &rep);
   if (!st && rep.objective < c->screen_F) {
     c->screen_F = rep.objective;
+    keep_chain(c, f);
     rcb_model_destroy(c->model);
     c->model = m, m = NULL;
   }

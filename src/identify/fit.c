@@ -49,6 +49,7 @@ rcb_status rcb_fit_set_solver(rcb_fit *f, rcb_solver_kind s) {
   ins = rcb_alloc(&f->alloc, f->nch * sizeof *ins);
   if (!outs || !ins) st = rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory");
   else if (!(st = resolve_channels(f, outs, ins))) {
+    rcb_fit_chain_reroute(f); /* the resolver wrote every channel's own output */
     rcb_frf_destroy(f->frf);
     f->frf = NULL;
     st = make_frf(f, outs, ins, s);
@@ -67,12 +68,14 @@ static rcb_status fit_setup(rcb_fit *f) {
   f->ch_in = rcb_alloc(&f->alloc, nch * sizeof *f->ch_in);
   f->ch_kind = rcb_alloc(&f->alloc, nch * sizeof *f->ch_kind);
   f->Hmod = rcb_alloc(&f->alloc, nch * f->npts * sizeof *f->Hmod);
-  if (!outs || !ins || !f->ch_out || !f->ch_in || !f->ch_kind || !f->Hmod)
+  f->Hraw = rcb_alloc(&f->alloc, nch * f->npts * sizeof *f->Hraw);
+  if (!outs || !ins || !f->ch_out || !f->ch_in || !f->ch_kind || !f->Hmod || !f->Hraw)
     st = rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory setting up the fit");
   else if (!(st = resolve_channels(f, outs, ins))) {
     st = make_frf(f, outs, ins, RCB_SOLVER_AUTO);
     f->Hwork = rcb_alloc(&f->alloc, f->nout * (f->nin ? f->nin : 1) * sizeof *f->Hwork);
     if (!st && !f->Hwork) st = rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory");
+    if (!st) st = rcb_fit_chain_init(f);
   }
   rcb_free(&f->alloc, outs);
   rcb_free(&f->alloc, ins);
@@ -149,6 +152,10 @@ void rcb_fit_destroy(rcb_fit *f) {
   rcb_free(&a, f->ch_in);
   rcb_free(&a, f->ch_kind);
   rcb_free(&a, f->Hmod);
+  rcb_free(&a, f->Hraw);
+  rcb_free(&a, f->sens);
+  rcb_free(&a, f->ch_sens);
+  rcb_free(&a, f->ch_fac);
   rcb_free(&a, f->Hwork);
   rcb_free(&a, f->wuser);
   rcb_free(&a, f->sd);
@@ -165,11 +172,15 @@ rcb_status rcb_fit_add_param(rcb_fit *f, const char *name, double lo, double hi,
   rcb_fit_par *p;
   double v;
   size_t k;
+  rcb_status st;
   if (!f || !name) return RCB_ERR_ARG;
   if (strlen(name) >= RCB_PARAM_NAME_MAX)
     return rcb_fit_fail(f, RCB_ERR_ARG, "parameter name '%s' too long", name);
-  if (rcb_model_get_param(f->m, name, &v))
+  if (rcb_fit_param_is_chain(name)) { /* a sensor's: RCB_ERR_ARG when not measured */
+    if ((st = rcb_fit_name_value(f, name, &v))) return st;
+  } else if (rcb_model_get_param(f->m, name, &v)) {
     return rcb_fit_fail(f, RCB_ERR_NOT_FOUND, "parameter: %s", rcb_model_errmsg(f->m));
+  }
   for (k = 0; k < f->np; k++)
     if (strcmp(f->par[k].name, name) == 0)
       return rcb_fit_fail(f, RCB_ERR_ARG, "parameter '%s' is given twice", name);
@@ -196,6 +207,7 @@ rcb_status rcb_fit_add_param(rcb_fit *f, const char *name, double lo, double hi,
   p->start = p->value = v;
   p->scale = v != 0.0 ? fabs(v) : (fabs(lo) > fabs(hi) ? fabs(lo) : fabs(hi));
   p->identifiable = 1;
+  if (rcb_fit_param_is_chain(name)) rcb_fit_chain_param(f, p); /* found above */
   f->prepared = 0;
   return RCB_OK;
 }
@@ -504,10 +516,7 @@ rcb_status rcb_fit_run(rcb_fit *f) {
   if (f->first_start >= (f->nstarts ? f->nstarts : 1))
     return rcb_fit_fail(f, RCB_ERR_ARG, "first start %zu of %zu starting points: nothing to try",
                         f->first_start, f->nstarts ? f->nstarts : 1);
-  for (k = 0; k < f->np; k++) {
-    rcb_model_get_param(f->m, f->par[k].name, &f->par[k].start);
-    f->par[k].value = f->par[k].start;
-  }
+  for (k = 0; k < f->np; k++) f->par[k].value = f->par[k].start = rcb_fit_par_get(f, k);
   if ((st = rcb_fit_prepare(f))) return st;
   rcb_frf_refresh(f->frf); /* the caller may have changed the model */
   f->iterations = f->evaluations = 0;
@@ -524,7 +533,7 @@ rcb_status rcb_fit_run(rcb_fit *f) {
   f->iterations += it0, f->evaluations += ev0 + 1;
   rcb_free(&f->alloc, x);
   if (st) return st;
-  for (k = 0; k < f->np; k++) rcb_model_get_param(f->m, f->par[k].name, &f->par[k].value);
+  for (k = 0; k < f->np; k++) f->par[k].value = rcb_fit_par_get(f, k);
   /* the final evaluation, with the condition of every solve checked */
   rcb_frf_set_condition_check(f->frf, RCB_COND_SCREEN, RCB_RCOND_WARN);
   st = rcb_fit_eval(f, f->r);
@@ -622,8 +631,9 @@ rcb_status rcb_fit_channel_sensitivity(rcb_fit *f, double *S) {
   memset(S, 0, f->nch * f->np * sizeof *S);
   for (j = 0; j < n; j++) cnt[f->res_ch[j]]++;
   for (k = 0; k < f->np; k++) {
-    double p;
-    rcb_model_get_param(f->m, f->par[k].name, &p);
+    /* a sensor's phase is neutral at 0, where a relative change says
+     * nothing: its figure is per rad */
+    double p = f->par[k].chain == RCB_CHAIN_PHASE ? 1.0 : rcb_fit_par_get(f, k);
     for (j = 0; j < n; j++) {
       double v = J[j + n * k] * p / f->res_sqrtw[j]; /* unweighted, relative change */
       if (f->res_sqrtw[j] > 0) S[f->res_ch[j] + f->nch * k] += v * v;
@@ -652,9 +662,7 @@ rcb_status rcb_fit_jacobian(rcb_fit *f, int analytic, double *J) {
   if (st) return st;
   /* d/dx -> d/dp */
   for (k = 0; k < f->np; k++) {
-    double v, dpdx;
-    rcb_model_get_param(f->m, f->par[k].name, &v);
-    dpdx = f->par[k].log_param ? v : f->par[k].scale;
+    double dpdx = f->par[k].log_param ? rcb_fit_par_get(f, k) : f->par[k].scale;
     for (i = 0; i < f->nres; i++) J[i + f->nres * k] /= dpdx;
   }
   return RCB_OK;

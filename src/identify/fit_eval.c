@@ -162,8 +162,7 @@ rcb_status rcb_fit_prepare(rcb_fit *f) {
 void rcb_fit_get_x(const rcb_fit *f, double *x) {
   size_t k;
   for (k = 0; k < f->np; k++) {
-    double v;
-    rcb_model_get_param(f->m, f->par[k].name, &v);
+    double v = rcb_fit_par_get(f, k);
     x[k] = f->par[k].log_param ? log(v) : v / f->par[k].scale;
   }
 }
@@ -178,8 +177,7 @@ rcb_status rcb_fit_set_x(rcb_fit *f, const double *x) {
     double v = p->log_param ? exp(x[k]) : x[k] * p->scale;
     if (!(v >= p->lo)) v = p->lo;
     if (v > p->hi) v = p->hi;
-    if ((st = rcb_model_set_param(f->m, p->name, v)))
-      return rcb_fit_fail(f, st, "setting %s = %g: %s", p->name, v, rcb_model_errmsg(f->m));
+    if ((st = rcb_fit_par_set(f, k, v))) return st;
   }
   return rcb_frf_refresh(f->frf);
 }
@@ -205,9 +203,10 @@ rcb_status rcb_fit_solve_point(rcb_fit *f, size_t i) {
   }
   if (st) return rcb_fit_fail(f, st, "model at %g rad/s: %s", w, rcb_frf_errmsg(f->frf));
   for (c = 0; c < f->nch; c++) {
-    size_t o = f->ch_out[c], in = f->unbalance ? 0 : f->ch_in[c];
-    f->Hmod[c * f->npts + i] =
+    size_t o = f->ch_out[c], in = f->unbalance ? 0 : f->ch_in[c]; /* o: after any swap */
+    f->Hraw[c * f->npts + i] =
         f->Hwork[o + f->nout * in] * (f->unbalance ? 1.0 : kind_factor(f->ch_kind[c], w));
+    f->Hmod[c * f->npts + i] = f->ch_fac[c] * f->Hraw[c * f->npts + i];
   }
   return RCB_OK;
 }
@@ -294,9 +293,7 @@ double rcb_fit_floor_pct(const rcb_fit *f) {
 /* ---- sensitivities ---- */
 
 static double dpdx(const rcb_fit *f, size_t k) {
-  double v;
-  rcb_model_get_param(f->m, f->par[k].name, &v);
-  return f->par[k].log_param ? v : f->par[k].scale;
+  return f->par[k].log_param ? rcb_fit_par_get(f, k) : f->par[k].scale;
 }
 
 /* Forward differences with the paper's step rule, eq. 11. */
@@ -306,15 +303,15 @@ static rcb_status jac_fd(rcb_fit *f, double *r, double *Jx) {
   rcb_status st;
   if ((st = rcb_fit_eval(f, r))) return st;
   for (k = 0; k < f->np; k++) {
-    const char *name = f->par[k].name;
-    double p, dp, g = dpdx(f, k);
-    rcb_model_get_param(f->m, name, &p);
+    double p = rcb_fit_par_get(f, k), dp, g = dpdx(f, k);
     dp = fabs(p) < 1e-6 ? 1e-9 : 1e-3 * fabs(p);
-    if ((st = rcb_model_set_param(f->m, name, p + dp)))
-      return rcb_fit_fail(f, st, "%s", rcb_model_errmsg(f->m));
+    /* a sensor's phase at its neutral 0 would get the 1e-9 of a vanishing
+     * model parameter: too small a step for a quantity of order 1 rad */
+    if (f->par[k].chain == RCB_CHAIN_PHASE && fabs(p) < 1e-3) dp = 1e-6;
+    if ((st = rcb_fit_par_set(f, k, p + dp))) return st;
     rcb_frf_refresh(f->frf);
     st = rcb_fit_eval(f, r2);
-    rcb_model_set_param(f->m, name, p);
+    rcb_fit_par_set(f, k, p);
     rcb_frf_refresh(f->frf);
     if (st) return st;
     for (j = 0; j < f->nres; j++) Jx[j + f->nres * k] = (r2[j] - r[j]) / dp * g;
@@ -353,6 +350,11 @@ rcb_status rcb_fit_derivative_matrices(rcb_fit *f) {
     const char *name = f->par[k].name;
     double *dk = f->dmat + k * sz, p, h;
     Fk = f->dF + k * n;
+    if (f->par[k].chain) { /* not in the model: its column is rcb_fit_chain_columns' */
+      memset(dk, 0, sz * sizeof *dk);
+      for (i = 0; i < n; i++) Fk[i] = 0.0;
+      continue;
+    }
     rcb_model_get_param(f->m, name, &p);
     h = strncmp(name, "unbalance.", 10) == 0 ? 1e-6 * (fabs(p) > 1e-3 ? fabs(p) : 1e-3)
                                              : (p != 0.0 ? 1e-3 * fabs(p) : 1e-3);
@@ -409,10 +411,15 @@ double rcb_fit_point_speed(const rcb_fit *f, double w) {
   return f->unbalance ? w / f->m->speed_factor : (f->speed < 0 ? w : f->speed);
 }
 
+double rcb_fit_res_deriv_pred(const rcb_fit *f, size_t j, double complex dP) {
+  size_t c = f->res_ch[j], i = f->res_pt[j];
+  return f->res_sqrtw[j] * on_scale_d(f->scale, f->Hmod[c * f->npts + i], dP, f->res_part[j]);
+}
+
 double rcb_fit_res_deriv(const rcb_fit *f, size_t j, double complex dh) {
   size_t c = f->res_ch[j], i = f->res_pt[j];
   if (!f->unbalance) dh *= kind_factor(f->ch_kind[c], f->grid[i]);
-  return f->res_sqrtw[j] * on_scale_d(f->scale, f->Hmod[c * f->npts + i], dh, f->res_part[j]);
+  return rcb_fit_res_deriv_pred(f, j, f->ch_fac[c] * dh); /* the chain's factor */
 }
 
 /* Analytic Jacobian, eq. 9, one point: X = Z^-1 B (kept by the solve), then
@@ -429,6 +436,10 @@ static rcb_status jac_point(rcb_fit *f, size_t i, double *Jx) {
       const rcb_complex *x = rcb_frf_solution(f->frf, q);
       size_t d;
       if (!x) return rcb_fit_fail(f, RCB_ERR_STATE, "no model solution at %g rad/s", w);
+      if (f->par[k].chain) { /* no dZ: rcb_fit_chain_columns fills its column */
+        memset(y, 0, n * sizeof *y);
+        continue;
+      }
       dz_times(L, f->dmat + k * sz, w, W, x, y);
       for (d = 0; d < n; d++) y[d] = -y[d] + (f->unbalance ? w * w * f->dF[k * n + d] : 0.0);
     }
@@ -458,6 +469,7 @@ static rcb_status jac_analytic(rcb_fit *f, double *r, double *Jx) {
     }
   }
   residuals_from_model(f, r);
+  rcb_fit_chain_columns(f, Jx);
   f->evaluations++;
   f->sweeps++;
   for (k = 0; k < f->np; k++) {

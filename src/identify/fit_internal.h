@@ -27,7 +27,21 @@ typedef struct rcb_fit_par_s {
   double value;     /* current / fitted value */
   double se, ci_lo, ci_hi;
   int identifiable;
+  int chain;        /* 0: a model parameter; RCB_CHAIN_GAIN, RCB_CHAIN_PHASE: a
+                       sensor's (fit_chain.c), not in the model */
+  size_t sensor;    /* the sensor of a chain parameter (index into sens) */
 } rcb_fit_par;
+
+/* One measured response's sensor in the measurement chain (fit_chain.c):
+ * every channel with that response is predicted as
+ * gain e^{i phase} fgain e^{i fphase} H_model(the response of sensor swap). */
+typedef struct rcb_fit_sensor {
+  const char *response; /* the channels' response name (owned by the measurement) */
+  size_t out;           /* its FRF output (the resolver's, before any swap) */
+  double gain, phase;   /* fixed edit (rcb_fit_set_sensor): -, rad; 1, 0 neutral */
+  double fgain, fphase; /* current values of sensor.<response>.gain, .phase: -, rad */
+  size_t swap;          /* the sensor whose model response it reads (itself: none) */
+} rcb_fit_sensor;
 
 struct rcb_fit {
   rcb_allocator alloc;
@@ -38,6 +52,12 @@ struct rcb_fit {
   size_t nch, npts;      /* channels, abscissa points */
   size_t *ch_out, *ch_in; /* per channel: index into the frf outputs / inputs */
   rcb_frf_kind *ch_kind; /* per channel: kind of the measured values */
+  /* measurement chain (fit_chain.c): ch_out above is the output each
+   * channel's prediction reads, its own unless its sensor is swapped */
+  rcb_fit_sensor *sens;  /* nsens distinct measured responses */
+  size_t nsens;
+  size_t *ch_sens;       /* per channel: its sensor */
+  rcb_complex *ch_fac;   /* per channel: the chain's factor (-) */
   const double *grid;    /* rad/s, npts */
   int unbalance;         /* 1: unbalance responses over speed */
   double speed;          /* rotor speed of an FRF test, rad/s (< 0: synchronous) */
@@ -66,7 +86,9 @@ struct rcb_fit {
   unsigned char *res_part;
   double *res_sqrtw;     /* sqrt of the weight */
   double *res_meas;      /* measured value on the scale */
-  rcb_complex *Hmod;     /* model values, nch * npts (kind of each channel) */
+  rcb_complex *Hmod;     /* predicted values, nch * npts (kind of each channel): the
+                            chain's factor times Hraw */
+  rcb_complex *Hraw;     /* the model's values before the chain's factor */
   rcb_complex *Hwork;    /* frf output buffer, nout * nin */
   size_t nout, nin;
   unsigned char *pt_used; /* npts: 1 when some residual needs the model there */
@@ -99,6 +121,30 @@ struct rcb_fit {
 #define rcb_fit_fail(f, st, ...) rcb_fail((f), (st), __VA_ARGS__)
 double rcb_fit_sumsq(const double *r, size_t n);
 void rcb_fit_free_layout(rcb_fit *f);
+
+/* The measurement chain (fit_chain.c). Sensors of the measured responses,
+ * after the channels are resolved (ch_out); reroute after a new resolve. */
+rcb_status rcb_fit_chain_init(rcb_fit *f);
+void rcb_fit_chain_reroute(rcb_fit *f);
+/* A new parameter p whose name is a sensor's (rcb_fit_param_is_chain):
+ * its sensor, or RCB_ERR_ARG naming the measured responses. */
+rcb_status rcb_fit_chain_param(rcb_fit *f, rcb_fit_par *p);
+/* The current value of a parameter by name, the chain's or the model's,
+ * with a message on failure. */
+rcb_status rcb_fit_name_value(rcb_fit *f, const char *name, double *v);
+/* Parameter k's current value, and setting it (parameter units): every
+ * path of the fit goes through these, never rcb_model_*_param on a name, so
+ * that sensor parameters reach the chain. par_set leaves the FRF workspace
+ * to the caller (rcb_frf_refresh after model parameters). */
+double rcb_fit_par_get(const rcb_fit *f, size_t k);
+rcb_status rcb_fit_par_set(rcb_fit *f, size_t k, double v);
+/* The columns d r / d p (parameter units) of the chain parameters into J
+ * (nres x np), from the predictions of the last evaluation; the other
+ * columns untouched. */
+void rcb_fit_chain_columns(const rcb_fit *f, double *J);
+/* d r_j / d p from the derivative dP of residual j's predicted value
+ * (channel's kind, chain included) (fit_eval.c). */
+double rcb_fit_res_deriv_pred(const rcb_fit *f, size_t j, double complex dP);
 
 /* Parameters <-> internal coordinates. set_x writes the model and refreshes
  * the FRF workspace. */

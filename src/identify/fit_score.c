@@ -86,6 +86,12 @@ rcb_status rcb_fit_dz_get(rcb_fit *c, const rcb_allocator *a, rcb_fit_dz *dz) {
   size_t k;
   rcb_status st;
   for (k = 0; k < c->np; k++) dz[k].e = NULL, dz[k].dF = NULL, dz[k].ne = 0;
+  for (k = 0; k < c->np; k++)
+    if (c->par[k].chain)
+      return rcb_fit_fail(c, RCB_ERR_ARG,
+                          "parameter %s belongs to the measurement chain: it has no dZ/dp "
+                          "(its column is the fit's own, rcb_fit_jacobian)",
+                          c->par[k].name);
   if ((st = dz_workspace(c)) || (st = rcb_fit_derivative_matrices(c))) return st;
   return rcb_fit_dz_collect(c, a, dz);
 }

@@ -67,4 +67,26 @@ void rcb_fit_dz_free(const rcb_allocator *a, rcb_fit_dz *dz, size_t n);
  * all of them (fit_score.c). One sweep. */
 rcb_status rcb_fit_jacobian_dz(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, double *J);
 
+/* Whether a parameter name belongs to the measurement chain rather than the
+ * model (sensor.<response>.gain or .phase, rcb_identify.h): such a
+ * parameter has no dZ/dp (rcb_fit_dz_get refuses it), and its column comes
+ * from the fit's own Jacobian (rcb_fit_jacobian). 0: not a chain
+ * parameter, RCB_CHAIN_GAIN or RCB_CHAIN_PHASE. Syntactic only: whether the
+ * response is measured is checked by rcb_fit_add_param. */
+#define RCB_CHAIN_GAIN 1
+#define RCB_CHAIN_PHASE 2
+int rcb_fit_param_is_chain(const char *name);
+
+/* The sensors of f's measurement chain: one per distinct measured response,
+ * in order of first appearance among the channels; the response name
+ * (owned by the measurement), NULL past the end. */
+size_t rcb_fit_sensor_count(const rcb_fit *f);
+const char *rcb_fit_sensor_response(const rcb_fit *f, size_t k);
+/* Move chain parameter name, already added to f, to value v (its units,
+ * within its bounds): where a chain parameter lives between fits, as a
+ * model parameter lives in the model (the diagnosis keeps a candidate's
+ * fitted gain from its screen to its polish). RCB_ERR_ARG when name is not
+ * a chain parameter of f or v is outside its bounds. */
+rcb_status rcb_fit_set_chain_value(rcb_fit *f, const char *name, double v);
+
 #endif /* RCB_IDENTIFY_INTERNAL_API_H */

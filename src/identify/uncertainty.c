@@ -46,13 +46,12 @@ static void flag_and_fill(rcb_fit *f, const double *s, const double *Vt, const d
 
 /* Objective with parameter k set to v (the model is restored afterwards). */
 static rcb_status objective_with(rcb_fit *f, size_t k, double v, double *F) {
-  double p;
+  double p = rcb_fit_par_get(f, k);
   rcb_status st;
-  rcb_model_get_param(f->m, f->par[k].name, &p);
-  if ((st = rcb_model_set_param(f->m, f->par[k].name, v))) return st;
+  if ((st = rcb_fit_par_set(f, k, v))) return st;
   rcb_frf_refresh(f->frf);
   st = rcb_fit_eval(f, f->r + f->nres);
-  rcb_model_set_param(f->m, f->par[k].name, p);
+  rcb_fit_par_set(f, k, p);
   rcb_frf_refresh(f->frf);
   if (!st) *F = rcb_fit_sumsq(f->r + f->nres, f->nres);
   return st;
@@ -95,8 +94,7 @@ rcb_status rcb_fit_uncertainty(rcb_fit *f) {
   sigma2 = n > np ? rcb_fit_sumsq(f->r, n) / (double)(n - np) : (double)NAN;
   /* J in internal units -> columns scaled to relative parameter changes */
   for (k = 0; k < np; k++) {
-    double v, dpdx;
-    rcb_model_get_param(f->m, f->par[k].name, &v);
+    double v = rcb_fit_par_get(f, k), dpdx;
     dpdx = f->par[k].log_param ? v : f->par[k].scale;
     d[k] = v != 0.0 ? fabs(v) : f->par[k].scale;
     for (i = 0; i < n; i++) A[i + n * k] = f->J[i + n * k] / dpdx * d[k];
