@@ -59,7 +59,11 @@ RCB_API const char *rcb_effect_name(rcb_effect e);
  * history, and the Python package, which all call these functions.
  *
  * - significant: BIC falls by more than 10 ("strong" evidence, Kass &
- *   Raftery) and the error % falls by at least 2 % of itself;
+ *   Raftery); when the noise is unknown (chi2_limit NaN: F is not a
+ *   chi-square, BIC is N ln F + k ln N) the error % must also fall by at
+ *   least 2 % of itself. With a known noise the BIC test stands alone: the
+ *   unweighted error % can rise while the weighted F falls (a sensor's gain
+ *   on data already at the floor: error 5.39 -> 5.44 %, BIC -1663);
  * - adequate: the model with the edit passes the adequacy test of
  *   rcb_fit_get_adequacy (chi2 <= chi2_limit, 1 % false rejections); unknown
  *   when the noise is unknown (chi2_limit NaN);
@@ -81,7 +85,7 @@ typedef struct rcb_evidence {
   double chi2_limit;       /**< the adequacy test's limit (-); NaN: the noise is unknown */
 } rcb_evidence;
 #define RCB_BIC_SIGNIFICANT (-10.0) /**< dBIC below this is significant */
-#define RCB_ERROR_FALL 0.98         /**< and the error below this fraction of the one before */
+#define RCB_ERROR_FALL 0.98         /**< and, noise unknown, the error below this fraction */
 /** @brief 1 when significant, else 0. */
 RCB_API int rcb_evidence_significant(const rcb_evidence *e);
 /** @brief 1 adequate, 0 not, -1 unknown (no noise model, no standard deviations). */

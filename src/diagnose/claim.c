@@ -9,8 +9,10 @@
 #include "rcb/rcb_diagnose.h"
 
 int rcb_evidence_significant(const rcb_evidence *e) {
+  /* with a known noise F is a chi-square and the BIC test stands alone;
+   * without one, the error itself must fall too */
   return e && e->delta_bic < RCB_BIC_SIGNIFICANT &&
-         e->error_after_pct < RCB_ERROR_FALL * e->error_before_pct;
+         (isfinite(e->chi2_limit) || e->error_after_pct < RCB_ERROR_FALL * e->error_before_pct);
 }
 
 int rcb_evidence_adequate(const rcb_evidence *e) {

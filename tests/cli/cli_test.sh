@@ -975,7 +975,12 @@ diagnose_progress_and_warnings)
   cp "$MODEL" "$M2"
   run fit "$M2" "$W/meas.csv" --params coupling.C.kt --history "$W/h.jsonl"; expect_rc 0
   run diagnose "$M2" "$W/meas.csv" --params coupling.C.kt,coupling.C.kr --log --noise 10,1 \
-    --progress --apply 1 -o "$W/m2.ini" --history "$W/h.jsonl"
+    --json
+  expect_rc 0
+  # the first candidate that edits the model (a sensor's is never applied)
+  K=$(python3 -c 'import json,sys; print(next(c["rank"] for c in json.load(open(sys.argv[1]))["candidates"] if not c["chain"]))' "$W/out")
+  run diagnose "$M2" "$W/meas.csv" --params coupling.C.kt,coupling.C.kr --log --noise 10,1 \
+    --progress --apply "$K" -o "$W/m2.ini" --history "$W/h.jsonl"
   expect_rc 3; [ ! -e "$W/m2.ini" ] || fail "a refused --apply wrote the model"
   err_has "is not significant"; err_has "add --force"
   grep -o '[0-9]*/[0-9]* steps' "$W/err" | cut -d/ -f1 >"$W/counts"
@@ -986,7 +991,7 @@ diagnose_progress_and_warnings)
   out_has "none is needed"; out_has "within the 1 % limit"
   grep -q '^1 *explains\|^1 *improves' "$W/out" && fail "null case: a candidate came out significant"
   run diagnose "$M2" "$W/meas.csv" --params coupling.C.kt,coupling.C.kr --log --noise 10,1 \
-    --apply 1 --force -o "$W/m2.ini" --history "$W/h.jsonl"
+    --apply "$K" --force -o "$W/m2.ini" --history "$W/h.jsonl"
   expect_rc 0; [ -s "$W/m2.ini" ] || fail "--force wrote no model"
   err_has "is not significant"
   run history "$W/h.jsonl"; expect_rc 0; out_has "the_model_file.ini"; out_has "predicted" ;;

@@ -27,8 +27,9 @@ const char cli_help_diagnose[] =
     "effect can explain (score test on the weighted objective, orthogonal to the\n"
     "fitted parameters); the best N (--refits, default 8) and the other coupling\n"
     "models are refitted. What may be said of a candidate follows one rule\n"
-    "(rcb_evidence_claim): it is significant when BIC falls by more than 10 and\n"
-    "the error by at least 2 % of itself; it \"explains\" the data only when it is\n"
+    "(rcb_evidence_claim): it is significant when BIC falls by more than 10 (and,\n"
+    "without --noise or --sd, the error by at least 2 % of itself); it \"explains\"\n"
+    "the data only when it is\n"
     "significant and the model with it passes the adequacy test (its chi-square\n"
     "within the 1 % limit of what the noise alone leaves: --noise or --sd needed);\n"
     "a significant one that fails the test \"improves\": another effect is still\n"
@@ -323,13 +324,19 @@ static int apply(const cli_args *a, const diag_job *j, const rcb_diag *d) {
                      rcb_diag_candidate_count(d));
   {
     rcb_diag_candidate c;
-    if (rcb_diag_candidate_get(d, j->apply - 1, &c) == RCB_OK && c.claim == RCB_CLAIM_NONE &&
-        !c.chain) {
+    if (rcb_diag_candidate_get(d, j->apply - 1, &c) == RCB_OK && c.chain)
+      return cli_fail(CLI_EXIT_INPUT,
+                      "%s: --apply %zu: candidate %zu (%s) is a fault of the measurement "
+                      "chain, not of the model: nothing written; check or recalibrate the "
+                      "sensor, or apply a model candidate",
+                      a->cmd, j->apply, j->apply, c.description);
+    if (rcb_diag_candidate_get(d, j->apply - 1, &c) == RCB_OK && c.claim == RCB_CLAIM_NONE) {
       if (!j->force)
         return cli_fail(CLI_EXIT_INPUT,
                         "%s: --apply %zu: candidate %zu (%s) is not significant (dBIC %+.1f; "
-                        "significant needs BIC to fall by more than 10 and the error by 2 %% "
-                        "of itself): the model would be fitting noise; nothing written. Apply "
+                        "significant needs BIC to fall by more than 10, and without --noise "
+                        "or --sd the error by 2 %% of itself): the model would be fitting "
+                        "noise; nothing written. Apply "
                         "a significant candidate, bring more data, or add --force",
                         a->cmd, j->apply, j->apply, c.description, c.delta_bic);
       cli_warn("%s: --apply %zu --force: candidate %zu (%s) is not significant (dBIC %+.1f): "
