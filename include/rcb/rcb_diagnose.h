@@ -210,7 +210,8 @@ typedef struct rcb_diag_misfit {
 RCB_API size_t rcb_diag_misfit_count(const rcb_diag *d);
 /**
  * @brief Sensor @p k, the largest excess first. The misfit concentrates on
- * one sensor, or on two (a swapped pair), when they hold at least 80 % of
+ * one sensor, or on the two directions of one station (a swapped pair), when
+ * they hold at least 80 % of
  * F's excess over the noise, each fails its own adequacy test beyond a
  * Bonferroni limit over the sensors (z = (chi2 - expected) / sd above the
  * normal quantile of 0.01 / sensors) and its chi2 / expected is at least

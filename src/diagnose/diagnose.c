@@ -327,6 +327,13 @@ static double z_upper(double p) {
 /* Which sensors concentrate the misfit (rcb_diag_misfit_get states the
  * rule): the per-channel parts of the adequacy test summed per response. */
 #define RCB_DIAG_MISFIT_SHARE 80.0 /* % of the excess on one sensor or a pair */
+
+/* Whether responses a and b ("C.A.x", "C.A.y") are two directions of one
+ * station (a probe pair that may be swapped). */
+static int same_station(const char *a, const char *b) {
+  const char *da = strrchr(a, '.'), *db = strrchr(b, '.');
+  return da && db && da - a == db - b && strncmp(a, b, (size_t)(da - a)) == 0;
+}
 #define RCB_DIAG_MISFIT_RATIO 3.0
 static rcb_status misfit_sensors(rcb_diag *d, const double *chi2, const double *mean,
                                  const double *var) {
@@ -358,7 +365,7 @@ static rcb_status misfit_sensors(rcb_diag *d, const double *chi2, const double *
       d->mis[i] = d->mis[i - 1];
       d->mis[i - 1] = t;
     }
-  /* one sensor, or two (a swapped pair), holding RCB_DIAG_MISFIT_SHARE of
+  /* one sensor, or two of one station (a swapped pair), holding RCB_DIAG_MISFIT_SHARE of
    * the excess, each failing its own test beyond the Bonferroni limit and
    * RCB_DIAG_MISFIT_RATIO x the median chi2 / expected of the rest */
   zlim = z_upper(0.01 / (double)(d->nmis ? d->nmis : 1));
@@ -367,6 +374,7 @@ static rcb_status misfit_sensors(rcb_diag *d, const double *chi2, const double *
     size_t n = 0;
     for (k = 0; k < m; k++) share += d->mis[k].excess_pct;
     if (share < RCB_DIAG_MISFIT_SHARE) continue;
+    if (m == 2 && !same_station(d->mis[0].sensor, d->mis[1].sensor)) break;
     for (i = m; i < d->nmis; i++)
       if (d->mis[i].expected > 0) ratio[n++] = d->mis[i].chi2 / d->mis[i].expected;
     med = median(ratio, n);

@@ -197,7 +197,7 @@ static void print_adequacy(FILE *fp, const rcb_diag *d) {
       rcb_diag_misfit s;
       rcb_diag_misfit_get(d, k, &s);
       fprintf(fp, "%-14s %12.6g %12.6g %9.1f  %s\n", s.sensor, s.chi2, s.expected,
-              s.excess_pct, s.concentrated ? "<- check this sensor" : "");
+              s.excess_pct, s.concentrated ? "<- the misfit concentrates here" : "");
     }
   }
   fputc('\n', fp);
