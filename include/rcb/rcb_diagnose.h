@@ -92,6 +92,13 @@ RCB_API int rcb_evidence_significant(const rcb_evidence *e);
 RCB_API int rcb_evidence_adequate(const rcb_evidence *e);
 /** @brief The claim the evidence supports. */
 RCB_API rcb_claim rcb_evidence_claim(const rcb_evidence *e);
+/**
+ * @brief 1 when two significant candidates with BIC changes @p dbic_a and
+ * @p dbic_b are told apart by the data: their BICs differ by more than 10
+ * (the same "strong" evidence as significance); 0 when the data cannot
+ * separate them (then rcb_plan names the measurement that would).
+ */
+RCB_API int rcb_evidence_separable(double dbic_a, double dbic_b);
 /** @brief "explains", "improves" or "none" (the JSON and Python spelling). */
 RCB_API const char *rcb_claim_str(rcb_claim c);
 

@@ -28,3 +28,7 @@ rcb_claim rcb_evidence_claim(const rcb_evidence *e) {
 const char *rcb_claim_str(rcb_claim c) {
   return c == RCB_CLAIM_EXPLAINS ? "explains" : c == RCB_CLAIM_IMPROVES ? "improves" : "none";
 }
+
+int rcb_evidence_separable(double dbic_a, double dbic_b) {
+  return fabs(dbic_a - dbic_b) > -RCB_BIC_SIGNIFICANT;
+}

@@ -1525,6 +1525,36 @@ static size_t say_span(const rcb_diag *d, char *text, size_t size, size_t n) {
   return n < size ? n : size - 1;
 }
 
+/* A parameter list "a, b" as "a,b" (one shell word). */
+static void no_spaces(const char *in, char *out) {
+  for (; *in; in++)
+    if (*in != ' ') *out++ = *in;
+  *out = '\0';
+}
+
+/* When the second candidate has the first's claim and the data cannot tell
+ * them apart (rcb_evidence_separable), say so and name the plan that would
+ * (appended to text at n). Sensor candidates are left out: their rival is
+ * a check of the sensor, not a test campaign. */
+static size_t say_rival(const rcb_diag *d, char *text, size_t size, size_t n) {
+  const diag_cand *a, *b;
+  if (d->ncand < 2 || n >= size) return n;
+  a = &d->cand[d->order[0]], b = &d->cand[d->order[1]];
+  if (!a->refitted || !b->refitted || a->claim == RCB_CLAIM_NONE || b->claim != a->claim ||
+      rcb_evidence_separable(a->dbic, b->dbic) || ((a->fam->flags | b->fam->flags) & DIAG_FAM_CHAIN))
+    return n;
+  {
+    char pa[sizeof a->params], pb[sizeof b->params];
+    no_spaces(a->params, pa), no_spaces(b->params, pb);
+    n += (size_t)snprintf(text + n, size - n,
+                          " These data cannot separate it from %s (BIC %+.1f, within %g of it): "
+                          "rcb_plan (rcbtool plan --between %s %s) names the measurement that "
+                          "would.",
+                          b->desc, b->dbic, -RCB_BIC_SIGNIFICANT, pa, pb);
+  }
+  return n < size ? n : size - 1;
+}
+
 /* The adequacy test's figures in words: "chi-square F above the limit L". */
 static void say_test(char *t, size_t size, double F, double limit) {
   snprintf(t, size, "chi-square %.6g %s the adequacy limit %.6g at 1 %%", F,
@@ -1564,8 +1594,8 @@ rcb_status rcb_diag_explain(const rcb_diag *d, char *buf, size_t size, size_t *n
     } else {
       snprintf(text, sizeof text,
                "The best candidate, %s (%s), lowers the misfit by %.1f %%: the error falls "
-               "from %.3g %% to %.3g %%, BIC %+.1f. Whether the model then explains the data "
-               "cannot be tested: the noise is unknown (give --noise or --sd).",
+               "from %.3g %% to %.3g %%, BIC %+.1f. Whether the model then fits the data to their "
+               "noise cannot be tested: the noise is unknown (give --noise or --sd).",
                c->desc, c->fitted, 100.0 * (d->F0 - c->F) / d->F0, d->err0, c->err, c->dbic);
     }
   } else if (d->adeq0.known && d->adeq0.adequate) {
@@ -1585,11 +1615,12 @@ rcb_status rcb_diag_explain(const rcb_diag *d, char *buf, size_t size, size_t *n
   } else {
     snprintf(text, sizeof text,
              "No candidate is significant: no effect of the catalogue lowers BIC by more than "
-             "%g while lowering the error (%.3g %%). Whether the model as it is explains the "
-             "data cannot be tested: the noise is unknown (give --noise or --sd).",
+             "%g while lowering the error (%.3g %%). Whether the model as it is fits the data to their "
+             "noise cannot be tested: the noise is unknown (give --noise or --sd).",
              -RCB_BIC_SIGNIFICANT, d->err0);
   }
   n = strlen(text);
+  n = say_rival(d, text, sizeof text, n);
   if (!(c && c->refitted && c->claim == RCB_CLAIM_EXPLAINS) &&
       !(d->adeq0.known && d->adeq0.adequate)) {
     n = say_where(d, text, sizeof text, n);
