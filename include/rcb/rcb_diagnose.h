@@ -9,10 +9,13 @@
  * score test on the fit's own (noise-aware) objective, with the candidate's
  * sensitivity columns orthogonalised against the parameters already fitted.
  * The best candidates (and the alternative coupling models, which have no
- * neutral value) are then refitted; a candidate is significant when its
- * information criterion (BIC) falls by more than 10 and the error itself
- * falls. With known standard deviations per point (rcb_diag_set_sd) or the
- * noise model, the objective is a chi-square and the BIC uses it as one.
+ * neutral value) are then refitted, and one rule (rcb_evidence_claim) decides
+ * what may be said of each: significant, and whether it explains the data
+ * (the adequacy test of the model with it). With known standard deviations
+ * per point (rcb_diag_set_sd) or the noise model, the objective is a
+ * chi-square and the BIC uses it as one. The catalogue holds the model's
+ * effects and the measurement chain's (a sensor's gain, sign, a swapped pair:
+ * never applied to the model).
  */
 #ifndef RCB_DIAGNOSE_H
 #define RCB_DIAGNOSE_H
