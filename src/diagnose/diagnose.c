@@ -658,6 +658,7 @@ static void record_fit(diag_cand *c, rcb_fit *f) {
     n += (size_t)snprintf(c->fitted + n, n < sizeof c->fitted ? sizeof c->fitted - n : 0,
                           "%s%s = %.6g", n ? ", " : "", p.name, p.value);
   }
+  if (!c->np) snprintf(c->fitted, sizeof c->fitted, "no parameter of its own");
 }
 
 /* The candidate's model built on the base model src (the fitted one, or the
@@ -668,7 +669,7 @@ static rcb_status refit_setup(rcb_diag *d, const diag_cand *c, const rcb_model *
   rcb_status st;
   *m = NULL, *f = NULL;
   st = rcb_diag_candidate_model(d, c, src, m);
-  if (!st) st = make_fit(d, *m, 1, c, f);
+  if (!st) st = make_fit(d, *m, FIT_BASE, c, f);
   /* not when the start is where the pre-fit ended (set by the caller) */
   if (!st && !from_pre) st = rcb_diag_refit_start(d, c, *m, *f);
   if (!st) st = rcb_fit_set_starts(*f, refit_starts(d, c), 1);
@@ -1300,6 +1301,38 @@ static rcb_status nominal_starts(rcb_diag *d, cand_jobs *j) {
   return RCB_OK;
 }
 
+/* A fixed edit of the measurement chain (a sign, a swap: no parameter, no
+ * neutral value) is scored by what it does at the fitted base, one sweep:
+ * its predicted reduction is F0 less F with the edit. Only an edit that
+ * lowers F there is refitted (with the base parameters: a swap evaluated at
+ * the base alone left 13.4 % of error for 5.8 % after its refit, 8 x 151);
+ * the 4 swaps of 32 x 1101 cost 62 sweeps of refits, 0.8 s, for nothing on
+ * a machine whose probes are right. */
+static int fixed_chain(const diag_cand *c) {
+  return (c->fam->flags & DIAG_FAM_CHAIN) && c->np == 0;
+}
+
+static rcb_status score_fixed_chain(rcb_diag *d) {
+  size_t k;
+  double *r = rcb_alloc(&d->alloc, (d->nres ? d->nres : 1) * sizeof *r);
+  rcb_status st = r ? RCB_OK : rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
+  for (k = 0; !st && k < d->ncand; k++) {
+    diag_cand *c = &d->cand[k];
+    rcb_model *m = NULL;
+    rcb_fit *f = NULL;
+    double F = HUGE_VAL, err;
+    if (!fixed_chain(c)) continue;
+    st = candidate_fit(d, c, &m, &f);
+    if (!st) st = objective(d, f, r, &F, &err);
+    if (st != RCB_ERR_NOMEM) st = RCB_OK; /* an edit that cannot be evaluated: not refitted */
+    c->predicted = isfinite(F) ? d->F0 - F : 0.0;
+    drop_fit(d, f);
+    rcb_model_destroy(m);
+  }
+  rcb_free(&d->alloc, r);
+  return st;
+}
+
 static rcb_status refit_best(rcb_diag *d) {
   /* a run-off fit is a poor start (every damping candidate refitted there
    * on the 0.15 kg hub case stayed at F0): its best RCB_DIAG_NOM_REFITS only */
@@ -1317,10 +1350,16 @@ static rcb_status refit_best(rcb_diag *d) {
     rcb_free(&d->alloc, j.w);
     return rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
   }
+  if ((st = score_fixed_chain(d))) {
+    rcb_free(&d->alloc, j.w);
+    rcb_free(&d->alloc, j.k);
+    return st;
+  }
   sort_order(d); /* by predicted reduction (nothing refitted yet) */
   for (k = 0; k < d->ncand; k++) {
     diag_cand *c = &d->cand[d->order[k]];
-    c->from_fit = c->refit_only || (j.todo < nfit && c->predicted > 0);
+    c->from_fit = (c->refit_only && !(fixed_chain(c) && !(c->predicted > 0))) ||
+                  (j.todo < nfit && c->predicted > 0);
     j.todo += !c->refit_only && c->from_fit;
   }
   if (d->far) st = nominal_starts(d, &j);
@@ -1330,7 +1369,7 @@ static rcb_status refit_best(rcb_diag *d) {
     if (!c->refit_only && (c->from_fit || c->from_nom)) j.k[j.n++] = d->order[k];
   }
   for (k = 0; k < d->ncand; k++)
-    if (d->cand[k].refit_only) j.k[j.n++] = k;
+    if (d->cand[k].refit_only && d->cand[k].from_fit) j.k[j.n++] = k;
   if (!st) st = rcb_diag_for_each(d, j.n, refit_job, &j, refit_done);
   if (!st) any_screen_at_floor(d);
   if (!st) st = rcb_diag_for_each(d, j.n, restart_job, &j, NULL);
