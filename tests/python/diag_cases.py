@@ -581,6 +581,7 @@ def at_floor(step):
 
 ELEMENT = "shaft element stiffness"
 SENSOR = "sensor gain and phase"
+SWAP = "swapped sensors"
 
 
 def _element_stiffness_edit(shaft, k, factor):
@@ -662,6 +663,20 @@ def probe_edit(response, gain):
     return edit
 
 
+def swap_edit(a, b):
+    """after_noise: the probes of responses A and B swapped on every input's
+    block (a cabling fault: A's channel holds what B measured, and back)."""
+
+    def edit(data):
+        data = np.array(data, dtype=complex)
+        for q in range(data.shape[0] // len(OUTS)):
+            i, j = q * len(OUTS) + OUTS.index(a), q * len(OUTS) + OUTS.index(b)
+            data[[i, j]] = data[[j, i]]
+        return data
+
+    return edit
+
+
 class ClaimCase(Case):
     """A case of issue #23. kind: what the test asserts (crack, hub, probe, two,
     weak, null); after_noise: the measurement chain's edit of the noisy data."""
@@ -697,6 +712,8 @@ CLAIM_CASES = [
     ClaimCase("claim_weak", f"kxy = -kyx = {WEAK_KCROSS:g} N/m at B3", [(CROSS, "bearing B3")],
               "weak", model_edit=bearing_keys("B3", kxy=WEAK_KCROSS, kyx=-WEAK_KCROSS),
               grid="small"),
+    ClaimCase("claim_swap_CB", "the model as it is; the probes C.B.x and C.B.y swapped",
+              [(SWAP, "C.B")], "swap", after_noise=swap_edit("C.B.x", "C.B.y"), grid="small"),
     ClaimCase("claim_null", "nothing hidden", [], "null", grid="small"),
 ]
 

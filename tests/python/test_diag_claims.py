@@ -254,10 +254,24 @@ def test_bad_probe(tool, claims, tmp_path):
     sensors = d.get("misfit", {}).get("sensors", [])
     assert _is(c0, dc.SENSOR, "DB.y") or (sensors and sensors[0]["response"] == "DB.y"), \
         (c0, sensors[:3])
+    # with the sensor family: the gain at DB.y named, and it explains the data
+    assert _is(c0, dc.SENSOR, "DB.y") and c0["claim"] == "explains", c0
+    assert "sensor.DB.y.gain = 0.8" in c0["fitted"] or "sensor.DB.y.gain = 0.79" in c0["fitted"], c0
     edits = [c for c in _explains(d) if c["effect"] not in CHAIN]
     assert not edits, edits
     if c0["effect"] in CHAIN:  # the model untouched: --apply of a sensor refuses
         assert s["applied"] is None, s["applied"]
+
+
+def test_swapped_probes(tool, claims, tmp_path):
+    """C.B.x and C.B.y swapped on a rotor exactly as modelled: the swap named
+    first, explaining the data, and --apply refuses it (the model untouched)."""
+    case = CASES["claim_swap_CB"]
+    (s,) = _rounds(tool, tmp_path, case)
+    c0 = s["diag"]["candidates"][0]
+    assert _is(c0, dc.SWAP, "C.B"), c0
+    assert c0["claim"] == "explains" and c0["chain"], c0
+    assert s["applied"] is None, s["applied"]
 
 
 def test_two_effects_two_rounds(tool, claims, tmp_path):
