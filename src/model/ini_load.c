@@ -420,7 +420,11 @@ static void model_reset(rcb_model *m) {
   size_t i;
   for (i = 0; i < m->n_shafts; i++) {
     rcb_free(&m->alloc, m->shafts[i].seg);
+    rcb_free(&m->alloc, m->shafts[i].ef);
     m->shafts[i].seg = NULL;
+    m->shafts[i].ef = NULL;
+    m->shafts[i].nseg = m->shafts[i].capseg = 0;
+    m->shafts[i].nef = m->shafts[i].capef = 0;
   }
   for (i = 0; i < m->n_bearings; i++) {
     rcb_free(&m->alloc, m->bearings[i].speeds);
