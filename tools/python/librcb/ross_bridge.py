@@ -173,6 +173,10 @@ class Shaft:
         self.alpha = _f(d, "damping_mass", 0.0)
         self.beta = _f(d, "damping_stiffness", 0.0)
         self.elements = []  # (L, od, id)
+        # per-element factors (librcb's shaft.NAME.e<k>.stiffness | mass):
+        # local element index (0-based, z order) -> (factor on E and G, on rho);
+        # the ROSS builder gives such an element its own Material
+        self.factors = {}
         for seg in d.get("segment", []):
             length, od, idd, n = _floats(seg)
             n = int(n)
@@ -335,8 +339,13 @@ class IniRotor:
         }
         shaft_els = []
         for sh in model.shafts:
-            mat = mats[sh.material]
             for i, (L, od, idd) in enumerate(sh.elements):
+                mat = mats[sh.material]
+                if i in sh.factors:  # its own Material: E (G follows) and rho scaled
+                    fk, fm = sh.factors[i]
+                    rho, E, nu = model.materials[sh.material]
+                    mat = rs.Material(name=f"{mat.name}_{sh.name}_e{i + 1}", rho=fm * rho,
+                                      E=fk * E, Poisson=nu)
                 el = rs.ShaftElement(
                     L=L, idl=idd, odl=od, material=mat, n=self.node_of[(sh.name, i)],
                     shear_effects=sh.kappa > 0, rotary_inertia=True, gyroscopic=True,
