@@ -542,6 +542,35 @@ static void test_write_round_trip_after_set(void **state) {
   rcb_model_destroy(m);
 }
 
+/* Element factors (element_stiffness, element_mass: pairs "k factor", the
+ * key repeated every four pairs) survive the round trip bit for bit, and
+ * the reloaded model holds them as parameters. */
+static void test_write_round_trip_element_factors(void **state) {
+  rcb_model *m = rcb_test_model_from_example("paper_system.ini"), *r = NULL;
+  char name[64], *text;
+  size_t k;
+  (void)state;
+  for (k = 1; k <= 9; k++) {
+    snprintf(name, sizeof name, "shaft.B.e%zu.stiffness", k);
+    set(m, name, 1.0 - 1.0 / (3.0 + (double)k));
+  }
+  set(m, "shaft.A.e10.mass", 1.0 / 3.0);
+  set(m, "shaft.A.e1.stiffness", 2.5);
+  expect_round_trip(m, "paper system, element factors");
+  text = write_text(m);
+  assert_non_null(strstr(text, "element_stiffness = 1 2.5 ; "));
+  assert_non_null(strstr(text, "element_mass = 10 0.3333333333333333 ; "));
+  assert_non_null(strstr(text, "\nelement_stiffness = 5 0.875 6 "));
+  assert_int_equal(rcb_model_create(&r, NULL), RCB_OK);
+  assert_int_equal(rcb_model_load_string(r, text, "<written>"), RCB_OK);
+  assert_true(get(r, "shaft.B.e4.stiffness") == 1.0 - 1.0 / 7.0);
+  assert_true(get(r, "shaft.B.e10.stiffness") == 1.0);
+  assert_true(get(r, "shaft.A.e10.mass") == 1.0 / 3.0);
+  free(text);
+  rcb_model_destroy(r);
+  rcb_model_destroy(m);
+}
+
 static void test_write_sizing(void **state) {
   rcb_test_counter cnt = {0, 0};
   rcb_allocator a = rcb_test_counting_allocator(&cnt);
@@ -928,6 +957,7 @@ int main(void) {
       cmocka_unit_test(test_write_round_trip_examples),
       cmocka_unit_test(test_write_round_trip_kramer_table),
       cmocka_unit_test(test_write_round_trip_after_set),
+      cmocka_unit_test(test_write_round_trip_element_factors),
       cmocka_unit_test(test_write_sizing),
       cmocka_unit_test(test_write_unequal_hubs),
       cmocka_unit_test(test_write_long_names),

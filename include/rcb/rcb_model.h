@@ -382,7 +382,8 @@ RCB_API rcb_status rcb_model_unbalance_force(const rcb_model *m, double speed,
  *    loss of stiffness such as a crack, wear or a loose shrink fit. k counts
  *    shaft A's elements from 1 in z order (rcb_model_element_info gives each
  *    element's z range; `rcbtool check` lists them). Not enumerated by
- *    rcb_model_param_count, and not written by rcb_model_write_ini (no INI key).
+ *    rcb_model_param_count; INI: [shaft] element_stiffness | element_mass =
+ *    k factor [k factor ...] (the writer lists those that are not 1).
  *  - material.steel.density | young
  *  - unbalance.UA.amount (kg m) | phase (rad)
  * All of them enter M, C, G, K (and the unbalance force) affinely, which the

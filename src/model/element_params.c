@@ -13,9 +13,11 @@
  * qz_k K), G and K linearly, as the analytic sensitivities need. They live
  * on the shaft (rcb_shaft_t.ef, grown with its segments), so a clone keeps
  * them and finalize does not reset them. They are not enumerated by
- * rcb_model_param_count (one pair per element would swamp the list and the
- * INI format has no key for them); rcb_model_element_info lists each
- * element with its z range and factors.
+ * rcb_model_param_count (one pair per element would swamp the list);
+ * rcb_model_element_info lists each element with its z range and factors.
+ * INI: [shaft] element_stiffness | element_mass = k factor [k factor ...]
+ * (ini_build.c reads them through rcb_model_set_param, ini_write.c writes
+ * those that are not 1).
  */
 #include <stdio.h>
 #include <stdlib.h>

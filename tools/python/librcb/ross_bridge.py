@@ -177,6 +177,13 @@ class Shaft:
         # local element index (0-based, z order) -> (factor on E and G, on rho);
         # the ROSS builder gives such an element its own Material
         self.factors = {}
+        for j, key in enumerate(("element_stiffness", "element_mass")):
+            for line in d.get(key, []):  # pairs "k factor", k from 1
+                vals = _floats(line)
+                for k, f in zip(vals[0::2], vals[1::2]):
+                    fk = list(self.factors.get(int(k) - 1, (1.0, 1.0)))
+                    fk[j] = f
+                    self.factors[int(k) - 1] = tuple(fk)
         for seg in d.get("segment", []):
             length, od, idd, n = _floats(seg)
             n = int(n)
