@@ -65,7 +65,7 @@ static void write_csv(FILE *fp, const rcb_model *m, const char *path) {
   for (i = 0; i < rcb_model_element_count(m); i++) {
     rcb_element_info ei;
     if (rcb_model_element_info(m, i, &ei)) continue;
-    fprintf(fp, "shaft.%s.e%zu,%s,%zu,%zu,%zu,%.10g,%.10g,%.10g,%.10g,%.17g,%.17g\n", ei.shaft,
+    fprintf(fp, "shaft.%s.e%zu,%s,%zu,%zu,%zu,%.10g,%.10g,%.10g,%.10g,%.15g,%.15g\n", ei.shaft,
             ei.index, ei.shaft, ei.index, ei.node0, ei.node1, ei.z0, ei.z1, ei.outer_d,
             ei.inner_d, ei.stiffness, ei.mass);
   }
