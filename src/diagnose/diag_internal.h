@@ -1,40 +1,40 @@
 /*
- * The diagnosis object, shared by catalogue.c (the candidate effects of a
- * model) and diagnose.c (scoring, refitting, ranking, explaining).
- * Candidates are expressed as a structural edit of the model (none, a
- * coupling model change, an added disk, an added pedestal) plus the
- * parameters the effect adds, so every candidate model is made through the
- * public edit API: clone the fitted base model, edit, finalize, set
- * parameters (rcb_model.h).
+ * The diagnosis object, shared by catalogue.c and the family files (the
+ * candidate effects of a model, family.h) and diagnose.c (scoring,
+ * refitting, ranking, explaining). A candidate is its family's edit of the
+ * model (none, a coupling model change, an added disk, an added pedestal) or
+ * of the measurement chain, plus the parameters the effect adds, so every
+ * candidate model is made through the public edit API: clone the fitted
+ * base model, edit, finalize, set parameters (rcb_model.h).
  */
 #ifndef RCB_DIAG_INTERNAL_H
 #define RCB_DIAG_INTERNAL_H
 
 #include "core/rcb_internal.h"
 #include "diagnose/diagnose.h" /* the interface other folders use */
+#include "diagnose/family.h"
 
 #define RCB_DIAG_NAME 128
 
-typedef enum diag_edit {
-  EDIT_NONE = 0,
-  EDIT_COUPLING_MODEL = 1,
-  EDIT_ADD_DISK = 2,
-  EDIT_ADD_PEDESTAL = 3 /* target: the bearing; ped0: its starting values */
-} diag_edit;
-
 typedef struct diag_cand {
+  const diag_family *fam;           /* its family: the edit, the start, the flags */
   rcb_effect effect;
   char place[RCB_DIAG_NAME];
   char desc[2 * RCB_DIAG_NAME];
-  diag_edit edit;
-  char target[RCB_NAME_MAX];        /* coupling name, or the new disk's name */
-  rcb_coupling_model new_type;      /* EDIT_COUPLING_MODEL */
+  /* what the family's edit needs (family_<name>.c) */
+  char target[RCB_NAME_MAX];        /* coupling, bearing, new disk or sensor name */
+  char target2[RCB_NAME_MAX];       /* a second name (the other sensor of a swap) */
+  int new_model;                    /* coupling: another coupling model, new_type */
+  rcb_coupling_model new_type;
   double kt0, kr0, ct0, cr0;        /* its starting values */
-  char at[RCB_DIAG_NAME];           /* EDIT_ADD_DISK: its node, "#N" */
-  double ped0[3];                   /* EDIT_ADD_PEDESTAL: kg, N/m, N s/m */
+  int new_disk;                     /* added mass: a new disk named target at node at */
+  char at[RCB_DIAG_NAME];           /* its node, "#N" */
+  double ped0[3];                   /* pedestal: kg, N/m, N s/m */
+  double v0[4];                     /* other families' fixed values (a sensor's gain) */
   int refit_only;                   /* no neutral value: refitted, not scored */
-  size_t node;                      /* an added mass or inertia: its node + 1 (0: other effects) */
-  int inertia;                      /* that candidate is a diametral inertia, not a mass */
+  /* a candidate at a node of a shaft (DIAG_FAM_PLACE_WALK) */
+  size_t node;                      /* its node + 1 (0: other effects) */
+  int variant;                      /* which parameter of the family (mass 0, inertia 1) */
   size_t shaft;                     /* and the shaft of its node */
   size_t np;
   char pname[RCB_DIAG_MAXP][RCB_DIAG_NAME];

@@ -180,6 +180,7 @@ static rcb_status make_fit(rcb_diag *d, rcb_model *m, int with_base, const diag_
   }
   for (k = 0; !st && c && k < c->np; k++)
     st = rcb_fit_add_param(f, c->pname[k], c->lo[k], c->hi[k], c->logp[k]);
+  if (!st && c && c->fam->fit_setup) st = c->fam->fit_setup(c, f);
   if (st) {
     rcb_diag_fail(d, st, "%s", f ? rcb_fit_errmsg(f) : "out of memory");
     rcb_fit_destroy(f);
@@ -351,7 +352,7 @@ static rcb_status candidate_dz(rcb_diag *d, const diag_cand *c, size_t ndof, rcb
   rcb_fit *f = NULL;
   rcb_status st = rcb_diag_candidate_model(d, c, d->base_model, &m);
   if (!st) st = make_fit(d, m, 0, c, &f); /* no residual layout needed */
-  *same = !st && rcb_model_dof_count(m) == ndof;
+  *same = !st && rcb_model_dof_count(m) == ndof && !(c->fam->flags & DIAG_FAM_SCORE_ALONE);
   if (*same && (st = rcb_fit_dz_get(f, &d->alloc, dz))) {
     rcb_diag_fail(d, st, "%s: %s", c->desc, rcb_fit_errmsg(f));
     *same = 0;
@@ -468,7 +469,7 @@ static rcb_status score_all(rcb_diag *d, int nominal) {
  * the fitted and from the nominal base, two informed starts in place of the
  * random ones (see refit). */
 static size_t refit_starts(const rcb_diag *d, const diag_cand *c) {
-  return c->refit_only || c->edit == EDIT_ADD_PEDESTAL || d->far ? 1 : 3;
+  return c->refit_only || (c->fam->flags & DIAG_FAM_ADDS_DOFS) || d->far ? 1 : 3;
 }
 
 /* Another coupling model (no neutral value, no score) is fitted to the
@@ -688,7 +689,8 @@ static rcb_status prefit(rcb_diag *d, diag_cand *c, const double *w) {
   if (!st) st = rcb_diag_refit_start(d, c, m, f);
   if (!st) st = rcb_fit_set_weights(f, w);
   if (!st)
-    st = w && c->edit == EDIT_ADD_PEDESTAL ? prefit_grid(d, c, m, f) : prefit_run(c, m, f, w);
+    st = w && (c->fam->flags & DIAG_FAM_ADDS_DOFS) ? prefit_grid(d, c, m, f)
+                                                  : prefit_run(c, m, f, w);
   drop_fit(d, f);
   rcb_model_destroy(m);
   if (st == RCB_ERR_NOMEM) return rcb_diag_fail(d, st, "pre-fitting %s: out of memory", c->desc);
@@ -1020,7 +1022,8 @@ static diag_cand *next_place(rcb_diag *d, const diag_cand *c, int step) {
   if (!c->node || want == 0) return NULL;
   for (k = 0; k < d->ncand; k++) {
     diag_cand *e = &d->cand[k];
-    if (e->node == want && e->inertia == c->inertia && e->shaft == c->shaft) return e;
+    if (e->fam == c->fam && e->node == want && e->variant == c->variant && e->shaft == c->shaft)
+      return e;
   }
   return NULL;
 }
@@ -1034,17 +1037,30 @@ static diag_cand *next_place(rcb_diag *d, const diag_cand *c, int step) {
  * noise floor: nothing is left for the walk to explain (the 0.15 kg hub
  * case: the hub mass there, the walk 187 subset sweeps, 0.85 s, to added
  * masses at F = 1e6 against 4529). */
+/* Whether candidate k is the first of its (family, variant) among the
+ * candidates that sit at nodes (DIAG_FAM_PLACE_WALK). */
+static int first_of_kind(const rcb_diag *d, size_t k) {
+  size_t i;
+  const diag_cand *c = &d->cand[k];
+  if (!(c->fam->flags & DIAG_FAM_PLACE_WALK) || !c->node) return 0;
+  for (i = 0; i < k; i++)
+    if (d->cand[i].fam == c->fam && d->cand[i].variant == c->variant && d->cand[i].node)
+      return 0;
+  return 1;
+}
+
 static rcb_status place_search(rcb_diag *d, const double *w) {
-  size_t k, pass;
+  size_t k, i;
   rcb_status st;
   if (pre_at_floor(d)) return RCB_OK;
-  for (pass = 0; pass < 2; pass++) { /* the best mass, then the best inertia */
+  for (k = 0; k < d->ncand; k++) { /* each kind: the best mass, the best inertia, ... */
     diag_cand *best = NULL;
     int step;
-    for (k = 0; k < d->ncand; k++) {
-      diag_cand *e = &d->cand[k];
-      if (e->node && e->inertia == (int)pass && e->prefitted && e->pre_F < HUGE_VAL &&
-          (!best || e->pre_F < best->pre_F))
+    if (!first_of_kind(d, k)) continue;
+    for (i = k; i < d->ncand; i++) {
+      diag_cand *e = &d->cand[i];
+      if (e->fam == d->cand[k].fam && e->node && e->variant == d->cand[k].variant &&
+          e->prefitted && e->pre_F < HUGE_VAL && (!best || e->pre_F < best->pre_F))
         best = e;
     }
     if (!best) continue;
@@ -1073,7 +1089,7 @@ static rcb_status prefit_selected(rcb_diag *d, cand_jobs *j) {
   rcb_status st;
   for (i = 0; i < j->n; i++) { /* stable partition: the pedestals last */
     size_t t = j->k[i];
-    if (d->cand[t].edit == EDIT_ADD_PEDESTAL) continue;
+    if (d->cand[t].fam->flags & DIAG_FAM_ADDS_DOFS) continue;
     memmove(j->k + n1 + 1, j->k + n1, (i - n1) * sizeof *j->k);
     j->k[n1++] = t;
   }
@@ -1256,6 +1272,11 @@ rcb_status rcb_diag_apply_model(const rcb_diag *d, size_t rank, const rcb_alloca
   *out = NULL;
   if (!d || !d->ran || rank >= d->ncand) return RCB_ERR_ARG;
   c = &d->cand[d->order[rank]];
+  if (c->fam->flags & DIAG_FAM_CHAIN)
+    return rcb_diag_fail((rcb_diag *)d, RCB_ERR_STATE,
+                         "candidate %zu (%s) is a fault of the measurement chain, not of the "
+                         "model: nothing to apply; check or recalibrate the sensor, or fit with "
+                         "its gain (%s)", rank + 1, c->desc, c->params);
   if (!c->model)
     return rcb_diag_fail((rcb_diag *)d, RCB_ERR_STATE,
                          "candidate %zu (%s) was not refitted: nothing to apply", rank + 1,

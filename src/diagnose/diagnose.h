@@ -30,6 +30,7 @@ typedef struct rcb_diag_cand_desc {
   int logp[RCB_DIAG_MAXP];
   int refit_only; /* no neutral value (another coupling model): not scored */
   int adds_dofs;  /* its model has DOFs the base model lacks (a pedestal) */
+  int chain;      /* it edits the measurement chain (a sensor), not the model */
 } rcb_diag_cand_desc;
 size_t rcb_diag_catalogue_count(const rcb_diag *d);
 rcb_status rcb_diag_catalogue_get(const rcb_diag *d, size_t i, rcb_diag_cand_desc *out);

@@ -179,9 +179,13 @@ static rcb_status baseline(rcb_monitor *mon, const rcb_model *base, const rcb_mo
 /* ---- columns ---- */
 
 
+/* The candidates the monitor tracks: effects of the model (not of the
+ * measurement chain) with parameters; by default the catalogue of issue #4,
+ * not the shaft elements of issue #23 (a crack is a diagnosis' finding, and
+ * one candidate per element would double the columns of every update). */
 static int wanted(const rcb_diag_cand_desc *c, unsigned mask) {
-  if (c->refit_only || !c->np) return 0;
-  return mask ? (mask >> (unsigned)c->effect) & 1u : 1;
+  if (c->refit_only || !c->np || c->chain) return 0;
+  return mask ? (mask >> (unsigned)c->effect) & 1u : c->effect < RCB_EFFECT_ELEMENT_STIFFNESS;
 }
 
 /* A fit of candidate model cm with its parameters (complex scale, as the base). */

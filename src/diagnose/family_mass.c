@@ -1,0 +1,64 @@
+/*
+ * The added-mass family (issue #4): a mass and a diametral inertia at every
+ * node, on its disk where it has one (the disk's own values), else on a new
+ * massless disk there (neutral value 0). Its candidates sit at the nodes of a
+ * shaft (node, shaft, variant 0: mass, 1: inertia), where the run-off path
+ * walks along the shaft (DIAG_FAM_PLACE_WALK).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "diagnose/diag_internal.h"
+
+/* A mass at every disk, and a new (massless) disk at every other node. */
+static rcb_status enumerate(rcb_diag *d, const rcb_model *m) {
+  double mtot = 0.0;
+  size_t i, k;
+  for (i = 0; i < m->n_disks; i++) mtot += m->disks[i].m;
+  if (mtot <= 0) mtot = 1.0;
+  for (i = 0; i < m->n_nodes; i++) {
+    const rcb_node_t *nd = &m->nodes[i];
+    const rcb_disk_t *disk = NULL;
+    char place[RCB_DIAG_NAME];
+    diag_cand *c;
+    for (k = 0; k < m->n_disks; k++)
+      if (m->disks[k].at.node == i) disk = &m->disks[k];
+    if (disk)
+      snprintf(place, sizeof place, "disk %s", disk->name);
+    else
+      snprintf(place, sizeof place, "node #%zu (shaft %s, z = %g m)", i,
+               m->shafts[nd->shaft].name, nd->z);
+    for (k = 0; k < 2; k++) { /* a mass, or a diametral inertia */
+      if (!(c = rcb_diag_new_cand(d, &rcb_diag_family_mass, RCB_EFFECT_ADDED_MASS, place))) return RCB_ERR_NOMEM;
+      snprintf(c->desc, sizeof c->desc, "an added %s at %s", k ? "diametral inertia" : "mass",
+               place);
+      c->node = i + 1;
+      c->variant = (int)k;
+      c->shaft = nd->shaft;
+      if (disk) {
+        double lo, hi;
+        int logp;
+        if (k == 0) rcb_diag_bounds(disk->m, 10 * mtot, &lo, &hi, &logp);
+        else rcb_diag_bounds(disk->Id, 0.01 * mtot, &lo, &hi, &logp);
+        rcb_diag_add_par(c, k ? "disk.%s.Id" : "disk.%s.mass", disk->name, lo, hi, logp);
+        continue;
+      }
+      c->new_disk = 1;
+      snprintf(c->target, sizeof c->target, "ADDED_%zu", i);
+      snprintf(c->at, sizeof c->at, "#%zu", i);
+      rcb_diag_add_par(c, k ? "disk.%s.Id" : "disk.%s.mass", c->target, 0.0, k ? 0.01 * mtot : mtot,
+              0);
+    }
+  }
+  return RCB_OK;
+}
+
+
+/* A new (massless) disk at the candidate's node, on the unfinalized copy m. */
+static rcb_status edit(const diag_cand *c, rcb_model *m) {
+  return c->new_disk ? rcb_model_add_disk_at(m, c->target, c->at, 0, 0, 0) : RCB_OK;
+}
+
+const diag_family rcb_diag_family_mass = {"mass", DIAG_FAM_PLACE_WALK, enumerate, edit, NULL,
+                                          NULL, NULL};
