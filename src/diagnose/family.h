@@ -68,6 +68,7 @@ extern const diag_family rcb_diag_family_pedestal;
 extern const diag_family rcb_diag_family_shaft;
 extern const diag_family rcb_diag_family_mass;
 extern const diag_family rcb_diag_family_speed;
+extern const diag_family rcb_diag_family_element;
 
 /* Helpers for the families (catalogue.c). */
 /* A new candidate of family fam and effect e at place (NULL: out of memory;
