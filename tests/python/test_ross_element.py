@@ -74,6 +74,22 @@ def test_element_factor_frf(k, stiffness, mass):
     assert moved > 1e3 * RTOL, f"the edit changes the FRFs by {moved:.3e} only"
 
 
+def test_element_table():
+    """The package's element table: k from 1 along z, the z range of each element
+    (shaft B: 0.52 to 1.02 m in ten elements of 0.05 m), the factors set."""
+    rcb = import_librcb()
+    m = rcb.Model.from_ini(PAPER)
+    m.set("shaft.B.e5.stiffness", 0.6)
+    els = [e for e in m.elements if e.shaft == "B"]
+    assert [e.k for e in els] == list(range(1, 11))
+    for e in els:
+        assert e.param == f"shaft.B.e{e.k}"
+        assert e.z0 == pytest.approx(0.52 + 0.05 * (e.k - 1), abs=1e-12)
+        assert e.z1 == pytest.approx(0.52 + 0.05 * e.k, abs=1e-12)
+        assert e.node1 == e.node0 + 1
+        assert (e.stiffness, e.mass) == ((0.6, 1.0) if e.k == 5 else (1.0, 1.0))
+
+
 def test_element_stiffness_edit_helper():
     """element_stiffness_edit (for diag_cases) is the stiffness-only edit."""
     model = rm.Model(PAPER.read_text())
