@@ -38,6 +38,10 @@ struct rcb_diag;
 #define DIAG_FAM_PLACE_WALK 8u  /* its candidates sit at nodes of a shaft (node, shaft,
                                    variant set): the run-off path walks from the best
                                    pre-fit to the neighbouring nodes (place_search) */
+#define DIAG_FAM_ONE_REFIT 16u  /* its candidates are alike from place to place (one at
+                                   every shaft element): of each variant only the best
+                                   scored takes a refit, so that neighbours do not crowd
+                                   the other effects out of the refits (refit_best) */
 
 typedef struct diag_family {
   const char *name; /* "coupling", "bearing", ...: for messages and tests */

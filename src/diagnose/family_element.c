@@ -7,6 +7,8 @@
  * value. The candidates sit along a shaft (node: the element's first node
  * + 1, variant 0: stiffness, 1: mass), so the run-off path walks to the
  * neighbouring elements as it does for added masses (DIAG_FAM_PLACE_WALK).
+ * Neighbouring elements score alike: of each variant only the best scored
+ * is refitted (DIAG_FAM_ONE_REFIT), or they would take most of the refits.
  */
 #include <math.h>
 #include <stdio.h>
@@ -63,5 +65,5 @@ static rcb_status enumerate(rcb_diag *d, const rcb_model *m) {
   return RCB_OK;
 }
 
-const diag_family rcb_diag_family_element = {"element", DIAG_FAM_PLACE_WALK, enumerate, NULL,
-                                             NULL, NULL, NULL};
+const diag_family rcb_diag_family_element = {"element", DIAG_FAM_PLACE_WALK | DIAG_FAM_ONE_REFIT,
+                                             enumerate, NULL, NULL, NULL, NULL};
