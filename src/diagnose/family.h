@@ -40,8 +40,9 @@ struct rcb_diag;
                                    pre-fit to the neighbouring nodes (place_search) */
 #define DIAG_FAM_ONE_REFIT 16u  /* its candidates are alike from place to place (one at
                                    every shaft element): of each variant only the best
-                                   scored takes a refit, so that neighbours do not crowd
-                                   the other effects out of the refits (refit_best) */
+                                   scored takes a refit, and none a pre-fit of the
+                                   run-off path, so that neighbours do not crowd the
+                                   other effects out (refit_best, nominal_starts) */
 
 typedef struct diag_family {
   const char *name; /* "coupling", "bearing", ...: for messages and tests */
