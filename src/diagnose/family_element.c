@@ -5,10 +5,11 @@
  * Each is a factor of the model (shaft.S.e<k>.stiffness | mass, neutral 1,
  * model/element_params.c): no structural edit, no start but the model's own
  * value. The candidates sit along a shaft (node: the element's first node
- * + 1, variant 0: stiffness, 1: mass), so the run-off path walks to the
- * neighbouring elements as it does for added masses (DIAG_FAM_PLACE_WALK).
- * Neighbouring elements score alike: of each variant only the best scored
- * is refitted (DIAG_FAM_ONE_REFIT), or they would take most of the refits.
+ * + 1, variant 0: stiffness, 1: mass: DIAG_FAM_PLACE_WALK), as added masses
+ * do. Neighbouring elements score alike: of each variant only the best
+ * scored is refitted, and none is pre-fitted on the run-off path
+ * (DIAG_FAM_ONE_REFIT, diagnose.c one_taken), or they would take most of
+ * the refits from the other effects.
  */
 #include <math.h>
 #include <stdio.h>
