@@ -10,7 +10,12 @@
  *  - every enumerated name is accepted by get;
  *  - write -> reload gives bit-identical M, C, G, K and unbalance forces, for
  *    the four examples and a kramer_2 model with a tabulated bearing; the
- *    two-call sizing idiom works and the writer does not allocate.
+ *    two-call sizing idiom works and the writer does not allocate;
+ *  - per-element factors shaft.S.e<k>.stiffness | mass: on every element of
+ *    a uniform shaft, f times K (or M and G), bit for bit at f = 1/4; one
+ *    element changes only its own rows, linearly; free-free frequencies
+ *    scale by sqrt(f) (1/sqrt(f) for mass), and a pinned-pinned Timoshenko
+ *    beam matches the closed form with E -> f E.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -537,6 +542,35 @@ static void test_write_round_trip_after_set(void **state) {
   rcb_model_destroy(m);
 }
 
+/* Element factors (element_stiffness, element_mass: pairs "k factor", the
+ * key repeated every four pairs) survive the round trip bit for bit, and
+ * the reloaded model holds them as parameters. */
+static void test_write_round_trip_element_factors(void **state) {
+  rcb_model *m = rcb_test_model_from_example("paper_system.ini"), *r = NULL;
+  char name[64], *text;
+  size_t k;
+  (void)state;
+  for (k = 1; k <= 9; k++) {
+    snprintf(name, sizeof name, "shaft.B.e%zu.stiffness", k);
+    set(m, name, 1.0 - 1.0 / (3.0 + (double)k));
+  }
+  set(m, "shaft.A.e10.mass", 1.0 / 3.0);
+  set(m, "shaft.A.e1.stiffness", 2.5);
+  expect_round_trip(m, "paper system, element factors");
+  text = write_text(m);
+  assert_non_null(strstr(text, "element_stiffness = 1 2.5 ; "));
+  assert_non_null(strstr(text, "element_mass = 10 0.3333333333333333 ; "));
+  assert_non_null(strstr(text, "\nelement_stiffness = 5 0.875 6 "));
+  assert_int_equal(rcb_model_create(&r, NULL), RCB_OK);
+  assert_int_equal(rcb_model_load_string(r, text, "<written>"), RCB_OK);
+  assert_true(get(r, "shaft.B.e4.stiffness") == 1.0 - 1.0 / 7.0);
+  assert_true(get(r, "shaft.B.e10.stiffness") == 1.0);
+  assert_true(get(r, "shaft.A.e10.mass") == 1.0 / 3.0);
+  free(text);
+  rcb_model_destroy(r);
+  rcb_model_destroy(m);
+}
+
 static void test_write_sizing(void **state) {
   rcb_test_counter cnt = {0, 0};
   rcb_allocator a = rcb_test_counting_allocator(&cnt);
@@ -656,6 +690,260 @@ static void test_write_bad_name(void **state) {
   rcb_model_destroy(m);
 }
 
+/* ---- per-element factors (issue #23): shaft.S.e<k>.stiffness | mass ---- */
+
+/* Uniform shaft S from z = 0 (L m, diameter d m, nel elements, shear
+ * factor kappa), no support: a free-free beam. */
+static rcb_model *uniform_beam(double L, double d, int nel, double kappa) {
+  rcb_model *m = NULL;
+  assert_int_equal(rcb_model_create(&m, NULL), RCB_OK);
+  assert_int_equal(rcb_model_add_material(m, "st", 7800, 2e11, 0.3), RCB_OK);
+  assert_int_equal(rcb_model_add_shaft(m, "S", "st", 0.0, kappa), RCB_OK);
+  assert_int_equal(rcb_model_add_segment(m, "S", L, d, 0.0, nel), RCB_OK);
+  return m;
+}
+
+/* Every element of shaft S of m at factor f (key "stiffness" or "mass"). */
+static void set_all_elements(rcb_model *m, const char *key, double f) {
+  char name[64];
+  size_t k, ne = rcb_model_element_count(m);
+  for (k = 1; k <= ne; k++) {
+    snprintf(name, sizeof name, "shaft.S.e%zu.%s", k, key);
+    set(m, name, f);
+  }
+}
+
+/* B == f A entry by entry: bit for bit (tol 0), or to tol of the largest. */
+static void expect_scaled(const double *A, const double *B, size_t nn, double f, double tol,
+                          const char *what) {
+  double amax = 0.0;
+  size_t i;
+  for (i = 0; i < nn; i++) amax = fmax(amax, fabs(A[i]));
+  assert_true(amax > 0.0);
+  for (i = 0; i < nn; i++)
+    if (tol == 0.0 ? B[i] != f * A[i] : fabs(B[i] - f * A[i]) > tol * amax)
+      fail_msg("%s[%zu] = %.17g, expected %g x %.17g", what, i, B[i], f, A[i]);
+}
+
+/* The identity: a factor f on every element of a uniform shaft is f times
+ * its K (stiffness: E and G together, so phi and the shape of Ke stay) or
+ * its M and G (mass); C = qz_m M + qz_k K follows. A power of two scales
+ * every rounded operation exactly, so the check is bit for bit; 0.6 to
+ * round-off. */
+static void test_element_factor_identity(void **state) {
+  rcb_model *m = uniform_beam(1.0, 0.05, 12, 0.9);
+  size_t n, nn;
+  double *A0, *A1, *A2;
+  (void)state;
+  assert_int_equal(rcb_model_set_shaft_damping(m, "S", 0.0, 2e-5), RCB_OK);
+  assert_int_equal(rcb_model_finalize(m), RCB_OK);
+  n = rcb_model_dof_count(m), nn = n * n;
+  A0 = matrices(m, 500.0);
+  set_all_elements(m, "stiffness", 0.25);
+  A1 = matrices(m, 500.0);
+  expect_scaled(A0 + 3 * nn, A1 + 3 * nn, nn, 0.25, 0.0, "K");
+  expect_scaled(A0 + nn, A1 + nn, nn, 0.25, 0.0, "C (qz_k K)");
+  expect_scaled(A0, A1, nn, 1.0, 0.0, "M");
+  expect_scaled(A0 + 2 * nn, A1 + 2 * nn, nn, 1.0, 0.0, "G");
+  free(A1);
+  set_all_elements(m, "stiffness", 0.6);
+  A1 = matrices(m, 500.0);
+  expect_scaled(A0 + 3 * nn, A1 + 3 * nn, nn, 0.6, 1e-15, "K");
+  free(A1);
+  set_all_elements(m, "stiffness", 1.0);
+  A1 = matrices(m, 500.0);
+  expect_scaled(A0, A1, 4 * nn, 1.0, 0.0, "M, C, G, K back at 1");
+  free(A1);
+  /* mass, with mass-proportional damping instead */
+  set(m, "shaft.S.damping_stiffness", 0.0);
+  set(m, "shaft.S.damping_mass", 3.0);
+  free(A0);
+  A0 = matrices(m, 500.0);
+  set_all_elements(m, "mass", 0.25);
+  A1 = matrices(m, 500.0);
+  expect_scaled(A0, A1, nn, 0.25, 0.0, "M");
+  expect_scaled(A0 + nn, A1 + nn, nn, 0.25, 0.0, "C (qz_m M)");
+  expect_scaled(A0 + 2 * nn, A1 + 2 * nn, nn, 0.25, 0.0, "G");
+  expect_scaled(A0 + 3 * nn, A1 + 3 * nn, nn, 1.0, 0.0, "K");
+  set_all_elements(m, "mass", 1.7);
+  A2 = matrices(m, 500.0);
+  expect_scaled(A0, A2, nn, 1.7, 1e-15, "M");
+  expect_scaled(A0 + 2 * nn, A2 + 2 * nn, nn, 1.7, 1e-15, "G");
+  free(A0);
+  free(A1);
+  free(A2);
+  rcb_model_destroy(m);
+}
+
+/* One element of the paper system: only the rows of its two end nodes
+ * change, linearly in the factor (K(f) = K_rest + f Ke), and the factors
+ * are read back, kept by a clone and set before finalize. */
+static void test_element_factor_local(void **state) {
+  rcb_model *m = rcb_test_model_from_example("paper_system.ini"), *c = NULL;
+  rcb_element_info ei;
+  size_t n = rcb_model_dof_count(m), nn = n * n, i, j, e, d;
+  int own[400] = {0};
+  double *A0, *A1, *A2, amax = 0.0;
+  (void)state;
+  assert_true(n <= 400);
+  /* shaft.B.e3: the third element of shaft B, z = 0.62-0.67 m (B starts at 0.52) */
+  for (e = 0; e < rcb_model_element_count(m); e++) {
+    assert_int_equal(rcb_model_element_info(m, e, &ei), RCB_OK);
+    if (strcmp(ei.shaft, "B") == 0 && ei.index == 3) break;
+  }
+  assert_true(e < rcb_model_element_count(m));
+  assert_true(rcb_test_close(ei.z0, 0.62, 1e-12, 0) && rcb_test_close(ei.z1, 0.67, 1e-12, 0));
+  assert_int_equal(ei.node1, ei.node0 + 1);
+  for (d = 0; d < 4; d++) {
+    rcb_node_info ni;
+    assert_int_equal(rcb_model_node_info(m, ei.node0, &ni), RCB_OK);
+    own[ni.dof[d]] = 1;
+    assert_int_equal(rcb_model_node_info(m, ei.node1, &ni), RCB_OK);
+    own[ni.dof[d]] = 1;
+  }
+  assert_true(get(m, "shaft.B.e3.stiffness") == 1.0 && get(m, "shaft.B.e3.mass") == 1.0);
+  A0 = matrices(m, 1000.0);
+  set(m, "shaft.B.e3.stiffness", 0.5);
+  set(m, "shaft.B.e3.mass", 0.5);
+  A1 = matrices(m, 1000.0);
+  set(m, "shaft.B.e3.stiffness", 0.25);
+  set(m, "shaft.B.e3.mass", 0.25);
+  A2 = matrices(m, 1000.0);
+  for (i = 0; i < 4 * nn; i++) amax = fmax(amax, fabs(A0[i]));
+  for (j = 0; j < n; j++)
+    for (i = 0; i < n; i++)
+      for (d = 0; d < 4; d++) { /* M, C, G, K */
+        size_t a = d * nn + i + n * j;
+        if (!(own[i] && own[j])) {
+          if (A1[a] != A0[a] || A2[a] != A0[a]) fail_msg("matrix %zu (%zu,%zu) changed", d, i, j);
+        } else if (fabs((A2[a] - A0[a]) - 1.5 * (A1[a] - A0[a])) > 1e-13 * amax) {
+          fail_msg("matrix %zu (%zu,%zu): not linear in the factor", d, i, j);
+        }
+      }
+  /* a clone keeps the factors through its own finalize */
+  assert_int_equal(rcb_model_clone(&c, m, NULL), RCB_OK);
+  assert_true(get(c, "shaft.B.e3.stiffness") == 0.25);
+  assert_int_equal(rcb_model_finalize(c), RCB_OK);
+  free(A1);
+  A1 = matrices(c, 1000.0);
+  assert_int_equal(memcmp(A1, A2, 4 * nn * sizeof *A1), 0);
+  assert_int_equal(rcb_model_element_info(c, e, &ei), RCB_OK);
+  assert_true(ei.stiffness == 0.25 && ei.mass == 0.25);
+  /* not enumerated: the list of 55 stays */
+  assert_int_equal(rcb_model_param_count(m), 55);
+  free(A0);
+  free(A1);
+  free(A2);
+  rcb_model_destroy(c);
+  rcb_model_destroy(m);
+}
+
+static void test_element_factor_errors(void **state) {
+  rcb_model *m = rcb_test_model_from_example("paper_system.ini"), *u;
+  rcb_element_info ei;
+  double v;
+  (void)state;
+  expect_set_error(m, "shaft.B.e0.stiffness", 0.5, RCB_ERR_NOT_FOUND, "e1 to e10 of shaft 'B'",
+                   "rcbtool check");
+  expect_set_error(m, "shaft.B.e11.stiffness", 0.5, RCB_ERR_NOT_FOUND, "e1 to e10", NULL);
+  expect_set_error(m, "shaft.B.e03.mass", 0.5, RCB_ERR_NOT_FOUND, "e1 to e10", NULL);
+  expect_set_error(m, "shaft.B.x3.mass", 0.5, RCB_ERR_NOT_FOUND, "e1 to e10", NULL);
+  expect_set_error(m, "shaft.B.e3.young", 0.5, RCB_ERR_NOT_FOUND, "stiffness and mass", NULL);
+  expect_set_error(m, "shaft.Q.e3.mass", 0.5, RCB_ERR_NOT_FOUND, "no shaft 'Q'", NULL);
+  expect_set_error(m, "shaft.B.e3.stiffness", 0.0, RCB_ERR_ARG, "expected a positive value",
+                   NULL);
+  expect_set_error(m, "shaft.B.e3.mass", NAN, RCB_ERR_ARG, "not a finite number", NULL);
+  assert_int_equal(rcb_model_get_param(m, "shaft.B.e10.mass", &v), RCB_OK);
+  assert_int_equal(rcb_model_get_param(m, "shaft.A.e11.mass", &v), RCB_ERR_NOT_FOUND);
+  assert_int_equal(rcb_model_element_info(m, 20, &ei), RCB_ERR_NOT_FOUND);
+  rcb_model_destroy(m);
+  /* before finalize: numbered over the segments given so far */
+  u = uniform_beam(1.0, 0.05, 4, 0.9);
+  set(u, "shaft.S.e4.stiffness", 0.3);
+  expect_set_error(u, "shaft.S.e5.stiffness", 0.5, RCB_ERR_NOT_FOUND, "e1 to e4", NULL);
+  assert_int_equal(rcb_model_element_info(u, 0, &ei), RCB_ERR_STATE);
+  assert_int_equal(rcb_model_add_segment(u, "S", 0.5, 0.04, 0.0, 2), RCB_OK);
+  set(u, "shaft.S.e6.mass", 2.0);
+  assert_int_equal(rcb_model_finalize(u), RCB_OK);
+  assert_int_equal(rcb_model_element_info(u, 3, &ei), RCB_OK);
+  assert_true(ei.stiffness == 0.3 && ei.mass == 1.0 && ei.index == 4);
+  assert_true(rcb_test_close(ei.z0, 0.75, 1e-12, 0) && rcb_test_close(ei.z1, 1.0, 1e-12, 0));
+  assert_int_equal(rcb_model_element_info(u, 5, &ei), RCB_OK);
+  assert_true(ei.mass == 2.0 && ei.stiffness == 1.0 && ei.index == 6 && ei.outer_d == 0.04);
+  rcb_model_destroy(u);
+}
+
+#define NMODE 8
+
+/* The lowest NMODE damped frequencies of m at standstill, rad/s. */
+static void frequencies(const rcb_model *m, double *wd) {
+  rcb_modes *e = NULL;
+  rcb_mode md[64];
+  size_t n = 0, k;
+  assert_int_equal(rcb_modes_create(&e, m, NULL), RCB_OK);
+  if (rcb_modes_compute(e, 0.0, 64, md, &n, NULL) != RCB_OK)
+    fail_msg("modes: %s", rcb_modes_errmsg(e));
+  assert_true(n >= NMODE);
+  for (k = 0; k < NMODE; k++) wd[k] = md[k].wd;
+  rcb_modes_destroy(e);
+}
+
+/* Lowest root w of the simply supported Timoshenko beam, mode k:
+ * (rho A w^2 - kGA q^2)(rho I w^2 - E I q^2 - kGA) - (kGA q)^2 = 0, q = k pi/L. */
+static double timoshenko_ss(int k, double L, double d, double rho, double E, double nu,
+                            double kappa) {
+  const double A = PI * d * d / 4, Ie = PI * d * d * d * d / 64;
+  const double kGA = kappa * E / (2 * (1 + nu)) * A, q = k * PI / L;
+  const double a = rho * A * rho * Ie;
+  const double b = -(rho * A * (E * Ie * q * q + kGA) + kGA * q * q * rho * Ie);
+  const double c = kGA * E * Ie * q * q * q * q;
+  return sqrt((-b - sqrt(b * b - 4 * a * c)) / (2 * a));
+}
+
+/* Natural frequencies: with every element's stiffness factor f the free-free
+ * beam's frequencies are sqrt(f) times its own (K -> f K, M unchanged), and
+ * with a mass factor g 1/sqrt(g) times; a stocky pinned-pinned Timoshenko
+ * beam at factor f matches the closed form with E -> f E (G follows) as the
+ * unmodified beam matches it with E. */
+static void test_element_factor_frequencies(void **state) {
+  const double f = 0.6, g = 1.7;
+  double w0[NMODE], w1[NMODE];
+  rcb_model *m = uniform_beam(1.0, 0.05, 24, 0.9);
+  rcb_bearing_coefs bc;
+  size_t k;
+  (void)state;
+  assert_int_equal(rcb_model_finalize(m), RCB_OK);
+  frequencies(m, w0);
+  set_all_elements(m, "stiffness", f);
+  frequencies(m, w1);
+  for (k = 0; k < NMODE; k++)
+    if (!rcb_test_close(w1[k], sqrt(f) * w0[k], 1e-9, 0))
+      fail_msg("stiffness %g, mode %zu: %.12g rad/s, expected sqrt(f) x %.12g", f, k, w1[k],
+               w0[k]);
+  set_all_elements(m, "stiffness", 1.0);
+  set_all_elements(m, "mass", g);
+  frequencies(m, w1);
+  for (k = 0; k < NMODE; k++)
+    if (!rcb_test_close(w1[k], w0[k] / sqrt(g), 1e-9, 0))
+      fail_msg("mass %g, mode %zu: %.12g rad/s, expected %.12g / sqrt(g)", g, k, w1[k], w0[k]);
+  rcb_model_destroy(m);
+  /* pinned-pinned stocky beam (L/d = 4: shear matters), as test_modes */
+  m = uniform_beam(0.4, 0.1, 40, 0.9);
+  memset(&bc, 0, sizeof bc);
+  bc.kxx = bc.kyy = 1e14;
+  assert_int_equal(rcb_model_add_bearing(m, "B1", "S", 0.0, &bc), RCB_OK);
+  assert_int_equal(rcb_model_add_bearing(m, "B2", "S", 0.4, &bc), RCB_OK);
+  assert_int_equal(rcb_model_finalize(m), RCB_OK);
+  set_all_elements(m, "stiffness", f);
+  frequencies(m, w1);
+  for (k = 1; k <= 3; k++) {
+    double wt = timoshenko_ss((int)k, 0.4, 0.1, 7800, f * 2e11, 0.3, 0.9);
+    assert_true(rcb_test_close(w1[2 * (k - 1)], wt, 5e-3, 0));
+    assert_true(rcb_test_close(w1[2 * k - 1], wt, 5e-3, 0));
+  }
+  rcb_model_destroy(m);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_get_paper_values),
@@ -669,10 +957,15 @@ int main(void) {
       cmocka_unit_test(test_write_round_trip_examples),
       cmocka_unit_test(test_write_round_trip_kramer_table),
       cmocka_unit_test(test_write_round_trip_after_set),
+      cmocka_unit_test(test_write_round_trip_element_factors),
       cmocka_unit_test(test_write_sizing),
       cmocka_unit_test(test_write_unequal_hubs),
       cmocka_unit_test(test_write_long_names),
       cmocka_unit_test(test_write_bad_name),
+      cmocka_unit_test(test_element_factor_identity),
+      cmocka_unit_test(test_element_factor_local),
+      cmocka_unit_test(test_element_factor_errors),
+      cmocka_unit_test(test_element_factor_frequencies),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -293,6 +293,23 @@ typedef struct rcb_node_info {
 } rcb_node_info;
 RCB_API rcb_status rcb_model_node_info(const rcb_model *m, size_t node, rcb_node_info *out);
 
+/** @brief What is known about a shaft element (after finalize). */
+typedef struct rcb_element_info {
+  const char *shaft;   /**< owning shaft name */
+  size_t index;        /**< k of its parameters shaft.SHAFT.e<k>.*: from 1 in z order */
+  size_t node0, node1; /**< its end nodes (node1 = node0 + 1) */
+  double z0, z1;       /**< axial range, m */
+  double outer_d, inner_d; /**< m */
+  double stiffness;    /**< factor on E and G (1: as the material states) */
+  double mass;         /**< factor on the density (1: as the material states) */
+} rcb_element_info;
+/**
+ * @brief Shaft element e (0-based over the whole model, shaft by shaft in
+ * definition order, z order within a shaft; < rcb_model_element_count()).
+ * @return RCB_ERR_STATE before finalize, RCB_ERR_NOT_FOUND when out of range
+ */
+RCB_API rcb_status rcb_model_element_info(const rcb_model *m, size_t e, rcb_element_info *out);
+
 /** @brief Kind of a named station. */
 typedef enum rcb_station_kind {
   RCB_STATION_DISK = 0,
@@ -359,6 +376,14 @@ RCB_API rcb_status rcb_model_unbalance_force(const rcb_model *m, double speed,
  *    once-per-revolution frequency. INI: [model] speed_factor.
  *  - disk.DA.mass | Id | Ip
  *  - shaft.A.damping_mass | damping_stiffness
+ *  - shaft.A.e<k>.stiffness | mass: factors (neutral 1, > 0) on element k's
+ *    E and G (its whole stiffness matrix, bending and shear) and on its
+ *    density (translational and rotary inertia, gyroscopic matrix): a local
+ *    loss of stiffness such as a crack, wear or a loose shrink fit. k counts
+ *    shaft A's elements from 1 in z order (rcb_model_element_info gives each
+ *    element's z range; `rcbtool check` lists them). Not enumerated by
+ *    rcb_model_param_count; INI: [shaft] element_stiffness | element_mass =
+ *    k factor [k factor ...] (the writer lists those that are not 1).
  *  - material.steel.density | young
  *  - unbalance.UA.amount (kg m) | phase (rad)
  * All of them enter M, C, G, K (and the unbalance force) affinely, which the

@@ -80,6 +80,12 @@ typedef struct rcb_shaft_s {
   double qz_m, qz_k;  /* proportional damping 1/s, s */
   rcb_segment_t *seg;
   size_t nseg, capseg;
+  /* Per-element factors (issue #23), two per element in z order, grown with
+   * the segments (model.c) and owned like them: ef[2 k] multiplies element
+   * k's E and G (its whole K), ef[2 k + 1] its density (M and G); neutral 1.
+   * Parameters shaft.NAME.e<k+1>.stiffness | mass (element_params.c). */
+  double *ef;
+  size_t nef, capef; /* nef: elements of the shaft so far; capef: doubles allocated */
   size_t first_node, nnodes; /* after finalize */
 } rcb_shaft_t;
 
@@ -160,6 +166,7 @@ typedef struct rcb_node_s {
 
 typedef struct rcb_element_s {
   size_t shaft, node0; /* element joins node0 and node0+1 */
+  size_t k;            /* 0-based index within its shaft, z order (factors: ef[2 k]) */
   double L, od, id;    /* m */
 } rcb_element_t;
 

@@ -32,7 +32,7 @@ const char *rcb_effect_name(rcb_effect e) {
 static const diag_family *const families[] = {
     &rcb_diag_family_coupling, &rcb_diag_family_bearing, &rcb_diag_family_pedestal,
     &rcb_diag_family_shaft,    &rcb_diag_family_mass,    &rcb_diag_family_speed,
-    &rcb_diag_family_chain};
+    &rcb_diag_family_element, &rcb_diag_family_chain};
 #define NFAMILIES (sizeof families / sizeof families[0])
 
 diag_cand *rcb_diag_new_cand(rcb_diag *d, const diag_family *fam, int effect,

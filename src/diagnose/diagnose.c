@@ -1263,6 +1263,30 @@ static rcb_status prefit_selected(rcb_diag *d, cand_jobs *j) {
   return rcb_diag_for_each(d, ped.n, prefit_job, &ped, NULL);
 }
 
+/* Whether candidate c's family takes one refit per variant
+ * (DIAG_FAM_ONE_REFIT) and another of its variant already has it; such a
+ * family takes no pre-fit of the run-off path (prefit). On the ROSS case of
+ * a cross-coupling at B3 (8 x 151), the 40 shaft-element candidates took
+ * five of the eight refits with scores of 17-39 % (the cross-coupling
+ * scores 12.7 %) and it was not refitted at all; on the signals case of
+ * 1.3 kg at DB (test_signals_diagnose mass_DB, a run-off baseline) their
+ * pre-fits, one per variant and the walk to its neighbours, ended below the
+ * added mass at DB (elements 6 and 7 of shaft B, on either side of DB, at
+ * 5 x their mass: 3.65 and 4.22 % against 0.546 % for the mass at DB),
+ * which then took none of the three nominal refits. */
+static int one_taken(const rcb_diag *d, const diag_cand *c, int prefit) {
+  size_t k;
+  if (!(c->fam->flags & DIAG_FAM_ONE_REFIT)) return 0;
+  if (prefit) return 1;
+  for (k = 0; k < d->ncand; k++) {
+    const diag_cand *e = &d->cand[k];
+    if (e != c && e->fam == c->fam && e->variant == c->variant &&
+        (prefit ? e->prefitted : e->from_fit))
+      return 1;
+  }
+  return 0;
+}
+
 /* With the baseline run off: the best RCB_DIAG_NOM_PREFITS at the nominal
  * model pre-fitted alone there, the RCB_DIAG_NOM_REFITS best pre-fits
  * marked for a refit from where they ended. */
@@ -1275,7 +1299,7 @@ static rcb_status nominal_starts(rcb_diag *d, cand_jobs *j) {
     diag_cand *c = NULL;
     for (k = 0; k < d->ncand; k++) {
       diag_cand *e = &d->cand[k];
-      if (!e->refit_only && !e->prefitted && e->predicted_nom > 0 &&
+      if (!e->refit_only && !e->prefitted && e->predicted_nom > 0 && !one_taken(d, e, 1) &&
           (!c || e->predicted_nom > c->predicted_nom))
         c = e;
     }
@@ -1359,7 +1383,7 @@ static rcb_status refit_best(rcb_diag *d) {
   for (k = 0; k < d->ncand; k++) {
     diag_cand *c = &d->cand[d->order[k]];
     c->from_fit = (c->refit_only && !(fixed_chain(c) && !(c->predicted > 0))) ||
-                  (j.todo < nfit && c->predicted > 0);
+                  (j.todo < nfit && c->predicted > 0 && !one_taken(d, c, 0));
     j.todo += !c->refit_only && c->from_fit;
   }
   if (d->far) st = nominal_starts(d, &j);

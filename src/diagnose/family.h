@@ -38,6 +38,11 @@ struct rcb_diag;
 #define DIAG_FAM_PLACE_WALK 8u  /* its candidates sit at nodes of a shaft (node, shaft,
                                    variant set): the run-off path walks from the best
                                    pre-fit to the neighbouring nodes (place_search) */
+#define DIAG_FAM_ONE_REFIT 16u  /* its candidates are alike from place to place (one at
+                                   every shaft element): of each variant only the best
+                                   scored takes a refit, and none a pre-fit of the
+                                   run-off path, so that neighbours do not crowd the
+                                   other effects out (refit_best, nominal_starts) */
 
 typedef struct diag_family {
   const char *name; /* "coupling", "bearing", ...: for messages and tests */
@@ -69,6 +74,7 @@ extern const diag_family rcb_diag_family_shaft;
 extern const diag_family rcb_diag_family_mass;
 extern const diag_family rcb_diag_family_speed;
 extern const diag_family rcb_diag_family_chain;
+extern const diag_family rcb_diag_family_element;
 
 /* Helpers for the families (catalogue.c). */
 /* A new candidate of family fam and effect e at place (NULL: out of memory;

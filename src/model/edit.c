@@ -38,7 +38,7 @@ static void *dup_items(const rcb_allocator *a, const void *src, size_t n, size_t
     c->n_##arr = c->cap_##arr = c->arr ? src->n_##arr : 0;                           \
   } while (0)
 
-/* The shafts' segments and the bearings' tables: owned per item. The item
+/* The shafts' segments and element factors and the bearings' tables: owned per item. The item
  * arrays were copied bytewise, so their pointers are the source's until
  * replaced here; the ones not reached on a failure are cleared, so that
  * destroying the clone frees only what it owns. */
@@ -51,6 +51,10 @@ static int dup_owned(rcb_model *c, const rcb_model *src) {
                                       &fail);
     sh->capseg = sh->seg ? sh->nseg : 0;
     if (!sh->seg) sh->nseg = 0;
+    sh->ef = fail ? NULL : dup_items(&c->alloc, src->shafts[i].ef, 2 * sh->nef, sizeof *sh->ef,
+                                     &fail);
+    sh->capef = sh->ef ? 2 * sh->nef : 0;
+    if (!sh->ef) sh->nef = 0;
   }
   for (i = 0; i < c->n_bearings; i++) {
     rcb_bearing_t *b = &c->bearings[i];

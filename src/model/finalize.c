@@ -34,6 +34,7 @@ static rcb_status mesh_shafts(rcb_model *m) {
   for (s = 0; s < m->n_shafts; s++) {
     rcb_shaft_t *sh = &m->shafts[s];
     double z = sh->z0;
+    size_t first_el = m->n_elements;
     sh->first_node = m->n_nodes;
     m->nodes[m->n_nodes].shaft = s;
     m->nodes[m->n_nodes++].z = z;
@@ -44,6 +45,7 @@ static rcb_status mesh_shafts(rcb_model *m) {
       for (e = 0; e < (size_t)sg->nel; e++) {
         rcb_element_t *el = &m->elements[m->n_elements++];
         el->shaft = s;
+        el->k = m->n_elements - 1 - first_el;
         el->node0 = m->n_nodes - 1;
         el->L = le;
         el->od = sg->od;

@@ -67,6 +67,36 @@ static rcb_status segment(ini_ctx *c, ini_section *s, const ini_entry *e) {
   return RCB_OK;
 }
 
+/* element_stiffness | element_mass = k factor [k factor ...]: factors of
+ * single elements (k from 1 in z order over the shaft's segments; the
+ * parameters shaft.S.e<k>.stiffness | mass, model/element_params.c). */
+static rcb_status element_factors(ini_ctx *c, ini_section *s, const ini_entry *e) {
+  const char *p = e->val, *t, *key = strcmp(e->key, "element_mass") == 0 ? "mass" : "stiffness";
+  char name[256];
+  size_t n = rcb_ini_count_tok(e->val, e->val + e->len), len, i;
+  double k, f;
+  rcb_status st;
+  if (n == 0 || n % 2)
+    return rcb_ini_error(c, RCB_ERR_PARSE, e->line, s, e->key,
+                         "%zu fields in '%s'; expected pairs: element number (from 1 along "
+                         "the shaft) and factor, e.g. %s = 7 0.6",
+                         n, e->val, e->key);
+  for (i = 0; i < n; i += 2) {
+    t = rcb_ini_next_tok(&p, e->val + e->len, &len);
+    TRY(rcb_ini_parse_num(c, s, e, t, len, "an element number from 1 along the shaft", &k));
+    t = rcb_ini_next_tok(&p, e->val + e->len, &len);
+    TRY(rcb_ini_parse_num(c, s, e, t, len, "a factor > 0 (1: as the material states)", &f));
+    if (k != floor(k) || k < 1 || k > 1e9)
+      return rcb_ini_error(c, RCB_ERR_PARSE, e->line, s, e->key,
+                           "element %g; expected a whole element number from 1 along the "
+                           "shaft ('rcbtool check' lists them)",
+                           k);
+    snprintf(name, sizeof name, "shaft.%s.e%.0f.%s", s->name, k, key);
+    if ((st = rcb_model_set_param(c->m, name, f))) return builder_fail(c, s, e->line, st);
+  }
+  return RCB_OK;
+}
+
 static rcb_status build_shaft(ini_ctx *c, ini_section *s) {
   char mat[RCB_NAME_MAX], hint[200];
   double z0, kappa, qm, qk;
@@ -99,6 +129,10 @@ static rcb_status build_shaft(ini_ctx *c, ini_section *s) {
   s->z0 = s->z1 = z0;
   for (i = 0; i < s->n_ent; i++)
     if (strcmp(s->ent[i].key, "segment") == 0) TRY(segment(c, s, &s->ent[i]));
+  for (i = 0; i < s->n_ent; i++) /* after every segment: they number the elements */
+    if (strcmp(s->ent[i].key, "element_stiffness") == 0 ||
+        strcmp(s->ent[i].key, "element_mass") == 0)
+      TRY(element_factors(c, s, &s->ent[i]));
   s->built = 1;
   return RCB_OK;
 }

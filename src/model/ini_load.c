@@ -32,8 +32,10 @@ static const char *const type_names[INI_SEC_COUNT] = {
 /* Keys of each section type, in the order the format documents them. */
 static const char *const keys_model[] = {"name", "description", "speed_factor"};
 static const char *const keys_material[] = {"density", "young", "poisson"};
-static const char *const keys_shaft[] = {"material",     "start",           "shear_factor",
-                                         "damping_mass", "damping_stiffness", "segment"};
+static const char *const keys_shaft[] = {"material",          "start",
+                                         "shear_factor",      "damping_mass",
+                                         "damping_stiffness", "segment",
+                                         "element_stiffness", "element_mass"};
 static const char *const keys_disk[] = {"at",      "mass",           "Id",
                                         "Ip",      "density",        "outer_diameter",
                                         "inner_diameter", "width"};
@@ -396,7 +398,10 @@ static int on_key(void *user, const char *section, const char *key, const char *
     unknown_key(c, s, key);
     return 0;
   }
-  if (strcmp(k, "segment") != 0)
+  /* list keys that may be repeated: segment, and the element factors
+   * (pairs "k factor", any number of lines) */
+  if (strcmp(k, "segment") != 0 && strcmp(k, "element_stiffness") != 0 &&
+      strcmp(k, "element_mass") != 0)
     for (i = 0; i < s->n_ent; i++)
       if (s->ent[i].key == k) {
         rcb_ini_error(c, RCB_ERR_PARSE, c->line, s, key,
@@ -420,7 +425,11 @@ static void model_reset(rcb_model *m) {
   size_t i;
   for (i = 0; i < m->n_shafts; i++) {
     rcb_free(&m->alloc, m->shafts[i].seg);
+    rcb_free(&m->alloc, m->shafts[i].ef);
     m->shafts[i].seg = NULL;
+    m->shafts[i].ef = NULL;
+    m->shafts[i].nseg = m->shafts[i].capseg = 0;
+    m->shafts[i].nef = m->shafts[i].capef = 0;
   }
   for (i = 0; i < m->n_bearings; i++) {
     rcb_free(&m->alloc, m->bearings[i].speeds);

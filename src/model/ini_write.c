@@ -157,6 +157,26 @@ static void write_materials(wbuf *w, const rcb_model *m) {
   }
 }
 
+/* "element_stiffness = k f k f ..." (which 0) or element_mass (1): the
+ * elements whose factor is not 1, VALUES_PER_LINE pairs per line, each line
+ * with its key (the key may be repeated). */
+static void write_element_factors(wbuf *w, const rcb_shaft_t *s, int which) {
+  const char *key = which ? "element_mass" : "element_stiffness";
+  char b[32];
+  size_t k, on_line = 0, lines = 0;
+  for (k = 0; k < s->nef; k++) {
+    double f = s->ef[2 * k + (size_t)which];
+    if (f == 1.0) continue;
+    if (on_line == 0) wr(w, "%s =", key);
+    wr(w, " %zu %s", k + 1, num(b, f));
+    if (++on_line == VALUES_PER_LINE) {
+      wr(w, lines++ ? "\n" : " ; element k (from 1 along the shaft), factor\n");
+      on_line = 0;
+    }
+  }
+  if (on_line) wr(w, lines ? "\n" : " ; element k (from 1 along the shaft), factor\n");
+}
+
 static void write_shafts(wbuf *w, const rcb_model *m) {
   char a[32], b[32], c[32], line[128];
   size_t i, g;
@@ -174,6 +194,8 @@ static void write_shafts(wbuf *w, const rcb_model *m) {
                sg->nel);
       kv(w, "segment", line, g == 0 ? "length m, outer d m, inner d m, elements" : NULL);
     }
+    write_element_factors(w, s, 0);
+    write_element_factors(w, s, 1);
     wr(w, "\n");
   }
 }

@@ -28,7 +28,10 @@ void rcb_model_destroy(rcb_model *m) {
   rcb_allocator a;
   if (!m) return;
   a = m->alloc;
-  for (i = 0; i < m->n_shafts; i++) rcb_free(&a, m->shafts[i].seg);
+  for (i = 0; i < m->n_shafts; i++) {
+    rcb_free(&a, m->shafts[i].seg);
+    rcb_free(&a, m->shafts[i].ef);
+  }
   for (i = 0; i < m->n_bearings; i++) {
     rcb_free(&a, m->bearings[i].speeds);
     rcb_free(&a, m->bearings[i].c);
@@ -222,6 +225,7 @@ rcb_status rcb_model_set_shaft_damping(rcb_model *m, const char *shaft, double q
 rcb_status rcb_model_add_segment(rcb_model *m, const char *shaft, double length,
                                  double outer_d, double inner_d, int n_elements) {
   long s;
+  size_t e;
   rcb_shaft_t *sh;
   rcb_status st = rcb_model_check_editable(m, "segment");
   if (st) return st;
@@ -241,8 +245,13 @@ rcb_status rcb_model_add_segment(rcb_model *m, const char *shaft, double length,
                           "shaft '%s': segment with %d elements, expected 1 to 100000", shaft,
                           n_elements);
   sh = &m->shafts[s];
-  if (rcb_grow(&m->alloc, (void **)&sh->seg, &sh->capseg, sh->nseg + 1, sizeof *sh->seg))
+  if (rcb_grow(&m->alloc, (void **)&sh->seg, &sh->capseg, sh->nseg + 1, sizeof *sh->seg) ||
+      rcb_grow(&m->alloc, (void **)&sh->ef, &sh->capef, 2 * (sh->nef + (size_t)n_elements),
+               sizeof *sh->ef))
     return rcb_model_fail(m, RCB_ERR_NOMEM, "out of memory adding a segment");
+  for (e = 2 * sh->nef; e < 2 * (sh->nef + (size_t)n_elements); e++)
+    sh->ef[e] = 1.0; /* the element factors' neutral value */
+  sh->nef += (size_t)n_elements;
   sh->seg[sh->nseg].L = length;
   sh->seg[sh->nseg].od = outer_d;
   sh->seg[sh->nseg].id = inner_d;

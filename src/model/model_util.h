@@ -31,4 +31,10 @@ static inline double rcb_segment_node_z(double zs, double L, size_t e, int nel) 
   return zs + L * (double)(e + 1) / (double)nel;
 }
 
+/* element_params.c: whether name has the shape of an element parameter,
+ * "shaft.S.e<k>.KEY" (three dots; names have none), and the storage of one
+ * (RCB_ERR_NOT_FOUND with a message when S, k or KEY does not exist). */
+int rcb_element_param_shape(const char *name);
+rcb_status rcb_element_param_slot(rcb_model *m, const char *name, double **slot);
+
 #endif

@@ -388,6 +388,11 @@ rcb_status rcb_model_get_param(const rcb_model *m, const char *name, double *val
     *value = m->speed_factor;
     return RCB_OK;
   }
+  if (rcb_element_param_shape(name)) {
+    if ((st = rcb_element_param_slot(mm, name, v))) return st;
+    *value = *v[0];
+    return RCB_OK;
+  }
   if ((st = lookup(mm, name, &r))) return st;
   slots(mm, r.k, r.i, r.j, v);
   *value = *v[0]; /* hubs: station a */
@@ -409,6 +414,13 @@ rcb_status rcb_model_set_param(rcb_model *m, const char *name, double value) {
   if (is_speed_factor(name)) {
     if ((st = rcb_model_check_value(m, "model", "speed", "factor (-)", value, 1))) return st;
     m->speed_factor = value;
+    return RCB_OK;
+  }
+  if (rcb_element_param_shape(name)) { /* shaft.S.e<k>.stiffness | mass */
+    if ((st = rcb_element_param_slot(m, name, v)) ||
+        (st = rcb_model_check_value(m, "shaft element", name, "factor (-)", value, 1)))
+      return st;
+    *v[0] = value;
     return RCB_OK;
   }
   if ((st = lookup(m, name, &r))) return st;

@@ -44,6 +44,34 @@ def RossModel(model, speed=0.0, override_shear=True):
     return ross_bridge.IniRotor(model, speed=speed, override_shear=override_shear)
 
 
+def element_factors_edit(shaft, k, stiffness=1.0, mass=1.0):
+    """model_edit (as those of diag_cases.py): element k (counted from 1 in z
+    order, librcb's shaft.SHAFT.e<k>) of shaft SHAFT gets its own ROSS Material
+    with E (and so G) times `stiffness` and density times `mass`; librcb's
+    shaft.SHAFT.e<k>.stiffness and .mass are the same model."""
+
+    def edit(model):
+        sh = next(s for s in model.shafts if s.name == shaft)
+        if not 1 <= k <= len(sh.elements):
+            raise ValueError(f"shaft {shaft} has elements 1 to {len(sh.elements)}, not {k}")
+        fk, fm = sh.factors.get(k - 1, (1.0, 1.0))
+        sh.factors[k - 1] = (fk * stiffness, fm * mass)
+
+    return edit
+
+
+def element_stiffness_edit(shaft, k, factor):
+    """model_edit: element k of shaft SHAFT with E and G times factor (a crack,
+    wear, a loose shrink fit): librcb's shaft.SHAFT.e<k>.stiffness = factor."""
+    return element_factors_edit(shaft, k, stiffness=factor)
+
+
+def element_mass_edit(shaft, k, factor):
+    """model_edit: element k of shaft SHAFT with its density times factor:
+    librcb's shaft.SHAFT.e<k>.mass = factor."""
+    return element_factors_edit(shaft, k, mass=factor)
+
+
 # --------------------------------------------------------------------------
 # The models, as INI text in librcb's format. Used when examples/ lacks the
 # file, and always for the variants the examples do not cover.

@@ -9,10 +9,17 @@ const char cli_help_check[] =
     "DOFs; tied DOFs share a row) and the station table (name, kind, node, z in m).\n"
     "Station names are what the channel options of frf and unbalance accept,\n"
     "as STATION.DIR with DIR one of x, y, rx, ry (or #N.DIR for node N).\n"
+    "Then the element table: each shaft element's parameters\n"
+    "shaft.SHAFT.e<k>.stiffness and shaft.SHAFT.e<k>.mass (factors on its E and G,\n"
+    "and on its density; neutral 1), k counted from 1 in z order along the shaft,\n"
+    "with its end nodes, z range in m, diameters in m and current factors.\n"
     "\n"
-    "CSV: a '# summary' line, the node table, a blank line, the station table.\n"
+    "CSV: a '# summary' line, the node table, a blank line, the station table,\n"
+    "a blank line, the element table.\n"
     "JSON: {\"model\", \"n_nodes\", \"n_elements\", \"ndof\", \"nodes\": [{\"node\",\n"
-    "\"shaft\", \"z\", \"dof\": [4]}], \"stations\": [{\"name\", \"kind\", \"node\", \"z\"}]}\n";
+    "\"shaft\", \"z\", \"dof\": [4]}], \"stations\": [{\"name\", \"kind\", \"node\", \"z\"}],\n"
+    "\"elements\": [{\"shaft\", \"k\", \"param\", \"node0\", \"node1\", \"z0\", \"z1\",\n"
+    "\"outer_d\", \"inner_d\", \"stiffness\", \"mass\"}]} (param: \"shaft.SHAFT.e<k>\")\n";
 
 static const char *kind_name(rcb_station_kind k) {
   switch (k) {
@@ -54,6 +61,44 @@ static void write_csv(FILE *fp, const rcb_model *m, const char *path) {
     fprintf(fp, "%s,%s,%zu,%.10g\n", si.name, kind_name(si.kind), si.node,
             node_z(m, si.node));
   }
+  fputs("\nparam,shaft,k,node0,node1,z0_m,z1_m,outer_d_m,inner_d_m,stiffness,mass\n", fp);
+  for (i = 0; i < rcb_model_element_count(m); i++) {
+    rcb_element_info ei;
+    if (rcb_model_element_info(m, i, &ei)) continue;
+    fprintf(fp, "shaft.%s.e%zu,%s,%zu,%zu,%zu,%.10g,%.10g,%.10g,%.10g,%.15g,%.15g\n", ei.shaft,
+            ei.index, ei.shaft, ei.index, ei.node0, ei.node1, ei.z0, ei.z1, ei.outer_d,
+            ei.inner_d, ei.stiffness, ei.mass);
+  }
+}
+
+/* The element table: each element's parameter prefix, nodes, z range, factors. */
+static void json_elements(FILE *fp, const rcb_model *m) {
+  size_t i;
+  char pre[2 * RCB_NAME_MAX + 32];
+  fputs("[", fp);
+  for (i = 0; i < rcb_model_element_count(m); i++) {
+    rcb_element_info ei;
+    if (rcb_model_element_info(m, i, &ei)) continue;
+    fprintf(fp, "%s\n  {\"shaft\": ", i ? "," : "");
+    cli_json_str(fp, ei.shaft);
+    snprintf(pre, sizeof pre, "shaft.%s.e%zu", ei.shaft, ei.index);
+    fprintf(fp, ", \"k\": %zu, \"param\": ", ei.index);
+    cli_json_str(fp, pre);
+    fprintf(fp, ", \"node0\": %zu, \"node1\": %zu, \"z0\": ", ei.node0, ei.node1);
+    cli_json_num(fp, ei.z0);
+    fputs(", \"z1\": ", fp);
+    cli_json_num(fp, ei.z1);
+    fputs(", \"outer_d\": ", fp);
+    cli_json_num(fp, ei.outer_d);
+    fputs(", \"inner_d\": ", fp);
+    cli_json_num(fp, ei.inner_d);
+    fputs(", \"stiffness\": ", fp);
+    cli_json_num(fp, ei.stiffness);
+    fputs(", \"mass\": ", fp);
+    cli_json_num(fp, ei.mass);
+    fputs("}", fp);
+  }
+  fputs("]", fp);
 }
 
 void cli_json_nodes(FILE *fp, const rcb_model *m) {
@@ -89,7 +134,9 @@ static void write_json(FILE *fp, const rcb_model *m, const char *path) {
     cli_json_num(fp, node_z(m, si.node));
     fputs("}", fp);
   }
-  fputs("]}\n", fp);
+  fputs("],\n\"elements\": ", fp);
+  json_elements(fp, m);
+  fputs("}\n", fp);
 }
 
 int cmd_check(int argc, char **argv) {

@@ -53,6 +53,13 @@ class NodeInfo(ctypes.Structure):
     _fields_ = [("shaft", c_char_p), ("z", c_double), ("dof", c_long * 4)]
 
 
+class ElementInfo(ctypes.Structure):
+    _fields_ = [("shaft", c_char_p), ("index", c_size_t), ("node0", c_size_t),
+                ("node1", c_size_t), ("z0", c_double), ("z1", c_double),
+                ("outer_d", c_double), ("inner_d", c_double), ("stiffness", c_double),
+                ("mass", c_double)]
+
+
 class StationInfo(ctypes.Structure):
     _fields_ = [("name", c_char_p), ("kind", c_int), ("node", c_size_t)]
 
@@ -194,6 +201,7 @@ _PROTOTYPES = {
     "rcb_model_dof_count": (c_size_t, [c_void_p]),
     "rcb_model_element_count": (c_size_t, [c_void_p]),
     "rcb_model_node_info": (c_int, [c_void_p, c_size_t, ctypes.POINTER(NodeInfo)]),
+    "rcb_model_element_info": (c_int, [c_void_p, c_size_t, ctypes.POINTER(ElementInfo)]),
     "rcb_model_station_count": (c_size_t, [c_void_p]),
     "rcb_model_station_info": (c_int, [c_void_p, c_size_t, ctypes.POINTER(StationInfo)]),
     "rcb_model_find_dof": (c_int, [c_void_p, c_char_p, ctypes.POINTER(Dof)]),

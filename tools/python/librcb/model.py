@@ -15,6 +15,10 @@ RPM = math.pi / 30.0  # rad/s per rpm
 Node = namedtuple("Node", "index shaft z dofs")
 Node.__doc__ = ("A node: index, owning shaft, axial position z (m), matrix rows of "
                 "x, y, rot_x, rot_y (-1 where a constraint removed the DOF).")
+Element = namedtuple("Element", "param shaft k node0 node1 z0 z1 outer_d inner_d stiffness mass")
+Element.__doc__ = ("A shaft element: the prefix of its parameters ('shaft.B.e5': .stiffness, "
+                   ".mass), its shaft, k (from 1 along z), end nodes, z range (m), "
+                   "diameters (m), and its stiffness and mass factors (neutral 1).")
 Station = namedtuple("Station", "name kind node z")
 Station.__doc__ = "A named station: name, kind, node index, axial position z (m)."
 STATION_KINDS = ("disk", "bearing", "coupling", "unbalance", "probe", "pedestal")
@@ -152,6 +156,23 @@ class Model(Handle):
         for i in range(self.n_nodes):
             self.check(L.rcb_model_node_info(self.handle, i, ctypes.byref(info)))
             out.append(Node(i, _lib.text(info.shaft), float(info.z), tuple(info.dof)))
+        return out
+
+    @property
+    def elements(self):
+        """List of Element(param, shaft, k, node0, node1, z0, z1 [m], outer_d, inner_d [m],
+        stiffness, mass): every shaft element with its parameters
+        PARAM.stiffness and PARAM.mass (factors, neutral 1), k from 1 along z."""
+        L = _lib.lib()
+        out = []
+        info = _lib.ElementInfo()
+        for i in range(self.n_elements):
+            self.check(L.rcb_model_element_info(self.handle, i, ctypes.byref(info)))
+            sh = _lib.text(info.shaft)
+            out.append(Element(f"shaft.{sh}.e{info.index}", sh, int(info.index), int(info.node0),
+                               int(info.node1), float(info.z0), float(info.z1),
+                               float(info.outer_d), float(info.inner_d), float(info.stiffness),
+                               float(info.mass)))
         return out
 
     @property

@@ -173,6 +173,17 @@ class Shaft:
         self.alpha = _f(d, "damping_mass", 0.0)
         self.beta = _f(d, "damping_stiffness", 0.0)
         self.elements = []  # (L, od, id)
+        # per-element factors (librcb's shaft.NAME.e<k>.stiffness | mass):
+        # local element index (0-based, z order) -> (factor on E and G, on rho);
+        # the ROSS builder gives such an element its own Material
+        self.factors = {}
+        for j, key in enumerate(("element_stiffness", "element_mass")):
+            for line in d.get(key, []):  # pairs "k factor", k from 1
+                vals = _floats(line)
+                for k, f in zip(vals[0::2], vals[1::2]):
+                    fk = list(self.factors.get(int(k) - 1, (1.0, 1.0)))
+                    fk[j] = f
+                    self.factors[int(k) - 1] = tuple(fk)
         for seg in d.get("segment", []):
             length, od, idd, n = _floats(seg)
             n = int(n)
@@ -335,8 +346,13 @@ class IniRotor:
         }
         shaft_els = []
         for sh in model.shafts:
-            mat = mats[sh.material]
             for i, (L, od, idd) in enumerate(sh.elements):
+                mat = mats[sh.material]
+                if i in sh.factors:  # its own Material: E (G follows) and rho scaled
+                    fk, fm = sh.factors[i]
+                    rho, E, nu = model.materials[sh.material]
+                    mat = rs.Material(name=f"{mat.name}_{sh.name}_e{i + 1}", rho=fm * rho,
+                                      E=fk * E, Poisson=nu)
                 el = rs.ShaftElement(
                     L=L, idl=idd, odl=od, material=mat, n=self.node_of[(sh.name, i)],
                     shear_effects=sh.kappa > 0, rotary_inertia=True, gyroscopic=True,
