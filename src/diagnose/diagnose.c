@@ -1277,7 +1277,10 @@ static rcb_status prefit_selected(rcb_diag *d, cand_jobs *j) {
 static int one_taken(const rcb_diag *d, const diag_cand *c, int prefit) {
   size_t k;
   if (!(c->fam->flags & DIAG_FAM_ONE_REFIT)) return 0;
-  if (prefit) return 1;
+  /* on the run-off path only its first variant (an element's stiffness: a
+   * crack pulls the baseline off too, kr 221 -> 18.9 N m/rad) takes one
+   * pre-fit, the best scored */
+  if (prefit && c->variant != 0) return 1;
   for (k = 0; k < d->ncand; k++) {
     const diag_cand *e = &d->cand[k];
     if (e != c && e->fam == c->fam && e->variant == c->variant &&
