@@ -1604,10 +1604,11 @@ static void no_spaces(const char *in, char *out) {
  * a check of the sensor, not a test campaign. */
 static size_t say_rival(const rcb_diag *d, char *text, size_t size, size_t n) {
   const diag_cand *a, *b;
-  if (d->ncand < 2 || n >= size) return n;
+  if (!d->cand || !d->order || d->ncand < 2 || n >= size) return n;
   a = &d->cand[d->order[0]], b = &d->cand[d->order[1]];
   if (!a->refitted || !b->refitted || a->claim == RCB_CLAIM_NONE || b->claim != a->claim ||
-      rcb_evidence_separable(a->dbic, b->dbic) || ((a->fam->flags | b->fam->flags) & DIAG_FAM_CHAIN) ||
+      rcb_evidence_separable(a->dbic, b->dbic) ||
+      ((a->fam->flags | b->fam->flags) & DIAG_FAM_CHAIN) ||
       (a->effect == b->effect && strcmp(a->place, b->place) == 0)) /* one effect, two forms */
     return n;
   {
