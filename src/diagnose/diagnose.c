@@ -1583,11 +1583,17 @@ static size_t say_span(const rcb_diag *d, char *text, size_t size, size_t n) {
     found++;
   }
   if (!found || n >= size) return n;
-  n += (size_t)snprintf(text + n, size - n,
-                        " The local candidates point to shaft %s between z = %.3g and %.3g m "
-                        "(nodes #%zu-#%zu): an effect there that the catalogue lacks is "
-                        "possible.",
-                        m->shafts[shaft].name, m->nodes[lo].z, m->nodes[hi].z, lo, hi);
+  if (lo == hi)
+    n += (size_t)snprintf(text + n, size - n,
+                          " The local candidates point to shaft %s at z = %.3g m (node #%zu): "
+                          "an effect there that the catalogue lacks is possible.",
+                          m->shafts[shaft].name, m->nodes[lo].z, lo);
+  else
+    n += (size_t)snprintf(text + n, size - n,
+                          " The local candidates point to shaft %s between z = %.3g and %.3g m "
+                          "(nodes #%zu-#%zu): an effect there that the catalogue lacks is "
+                          "possible.",
+                          m->shafts[shaft].name, m->nodes[lo].z, m->nodes[hi].z, lo, hi);
   return n < size ? n : size - 1;
 }
 
