@@ -263,7 +263,7 @@ RCB_API rcb_status rcb_diag_explain(const rcb_diag *d, char *buf, size_t size, s
  * them": the diagnosis' BIC threshold (a candidate is significant when its
  * BIC falls by more than 10).
  */
-#define RCB_PLAN_SEPARATE_CHI2 10.0
+#define RCB_PLAN_SEPARATE_CHI2 (-RCB_BIC_SIGNIFICANT) /* rcb_evidence_separable's 10 */
 
 /**
  * Two rival effects A and B (each one or more model parameters) that fit the
@@ -327,7 +327,7 @@ typedef struct rcb_plan_result {
   double angle_deg;  /**< smallest principal angle between span(J_A) and span(J_B), deg */
   double size;       /**< S: the chi-square A's data move F by on their own */
   double chi2_sep;   /**< S sin^2(angle): F by which the best B misses A's data */
-  int separable;     /**< chi2_sep >= RCB_PLAN_SEPARATE_CHI2 */
+  int separable;     /**< rcb_evidence_separable(chi2_sep, 0): above 10 */
   size_t residuals;  /**< residuals of the present channels */
   size_t candidates; /**< candidate channels ranked */
 } rcb_plan_result;

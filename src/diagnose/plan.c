@@ -432,7 +432,7 @@ static rcb_status separate(rcb_plan *p, const double *J, size_t n, plan_basis *b
   p->res.angle_deg = asin(fmin(sigma, 1.0)) * 180.0 / RCB_PI;
   p->res.size = p->size;
   p->res.chi2_sep = F;
-  p->res.separable = F >= RCB_PLAN_SEPARATE_CHI2;
+  p->res.separable = rcb_evidence_separable(F, 0.0); /* the one rule (claim.c) */
   p->res.residuals = n;
 done:
   rcb_free(&p->alloc, QA);

@@ -170,7 +170,7 @@ static void print_text(FILE *fp, const cli_args *a, const plan_job *j, const rcb
     rcb_plan_get_candidate(p, i, &c);
     fprintf(fp, "%-5zu %-14s %-14s %9.6g %12.4g %12.4g %9.1f%s\n", i + 1, c.response,
             c.reference, c.speed / CLI_RPM_TO_RAD_S, c.gain, c.chi2_after, c.level_db,
-            !r.separable && c.chi2_after >= RCB_PLAN_SEPARATE_CHI2 ? "  separates" : "");
+            !r.separable && rcb_evidence_separable(c.chi2_after, 0.0) ? "  separates" : "");
   }
 }
 
