@@ -684,38 +684,47 @@ static void test_outlier_rule(void **state) {
   assert_true(isnan(rcb_compare_chi2_limit(0)));
 }
 
-/* Model-made FRFs of six sensors (paper system, input DA.x) with complex
- * Gaussian noise of sd 2 % of |e| on Re and Im; sensor DB.y's values scaled by
- * @p gain (a probe reading low). */
-static rcb_meas *six_sensors(const rcb_model *m, double gain, double **sd_out) {
-  static const char *const outs[] = {"C.A.x", "C.A.y", "C.B.x", "C.B.y", "DA.x", "DB.y"};
-  static const char *const ins[] = {"DA.x", "DA.x", "DA.x", "DA.x", "DA.x", "DA.x"};
-  size_t n = 400, k, i;
-  rcb_meas *clean = frf_meas(m, outs, ins, 6, 5.0, 400.0, n, 3000.0, RCB_INERTANCE), *ms;
+/* The channels of @p clean (n points, 3000 rpm) with complex Gaussian noise of
+ * sd 2 % of |e| on Re and Im (Box-Muller on the LCG from @p seed), the
+ * channels whose bit is set in @p low scaled by @p gain; the sds into @p sd
+ * (channel-major) when not NULL. Destroys clean. */
+static rcb_meas *noisy_copy(rcb_meas *clean, size_t n, unsigned long long seed,
+                            unsigned low, double gain, double *sd) {
+  size_t nch = rcb_meas_channel_count(clean), k, i;
   rcb_complex *col = calloc(n, sizeof *col);
-  double *sd = calloc(6 * n, sizeof *sd);
-  unsigned long long seed = 777;
+  rcb_meas *ms;
   assert_non_null(col);
-  assert_non_null(sd);
   assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
   assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, n, rcb_meas_grid(clean), 3000.0 * RPM),
                    RCB_OK);
-  for (k = 0; k < 6; k++) {
+  for (k = 0; k < nch; k++) {
     rcb_meas_channel_info ci;
     rcb_meas_channel(clean, k, &ci);
     for (i = 0; i < n; i++) {
       double u1 = lcg_uniform(&seed), u2 = lcg_uniform(&seed), r = sqrt(-2.0 * log(u1));
       double sdev = 0.02 * cabs(ci.data[i]);
       col[i] = ci.data[i] + sdev * r * CMPLX(cos(TWO_PI * u2), sin(TWO_PI * u2));
-      if (k == 5) col[i] *= gain;
-      sd[k * n + i] = sdev;
+      if (low >> k & 1u) col[i] *= gain;
+      if (sd) sd[k * n + i] = sdev;
     }
     assert_int_equal(rcb_meas_add_channel(ms, ci.response, ci.reference, ci.kind, col), RCB_OK);
   }
   rcb_meas_destroy(clean);
   free(col);
-  *sd_out = sd;
   return ms;
+}
+
+/* Model-made FRFs of six sensors (paper system, input DA.x), noise as
+ * noisy_copy; sensor DB.y's values scaled by @p gain (a probe reading low). */
+static rcb_meas *six_sensors(const rcb_model *m, double gain, double **sd_out) {
+  static const char *const outs[] = {"C.A.x", "C.A.y", "C.B.x", "C.B.y", "DA.x", "DB.y"};
+  static const char *const ins[] = {"DA.x", "DA.x", "DA.x", "DA.x", "DA.x", "DA.x"};
+  size_t n = 400;
+  double *sd = calloc(6 * n, sizeof *sd);
+  assert_non_null(sd);
+  *sd_out = sd;
+  return noisy_copy(frf_meas(m, outs, ins, 6, 5.0, 400.0, n, 3000.0, RCB_INERTANCE), n, 777,
+                    1u << 5, gain, sd);
 }
 
 /* A probe reading 20 % low is named (its error % about 20 against about 2
@@ -762,35 +771,16 @@ static void test_outlier_sensor(void **state) {
   rcb_model_destroy(m);
 }
 
-/* Six sensors per two references (DA.x, DB.y; channel 2 s + r), Gaussian
- * noise of sd 2 % of |e|; channels whose bit is set in @p low read 20 % low. */
+/* Twelve channels (six sensors, each per forces at DA.x and DB.y), noise as
+ * noisy_copy; channels whose bit is set in @p low read 20 % low. */
 static rcb_meas *two_refs(const rcb_model *m, unsigned low) {
   static const char *const outs[] = {"C.A.x", "C.A.x", "C.A.y", "C.A.y", "C.B.x", "C.B.x",
                                      "C.B.y", "C.B.y", "DA.x",  "DA.x",  "DB.y",  "DB.y"};
   static const char *const ins[] = {"DA.x", "DB.y", "DA.x", "DB.y", "DA.x", "DB.y",
                                     "DA.x", "DB.y", "DA.x", "DB.y", "DA.x", "DB.y"};
-  size_t n = 300, k, i;
-  rcb_meas *clean = frf_meas(m, outs, ins, 12, 5.0, 400.0, n, 3000.0, RCB_INERTANCE), *ms;
-  rcb_complex *col = calloc(n, sizeof *col);
-  unsigned long long seed = 99;
-  assert_non_null(col);
-  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
-  assert_int_equal(rcb_meas_set_grid(ms, RCB_MEAS_FRF, n, rcb_meas_grid(clean), 3000.0 * RPM),
-                   RCB_OK);
-  for (k = 0; k < 12; k++) {
-    rcb_meas_channel_info ci;
-    rcb_meas_channel(clean, k, &ci);
-    for (i = 0; i < n; i++) {
-      double u1 = lcg_uniform(&seed), u2 = lcg_uniform(&seed), r = sqrt(-2.0 * log(u1));
-      col[i] = ci.data[i] + 0.02 * cabs(ci.data[i]) * r * CMPLX(cos(TWO_PI * u2),
-                                                               sin(TWO_PI * u2));
-      if (low >> k & 1u) col[i] *= 0.8;
-    }
-    assert_int_equal(rcb_meas_add_channel(ms, ci.response, ci.reference, ci.kind, col), RCB_OK);
-  }
-  rcb_meas_destroy(clean);
-  free(col);
-  return ms;
+  size_t n = 300;
+  return noisy_copy(frf_meas(m, outs, ins, 12, 5.0, 400.0, n, 3000.0, RCB_INERTANCE), n, 99,
+                    low, 0.8, NULL);
 }
 
 /* With two references: DB.y low on both channels names the sensor; low on
