@@ -229,6 +229,48 @@ RCB_API size_t rcb_diag_misfit_count(const rcb_diag *d);
  * every sensor sees).
  */
 RCB_API rcb_status rcb_diag_misfit_get(const rcb_diag *d, size_t k, rcb_diag_misfit *out);
+/**
+ * @brief Where along the shafts the misfit of the model as it is sits, with
+ * the effect class left open (issue #23 item 3), by equivalent loads
+ * (Bachschmid, Pennacchi and Vania). An effect the model lacks at one node
+ * n loads the shaft there: exactly, H_meas - H = -H dZ H_meas with dZ
+ * non-zero at n's DOFs only, so each measured channel's residual at a
+ * frequency is H[response, n.x] f_x + H[response, n.y] f_y, with one
+ * unknown complex force (f_x, f_y) per frequency and reference, whatever
+ * the effect (a mass, a spring, a seal, a rub, a support: their forces
+ * differ, their place does not). At every shaft node that force is fitted
+ * by weighted least squares (the fit's weights, complex scale) to the
+ * residual of the model as it is (the nominal model when the fit of its
+ * parameters ran off); what it leaves, chi2, is a chi-square of dof
+ * degrees of freedom when the node is right. An effect that loads the
+ * shaft by moments (a crack) is placed near, not always at, its element.
+ */
+typedef struct rcb_diag_place {
+  size_t node;       /**< model node (0-based, "#N") */
+  const char *shaft; /**< its shaft (owned by the diagnosis) */
+  double z;          /**< its axial position, m */
+  double share_pct;  /**< share of the residual's excess over the noise a force at
+                          the node takes, % (0-100) */
+  double chi2;       /**< what the force there leaves (-) */
+  double dof;        /**< its degrees of freedom: residuals - 4 per frequency and reference */
+  int adequate;      /**< 1: chi2 within the 1 % limit (dof + 2.326 sqrt(2 dof)): a load
+                          at this node alone accounts for the misfit */
+  int in_span;       /**< 1: the data place the misfit here as well as at the best node:
+                          when the best is adequate, not separable from it
+                          (rcb_evidence_separable of the two chi2); else its chi2 - dof
+                          within RCB_DIAG_PLACE_SPAN_FACTOR x the best's (what the best
+                          leaves is then model error, which tells no neighbour apart) */
+} rcb_diag_place;
+#define RCB_DIAG_PLACE_SPAN_FACTOR 2.0
+#define RCB_DIAG_PLACE_LOCAL 50.0 /**< the misfit is local when the best node takes this % */
+/**
+ * @brief Shaft nodes placed (0 before a run, without a known noise, on
+ * unbalance responses, or when the model as it is passes the adequacy test:
+ * nothing to place).
+ */
+RCB_API size_t rcb_diag_place_count(const rcb_diag *d);
+/** @brief Node @p k of the placement, the largest share first. */
+RCB_API rcb_status rcb_diag_place_get(const rcb_diag *d, size_t k, rcb_diag_place *out);
 /** @brief Work done by the last rcb_diag_run (for benchmarks and progress reports). */
 typedef struct rcb_diag_stats {
   size_t evaluations; /**< model sweeps over the measured points (a Jacobian counts one) */

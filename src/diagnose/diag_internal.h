@@ -114,6 +114,8 @@ struct rcb_diag {
   rcb_diag_misfit *mis;             /* per response sensor, the largest excess first */
   size_t nmis;
   size_t nres;
+  rcb_diag_place *place;            /* per shaft node, the largest share first (locate.c) */
+  size_t nplace;
   diag_cand *cand;
   size_t ncand, cap_cand;
   size_t *order;                    /* rank -> candidate */
@@ -139,6 +141,20 @@ rcb_status rcb_diag_for_each(rcb_diag *d, size_t n, rcb_diag_job job, void *ctx,
  * fitted): move the candidate's parameters to a better start where the
  * neutral start sees nothing (a pedestal: a scan of its mass and stiffness). */
 rcb_status rcb_diag_refit_start(rcb_diag *d, const diag_cand *c, rcb_model *m, rcb_fit *f);
+/* A fit of model m (not copied: m must outlive it) against the diagnosis'
+ * measurement with its objective settings (scale, noise model or sd, band),
+ * the base parameters when with_base holds RCB_DIAG_FIT_BASE, and candidate
+ * c's parameters (c may be NULL); no intervals. rcb_diag_drop_fit destroys
+ * it, counting its model sweeps in the diagnosis' figures. */
+#define RCB_DIAG_FIT_BASE 1u
+rcb_status rcb_diag_make_fit(rcb_diag *d, rcb_model *m, unsigned with_base, const diag_cand *c,
+                             rcb_fit **out);
+void rcb_diag_drop_fit(rcb_diag *d, rcb_fit *f);
+/* Where the misfit of the model as it is sits, the effect class left open
+ * (locate.c): fills d->place / d->nplace when the noise is known and the
+ * model as it is fails the adequacy test; nothing otherwise. */
+rcb_status rcb_diag_locate(rcb_diag *d);
+
 /* A finalized copy of model src with the diagnosis' allocator (caller destroys). */
 rcb_status rcb_diag_copy_model(rcb_diag *d, const rcb_model *src, rcb_model **out);
 /* Weights (channel-major, 0 or 1) keeping a subset of the measured

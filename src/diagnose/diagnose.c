@@ -43,6 +43,8 @@ static void free_results(rcb_diag *d) {
   rcb_model_destroy(d->nom_model);
   rcb_free(&d->alloc, d->mis);
   d->mis = NULL, d->nmis = 0;
+  rcb_free(&d->alloc, d->place);
+  d->place = NULL, d->nplace = 0;
   memset(&d->adeq0, 0, sizeof d->adeq0);
   d->cand = NULL, d->order = NULL, d->base_model = NULL, d->nom_model = NULL;
   d->far = 0, d->drift[0] = '\0', d->pre_best = HUGE_VAL;
@@ -158,10 +160,12 @@ rcb_status rcb_diag_set_progress(rcb_diag *d, int (*cb)(void *user, size_t done,
 
 /* A fit of m with the diagnosis settings, the base parameters (with_base)
  * and the candidate's parameters (c, may be NULL). */
-#define FIT_BASE 1u /* make_fit: the base parameters too */
+#define FIT_BASE RCB_DIAG_FIT_BASE
 #define FIT_LEAD 2u /* make_fit: the candidate's first nlead parameters only (pre-fit) */
-static rcb_status make_fit(rcb_diag *d, rcb_model *m, unsigned with_base, const diag_cand *c,
-                           rcb_fit **out) {
+#define make_fit rcb_diag_make_fit
+#define drop_fit rcb_diag_drop_fit
+rcb_status rcb_diag_make_fit(rcb_diag *d, rcb_model *m, unsigned with_base, const diag_cand *c,
+                             rcb_fit **out) {
   rcb_fit *f = NULL;
   rcb_status st = rcb_fit_create(&f, m, d->meas, &d->alloc);
   size_t k, npc = !c ? 0 : (with_base & FIT_LEAD) && c->nlead ? c->nlead : c->np;
@@ -209,8 +213,7 @@ static void keep_chain(diag_cand *c, const rcb_fit *f) {
   }
 }
 
-/* Destroy a fit, counting its model sweeps in the diagnosis' figures. */
-static void drop_fit(rcb_diag *d, rcb_fit *f) {
+void rcb_diag_drop_fit(rcb_diag *d, rcb_fit *f) {
   d->stats.evaluations += rcb_fit_sweeps(f);
   rcb_fit_destroy(f);
 }
@@ -1424,6 +1427,7 @@ static rcb_status run_steps(rcb_diag *d) {
     d->base_model = fitted;
   }
   if (!st) st = refit_best(d);
+  if (!st) st = rcb_diag_locate(d);
   return st;
 }
 
@@ -1597,6 +1601,71 @@ static size_t say_span(const rcb_diag *d, char *text, size_t size, size_t n) {
   return n < size ? n : size - 1;
 }
 
+/* Where the equivalent loads place the misfit of the model as it is
+ * (locate.c), appended to text at n: the best node, its share, whether a
+ * load there alone accounts for it, and the runs of neighbouring nodes the
+ * data cannot separate from it; or that no one node takes
+ * RCB_DIAG_PLACE_LOCAL % of it. */
+static const rcb_diag_place *span_at(const rcb_diag *d, size_t node, const char *shaft) {
+  size_t j;
+  for (j = 0; j < d->nplace; j++)
+    if (d->place[j].in_span && d->place[j].node == node &&
+        (!shaft || strcmp(d->place[j].shaft, shaft) == 0))
+      return &d->place[j];
+  return NULL;
+}
+static size_t say_place(const rcb_diag *d, char *text, size_t size, size_t n) {
+  const rcb_diag_place *b = d->place;
+  size_t runs = 0, lo, hi;
+  if (!d->nplace || n >= size) return n;
+  if (b->share_pct < RCB_DIAG_PLACE_LOCAL) {
+    n += (size_t)snprintf(text + n, size - n,
+                          " No one place takes most of the misfit: a force at one node takes at "
+                          "most %.0f %% of its excess over the noise (shaft %s, z = %.3g m, node "
+                          "#%zu), so the missing effect is not local to one node, or there are "
+                          "several.",
+                          b->share_pct, b->shaft, b->z, b->node);
+    return n < size ? n : size - 1;
+  }
+  if (b->adequate)
+    n += (size_t)snprintf(text + n, size - n,
+                          " Placed by equivalent loads, whatever the effect: a force at shaft %s, "
+                          "z = %.3g m (node #%zu) takes %.0f %% of the misfit's excess over the "
+                          "noise and leaves the noise alone (chi-square %.6g within its 1 %% "
+                          "limit): the missing effect sits there",
+                          b->shaft, b->z, b->node, b->share_pct, b->chi2);
+  else
+    n += (size_t)snprintf(text + n, size - n,
+                          " Placed by equivalent loads, whatever the effect: a force at one node "
+                          "takes at most %.0f %% of the misfit's excess over the noise (shaft %s, "
+                          "z = %.3g m, node #%zu) and leaves more than the noise (chi-square "
+                          "%.6g for %.0f degrees of freedom), so the data place it along a span, "
+                          "not at one node",
+                          b->share_pct, b->shaft, b->z, b->node, b->chi2, b->dof);
+  /* the nodes the data cannot separate from it, in node order, as runs of
+   * neighbours on one shaft */
+  for (lo = 0; lo < d->nplace && n < size && runs < 4; lo++) {
+    const rcb_diag_place *pl = span_at(d, lo, NULL), *ph;
+    if (!pl) continue;
+    for (hi = lo, ph = pl; span_at(d, hi + 1, pl->shaft);) ph = span_at(d, ++hi, NULL);
+    if (!runs && lo == hi && lo == b->node) break; /* the best node alone */
+    n += (size_t)snprintf(text + n, size - n, "%s",
+                          runs ? ","
+                          : b->adequate ? "; these data cannot separate it from the nodes of"
+                                        : "; the nodes that leave at most twice as much:");
+    if (lo == hi)
+      n += (size_t)snprintf(text + n, size - n, " shaft %s z = %.3g m (#%zu)", pl->shaft, pl->z,
+                            lo);
+    else
+      n += (size_t)snprintf(text + n, size - n, " shaft %s z = %.3g-%.3g m (#%zu-#%zu)",
+                            pl->shaft, pl->z, ph->z, lo, hi);
+    runs++, lo = hi;
+  }
+  if (n < size)
+    n += (size_t)snprintf(text + n, size - n, ". The kind of effect there is left open.");
+  return n < size ? n : size - 1;
+}
+
 /* A parameter list "a, b" as "a,b" (one shell word). */
 static void no_spaces(const char *in, char *out) {
   for (; *in; in++)
@@ -1698,7 +1767,8 @@ rcb_status rcb_diag_explain(const rcb_diag *d, char *buf, size_t size, size_t *n
   if (!(c && c->refitted && c->claim == RCB_CLAIM_EXPLAINS) &&
       !(d->adeq0.known && d->adeq0.adequate)) {
     n = say_where(d, text, sizeof text, n);
-    n = say_span(d, text, sizeof text, n);
+    if (d->nplace && !(d->nmis && d->mis[0].concentrated)) n = say_place(d, text, sizeof text, n);
+    else if (!d->nplace) n = say_span(d, text, sizeof text, n);
   }
   if (d->far) /* the run-off baseline is a finding of its own */
     snprintf(text + n, sizeof text - n,

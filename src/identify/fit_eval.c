@@ -231,9 +231,18 @@ rcb_status rcb_fit_eval(rcb_fit *f, double *r) {
 }
 
 rcb_status rcb_fit_residual_channels(const rcb_fit *f, size_t *ch) {
-  if (!f || !ch) return RCB_ERR_ARG;
+  return ch ? rcb_fit_residual_layout(f, ch, NULL, NULL, NULL) : RCB_ERR_ARG;
+}
+
+rcb_status rcb_fit_residual_layout(const rcb_fit *f, size_t *ch, size_t *pt, unsigned char *part,
+                                   double *sqrtw) {
+  if (!f) return RCB_ERR_ARG;
   if (!f->res_ch && f->nres) return RCB_ERR_STATE;
-  if (f->nres) memcpy(ch, f->res_ch, f->nres * sizeof *ch);
+  if (!f->nres) return RCB_OK;
+  if (ch) memcpy(ch, f->res_ch, f->nres * sizeof *ch);
+  if (pt) memcpy(pt, f->res_pt, f->nres * sizeof *pt);
+  if (part) memcpy(part, f->res_part, f->nres);
+  if (sqrtw) memcpy(sqrtw, f->res_sqrtw, f->nres * sizeof *sqrtw);
   return RCB_OK;
 }
 

@@ -42,6 +42,15 @@ double rcb_fit_error_pct(const rcb_fit *f);
  * rcb_fit_jacobian and rcb_fit_residuals (the plan of issue #23 sums each
  * candidate channel's rows). RCB_ERR_STATE before a layout exists. */
 rcb_status rcb_fit_residual_channels(const rcb_fit *f, size_t *ch);
+/* The whole layout of f's residuals (after rcb_fit_prepare or any
+ * evaluation): for residual j < nres, its channel ch[j], point pt[j], part
+ * part[j] (0: Re or the scale's single value, 1: Im, complex scale only)
+ * and the square root of its weight sqrtw[j] (1 / sd on the scale with the
+ * noise model or known sds); any pointer may be NULL. The localisation of
+ * the misfit (diagnose/locate.c) weights its equivalent loads by them.
+ * RCB_ERR_STATE before a layout exists. */
+rcb_status rcb_fit_residual_layout(const rcb_fit *f, size_t *ch, size_t *pt, unsigned char *part,
+                                   double *sqrtw);
 /* One parameter's derivatives at a model: dM, dC, dG, dK over their
  * non-zero entries (DOF row, column; the units of M, C, G, K per unit of
  * the parameter) and dF/dp at unit speed (NULL when the force does not

@@ -263,6 +263,26 @@ static void json_adequacy(FILE *fp, const rcb_diag *d) {
     fprintf(fp, ", \"concentrated\": %s}", s.concentrated ? "true" : "false");
   }
   fputs("]}", fp);
+  /* where equivalent loads place it (rcb_diag_place_get), the largest share first */
+  n = rcb_diag_place_count(d);
+  fputs(",\n\"places\": [", fp);
+  for (k = 0; k < n; k++) {
+    rcb_diag_place p;
+    rcb_diag_place_get(d, k, &p);
+    fprintf(fp, "%s{\"node\": %zu, \"shaft\": ", k ? ", " : "", p.node);
+    cli_json_str(fp, p.shaft);
+    fputs(", \"z\": ", fp);
+    cli_json_num(fp, p.z);
+    fputs(", \"share_pct\": ", fp);
+    cli_json_num(fp, p.share_pct);
+    fputs(", \"chi2\": ", fp);
+    cli_json_num(fp, p.chi2);
+    fputs(", \"dof\": ", fp);
+    cli_json_num(fp, p.dof);
+    fprintf(fp, ", \"adequate\": %s, \"in_span\": %s}", p.adequate ? "true" : "false",
+            p.in_span ? "true" : "false");
+  }
+  fputs("]", fp);
 }
 
 static void print_json(FILE *fp, const diag_job *j, const rcb_diag *d, const char *explain) {

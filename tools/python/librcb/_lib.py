@@ -112,6 +112,12 @@ class DiagMisfit(ctypes.Structure):
                 ("sd", c_double), ("excess_pct", c_double), ("concentrated", c_int)]
 
 
+class DiagPlace(ctypes.Structure):
+    _fields_ = [("node", c_size_t), ("shaft", c_char_p), ("z", c_double),
+                ("share_pct", c_double), ("chi2", c_double), ("dof", c_double),
+                ("adequate", c_int), ("in_span", c_int)]
+
+
 class Evidence(ctypes.Structure):
     _fields_ = [("delta_bic", c_double), ("error_before_pct", c_double),
                 ("error_after_pct", c_double), ("chi2", c_double), ("chi2_limit", c_double)]
@@ -288,6 +294,8 @@ _PROTOTYPES = {
     "rcb_diag_explain": (c_int, [c_void_p, c_char_p, c_size_t, c_size_t_p]),
     "rcb_diag_adequacy": (c_int, [c_void_p, ctypes.POINTER(FitAdequacy)]),
     "rcb_diag_misfit_count": (c_size_t, [c_void_p]),
+    "rcb_diag_place_count": (c_size_t, [c_void_p]),
+    "rcb_diag_place_get": (c_int, [c_void_p, c_size_t, ctypes.POINTER(DiagPlace)]),
     "rcb_diag_misfit_get": (c_int, [c_void_p, c_size_t, ctypes.POINTER(DiagMisfit)]),
     "rcb_evidence_claim": (c_int, [ctypes.POINTER(Evidence)]),
     "rcb_evidence_significant": (c_int, [ctypes.POINTER(Evidence)]),

@@ -139,7 +139,7 @@ class Diagnosis(Handle):
         self.model, self.meas = model, meas
         self._create("rcb_diag_create", model.handle, meas.handle, None)
         self.candidates, self.baseline, self.explanation = [], {}, ""
-        self.adequacy, self.misfit = {}, []
+        self.adequacy, self.misfit, self.places = {}, [], []
 
     def _collect(self):
         L = _lib.lib()
@@ -174,6 +174,13 @@ class Diagnosis(Handle):
             self.misfit.append({"response": _lib.text(m.sensor), "chi2": m.chi2,
                                 "expected": m.expected, "excess_pct": m.excess_pct,
                                 "concentrated": bool(m.concentrated)})
+        pl = _lib.DiagPlace()
+        self.places = []  # where equivalent loads place the misfit, the largest share first
+        for k in range(L.rcb_diag_place_count(self.handle)):
+            self.check(L.rcb_diag_place_get(self.handle, k, ctypes.byref(pl)))
+            self.places.append({"node": pl.node, "shaft": _lib.text(pl.shaft), "z": pl.z,
+                                "share_pct": pl.share_pct, "chi2": pl.chi2, "dof": pl.dof,
+                                "adequate": bool(pl.adequate), "in_span": bool(pl.in_span)})
         st, self.explanation = _lib.two_call_string(L.rcb_diag_explain, self.handle)
         self.check(st, "rcb_diag_explain")
 
