@@ -109,8 +109,9 @@ static rcb_status locate_alloc(rcb_diag *d, locate_ws *w, size_t npts) {
   return RCB_OK;
 }
 
-/* The channels' responses and references as FRF outputs and extra inputs
- * (every shaft node's x and y come first as inputs). */
+/* The channels' responses as FRF outputs, their references as groups (the
+ * force is one per frequency and reference); every shaft node's x and y as
+ * inputs. */
 static rcb_status locate_channels(rcb_diag *d, locate_ws *w) {
   size_t c, k;
   rcb_status st;
@@ -129,9 +130,6 @@ static rcb_status locate_channels(rcb_diag *d, locate_ws *w) {
     w->ins[2 * k + 1].node = k, w->ins[2 * k + 1].dir = RCB_DIR_Y;
   }
   w->nin = 2 * w->nn;
-  for (k = 0; k < w->nref; k++)
-    if ((st = rcb_model_find_dof(w->m, w->rname[k], &w->ins[w->nin++])))
-      return rcb_diag_fail(d, st, "locating the misfit: reference %s", w->rname[k]);
   return RCB_OK;
 }
 

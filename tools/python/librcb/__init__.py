@@ -18,7 +18,7 @@ $LIBRCB_PATH, next to the package, or the loader's standard names.
 
 from ._lib import LibraryNotFound, RcbError
 from .analyses import Campbell, Modes, campbell, export_uff, frf, modes, simulate, unbalance
-from .identify import Diagnosis, FitResult, claim, compare, diagnose, fit
+from .identify import Diagnosis, FitResult, claim, compare, diagnose, fit, plan
 from .meas import Meas, read_meas
 from .model import Model
 from .monitor import Monitor
@@ -40,5 +40,5 @@ def library_path():
 
 
 __all__ = ["Model", "Meas", "read_meas", "frf", "unbalance", "modes", "campbell", "simulate",
-           "export_uff", "fit", "diagnose", "claim", "compare", "Modes", "Campbell", "FitResult",
+           "export_uff", "fit", "diagnose", "claim", "plan", "compare", "Modes", "Campbell", "FitResult",
            "Diagnosis", "Monitor", "RcbError", "LibraryNotFound", "library_version", "library_path"]

@@ -118,6 +118,21 @@ class DiagPlace(ctypes.Structure):
                 ("adequate", c_int), ("in_span", c_int)]
 
 
+class PlanResult(ctypes.Structure):
+    _fields_ = [("angle_deg", c_double), ("size", c_double), ("chi2_sep", c_double),
+                ("separable", c_int), ("residuals", c_size_t), ("candidates", c_size_t)]
+
+
+class PlanParam(ctypes.Structure):
+    _fields_ = [("name", c_char_p), ("side", c_int), ("value", c_double),
+                ("change", c_double)]
+
+
+class PlanCandidate(ctypes.Structure):
+    _fields_ = [("response", c_char_p), ("reference", c_char_p), ("speed", c_double),
+                ("gain", c_double), ("chi2_after", c_double), ("level_db", c_double)]
+
+
 class Evidence(ctypes.Structure):
     _fields_ = [("delta_bic", c_double), ("error_before_pct", c_double),
                 ("error_after_pct", c_double), ("chi2", c_double), ("chi2_limit", c_double)]
@@ -279,6 +294,18 @@ _PROTOTYPES = {
     # diagnosis
     "rcb_effect_name": (c_char_p, [c_int]),
     "rcb_diag_create": (c_int, [PP, c_void_p, c_void_p, c_void_p]),
+    "rcb_plan_create": (c_int, [PP, c_void_p, c_void_p, c_void_p]),
+    "rcb_plan_destroy": (None, [c_void_p]),
+    "rcb_plan_errmsg": (c_char_p, [c_void_p]),
+    "rcb_plan_add_param": (c_int, [c_void_p, c_int, c_char_p]),
+    "rcb_plan_set_noise_model": (c_int, [c_void_p, c_double, c_double]),
+    "rcb_plan_set_size": (c_int, [c_void_p, c_double]),
+    "rcb_plan_add_speed": (c_int, [c_void_p, c_double]),
+    "rcb_plan_run": (c_int, [c_void_p]),
+    "rcb_plan_get_result": (c_int, [c_void_p, ctypes.POINTER(PlanResult)]),
+    "rcb_plan_param_count": (c_size_t, [c_void_p]),
+    "rcb_plan_get_param": (c_int, [c_void_p, c_size_t, ctypes.POINTER(PlanParam)]),
+    "rcb_plan_get_candidate": (c_int, [c_void_p, c_size_t, ctypes.POINTER(PlanCandidate)]),
     "rcb_diag_destroy": (None, [c_void_p]),
     "rcb_diag_errmsg": (c_char_p, [c_void_p]),
     "rcb_diag_add_fitted_param": (c_int, [c_void_p, c_char_p, c_double, c_double, c_int]),

@@ -281,3 +281,54 @@ def claim(delta_bic, error_before_pct, error_after_pct, chi2=float("nan"),
     e = _lib.Evidence(float(delta_bic), float(error_before_pct), float(error_after_pct),
                       float(chi2), float(chi2_limit))
     return _lib.text(L.rcb_claim_str(L.rcb_evidence_claim(ctypes.byref(e))))
+
+
+class _Plan(Handle):
+    _destroy = "rcb_plan_destroy"
+    _errmsg = "rcb_plan_errmsg"
+
+    def __init__(self, model, meas):
+        super().__init__()
+        self.model, self.meas = model, meas  # the library reads meas until run
+        self._create("rcb_plan_create", model.handle, meas.handle, None)
+
+
+def plan(model, meas, between, noise=(10.0, 1.0), size=25.0, rpm=()):
+    """Which measurement would tell two rival effects apart (rcb_plan; the
+    library call beneath `rcbtool plan`). between = (A, B), each a parameter
+    name or a list of them (A's data are made, B is fitted to them); noise:
+    eq. 19 (beta_a, beta_s) in %; size: the chi-square A moves F by on its own;
+    rpm: other rotor speeds for the candidates (the test speed is always one).
+    Returns {"angle_deg", "size", "chi2_sep", "separable" (the one rule,
+    rcb_evidence_separable), "residuals", "params": [{"name", "side", "value",
+    "change"}], "candidates": [{"response", "reference", "rpm", "gain",
+    "chi2_after", "level_db"}] by falling gain}."""
+    L = _lib.lib()
+    p = _Plan(model, meas)
+    for side, names in enumerate(between):
+        for name in ([names] if isinstance(names, str) else names):
+            p.check(L.rcb_plan_add_param(p.handle, side, name.encode()), "rcb_plan_add_param")
+    p.check(L.rcb_plan_set_noise_model(p.handle, float(noise[0]), float(noise[1])),
+            "rcb_plan_set_noise_model")
+    p.check(L.rcb_plan_set_size(p.handle, float(size)), "rcb_plan_set_size")
+    for r in rpm:
+        p.check(L.rcb_plan_add_speed(p.handle, float(r) * RPM), "rcb_plan_add_speed")
+    p.check(L.rcb_plan_run(p.handle), "rcb_plan_run")
+    res = _lib.PlanResult()
+    p.check(L.rcb_plan_get_result(p.handle, ctypes.byref(res)), "rcb_plan_get_result")
+    out = {"angle_deg": res.angle_deg, "size": res.size, "chi2_sep": res.chi2_sep,
+           "separable": bool(res.separable), "residuals": int(res.residuals), "params": [],
+           "candidates": []}
+    pp = _lib.PlanParam()
+    for k in range(L.rcb_plan_param_count(p.handle)):
+        p.check(L.rcb_plan_get_param(p.handle, k, ctypes.byref(pp)))
+        out["params"].append({"name": _lib.text(pp.name), "side": "AB"[pp.side],
+                              "value": pp.value, "change": pp.change})
+    c = _lib.PlanCandidate()
+    for k in range(int(res.candidates)):
+        p.check(L.rcb_plan_get_candidate(p.handle, k, ctypes.byref(c)))
+        out["candidates"].append({"response": _lib.text(c.response),
+                                  "reference": _lib.text(c.reference), "rpm": c.speed / RPM,
+                                  "gain": c.gain, "chi2_after": c.chi2_after,
+                                  "level_db": c.level_db})
+    return out
