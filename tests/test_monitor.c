@@ -638,6 +638,149 @@ static void test_alloc_walk(void **state) {
   rcb_meas_destroy(small);
 }
 
+/* ---- state that survives a restart (issue #24) ---- */
+
+/* Every field of two results the same, bit for bit (doubles compared as
+ * their bytes: NaN or -0 would show). */
+static int same_result(const rcb_monitor_result *a, const rcb_monitor_result *b) {
+  size_t k;
+  if (a->update != b->update || a->alarm != b->alarm || a->cusum_alarm != b->cusum_alarm ||
+      a->ntop != b->ntop || a->ntracked != b->ntracked ||
+      memcmp(&a->T, &b->T, sizeof a->T) != 0 || memcmp(&a->p_value, &b->p_value, sizeof a->p_value))
+    return 0;
+  for (k = 0; k < a->ntop; k++)
+    if (a->top[k].index != b->top[k].index ||
+        memcmp(a->top[k].size, b->top[k].size, sizeof a->top[k].size) != 0)
+      return 0;
+  for (k = 0; k < a->ntracked; k++)
+    if (memcmp(&a->tracked[k], &b->tracked[k], sizeof a->tracked[k]) != 0) return 0;
+  return 1;
+}
+
+static void rewrite_crc(unsigned char *b, size_t n) {
+  unsigned long c = rcb_monitor_crc32(0, b, n - 4);
+  size_t i;
+  for (i = 0; i < 4; i++) b[n - 4 + i] = (unsigned char)(c >> (8 * i));
+}
+
+/* A monitor run through a drift of kt, "restarted" after N1 updates (save,
+ * destroy, create again, load): every later result and the final state
+ * are bit for bit those of the monitor that ran on; the load allocates
+ * nothing; the layout is little-endian; a state of another model, set-up,
+ * settings or version, or a damaged one, is refused with its own status
+ * and leaves the monitor as it was. */
+static void test_state_restart(void **state) {
+  fixture *f = *state;
+  enum { NAVG = 4, N1 = 30, N = 60 };
+  const double DK = 1e-3;
+  rcb_monitor_param tp;
+  rcb_monitor_opts o = opts_kt(&tp, f->kt);
+  rcb_test_counter cnt = {0, 0};
+  rcb_allocator al = rcb_test_counting_allocator(&cnt);
+  rcb_monitor *a = NULL, *b = NULL, *other = NULL;
+  rcb_monitor_result ra, rb;
+  rcb_model *m2 = edited(f->truth, KT_NAME, (1 + DK) * f->kt);
+  rcb_meas *ms = frf_of(m2), *setup, *setup2;
+  rcb_complex *acc = calloc(NPT, sizeof *acc), *dh = malloc(NPT * sizeof *dh);
+  unsigned char buf[512], buf2[512], keep[512];
+  size_t u, i, n = 0, n2 = 0, before, first_alarm = 0;
+  double cusum_at_restart = 0;
+  uint64_t seed = 99;
+  double se = 0;
+  static const unsigned char check[] = "123456789";
+  /* the CRC-32 check value of the catalogue of parametrised CRCs */
+  assert_int_equal(rcb_monitor_crc32(0, check, 9), 0xCBF43926ul);
+  values_of(ms, dh);
+  for (i = 0; i < NPT; i++) dh[i] = (dh[i] - f->fs[i]) / (DK * f->kt);
+  for (u = 0; u < NAVG; u++) {
+    eq19(f->fs, f->v, &seed);
+    for (i = 0; i < NPT; i++) acc[i] += f->v[i] / NAVG;
+  }
+  setup = with_values(f->setup, acc, 1.0);
+  o.setup_averages = NAVG;
+  o.relinearise = 2;
+  assert_int_equal(rcb_monitor_create(&a, f->base, setup, &o, NULL), RCB_OK);
+  assert_int_equal(rcb_monitor_state_size(a), 76 + 40);
+  for (u = 0; u < N; u++) {
+    /* kt falls by 0.2 standard errors per update from update 26 */
+    double dkt = u < 25 ? 0.0 : -0.2 * se * (double)(u - 24);
+    eq19(f->fs, f->v, &seed);
+    for (i = 0; i < NPT; i++) f->v[i] += dkt * dh[i];
+    assert_int_equal(rcb_monitor_update(a, f->v, NULL, &ra), RCB_OK);
+    if (!u) se = ra.tracked[0].stderr_;
+    if (ra.cusum_alarm && !first_alarm) first_alarm = u + 1;
+    if (u + 1 == N1) { /* the restart */
+      cusum_at_restart = ra.tracked[0].cusum_down;
+      assert_int_equal(rcb_monitor_save(a, buf, 10, &n), RCB_ERR_WORKSPACE);
+      assert_int_equal(rcb_monitor_save(a, buf, sizeof buf, &n), RCB_OK);
+      assert_int_equal(n, rcb_monitor_state_size(a));
+      assert_memory_equal(buf, "RCBM\1\0\0\0", 8); /* magic, version 1 little-endian */
+      assert_int_equal(buf[56], N1);                /* the update count, low byte first */
+      assert_int_equal(rcb_monitor_create(&b, f->base, setup, &o, &al), RCB_OK);
+      before = cnt.allocs;
+      assert_int_equal(rcb_monitor_load(b, buf, n), RCB_OK);
+      assert_int_equal(cnt.allocs, before); /* load allocates nothing */
+      continue;
+    }
+    if (u + 1 > N1) {
+      assert_int_equal(rcb_monitor_update(b, f->v, NULL, &rb), RCB_OK);
+      assert_true(same_result(&ra, &rb));
+    }
+  }
+  /* the drift had begun to accumulate before the restart and alarmed after
+   * it: the sums carried over */
+  assert_true(cusum_at_restart > 0 && first_alarm > N1);
+  assert_int_equal(rcb_monitor_save(a, buf, sizeof buf, &n), RCB_OK);
+  assert_int_equal(rcb_monitor_save(b, buf2, sizeof buf2, &n2), RCB_OK);
+  assert_int_equal(n, n2);
+  assert_memory_equal(buf, buf2, n);
+  print_message("restart after %d of %d updates (CUSUM- %.2f then): %d results and the final "
+                "state (%zu bytes) bit-identical; first CUSUM alarm at update %zu\n", (int)N1,
+                (int)N, cusum_at_restart, (int)(N - N1), n, first_alarm);
+  /* refusals, each leaving b as it was */
+  memcpy(keep, buf, n);
+  buf[60] ^= 1; /* a damaged byte */
+  assert_int_equal(rcb_monitor_load(b, buf, n), RCB_ERR_CORRUPT);
+  assert_non_null(strstr(rcb_monitor_errmsg(b), "CRC"));
+  memcpy(buf, keep, n);
+  assert_int_equal(rcb_monitor_load(b, buf, n - 1), RCB_ERR_CORRUPT); /* truncated */
+  assert_int_equal(rcb_monitor_load(b, "hello", 5), RCB_ERR_CORRUPT);
+  buf[4] = 2;
+  rewrite_crc(buf, n);
+  assert_int_equal(rcb_monitor_load(b, buf, n), RCB_ERR_VERSION);
+  memcpy(buf, keep, n);
+  assert_int_equal(rcb_monitor_save(b, buf2, sizeof buf2, &n2), RCB_OK);
+  assert_memory_equal(buf2, keep, n); /* unchanged by the refused loads */
+  /* another model (kt of the baseline 0.1 % higher) */
+  {
+    rcb_model *m3 = edited(f->base, KT_NAME, 1.001 * f->kt);
+    assert_int_equal(rcb_monitor_create(&other, m3, setup, &o, NULL), RCB_OK);
+    assert_int_equal(rcb_monitor_load(other, buf, n), RCB_ERR_OTHER_MODEL);
+    rcb_monitor_destroy(other);
+    rcb_model_destroy(m3);
+  }
+  /* another set-up (commissioning values 1 % larger), other settings */
+  setup2 = scaled(setup, 1.01);
+  assert_int_equal(rcb_monitor_create(&other, f->base, setup2, &o, NULL), RCB_OK);
+  assert_int_equal(rcb_monitor_load(other, buf, n), RCB_ERR_OTHER_SETUP);
+  assert_non_null(strstr(rcb_monitor_errmsg(other), "set-up"));
+  rcb_monitor_destroy(other);
+  o.cusum_h = 6;
+  assert_int_equal(rcb_monitor_create(&other, f->base, setup, &o, NULL), RCB_OK);
+  assert_int_equal(rcb_monitor_load(other, buf, n), RCB_ERR_OTHER_SETUP);
+  assert_non_null(strstr(rcb_monitor_errmsg(other), "settings"));
+  rcb_monitor_destroy(other);
+  rcb_monitor_destroy(a);
+  rcb_monitor_destroy(b);
+  assert_int_equal(cnt.allocs, cnt.frees);
+  rcb_meas_destroy(setup);
+  rcb_meas_destroy(setup2);
+  rcb_meas_destroy(ms);
+  rcb_model_destroy(m2);
+  free(acc);
+  free(dh);
+}
+
 /* ---- bad input ---- */
 
 static void test_bad_input(void **state) {
@@ -707,6 +850,7 @@ int main(void) {
       cmocka_unit_test(test_no_alloc_in_update),
       cmocka_unit_test(test_alloc_walk),
       cmocka_unit_test(test_bad_input),
+      cmocka_unit_test(test_state_restart),
   };
   return cmocka_run_group_tests(tests, fixture_setup, fixture_teardown);
 }

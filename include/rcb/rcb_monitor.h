@@ -317,6 +317,67 @@ RCB_API rcb_status rcb_monitor_candidate_info_get(const rcb_monitor *mon, size_t
 RCB_API rcb_status rcb_monitor_tracked_info(const rcb_monitor *mon, size_t k,
                                             const char **name, double *baseline);
 
+/** @brief The thresholds in use (the defaults resolved): the instant test's
+ * false-alarm probability per update @p alpha (-) and its chi-square
+ * threshold @p threshold (-), the CUSUM's reference @p cusum_k and decision
+ * threshold @p cusum_h (standard deviations of u); any pointer may be NULL. */
+RCB_API rcb_status rcb_monitor_thresholds(const rcb_monitor *mon, double *alpha,
+                                          double *threshold, double *cusum_k,
+                                          double *cusum_h);
+
+/* ---- state that survives a restart (issue #24) ----
+ *
+ * What the updates accumulate (the update count, each tracked parameter's
+ * CUSUM sums S+ and S-, the self-starting reference's weighted sums and
+ * whether it is frozen) saved into a caller's buffer and loaded into a
+ * monitor created again from the same baseline model, set-up and settings:
+ * the updates after the load then give bit for bit what the original
+ * monitor would have given (examples/firmware "reboots" mid-year and
+ * checks this). Format (version RCB_MONITOR_STATE_VERSION), every field
+ * little-endian whatever the host: "RCBM", version u32, size u32, tracked
+ * count u32, the model's fingerprint (u64 FNV-1a of the tracked names and
+ * baseline values and the candidates' places, and two weighted sums of
+ * |baseline model| over the set-up, compared to 1e-9 relative so that
+ * another BLAS's last bits do not refuse a state), the set-up's (u64 of its
+ * grid, speed, channels and commissioning values), the settings' (u64 of
+ * alpha, CUSUM k and h, noise, averages, re-linearisation, reweighting,
+ * tracked ranges), the update count u64, the reference-started flag u32,
+ * then per tracked parameter S+, S-, reference sum and weight (IEEE-754
+ * binary64) and the frozen flag, and last the CRC-32 (IEEE 802.3,
+ * reflected 0xEDB88320, as zlib's crc32) of everything before it. Neither
+ * call allocates. */
+
+/** @brief Format version of the saved state. */
+#define RCB_MONITOR_STATE_VERSION 1u
+
+/** @brief Bytes rcb_monitor_save writes for this monitor (76 + 40 per
+ * tracked parameter); 0 for a monitor not created successfully. */
+RCB_API size_t rcb_monitor_state_size(const rcb_monitor *mon);
+/**
+ * @brief Save the monitor's accumulated state into @p buf.
+ * @param size bytes available at @p buf
+ * @param written bytes written (rcb_monitor_state_size), may be NULL
+ * @return RCB_ERR_WORKSPACE when @p size is too small (nothing written),
+ * RCB_ERR_STATE for a monitor not created successfully
+ */
+RCB_API rcb_status rcb_monitor_save(const rcb_monitor *mon, void *buf, size_t size,
+                                    size_t *written);
+/**
+ * @brief Load a state saved by rcb_monitor_save into @p mon, created from
+ * the same baseline model, set-up and settings. All checks come before
+ * anything is changed: on any error the monitor is left as it was.
+ * @return RCB_ERR_CORRUPT (not a monitor state, truncated, or a CRC that
+ * does not match), RCB_ERR_VERSION (another format version),
+ * RCB_ERR_OTHER_MODEL (another baseline model or tracked parameters),
+ * RCB_ERR_OTHER_SETUP (another set-up or other settings); the message
+ * (rcb_monitor_errmsg) says which field differs
+ */
+RCB_API rcb_status rcb_monitor_load(rcb_monitor *mon, const void *buf, size_t size);
+/** @brief CRC-32 (IEEE 802.3, zlib's crc32) of @p n bytes continuing from
+ * @p crc (0 to start): the state's checksum, for hosts that store the state
+ * inside records of their own. */
+RCB_API unsigned long rcb_monitor_crc32(unsigned long crc, const void *data, size_t n);
+
 /* ---- statistics used by the monitor, pure functions ---- */
 
 /** @brief Upper tail P(X > x) of the chi-square distribution with @p dof
