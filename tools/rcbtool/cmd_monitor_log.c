@@ -96,8 +96,8 @@ static void json_update(FILE *fp, const mon_state *s, size_t k) {
 
 void mon_print_json(FILE *fp, const mon_state *s) {
   size_t k;
-  double alpha = s->nrec ? rcb_chi2_sf(s->rec[0].r.threshold, (double)s->rec[0].r.dof)
-                         : (double)NAN;
+  double alpha = NAN, cusum_k = NAN, cusum_h = NAN;
+  rcb_monitor_thresholds(s->mon, &alpha, NULL, &cusum_k, &cusum_h); /* the defaults resolved */
   fputs("{\"model\": ", fp);
   cli_json_str(fp, s->a->model);
   fputs(", \"commissioning\": [", fp);
@@ -110,8 +110,9 @@ void mon_print_json(FILE *fp, const mon_state *s) {
   fprintf(fp, ", \"channels\": %zu, \"points\": %zu, \"candidates\": %zu, \"rank\": %zu, "
           "\"rank_tracked\": %zu, \"memory_bytes\": %zu", s->channels, s->points,
           s->candidates, s->rank, s->rank_tracked, s->memory);
-  json_key_num(fp, "alpha", alpha); /* the rate the threshold stands for */
-  json_key_num(fp, "cusum_h", s->j->cusum_h > 0 ? s->j->cusum_h : (double)NAN);
+  json_key_num(fp, "alpha", alpha);
+  json_key_num(fp, "cusum_k", cusum_k);
+  json_key_num(fp, "cusum_h", cusum_h);
   fputs(", \"noise\": ", fp);
   if (s->j->sd_path)
     cli_json_str(fp, s->j->sd_path);
