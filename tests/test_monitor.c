@@ -638,6 +638,70 @@ static void test_alloc_walk(void **state) {
   rcb_meas_destroy(small);
 }
 
+/* ---- the baseline's own uncertainty (issue #24) ---- */
+
+/* The baseline is an estimate: replicas whose baseline kt is the truth plus
+ * a draw of N(0, sb^2) (as a fit's error of standard error sb), the machine
+ * the truth, unchanged since commissioning. With opts.baseline_cov = sb^2
+ * the value's 95 % interval covers the true kt as often as the binomial
+ * 99 % interval of 95 % allows; the interval of the change alone around the
+ * value (what was printed before) almost never does; the change's interval
+ * covers the true change, 0, as a 95 % interval should. */
+static void test_baseline_cov(void **state) {
+  fixture *f = *state;
+  enum { NREP = 60 };
+  const char *const outs[2] = {"DA.x", "DB.y"};
+  rcb_meas *small = rcb_test_frf_meas(f->base, outs, 2, INS, 1, 50.0, 300.0, 24, 10000.0,
+                                      RCB_RECEPTANCE), *setup;
+  rcb_monitor_param tp;
+  rcb_monitor_opts o = opts_kt(&tp, f->kt);
+  rcb_complex fs[48], v[48];
+  double sb = 0.01 * f->kt, var = sb * sb; /* N/m, N^2/m^2 */
+  uint64_t seed = 2424;
+  size_t r, lo, hi, cover = 0, narrow = 0, change = 0;
+  values_of(small, fs);
+  o.effects = (1u << RCB_EFFECT_BEARING_CROSS_COUPLING) | (1u << RCB_EFFECT_BEARING_STIFFNESS);
+  o.baseline_cov = &var;
+  for (r = 0; r < NREP; r++) {
+    double g = sqrt(-2 * log(1 - rng_uniform(&seed))) * cos(2 * 3.14159265358979323846 *
+                                                             rng_uniform(&seed));
+    rcb_model *b = edited(f->base, KT_NAME, f->kt + sb * g);
+    rcb_monitor *mon = NULL;
+    rcb_monitor_result res;
+    const rcb_monitor_tracked *t = &res.tracked[0];
+    eq19n(fs, v, 2, 24, &seed);
+    setup = with_values(small, v, 1.0);
+    assert_int_equal(rcb_monitor_create(&mon, b, setup, &o, NULL), RCB_OK);
+    eq19n(fs, v, 2, 24, &seed);
+    assert_int_equal(rcb_monitor_update(mon, v, NULL, &res), RCB_OK);
+    assert_true(fabs(t->abs_stderr - sqrt(t->stderr_ * t->stderr_ + var)) <= 1e-9 * sb);
+    assert_true(fabs(t->change - (t->value - (f->kt + sb * g))) <= 1e-9 * sb);
+    cover += t->ci_lo <= f->kt && f->kt <= t->ci_hi;
+    narrow += fabs(t->value - f->kt) <= 1.959963984540054 * t->stderr_;
+    change += t->change_lo <= 0 && 0 <= t->change_hi;
+    rcb_monitor_destroy(mon);
+    rcb_meas_destroy(setup);
+    rcb_model_destroy(b);
+  }
+  binom99(NREP, 0.95, &lo, &hi);
+  print_message("baseline kt off by N(0, (1 %%)^2): the value's interval with baseline_cov "
+                "covers the truth in %zu of %d replicas (binomial 99 %% [%zu, %zu]), the "
+                "change's interval around the value in %zu; the change's covers 0 in %zu\n",
+                cover, (int)NREP, lo, hi, narrow, change);
+  assert_true(cover >= lo && cover <= hi);
+  assert_true(change >= lo && change <= hi);
+  assert_true(narrow < lo);
+  /* a negative variance is refused, naming it */
+  {
+    rcb_monitor *mon = NULL;
+    var = -1;
+    assert_int_equal(rcb_monitor_create(&mon, f->base, small, &o, NULL), RCB_ERR_ARG);
+    assert_non_null(strstr(rcb_monitor_errmsg(mon), "baseline_cov"));
+    rcb_monitor_destroy(mon);
+  }
+  rcb_meas_destroy(small);
+}
+
 /* ---- state that survives a restart (issue #24) ---- */
 
 /* Every field of two results the same, bit for bit (doubles compared as
@@ -851,6 +915,7 @@ int main(void) {
       cmocka_unit_test(test_alloc_walk),
       cmocka_unit_test(test_bad_input),
       cmocka_unit_test(test_state_restart),
+      cmocka_unit_test(test_baseline_cov),
   };
   return cmocka_run_group_tests(tests, fixture_setup, fixture_teardown);
 }

@@ -174,6 +174,13 @@ typedef struct rcb_monitor_opts {
                           #14's noise), tangential variance
                           |e|^2 (phase_deg pi/180)^2 / 3 added to the eq. 19
                           model's (used when sd is NULL); 0: none */
+  const double *baseline_cov; /**< covariance of the baseline's tracked values,
+                          ntracked x ntracked row-major, parameter units^2 (the
+                          fit that made the baseline: its standard errors and
+                          correlation); its diagonal widens the absolute
+                          values' intervals (rcb_monitor_tracked.ci_lo, ci_hi),
+                          taken independent of the change's noise. NULL: the
+                          baseline is exact (the intervals are the change's) */
 } rcb_monitor_opts;
 
 /** @brief One ranked candidate effect in a result. */
@@ -199,11 +206,15 @@ typedef struct rcb_monitor_candidate {
 
 /** @brief One tracked parameter in a result. While the instant test fires,
  * the estimate is fitted jointly with the best-ranked candidate (a new
- * effect left out of the fit would bias the trend). */
+ * effect left out of the fit would bias the trend). Two intervals: of the
+ * absolute value (the change's noise and the baseline's own uncertainty,
+ * opts.baseline_cov) and of the change since the baseline (its noise only:
+ * what the CUSUM and z watch). */
 typedef struct rcb_monitor_tracked {
   double value;        /**< estimate, parameter units */
-  double ci_lo, ci_hi; /**< 95 % interval, parameter units */
-  double stderr_;      /**< standard error, parameter units */
+  double ci_lo, ci_hi; /**< 95 % interval of the value, parameter units:
+                            value -+ 1.96 abs_stderr */
+  double stderr_;      /**< standard error of the change, parameter units */
   double z;            /**< (value - baseline) / stderr (-): the change since
                             commissioning */
   double u;            /**< the self-starting CUSUM's input (-): the step's
@@ -213,6 +224,10 @@ typedef struct rcb_monitor_tracked {
   double cusum_down;   /**< CUSUM S- (-) */
   int cusum_alarm;     /**< +1: S+ > h (rising), -1: S- > h (falling), 0 */
   int out_of_range;    /**< 1 when value lies outside [lo, hi] */
+  double abs_stderr;   /**< standard error of the value, parameter units:
+                            sqrt(stderr_^2 + the baseline's variance) */
+  double change;       /**< value - baseline, parameter units */
+  double change_lo, change_hi; /**< its 95 % interval: change -+ 1.96 stderr_ */
 } rcb_monitor_tracked;
 
 /** @brief What one update found. Plain value type, owns nothing. */

@@ -136,7 +136,8 @@ static uint64_t settings_hash(const rcb_monitor *mon) {
   size_t i;
   for (i = 0; i < sizeof v / sizeof v[0]; i++) h = fnv_f64(h, v[i]);
   h = fnv_u64(fnv_u64(fnv_u64(h, mon->top), mon->relin), (uint64_t)mon->reweight);
-  for (i = 0; i < mon->nt; i++) h = fnv_f64(fnv_f64(h, mon->tlo[i]), mon->thi[i]);
+  for (i = 0; i < mon->nt; i++)
+    h = fnv_f64(fnv_f64(fnv_f64(h, mon->tlo[i]), mon->thi[i]), mon->tbv[i]);
   h = fnv_u64(h, (uint64_t)mon->have_sd0);
   for (i = 0; mon->have_sd0 && i < mon->npt; i++) h = fnv_f64(h, mon->sd0[i]);
   return h;

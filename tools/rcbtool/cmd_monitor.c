@@ -19,7 +19,8 @@ const char cli_help_monitor[] =
     "usage: rcbtool monitor BASELINE.ini DIR|MEAS... --params NAME[:LO:HI],...\n"
     "                       [--noise A,S[,P] | --sd STATS.csv|DIR] [--commission N]\n"
     "                       [--alpha A] [--cusum-h H] [--cusum-k K] [--relinearise N]\n"
-    "                       [--reweight] [--map NODE=STATION,...] [--rpm R]\n"
+    "                       [--reweight] [--baseline-sd SD,...]\n"
+    "                       [--map NODE=STATION,...] [--rpm R]\n"
     "                       [--log OUT.json|OUT.csv] [--plot TREND.png] [--json]\n"
     "                       [-o FILE] [--progress]\n"
     "       rcbtool monitor BASELINE.ini --state S.rcbmon [options] [NEW...]\n"
@@ -35,7 +36,9 @@ const char cli_help_monitor[] =
     "a chi-square test, at false-alarm rate --alpha per update, that nothing but\n"
     "the tracked parameters changed), the alarm flags (TEST: the instant test;\n"
     "CUSUM-/CUSUM+: a tracked parameter's two-sided CUSUM passed --cusum-h,\n"
-    "falling or rising), the tracked parameters with their 95 % intervals, and on\n"
+    "falling or rising), each tracked parameter's value with its 95 % interval\n"
+    "(the baseline's uncertainty included, --baseline-sd) and its change since the\n"
+    "baseline with its own 95 % interval (the noise of the change only), and on\n"
     "a TEST alarm the effect and place of the catalogue (as rcbtool diagnose)\n"
     "that explain the change best, with its size. See docs/monitoring.md.\n"
     "  --params LIST   parameters to track (fitted at commissioning, e.g.\n"
@@ -58,6 +61,10 @@ const char cli_help_monitor[] =
     "                  its --sd file), statistics by generalised least squares: T\n"
     "                  stays chi-square after a large change of the tracked\n"
     "                  parameters (a moved resonance); slower per update\n"
+    "  --baseline-sd L standard errors of the baseline's values of the --params, in\n"
+    "                  their order and units (the 'stderr' of the rcbtool fit that\n"
+    "                  made the baseline): they widen the values' intervals (the\n"
+    "                  changes' stay); default 0, the baseline taken as exact\n"
     "  --log FILE      every update as JSON (.json) or CSV (.csv), atomically\n"
     "  --plot FILE     the trend (.png, .pdf or .svg): tracked parameters with\n"
     "                  their 95 % bands, T/thr with the alarm line, alarms marked;\n"
@@ -95,6 +102,25 @@ static int noise_opt(const cli_args *a, const char *opt, double *x, double *y, d
   return 0;
 }
 
+/* --baseline-sd SD,...: one standard error >= 0 per tracked parameter. */
+static int baseline_sd_opt(const cli_args *a, mon_job *j) {
+  const char *s = cli_opt_value(a, "--baseline-sd"), *p = s;
+  size_t k;
+  if (!s) return 0;
+  for (k = 0; k < j->params.n; k++) {
+    char *end;
+    j->baseline_sd[k] = strtod(p, &end);
+    if (end == p || !(j->baseline_sd[k] >= 0) || !isfinite(j->baseline_sd[k]) ||
+        (k + 1 < j->params.n ? *end != ',' : *end != '\0'))
+      return cli_usage(a->cmd, "option --baseline-sd expects %zu standard errors >= 0 "
+                       "separated by ',' (one per --params entry, in its units), got '%s'",
+                       j->params.n, s);
+    p = end + 1;
+  }
+  j->have_baseline_sd = 1;
+  return 0;
+}
+
 static int parse_job(const cli_args *a, mon_job *j) {
   int rc;
   double relin = 0.0;
@@ -125,6 +151,7 @@ static int parse_job(const cli_args *a, mon_job *j) {
   if ((cli_opt_value(a, "--cusum-h") && !(j->cusum_h > 0.0)) ||
       (cli_opt_value(a, "--cusum-k") && !(j->cusum_k > 0.0)))
     return cli_usage(a->cmd, "options --cusum-h and --cusum-k expect values > 0");
+  if ((rc = baseline_sd_opt(a, j))) return rc;
   if (cli_opt_value(a, "--noise") && j->sd_path)
     return cli_usage(a->cmd, "--noise and --sd exclude each other: give the eq. 19 model or "
                      "the per-point standard deviations");
@@ -292,7 +319,7 @@ static int guard_outputs(const cli_args *a, const mon_job *j) {
 
 static const char *const SETTING_OPTS[] = {"--params", "--noise",  "--sd",     "--commission",
                                            "--alpha",  "--cusum-h", "--cusum-k", "--relinearise",
-                                           "--reweight", "--map",  "--rpm"};
+                                           "--reweight", "--map",  "--rpm", "--baseline-sd"};
 
 /* 1 + the number of strings @p argv[k] (with its value) takes when it is a
  * setting option, else 0. */
@@ -372,6 +399,7 @@ int cmd_monitor(int argc, char **argv) {
                     {"--cusum-k", "K", NULL},
                     {"--relinearise", "N", NULL},
                     {"--reweight", NULL, NULL},
+                    {"--baseline-sd", "SD,...", NULL},
                     {"--map", "NODE=STATION,...", NULL},
                     {"--rpm", "R", NULL},
                     {"--log", "FILE", NULL},

@@ -47,6 +47,8 @@ typedef struct mon_job {
   double alpha, cusum_h, cusum_k; /**< 0: the library's defaults */
   double beta_a, beta_s;          /**< --noise, % */
   double phase_deg;               /**< --noise's third number, degrees */
+  double baseline_sd[RCB_MONITOR_MAX_TRACKED]; /**< --baseline-sd, parameter units */
+  int have_baseline_sd;
   const char *sd_path;            /**< --sd FILE or DIR, NULL */
   const char *log, *plot;         /**< --log, --plot, NULL */
   mon_series series;

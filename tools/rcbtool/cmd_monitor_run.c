@@ -210,6 +210,7 @@ static int averaged_setup(mon_ctx *x, rcb_meas **out) {
 
 static int create_monitor(mon_ctx *x, rcb_monitor **mon) {
   rcb_monitor_param tp[RCB_MONITOR_MAX_TRACKED];
+  double cov[RCB_MONITOR_MAX_TRACKED * RCB_MONITOR_MAX_TRACKED];
   rcb_monitor_opts o;
   rcb_meas *avg = NULL;
   rcb_status st;
@@ -236,6 +237,12 @@ static int create_monitor(mon_ctx *x, rcb_monitor **mon) {
   o.setup_averages = (double)x->j->commission;
   o.relinearise = x->j->relinearise;
   o.reweight = x->j->reweight;
+  if (x->j->have_baseline_sd) { /* the fit's standard errors: the diagonal */
+    memset(cov, 0, sizeof cov);
+    for (k = 0; k < x->j->params.n; k++)
+      cov[k * x->j->params.n + k] = x->j->baseline_sd[k] * x->j->baseline_sd[k];
+    o.baseline_cov = cov;
+  }
   if (x->j->commission > 1 && (rc = averaged_setup(x, &avg))) return rc;
   st = rcb_monitor_create(mon, x->m, avg ? avg : x->setup, &o, NULL);
   x->avg = avg; /* kept for --state */
@@ -260,7 +267,8 @@ static void print_header(FILE *fp, const mon_state *s) {
             s->j->saved->nrec);
   fprintf(fp, "%6s  %-24s %8s %8s %8s  %-12s", "update", "file", "error %", "floor %", "T/thr",
           "alarms");
-  for (k = 0; k < s->j->params.n; k++) fprintf(fp, "  %s [95 %% CI]", s->j->params.items[k].name);
+  for (k = 0; k < s->j->params.n; k++)
+    fprintf(fp, "  %s value [95 %% CI] change [95 %% CI]", s->j->params.items[k].name);
   fputc('\n', fp);
 }
 
@@ -285,8 +293,9 @@ static void print_line(FILE *fp, const mon_state *s, const mon_record *rec) {
           base_name(s->j->series.files[rec->file]), r->error_pct, r->floor_pct,
           r->T / r->threshold, flags);
   for (k = 0; k < r->ntracked; k++)
-    fprintf(fp, "  %.6g [%.6g, %.6g]", r->tracked[k].value, r->tracked[k].ci_lo,
-            r->tracked[k].ci_hi);
+    fprintf(fp, "  %.6g [%.6g, %.6g] %+.4g [%+.4g, %+.4g]", r->tracked[k].value,
+            r->tracked[k].ci_lo, r->tracked[k].ci_hi, r->tracked[k].change,
+            r->tracked[k].change_lo, r->tracked[k].change_hi);
   if (r->alarm && r->ntop > 0) {
     const rcb_monitor_candidate *c = &r->top[0];
     rcb_monitor_candidate_info ci;

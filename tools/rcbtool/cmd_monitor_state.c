@@ -125,6 +125,8 @@ static void io_result(st_buf *b, rcb_monitor_result *r) {
     io_f64(b, &t->value), io_f64(b, &t->ci_lo), io_f64(b, &t->ci_hi), io_f64(b, &t->stderr_);
     io_f64(b, &t->z), io_f64(b, &t->u), io_f64(b, &t->cusum_up), io_f64(b, &t->cusum_down);
     io_int(b, &t->cusum_alarm), io_int(b, &t->out_of_range);
+    io_f64(b, &t->abs_stderr), io_f64(b, &t->change), io_f64(b, &t->change_lo);
+    io_f64(b, &t->change_hi);
   }
 }
 
