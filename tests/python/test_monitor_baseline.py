@@ -99,6 +99,62 @@ def test_log10_biased_and_scattered(fits):
         assert summary(fits["log10"], name)[2] > 3 * summary(fits["complex"], name)[2], FIGURES
 
 
+def wear_run(tool, scale, tmp):
+    """kt_wear monitored from a baseline fitted on its first file on @p scale, the
+    fit's standard errors given as --baseline-sd."""
+    d, truth, model = mc.series("kt_wear")
+    base = tmp / f"base_{scale}.ini"
+    res = subprocess.run([tool, "fit", str(model), str(d / truth["files"][0]), "--params",
+                          ",".join(PARAMS), "--noise", "10,1", "--scale", scale, "--json",
+                          "-o", str(base)], capture_output=True, text=True, timeout=300,
+                         env=ENV)
+    assert res.returncode == 0, res.stderr[-2000:]
+    sd = {p["name"]: p["stderr"] for p in json.loads(res.stdout)["params"]}
+    res = subprocess.run([tool, "monitor", str(base), str(d), "--params", ",".join(PARAMS),
+                          "--noise", "10,1", "--commission", str(mc.COMMISSION), "--reweight",
+                          "--relinearise", "8", "--alpha", "0.01", "--baseline-sd",
+                          ",".join(f"{sd[n]:.9g}" for n in PARAMS), "--json"],
+                         capture_output=True, text=True, timeout=600, env=ENV)
+    assert res.returncode == 0, res.stderr[-2000:]
+    log = json.loads(res.stdout)
+    ups = log["updates"]
+    kt = [truth["kt"][truth["files"].index(u["file"])] for u in ups]
+    k = PARAMS.index("coupling.C.kt")
+    out = {
+        "n": len(ups), "tests": sum(u["alarm"] for u in ups),
+        "cusum_others": {n: [u["update"] for u in ups if u["tracked"][j]["cusum_alarm"]]
+                         for j, n in enumerate(PARAMS) if j != k},
+        "value": sum(u["tracked"][k]["ci_lo"] <= t <= u["tracked"][k]["ci_hi"]
+                     for u, t in zip(ups, kt)),
+        "change": sum(u["tracked"][k]["change_lo"] <= t - truth["kt0"] <= u["tracked"][k]["change_hi"]
+                      for u, t in zip(ups, kt)),
+    }
+    FIGURES[f"kt_wear from a {scale} baseline"] = (
+        f"{out['tests']} TEST alarms in {out['n']} updates; CUSUM alarms of kr, ct at "
+        f"{out['cusum_others']}; kt's value interval (baseline sd {sd['coupling.C.kt']:.3g} N/m) "
+        f"covers the truth in {out['value']}, its change interval the true change in "
+        f"{out['change']}")
+    return out
+
+
+def test_wear_from_fitted_baseline(tmp_path):
+    """kt_wear (kt -0.1 % per update) monitored from a baseline fitted on its first
+    file with --scale complex, its standard errors carried (--baseline-sd): TEST
+    alarms within the binomial 99 % interval at alpha 0.01, no CUSUM alarm of the
+    unchanged kr and ct, and kt's value and change intervals each covering the truth
+    at least as often as the binomial 99 % lower end of 95 % allows. The log10
+    baseline's run is printed beside it."""
+    tool = _rcbtool_path()
+    out = wear_run(tool, "complex", tmp_path)
+    wear_run(tool, "log10", tmp_path)
+    _, hi = stats.binom.interval(0.99, out["n"], 0.01)
+    lo, _ = stats.binom.interval(0.99, out["n"], 0.95)
+    msg = FIGURES["kt_wear from a complex baseline"]
+    assert out["tests"] <= hi, msg
+    assert not any(out["cusum_others"].values()), msg
+    assert out["value"] >= lo and out["change"] >= lo, msg
+
+
 def teardown_module(module):
     if FIGURES:
         print(f"\ncommissioning fits on {NFILES} files of the ROSS null series:")
