@@ -218,8 +218,8 @@ static int reboot(plant *p, arena *ar, const rcb_allocator *al) {
   static unsigned char flash[STATE_MAX];
   size_t n = 0, before;
   if (rcb_monitor_save(p->mon, flash, sizeof flash, &n)) {
-    fprintf(stderr, "reboot: the state needs %zu bytes, the flash has %u\n",
-            rcb_monitor_state_size(p->mon), STATE_MAX);
+    fprintf(stderr, "reboot: the state needs %zu bytes, the flash has %zu\n",
+            rcb_monitor_state_size(p->mon), sizeof flash);
     return 1;
   }
   rcb_monitor_destroy(p->mon);
@@ -237,16 +237,26 @@ static int reboot(plant *p, arena *ar, const rcb_allocator *al) {
   return ar->allocs != before;
 }
 
-/* Every field of the two results the same, bit for bit. */
+/* The same double, bit for bit (a NaN or -0 would show). */
+static int same(double x, double y) {
+  uint64_t a, b;
+  memcpy(&a, &x, sizeof a);
+  memcpy(&b, &y, sizeof b);
+  return a == b;
+}
+
+/* The two results the same, bit for bit, in every number the example uses. */
 static int same_result(const rcb_monitor_result *a, const rcb_monitor_result *b) {
+  const rcb_monitor_tracked *s = &a->tracked[0], *t = &b->tracked[0];
   size_t k;
-  if (a->update != b->update || a->alarm != b->alarm || a->ntop != b->ntop ||
-      memcmp(&a->T, &b->T, sizeof a->T) != 0 ||
-      memcmp(&a->tracked[0], &b->tracked[0], sizeof a->tracked[0]) != 0)
+  if (a->update != b->update || a->alarm != b->alarm || a->ntop != b->ntop || !same(a->T, b->T) ||
+      !same(s->value, t->value) || !same(s->ci_lo, t->ci_lo) || !same(s->ci_hi, t->ci_hi) ||
+      !same(s->stderr_, t->stderr_) || !same(s->u, t->u) || !same(s->cusum_up, t->cusum_up) ||
+      !same(s->cusum_down, t->cusum_down) || s->cusum_alarm != t->cusum_alarm)
     return 0;
   for (k = 0; k < a->ntop; k++)
-    if (a->top[k].index != b->top[k].index ||
-        memcmp(a->top[k].size, b->top[k].size, sizeof a->top[k].size) != 0)
+    if (a->top[k].index != b->top[k].index || !same(a->top[k].size[0], b->top[k].size[0]) ||
+        !same(a->top[k].ci_lo[0], b->top[k].ci_lo[0]))
       return 0;
   return 1;
 }

@@ -11,7 +11,7 @@
 
 #include "monitor/monitor_internal.h"
 
-#define ST_MAGIC "RCBM"
+#define ST_MAGIC "RCBM" /* 4 bytes, no terminator in the state */
 #define ST_HEAD 72u   /* bytes before the tracked parameters */
 #define ST_PER 40u    /* bytes per tracked parameter */
 #define ST_CRC 4u
@@ -64,7 +64,8 @@ unsigned long rcb_monitor_crc32(unsigned long crc, const void *data, size_t n) {
     c ^= p[i];
     for (b = 0; b < 8; b++) c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
   }
-  return (unsigned long)~c;
+  c = ~c;
+  return (unsigned long)c;
 }
 
 /* ---- fingerprints: FNV-1a 64 over values in a fixed byte order ---- */
@@ -157,7 +158,7 @@ rcb_status rcb_monitor_save(const rcb_monitor *mon, void *buf, size_t size, size
   if (!need) return RCB_ERR_STATE;
   if (!buf || size < need) return RCB_ERR_WORKSPACE;
   memset(b, 0, need);
-  memcpy(b, ST_MAGIC, 4);
+  b[0] = 'R', b[1] = 'C', b[2] = 'B', b[3] = 'M';
   put_u32(b + 4, RCB_MONITOR_STATE_VERSION);
   put_u32(b + 8, (uint32_t)need);
   put_u32(b + 12, (uint32_t)mon->nt);

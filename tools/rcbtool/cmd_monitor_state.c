@@ -27,7 +27,11 @@ typedef struct st_buf {
 } st_buf;
 
 static void io_bytes(st_buf *b, void *x, size_t n) {
-  if (b->bad) return;
+  if (b->bad || !n) return;
+  if (!x) {
+    b->bad = 1;
+    return;
+  }
   if (b->reading) {
     if (n > b->n - b->pos) {
       b->bad = 1;
@@ -79,17 +83,21 @@ static void io_f64s(st_buf *b, double *x, size_t n) {
   size_t i;
   for (i = 0; i < n; i++) io_f64(b, x + i);
 }
-/* A string (NULL written as length 0 with a flag): read as a malloc'd copy. */
-static void io_str(st_buf *b, char **s) {
-  size_t n = *s ? strlen(*s) : 0;
-  int has = *s != NULL;
+/* A string: a flag (NULL or not), its length, its bytes. */
+static void put_str(st_buf *b, const char *s) {
+  size_t n = s ? strlen(s) : 0;
+  int has = s != NULL;
   io_int(b, &has);
   io_size(b, &n);
-  if (!b->reading) {
-    if (has) io_bytes(b, *s, n);
-    return;
-  }
+  if (has) io_bytes(b, (void *)(uintptr_t)s, n);
+}
+/* Read as a malloc'd copy (NULL for a NULL string or on failure). */
+static void get_str(st_buf *b, char **s) {
+  size_t n = 0;
+  int has = 0;
   *s = NULL;
+  io_int(b, &has);
+  io_size(b, &n);
   if (b->bad || !has) return;
   if (n > b->n - b->pos || !(*s = malloc(n + 1))) {
     b->bad = 1;
@@ -97,6 +105,12 @@ static void io_str(st_buf *b, char **s) {
   }
   io_bytes(b, *s, n);
   (*s)[n] = '\0';
+}
+static void io_str(st_buf *b, char **s) {
+  if (b->reading)
+    get_str(b, s);
+  else
+    put_str(b, *s);
 }
 
 static void io_result(st_buf *b, rcb_monitor_result *r) {
@@ -134,42 +148,47 @@ static void io_result(st_buf *b, rcb_monitor_result *r) {
 static void io_setup(st_buf *b, rcb_meas **ms) {
   size_t n = 0, nch = 0, c;
   int type = 0;
+  const int rd = b->reading;
   double speed = 0, *grid = NULL;
-  if (!b->reading) {
+  if (!rd) {
     n = rcb_meas_point_count(*ms), nch = rcb_meas_channel_count(*ms);
     type = (int)rcb_meas_get_type(*ms), speed = rcb_meas_speed(*ms);
     grid = (double *)rcb_meas_grid(*ms);
   }
   io_int(b, &type), io_size(b, &n), io_f64(b, &speed), io_size(b, &nch);
-  if (b->reading) {
+  if (rd) {
     if (b->bad || n == 0 || n > (b->n - b->pos) / 8 || !(grid = malloc(n * sizeof *grid)) ||
         rcb_meas_create(ms, NULL)) {
       b->bad = 1;
       free(grid);
       return;
     }
+    io_f64s(b, grid, n);
+    if (b->bad || rcb_meas_set_grid(*ms, (rcb_meas_type)type, n, grid, speed)) b->bad = 1;
+    free(grid);
+  } else {
+    io_f64s(b, grid, n);
   }
-  io_f64s(b, grid, n);
-  if (b->reading && (b->bad || rcb_meas_set_grid(*ms, (rcb_meas_type)type, n, grid, speed)))
-    b->bad = 1;
-  if (b->reading) free(grid);
   for (c = 0; !b->bad && c < nch; c++) {
     rcb_meas_channel_info ci;
     char *resp = NULL, *ref = NULL;
     int kind = 0;
     rcb_complex *v = NULL;
-    if (!b->reading) {
+    if (!rd) {
       rcb_meas_channel(*ms, c, &ci);
       resp = (char *)ci.response, ref = (char *)ci.reference, kind = (int)ci.kind;
       v = (rcb_complex *)ci.data;
+      put_str(b, resp), put_str(b, ref), io_int(b, &kind);
+      io_f64s(b, (double *)(void *)v, 2 * n);
+      continue;
     }
-    io_str(b, &resp), io_str(b, &ref), io_int(b, &kind);
-    if (b->reading && !b->bad && !(v = malloc(n * sizeof *v))) b->bad = 1;
+    get_str(b, &resp), get_str(b, &ref), io_int(b, &kind);
+    if (!b->bad && !(v = malloc(n * sizeof *v))) b->bad = 1;
     if (!b->bad) io_f64s(b, (double *)(void *)v, 2 * n);
-    if (b->reading) {
-      if (!b->bad && (!resp || rcb_meas_add_channel(*ms, resp, ref, kind, v))) b->bad = 1;
-      free(resp), free(ref), free(v);
-    }
+    if (!b->bad && (!resp || rcb_meas_add_channel(*ms, resp, ref, kind, v))) b->bad = 1;
+    free(resp);
+    free(ref);
+    free(v);
   }
 }
 
