@@ -763,6 +763,8 @@ static void test_state_restart(void **state) {
   setup = with_values(f->setup, acc, 1.0);
   o.setup_averages = NAVG;
   o.relinearise = 2;
+  /* a small catalogue: five creates, each a fraction of the full one's time */
+  o.effects = (1u << RCB_EFFECT_BEARING_CROSS_COUPLING) | (1u << RCB_EFFECT_BEARING_STIFFNESS);
   assert_int_equal(rcb_monitor_create(&a, f->base, setup, &o, NULL), RCB_OK);
   assert_int_equal(rcb_monitor_state_size(a), 76 + 40);
   for (u = 0; u < N; u++) {
