@@ -99,10 +99,10 @@ def test_log10_biased_and_scattered(fits):
         assert summary(fits["log10"], name)[2] > 3 * summary(fits["complex"], name)[2], FIGURES
 
 
-def wear_run(tool, scale, tmp):
-    """kt_wear monitored from a baseline fitted on its first file on @p scale, the
+def wear_run(tool, scale, tmp, series="kt_wear"):
+    """@p series monitored from a baseline fitted on its first file on @p scale, the
     fit's standard errors given as --baseline-sd."""
-    d, truth, model = mc.series("kt_wear")
+    d, truth, model = mc.series(series)
     base = tmp / f"base_{scale}.ini"
     res = subprocess.run([tool, "fit", str(model), str(d / truth["files"][0]), "--params",
                           ",".join(PARAMS), "--noise", "10,1", "--scale", scale, "--json",
@@ -124,12 +124,13 @@ def wear_run(tool, scale, tmp):
         "n": len(ups), "tests": sum(u["alarm"] for u in ups),
         "cusum_others": {n: [u["update"] for u in ups if u["tracked"][j]["cusum_alarm"]]
                          for j, n in enumerate(PARAMS) if j != k},
+        "cusum_kt": [u["update"] for u in ups if u["tracked"][k]["cusum_alarm"]],
         "value": sum(u["tracked"][k]["ci_lo"] <= t <= u["tracked"][k]["ci_hi"]
                      for u, t in zip(ups, kt)),
         "change": sum(u["tracked"][k]["change_lo"] <= t - truth["kt0"] <= u["tracked"][k]["change_hi"]
                       for u, t in zip(ups, kt)),
     }
-    FIGURES[f"kt_wear from a {scale} baseline"] = (
+    FIGURES[f"{series} from a {scale} baseline"] = (
         f"{out['tests']} TEST alarms in {out['n']} updates; CUSUM alarms of kr, ct at "
         f"{out['cusum_others']}; kt's value interval (baseline sd {sd['coupling.C.kt']:.3g} N/m) "
         f"covers the truth in {out['value']}, its change interval the true change in "
@@ -152,6 +153,22 @@ def test_wear_from_fitted_baseline(tmp_path):
     msg = FIGURES["kt_wear from a complex baseline"]
     assert out["tests"] <= hi, msg
     assert not any(out["cusum_others"].values()), msg
+    assert out["value"] >= lo and out["change"] >= lo, msg
+
+
+def test_null_from_fitted_baseline(tmp_path):
+    """The null series (190 updates) from a baseline fitted on its first file with
+    --scale complex: TEST alarms within the binomial 99 % interval at alpha 0.01, no
+    CUSUM alarm (its false-alarm rate holds with a baseline that is itself an
+    estimate), and kt's value interval covering the truth and its change interval
+    the true change (0) at least as often as the binomial 99 % lower end of 95 %."""
+    tool = _rcbtool_path()
+    out = wear_run(tool, "complex", tmp_path, "null")
+    _, hi = stats.binom.interval(0.99, out["n"], 0.01)
+    lo, _ = stats.binom.interval(0.99, out["n"], 0.95)
+    msg = FIGURES["null from a complex baseline"] + f"; kt's CUSUM at {out['cusum_kt']}"
+    assert out["tests"] <= hi, msg
+    assert not any(out["cusum_others"].values()) and not out["cusum_kt"], msg
     assert out["value"] >= lo and out["change"] >= lo, msg
 
 
