@@ -49,7 +49,8 @@
  *    no sigma^2 factor).
  *  - Trend. Tracked parameters: the same step with the tracked parameters
  *    alone (jointly with the best candidate while the instant test fires),
- *    value = baseline + step, 95 % interval. With
+ *    value = baseline + step, 95 % intervals of the value (with the variance
+ *    of opts.baseline_cov) and of the change (without). With
  *    opts.relinearise > 0 the step is refined by chord iterations that
  *    re-evaluate the model at the new value (the fit's preallocated FRF
  *    object, no allocation); T is taken on what that step leaves, but the
