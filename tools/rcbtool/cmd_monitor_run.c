@@ -508,6 +508,7 @@ int mon_run(const cli_args *a, const mon_job *j) {
     cli_out_abort(&o);
     goto done;
   }
+  if (j->state) mon_sync_dir(j->state);
   rc = cli_out_close(&o);
 done:
   rcb_monitor_destroy(mon);

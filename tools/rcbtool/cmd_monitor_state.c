@@ -8,6 +8,7 @@
  * then the CRC-32 of all that (rcb_monitor_crc32). The log and the plot of
  * the series are rebuilt from it; it is replaced by write, fsync, rename. */
 #include <errno.h>
+#include <fcntl.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -319,6 +320,22 @@ int mon_saved_write(const char *cmd, const char *path, mon_saved *sv, cli_tmpfil
     return cli_fail(CLI_EXIT_IO, "%s: cannot write the state '%s'", cmd, path);
   }
   return 0; /* renamed by the caller with the other outputs */
+}
+
+void mon_sync_dir(const char *path) {
+  const char *slash = strrchr(path, '/');
+  char *dir = NULL;
+  int fd;
+  if (slash && !(dir = malloc((size_t)(slash - path) + 2))) return;
+  if (dir) {
+    memcpy(dir, path, (size_t)(slash - path) + 1);
+    dir[slash - path + 1] = '\0';
+  }
+  fd = open(dir ? dir : ".", O_RDONLY);
+  free(dir);
+  if (fd < 0) return;
+  (void)fsync(fd); /* the rename itself on the disk; best effort */
+  close(fd);
 }
 
 uint64_t mon_file_hash(const char *path, int *ok) {
