@@ -638,6 +638,215 @@ static void test_alloc_walk(void **state) {
   rcb_meas_destroy(small);
 }
 
+/* ---- the baseline's own uncertainty (issue #24) ---- */
+
+/* The baseline is an estimate: replicas whose baseline kt is the truth plus
+ * a draw of N(0, sb^2) (as a fit's error of standard error sb), the machine
+ * the truth, unchanged since commissioning. With opts.baseline_cov = sb^2
+ * the value's 95 % interval covers the true kt as often as the binomial
+ * 99 % interval of 95 % allows; the interval of the change alone around the
+ * value (what was printed before) almost never does; the change's interval
+ * covers the true change, 0, as a 95 % interval should. */
+static void test_baseline_cov(void **state) {
+  fixture *f = *state;
+  enum { NREP = 60 };
+  const char *const outs[2] = {"DA.x", "DB.y"};
+  rcb_meas *small = rcb_test_frf_meas(f->base, outs, 2, INS, 1, 50.0, 300.0, 24, 10000.0,
+                                      RCB_RECEPTANCE), *setup;
+  rcb_monitor_param tp;
+  rcb_monitor_opts o = opts_kt(&tp, f->kt);
+  rcb_complex fs[48], v[48];
+  double sb = 0.01 * f->kt, var = sb * sb; /* N/m, N^2/m^2 */
+  uint64_t seed = 2424;
+  size_t r, lo, hi, cover = 0, narrow = 0, change = 0;
+  values_of(small, fs);
+  o.effects = (1u << RCB_EFFECT_BEARING_CROSS_COUPLING) | (1u << RCB_EFFECT_BEARING_STIFFNESS);
+  o.baseline_cov = &var;
+  for (r = 0; r < NREP; r++) {
+    double g = sqrt(-2 * log(1 - rng_uniform(&seed))) * cos(2 * 3.14159265358979323846 *
+                                                             rng_uniform(&seed));
+    rcb_model *b = edited(f->base, KT_NAME, f->kt + sb * g);
+    rcb_monitor *mon = NULL;
+    rcb_monitor_result res;
+    const rcb_monitor_tracked *t = &res.tracked[0];
+    eq19n(fs, v, 2, 24, &seed);
+    setup = with_values(small, v, 1.0);
+    assert_int_equal(rcb_monitor_create(&mon, b, setup, &o, NULL), RCB_OK);
+    eq19n(fs, v, 2, 24, &seed);
+    assert_int_equal(rcb_monitor_update(mon, v, NULL, &res), RCB_OK);
+    assert_true(fabs(t->abs_stderr - sqrt(t->stderr_ * t->stderr_ + var)) <= 1e-9 * sb);
+    assert_true(fabs(t->change - (t->value - (f->kt + sb * g))) <= 1e-9 * sb);
+    cover += t->ci_lo <= f->kt && f->kt <= t->ci_hi;
+    narrow += fabs(t->value - f->kt) <= 1.959963984540054 * t->stderr_;
+    change += t->change_lo <= 0 && 0 <= t->change_hi;
+    rcb_monitor_destroy(mon);
+    rcb_meas_destroy(setup);
+    rcb_model_destroy(b);
+  }
+  binom99(NREP, 0.95, &lo, &hi);
+  print_message("baseline kt off by N(0, (1 %%)^2): the value's interval with baseline_cov "
+                "covers the truth in %zu of %d replicas (binomial 99 %% [%zu, %zu]), the "
+                "change's interval around the value in %zu; the change's covers 0 in %zu\n",
+                cover, (int)NREP, lo, hi, narrow, change);
+  assert_true(cover >= lo && cover <= hi);
+  assert_true(change >= lo && change <= hi);
+  assert_true(narrow < lo);
+  /* a negative variance is refused, naming it */
+  {
+    rcb_monitor *mon = NULL;
+    var = -1;
+    assert_int_equal(rcb_monitor_create(&mon, f->base, small, &o, NULL), RCB_ERR_ARG);
+    assert_non_null(strstr(rcb_monitor_errmsg(mon), "baseline_cov"));
+    rcb_monitor_destroy(mon);
+  }
+  rcb_meas_destroy(small);
+}
+
+/* ---- state that survives a restart (issue #24) ---- */
+
+/* Every field of two results the same, bit for bit (doubles compared as
+ * their bytes: NaN or -0 would show). */
+static int same_result(const rcb_monitor_result *a, const rcb_monitor_result *b) {
+  size_t k;
+  if (a->update != b->update || a->alarm != b->alarm || a->cusum_alarm != b->cusum_alarm ||
+      a->ntop != b->ntop || a->ntracked != b->ntracked ||
+      memcmp(&a->T, &b->T, sizeof a->T) != 0 || memcmp(&a->p_value, &b->p_value, sizeof a->p_value))
+    return 0;
+  for (k = 0; k < a->ntop; k++)
+    if (a->top[k].index != b->top[k].index ||
+        memcmp(a->top[k].size, b->top[k].size, sizeof a->top[k].size) != 0)
+      return 0;
+  for (k = 0; k < a->ntracked; k++)
+    if (memcmp(&a->tracked[k], &b->tracked[k], sizeof a->tracked[k]) != 0) return 0;
+  return 1;
+}
+
+static void rewrite_crc(unsigned char *b, size_t n) {
+  unsigned long c = rcb_monitor_crc32(0, b, n - 4);
+  size_t i;
+  for (i = 0; i < 4; i++) b[n - 4 + i] = (unsigned char)(c >> (8 * i));
+}
+
+/* A monitor run through a drift of kt, "restarted" after N1 updates (save,
+ * destroy, create again, load): every later result and the final state
+ * are bit for bit those of the monitor that ran on; the load allocates
+ * nothing; the layout is little-endian; a state of another model, set-up,
+ * settings or version, or a damaged one, is refused with its own status
+ * and leaves the monitor as it was. */
+static void test_state_restart(void **state) {
+  fixture *f = *state;
+  enum { NAVG = 4, N1 = 30, N = 60 };
+  const double DK = 1e-3;
+  rcb_monitor_param tp;
+  rcb_monitor_opts o = opts_kt(&tp, f->kt);
+  rcb_test_counter cnt = {0, 0};
+  rcb_allocator al = rcb_test_counting_allocator(&cnt);
+  rcb_monitor *a = NULL, *b = NULL, *other = NULL;
+  rcb_monitor_result ra, rb;
+  rcb_model *m2 = edited(f->truth, KT_NAME, (1 + DK) * f->kt);
+  rcb_meas *ms = frf_of(m2), *setup, *setup2;
+  rcb_complex *acc = calloc(NPT, sizeof *acc), *dh = malloc(NPT * sizeof *dh);
+  unsigned char buf[512], buf2[512], keep[512];
+  size_t u, i, n = 0, n2 = 0, before, first_alarm = 0;
+  double cusum_at_restart = 0;
+  uint64_t seed = 99;
+  double se = 0;
+  static const unsigned char check[] = "123456789";
+  /* the CRC-32 check value of the catalogue of parametrised CRCs */
+  assert_int_equal(rcb_monitor_crc32(0, check, 9), 0xCBF43926ul);
+  values_of(ms, dh);
+  for (i = 0; i < NPT; i++) dh[i] = (dh[i] - f->fs[i]) / (DK * f->kt);
+  for (u = 0; u < NAVG; u++) {
+    eq19(f->fs, f->v, &seed);
+    for (i = 0; i < NPT; i++) acc[i] += f->v[i] / NAVG;
+  }
+  setup = with_values(f->setup, acc, 1.0);
+  o.setup_averages = NAVG;
+  o.relinearise = 2;
+  /* a small catalogue: five creates, each a fraction of the full one's time */
+  o.effects = (1u << RCB_EFFECT_BEARING_CROSS_COUPLING) | (1u << RCB_EFFECT_BEARING_STIFFNESS);
+  assert_int_equal(rcb_monitor_create(&a, f->base, setup, &o, NULL), RCB_OK);
+  assert_int_equal(rcb_monitor_state_size(a), 76 + 40);
+  for (u = 0; u < N; u++) {
+    /* kt falls by 0.2 standard errors per update from update 26 */
+    double dkt = u < 25 ? 0.0 : -0.2 * se * (double)(u - 24);
+    eq19(f->fs, f->v, &seed);
+    for (i = 0; i < NPT; i++) f->v[i] += dkt * dh[i];
+    assert_int_equal(rcb_monitor_update(a, f->v, NULL, &ra), RCB_OK);
+    if (!u) se = ra.tracked[0].stderr_;
+    if (ra.cusum_alarm && !first_alarm) first_alarm = u + 1;
+    if (u + 1 == N1) { /* the restart */
+      cusum_at_restart = ra.tracked[0].cusum_down;
+      assert_int_equal(rcb_monitor_save(a, buf, 10, &n), RCB_ERR_WORKSPACE);
+      assert_int_equal(rcb_monitor_save(a, buf, sizeof buf, &n), RCB_OK);
+      assert_int_equal(n, rcb_monitor_state_size(a));
+      assert_memory_equal(buf, "RCBM\1\0\0\0", 8); /* magic, version 1 little-endian */
+      assert_int_equal(buf[56], N1);                /* the update count, low byte first */
+      assert_int_equal(rcb_monitor_create(&b, f->base, setup, &o, &al), RCB_OK);
+      before = cnt.allocs;
+      assert_int_equal(rcb_monitor_load(b, buf, n), RCB_OK);
+      assert_int_equal(cnt.allocs, before); /* load allocates nothing */
+      continue;
+    }
+    if (u + 1 > N1) {
+      assert_int_equal(rcb_monitor_update(b, f->v, NULL, &rb), RCB_OK);
+      assert_true(same_result(&ra, &rb));
+    }
+  }
+  /* the drift had begun to accumulate before the restart and alarmed after
+   * it: the sums carried over */
+  assert_true(cusum_at_restart > 0 && first_alarm > N1);
+  assert_int_equal(rcb_monitor_save(a, buf, sizeof buf, &n), RCB_OK);
+  assert_int_equal(rcb_monitor_save(b, buf2, sizeof buf2, &n2), RCB_OK);
+  assert_int_equal(n, n2);
+  assert_memory_equal(buf, buf2, n);
+  print_message("restart after %d of %d updates (CUSUM- %.2f then): %d results and the final "
+                "state (%zu bytes) bit-identical; first CUSUM alarm at update %zu\n", (int)N1,
+                (int)N, cusum_at_restart, (int)(N - N1), n, first_alarm);
+  /* refusals, each leaving b as it was */
+  memcpy(keep, buf, n);
+  buf[60] ^= 1; /* a damaged byte */
+  assert_int_equal(rcb_monitor_load(b, buf, n), RCB_ERR_CORRUPT);
+  assert_non_null(strstr(rcb_monitor_errmsg(b), "CRC"));
+  memcpy(buf, keep, n);
+  assert_int_equal(rcb_monitor_load(b, buf, n - 1), RCB_ERR_CORRUPT); /* truncated */
+  assert_int_equal(rcb_monitor_load(b, "hello", 5), RCB_ERR_CORRUPT);
+  buf[4] = 2;
+  rewrite_crc(buf, n);
+  assert_int_equal(rcb_monitor_load(b, buf, n), RCB_ERR_VERSION);
+  memcpy(buf, keep, n);
+  assert_int_equal(rcb_monitor_save(b, buf2, sizeof buf2, &n2), RCB_OK);
+  assert_memory_equal(buf2, keep, n); /* unchanged by the refused loads */
+  /* another model (kt of the baseline 0.1 % higher) */
+  {
+    rcb_model *m3 = edited(f->base, KT_NAME, 1.001 * f->kt);
+    assert_int_equal(rcb_monitor_create(&other, m3, setup, &o, NULL), RCB_OK);
+    assert_int_equal(rcb_monitor_load(other, buf, n), RCB_ERR_OTHER_MODEL);
+    rcb_monitor_destroy(other);
+    rcb_model_destroy(m3);
+  }
+  /* another set-up (commissioning values 1 % larger), other settings */
+  setup2 = scaled(setup, 1.01);
+  assert_int_equal(rcb_monitor_create(&other, f->base, setup2, &o, NULL), RCB_OK);
+  assert_int_equal(rcb_monitor_load(other, buf, n), RCB_ERR_OTHER_SETUP);
+  assert_non_null(strstr(rcb_monitor_errmsg(other), "set-up"));
+  rcb_monitor_destroy(other);
+  o.cusum_h = 6;
+  assert_int_equal(rcb_monitor_create(&other, f->base, setup, &o, NULL), RCB_OK);
+  assert_int_equal(rcb_monitor_load(other, buf, n), RCB_ERR_OTHER_SETUP);
+  assert_non_null(strstr(rcb_monitor_errmsg(other), "settings"));
+  rcb_monitor_destroy(other);
+  rcb_monitor_destroy(a);
+  rcb_monitor_destroy(b);
+  assert_int_equal(cnt.allocs, cnt.frees);
+  rcb_meas_destroy(setup);
+  rcb_meas_destroy(setup2);
+  rcb_meas_destroy(ms);
+  rcb_model_destroy(m2);
+  free(acc);
+  free(dh);
+}
+
 /* ---- bad input ---- */
 
 static void test_bad_input(void **state) {
@@ -707,6 +916,8 @@ int main(void) {
       cmocka_unit_test(test_no_alloc_in_update),
       cmocka_unit_test(test_alloc_walk),
       cmocka_unit_test(test_bad_input),
+      cmocka_unit_test(test_state_restart),
+      cmocka_unit_test(test_baseline_cov),
   };
   return cmocka_run_group_tests(tests, fixture_setup, fixture_teardown);
 }

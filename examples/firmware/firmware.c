@@ -29,7 +29,14 @@
  *    kt's over the year, and the cross-coupling's on the days after the
  *    fault, each at least the lower end of the binomial 99 % interval
  *    (335 of 365, 102 of 115; scipy.stats.binom.interval(0.99, n, 0.95));
- *  - no allocation in the loop.
+ *  - no allocation in the loop;
+ *  - the firmware "reboots" on day REBOOT_DAY (issue #24): the monitor's
+ *    state is saved into a buffer (the flash a real host would write),
+ *    the monitor destroyed, created again from the same model, commissioning
+ *    values and settings, and the state loaded (no allocation in the load).
+ *    A second monitor that never restarts runs beside it: every result
+ *    after the reboot and the saved state at the year's end must be bit
+ *    for bit the same.
  * It prints the arena used, the detection delays and the estimated sizes.
  */
 #include <complex.h>
@@ -66,7 +73,9 @@ static void arena_free(void *user, void *p) {
   a->frees++;
 }
 
-#define ARENA_BYTES (16u * 1024u * 1024u)
+/* Two monitors (the one that restarts and its never-restarted shadow) and
+ * the restart's create: the bump arena reclaims nothing. */
+#define ARENA_BYTES (32u * 1024u * 1024u)
 static unsigned char g_memory[ARENA_BYTES]; /* the firmware's heap */
 
 static const char MODEL_INI[] =
@@ -104,6 +113,8 @@ static const char MODEL_INI[] =
 #define BETA_S 2.0       /* %, eq. 19 additive noise */
 #define N_COMMISSION 16  /* FRF tests averaged into the commissioning values */
 #define PI 3.14159265358979323846
+#define REBOOT_DAY 182   /* the host restarts before this day's test */
+#define STATE_MAX 1024   /* bytes of "flash" for the monitor's state */
 
 static const char *const OUTS[NOUT] = {"DA.x", "DA.y", "DB.x", "DB.y"};
 
@@ -111,6 +122,10 @@ typedef struct plant {
   rcb_model *model, *machine; /* the baseline model; the "real" machine */
   rcb_frf *frf_machine;       /* the machine's FRFs */
   rcb_monitor *mon;
+  rcb_monitor *shadow;        /* the same monitor never restarted, for the check */
+  rcb_meas *setup;            /* the commissioning values, kept for a restart */
+  rcb_monitor_param kt;       /* the tracked parameter */
+  rcb_monitor_opts opts;
   double freqs[NFREQ];        /* rad/s */
   rcb_complex clean[NPT], meas[NPT]; /* channel-major, m */
   uint64_t rng;
@@ -156,25 +171,33 @@ static int load(rcb_model **m, const rcb_allocator *al) {
   return 0;
 }
 
+/* A monitor from the baseline model, the commissioning values and the settings. */
+static int make_monitor(plant *p, const rcb_allocator *al, rcb_monitor **mon) {
+  if (rcb_monitor_create(mon, p->model, p->setup, &p->opts, al)) {
+    fprintf(stderr, "monitor: %s\n", rcb_monitor_errmsg(*mon));
+    return 1;
+  }
+  return 0;
+}
+
 /* Commissioning: the average of N_COMMISSION FRF tests of the healthy machine. */
 static int commission(plant *p, const rcb_allocator *al) {
   static rcb_complex avg[NPT];
-  rcb_meas *setup = NULL;
-  rcb_monitor_param kt = {"coupling.C.kt", 20e3, 80e3};
   rcb_monitor_opts o;
   size_t n, c, j;
-  int rc = 1;
   for (n = 0; n < N_COMMISSION; n++) {
     if (daily_test(p)) return 1;
     for (j = 0; j < NPT; j++) avg[j] += p->meas[j] / N_COMMISSION;
   }
-  if (rcb_meas_create(&setup, al) ||
-      rcb_meas_set_grid(setup, RCB_MEAS_FRF, NFREQ, p->freqs, RPM * PI / 30.0))
+  if (rcb_meas_create(&p->setup, al) ||
+      rcb_meas_set_grid(p->setup, RCB_MEAS_FRF, NFREQ, p->freqs, RPM * PI / 30.0))
     return 1;
   for (c = 0; c < NOUT; c++)
-    if (rcb_meas_add_channel(setup, OUTS[c], "DA.x", RCB_RECEPTANCE, avg + c * NFREQ)) goto done;
+    if (rcb_meas_add_channel(p->setup, OUTS[c], "DA.x", RCB_RECEPTANCE, avg + c * NFREQ))
+      return 1;
+  p->kt.name = "coupling.C.kt", p->kt.lo = 20e3, p->kt.hi = 80e3;
   memset(&o, 0, sizeof o);
-  o.ntracked = 1, o.tracked = &kt;
+  o.ntracked = 1, o.tracked = &p->kt;
   o.beta_a = BETA_A, o.beta_s = BETA_S, o.setup_averages = N_COMMISSION;
   o.alpha = 1e-4;       /* false alarms: 1 in 10000 days */
   o.cusum_k = 0.5, o.cusum_h = 8; /* one side's ARL0 ~ 1.9e4 days */
@@ -183,14 +206,69 @@ static int commission(plant *p, const rcb_allocator *al) {
   o.effects = (1u << RCB_EFFECT_BEARING_STIFFNESS) | (1u << RCB_EFFECT_BEARING_CROSS_COUPLING) |
               (1u << RCB_EFFECT_BEARING_DAMPING) | (1u << RCB_EFFECT_COUPLING_ROTATIONAL_STIFFNESS) |
               (1u << RCB_EFFECT_COUPLING_TRANSLATIONAL_DAMPING);
-  if (rcb_monitor_create(&p->mon, p->model, setup, &o, al)) {
-    fprintf(stderr, "monitor: %s\n", rcb_monitor_errmsg(p->mon));
-    goto done;
+  p->opts = o;
+  return make_monitor(p, al, &p->mon) || make_monitor(p, al, &p->shadow);
+}
+
+/* The restart: the state into "flash", the monitor destroyed (a real host
+ * loses its RAM here; the bump arena is not reclaimed, a real one would
+ * start afresh), created again and the state loaded. Creating allocates,
+ * as at power-up; loading must not. 0 on success. */
+static int reboot(plant *p, arena *ar, const rcb_allocator *al) {
+  static unsigned char flash[STATE_MAX];
+  size_t n = 0, before;
+  if (rcb_monitor_save(p->mon, flash, sizeof flash, &n)) {
+    fprintf(stderr, "reboot: the state needs %zu bytes, the flash has %zu\n",
+            rcb_monitor_state_size(p->mon), sizeof flash);
+    return 1;
   }
-  rc = 0;
-done:
-  rcb_meas_destroy(setup); /* the monitor keeps its own copy */
-  return rc;
+  rcb_monitor_destroy(p->mon);
+  p->mon = NULL;
+  ar->sealed = 0;
+  if (make_monitor(p, al, &p->mon)) return 1;
+  ar->sealed = 1;
+  before = ar->allocs;
+  if (rcb_monitor_load(p->mon, flash, n)) {
+    fprintf(stderr, "reboot: %s\n", rcb_monitor_errmsg(p->mon));
+    return 1;
+  }
+  printf("reboot before day %d: state of %zu bytes saved, monitor created again, state "
+         "loaded (%zu allocations in the load)\n", REBOOT_DAY, n, ar->allocs - before);
+  return ar->allocs != before;
+}
+
+/* The same double, bit for bit (a NaN or -0 would show). */
+static int same(double x, double y) {
+  uint64_t a, b;
+  memcpy(&a, &x, sizeof a);
+  memcpy(&b, &y, sizeof b);
+  return a == b;
+}
+
+/* The two results the same, bit for bit, in every number the example uses. */
+static int same_result(const rcb_monitor_result *a, const rcb_monitor_result *b) {
+  const rcb_monitor_tracked *s = &a->tracked[0], *t = &b->tracked[0];
+  size_t k;
+  if (a->update != b->update || a->alarm != b->alarm || a->ntop != b->ntop || !same(a->T, b->T) ||
+      !same(s->value, t->value) || !same(s->ci_lo, t->ci_lo) || !same(s->ci_hi, t->ci_hi) ||
+      !same(s->stderr_, t->stderr_) || !same(s->u, t->u) || !same(s->cusum_up, t->cusum_up) ||
+      !same(s->cusum_down, t->cusum_down) || s->cusum_alarm != t->cusum_alarm)
+    return 0;
+  for (k = 0; k < a->ntop; k++)
+    if (a->top[k].index != b->top[k].index || !same(a->top[k].size[0], b->top[k].size[0]) ||
+        !same(a->top[k].ci_lo[0], b->top[k].ci_lo[0]))
+      return 0;
+  return 1;
+}
+
+/* The states of the restarted monitor and of the shadow at the year's end. */
+static int same_state(const plant *p) {
+  static unsigned char s1[STATE_MAX], s2[STATE_MAX];
+  size_t n1 = 0, n2 = 0;
+  if (rcb_monitor_save(p->mon, s1, sizeof s1, &n1) ||
+      rcb_monitor_save(p->shadow, s2, sizeof s2, &n2))
+    return 0;
+  return n1 == n2 && memcmp(s1, s2, n1) == 0;
 }
 
 static int init(plant *p, const rcb_allocator *al) {
@@ -259,8 +337,9 @@ int main(void) {
   static plant p;
   arena ar = {g_memory, sizeof g_memory, 0, 0, 0, 0, 0};
   rcb_allocator al = {arena_alloc, arena_free, &ar};
-  rcb_monitor_result r;
+  rcb_monitor_result r, rs;
   verdict v = {-1, -1, 0, 0, 0, 0, 0, 0};
+  size_t differ = 0;
   double kt0, kt;
   int day;
   if (init(&p, &al)) return 1;
@@ -275,10 +354,14 @@ int main(void) {
       fprintf(stderr, "day %d: the machine's FRF test failed\n", day);
       return 1;
     }
-    if (rcb_monitor_update(p.mon, p.meas, NULL, &r)) {
-      fprintf(stderr, "day %d: %s\n", day, rcb_monitor_errmsg(p.mon));
+    if (day == REBOOT_DAY && reboot(&p, &ar, &al)) return 1;
+    if (rcb_monitor_update(p.mon, p.meas, NULL, &r) ||
+        rcb_monitor_update(p.shadow, p.meas, NULL, &rs)) {
+      fprintf(stderr, "day %d: %s %s\n", day, rcb_monitor_errmsg(p.mon),
+              rcb_monitor_errmsg(p.shadow));
       return 1;
     }
+    differ += !same_result(&r, &rs);
     judge(&p, day, &r, &v);
     v.kt_covered += r.tracked[0].ci_lo <= kt && kt <= r.tracked[0].ci_hi;
   }
@@ -295,9 +378,15 @@ int main(void) {
   if (v.alarm_day != FAULT_DAY || v.instant_before) v.errors++;
   if (v.instant_after != DAYS - FAULT_DAY || v.named_right != v.instant_after) v.errors++;
   if (v.kt_covered < 335 || v.covered < 102) v.errors++; /* binomial 99 % lower ends */
-  printf("loop: %zu allocations after initialisation\n", ar.allocs_after_init);
+  printf("loop: %zu allocations after initialisation (the reboot's create aside)\n",
+         ar.allocs_after_init);
   if (ar.allocs_after_init) v.errors++;
+  printf("restart: %zu of %d days differ from the monitor never restarted; final state %s\n",
+         differ, DAYS, same_state(&p) ? "bit-identical" : "DIFFERENT");
+  if (differ || !same_state(&p)) v.errors++;
   rcb_monitor_destroy(p.mon);
+  rcb_monitor_destroy(p.shadow);
+  rcb_meas_destroy(p.setup);
   rcb_frf_destroy(p.frf_machine);
   rcb_model_destroy(p.machine);
   rcb_model_destroy(p.model);
@@ -306,6 +395,7 @@ int main(void) {
     v.errors++;
   }
   printf("%s\n", v.errors ? "FAILED" : "OK: drift and fault alarmed on time and named, "
-                                        "intervals covering, no allocation in the loop");
+                                        "intervals covering, no allocation in the loop, "
+                                        "restart bit-identical");
   return v.errors ? 1 : 0;
 }

@@ -49,7 +49,11 @@ RCB_API const char *rcb_version_string(void);
   X(RCB_ERR_IO, -9, "input/output error")                                   \
   X(RCB_ERR_UNSUPPORTED, -10, "feature not built into this library")        \
   X(RCB_ERR_WORKSPACE, -11, "caller workspace too small")                  \
-  X(RCB_ERR_NOT_CONVERGED, -12, "iteration did not converge")
+  X(RCB_ERR_NOT_CONVERGED, -12, "iteration did not converge")              \
+  X(RCB_ERR_CORRUPT, -13, "saved data corrupt (checksum or layout)")        \
+  X(RCB_ERR_VERSION, -14, "saved data of another format version")          \
+  X(RCB_ERR_OTHER_MODEL, -15, "saved state of another model")              \
+  X(RCB_ERR_OTHER_SETUP, -16, "saved state of another set-up or settings")
 
 #define RCB_STATUS_ENUM_(name, value, text) name = (value),
 typedef enum rcb_status { RCB_STATUS_LIST(RCB_STATUS_ENUM_) } rcb_status;

@@ -49,7 +49,8 @@
  *    no sigma^2 factor).
  *  - Trend. Tracked parameters: the same step with the tracked parameters
  *    alone (jointly with the best candidate while the instant test fires),
- *    value = baseline + step, 95 % interval. With
+ *    value = baseline + step, 95 % intervals of the value (with the variance
+ *    of opts.baseline_cov) and of the change (without). With
  *    opts.relinearise > 0 the step is refined by chord iterations that
  *    re-evaluate the model at the new value (the fit's preallocated FRF
  *    object, no allocation); T is taken on what that step leaves, but the
@@ -174,6 +175,13 @@ typedef struct rcb_monitor_opts {
                           #14's noise), tangential variance
                           |e|^2 (phase_deg pi/180)^2 / 3 added to the eq. 19
                           model's (used when sd is NULL); 0: none */
+  const double *baseline_cov; /**< covariance of the baseline's tracked values,
+                          ntracked x ntracked row-major, parameter units^2 (the
+                          fit that made the baseline: its standard errors and
+                          correlation); its diagonal widens the absolute
+                          values' intervals (rcb_monitor_tracked.ci_lo, ci_hi),
+                          taken independent of the change's noise. NULL: the
+                          baseline is exact (the intervals are the change's) */
 } rcb_monitor_opts;
 
 /** @brief One ranked candidate effect in a result. */
@@ -199,11 +207,15 @@ typedef struct rcb_monitor_candidate {
 
 /** @brief One tracked parameter in a result. While the instant test fires,
  * the estimate is fitted jointly with the best-ranked candidate (a new
- * effect left out of the fit would bias the trend). */
+ * effect left out of the fit would bias the trend). Two intervals: of the
+ * absolute value (the change's noise and the baseline's own uncertainty,
+ * opts.baseline_cov) and of the change since the baseline (its noise only:
+ * what the CUSUM and z watch). */
 typedef struct rcb_monitor_tracked {
   double value;        /**< estimate, parameter units */
-  double ci_lo, ci_hi; /**< 95 % interval, parameter units */
-  double stderr_;      /**< standard error, parameter units */
+  double ci_lo, ci_hi; /**< 95 % interval of the value, parameter units:
+                            value -+ 1.96 abs_stderr */
+  double stderr_;      /**< standard error of the change, parameter units */
   double z;            /**< (value - baseline) / stderr (-): the change since
                             commissioning */
   double u;            /**< the self-starting CUSUM's input (-): the step's
@@ -213,6 +225,10 @@ typedef struct rcb_monitor_tracked {
   double cusum_down;   /**< CUSUM S- (-) */
   int cusum_alarm;     /**< +1: S+ > h (rising), -1: S- > h (falling), 0 */
   int out_of_range;    /**< 1 when value lies outside [lo, hi] */
+  double abs_stderr;   /**< standard error of the value, parameter units:
+                            sqrt(stderr_^2 + the baseline's variance) */
+  double change;       /**< value - baseline, parameter units */
+  double change_lo, change_hi; /**< its 95 % interval: change -+ 1.96 stderr_ */
 } rcb_monitor_tracked;
 
 /** @brief What one update found. Plain value type, owns nothing. */
@@ -316,6 +332,67 @@ RCB_API rcb_status rcb_monitor_candidate_info_get(const rcb_monitor *mon, size_t
 /** @brief Name and baseline value (parameter units) of tracked parameter @p k. */
 RCB_API rcb_status rcb_monitor_tracked_info(const rcb_monitor *mon, size_t k,
                                             const char **name, double *baseline);
+
+/** @brief The thresholds in use (the defaults resolved): the instant test's
+ * false-alarm probability per update @p alpha (-) and its chi-square
+ * threshold @p threshold (-), the CUSUM's reference @p cusum_k and decision
+ * threshold @p cusum_h (standard deviations of u); any pointer may be NULL. */
+RCB_API rcb_status rcb_monitor_thresholds(const rcb_monitor *mon, double *alpha,
+                                          double *threshold, double *cusum_k,
+                                          double *cusum_h);
+
+/* ---- state that survives a restart (issue #24) ----
+ *
+ * What the updates accumulate (the update count, each tracked parameter's
+ * CUSUM sums S+ and S-, the self-starting reference's weighted sums and
+ * whether it is frozen) saved into a caller's buffer and loaded into a
+ * monitor created again from the same baseline model, set-up and settings:
+ * the updates after the load then give bit for bit what the original
+ * monitor would have given (examples/firmware "reboots" mid-year and
+ * checks this). Format (version RCB_MONITOR_STATE_VERSION), every field
+ * little-endian whatever the host: "RCBM", version u32, size u32, tracked
+ * count u32, the model's fingerprint (u64 FNV-1a of the tracked names and
+ * baseline values and the candidates' places, and two weighted sums of
+ * |baseline model| over the set-up, compared to 1e-9 relative so that
+ * another BLAS's last bits do not refuse a state), the set-up's (u64 of its
+ * grid, speed, channels and commissioning values), the settings' (u64 of
+ * alpha, CUSUM k and h, noise, averages, re-linearisation, reweighting,
+ * tracked ranges), the update count u64, the reference-started flag u32,
+ * then per tracked parameter S+, S-, reference sum and weight (IEEE-754
+ * binary64) and the frozen flag, and last the CRC-32 (IEEE 802.3,
+ * reflected 0xEDB88320, as zlib's crc32) of everything before it. Neither
+ * call allocates. */
+
+/** @brief Format version of the saved state. */
+#define RCB_MONITOR_STATE_VERSION 1u
+
+/** @brief Bytes rcb_monitor_save writes for this monitor (76 + 40 per
+ * tracked parameter); 0 for a monitor not created successfully. */
+RCB_API size_t rcb_monitor_state_size(const rcb_monitor *mon);
+/**
+ * @brief Save the monitor's accumulated state into @p buf.
+ * @param size bytes available at @p buf
+ * @param written bytes written (rcb_monitor_state_size), may be NULL
+ * @return RCB_ERR_WORKSPACE when @p size is too small (nothing written),
+ * RCB_ERR_STATE for a monitor not created successfully
+ */
+RCB_API rcb_status rcb_monitor_save(const rcb_monitor *mon, void *buf, size_t size,
+                                    size_t *written);
+/**
+ * @brief Load a state saved by rcb_monitor_save into @p mon, created from
+ * the same baseline model, set-up and settings. All checks come before
+ * anything is changed: on any error the monitor is left as it was.
+ * @return RCB_ERR_CORRUPT (not a monitor state, truncated, or a CRC that
+ * does not match), RCB_ERR_VERSION (another format version),
+ * RCB_ERR_OTHER_MODEL (another baseline model or tracked parameters),
+ * RCB_ERR_OTHER_SETUP (another set-up or other settings); the message
+ * (rcb_monitor_errmsg) says which field differs
+ */
+RCB_API rcb_status rcb_monitor_load(rcb_monitor *mon, const void *buf, size_t size);
+/** @brief CRC-32 (IEEE 802.3, zlib's crc32) of @p n bytes continuing from
+ * @p crc (0 to start): the state's checksum, for hosts that store the state
+ * inside records of their own. */
+RCB_API unsigned long rcb_monitor_crc32(unsigned long crc, const void *data, size_t n);
 
 /* ---- statistics used by the monitor, pure functions ---- */
 

@@ -199,7 +199,10 @@ static void tracked_result(rcb_monitor *mon, const double *theta, const double *
     double se = sev[a], v, u = innovation(mon, a, theta[a], se, &v);
     t->value = mon->t0[a] + theta[a];
     t->stderr_ = se;
-    t->ci_lo = t->value - MON_Z95 * se, t->ci_hi = t->value + MON_Z95 * se;
+    t->abs_stderr = sqrt(se * se + mon->tbv[a]);
+    t->ci_lo = t->value - MON_Z95 * t->abs_stderr, t->ci_hi = t->value + MON_Z95 * t->abs_stderr;
+    t->change = theta[a];
+    t->change_lo = theta[a] - MON_Z95 * se, t->change_hi = theta[a] + MON_Z95 * se;
     t->z = theta[a] / se;
     t->u = u;
     mon->cus_up[a] = fmax(0.0, mon->cus_up[a] + u - mon->cusum_k);

@@ -321,6 +321,7 @@ static rcb_status buffers(rcb_monitor *mon) {
 }
 
 static rcb_status settings(rcb_monitor *mon, const rcb_monitor_opts *o) {
+  size_t k;
   mon->alpha = o->alpha > 0 ? o->alpha : 1e-3;
   mon->cusum_k = o->cusum_k > 0 ? o->cusum_k : 0.5;
   mon->cusum_h = o->cusum_h > 0 ? o->cusum_h : 8.0;
@@ -339,6 +340,12 @@ static rcb_status settings(rcb_monitor *mon, const rcb_monitor_opts *o) {
   if (mon->nt > RCB_MONITOR_MAX_TRACKED || (mon->nt && !o->tracked))
     return rcb_mon_fail(mon, RCB_ERR_ARG, "options: %zu tracked parameters (at most %d, and "
                         "opts.tracked must list them)", mon->nt, RCB_MONITOR_MAX_TRACKED);
+  for (k = 0; o->baseline_cov && k < mon->nt; k++) {
+    mon->tbv[k] = o->baseline_cov[k * mon->nt + k];
+    if (!(mon->tbv[k] >= 0) || !isfinite(mon->tbv[k]))
+      return rcb_mon_fail(mon, RCB_ERR_ARG, "options: baseline_cov[%zu][%zu] = %g: a variance "
+                          "must be finite >= 0 (parameter units^2)", k, k, mon->tbv[k]);
+  }
   return RCB_OK;
 }
 

@@ -111,6 +111,8 @@ struct rcb_monitor {
   double tlo[RCB_MONITOR_MAX_TRACKED], thi[RCB_MONITOR_MAX_TRACKED];
   double t0[RCB_MONITOR_MAX_TRACKED];   /* baseline values */
   double tse[RCB_MONITOR_MAX_TRACKED];  /* standard errors */
+  double tbv[RCB_MONITOR_MAX_TRACKED];  /* the baseline values' variances
+                                           (opts.baseline_cov's diagonal, 0: exact) */
   double *test;        /* nt x k row-major: tracked step = test y */
   double *tdir;        /* nt x k row-major: orthonormal basis of the tracked columns */
   double cus_up[RCB_MONITOR_MAX_TRACKED], cus_dn[RCB_MONITOR_MAX_TRACKED];

@@ -808,6 +808,30 @@ for t, b in zip(u[0]["tracked"], d["tracked"]):
 assert u[1]["T"] > 0 and u[1]["threshold"] > 0 and u[1]["dof"] >= 1, u[1]
 PY
   [ "$(grep -c -v '^#' "$W/log.csv")" -eq 3 ] || fail "log.csv: expected a header and 2 rows" ;;
+monitor_state)
+  # --state (issue #24): a series taken in three runs (3 files, then 1, then 1)
+  # writes the same log, byte for byte, as the one run over all 5; an update
+  # already in the state is refused and leaves the state as it was
+  M="--params coupling.C.kt,coupling.C.ct --noise 10,1 --relinearise 2"
+  for k in 0 1 2 3 4; do
+    run simulate "$MODEL" --frf --out C.A.x,C.A.y,C.B.x,C.B.y --in DA.x --fmin 100 --fmax 400 \
+      --points 61 --rpm 10000 --kind inertance --noise 10,1 --seed $((k + 1)) -o "$W/m$k.csv"
+    expect_rc 0
+  done
+  # shellcheck disable=SC2086 # $M is split into options on purpose
+  { run monitor "$MODEL" "$W/m0.csv" "$W/m1.csv" "$W/m2.csv" "$W/m3.csv" "$W/m4.csv" $M \
+      --log "$W/all.json"; expect_rc 0
+    run monitor "$MODEL" "$W/m0.csv" "$W/m1.csv" "$W/m2.csv" $M --state "$W/s.rcbmon"; expect_rc 0; }
+  run monitor "$MODEL" --state "$W/s.rcbmon" "$W/m3.csv"; expect_rc 0; out_has "after 2 updates"
+  cp "$W/s.rcbmon" "$W/s.orig"
+  cp "$W/m1.csv" "$W/again.csv"
+  run monitor "$MODEL" --state "$W/s.rcbmon" "$W/again.csv"; expect_rc 3; err_has "taken once"
+  cmp -s "$W/s.rcbmon" "$W/s.orig" || fail "a refused update changed the state"
+  usage monitor "$MODEL" --state "$W/s.rcbmon" --noise 5,1 "$W/m4.csv"; err_has "--noise"
+  run monitor "$MODEL" --state "$W/s.rcbmon" "$W/m4.csv" --log "$W/st.json"; expect_rc 0
+  cmp -s "$W/all.json" "$W/st.json" || fail "the state's log differs from the one-shot run's"
+  ls "$W" | grep -q 's.rcbmon.' && fail "temporary state left behind"
+  : ;;
 monitor_sd)
   # per-point sds: one --sd file for every update, or a directory of STEM_stats.csv
   # (each update's own sds); the same sds both ways must give the same statistics
@@ -903,6 +927,10 @@ history_not_history)
   done
   [ "$(wc -l <"$W/h.jsonl")" -eq 2 ] || fail "history should hold 2 steps"
   run history "$W/h.jsonl"; expect_rc 0; out_has "fit"
+  # reading: what is not a history is refused, naming the file and line
+  run history "$W/notes.txt"; expect_rc 3; err_has "notes.txt':1: not a history record"
+  { cat "$W/h.jsonl"; echo '{"update": 1, "file": "m1.uff"}'; } >"$W/mixed.jsonl"
+  run history "$W/mixed.jsonl"; expect_rc 3; err_has "mixed.jsonl':3"
   usage fit "$W/model.ini" "$W/meas.csv" --params coupling.C.kt --history "$W/new.ini" -o "$W/new.ini"
   err_has "the same file"; [ ! -e "$W/new.ini" ] || fail "wrote new.ini" ;;
 signal_removes_temporaries)

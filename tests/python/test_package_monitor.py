@@ -83,3 +83,29 @@ def test_package_and_rcbtool_agree(rcb, tmp_path):
         for ca, cb in zip(a["top"], b["top"]):
             assert ca["size"] == pytest.approx(cb["size"], rel=1e-12)
     assert py[-1]["alarm"]  # the cross-coupled day is a change
+
+
+def test_state_restart(rcb, tmp_path):
+    """save_state / load_state (issue #24): a second monitor loaded from the first's
+    state after 2 updates gives the first's next result exactly; bytes of another
+    model are refused."""
+    paths = _series(rcb, tmp_path)
+    with rcb.Model.from_ini(PAPER) as m, rcb.Meas.read(paths[0], uff_map=UFF_MAP) as setup:
+        def make():
+            return rcb.Monitor(m, setup, PARAMS, noise=(10, 1), alpha=0.01, baseline_sd=[5.0, 0.01])
+        with make() as a, make() as b:
+            for p in paths[1:3]:
+                with rcb.Meas.read(p, uff_map=UFF_MAP) as ms:
+                    a.update(ms)
+            state = a.save_state()
+            assert len(state) == 76 + 40 * len(PARAMS) and state[:4] == b"RCBM"
+            b.load_state(state)
+            with rcb.Meas.read(paths[3], uff_map=UFF_MAP) as ms:
+                ra, rb = a.update(ms), b.update(ms)
+            assert ra == rb and rb["update"] == 3
+            t = rb["tracked"][0]
+            assert t["abs_stderr"] == pytest.approx((t["stderr"] ** 2 + 25.0) ** 0.5, rel=1e-12)
+            bad = bytearray(state)
+            bad[40] ^= 1
+            with pytest.raises(rcb.RcbError):
+                b.load_state(bytes(bad))

@@ -104,6 +104,25 @@ static void values(const rcb_meas *ms, rcb_complex *v) {
   }
 }
 
+/* The state's save and load (each the mean of NSTATE calls), seconds. */
+#define NSTATE 200
+static int state_times(rcb_monitor *mon, double *ts, double *tl, size_t *n) {
+  static unsigned char buf[4096];
+  size_t i;
+  double t0 = now();
+  for (i = 0; i < NSTATE; i++)
+    if (rcb_monitor_save(mon, buf, sizeof buf, n)) return 1;
+  *ts = (now() - t0) / NSTATE;
+  t0 = now();
+  for (i = 0; i < NSTATE; i++)
+    if (rcb_monitor_load(mon, buf, *n)) {
+      fprintf(stderr, "load: %s\n", rcb_monitor_errmsg(mon));
+      return 1;
+    }
+  *tl = (now() - t0) / NSTATE;
+  return 0;
+}
+
 static int run(const rcb_model *m, const rcb_meas *setup, rcb_complex *const *noisy,
                const char *label, size_t relin, int reweight, size_t nupd, unsigned effects) {
   static unsigned char mem[64u << 20];
@@ -114,8 +133,8 @@ static int run(const rcb_model *m, const rcb_meas *setup, rcb_complex *const *no
   rcb_monitor_opts o;
   rcb_monitor *mon = NULL;
   rcb_monitor_result r;
-  size_t u, k = 0, kt = 0, alarms = 0;
-  double t0, tc, tu;
+  size_t u, k = 0, kt = 0, alarms = 0, nst = 0;
+  double t0, tc, tu, ts = 0, tl = 0;
   memset(&o, 0, sizeof o);
   o.ntracked = 1, o.tracked = &tp, o.beta_a = 2, o.beta_s = 2, o.setup_averages = 16;
   o.relinearise = relin, o.reweight = reweight, o.effects = effects;
@@ -142,11 +161,14 @@ static int run(const rcb_model *m, const rcb_meas *setup, rcb_complex *const *no
     alarms += (size_t)r.alarm;
   }
   tu = (now() - t0) / (double)nupd;
+  if (state_times(mon, &ts, &tl, &nst)) return 1;
   printf("%-24s create %5.3f s  bump arena %6.0f kB, heap peak %6.0f kB, kept %6.0f kB  "
          "k = %zu (%zu candidates)  update %7.3f ms  (%zu updates, %zu alarms%s)\n", label, tc,
          (double)ar.used / 1024.0, (double)hp.peak / 1024.0,
          (double)rcb_monitor_memory(mon) / 1024.0, k, rcb_monitor_candidate_count(mon), 1e3 * tu,
          nupd, alarms, rcb_monitor_fast_relinearise(mon) ? "; re-linearised without a sweep" : "");
+  printf("%-24s state %zu bytes: save %.1f us, load %.1f us (issue #24)\n", "", nst, 1e6 * ts,
+         1e6 * tl);
   rcb_monitor_destroy(mon);
   return 0;
 }

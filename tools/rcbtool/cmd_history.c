@@ -14,7 +14,9 @@ const char cli_help_history[] =
     "Prints the steps recorded in FILE by 'rcbtool fit --history FILE' and 'rcbtool\n"
     "diagnose --history FILE': command, model, error %, noise floor %, number of\n"
     "parameters, note; then draws the error falling, one bar per step.\n"
-    "FILE holds one JSON object per line; --json prints them as one JSON array.\n";
+    "FILE holds one JSON object per line; --json prints them as one JSON array.\n"
+    "A file with a line that is not such a record is refused (exit 3), naming the\n"
+    "line.\n";
 
 /* Escape a string for JSON (quotes, backslashes, control characters). */
 static void json_str(FILE *fp, const char *s) {
@@ -244,7 +246,7 @@ static void print_steps(char *text) {
 
 int cmd_history(int argc, char **argv) {
   cli_args a;
-  size_t len;
+  size_t len, bad;
   char *text;
   int rc = cli_parse(argc, argv, NULL, 0, &a);
   if (rc) return rc;
@@ -253,6 +255,13 @@ int cmd_history(int argc, char **argv) {
     return cli_usage(a.cmd, "missing the history file; expected rcbtool history FILE");
   if (!(text = slurp(a.model, &len)))
     return cli_fail(CLI_EXIT_INPUT, "history '%s': cannot read it", a.model);
+  if ((bad = first_bad_line(text, len)) != 0) {
+    free(text);
+    return cli_fail(CLI_EXIT_INPUT, "history '%s':%zu: not a history record (expected one JSON "
+                    "line per step with \"command\", \"model\" and \"error_pct\", as 'rcbtool "
+                    "fit --history' and 'rcbtool diagnose --history' write them); give a "
+                    "history file", a.model, bad);
+  }
   if (a.json) {
     char *line, *save = NULL;
     int first = 1;

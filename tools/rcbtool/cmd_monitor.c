@@ -19,9 +19,11 @@ const char cli_help_monitor[] =
     "usage: rcbtool monitor BASELINE.ini DIR|MEAS... --params NAME[:LO:HI],...\n"
     "                       [--noise A,S[,P] | --sd STATS.csv|DIR] [--commission N]\n"
     "                       [--alpha A] [--cusum-h H] [--cusum-k K] [--relinearise N]\n"
-    "                       [--reweight] [--map NODE=STATION,...] [--rpm R]\n"
+    "                       [--reweight] [--baseline-sd SD,...]\n"
+    "                       [--map NODE=STATION,...] [--rpm R]\n"
     "                       [--log OUT.json|OUT.csv] [--plot TREND.png] [--json]\n"
     "                       [-o FILE] [--progress]\n"
+    "       rcbtool monitor BASELINE.ini --state S.rcbmon [options] [NEW...]\n"
     "\n"
     "Condition monitoring against a fitted baseline model. The measurements are\n"
     "taken in time order: the files of DIR sorted by name (.uff, .unv, .uf, .csv;\n"
@@ -34,7 +36,9 @@ const char cli_help_monitor[] =
     "a chi-square test, at false-alarm rate --alpha per update, that nothing but\n"
     "the tracked parameters changed), the alarm flags (TEST: the instant test;\n"
     "CUSUM-/CUSUM+: a tracked parameter's two-sided CUSUM passed --cusum-h,\n"
-    "falling or rising), the tracked parameters with their 95 % intervals, and on\n"
+    "falling or rising), each tracked parameter's value with its 95 % interval\n"
+    "(the baseline's uncertainty included, --baseline-sd) and its change since the\n"
+    "baseline with its own 95 % interval (the noise of the change only), and on\n"
     "a TEST alarm the effect and place of the catalogue (as rcbtool diagnose)\n"
     "that explain the change best, with its size. See docs/monitoring.md.\n"
     "  --params LIST   parameters to track (fitted at commissioning, e.g.\n"
@@ -57,11 +61,24 @@ const char cli_help_monitor[] =
     "                  its --sd file), statistics by generalised least squares: T\n"
     "                  stays chi-square after a large change of the tracked\n"
     "                  parameters (a moved resonance); slower per update\n"
+    "  --baseline-sd L standard errors of the baseline's values of the --params, in\n"
+    "                  their order and units (the 'stderr' of the rcbtool fit that\n"
+    "                  made the baseline): they widen the values' intervals (the\n"
+    "                  changes' stay); default 0, the baseline taken as exact\n"
     "  --log FILE      every update as JSON (.json) or CSV (.csv), atomically\n"
     "  --plot FILE     the trend (.png, .pdf or .svg): tracked parameters with\n"
     "                  their 95 % bands, T/thr with the alarm line, alarms marked;\n"
     "                  Python 3 with matplotlib (RCB_PYTHON, RCB_PLOTS as compare)\n"
     "  --json          the log's JSON on standard output instead of the lines\n"
+    "  --state FILE    keep the series' state in FILE between runs. A new FILE: the\n"
+    "                  run as above, then FILE holds its settings, commissioning and\n"
+    "                  updates. An existing FILE: the settings and the commissioning\n"
+    "                  come from it (give no setting option), each NEW file is one\n"
+    "                  more update (a file whose content is already in the state is\n"
+    "                  refused), and FILE is replaced atomically (write, fsync,\n"
+    "                  rename; a crash leaves the previous state). --log and --plot\n"
+    "                  then cover the whole series, so with no NEW file they rebuild\n"
+    "                  them from the state\n"
     "Units: error, floor %; T and its threshold have no unit; parameters in SI\n"
     "(N/m, N s/m, N m/rad, N m s/rad, kg). Exit codes: 0 ok (alarms or not), 2\n"
     "usage, 3 bad input (a missing or empty DIR, a file whose channels, points or\n"
@@ -82,6 +99,25 @@ static int noise_opt(const cli_args *a, const char *opt, double *x, double *y, d
       !isfinite(*x) || !isfinite(*y) || !(*ph >= 0 && *ph < 90))
     return cli_usage(a->cmd, "option %s expects A,S[,P]: A, S >= 0 (%%), P phase noise "
                      "0 <= P < 90 (degrees), got '%s'", opt, s);
+  return 0;
+}
+
+/* --baseline-sd SD,...: one standard error >= 0 per tracked parameter. */
+static int baseline_sd_opt(const cli_args *a, mon_job *j) {
+  const char *s = cli_opt_value(a, "--baseline-sd"), *p = s;
+  size_t k;
+  if (!s) return 0;
+  for (k = 0; k < j->params.n; k++) {
+    char *end;
+    j->baseline_sd[k] = strtod(p, &end);
+    if (end == p || !(j->baseline_sd[k] >= 0) || !isfinite(j->baseline_sd[k]) ||
+        (k + 1 < j->params.n ? *end != ',' : *end != '\0'))
+      return cli_usage(a->cmd, "option --baseline-sd expects %zu standard errors >= 0 "
+                       "separated by ',' (one per --params entry, in its units), got '%s'",
+                       j->params.n, s);
+    p = end + 1;
+  }
+  j->have_baseline_sd = 1;
   return 0;
 }
 
@@ -115,6 +151,7 @@ static int parse_job(const cli_args *a, mon_job *j) {
   if ((cli_opt_value(a, "--cusum-h") && !(j->cusum_h > 0.0)) ||
       (cli_opt_value(a, "--cusum-k") && !(j->cusum_k > 0.0)))
     return cli_usage(a->cmd, "options --cusum-h and --cusum-k expect values > 0");
+  if ((rc = baseline_sd_opt(a, j))) return rc;
   if (cli_opt_value(a, "--noise") && j->sd_path)
     return cli_usage(a->cmd, "--noise and --sd exclude each other: give the eq. 19 model or "
                      "the per-point standard deviations");
@@ -242,15 +279,17 @@ static void split_series(int argc, char **argv, const cli_opt *opts, size_t nopt
 
 /* Every output (-o, --log, --plot) is checked against every input before any work. */
 static int guard_outputs(const cli_args *a, const mon_job *j) {
-  const char *outs[3];
+  enum { NOUT = 4 };
+  const char *outs[NOUT];
   size_t i, k;
   struct stat so, si;
   int rc;
   outs[0] = a->output;
   outs[1] = j->log;
   outs[2] = j->plot;
+  outs[3] = j->state;
   cli_input_add(a->model, "model");
-  for (k = 0; k < 3; k++) {
+  for (k = 0; k < NOUT; k++) {
     if (!outs[k] || strcmp(outs[k], "-") == 0) continue;
     if ((rc = cli_output_check(outs[k]))) return rc;
     if (stat(outs[k], &so) != 0) continue;
@@ -261,17 +300,92 @@ static int guard_outputs(const cli_args *a, const mon_job *j) {
                         "file '%s' (an input of this run); choose another output name",
                         outs[k], j->series.files[i]);
   }
-  for (k = 0; k < 3; k++)
-    for (i = k + 1; i < 3; i++)
+  for (k = 0; k < NOUT; k++)
+    for (i = k + 1; i < NOUT; i++)
       if (outs[k] && outs[i] && strcmp(outs[k], outs[i]) == 0 && strcmp(outs[k], "-") != 0)
-        return cli_usage(a->cmd, "-o, --log and --plot name the same file '%s'", outs[k]);
-  if (j->sd_path && (j->log || j->plot || a->output)) {
-    for (k = 0; k < 3; k++)
+        return cli_usage(a->cmd, "-o, --log, --plot and --state name the same file '%s'",
+                         outs[k]);
+  if (j->sd_path && (j->log || j->plot || a->output || j->state)) {
+    for (k = 0; k < NOUT; k++)
       if (outs[k] && stat(outs[k], &so) == 0 && stat(j->sd_path, &si) == 0 &&
           so.st_dev == si.st_dev && so.st_ino == si.st_ino)
         return cli_fail(CLI_EXIT_IO, "refusing to write the output '%s' over the --sd file",
                         outs[k]);
   }
+  return 0;
+}
+
+/* ---- --state: the settings' options kept in the state ---- */
+
+static const char *const SETTING_OPTS[] = {"--params", "--noise",  "--sd",     "--commission",
+                                           "--alpha",  "--cusum-h", "--cusum-k", "--relinearise",
+                                           "--reweight", "--map",  "--rpm", "--baseline-sd"};
+
+/* 1 + the number of strings @p argv[k] (with its value) takes when it is a
+ * setting option, else 0. */
+static int setting_at(int argc, char **argv, int k) {
+  size_t i, n;
+  for (i = 0; i < sizeof SETTING_OPTS / sizeof SETTING_OPTS[0]; i++) {
+    n = strlen(SETTING_OPTS[i]);
+    if (strncmp(argv[k], SETTING_OPTS[i], n) != 0) continue;
+    if (argv[k][n] == '=') return 2;
+    if (argv[k][n] != '\0') continue;
+    if (strcmp(SETTING_OPTS[i], "--reweight") == 0) return 2;
+    return k + 1 < argc ? 3 : 2;
+  }
+  return 0;
+}
+
+/* The value of --state on the command line (NULL without). */
+static const char *state_arg(int argc, char **argv) {
+  int k;
+  for (k = 1; k < argc; k++) {
+    if (strcmp(argv[k], "--") == 0) break;
+    if (strcmp(argv[k], "--state") == 0 && k + 1 < argc) return argv[k + 1];
+    if (strncmp(argv[k], "--state=", 8) == 0) return argv[k] + 8;
+  }
+  return NULL;
+}
+
+/* The setting options of argv into *out (pointers into argv), n of them. */
+static size_t settings_of(int argc, char **argv, char **out) {
+  int k, t;
+  size_t n = 0;
+  for (k = 1; k < argc; k++) {
+    if (strcmp(argv[k], "--") == 0) break;
+    if (!(t = setting_at(argc, argv, k))) continue;
+    out[n++] = argv[k];
+    if (t == 3) out[n++] = argv[++k];
+  }
+  return n;
+}
+
+/* With an existing state: its settings appended to the command line, which
+ * may give none of its own. *nargv the new count; 0 or an exit code. */
+static int with_saved(int argc, char **argv, const char *state, mon_saved *sv, char ***nargv,
+                      int *nargc) {
+  char **own = malloc(((size_t)argc + 1) * sizeof *own);
+  size_t n, k;
+  int rc;
+  if (!own) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  n = settings_of(argc, argv, own);
+  if (n) {
+    rc = cli_usage(argv[0], "--state '%s' exists and holds the series' settings: %s cannot be "
+                   "given again (give the new files, --log, --plot, --json or -o; a new "
+                   "state file starts a new series)", state, own[0]);
+    free(own);
+    return rc;
+  }
+  free(own);
+  if ((rc = mon_saved_read(argv[0], state, sv))) return rc;
+  if (!(*nargv = malloc(((size_t)argc + sv->nopts + 1) * sizeof **nargv)))
+    return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  /* right after the command, before any "--" */
+  (*nargv)[0] = argv[0];
+  *nargc = 1;
+  for (k = 0; k < sv->nopts; k++) (*nargv)[(*nargc)++] = sv->opts[k];
+  for (k = 1; k < (size_t)argc; k++) (*nargv)[(*nargc)++] = argv[k];
+  (*nargv)[*nargc] = NULL;
   return 0;
 }
 
@@ -285,38 +399,62 @@ int cmd_monitor(int argc, char **argv) {
                     {"--cusum-k", "K", NULL},
                     {"--relinearise", "N", NULL},
                     {"--reweight", NULL, NULL},
+                    {"--baseline-sd", "SD,...", NULL},
                     {"--map", "NODE=STATION,...", NULL},
                     {"--rpm", "R", NULL},
                     {"--log", "FILE", NULL},
-                    {"--plot", "FILE", NULL}};
+                    {"--plot", "FILE", NULL},
+                    {"--state", "FILE", NULL}};
   size_t nopts = sizeof opts / sizeof opts[0], nseries = 0, k;
   const char **series = NULL;
-  char **args = NULL;
+  char **args = NULL, **sargv = NULL;
   int nargs = 0, rc = 0;
   mon_job j;
+  mon_saved saved;
   cli_args a;
+  struct stat sst;
+  const char *state = state_arg(argc, argv);
   memset(&j, 0, sizeof j);
+  memset(&saved, 0, sizeof saved);
+  if (state && stat(state, &sst) == 0) {
+    if ((rc = with_saved(argc, argv, state, &saved, &sargv, &argc))) goto done;
+    argv = sargv;
+    j.saved = &saved;
+  }
   args = malloc(((size_t)argc + 1) * sizeof *args);
   series = malloc(((size_t)argc + 1) * sizeof *series);
-  if (!args || !series) {
+  j.setopts = malloc(((size_t)argc + 1) * sizeof *j.setopts);
+  if (!args || !series || !j.setopts) {
     rc = cli_fail(CLI_EXIT_NUMERIC, "out of memory");
     goto done;
   }
+  j.nsetopts = settings_of(argc, argv, j.setopts);
+  j.state = state;
   split_series(argc, argv, opts, nopts, args, &nargs, series, &nseries);
   if ((rc = cli_parse(nargs, args, opts, nopts, &a))) goto done;
   if (a.help) {
     rc = cli_print_help(cli_help_monitor);
     goto done;
   }
-  if (!nseries) {
+  if (!nseries && !j.saved) {
     rc = cli_usage(a.cmd, "missing the measurements: expected 'rcbtool monitor BASELINE.ini "
                    "DIR|MEAS...'");
     goto done;
   }
   if ((rc = parse_job(&a, &j))) goto done;
+  if (j.saved) { /* the series so far by name (the files need not be here any more) */
+    if (saved.ncomm != j.commission) {
+      rc = cli_fail(CLI_EXIT_INPUT, "%s: --state '%s': %zu commissioning files for "
+                    "--commission %zu: damaged", a.cmd, state, saved.ncomm, j.commission);
+      goto done;
+    }
+    for (k = 0; k < saved.ncomm && !rc; k++) rc = add_file(&j.series, NULL, saved.comm[k]);
+    for (k = 0; k < saved.nrec && !rc; k++) rc = add_file(&j.series, NULL, saved.recfile[k]);
+    j.resume = j.series.n;
+  }
   for (k = 0; k < nseries && !rc; k++) rc = mon_series_add(a.cmd, &j.series, series[k]);
   if (rc) goto done;
-  if (j.series.n <= j.commission) {
+  if (!j.saved && j.series.n <= j.commission) {
     rc = cli_usage(a.cmd, "%zu measurement file%s: the first %zu commission%s the reference "
                    "and none is left to monitor (--commission N takes the first N)",
                    j.series.n, j.series.n == 1 ? "" : "s", j.commission,
@@ -328,6 +466,9 @@ int cmd_monitor(int argc, char **argv) {
 done:
   if (j.have_params) cli_params_free(&j.params);
   mon_series_free(&j.series);
+  mon_saved_free(&saved);
+  free(sargv);
+  free(j.setopts);
   free(args);
   free((void *)series);
   return rc;

@@ -6,6 +6,8 @@
 #ifndef RCBTOOL_CMD_MONITOR_H
 #define RCBTOOL_CMD_MONITOR_H
 
+#include <stdint.h>
+
 #include "cli.h"
 
 /** The measurement files in time order (owned copies of the paths). */
@@ -13,6 +15,27 @@ typedef struct mon_series {
   char **files;
   size_t n, cap;
 } mon_series;
+
+/** One update as the log keeps it. */
+typedef struct mon_record {
+  size_t file;   /**< index into the series */
+  uint64_t hash; /**< FNV-1a 64 of the file's bytes (with --state) */
+  rcb_monitor_result r;
+} mon_record;
+
+/** A --state file read back (cmd_monitor_state.c), or one to write. */
+typedef struct mon_saved {
+  char **opts;     /**< the settings' options as first given (argv strings) */
+  size_t nopts;
+  char **comm;     /**< the commissioning files' names */
+  size_t ncomm;
+  rcb_meas *setup; /**< the set-up the monitor was created from (owned when read) */
+  unsigned char *blob; /**< rcb_monitor_save's bytes */
+  size_t nblob;
+  mon_record *rec; /**< the updates so far (file: index into recfile) */
+  char **recfile;
+  size_t nrec;
+} mon_saved;
 
 /** The command line of one run. */
 typedef struct mon_job {
@@ -24,16 +47,17 @@ typedef struct mon_job {
   double alpha, cusum_h, cusum_k; /**< 0: the library's defaults */
   double beta_a, beta_s;          /**< --noise, % */
   double phase_deg;               /**< --noise's third number, degrees */
+  double baseline_sd[RCB_MONITOR_MAX_TRACKED]; /**< --baseline-sd, parameter units */
+  int have_baseline_sd;
   const char *sd_path;            /**< --sd FILE or DIR, NULL */
   const char *log, *plot;         /**< --log, --plot, NULL */
   mon_series series;
+  const char *state;   /**< --state FILE, NULL */
+  mon_saved *saved;    /**< what it held (NULL: a new state) */
+  char **setopts;      /**< the settings' options of this command line (to store) */
+  size_t nsetopts;
+  size_t resume;       /**< first file of the series to update (0: after commissioning) */
 } mon_job;
-
-/** One update as the log keeps it. */
-typedef struct mon_record {
-  size_t file; /**< index into the series */
-  rcb_monitor_result r;
-} mon_record;
 
 /** A finished (or interrupted) run: what the outputs are written from. */
 typedef struct mon_state {
@@ -59,6 +83,18 @@ int mon_has_ext(const char *path, const char *ext);
 int mon_log_is_csv(const char *path);
 /** matplotlib's format for --plot FILE ("png", "pdf", "svg"), NULL otherwise. */
 const char *mon_plot_format(const char *path);
+
+/** Read a --state file (all of it checked: magic, version, CRC, layout); 0 or
+ * exit 3 naming the file and what is wrong. */
+int mon_saved_read(const char *cmd, const char *path, mon_saved *sv);
+void mon_saved_free(mon_saved *sv);
+/** Write @p sv to a temporary for @p path (written and fsync'ed; the caller
+ * renames it with cli_tmpfile_close); 0 or an exit code. */
+int mon_saved_write(const char *cmd, const char *path, mon_saved *sv, cli_tmpfile *t);
+/** fsync the directory holding @p path (after a rename into it; best effort). */
+void mon_sync_dir(const char *path);
+/** FNV-1a 64 of the bytes of @p path; *ok 0 when it cannot be read. */
+uint64_t mon_file_hash(const char *path, int *ok);
 
 /** Commission, update over the series, print; then the log and the plot. */
 int mon_run(const cli_args *a, const mon_job *j);

@@ -59,6 +59,10 @@ static void json_tracked(FILE *fp, const rcb_monitor_tracked *t, const char *nam
   json_key_num(fp, "value", t->value);
   json_key_num(fp, "ci_lo", t->ci_lo);
   json_key_num(fp, "ci_hi", t->ci_hi);
+  json_key_num(fp, "abs_stderr", t->abs_stderr);
+  json_key_num(fp, "change", t->change);
+  json_key_num(fp, "change_lo", t->change_lo);
+  json_key_num(fp, "change_hi", t->change_hi);
   json_key_num(fp, "stderr", t->stderr_);
   json_key_num(fp, "z", t->z);
   json_key_num(fp, "u", t->u);
@@ -96,8 +100,8 @@ static void json_update(FILE *fp, const mon_state *s, size_t k) {
 
 void mon_print_json(FILE *fp, const mon_state *s) {
   size_t k;
-  double alpha = s->nrec ? rcb_chi2_sf(s->rec[0].r.threshold, (double)s->rec[0].r.dof)
-                         : (double)NAN;
+  double alpha = NAN, cusum_k = NAN, cusum_h = NAN;
+  rcb_monitor_thresholds(s->mon, &alpha, NULL, &cusum_k, &cusum_h); /* the defaults resolved */
   fputs("{\"model\": ", fp);
   cli_json_str(fp, s->a->model);
   fputs(", \"commissioning\": [", fp);
@@ -110,8 +114,9 @@ void mon_print_json(FILE *fp, const mon_state *s) {
   fprintf(fp, ", \"channels\": %zu, \"points\": %zu, \"candidates\": %zu, \"rank\": %zu, "
           "\"rank_tracked\": %zu, \"memory_bytes\": %zu", s->channels, s->points,
           s->candidates, s->rank, s->rank_tracked, s->memory);
-  json_key_num(fp, "alpha", alpha); /* the rate the threshold stands for */
-  json_key_num(fp, "cusum_h", s->j->cusum_h > 0 ? s->j->cusum_h : (double)NAN);
+  json_key_num(fp, "alpha", alpha);
+  json_key_num(fp, "cusum_k", cusum_k);
+  json_key_num(fp, "cusum_h", cusum_h);
   fputs(", \"noise\": ", fp);
   if (s->j->sd_path)
     cli_json_str(fp, s->j->sd_path);
@@ -125,6 +130,7 @@ void mon_print_json(FILE *fp, const mon_state *s) {
     fputs(k ? ", {\"name\": " : "{\"name\": ", fp);
     cli_json_str(fp, s->j->params.items[k].name);
     json_key_num(fp, "baseline", base);
+    json_key_num(fp, "baseline_sd", s->j->have_baseline_sd ? s->j->baseline_sd[k] : 0.0);
     fputc('}', fp);
   }
   fputs("],\n\"updates\": [\n", fp);
@@ -162,7 +168,8 @@ static void csv_row(FILE *fp, const mon_state *s, size_t k) {
   csv_str(fp, flags);
   for (i = 0; i < r->ntracked; i++) {
     const rcb_monitor_tracked *t = &r->tracked[i];
-    const double tv[] = {t->value, t->ci_lo, t->ci_hi, t->z, t->u, t->cusum_down, t->cusum_up};
+    const double tv[] = {t->value,     t->ci_lo,  t->ci_hi,     t->z,         t->u,
+                         t->cusum_down, t->cusum_up, t->change, t->change_lo, t->change_hi};
     size_t q;
     for (q = 0; q < sizeof tv / sizeof tv[0]; q++) {
       fputc(',', fp);
@@ -193,8 +200,8 @@ static void print_csv(FILE *fp, const mon_state *s) {
         "cusum_alarm,flags", fp);
   for (k = 0; k < s->j->params.n; k++) {
     const char *n = s->j->params.items[k].name;
-    fprintf(fp, ",%s,%s ci_lo,%s ci_hi,%s z,%s u,%s cusum_down,%s cusum_up", n, n, n, n, n, n,
-            n);
+    fprintf(fp, ",%s,%s ci_lo,%s ci_hi,%s z,%s u,%s cusum_down,%s cusum_up,%s change,"
+            "%s change_lo,%s change_hi", n, n, n, n, n, n, n, n, n, n);
   }
   fputs(",top_effect,top_place,top_p_value\n", fp);
   for (k = 0; k < s->nrec; k++) csv_row(fp, s, k);

@@ -94,6 +94,8 @@ typedef struct mon_ctx {
   const mon_job *j;
   rcb_model *m;
   rcb_meas *setup; /* the first commissioning file, its values the average */
+  rcb_meas *avg;   /* with --commission N > 1: the set-up holding the average */
+  uint64_t *hash;  /* --state: the new files' content hashes */
   size_t n, nc, *perm;
   rcb_complex *values;
   double *sd;
@@ -133,12 +135,21 @@ static int read_file(mon_ctx *x, size_t k, rcb_meas **out) {
   return rc;
 }
 
+/* --state: the set-up the monitor was created from, kept in the state (the
+ * commissioning files need not be here any more). */
+static int restored_setup(mon_ctx *x) {
+  mon_saved *sv = x->j->saved;
+  x->setup = sv->setup;
+  sv->setup = NULL;
+  return 0;
+}
+
 /* The first --commission files: their average into the set-up's values. */
 static int commission(mon_ctx *x) {
   size_t k, i, nv;
   rcb_meas *ms = NULL;
-  int rc;
-  if ((rc = read_file(x, 0, &x->setup))) return rc;
+  int rc, saved = x->j->saved != NULL;
+  if ((rc = saved ? restored_setup(x) : read_file(x, 0, &x->setup))) return rc;
   x->n = rcb_meas_point_count(x->setup);
   x->nc = rcb_meas_channel_count(x->setup);
   nv = x->n * x->nc;
@@ -158,6 +169,7 @@ static int commission(mon_ctx *x) {
   }
   if (x->j->commission == 1) return 0;
   gather(x->setup, x->perm, x->nc, x->n, x->values);
+  if (saved) return 0; /* the average itself */
   for (k = 1; k < x->j->commission; k++) {
     rcb_complex *v = x->values;
     if ((rc = read_file(x, k, &ms))) return rc;
@@ -198,6 +210,7 @@ static int averaged_setup(mon_ctx *x, rcb_meas **out) {
 
 static int create_monitor(mon_ctx *x, rcb_monitor **mon) {
   rcb_monitor_param tp[RCB_MONITOR_MAX_TRACKED];
+  double cov[RCB_MONITOR_MAX_TRACKED * RCB_MONITOR_MAX_TRACKED];
   rcb_monitor_opts o;
   rcb_meas *avg = NULL;
   rcb_status st;
@@ -224,9 +237,15 @@ static int create_monitor(mon_ctx *x, rcb_monitor **mon) {
   o.setup_averages = (double)x->j->commission;
   o.relinearise = x->j->relinearise;
   o.reweight = x->j->reweight;
+  if (x->j->have_baseline_sd) { /* the fit's standard errors: the diagonal */
+    memset(cov, 0, sizeof cov);
+    for (k = 0; k < x->j->params.n; k++)
+      cov[k * x->j->params.n + k] = x->j->baseline_sd[k] * x->j->baseline_sd[k];
+    o.baseline_cov = cov;
+  }
   if (x->j->commission > 1 && (rc = averaged_setup(x, &avg))) return rc;
   st = rcb_monitor_create(mon, x->m, avg ? avg : x->setup, &o, NULL);
-  rcb_meas_destroy(avg);
+  x->avg = avg; /* kept for --state */
   if (st)
     return cli_fail(st == RCB_ERR_ARG || st == RCB_ERR_NOT_FOUND ? CLI_EXIT_INPUT
                                                                   : cli_status_exit(st),
@@ -243,9 +262,13 @@ static void print_header(FILE *fp, const mon_state *s) {
   if (s->j->commission > 1) fprintf(fp, " and the next %zu files (averaged)", s->j->commission - 1);
   fprintf(fp, "; %zu channels x %zu points; %zu candidate effects; monitor memory %zu bytes\n",
           s->channels, s->points, s->candidates, s->memory);
+  if (s->j->saved)
+    fprintf(fp, "# resumed from the state '%s' after %zu updates\n", s->j->state,
+            s->j->saved->nrec);
   fprintf(fp, "%6s  %-24s %8s %8s %8s  %-12s", "update", "file", "error %", "floor %", "T/thr",
           "alarms");
-  for (k = 0; k < s->j->params.n; k++) fprintf(fp, "  %s [95 %% CI]", s->j->params.items[k].name);
+  for (k = 0; k < s->j->params.n; k++)
+    fprintf(fp, "  %s value [95 %% CI] change [95 %% CI]", s->j->params.items[k].name);
   fputc('\n', fp);
 }
 
@@ -270,8 +293,9 @@ static void print_line(FILE *fp, const mon_state *s, const mon_record *rec) {
           base_name(s->j->series.files[rec->file]), r->error_pct, r->floor_pct,
           r->T / r->threshold, flags);
   for (k = 0; k < r->ntracked; k++)
-    fprintf(fp, "  %.6g [%.6g, %.6g]", r->tracked[k].value, r->tracked[k].ci_lo,
-            r->tracked[k].ci_hi);
+    fprintf(fp, "  %.6g [%.6g, %.6g] %+.4g [%+.4g, %+.4g]", r->tracked[k].value,
+            r->tracked[k].ci_lo, r->tracked[k].ci_hi, r->tracked[k].change,
+            r->tracked[k].change_lo, r->tracked[k].change_hi);
   if (r->alarm && r->ntop > 0) {
     const rcb_monitor_candidate *c = &r->top[0];
     rcb_monitor_candidate_info ci;
@@ -296,10 +320,38 @@ static int keep(mon_state *s, size_t file, const rcb_monitor_result *r) {
   return 0;
 }
 
+/* --state: every new file's content hash (x->hash[k - first]), checked
+ * before any update: a content the series already had (an update in the
+ * state, or an earlier file of this run) is refused. 0 or exit 3. */
+static int not_seen(mon_ctx *x, const mon_state *s, size_t first) {
+  size_t k, i, n = x->j->series.n - first;
+  int ok;
+  if (!(x->hash = calloc(n ? n : 1, sizeof *x->hash)))
+    return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  for (k = 0; k < n; k++) {
+    const char *path = x->j->series.files[first + k];
+    x->hash[k] = mon_file_hash(path, &ok);
+    if (!ok) return cli_fail(CLI_EXIT_INPUT, "%s: cannot read '%s'", x->a->cmd, path);
+    for (i = 0; i < s->nrec; i++)
+      if (s->rec[i].hash == x->hash[k])
+        return cli_fail(CLI_EXIT_INPUT, "%s: '%s' has the content of update %zu ('%s') of the "
+                        "series in --state '%s': an update is taken once; give only new "
+                        "measurements (nothing was changed)", x->a->cmd, path,
+                        s->rec[i].r.update, x->j->series.files[s->rec[i].file], x->j->state);
+    for (i = 0; i < k; i++)
+      if (x->hash[i] == x->hash[k])
+        return cli_fail(CLI_EXIT_INPUT, "%s: '%s' has the content of '%s' given before it: an "
+                        "update is taken once (nothing was changed)", x->a->cmd, path,
+                        x->j->series.files[first + i]);
+  }
+  return 0;
+}
+
 static int one_update(mon_ctx *x, mon_state *s, rcb_monitor *mon, size_t k) {
   rcb_meas *ms = NULL;
   rcb_monitor_result r;
   rcb_status st;
+  uint64_t hash = x->hash ? x->hash[k - (x->j->resume ? x->j->resume : x->j->commission)] : 0;
   int rc, have_sd = 0;
   if ((rc = read_file(x, k, &ms))) return rc;
   gather(ms, x->perm, x->nc, x->n, x->values);
@@ -309,7 +361,9 @@ static int one_update(mon_ctx *x, mon_state *s, rcb_monitor *mon, size_t k) {
   if ((st = rcb_monitor_update(mon, x->values, have_sd ? x->sd : NULL, &r)))
     return cli_fail(st == RCB_ERR_ARG ? CLI_EXIT_INPUT : cli_status_exit(st), "%s: '%s': %s",
                     x->a->cmd, x->j->series.files[k], cli_msg(rcb_monitor_errmsg(mon), st));
-  return keep(s, k, &r);
+  if ((rc = keep(s, k, &r))) return rc;
+  s->rec[s->nrec - 1].hash = hash;
+  return 0;
 }
 
 static void summary(FILE *fp, const mon_state *s) {
@@ -328,19 +382,21 @@ static void summary(FILE *fp, const mon_state *s) {
 
 static int updates(mon_ctx *x, mon_state *s, rcb_monitor *mon, cli_out *o) {
   cli_progress p;
-  size_t k, total = x->j->series.n - x->j->commission;
+  size_t first = x->j->resume ? x->j->resume : x->j->commission, k,
+         total = x->j->series.n - first;
   int rc = 0;
   memset(&p, 0, sizeof p);
+  if (x->j->state && (rc = not_seen(x, s, first))) return rc;
   /* on a terminal the lines are the progress: the counter only when they go elsewhere */
   if (x->a->progress || x->a->json || o->fp != stdout || !isatty(fileno(stdout)))
     cli_progress_start(&p, x->a, "monitor", "updates", total);
   if (!x->a->json) print_header(o->fp, s);
-  for (k = x->j->commission; k < x->j->series.n && !rc; k++) {
+  for (k = first; k < x->j->series.n && !rc; k++) {
     if (!(rc = one_update(x, s, mon, k)) && !x->a->json) {
       print_line(o->fp, s, &s->rec[s->nrec - 1]);
       if (o->fp == stdout) fflush(stdout);
     }
-    cli_progress_step(&p, k + 1 - x->j->commission);
+    cli_progress_step(&p, k + 1 - first);
   }
   cli_progress_end(&p);
   if (!rc && !x->a->json) summary(o->fp, s);
@@ -359,12 +415,68 @@ static void describe(mon_state *s, const mon_ctx *x, const rcb_monitor *mon) {
                : (double)NAN;
 }
 
+/* --state: the library's state loaded into the monitor just created and the
+ * series' records so far into s; 0 or exit 3 naming the state file. */
+static int resume(const mon_ctx *x, mon_state *s, rcb_monitor *mon) {
+  const mon_saved *sv = x->j->saved;
+  rcb_status st = rcb_monitor_load(mon, sv->blob, sv->nblob);
+  size_t k;
+  int rc;
+  if (st)
+    return cli_fail(CLI_EXIT_INPUT, "%s: --state '%s': %s%s", x->a->cmd, x->j->state,
+                    cli_msg(rcb_monitor_errmsg(mon), st),
+                    st == RCB_ERR_OTHER_MODEL ? " (give the baseline model the series was "
+                                                "started with)" : "");
+  for (k = 0; k < sv->nrec; k++) {
+    if ((rc = keep(s, sv->ncomm + k, &sv->rec[k].r))) return rc;
+    s->rec[s->nrec - 1].hash = sv->rec[k].hash;
+  }
+  return 0;
+}
+
+/* --state: the series' state written to a temporary (renamed by the caller). */
+static int save_state(const mon_ctx *x, const mon_state *s, const rcb_monitor *mon,
+                      cli_tmpfile *t) {
+  mon_saved sv;
+  char **names = NULL;
+  size_t k;
+  int rc;
+  memset(&sv, 0, sizeof sv);
+  sv.nblob = rcb_monitor_state_size(mon);
+  sv.blob = malloc(sv.nblob ? sv.nblob : 1);
+  sv.rec = malloc((s->nrec + 1) * sizeof *sv.rec);
+  names = malloc((s->nrec + 1) * sizeof *names);
+  if (!sv.blob || !sv.rec || !names || rcb_monitor_save(mon, sv.blob, sv.nblob, NULL)) {
+    rc = cli_fail(CLI_EXIT_NUMERIC, "%s: out of memory (state)", x->a->cmd);
+    goto done;
+  }
+  sv.opts = x->j->saved ? x->j->saved->opts : x->j->setopts;
+  sv.nopts = x->j->saved ? x->j->saved->nopts : x->j->nsetopts;
+  sv.comm = x->j->series.files;
+  sv.ncomm = x->j->commission;
+  sv.setup = x->avg ? x->avg : x->setup;
+  for (k = 0; k < s->nrec; k++) {
+    sv.rec[k] = s->rec[k];
+    names[k] = x->j->series.files[s->rec[k].file];
+  }
+  sv.recfile = names;
+  sv.nrec = s->nrec;
+  rc = mon_saved_write(x->a->cmd, x->j->state, &sv, t);
+done:
+  free(sv.blob);
+  free(sv.rec);
+  free(names);
+  return rc;
+}
+
 int mon_run(const cli_args *a, const mon_job *j) {
   mon_ctx x;
   mon_state s;
   rcb_monitor *mon = NULL;
   cli_out o;
+  cli_tmpfile st;
   int rc;
+  memset(&st, 0, sizeof st);
   memset(&x, 0, sizeof x);
   memset(&s, 0, sizeof s);
   memset(&o, 0, sizeof o);
@@ -372,6 +484,7 @@ int mon_run(const cli_args *a, const mon_job *j) {
   x.j = s.j = j;
   if ((rc = cli_load_model(a, &x.m))) return rc;
   if ((rc = commission(&x)) || (rc = create_monitor(&x, &mon))) goto done;
+  if (j->saved && (rc = resume(&x, &s, mon))) goto done;
   s.mon = mon;
   describe(&s, &x, mon);
   if ((rc = cli_out_open(&o, a))) goto done;
@@ -380,14 +493,27 @@ int mon_run(const cli_args *a, const mon_job *j) {
     goto done;
   }
   if (a->json) mon_print_json(o.fp, &s);
-  /* the log and the plot first: -o is renamed into place only when they are written */
-  if ((rc = cli_out_flush(&o)) || (rc = mon_write_outputs(&s))) {
+  /* the state written (fsync'ed) first, then the log and the plot, then the
+   * state and -o renamed into place only when all are written */
+  if (j->state && (rc = save_state(&x, &s, mon, &st))) {
     cli_out_abort(&o);
     goto done;
   }
+  if ((rc = cli_out_flush(&o)) || (rc = mon_write_outputs(&s))) {
+    if (j->state) cli_tmpfile_close(&st, 0);
+    cli_out_abort(&o);
+    goto done;
+  }
+  if (j->state && (rc = cli_tmpfile_close(&st, 1))) {
+    cli_out_abort(&o);
+    goto done;
+  }
+  if (j->state) mon_sync_dir(j->state);
   rc = cli_out_close(&o);
 done:
   rcb_monitor_destroy(mon);
+  rcb_meas_destroy(x.avg);
+  free(x.hash);
   rcb_meas_destroy(x.setup);
   rcb_model_destroy(x.m);
   free(x.perm);

@@ -172,7 +172,8 @@ class MonitorOpts(ctypes.Structure):
                 ("alpha", c_double), ("cusum_k", c_double), ("cusum_h", c_double),
                 ("beta_a", c_double), ("beta_s", c_double), ("sd", c_void_p),
                 ("setup_averages", c_double), ("effects", ctypes.c_uint), ("top", c_size_t),
-                ("relinearise", c_size_t), ("reweight", c_int), ("phase_deg", c_double)]
+                ("relinearise", c_size_t), ("reweight", c_int), ("phase_deg", c_double),
+                ("baseline_cov", c_void_p)]
 
 
 class MonitorCandidate(ctypes.Structure):
@@ -186,7 +187,9 @@ class MonitorTracked(ctypes.Structure):
     _fields_ = [("value", c_double), ("ci_lo", c_double), ("ci_hi", c_double),
                 ("stderr_", c_double), ("z", c_double), ("u", c_double),
                 ("cusum_up", c_double),
-                ("cusum_down", c_double), ("cusum_alarm", c_int), ("out_of_range", c_int)]
+                ("cusum_down", c_double), ("cusum_alarm", c_int), ("out_of_range", c_int),
+                ("abs_stderr", c_double), ("change", c_double), ("change_lo", c_double),
+                ("change_hi", c_double)]
 
 
 class MonitorResult(ctypes.Structure):
@@ -348,6 +351,9 @@ _PROTOTYPES = {
     "rcb_monitor_update": (c_int, [c_void_p, c_void_p, c_void_p,
                                    ctypes.POINTER(MonitorResult)]),
     "rcb_monitor_reset_cusum": (None, [c_void_p]),
+    "rcb_monitor_state_size": (c_size_t, [c_void_p]),
+    "rcb_monitor_save": (c_int, [c_void_p, c_void_p, c_size_t, ctypes.POINTER(c_size_t)]),
+    "rcb_monitor_load": (c_int, [c_void_p, c_void_p, c_size_t]),
     "rcb_monitor_point_count": (c_size_t, [c_void_p]),
     "rcb_monitor_memory": (c_size_t, [c_void_p]),
     "rcb_monitor_candidate_count": (c_size_t, [c_void_p]),

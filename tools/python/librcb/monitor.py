@@ -43,7 +43,8 @@ class Monitor(Handle):
     _errmsg = "rcb_monitor_errmsg"
 
     def __init__(self, model, setup, params, noise=None, sd=None, alpha=None, cusum_h=None,
-                 cusum_k=None, setup_averages=1, relinearise=0, reweight=False):
+                 cusum_k=None, setup_averages=1, relinearise=0, reweight=False,
+                 baseline_sd=None):
         """model: the fitted baseline (a Model); setup: the commissioning
         measurement (a Meas: channels, grid and the reference values); params:
         tracked parameter names or {name: (lo, hi)}; noise: eq. 19 (beta_a,
@@ -52,7 +53,9 @@ class Monitor(Handle):
         point), shape (channels, points), SI; alpha, cusum_h, cusum_k: None for
         the library's defaults; setup_averages: measurements averaged into setup;
         reweight: each update's noise from its own values (generalised least
-        squares: T stays chi-square after large changes; O(n k^2) per update)."""
+        squares: T stays chi-square after large changes; O(n k^2) per update);
+        baseline_sd: standard errors of the baseline's tracked values (the fit that
+        made it), which widen the values' intervals (the changes' stay)."""
         super().__init__()
         self._names = [r if ref is None else f"{r}/{ref}" for r, ref, _ in setup.channels]
         self._shape = (len(self._names), setup.n_points)
@@ -73,6 +76,12 @@ class Monitor(Handle):
         o.setup_averages = float(setup_averages)
         o.relinearise = int(relinearise)
         o.reweight = int(bool(reweight))
+        if baseline_sd is not None:
+            sdb = np.asarray(baseline_sd, dtype=float)
+            if sdb.shape != (len(tp),):
+                raise ValueError(f"baseline_sd: {sdb.shape}, expected {len(tp)} values")
+            self._cov = np.ascontiguousarray(np.diag(sdb ** 2))
+            o.baseline_cov = self._cov.ctypes.data
         self._create("rcb_monitor_create", model.handle, setup.handle, ctypes.byref(o), None)
         self.tracked = [self._tracked_info(k) for k in range(len(tp))]
 
@@ -113,6 +122,22 @@ class Monitor(Handle):
                 "place": _lib.text(info.place), "description": _lib.text(info.description),
                 "params": _lib.text(info.params)}
 
+    def save_state(self):
+        """The monitor's accumulated state (CUSUMs, references, update count) as
+        bytes: little-endian, versioned, with a CRC-32 (rcb_monitor_save)."""
+        n = _lib.lib().rcb_monitor_state_size(self.handle)
+        buf = ctypes.create_string_buffer(max(n, 1))
+        self.check(_lib.lib().rcb_monitor_save(self.handle, buf, n, None), "rcb_monitor_save")
+        return buf.raw[:n]
+
+    def load_state(self, state):
+        """Load bytes from save_state into this monitor, created from the same
+        model, set-up and options (else RcbError: another model, set-up, version,
+        or damaged data)."""
+        state = bytes(state)
+        self.check(_lib.lib().rcb_monitor_load(self.handle, state, len(state)),
+                   "rcb_monitor_load")
+
     def reset_cusum(self):
         _lib.lib().rcb_monitor_reset_cusum(self.handle)
 
@@ -134,7 +159,9 @@ class Monitor(Handle):
             tracked.append({"name": self.tracked[k]["name"], "value": t.value,
                             "ci_lo": t.ci_lo, "ci_hi": t.ci_hi, "stderr": t.stderr_,
                             "z": t.z, "u": t.u, "cusum_up": t.cusum_up, "cusum_down": t.cusum_down,
-                            "cusum_alarm": t.cusum_alarm, "out_of_range": bool(t.out_of_range)})
+                            "cusum_alarm": t.cusum_alarm, "out_of_range": bool(t.out_of_range),
+                            "abs_stderr": t.abs_stderr, "change": t.change,
+                            "change_lo": t.change_lo, "change_hi": t.change_hi})
         top = []
         for k in range(r.ntop):
             c = r.top[k]

@@ -1,0 +1,267 @@
+/*
+ * rcb_monitor's state that survives a restart (rcb_monitor.h, issue #24):
+ * the accumulated CUSUM and reference sums saved into a caller's buffer in
+ * a little-endian, versioned layout with a CRC-32, and loaded into a
+ * monitor created again from the same model, set-up and settings, checked
+ * by fingerprints. Neither direction allocates.
+ */
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "monitor/monitor_internal.h"
+
+#define ST_MAGIC "RCBM" /* 4 bytes, no terminator in the state */
+#define ST_HEAD 72u   /* bytes before the tracked parameters */
+#define ST_PER 40u    /* bytes per tracked parameter */
+#define ST_CRC 4u
+/* The model's response sums agree to this relative difference (another
+ * BLAS may change their last bits, never their 9th digit). */
+#define ST_SIG_TOL 1e-9
+
+/* ---- little-endian fields ---- */
+
+static void put_u32(unsigned char *p, uint32_t v) {
+  int i;
+  for (i = 0; i < 4; i++) p[i] = (unsigned char)(v >> (8 * i));
+}
+static void put_u64(unsigned char *p, uint64_t v) {
+  int i;
+  for (i = 0; i < 8; i++) p[i] = (unsigned char)(v >> (8 * i));
+}
+static void put_f64(unsigned char *p, double x) {
+  uint64_t v;
+  memcpy(&v, &x, sizeof v);
+  put_u64(p, v);
+}
+static uint32_t get_u32(const unsigned char *p) {
+  uint32_t v = 0;
+  int i;
+  for (i = 3; i >= 0; i--) v = (v << 8) | p[i];
+  return v;
+}
+static uint64_t get_u64(const unsigned char *p) {
+  uint64_t v = 0;
+  int i;
+  for (i = 7; i >= 0; i--) v = (v << 8) | p[i];
+  return v;
+}
+static double get_f64(const unsigned char *p) {
+  uint64_t v = get_u64(p);
+  double x;
+  memcpy(&x, &v, sizeof x);
+  return x;
+}
+
+/* CRC-32, IEEE 802.3 polynomial reflected (0xEDB88320), bit by bit: the
+ * state is a few hundred bytes, a table would cost more than it saves. */
+unsigned long rcb_monitor_crc32(unsigned long crc, const void *data, size_t n) {
+  const unsigned char *p = data;
+  uint32_t c = ~(uint32_t)crc;
+  size_t i;
+  int b;
+  for (i = 0; i < n; i++) {
+    c ^= p[i];
+    for (b = 0; b < 8; b++) c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
+  }
+  c = ~c;
+  return (unsigned long)c;
+}
+
+/* ---- fingerprints: FNV-1a 64 over values in a fixed byte order ---- */
+
+#define FNV_OFFSET 0xcbf29ce484222325ull
+#define FNV_PRIME 0x100000001b3ull
+
+static uint64_t fnv_bytes(uint64_t h, const void *data, size_t n) {
+  const unsigned char *p = data;
+  size_t i;
+  for (i = 0; i < n; i++) h = (h ^ p[i]) * FNV_PRIME;
+  return h;
+}
+static uint64_t fnv_u64(uint64_t h, uint64_t v) {
+  unsigned char b[8];
+  put_u64(b, v);
+  return fnv_bytes(h, b, 8);
+}
+static uint64_t fnv_f64(uint64_t h, double x) {
+  unsigned char b[8];
+  put_f64(b, x);
+  return fnv_bytes(h, b, 8);
+}
+static uint64_t fnv_str(uint64_t h, const char *s) {
+  return fnv_bytes(h, s ? s : "", (s ? strlen(s) : 0) + 1);
+}
+
+/* The tracked names and baseline values, the candidates (a structural
+ * change of the model changes them), and two sums of |baseline model|
+ * over the set-up's points (weights 1 and 1 + (p mod 7) / 7), compared with
+ * a tolerance. */
+static uint64_t model_hash(const rcb_monitor *mon, double sig[2]) {
+  uint64_t h = FNV_OFFSET;
+  size_t a, p;
+  h = fnv_u64(h, mon->nt);
+  for (a = 0; a < mon->nt; a++) h = fnv_f64(fnv_str(h, mon->tname[a]), mon->t0[a]);
+  h = fnv_u64(h, mon->ncand);
+  for (a = 0; a < mon->ncand; a++)
+    h = fnv_str(fnv_u64(h, (uint64_t)mon->cand[a].effect), mon->cand[a].place);
+  sig[0] = sig[1] = 0;
+  for (p = 0; p < mon->npt; p++) {
+    sig[0] += mon->h0abs[p];
+    sig[1] += mon->h0abs[p] * (1.0 + (double)(p % 7) / 7.0);
+  }
+  return h;
+}
+
+static uint64_t setup_hash(const rcb_monitor *mon) {
+  const double *x = rcb_meas_grid(mon->setup);
+  uint64_t h = FNV_OFFSET;
+  size_t c, i;
+  h = fnv_u64(h, (uint64_t)rcb_meas_get_type(mon->setup));
+  h = fnv_f64(fnv_u64(h, mon->npts), rcb_meas_speed(mon->setup));
+  for (i = 0; i < mon->npts; i++) h = fnv_f64(h, x[i]);
+  h = fnv_u64(h, mon->nch);
+  for (c = 0; c < mon->nch; c++) {
+    rcb_meas_channel_info ci;
+    rcb_meas_channel(mon->setup, c, &ci);
+    h = fnv_u64(fnv_str(fnv_str(h, ci.response), ci.reference), (uint64_t)ci.kind);
+  }
+  for (i = 0; i < mon->npt; i++) h = fnv_f64(fnv_f64(h, creal(mon->e0[i])), cimag(mon->e0[i]));
+  return h;
+}
+
+static uint64_t settings_hash(const rcb_monitor *mon) {
+  const double v[] = {mon->alpha, mon->cusum_k, mon->cusum_h, mon->beta_a, mon->beta_s,
+                      mon->navg_inv, mon->phase_var};
+  uint64_t h = FNV_OFFSET;
+  size_t i;
+  for (i = 0; i < sizeof v / sizeof v[0]; i++) h = fnv_f64(h, v[i]);
+  h = fnv_u64(fnv_u64(fnv_u64(h, mon->top), mon->relin), (uint64_t)mon->reweight);
+  for (i = 0; i < mon->nt; i++)
+    h = fnv_f64(fnv_f64(fnv_f64(h, mon->tlo[i]), mon->thi[i]), mon->tbv[i]);
+  h = fnv_u64(h, (uint64_t)mon->have_sd0);
+  for (i = 0; mon->have_sd0 && i < mon->npt; i++) h = fnv_f64(h, mon->sd0[i]);
+  return h;
+}
+
+static int ready(const rcb_monitor *mon) { return mon && mon->k > 0 && mon->y; }
+
+size_t rcb_monitor_state_size(const rcb_monitor *mon) {
+  return ready(mon) ? ST_HEAD + ST_PER * mon->nt + ST_CRC : 0;
+}
+
+rcb_status rcb_monitor_save(const rcb_monitor *mon, void *buf, size_t size, size_t *written) {
+  unsigned char *b = buf, *q;
+  size_t need = rcb_monitor_state_size(mon), a;
+  double sig[2];
+  if (written) *written = 0;
+  if (!need) return RCB_ERR_STATE;
+  if (!buf || size < need) return RCB_ERR_WORKSPACE;
+  memset(b, 0, need);
+  b[0] = 'R', b[1] = 'C', b[2] = 'B', b[3] = 'M';
+  put_u32(b + 4, RCB_MONITOR_STATE_VERSION);
+  put_u32(b + 8, (uint32_t)need);
+  put_u32(b + 12, (uint32_t)mon->nt);
+  put_u64(b + 16, model_hash(mon, sig));
+  put_f64(b + 24, sig[0]);
+  put_f64(b + 32, sig[1]);
+  put_u64(b + 40, setup_hash(mon));
+  put_u64(b + 48, settings_hash(mon));
+  put_u64(b + 56, (uint64_t)mon->updates);
+  put_u32(b + 64, (uint32_t)mon->ref_started);
+  for (a = 0, q = b + ST_HEAD; a < mon->nt; a++, q += ST_PER) {
+    put_f64(q, mon->cus_up[a]);
+    put_f64(q + 8, mon->cus_dn[a]);
+    put_f64(q + 16, mon->ref_sum[a]);
+    put_f64(q + 24, mon->ref_w[a]);
+    put_u32(q + 32, (uint32_t)mon->ref_frozen[a]);
+  }
+  put_u32(b + need - ST_CRC, (uint32_t)rcb_monitor_crc32(0, b, need - ST_CRC));
+  if (written) *written = need;
+  return RCB_OK;
+}
+
+static int sig_differs(double x, double y) {
+  return !(fabs(x - y) <= ST_SIG_TOL * fmax(fabs(x), fabs(y)));
+}
+
+/* The header's checks, in the order a reader needs them: what it is, its
+ * version (a newer layout may move everything after it), its integrity, and
+ * then whose it is. */
+static rcb_status check(rcb_monitor *mon, const unsigned char *b, size_t size) {
+  size_t need = rcb_monitor_state_size(mon), len;
+  uint32_t ver;
+  double sig[2];
+  if (size < 16 || memcmp(b, ST_MAGIC, 4) != 0)
+    return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: %zu bytes that do not begin with '%s': "
+                        "not a monitor state (rcb_monitor_save)", size, ST_MAGIC);
+  if ((ver = get_u32(b + 4)) != RCB_MONITOR_STATE_VERSION)
+    return rcb_mon_fail(mon, RCB_ERR_VERSION, "state: format version %lu, this library reads "
+                        "version %u; replay the series to rebuild it", (unsigned long)ver,
+                        RCB_MONITOR_STATE_VERSION);
+  len = get_u32(b + 8);
+  if (len < ST_HEAD + ST_CRC || len > size)
+    return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: it says %zu bytes, %zu were given "
+                        "(truncated)", len, size);
+  if (get_u32(b + len - ST_CRC) != (uint32_t)rcb_monitor_crc32(0, b, len - ST_CRC))
+    return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: CRC-32 does not match (the %zu bytes "
+                        "were changed or damaged)", len);
+  if (get_u32(b + 12) != mon->nt || len != need)
+    return rcb_mon_fail(mon, RCB_ERR_OTHER_MODEL, "state: %lu tracked parameters, this "
+                        "monitor tracks %zu", (unsigned long)get_u32(b + 12), mon->nt);
+  if (get_u64(b + 16) != model_hash(mon, sig) || sig_differs(get_f64(b + 24), sig[0]) ||
+      sig_differs(get_f64(b + 32), sig[1]))
+    return rcb_mon_fail(mon, RCB_ERR_OTHER_MODEL, "state: saved from another baseline model "
+                        "(tracked parameters, their baseline values, the candidate effects "
+                        "or the model's response differ); create the monitor from the model "
+                        "the state was saved with");
+  if (get_u64(b + 40) != setup_hash(mon))
+    return rcb_mon_fail(mon, RCB_ERR_OTHER_SETUP, "state: saved with another set-up "
+                        "(channels, points, speed or commissioning values differ)");
+  if (get_u64(b + 48) != settings_hash(mon))
+    return rcb_mon_fail(mon, RCB_ERR_OTHER_SETUP, "state: saved with other settings (alpha, "
+                        "CUSUM k or h, noise, averages, re-linearisation, reweighting or "
+                        "tracked ranges differ)");
+  return RCB_OK;
+}
+
+rcb_status rcb_monitor_load(rcb_monitor *mon, const void *buf, size_t size) {
+  const unsigned char *b = buf, *q;
+  size_t a;
+  rcb_status st;
+  if (!mon) return RCB_ERR_ARG;
+  if (!ready(mon))
+    return rcb_mon_fail(mon, RCB_ERR_STATE, "rcb_monitor_load: the monitor was not created "
+                        "successfully");
+  if (!buf) return rcb_mon_fail(mon, RCB_ERR_ARG, "rcb_monitor_load: no buffer");
+  if ((st = check(mon, b, size))) return st;
+  for (a = 0, q = b + ST_HEAD; a < mon->nt; a++, q += ST_PER) {
+    double v[4];
+    size_t i;
+    for (i = 0; i < 4; i++) v[i] = get_f64(q + 8 * i);
+    if (!(v[0] >= 0) || !(v[1] >= 0) || isnan(v[2]) || !(v[3] >= 0) || get_u32(q + 32) > 1)
+      return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: tracked parameter %zu: CUSUM %g, %g, "
+                          "reference %g / %g: not a state the monitor writes", a + 1, v[0],
+                          v[1], v[2], v[3]);
+  }
+  mon->updates = (size_t)get_u64(b + 56);
+  mon->ref_started = get_u32(b + 64) != 0;
+  for (a = 0, q = b + ST_HEAD; a < mon->nt; a++, q += ST_PER) {
+    mon->cus_up[a] = get_f64(q);
+    mon->cus_dn[a] = get_f64(q + 8);
+    mon->ref_sum[a] = get_f64(q + 16);
+    mon->ref_w[a] = get_f64(q + 24);
+    mon->ref_frozen[a] = get_u32(q + 32) != 0;
+  }
+  return RCB_OK;
+}
+
+rcb_status rcb_monitor_thresholds(const rcb_monitor *mon, double *alpha, double *threshold,
+                                  double *cusum_k, double *cusum_h) {
+  if (!ready(mon)) return RCB_ERR_STATE;
+  if (alpha) *alpha = mon->alpha;
+  if (threshold) *threshold = mon->threshold;
+  if (cusum_k) *cusum_k = mon->cusum_k;
+  if (cusum_h) *cusum_h = mon->cusum_h;
+  return RCB_OK;
+}
