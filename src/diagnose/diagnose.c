@@ -1463,31 +1463,47 @@ static int node_placed(const rcb_diag *d, long node, int element) {
 /* Candidate c, one parameter, acting where the misfit is placed: its
  * objective on a grid across its bounds (one sweep each, the base
  * parameters where the base fit left them), then a fit from the best grid
- * point with the base parameters; kept when it ends below its refit. */
-static rcb_status placed_refit(rcb_diag *d, diag_cand *c) {
+ * point with the base parameters. On a frequency subset w (32 x 1101) the
+ * grid and that fit are screens: the result is evaluated on all points,
+ * and polished there (RCB_DIAG_POLISH_ITER) only when it then leads every
+ * refit. Kept when it ends below the candidate's own refit. */
+static rcb_status placed_refit(rcb_diag *d, diag_cand *c, const double *w) {
   const rcb_model *from = d->far && d->nom_model ? d->nom_model : d->base_model;
   rcb_model *m = NULL;
   rcb_fit *f = NULL;
   double *r = rcb_alloc(&d->alloc, (d->nres ? d->nres : 1) * sizeof *r), bestF = HUGE_VAL;
-  double bestv = NAN;
+  double bestv = NAN, F = HUGE_VAL, err = NAN;
   rcb_fit_report rep;
-  size_t g, i;
+  size_t g, i, n = 0;
+  int polished = !w;
   rcb_status st = r ? rcb_diag_candidate_model(d, c, from, &m) : RCB_ERR_NOMEM;
   if (!st) st = make_fit(d, m, FIT_BASE, c, &f);
+  if (!st) st = rcb_fit_set_weights(f, w);
   for (g = 0; !st && g < RCB_DIAG_PLACED_GRID; g++) {
-    double t = (double)g / (RCB_DIAG_PLACED_GRID - 1), v, F = 0.0;
+    double t = (double)g / (RCB_DIAG_PLACED_GRID - 1), v, Fg = 0.0;
     v = c->logp[0] ? c->lo[0] * pow(c->hi[0] / c->lo[0], t) : c->lo[0] + t * (c->hi[0] - c->lo[0]);
     if (rcb_model_set_param(m, c->pname[0], v) || rcb_fit_residuals(f, r)) continue;
-    for (i = 0; i < d->nres; i++) F += r[i] * r[i];
-    if (F < bestF) bestF = F, bestv = v;
+    n = rcb_fit_residual_count(f);
+    for (i = 0; i < n; i++) Fg += r[i] * r[i];
+    if (Fg < bestF) bestF = Fg, bestv = v;
   }
   d->stats.refits += !st;
-  if (!st && isfinite(bestv) && !rcb_model_set_param(m, c->pname[0], bestv) &&
-      !rcb_fit_set_starts(f, 1, 1) && !rcb_fit_run(f) && !rcb_fit_get_report(f, &rep) &&
-      (!c->refitted || rep.objective < c->F)) {
-    c->from_fit = 1;
-    refit_result(d, c, &m, f, rep.objective, rep.error_pct, 1);
+  if (st || !isfinite(bestv) || rcb_model_set_param(m, c->pname[0], bestv) ||
+      rcb_fit_set_starts(f, 1, 1) || screen(f, w, RCB_DIAG_SCREEN_ITER))
+    goto done;
+  if (w) { /* on all points where the screen ended; polished when it leads */
+    if (rcb_fit_set_weights(f, NULL) || objective(d, f, r, &F, &err)) goto done;
+    if (F < d->best_F && !polish(f) && !rcb_fit_get_report(f, &rep))
+      F = rep.objective, err = rep.error_pct, polished = 1;
+  } else if (!rcb_fit_get_report(f, &rep)) {
+    F = rep.objective, err = rep.error_pct;
   }
+  if (isfinite(F) && (!c->refitted || F < c->F)) {
+    c->from_fit = 1;
+    refit_result(d, c, &m, f, F, err, polished);
+    if (F < d->best_F) d->best_F = F;
+  }
+done:
   if (f) drop_fit(d, f);
   rcb_model_destroy(m);
   rcb_free(&d->alloc, r);
@@ -1502,15 +1518,18 @@ static rcb_status placed_refits(rcb_diag *d) {
   size_t k;
   rcb_status st = RCB_OK;
   if (!d->nplace || d->place[0].share_pct < RCB_DIAG_PLACE_LOCAL) return RCB_OK;
+  double *w = NULL;
   for (k = 0; k < d->ncand; k++)
     if (d->cand[k].refitted && d->cand[k].claim == RCB_CLAIM_EXPLAINS) return RCB_OK;
+  if ((st = subset(d, &w))) return st;
   for (k = 0; !st && k < d->ncand; k++) {
     diag_cand *c = &d->cand[k];
     if (c->np != 1 || c->refit_only || (c->fam->flags & (DIAG_FAM_CHAIN | DIAG_FAM_ADDS_DOFS)) ||
         !node_placed(d, cand_node(d, c), strncmp(c->pname[0], "shaft.", 6) == 0))
       continue;
-    st = placed_refit(d, c);
+    st = placed_refit(d, c, w);
   }
+  rcb_free(&d->alloc, w);
   if (!st) sort_order(d);
   return st;
 }
