@@ -1511,14 +1511,21 @@ done:
 }
 
 /* When no candidate explains the data and equivalent loads place the
- * misfit at a node (locate.c), every one-parameter model candidate acting
- * there is fitted from a grid across its bounds (placed_refit), and the
- * candidates ranked again: place first, then name. */
+ * misfit at a node (locate.c; a span of at most RCB_DIAG_PLACED_SPAN
+ * nodes), every one-parameter model candidate acting there is fitted from a
+ * grid across its bounds (placed_refit), and the candidates ranked again:
+ * place first, then name. A wider span places nothing one can name (two
+ * effects at once: round 1 of the crack and B2 cross-coupling on 32 x 1101
+ * spans nodes #0-#10, whose 40 candidates took 33 s of CPU to name none). */
+#define RCB_DIAG_PLACED_SPAN 3
 static rcb_status placed_refits(rcb_diag *d) {
   size_t k;
   rcb_status st = RCB_OK;
   if (!d->nplace || d->place[0].share_pct < RCB_DIAG_PLACE_LOCAL) return RCB_OK;
   double *w = NULL;
+  size_t nspan = 0;
+  for (k = 0; k < d->nplace; k++) nspan += d->place[k].in_span != 0;
+  if (nspan > RCB_DIAG_PLACED_SPAN) return RCB_OK;
   for (k = 0; k < d->ncand; k++)
     if (d->cand[k].refitted && d->cand[k].claim == RCB_CLAIM_EXPLAINS) return RCB_OK;
   if ((st = subset(d, &w))) return st;
