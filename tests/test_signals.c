@@ -404,6 +404,67 @@ static void test_wav(void **state) {
   rcb_signals_destroy(s);
 }
 
+/* Keep the first @p keep bytes of @p path; with @p data_claim nonzero, also
+ * set the data chunk's size field (byte 40 of write_wav's header) to it. */
+static void cut_file(const char *path, size_t keep, unsigned long data_claim) {
+  unsigned char b[256];
+  size_t n;
+  FILE *fp = fopen(path, "rb");
+  assert_non_null(fp);
+  n = fread(b, 1, sizeof b, fp);
+  fclose(fp);
+  assert_true(keep <= n);
+  if (data_claim) put_le(b + 40, data_claim, 4);
+  fp = fopen(path, "wb");
+  assert_non_null(fp);
+  assert_int_equal(fwrite(b, 1, keep, fp), keep);
+  fclose(fp);
+}
+
+/* Issue #25 item 3: a WAV file cut short, cut mid-frame, or whose data chunk
+ * claims more than the file holds is refused with the byte counts (it was
+ * read silently from what was there); allowed, its whole frames are read
+ * with a warning that gives the counts. 16-bit stereo: 4-byte frames. */
+static void test_wav_truncated(void **state) {
+  const char *p = rcb_test_tmp_path("cut.wav");
+  long pcm[8] = {100, -100, 200, -200, 300, -300, 400, -400};
+  rcb_signals *s;
+  const double *v;
+  (void)state;
+  assert_int_equal(rcb_signals_create(&s, NULL), RCB_OK);
+  /* 4 frames (16 bytes) claimed, 1 frame and 2 bytes present */
+  write_wav(p, 1, 16, pcm, NULL, 4);
+  cut_file(p, 44 + 6, 0);
+  assert_int_equal(rcb_signals_read_wav(s, p, 0, NULL, NULL, NULL), RCB_ERR_PARSE);
+  assert_non_null(strstr(rcb_signals_errmsg(s), "claims 16 bytes, the file holds 6"));
+  assert_non_null(strstr(rcb_signals_errmsg(s), "1 whole frames"));
+  assert_int_equal(rcb_signals_channel_count(s), 0);
+  assert_int_equal(rcb_signals_set_allow_truncated(s, 1), RCB_OK);
+  assert_int_equal(rcb_signals_read_wav(s, p, 0, NULL, NULL, NULL), RCB_OK);
+  assert_int_equal(rcb_signals_length(s), 1);
+  rcb_signals_channel(s, 1, NULL, NULL, &v);
+  assert_true(v[0] == -100.0 / 32768.0);
+  assert_int_equal(rcb_signals_warning_count(s), 1);
+  assert_non_null(strstr(rcb_signals_warning(s, 0), "claims 16 bytes, the file holds 6"));
+  /* the header says 6 bytes and 6 are there: cut mid-frame */
+  assert_int_equal(rcb_signals_set_allow_truncated(s, 0), RCB_OK);
+  write_wav(p, 1, 16, pcm, NULL, 4);
+  cut_file(p, 44 + 6, 6);
+  assert_int_equal(rcb_signals_read_wav(s, p, 0, NULL, NULL, NULL), RCB_ERR_PARSE);
+  assert_non_null(strstr(rcb_signals_errmsg(s), "6 bytes ends 2 bytes into a frame of 4"));
+  /* a streaming writer's placeholder: 0xFFFFFFFF bytes claimed, all 4 frames there */
+  write_wav(p, 1, 16, pcm, NULL, 4);
+  cut_file(p, 44 + 16, 0xFFFFFFFFUL);
+  assert_int_equal(rcb_signals_read_wav(s, p, 0, NULL, NULL, NULL), RCB_ERR_PARSE);
+  assert_non_null(strstr(rcb_signals_errmsg(s), "claims 4294967295 bytes, the file holds 16"));
+  /* the whole file reads with no warning */
+  write_wav(p, 1, 16, pcm, NULL, 4);
+  assert_int_equal(rcb_signals_read_wav(s, p, 0, NULL, NULL, NULL), RCB_OK);
+  assert_int_equal(rcb_signals_length(s), 4);
+  assert_int_equal(rcb_signals_warning_count(s), 0);
+  rcb_signals_destroy(s);
+}
+
 static void test_units_table(void **state) {
   rcb_quantity q;
   double f;
@@ -416,6 +477,29 @@ static void test_units_table(void **state) {
   assert_int_equal(q, RCB_QTY_ACCELERATION);
   assert_int_equal(rcb_unit_parse("Mm", &q, &f), -1);
   assert_string_equal(rcb_quantity_name(RCB_QTY_VELOCITY), "velocity");
+  /* vendor labels (issue #25): m/s² in UTF-8 and in Latin-1, Pa, in, in/s, lbf */
+  assert_int_equal(rcb_unit_parse("m/s\xc2\xb2", &q, &f), 0);
+  assert_true(q == RCB_QTY_ACCELERATION && f == 1.0);
+  assert_int_equal(rcb_unit_parse("m/s\xb2", &q, &f), 0);
+  assert_true(q == RCB_QTY_ACCELERATION && f == 1.0);
+  assert_int_equal(rcb_unit_parse("Pa", &q, &f), 0);
+  assert_true(q == RCB_QTY_PRESSURE && f == 1.0);
+  assert_int_equal(rcb_unit_parse("in", &q, &f), 0);
+  assert_true(q == RCB_QTY_DISPLACEMENT && f == 0.0254);
+  assert_int_equal(rcb_unit_parse("in/s", &q, &f), 0);
+  assert_true(q == RCB_QTY_VELOCITY && f == 0.0254);
+  assert_int_equal(rcb_unit_parse("lbf", &q, &f), 0);
+  assert_true(q == RCB_QTY_FORCE && fabs(f - 0.45359237 * 9.80665) < 1e-15);
+  {
+    char list[512];
+    size_t n = rcb_unit_list(list, sizeof list);
+    assert_true(n < sizeof list && strlen(list) == n);
+    assert_non_null(strstr(list, "m/s^2"));
+    assert_non_null(strstr(list, ", Pa"));
+    assert_null(strstr(list, "m/s2")); /* aliases are not listed */
+    assert_int_equal(rcb_unit_list(list, 4), n);
+    assert_int_equal(strlen(list), 3);
+  }
 }
 
 /* ---- units of FRF files (UFF 164, record-9/10 labels) ---- */
@@ -630,6 +714,7 @@ int main(void) {
       cmocka_unit_test(test_workspace),
       cmocka_unit_test(test_csv_units),
       cmocka_unit_test(test_wav),
+      cmocka_unit_test(test_wav_truncated),
       cmocka_unit_test(test_units_table),
       cmocka_unit_test(test_frf_units),
       cmocka_unit_test(test_order_runup),

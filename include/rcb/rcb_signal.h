@@ -36,19 +36,28 @@ typedef enum rcb_quantity {
   RCB_QTY_VELOCITY = 2,     /**< m/s */
   RCB_QTY_ACCELERATION = 3, /**< m/s^2 */
   RCB_QTY_FORCE = 4,        /**< N */
-  RCB_QTY_VOLTAGE = 5       /**< V (keyphasor, uncalibrated sensor) */
+  RCB_QTY_VOLTAGE = 5,      /**< V (keyphasor, uncalibrated sensor) */
+  RCB_QTY_PRESSURE = 6      /**< Pa (a microphone or pressure transducer: read, not a
+                                 response the rotor model predicts) */
 } rcb_quantity;
 
 /**
- * @brief Parse a unit label ("m", "mm", "um", "mil", "m/s", "mm/s", "in/s",
- * "m/s^2", "m/s2", "g", "N", "kN", "lbf", "V", "mV"; case-sensitive where it
- * matters: "mm" vs "Mm" is not guessed).
+ * @brief Parse a unit label ("m", "mm", "um", "mil", "in", "m/s", "mm/s",
+ * "in/s", "m/s^2", "m/s2", "m/s²" (UTF-8 or Latin-1 ²), "g", "N", "kN", "lbf",
+ * "V", "mV", "Pa", "kPa"; the full list: rcb_unit_list; case-sensitive where
+ * it matters: "mm" vs "Mm" is not guessed).
  * @param to_si factor: SI value = file value * to_si
  * @return 0, or -1 if the label is not a unit librcb knows.
  */
 RCB_API int rcb_unit_parse(const char *label, rcb_quantity *q, double *to_si);
 /** @brief "displacement", "velocity", ... (never NULL). */
 RCB_API const char *rcb_quantity_name(rcb_quantity q);
+/**
+ * @brief The unit labels rcb_unit_parse knows, comma separated, into @p buf
+ * (NUL-terminated, cut to @p size; for messages and --help).
+ * @return the length of the whole list (as snprintf)
+ */
+RCB_API size_t rcb_unit_list(char *buf, size_t size);
 
 /* ---------------------------------------------------------- signals -- */
 
@@ -78,6 +87,26 @@ RCB_API rcb_status rcb_signals_channel(const rcb_signals *s, size_t i, const cha
                                        rcb_quantity *q, const double **values);
 /** @brief Index of the channel named @p name, or RCB_ERR_NOT_FOUND. */
 RCB_API rcb_status rcb_signals_find(const rcb_signals *s, const char *name, size_t *index);
+
+/**
+ * @brief Whether the readers accept a truncated file (default 0: refused).
+ * A WAV data chunk that claims more bytes than the file holds, or that ends
+ * inside a frame, is refused with the byte counts; with @p allow nonzero the
+ * whole frames present are read and a warning (rcb_signals_warning) says so.
+ */
+RCB_API rcb_status rcb_signals_set_allow_truncated(rcb_signals *s, int allow);
+/**
+ * @brief Give channel @p name the unit @p unit (a label rcb_unit_parse
+ * knows), for files whose label is missing or not known (UFF records: the
+ * name as the reader forms it, "STATION.DIR" or "#NODE.DIR"). Kept for every
+ * later read; RCB_ERR_ARG for an unknown unit.
+ */
+RCB_API rcb_status rcb_signals_set_unit(rcb_signals *s, const char *name, const char *unit);
+/** @brief Warnings of the last read: what was read but may not be what the
+ * file means, and what was skipped (a UFF record the model cannot use). */
+RCB_API size_t rcb_signals_warning_count(const rcb_signals *s);
+/** @brief Warning @p i of the last read ("" out of range). */
+RCB_API const char *rcb_signals_warning(const rcb_signals *s, size_t i);
 
 /**
  * @brief Read CSV: optional "# units = U1,U2,..." line (one unit per channel

@@ -242,7 +242,7 @@ rcb_status rcb_signals_read_csv(rcb_signals *s, const char *path) {
   size_t len;
   rcb_status st;
   if (!s) return RCB_ERR_ARG;
-  rcb_signals_empty(s);
+  rcb_signals_begin_read(s);
   if ((st = rcb_signals_slurp(s, path, &buf, &len))) return st;
   C = rcb_alloc(&s->alloc, sizeof *C);
   if (!C) {

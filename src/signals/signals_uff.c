@@ -52,7 +52,7 @@ rcb_status rcb_signals_read_uff(rcb_signals *s, const char *path, size_t nmap,
   uff_ctx c;
   rcb_status st;
   if (!s) return RCB_ERR_ARG;
-  rcb_signals_empty(s);
+  rcb_signals_begin_read(s);
   if (rcb_meas_create(&ms, &s->alloc))
     return rcb_signals_fail(s, RCB_ERR_NOMEM, "out of memory");
   memset(&c, 0, sizeof c);

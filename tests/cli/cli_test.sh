@@ -664,6 +664,28 @@ for a, b in (("h1.csv", "h2.csv"), ("st1.csv", "st2.csv")):
 EOF
   run estimate "$W/s.csv" --input f=DA.x --outputs DA.x --nseg 256 --every 0 -o "$W/h3.csv"
   expect_rc 2; err_has "--every"; [ ! -e "$W/h3.csv" ] || fail "output written" ;;
+wav_truncated)
+  # issue #25: a WAV cut short is refused with the byte counts (it was read
+  # silently); --allow-truncated reads its whole frames with a warning
+  python3 - "$W/s.wav" <<'PY' || fail "writing the WAV file"
+import random, struct, sys, wave
+random.seed(3)
+with wave.open(sys.argv[1], "wb") as w:
+    w.setnchannels(2); w.setsampwidth(2); w.setframerate(1024)
+    f = [random.uniform(-0.5, 0.5) for i in range(2048)]
+    w.writeframes(b"".join(struct.pack("<hh", int(x * 30000), int(x * 15000)) for x in f))
+PY
+  head -c $((44 + 4 * 1500 + 3)) "$W/s.wav" >"$W/cut.wav"
+  set -- --input f=DA.x --outputs DA.x --nseg 256 --wav-names f,DA.x --wav-units N,mm
+  run estimate "$W/cut.wav" "$@" -o "$W/h.csv"
+  if [ "$RC" -eq 4 ] && grep -F -q "without an FFT backend" "$W/err"; then exit 77; fi
+  expect_rc 3; err_has "cut.wav: the data chunk claims 8192 bytes, the file holds 6003"
+  err_has "--allow-truncated"; [ ! -e "$W/h.csv" ] || fail "output written from a cut file"
+  run estimate "$W/cut.wav" "$@" --allow-truncated -o "$W/h.csv"; expect_rc 0
+  err_has "warning: $W/cut.wav: the data chunk claims 8192 bytes"
+  err_has "read the 1500 whole frames"
+  run estimate "$W/s.wav" "$@" -o "$W/h2.csv"; expect_rc 0
+  [ ! -s "$W/err" ] || fail "a warning on a whole WAV file" ;;
 bad_signal_units)
   # estimate: a force without a force unit, a response in an unknown unit
   printf '# units = V,mm\ntime_s,f,DA.x\n0,1,1\n0.001,2,1\n0.002,3,2\n' >"$W/s.csv"

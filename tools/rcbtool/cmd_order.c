@@ -21,7 +21,8 @@ const char cli_help_order[] =
     "angles are relative to the rotor's angle 0.\n"
     "  SIGNALS        .csv as rcbtool transient --signals writes ('# units = V,m',\n"
     "                 'time_s,KP,DA.x,...'); responses in m, mm, um or mil; or .uff\n"
-    "                 (UFF58 time records, --map) or .wav (as rcbtool estimate)\n"
+    "                 (UFF58 time records, --map) or .wav (as rcbtool estimate);\n"
+    "                 --units CH=U,... and --allow-truncated as for rcbtool estimate\n"
     "  --kp CH        keyphasor channel\n"
     "  --outputs LIST response channels (NAME or NAME=STATION.DIR)\n"
     "  --bin-rpm W    speed bin width, rpm (default 50)\n"
@@ -278,7 +279,8 @@ int cmd_order(int argc, char **argv) {
                     {"--min-revs", "N", NULL},    {"--order2", "FILE", NULL},
                     {"--stats", "FILE", NULL},    {"--map", "NODE=STATION,...", NULL},
                     {"--wav-names", "LIST", NULL}, {"--wav-units", "LIST", NULL},
-                    {"--wav-scale", "LIST", NULL}, {"--plot", "FILE.png", NULL}};
+                    {"--wav-scale", "LIST", NULL}, {"--plot", "FILE.png", NULL},
+                    {"--units", "CH=UNIT,...", NULL}, {"--allow-truncated", NULL, NULL}};
   cli_args a;
   int rc = cli_parse(argc, argv, opts, sizeof opts / sizeof opts[0], &a);
   if (rc || a.help) return rc ? rc : cli_print_help(cli_help_order);
