@@ -103,8 +103,7 @@ int cli_signals_read(const cli_args *a, rcb_signals *s) {
   int rc;
   rcb_signals_set_allow_truncated(s, cli_opt_value(a, "--allow-truncated") != NULL);
   if ((rc = unit_overrides(a, s))) return rc;
-  rc = read_file(a, s);
-  if (!rc) warnings(s);
+  if (!(rc = read_file(a, s)) || rc == CLI_EXIT_INPUT) warnings(s); /* also why nothing was read */
   return rc;
 }
 
