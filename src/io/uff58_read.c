@@ -562,7 +562,35 @@ typedef struct uff_set {
   double speed; /* rad/s */
   long ztype;   /* z axis data type of the first record (19: speed in rpm) */
   size_t first_index, first_line;
+  size_t ndirskip; /* records skipped for a direction the model has no channel for */
+  char dirskip[200]; /* the first of them, for the message when nothing is left */
 } uff_set;
+
+/* An FRF or unbalance record whose response or reference is axial (3),
+ * torsional (6) or scalar (0): the model has no such channel. Skipped with
+ * a warning, not fatal (issue #25: one axial channel refused a whole
+ * 4-channel file). 1 when skipped (*st: a warning that could not be kept). */
+static int skip_direction(uff_reader *R, uff_set *S, const uff_rec *r, rcb_status *st) {
+  static const char *const why[] = {"scalar (direction 0)", NULL, NULL, "axial (direction 3, z)",
+                                    NULL, NULL, "torsional (direction 6, rz)"};
+  long d[2], a;
+  int k;
+  d[0] = r->rsp_dir;
+  d[1] = r->func_type == 4 ? r->ref_dir : 1;
+  for (k = 0; k < 2; k++) {
+    a = d[k] < 0 ? -d[k] : d[k];
+    if (a > 6 || !why[a]) continue;
+    if (S->ndirskip++ == 0)
+      snprintf(S->dirskip, sizeof S->dirskip, "%zu: dataset 58 record %zu: its %s is %s",
+               r->line + 6, r->index, k ? "reference" : "response", why[a]);
+    *st = rcb_meas_warn(R->ms, "%s:%zu: dataset 58 record %zu: skipped: its %s (node %ld) is "
+                        "%s; the model's channels are x, y, rx, ry", R->path, r->line + 6,
+                        r->index, k ? "reference" : "response", k ? r->ref_node : r->rsp_node,
+                        why[a]);
+    return 1;
+  }
+  return 0;
+}
 
 static rcb_status match_first(uff_reader *R, uff_set *S, const uff_rec *r, int type,
                               double scale, double speed) {
@@ -604,6 +632,7 @@ static rcb_status accept(uff_reader *R, uff_set *S, uff_rec *r) {
   if (!frf && r->ref_node != 0)
     return rfail(R, r, r->line + 6, "function type 1 with reference node %ld: read as an "
                  "unbalance response, which needs reference node 0", r->ref_node);
+  if (skip_direction(R, S, r, &st)) return st;
   if ((st = dir_name(R, r, r->rsp_dir, "response", &rd))) return st;
   if (frf && (st = dir_name(R, r, r->ref_dir, "reference", &fd))) return st;
   if ((st = record_kind(R, r, frf, &kind))) return st;
@@ -839,6 +868,10 @@ static rcb_status scan(uff_reader *R, uff_set *S) {
     rcb_free(&R->ms->alloc, r.x);
     rcb_free(&R->ms->alloc, r.y);
   }
+  if (!st && S->type < 0 && !R->on_time && S->ndirskip)
+    st = rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s:%s; the model's channels are x, y, rx, ry, "
+                       "and all %zu records were skipped so: nothing to read", R->path,
+                       S->dirskip, S->ndirskip);
   if (!st && S->type < 0 && !R->on_time) {
     char why[360];
     skipped_text(R, why, sizeof why);

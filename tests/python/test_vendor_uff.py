@@ -122,3 +122,14 @@ def test_front_end_recording_reads_what_the_model_uses(tmp_path: Path):
     err = np.max(np.abs(got - ref)) / np.max(np.abs(ref))
     print(f"front-end recording, DA.y in mm by --units: H1 vs SciPy {err:.2e}")
     assert err < 1e-10
+
+
+def test_frf_of_scalar_channels_is_skipped_with_the_reason(tmp_path: Path):
+    """An FRF between two direction-0 channels: the model has no such channel;
+    the message gives file:line and the direction (before: 'unknown response
+    direction code 0', as for a corrupt file)."""
+    res = _run("convert", DATA / "non_ascii_header.uff", tmp_path / "o.csv")
+    assert res.returncode == 3
+    assert ("non_ascii_header.uff:8: dataset 58 record 1: its response is scalar "
+            "(direction 0)") in res.stderr, res.stderr
+    assert not (tmp_path / "o.csv").exists()
