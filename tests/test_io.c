@@ -667,6 +667,10 @@ static void test_bad_uff(void **state) {
           "bad.uff:8:", "nothing to read", NULL);
   bad_uff(uff_text(1, 4, 7, 6, 3L, 1, 10.0, 8, 13, V3), "unknown response direction code 7",
           "bad.uff:8:", NULL);
+  /* a count no file of this size can hold: refused before allocating it (it
+   * said "expected at least 1") */
+  bad_uff(uff_text(1, 4, 1, 6, 999999999L, 1, 10.0, 8, 13, V3), "bad.uff:9:",
+          "claims 999999999 points", "truncated, or a wrong count", NULL);
   bad_uff(uff_text(1, 4, 1, 6, 3L, 1, 10.0, 9, 13, V3), "wrong units", "ordinate data type 9",
           NULL);
   bad_uff(uff_text(1, 4, 1, 6, 3L, 1, 10.0, 8, 0, V3), "wrong units", "denominator", NULL);

@@ -320,6 +320,19 @@ static void test_csv_units(void **state) {
   write_text(p, "time_s,DA.x [m],DB.x [m]\n0,1,1\n0.001,2\n");
   assert_int_equal(rcb_signals_read_csv(s, p), RCB_ERR_PARSE);
   assert_non_null(strstr(rcb_signals_errmsg(s), ":3:"));
+  /* 1e308 is finite but its power overflows: refused at its line (issue #26
+   * saw a NaN spectrum, "value -nan-nani", with no place in the file) */
+  write_text(p, "time_s,DA.x [m]\n0,1\n0.001,1e308\n0.002,2\n");
+  assert_int_equal(rcb_signals_read_csv(s, p), RCB_ERR_PARSE);
+  assert_non_null(strstr(rcb_signals_errmsg(s), ":3: field 2 is 1e+308"));
+  /* an unknown unit given by the caller (--units): read */
+  write_text(p, "time_s,DA.x [furlong]\n0,1\n0.001,2\n");
+  assert_int_equal(rcb_signals_set_unit(s, "DA.x", "furlong"), RCB_ERR_ARG);
+  assert_non_null(strstr(rcb_signals_errmsg(s), "m/s^2"));
+  assert_int_equal(rcb_signals_set_unit(s, "DA.x", "mm"), RCB_OK);
+  assert_int_equal(rcb_signals_read_csv(s, p), RCB_OK);
+  rcb_signals_channel(s, 0, NULL, &q, &v);
+  assert_true(q == RCB_QTY_DISPLACEMENT && v[1] == 2e-3);
   rcb_signals_destroy(s);
 }
 
@@ -492,13 +505,15 @@ static void test_units_table(void **state) {
   assert_true(q == RCB_QTY_FORCE && fabs(f - 0.45359237 * 9.80665) < 1e-15);
   {
     char list[512];
-    size_t n = rcb_unit_list(list, sizeof list);
+    size_t n = rcb_unit_list(RCB_QTY_UNKNOWN, list, sizeof list);
     assert_true(n < sizeof list && strlen(list) == n);
     assert_non_null(strstr(list, "m/s^2"));
     assert_non_null(strstr(list, ", Pa"));
     assert_null(strstr(list, "m/s2")); /* aliases are not listed */
-    assert_int_equal(rcb_unit_list(list, 4), n);
+    assert_int_equal(rcb_unit_list(RCB_QTY_UNKNOWN, list, 4), n);
     assert_int_equal(strlen(list), 3);
+    rcb_unit_list(RCB_QTY_FORCE, list, sizeof list); /* one quantity's labels only */
+    assert_string_equal(list, "N, kN, lbf, N m");
   }
 }
 
@@ -569,6 +584,9 @@ static void test_frf_units(void **state) {
   refused(frf_uff(NULL, 8, "m", "g"), "is an acceleration, but its data type 13 says force");
   refused(frf_uff(U164_MM, 8, "m", "N"), "disagrees with dataset 164");
   refused(frf_uff(NULL, 8, "furlong", "N"), "'furlong' is not a unit");
+  /* the labels listed are the expected quantity's (issue #26: displacement
+   * units were listed after "expected force") */
+  refused(frf_uff(NULL, 8, "m", "pound"), "expected force (N, kN, lbf, N m) or NONE");
   refused(frf_uff("    -1\n   164\n        42\n    -1\n", 8, "m", "N"), "dataset 164");
 }
 

@@ -53,11 +53,13 @@ RCB_API int rcb_unit_parse(const char *label, rcb_quantity *q, double *to_si);
 /** @brief "displacement", "velocity", ... (never NULL). */
 RCB_API const char *rcb_quantity_name(rcb_quantity q);
 /**
- * @brief The unit labels rcb_unit_parse knows, comma separated, into @p buf
- * (NUL-terminated, cut to @p size; for messages and --help).
+ * @brief The unit labels rcb_unit_parse knows for quantity @p q (all of them
+ * for RCB_QTY_UNKNOWN), comma separated, into @p buf (NUL-terminated, cut to
+ * @p size; for messages and --help). Other spellings of a label (m/s2, µm)
+ * are parsed but not listed.
  * @return the length of the whole list (as snprintf)
  */
-RCB_API size_t rcb_unit_list(char *buf, size_t size);
+RCB_API size_t rcb_unit_list(rcb_quantity q, char *buf, size_t size);
 
 /* ---------------------------------------------------------- signals -- */
 

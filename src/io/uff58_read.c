@@ -191,8 +191,17 @@ static rcb_status check_form(uff_reader *R, uff_rec *r) {
   if (!r->real && r->ord_type != 5 && r->ord_type != 6)
     return rfail(R, r, line, "unknown ordinate data type %ld; expected 5 or 6 (complex)",
                  r->ord_type);
-  if (r->npts < 1 || r->npts > 100000000L)
+  if (r->npts < 1)
     return rfail(R, r, line, "number of points %ld; expected at least 1", r->npts);
+  { /* before allocating: can the bytes left hold that many values? (a value
+     * takes at least 2 bytes in ASCII, 4 in binary) */
+    size_t per = r->real ? (r->spacing ? 1u : 2u) : (r->spacing ? 2u : 3u);
+    size_t least = r->binary ? 4u : 2u, left = R->c.len - R->c.pos;
+    if (r->npts > 100000000L || (size_t)r->npts > left / (per * least))
+      return rfail(R, r, line, "record 7 claims %ld points (%zu values), but the %zu bytes "
+                   "left in the file hold at most %zu: truncated, or a wrong count", r->npts,
+                   (size_t)r->npts * per, left, left / least);
+  }
   if (r->spacing != 0 && r->spacing != 1)
     return rfail(R, r, line, "abscissa spacing %ld; expected 0 (uneven) or 1 (even)",
                  r->spacing);
@@ -514,11 +523,14 @@ static rcb_status unit_factor(uff_reader *R, const uff_rec *r, int k, rcb_quanti
   if (R->has164) f164 = want == RCB_QTY_FORCE ? 1.0 / R->ff : 1.0 / R->lf;
   *f = f164;
   if (no_label(lab)) return RCB_OK;
-  if (rcb_unit_parse(lab, &q, &fl))
+  if (rcb_unit_parse(lab, &q, &fl)) {
+    char known[200];
+    rcb_unit_list(want, known, sizeof known);
     return rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu: record %d "
-                         "units label '%s' is not a unit librcb knows; expected %s (m, mm, um, "
-                         "mil, m/s, mm/s, m/s^2, g, N, kN, lbf) or NONE", R->path,
-                         r->line + 8 + (size_t)k, r->index, 8 + k, lab, rcb_quantity_name(want));
+                         "units label '%s' is not a unit librcb knows; expected %s (%s) or "
+                         "NONE", R->path, r->line + 8 + (size_t)k, r->index, 8 + k, lab,
+                         rcb_quantity_name(want), known);
+  }
   if (q != want)
     return rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu: record %d "
                          "units label '%s' is %s %s, but its data type %ld says %s; fix the "

@@ -77,12 +77,12 @@ int rcb_unit_parse(const char *label, rcb_quantity *q, double *to_si) {
   return -1;
 }
 
-size_t rcb_unit_list(char *buf, size_t size) {
+size_t rcb_unit_list(rcb_quantity q, char *buf, size_t size) {
   size_t i, at = 0;
   if (buf && size) buf[0] = '\0';
   for (i = 0; i < sizeof units / sizeof units[0]; i++) {
     int k;
-    if (units[i].alias) continue;
+    if (units[i].alias || (q != RCB_QTY_UNKNOWN && units[i].q != q)) continue;
     k = snprintf(buf && at < size ? buf + at : NULL, buf && at < size ? size - at : 0, "%s%s",
                  at ? ", " : "", units[i].label);
     at += k > 0 ? (size_t)k : 0;

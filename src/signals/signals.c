@@ -70,7 +70,7 @@ rcb_status rcb_signals_set_unit(rcb_signals *s, const char *name, const char *un
                             unit ? unit : "", RCB_SIGNAL_NAME_MAX - 1);
   if (rcb_unit_parse(unit, &q, &f)) {
     char known[RCB_ERRMSG_MAX / 2];
-    rcb_unit_list(known, sizeof known);
+    rcb_unit_list(RCB_QTY_UNKNOWN, known, sizeof known);
     return rcb_signals_fail(s, RCB_ERR_ARG, "unit override %s=%s: '%s' is not a unit librcb "
                             "knows; expected one of %s", name, unit, unit, known);
   }
@@ -149,9 +149,9 @@ rcb_status rcb_signals_add(rcb_signals *s, const char *name, rcb_quantity q,
   if ((unsigned)q > RCB_QTY_PRESSURE)
     return rcb_signals_fail(s, RCB_ERR_ARG, "channel '%s': unknown quantity %d", name, (int)q);
   for (i = 0; i < s->n; i++)
-    if (!isfinite(values[i]))
-      return rcb_signals_fail(s, RCB_ERR_ARG, "channel '%s': sample %zu is not finite", name,
-                              i + 1);
+    if (!isfinite(values[i]) || fabs(values[i]) > RCB_SIGNAL_MAX)
+      return rcb_signals_fail(s, RCB_ERR_ARG, "channel '%s': sample %zu is %g; expected a "
+                              "finite value within +-%g", name, i + 1, values[i], RCB_SIGNAL_MAX);
   v = rcb_alloc(&s->alloc, s->n * sizeof *v);
   if (!v) return rcb_signals_fail(s, RCB_ERR_NOMEM, "out of memory (%zu samples)", s->n);
   memcpy(v, values, s->n * sizeof *v);

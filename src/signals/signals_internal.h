@@ -33,6 +33,13 @@ double rcb_spectral_line_scale(const rcb_spectral *e, size_t k);
 
 #define RCB_SIGNAL_NAME_MAX 64
 
+/* Largest sample magnitude a reader takes, in the file's unit or SI: the
+ * estimator sums squares of segment sums (nseg samples), which overflow
+ * near 1e154; no sensor reads 1e100 of any unit. A value beyond it (a
+ * corrupt field, 1e308) is refused with its place in the file instead of
+ * surfacing as a NaN spectrum (issue #26 saw "value -nan-nani"). */
+#define RCB_SIGNAL_MAX 1e100
+
 typedef struct rcb_signal_ch {
   char name[RCB_SIGNAL_NAME_MAX];
   rcb_quantity q;

@@ -57,11 +57,14 @@ static rcb_status unknown_label(uff_ctx *c, const rcb_uff_time_rec *r, rcb_quant
                             "label '%s' is a level in decibels, a logarithm of the amplitude: "
                             "a time record needs a linear unit (export it in Pa, m/s^2, ...)",
                             c->path, r->line + 9, r->index, r->name, r->label);
-  rcb_unit_list(known, sizeof known);
+  rcb_unit_list(r->q, known, sizeof known);
   return rcb_signals_fail(c->s, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu: units label "
-                          "'%s' of channel '%s' is not one librcb knows (%s); give it: "
+                          "'%s' of channel '%s' is not one librcb knows (%s%s%s); give it: "
                           "--units '%s=UNIT' (rcb_signals_set_unit)", c->path, r->line + 9,
-                          r->index, r->label, r->name, known, r->name);
+                          r->index, r->label, r->name,
+                          r->q != RCB_QTY_UNKNOWN ? rcb_quantity_name(r->q) : "",
+                          r->q != RCB_QTY_UNKNOWN ? ", as its data type says: " : "", known,
+                          r->name);
 }
 
 static rcb_status take_record(void *user, const rcb_uff_time_rec *r) {
@@ -95,7 +98,17 @@ static rcb_status take_record(void *user, const rcb_uff_time_rec *r) {
   }
   v = rcb_alloc(&s->alloc, r->n * sizeof *v);
   if (!v) return rcb_signals_fail(s, RCB_ERR_NOMEM, "%s: out of memory", c->path);
-  for (i = 0; i < r->n; i++) v[i] = creal(r->y[i]) * f;
+  for (i = 0; i < r->n; i++) {
+    v[i] = creal(r->y[i]) * f;
+    if (fabs(v[i]) > RCB_SIGNAL_MAX) {
+      double x = v[i];
+      rcb_free(&s->alloc, v);
+      return rcb_signals_fail(s, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu, value %zu is "
+                              "%g (SI): beyond %g, the largest sample librcb takes (its power "
+                              "would overflow); a corrupt value?", c->path, r->line + 12,
+                              r->index, i + 1, x, RCB_SIGNAL_MAX);
+    }
+  }
   if ((st = rcb_signals_take(s, r->name, q, v))) return st;
   c->failed = 0;
   return RCB_OK;

@@ -140,10 +140,12 @@ static rcb_status wav_channel(rcb_signals *s, const char *path, const wav_fmt *f
   double to_si = 1.0, *v;
   char def[16];
   size_t i;
-  if (unit && rcb_unit_parse(unit, &q, &to_si))
+  if (unit && rcb_unit_parse(unit, &q, &to_si)) {
+    char known[300];
+    rcb_unit_list(RCB_QTY_UNKNOWN, known, sizeof known);
     return rcb_signals_fail(s, RCB_ERR_ARG, "%s: channel %zu: unit '%s' is not one librcb "
-                            "knows; expected m, mm, um, mil, m/s, mm/s, m/s^2, g, N, kN, lbf, V "
-                            "or mV", path, c + 1, unit);
+                            "knows; expected one of %s", path, c + 1, unit, known);
+  }
   if (!isfinite(fs) || fs == 0.0)
     return rcb_signals_fail(s, RCB_ERR_ARG, "%s: channel %zu: full scale %g; expected a finite "
                             "nonzero value", path, c + 1, fs);
@@ -151,10 +153,13 @@ static rcb_status wav_channel(rcb_signals *s, const char *path, const wav_fmt *f
   if (!v) return rcb_signals_fail(s, RCB_ERR_NOMEM, "%s: out of memory", path);
   for (i = 0; i < n; i++) {
     v[i] = sample(f, f->data + i * f->align + c * (f->bits / 8)) * fs * to_si;
-    if (!isfinite(v[i])) {
+    if (!isfinite(v[i]) || fabs(v[i]) > RCB_SIGNAL_MAX) {
+      double x = v[i];
       rcb_free(&s->alloc, v);
-      return rcb_signals_fail(s, RCB_ERR_PARSE, "%s: channel %zu, sample %zu is not finite",
-                              path, c + 1, i + 1);
+      return rcb_signals_fail(s, RCB_ERR_PARSE, "%s: channel %zu, sample %zu is %g: %s", path,
+                              c + 1, i + 1, x, isfinite(x) ? "beyond 1e100, the largest sample "
+                              "librcb takes (its power would overflow); a corrupt file?"
+                              : "not finite");
     }
   }
   if (!name) snprintf(def, sizeof def, "ch%zu", c + 1);

@@ -103,7 +103,8 @@ def test_front_end_recording_reads_what_the_model_uses(tmp_path: Path):
     res = _run(*args, "-o", tmp_path / "h.csv")
     assert res.returncode == 3
     assert "units label 'furlong' of channel 'DA.y' is not one librcb knows" in res.stderr
-    assert "m/s^2" in res.stderr and "Pa" in res.stderr  # the known units are listed
+    # the known units of its data type's quantity are listed
+    assert "(displacement, as its data type says: m, mm, um, mil, in" in res.stderr
     assert "--units 'DA.y=UNIT'" in res.stderr, res.stderr
     res = _run(*args, "--units", "DA.y=mm", "--stats", tmp_path / "s.csv",
                "-o", tmp_path / "h.csv")
