@@ -159,6 +159,32 @@ static void test_unbalance_roundtrip(void **state) {
     assert_same(a, b, f == 1 ? 1e-15 : 1e-12, f == 0 ? 5e-13 : 1e-15);
     rcb_meas_destroy(b);
   }
+  /* phase lag (issue #25): the CSV states it and holds the conjugates (arg =
+   * the lag a vibration monitor shows); read back, the model's values */
+  {
+    const char *p = rcb_test_tmp_path("lag.csv");
+    rcb_meas_channel_info got;
+    char text[512];
+    FILE *fp;
+    size_t len;
+    assert_int_equal(rcb_meas_set_phase(a, RCB_PHASE_LAG, "keyphasor falling edge"), RCB_OK);
+    assert_int_equal(rcb_meas_write_csv(a, p), RCB_OK);
+    fp = fopen(p, "r");
+    assert_non_null(fp);
+    len = fread(text, 1, sizeof text - 1, fp);
+    fclose(fp);
+    text[len] = '\0';
+    assert_non_null(strstr(text, "# phase = lag (keyphasor falling edge)\nrpm,"));
+    assert_non_null(strstr(text, ",1.9999999999999999e-06\n")); /* conj of -2e-6 i, point 2 */
+    assert_int_equal(rcb_meas_create(&b, NULL), RCB_OK);
+    if (rcb_meas_read_csv(b, p) != RCB_OK) fail_msg("%s", rcb_meas_errmsg(b));
+    assert_int_equal(rcb_meas_phase(b), RCB_PHASE_LAG);
+    assert_same(a, b, 1e-15, 1e-15);
+    assert_int_equal(rcb_meas_channel(b, 0, &got), RCB_OK);
+    assert_true(cimag(got.data[1]) < 0.0); /* the model's -2e-6 */
+    rcb_meas_destroy(b);
+    assert_int_equal(rcb_meas_set_phase(a, (rcb_phase_convention)3, NULL), RCB_ERR_ARG);
+  }
   rcb_meas_destroy(a);
 }
 

@@ -664,6 +664,68 @@ static void test_order_runup(void **state) {
   free(yn);
 }
 
+/* A notch keyphasor (issue #25): 5 V, falling linearly through 2.5 V at the
+ * shaft's angle 0 (over +-7.2 deg), 0 V in the notch, stepping back to 5 V
+ * at 45 deg. */
+static double notch(double phi) {
+  double w = fmod(phi, 2 * PI), d = 2 * PI * 0.02;
+  if (w > PI) w -= 2 * PI;
+  if (w >= -d && w <= d) return 2.5 - 2.5 * w / d;
+  return w > d && w < PI / 4 ? 0.0 : 5.0;
+}
+
+/* --kp-edge falling: a notch keyphasor's falling edge marks angle 0, so 1X is
+ * 2 e^{0.3i} to 1e-4 as with a projection's rising edge; its rising edge (the
+ * default, before the option) is the notch's far end, 45 deg later, and
+ * turns the phase by those 45 deg. */
+static void test_order_kp_edge(void **state) {
+  enum { N = 4 * 20000 };
+  const double fs = 20000.0, w0 = 1000 * PI / 30, al = 500 * PI / 30;
+  double *kp = malloc(N * sizeof *kp), *y = malloc(N * sizeof *y);
+  const double *ch[1];
+  rcb_order_opts o;
+  rcb_order *e;
+  size_t bytes, b, n, reported = 0;
+  void *work;
+  int edge;
+  (void)state;
+  for (n = 0; n < N; n++) {
+    double t = (double)n / fs, phi = w0 * t + 0.5 * al * t * t;
+    kp[n] = notch(phi);
+    y[n] = 2 * cos(phi + 0.3);
+  }
+  ch[0] = y;
+  memset(&o, 0, sizeof o);
+  o.norders = 1;
+  o.trigger = NAN;
+  o.bin_width = 100 * PI / 30;
+  o.speed_max = 4000 * PI / 30;
+  assert_int_equal(rcb_order_workspace_size(&o, 1, &bytes), RCB_OK);
+  work = malloc(bytes);
+  for (edge = 1; edge >= 0; edge--) {
+    o.kp_falling = edge;
+    assert_int_equal(rcb_order_init(&e, &o, 1, work, bytes), RCB_OK);
+    assert_int_equal(rcb_order_add(e, fs, N, kp, ch), RCB_OK);
+    for (b = 0; b < rcb_order_bin_count(e); b++) {
+      rcb_complex q;
+      size_t nr;
+      rcb_order_result(e, b, 0, 1, NULL, &q, NULL, &nr);
+      if (nr < 2) continue;
+      reported += edge;
+      if (edge && cabs(q - 2 * cexp(CMPLX(0, 0.3))) > 1e-4 * 2)
+        fail_msg("falling edge, bin %zu: 1X %g at %g deg", b, cabs(q), carg(q) * 180 / PI);
+      /* the rising edge is a step between samples: within 1 sample (<= 0.9 deg) */
+      if (!edge && fabs(carg(q * cexp(CMPLX(0, -0.3 - PI / 4)))) > 0.9 * PI / 180)
+        fail_msg("rising edge of the notch, bin %zu: phase %g deg, expected %g", b,
+                 carg(q) * 180 / PI, (0.3 + PI / 4) * 180 / PI);
+    }
+  }
+  assert_int_equal(reported, 20);
+  free(work);
+  free(kp);
+  free(y);
+}
+
 /* ---- UFF58 time records ---- */
 
 /* One real, evenly spaced time record (4E20.12): node, direction, ordinate
@@ -736,6 +798,7 @@ int main(void) {
       cmocka_unit_test(test_units_table),
       cmocka_unit_test(test_frf_units),
       cmocka_unit_test(test_order_runup),
+      cmocka_unit_test(test_order_kp_edge),
       cmocka_unit_test(test_uff_time_records),
   };
   return cmocka_run_group_tests(tests, rcb_test_setup_tmpdir, rcb_test_teardown_tmpdir);

@@ -245,14 +245,16 @@ RCB_API rcb_status rcb_spectral_frf(rcb_spectral *e, rcb_estimator est, size_t o
 /**
  * @brief Order-tracking settings. Method: computed order tracking, one
  * revolution at a time. Keyphasor pulses (upward crossings of @c trigger,
- * interpolated between samples) bound each revolution; its samples are
+ * or downward with @c kp_falling, interpolated between samples) bound each
+ * revolution; its samples are
  * resampled (linear interpolation in time) to @c per_rev equally spaced
  * shaft angles, the angle taken as a quadratic in time through the pulses
  * before, at and after the revolution (constant angular acceleration; Fyfe
  * & Munck 1997, so the first revolution is not reported), and an exact
  * per_rev-point DFT gives the order-m phasor Q_m = (2/N) sum_j y_j
  * e^{-i m theta_j}, y = Re(Q_m e^{i m theta}), theta from the keyphasor mark
- * plus @c kp_angle. Revolutions are grouped into speed bins of width
+ * plus @c kp_angle: arg Q_m is a phase lead (the model's convention; a
+ * vibration monitor's phase lag is -arg Q_m, see rcb_meas_set_phase). Revolutions are grouped into speed bins of width
  * @c bin_width; a bin reports the mean phasor, the mean speed and the
  * standard deviation of the mean from the scatter over its revolutions.
  * Why not Vold-Kalman: with the angle exact for a constant acceleration,
@@ -268,6 +270,9 @@ typedef struct rcb_order_opts {
   double bin_width; /**< speed bin, rad/s (> 0) */
   double speed_max; /**< highest speed binned, rad/s (faster revolutions are ignored) */
   size_t min_revs;  /**< revolutions a bin needs to be reported (>= 2; 0: 2) */
+  int kp_falling;   /**< 0: revolutions marked by the keyphasor's upward crossings of
+                         @c trigger (a projection passing the probe); 1: downward (a
+                         notch, as most proximity-probe keyphasors) */
 } rcb_order_opts;
 
 typedef struct rcb_order rcb_order;

@@ -34,6 +34,8 @@ struct rcb_meas {
   rcb_warning_t *warnings; /* of the last read (rcb_meas_warning) */
   size_t n_warnings, cap_warnings;
   size_t speed_warning; /* 1 + index of the "speed not stated" warning, 0: none */
+  rcb_phase_convention phase; /* how a CSV presents the phase (rcb_meas_set_phase) */
+  char phase_ref[84];         /* what it is measured from ("keyphasor rising edge") */
 };
 
 /* The error message of rcb_meas (core/rcb_internal.h; ms may be NULL: no

@@ -140,7 +140,8 @@ rcb_status rcb_order_add(rcb_order *e, double rate, size_t n, const double *kp,
     trig = 0.5 * (lo + hi);
   }
   for (i = 1; i < n; i++)
-    if (kp[i - 1] < trig && kp[i] >= trig) {
+    if (e->o.kp_falling ? (kp[i - 1] > trig && kp[i] <= trig)
+                        : (kp[i - 1] < trig && kp[i] >= trig)) {
       double t = (double)(i - 1) + (trig - kp[i - 1]) / (kp[i] - kp[i - 1]);
       if (prev2 >= 0.0) revolution(e, rate, prev2, prev, t, chan);
       prev2 = prev;
@@ -148,10 +149,10 @@ rcb_status rcb_order_add(rcb_order *e, double rate, size_t n, const double *kp,
       pulses++;
     }
   if (pulses < 3)
-    return rcb_set_error(e->errmsg, RCB_ERR_ARG, "order: %zu keyphasor pulse%s (upward "
+    return rcb_set_error(e->errmsg, RCB_ERR_ARG, "order: %zu keyphasor pulse%s (%s "
                          "crossings of %g) in %zu samples; need three or more: check the "
-                         "keyphasor channel and the trigger level", pulses,
-                         pulses == 1 ? "" : "s", trig, n);
+                         "keyphasor channel, the trigger level and the edge", pulses,
+                         pulses == 1 ? "" : "s", e->o.kp_falling ? "downward" : "upward", trig, n);
   return RCB_OK;
 }
 
