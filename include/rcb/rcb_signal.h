@@ -254,13 +254,17 @@ RCB_API rcb_status rcb_spectral_frf(rcb_spectral *e, rcb_estimator est, size_t o
  * per_rev-point DFT gives the order-m phasor Q_m = (2/N) sum_j y_j
  * e^{-i m theta_j}, y = Re(Q_m e^{i m theta}), theta from the keyphasor mark
  * plus @c kp_angle: arg Q_m is a phase lead (the model's convention; a
- * vibration monitor's phase lag is -arg Q_m, see rcb_meas_set_phase). Revolutions are grouped into speed bins of width
- * @c bin_width; a bin reports the mean phasor, the mean speed and the
- * standard deviation of the mean from the scatter over its revolutions.
- * Why not Vold-Kalman: with the angle exact for a constant acceleration,
- * the per-revolution DFT is exact for every order at any run-up rate,
- * needs no tuning of a filter bandwidth, runs in O(samples) and gives the
- * revolution-to-revolution scatter that the statistics need.
+ * vibration monitor's phase lag is -arg Q_m, see rcb_meas_set_phase).
+ * Revolutions are grouped into speed bins of width @c bin_width; a bin
+ * reports the mean phasor, the mean speed and the standard deviation of the
+ * mean from the residual of a line in speed through its revolutions (so the
+ * response's change across the bin near a resonance is not counted as
+ * noise). Limits: an order whose amplitude changes within a revolution leaks
+ * into the others, about 0.42 x (speed change per revolution / half-power
+ * band) of the peak near a resonance (docs/signals.md has the measured table).
+ * Why not Vold-Kalman so far: the per-revolution DFT needs no tuning of a
+ * filter bandwidth, runs in O(samples) and gives the revolution-to-revolution
+ * scatter that the statistics need.
  */
 typedef struct rcb_order_opts {
   size_t norders;   /**< orders 1..norders (1 to 8) */
@@ -299,7 +303,9 @@ RCB_API size_t rcb_order_bin_count(const rcb_order *e);
  * @brief One bin's result for channel @p ch and order @p m (1-based).
  * @param speed mean speed of its revolutions, rad/s
  * @param Q mean phasor (channel unit) @param sd standard deviation of Re Q and
- * of Im Q of the mean, sqrt(sum |Q_r - Q|^2 / (2 n (n - 1)))
+ * of Im Q of the mean, sqrt(sum |Q_r - a - b (w_r - w_mean)|^2 / (2 n (n - 2)))
+ * from the line a + b (w - w_mean) fitted through the bin's revolutions
+ * (n = 2: sqrt(sum |Q_r - Q|^2 / (2 n (n - 1))), the scatter about the mean)
  * @param nrev revolutions in the bin (results valid when >= min_revs)
  */
 RCB_API rcb_status rcb_order_result(const rcb_order *e, size_t bin, size_t ch, size_t m,
