@@ -712,8 +712,8 @@ static rcb_status time_dir(uff_reader *R, const uff_rec *r, const char **dir) {
  * caller (t->label_unknown: values in file units). */
 static rcb_status time_units(uff_reader *R, const uff_rec *r, rcb_uff_time_rec *t, double *f) {
   static const long motion[] = {8, 11, 12};
-  rcb_quantity want = RCB_QTY_UNKNOWN, q;
-  double fl;
+  rcb_quantity want = RCB_QTY_UNKNOWN, q = RCB_QTY_UNKNOWN;
+  double fl = 1.0;
   size_t i;
   for (i = 0; i < 3; i++)
     if (r->spec[1] == motion[i]) want = (rcb_quantity)(RCB_QTY_DISPLACEMENT + (int)i);
@@ -748,7 +748,7 @@ static rcb_status time_units(uff_reader *R, const uff_rec *r, rcb_uff_time_rec *
 static rcb_status accept_time(uff_reader *R, uff_rec *r) {
   rcb_uff_time_rec t;
   char st_r[RCB_MEAS_CH_MAX];
-  const char *dir = NULL;
+  const char *dir = "";
   double f = 1.0;
   size_t i;
   rcb_status st;
