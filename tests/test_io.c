@@ -159,6 +159,32 @@ static void test_unbalance_roundtrip(void **state) {
     assert_same(a, b, f == 1 ? 1e-15 : 1e-12, f == 0 ? 5e-13 : 1e-15);
     rcb_meas_destroy(b);
   }
+  /* phase lag (issue #25): the CSV states it and holds the conjugates (arg =
+   * the lag a vibration monitor shows); read back, the model's values */
+  {
+    const char *p = rcb_test_tmp_path("lag.csv");
+    rcb_meas_channel_info got;
+    char text[512];
+    FILE *fp;
+    size_t len;
+    assert_int_equal(rcb_meas_set_phase(a, RCB_PHASE_LAG, "keyphasor falling edge"), RCB_OK);
+    assert_int_equal(rcb_meas_write_csv(a, p), RCB_OK);
+    fp = fopen(p, "r");
+    assert_non_null(fp);
+    len = fread(text, 1, sizeof text - 1, fp);
+    fclose(fp);
+    text[len] = '\0';
+    assert_non_null(strstr(text, "# phase = lag (keyphasor falling edge)\nrpm,"));
+    assert_non_null(strstr(text, ",1.9999999999999999e-06\n")); /* conj of -2e-6 i, point 2 */
+    assert_int_equal(rcb_meas_create(&b, NULL), RCB_OK);
+    if (rcb_meas_read_csv(b, p) != RCB_OK) fail_msg("%s", rcb_meas_errmsg(b));
+    assert_int_equal(rcb_meas_phase(b), RCB_PHASE_LAG);
+    assert_same(a, b, 1e-15, 1e-15);
+    assert_int_equal(rcb_meas_channel(b, 0, &got), RCB_OK);
+    assert_true(cimag(got.data[1]) < 0.0); /* the model's -2e-6 */
+    rcb_meas_destroy(b);
+    assert_int_equal(rcb_meas_set_phase(a, (rcb_phase_convention)3, NULL), RCB_ERR_ARG);
+  }
   rcb_meas_destroy(a);
 }
 
@@ -617,6 +643,25 @@ static char *uff_text(int nrec, ...) {
   return buf;
 }
 
+/* Issue #25: an axial record (direction 3) beside a lateral one is skipped
+ * with a warning naming it (it refused the whole file). */
+static void test_uff_axial_skipped(void **state) {
+  static const char v3[] = "   1.00000000000e+00   2.00000000000e+00   3.00000000000e+00   "
+                           "4.00000000000e+00\n   5.00000000000e+00   6.00000000000e+00\n";
+  const char *p = rcb_test_tmp_path("axial.uff");
+  rcb_meas *ms = NULL;
+  (void)state;
+  write_text(p, uff_text(2, 4, 3, 6, 3L, 1, 10.0, 8, 13, v3, 4, 1, 6, 3L, 1, 10.0, 8, 13, v3));
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  if (rcb_meas_read_uff(ms, p, 0, NULL)) fail_msg("%s", rcb_meas_errmsg(ms));
+  assert_int_equal(rcb_meas_channel_count(ms), 1);
+  assert_int_equal(rcb_meas_point_count(ms), 3);
+  assert_true(rcb_meas_warning_count(ms) >= 1);
+  assert_non_null(strstr(rcb_meas_warning(ms, 0), "axial.uff:8: dataset 58 record 1: skipped: "
+                                                 "its response (node 1) is axial"));
+  rcb_meas_destroy(ms);
+}
+
 static void test_bad_uff(void **state) {
   static const char uneven_dec[] =
       "  1.00000e+01   1.00000000000e+00   2.00000000000e+00\n"
@@ -644,8 +689,14 @@ static void test_bad_uff(void **state) {
           "record 2", "mismatched lengths", NULL);
   bad_uff(uff_text(2, 4, 1, 6, 3L, 1, 10.0, 8, 13, V3, 4, 2, 6, 3L, 1, 11.0, 8, 13, V3),
           "record 2", "abscissa differs from record 1", NULL);
-  bad_uff(uff_text(1, 4, 3, 6, 3L, 1, 10.0, 8, 13, V3), "unknown response direction code 3",
+  bad_uff(uff_text(1, 4, 3, 6, 3L, 1, 10.0, 8, 13, V3), "its response is axial (direction 3",
+          "bad.uff:8:", "nothing to read", NULL);
+  bad_uff(uff_text(1, 4, 7, 6, 3L, 1, 10.0, 8, 13, V3), "unknown response direction code 7",
           "bad.uff:8:", NULL);
+  /* a count no file of this size can hold: refused before allocating it (it
+   * said "expected at least 1") */
+  bad_uff(uff_text(1, 4, 1, 6, 999999999L, 1, 10.0, 8, 13, V3), "bad.uff:9:",
+          "claims 999999999 points", "truncated, or a wrong count", NULL);
   bad_uff(uff_text(1, 4, 1, 6, 3L, 1, 10.0, 9, 13, V3), "wrong units", "ordinate data type 9",
           NULL);
   bad_uff(uff_text(1, 4, 1, 6, 3L, 1, 10.0, 8, 0, V3), "wrong units", "denominator", NULL);
@@ -803,7 +854,7 @@ int main(void) {
       cmocka_unit_test(test_csv_comments),          cmocka_unit_test(test_kind_conversion),
       cmocka_unit_test(test_noise_proportional),    cmocka_unit_test(test_noise_systematic),
       cmocka_unit_test(test_noise_seeds),           cmocka_unit_test(test_noise_stream),
-      cmocka_unit_test(test_bad_uff),               cmocka_unit_test(test_bad_uff_binary),
+      cmocka_unit_test(test_bad_uff), cmocka_unit_test(test_uff_axial_skipped),               cmocka_unit_test(test_bad_uff_binary),
       cmocka_unit_test(test_csv_header_variants),
       cmocka_unit_test(test_uff_speed_not_stated),
       cmocka_unit_test(test_bad_csv),               cmocka_unit_test(test_bad_api),

@@ -73,6 +73,26 @@ RCB_API int rcb_meas_speed_given(const rcb_meas *ms);
  * an unbalance response or an empty object, RCB_ERR_ARG if not finite
  */
 RCB_API rcb_status rcb_meas_set_speed(rcb_meas *ms, double speed);
+/** @brief How a CSV file presents the phase (issue #25). The values held are
+ * always the model's (Q e^{i Omega t}: the phase is a lead); LAG presents
+ * their conjugate (the phase as vibration monitors show it: the response's
+ * peak that many degrees after the reference mark). */
+typedef enum rcb_phase_convention {
+  RCB_PHASE_UNSTATED = 0, /**< no "# phase" line (read as a lead) */
+  RCB_PHASE_LEAD = 1,     /**< "# phase = lead ...": values as held */
+  RCB_PHASE_LAG = 2       /**< "# phase = lag ...": conjugates written and read */
+} rcb_phase_convention;
+/**
+ * @brief State the phase convention of the CSV written (rcb_meas_write_csv
+ * writes "# phase = lead|lag (@p reference)" and, for LAG, conjugate values;
+ * rcb_meas_read_csv reads the line back to the model's values). @p reference
+ * (NULL: none) says what the phase is measured from, e.g. "keyphasor rising
+ * edge" (at most 80 characters). UFF files hold the model's values as they are.
+ */
+RCB_API rcb_status rcb_meas_set_phase(rcb_meas *ms, rcb_phase_convention conv,
+                                      const char *reference);
+/** @brief The convention a CSV read stated (or rcb_meas_set_phase set). */
+RCB_API rcb_phase_convention rcb_meas_phase(const rcb_meas *ms);
 /**
  * @brief Warnings of the last read: input that is valid but likely misread
  * (a UFF node with no entry in the node map, a UFF FRF that does not state

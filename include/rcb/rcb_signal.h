@@ -36,19 +36,30 @@ typedef enum rcb_quantity {
   RCB_QTY_VELOCITY = 2,     /**< m/s */
   RCB_QTY_ACCELERATION = 3, /**< m/s^2 */
   RCB_QTY_FORCE = 4,        /**< N */
-  RCB_QTY_VOLTAGE = 5       /**< V (keyphasor, uncalibrated sensor) */
+  RCB_QTY_VOLTAGE = 5,      /**< V (keyphasor, uncalibrated sensor) */
+  RCB_QTY_PRESSURE = 6      /**< Pa (a microphone or pressure transducer: read, not a
+                                 response the rotor model predicts) */
 } rcb_quantity;
 
 /**
- * @brief Parse a unit label ("m", "mm", "um", "mil", "m/s", "mm/s", "in/s",
- * "m/s^2", "m/s2", "g", "N", "kN", "lbf", "V", "mV"; case-sensitive where it
- * matters: "mm" vs "Mm" is not guessed).
+ * @brief Parse a unit label ("m", "mm", "um", "mil", "in", "m/s", "mm/s",
+ * "in/s", "m/s^2", "m/s2", "m/s²" (UTF-8 or Latin-1 ²), "g", "N", "kN", "lbf",
+ * "V", "mV", "Pa", "kPa"; the full list: rcb_unit_list; case-sensitive where
+ * it matters: "mm" vs "Mm" is not guessed).
  * @param to_si factor: SI value = file value * to_si
  * @return 0, or -1 if the label is not a unit librcb knows.
  */
 RCB_API int rcb_unit_parse(const char *label, rcb_quantity *q, double *to_si);
 /** @brief "displacement", "velocity", ... (never NULL). */
 RCB_API const char *rcb_quantity_name(rcb_quantity q);
+/**
+ * @brief The unit labels rcb_unit_parse knows for quantity @p q (all of them
+ * for RCB_QTY_UNKNOWN), comma separated, into @p buf (NUL-terminated, cut to
+ * @p size; for messages and --help). Other spellings of a label (m/s2, µm)
+ * are parsed but not listed.
+ * @return the length of the whole list (as snprintf)
+ */
+RCB_API size_t rcb_unit_list(rcb_quantity q, char *buf, size_t size);
 
 /* ---------------------------------------------------------- signals -- */
 
@@ -78,6 +89,26 @@ RCB_API rcb_status rcb_signals_channel(const rcb_signals *s, size_t i, const cha
                                        rcb_quantity *q, const double **values);
 /** @brief Index of the channel named @p name, or RCB_ERR_NOT_FOUND. */
 RCB_API rcb_status rcb_signals_find(const rcb_signals *s, const char *name, size_t *index);
+
+/**
+ * @brief Whether the readers accept a truncated file (default 0: refused).
+ * A WAV data chunk that claims more bytes than the file holds, or that ends
+ * inside a frame, is refused with the byte counts; with @p allow nonzero the
+ * whole frames present are read and a warning (rcb_signals_warning) says so.
+ */
+RCB_API rcb_status rcb_signals_set_allow_truncated(rcb_signals *s, int allow);
+/**
+ * @brief Give channel @p name the unit @p unit (a label rcb_unit_parse
+ * knows), for files whose label is missing or not known (UFF records: the
+ * name as the reader forms it, "STATION.DIR" or "#NODE.DIR"). Kept for every
+ * later read; RCB_ERR_ARG for an unknown unit.
+ */
+RCB_API rcb_status rcb_signals_set_unit(rcb_signals *s, const char *name, const char *unit);
+/** @brief Warnings of the last read: what was read but may not be what the
+ * file means, and what was skipped (a UFF record the model cannot use). */
+RCB_API size_t rcb_signals_warning_count(const rcb_signals *s);
+/** @brief Warning @p i of the last read ("" out of range). */
+RCB_API const char *rcb_signals_warning(const rcb_signals *s, size_t i);
 
 /**
  * @brief Read CSV: optional "# units = U1,U2,..." line (one unit per channel
@@ -214,20 +245,26 @@ RCB_API rcb_status rcb_spectral_frf(rcb_spectral *e, rcb_estimator est, size_t o
 /**
  * @brief Order-tracking settings. Method: computed order tracking, one
  * revolution at a time. Keyphasor pulses (upward crossings of @c trigger,
- * interpolated between samples) bound each revolution; its samples are
+ * or downward with @c kp_falling, interpolated between samples) bound each
+ * revolution; its samples are
  * resampled (linear interpolation in time) to @c per_rev equally spaced
  * shaft angles, the angle taken as a quadratic in time through the pulses
  * before, at and after the revolution (constant angular acceleration; Fyfe
  * & Munck 1997, so the first revolution is not reported), and an exact
  * per_rev-point DFT gives the order-m phasor Q_m = (2/N) sum_j y_j
  * e^{-i m theta_j}, y = Re(Q_m e^{i m theta}), theta from the keyphasor mark
- * plus @c kp_angle. Revolutions are grouped into speed bins of width
- * @c bin_width; a bin reports the mean phasor, the mean speed and the
- * standard deviation of the mean from the scatter over its revolutions.
- * Why not Vold-Kalman: with the angle exact for a constant acceleration,
- * the per-revolution DFT is exact for every order at any run-up rate,
- * needs no tuning of a filter bandwidth, runs in O(samples) and gives the
- * revolution-to-revolution scatter that the statistics need.
+ * plus @c kp_angle: arg Q_m is a phase lead (the model's convention; a
+ * vibration monitor's phase lag is -arg Q_m, see rcb_meas_set_phase).
+ * Revolutions are grouped into speed bins of width @c bin_width; a bin
+ * reports the mean phasor, the mean speed and the standard deviation of the
+ * mean from the residual of a line in speed through its revolutions (so the
+ * response's change across the bin near a resonance is not counted as
+ * noise). Limits: an order whose amplitude changes within a revolution leaks
+ * into the others, about 0.42 x (speed change per revolution / half-power
+ * band) of the peak near a resonance (docs/signals.md has the measured table).
+ * Why not Vold-Kalman so far: the per-revolution DFT needs no tuning of a
+ * filter bandwidth, runs in O(samples) and gives the revolution-to-revolution
+ * scatter that the statistics need.
  */
 typedef struct rcb_order_opts {
   size_t norders;   /**< orders 1..norders (1 to 8) */
@@ -237,6 +274,9 @@ typedef struct rcb_order_opts {
   double bin_width; /**< speed bin, rad/s (> 0) */
   double speed_max; /**< highest speed binned, rad/s (faster revolutions are ignored) */
   size_t min_revs;  /**< revolutions a bin needs to be reported (>= 2; 0: 2) */
+  int kp_falling;   /**< 0: revolutions marked by the keyphasor's upward crossings of
+                         @c trigger (a projection passing the probe); 1: downward (a
+                         notch, as most proximity-probe keyphasors) */
 } rcb_order_opts;
 
 typedef struct rcb_order rcb_order;
@@ -263,7 +303,9 @@ RCB_API size_t rcb_order_bin_count(const rcb_order *e);
  * @brief One bin's result for channel @p ch and order @p m (1-based).
  * @param speed mean speed of its revolutions, rad/s
  * @param Q mean phasor (channel unit) @param sd standard deviation of Re Q and
- * of Im Q of the mean, sqrt(sum |Q_r - Q|^2 / (2 n (n - 1)))
+ * of Im Q of the mean, sqrt(sum |Q_r - a - b (w_r - w_mean)|^2 / (2 n (n - 2)))
+ * from the line a + b (w - w_mean) fitted through the bin's revolutions
+ * (n = 2: sqrt(sum |Q_r - Q|^2 / (2 n (n - 1))), the scatter about the mean)
  * @param nrev revolutions in the bin (results valid when >= min_revs)
  */
 RCB_API rcb_status rcb_order_result(const rcb_order *e, size_t bin, size_t ch, size_t m,

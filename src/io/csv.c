@@ -2,6 +2,8 @@
  * CSV measurements, as rcbtool frf / unbalance write them:
  *   # kind = receptance          (optional; FRFs only; default receptance)
  *   # rpm = 3000                 (optional; FRF test speed, or "synchronous")
+ *   # phase = lag (keyphasor falling edge)   (optional; lag: the values are the
+ *                                 conjugates of the model's, read back to them)
  *   freq_hz,D1.x/C.x re,D1.x/C.x im,...     (FRF, abscissa Hz)
  *   rpm,DA.x amp,DA.x phase_deg,...         (unbalance, abscissa rpm)
  * Per channel two adjacent columns: "re","im", or "mag"/"amp","phase_deg"
@@ -37,6 +39,8 @@ typedef struct csv_state {
   rcb_meas_type type;
   rcb_frf_kind kind;
   double speed; /* rad/s, < 0 synchronous */
+  rcb_phase_convention phase; /* "# phase = lead|lag (reference)" */
+  char phase_ref[84];
   csv_col *cols; /* ncols value columns (after the abscissa) */
   size_t ncols, capcols;
   double *x, *v; /* rows: x[r], v[r * ncols + c] */
@@ -100,6 +104,19 @@ static rcb_status comment(csv_state *S, char *text) {
       S->speed = r * RCB_PI / 30.0;
     }
     S->have_rpm = 1;
+  } else if (strcmp(key, "phase") == 0) { /* "lead|lag [(reference)]" */
+    size_t w = strcspn(val, " \t(");
+    char *ref = val + w;
+    if ((w != 4 || strncmp(val, "lead", 4) != 0) && (w != 3 || strncmp(val, "lag", 3) != 0))
+      return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: phase '%s': expected lead or lag "
+                           "(then the reference in brackets)", S->path, S->line, val);
+    S->phase = w == 3 ? RCB_PHASE_LAG : RCB_PHASE_LEAD;
+    ref = trim(ref);
+    if (*ref == '(' && ref[strlen(ref) - 1] == ')') {
+      ref[strlen(ref) - 1] = '\0';
+      ref++;
+    }
+    snprintf(S->phase_ref, sizeof S->phase_ref, "%.80s", ref);
   }
   return RCB_OK;
 }
@@ -380,6 +397,7 @@ static rcb_status build(csv_state *S) {
       double a = S->v[r * S->ncols + c], b = S->v[r * S->ncols + c + 1];
       d[r] = S->cols[c].part == COL_RE ? CMPLX(a, b)
                                        : a * CMPLX(cos(b * RCB_PI / 180.0), sin(b * RCB_PI / 180.0));
+      if (S->phase == RCB_PHASE_LAG) d[r] = conj(d[r]); /* to the model's lead */
     }
     snprintf(where, sizeof where, "%s: columns %zu-%zu", S->path, c + 2, c + 3);
     if (slash) *slash = '\0';
@@ -410,6 +428,7 @@ rcb_status rcb_meas_read_csv(rcb_meas *ms, const char *path) {
   if (!st) st = parse_lines(&S, buf);
   if (!st) st = build(&S);
   if (!st) ms->speed_given = S.type == RCB_MEAS_FRF && S.have_rpm;
+  if (!st) rcb_meas_set_phase(ms, S.phase, S.phase_ref);
   if (!st && S.type == RCB_MEAS_FRF && !S.have_rpm) {
     st = rcb_meas_warn(ms, "%s: no '# rpm = R' line before the header: the file does not "
                        "state the test speed, so it reads as 0 rpm; state it (the line, "
@@ -448,6 +467,9 @@ static void write_body(const rcb_meas *ms, FILE *fp, rcb_frf_kind kind) {
     else
       fprintf(fp, "# rpm = %.17g\n", ms->speed * 30.0 / RCB_PI);
   }
+  if (ms->phase != RCB_PHASE_UNSTATED)
+    fprintf(fp, "# phase = %s%s%s%s\n", ms->phase == RCB_PHASE_LAG ? "lag" : "lead",
+            ms->phase_ref[0] ? " (" : "", ms->phase_ref, ms->phase_ref[0] ? ")" : "");
   fputs(frf ? "freq_hz" : "rpm", fp);
   for (c = 0; c < ms->nch; c++) {
     const rcb_meas_ch *h = &ms->ch[c];
@@ -459,8 +481,9 @@ static void write_body(const rcb_meas *ms, FILE *fp, rcb_frf_kind kind) {
   fputc('\n', fp);
   for (i = 0; i < ms->n; i++) {
     fprintf(fp, "%.17g", ms->x[i] * (frf ? 1.0 / (2.0 * RCB_PI) : 30.0 / RCB_PI));
-    for (c = 0; c < ms->nch; c++)
-      fprintf(fp, ",%.17g,%.17g", creal(ms->ch[c].data[i]), cimag(ms->ch[c].data[i]));
+    for (c = 0; c < ms->nch; c++) /* LAG: the conjugate, so arg is the lag */
+      fprintf(fp, ",%.17g,%.17g", creal(ms->ch[c].data[i]),
+              ms->phase == RCB_PHASE_LAG ? -cimag(ms->ch[c].data[i]) : cimag(ms->ch[c].data[i]));
     fputc('\n', fp);
   }
 }

@@ -38,6 +38,8 @@ void rcb_meas_clear(rcb_meas *ms) {
   ms->n = 0;
   ms->speed = 0.0;
   ms->speed_given = 0;
+  ms->phase = RCB_PHASE_UNSTATED;
+  ms->phase_ref[0] = '\0';
   ms->type = RCB_MEAS_FRF;
 }
 
@@ -67,6 +69,22 @@ const char *rcb_meas_warning(const rcb_meas *ms, size_t i) {
 }
 
 int rcb_meas_speed_given(const rcb_meas *ms) { return ms ? ms->speed_given : 0; }
+
+rcb_status rcb_meas_set_phase(rcb_meas *ms, rcb_phase_convention conv, const char *reference) {
+  if (!ms) return RCB_ERR_ARG;
+  if ((unsigned)conv > RCB_PHASE_LAG || (reference && strlen(reference) > 80) ||
+      (reference && strpbrk(reference, "\r\n")))
+    return rcb_meas_fail(ms, RCB_ERR_ARG, "set_phase: convention %d, reference of %zu "
+                         "characters: expected 0-2 and one line of at most 80", (int)conv,
+                         reference ? strlen(reference) : (size_t)0);
+  ms->phase = conv;
+  snprintf(ms->phase_ref, sizeof ms->phase_ref, "%s", reference ? reference : "");
+  return RCB_OK;
+}
+
+rcb_phase_convention rcb_meas_phase(const rcb_meas *ms) {
+  return ms ? ms->phase : RCB_PHASE_UNSTATED;
+}
 
 rcb_status rcb_meas_set_speed(rcb_meas *ms, double speed) {
   if (!ms) return RCB_ERR_ARG;

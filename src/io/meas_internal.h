@@ -34,6 +34,8 @@ struct rcb_meas {
   rcb_warning_t *warnings; /* of the last read (rcb_meas_warning) */
   size_t n_warnings, cap_warnings;
   size_t speed_warning; /* 1 + index of the "speed not stated" warning, 0: none */
+  rcb_phase_convention phase; /* how a CSV presents the phase (rcb_meas_set_phase) */
+  char phase_ref[84];         /* what it is measured from ("keyphasor rising edge") */
 };
 
 /* The error message of rcb_meas (core/rcb_internal.h; ms may be NULL: no
@@ -93,16 +95,28 @@ void rcb_atomic_abort(rcb_atomic_file *af);
  * direction flipped). Errors (and a file without such a record) land in
  * ms's message; a nonzero return of fn stops the read with that status. */
 typedef struct rcb_uff_time_rec {
-  char name[RCB_MEAS_CH_MAX]; /* "STATION.DIR", or the station for direction 0 */
+  char name[RCB_MEAS_CH_MAX]; /* "STATION.DIR" (DIR x, y, z, rx, ry, rz), or the
+                                 station for direction 0 (scalar) */
+  long dir;                   /* the record's direction code (0 scalar, 3 z, 6 rz, ...) */
   double t0, dt;              /* s */
   size_t n;
-  const rcb_complex *y;       /* n values, SI, imaginary parts 0 */
+  const rcb_complex *y;       /* n values, SI, imaginary parts 0 (file units when
+                                 label_unknown) */
   rcb_quantity q;             /* from the data type or the label; unknown if neither */
+  char label[24];             /* the record-9 units label as written */
+  int label_unknown;          /* a label rcb_unit_parse does not know: the caller
+                                 scales (or refuses) */
+  long spec;                  /* record 9's ordinate data type */
   size_t index, line;         /* dataset ordinal, line of its id line */
 } rcb_uff_time_rec;
 typedef rcb_status (*rcb_uff_time_fn)(void *user, const rcb_uff_time_rec *rec);
 rcb_status rcb_uff58_read_time(rcb_meas *ms, const char *path, size_t nmap,
                                const rcb_uff_node *map, rcb_uff_time_fn fn, void *user);
+
+/* What a UFF dataset 58 function type is and which rcbtool verb reads it
+ * ("9 (power spectral density): no rcbtool command reads it"), for messages
+ * (uff58_warn.c); @p abscissa: record 8's data type (17 time). */
+void rcb_uff_function_text(long func_type, long abscissa, char *buf, size_t size);
 
 /* Whole file into memory (NUL-terminated), through the object's allocator. */
 rcb_status rcb_meas_slurp(rcb_meas *ms, const char *path, char **buf, size_t *len);

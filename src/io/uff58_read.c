@@ -121,6 +121,8 @@ typedef struct uff_reader {
   rcb_uff_time_fn on_time; /* time mode (rcb_uff58_read_time): records go here */
   void *user;
   size_t ntime;
+  size_t nskip, skip_index; /* records of a function this read does not take; the first */
+  long skip_type, skip_abscissa;
   char err164[RCB_ERRMSG_MAX];
   double lf, ff;       /* its length and force factors (file units per SI unit) */
   size_t line164;
@@ -189,8 +191,17 @@ static rcb_status check_form(uff_reader *R, uff_rec *r) {
   if (!r->real && r->ord_type != 5 && r->ord_type != 6)
     return rfail(R, r, line, "unknown ordinate data type %ld; expected 5 or 6 (complex)",
                  r->ord_type);
-  if (r->npts < 1 || r->npts > 100000000L)
+  if (r->npts < 1)
     return rfail(R, r, line, "number of points %ld; expected at least 1", r->npts);
+  { /* before allocating: can the bytes left hold that many values? (a value
+     * takes at least 2 bytes in ASCII, 4 in binary) */
+    size_t per = r->real ? (r->spacing ? 1u : 2u) : (r->spacing ? 2u : 3u);
+    size_t least = r->binary ? 4u : 2u, left = R->c.len - R->c.pos;
+    if (r->npts > 100000000L || (size_t)r->npts > left / (per * least))
+      return rfail(R, r, line, "record 7 claims %ld points (%zu values), but the %zu bytes "
+                   "left in the file hold at most %zu: truncated, or a wrong count", r->npts,
+                   (size_t)r->npts * per, left, left / least);
+  }
   if (r->spacing != 0 && r->spacing != 1)
     return rfail(R, r, line, "abscissa spacing %ld; expected 0 (uneven) or 1 (even)",
                  r->spacing);
@@ -380,9 +391,15 @@ static void skip_values(uff_reader *R, const uff_rec *r) {
 static rcb_status read_record(uff_reader *R, uff_rec *r, int *used) {
   rcb_status st;
   *used = 0;
+  int is_time;
   if ((st = read_headers(R, r))) return st;
-  if (R->on_time ? !(r->func_type == 1 && r->spec[0] == 17)
-                 : (r->func_type != 4 && r->func_type != 1)) {
+  is_time = r->func_type == 1 && r->spec[0] == 17;
+  if (R->on_time ? !is_time : (r->func_type != 4 && (r->func_type != 1 || is_time))) {
+    if (R->nskip++ == 0) {
+      R->skip_index = r->index;
+      R->skip_type = r->func_type;
+      R->skip_abscissa = r->spec[0];
+    }
     skip_values(R, r);
     return RCB_OK;
   }
@@ -506,11 +523,14 @@ static rcb_status unit_factor(uff_reader *R, const uff_rec *r, int k, rcb_quanti
   if (R->has164) f164 = want == RCB_QTY_FORCE ? 1.0 / R->ff : 1.0 / R->lf;
   *f = f164;
   if (no_label(lab)) return RCB_OK;
-  if (rcb_unit_parse(lab, &q, &fl))
+  if (rcb_unit_parse(lab, &q, &fl)) {
+    char known[200];
+    rcb_unit_list(want, known, sizeof known);
     return rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu: record %d "
-                         "units label '%s' is not a unit librcb knows; expected %s (m, mm, um, "
-                         "mil, m/s, mm/s, m/s^2, g, N, kN, lbf) or NONE", R->path,
-                         r->line + 8 + (size_t)k, r->index, 8 + k, lab, rcb_quantity_name(want));
+                         "units label '%s' is not a unit librcb knows; expected %s (%s) or "
+                         "NONE", R->path, r->line + 8 + (size_t)k, r->index, 8 + k, lab,
+                         rcb_quantity_name(want), known);
+  }
   if (q != want)
     return rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu: record %d "
                          "units label '%s' is %s %s, but its data type %ld says %s; fix the "
@@ -554,7 +574,35 @@ typedef struct uff_set {
   double speed; /* rad/s */
   long ztype;   /* z axis data type of the first record (19: speed in rpm) */
   size_t first_index, first_line;
+  size_t ndirskip; /* records skipped for a direction the model has no channel for */
+  char dirskip[200]; /* the first of them, for the message when nothing is left */
 } uff_set;
+
+/* An FRF or unbalance record whose response or reference is axial (3),
+ * torsional (6) or scalar (0): the model has no such channel. Skipped with
+ * a warning, not fatal (issue #25: one axial channel refused a whole
+ * 4-channel file). 1 when skipped (*st: a warning that could not be kept). */
+static int skip_direction(uff_reader *R, uff_set *S, const uff_rec *r, rcb_status *st) {
+  static const char *const why[] = {"scalar (direction 0)", NULL, NULL, "axial (direction 3, z)",
+                                    NULL, NULL, "torsional (direction 6, rz)"};
+  long d[2], a;
+  int k;
+  d[0] = r->rsp_dir;
+  d[1] = r->func_type == 4 ? r->ref_dir : 1;
+  for (k = 0; k < 2; k++) {
+    a = d[k] < 0 ? -d[k] : d[k];
+    if (a > 6 || !why[a]) continue;
+    if (S->ndirskip++ == 0)
+      snprintf(S->dirskip, sizeof S->dirskip, "%zu: dataset 58 record %zu: its %s is %s",
+               r->line + 6, r->index, k ? "reference" : "response", why[a]);
+    *st = rcb_meas_warn(R->ms, "%s:%zu: dataset 58 record %zu: skipped: its %s (node %ld) is "
+                        "%s; the model's channels are x, y, rx, ry", R->path, r->line + 6,
+                        r->index, k ? "reference" : "response", k ? r->ref_node : r->rsp_node,
+                        why[a]);
+    return 1;
+  }
+  return 0;
+}
 
 static rcb_status match_first(uff_reader *R, uff_set *S, const uff_rec *r, int type,
                               double scale, double speed) {
@@ -596,6 +644,7 @@ static rcb_status accept(uff_reader *R, uff_set *S, uff_rec *r) {
   if (!frf && r->ref_node != 0)
     return rfail(R, r, r->line + 6, "function type 1 with reference node %ld: read as an "
                  "unbalance response, which needs reference node 0", r->ref_node);
+  if (skip_direction(R, S, r, &st)) return st;
   if ((st = dir_name(R, r, r->rsp_dir, "response", &rd))) return st;
   if (frf && (st = dir_name(R, r, r->ref_dir, "reference", &fd))) return st;
   if ((st = record_kind(R, r, frf, &kind))) return st;
@@ -644,36 +693,73 @@ static rcb_status accept(uff_reader *R, uff_set *S, uff_rec *r) {
 
 static rcb_status scan(uff_reader *R, uff_set *S);
 
-/* A time record (function type 1, abscissa time): channel "STATION.DIR" (or
- * the station alone for direction 0, e.g. a keyphasor), quantity from the
- * ordinate data type (8, 11, 12 motion; 9, 13 force) or else from the units
- * label, values to SI, then handed to the caller. */
-static rcb_status accept_time(uff_reader *R, uff_rec *r) {
+/* Direction suffix of a time record's channel: x, y, rx, ry as the model
+ * names them, z and rz for the axial and torsional directions (the caller
+ * decides what it can use), "" for 0 (scalar). */
+static rcb_status time_dir(uff_reader *R, const uff_rec *r, const char **dir) {
+  static const char *const names[] = {"", "x", "y", "z", "rx", "ry", "rz"};
+  long a = r->rsp_dir < 0 ? -r->rsp_dir : r->rsp_dir;
+  if (a > 6)
+    return rfail(R, r, r->line + 6, "unknown response direction code %ld; expected 0 "
+                 "(scalar) or 1 to 6 (x, y, z, rx, ry, rz) or their negatives", r->rsp_dir);
+  *dir = names[a];
+  return RCB_OK;
+}
+
+/* Quantity and factor to SI of a time record: from the ordinate data type
+ * (8, 11, 12 motion; 9, 13 force; 15, 21 pressure) checked against the
+ * label, or else from the label. A label librcb does not know is left to the
+ * caller (t->label_unknown: values in file units). */
+static rcb_status time_units(uff_reader *R, const uff_rec *r, rcb_uff_time_rec *t, double *f) {
   static const long motion[] = {8, 11, 12};
+  rcb_quantity want = RCB_QTY_UNKNOWN, q = RCB_QTY_UNKNOWN;
+  double fl = 1.0;
+  size_t i;
+  for (i = 0; i < 3; i++)
+    if (r->spec[1] == motion[i]) want = (rcb_quantity)(RCB_QTY_DISPLACEMENT + (int)i);
+  if (r->spec[1] == 9 || r->spec[1] == 13) want = RCB_QTY_FORCE;
+  if (r->spec[1] == 15 || r->spec[1] == 21) want = RCB_QTY_PRESSURE;
+  snprintf(t->label, sizeof t->label, "%s", r->lab[1]);
+  t->spec = r->spec[1];
+  *f = 1.0;
+  if (!no_label(r->lab[1]) && rcb_unit_parse(r->lab[1], &q, &fl)) {
+    t->label_unknown = 1;
+    t->q = want;
+    return RCB_OK;
+  }
+  if (want != RCB_QTY_UNKNOWN && want != RCB_QTY_PRESSURE) {
+    rcb_status st = unit_factor(R, r, 1, want, f);
+    if (st) return st;
+  } else if (!no_label(r->lab[1])) {
+    if (want == RCB_QTY_PRESSURE && q != want)
+      return rfail(R, r, r->line + 9, "record 9 units label '%s' is %s, but its data type %ld "
+                   "says pressure; fix the label or the data type", r->lab[1],
+                   rcb_quantity_name(q), r->spec[1]);
+    want = q;
+    *f = fl;
+  }
+  t->q = want;
+  return RCB_OK;
+}
+
+/* A time record (function type 1, abscissa time): channel "STATION.DIR" (or
+ * the station alone for direction 0), quantity and units (time_units),
+ * values to SI, then handed to the caller, which decides what it uses. */
+static rcb_status accept_time(uff_reader *R, uff_rec *r) {
   rcb_uff_time_rec t;
-  rcb_quantity want = RCB_QTY_UNKNOWN;
   char st_r[RCB_MEAS_CH_MAX];
-  const char *dir = NULL;
+  const char *dir = "";
   double f = 1.0;
   size_t i;
   rcb_status st;
   memset(&t, 0, sizeof t);
-  for (i = 0; i < 3; i++)
-    if (r->spec[1] == motion[i]) want = (rcb_quantity)(RCB_QTY_DISPLACEMENT + (int)i);
-  if (r->spec[1] == 9 || r->spec[1] == 13) want = RCB_QTY_FORCE;
-  if (want != RCB_QTY_UNKNOWN) {
-    if ((st = unit_factor(R, r, 1, want, &f))) return st;
-  } else if (!no_label(r->lab[1]) && rcb_unit_parse(r->lab[1], &want, &f)) {
-    return rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu: record 9 units "
-                         "label '%s' is not a unit librcb knows (m, mm, um, m/s, m/s^2, g, N, "
-                         "V, ...)", R->path, r->line + 9, r->index, r->lab[1]);
-  }
-  if (r->rsp_dir != 0 && (st = dir_name(R, r, r->rsp_dir, "response", &dir))) return st;
+  if ((st = time_units(R, r, &t, &f)) || (st = time_dir(R, r, &dir))) return st;
   station_of(R, r->rsp_node, st_r, sizeof st_r);
-  if (dir)
+  if (dir[0])
     snprintf(t.name, sizeof t.name, "%.*s.%s", (int)(sizeof t.name - 4), st_r, dir);
   else
     snprintf(t.name, sizeof t.name, "%s", st_r);
+  t.dir = r->rsp_dir;
   if (r->rsp_dir < 0) f = -f;
   for (i = 0; i < (size_t)r->npts; i++) r->y[i] *= f;
   t.t0 = r->xmin;
@@ -691,11 +777,20 @@ static rcb_status accept_time(uff_reader *R, uff_rec *r) {
   }
   t.n = (size_t)r->npts;
   t.y = r->y;
-  t.q = want;
   t.index = r->index;
   t.line = r->line;
   R->ntime++;
   return R->on_time(R->user, &t);
+}
+
+/* ", and record N is function type T (...)" for a read that found nothing. */
+static void skipped_text(const uff_reader *R, char *buf, size_t size) {
+  char what[300];
+  buf[0] = '\0';
+  if (!R->nskip) return;
+  rcb_uff_function_text(R->skip_type, R->skip_abscissa, what, sizeof what);
+  snprintf(buf, size, "; record %zu is %s%s", R->skip_index, what,
+           R->nskip > 1 ? " (the first of the records skipped)" : "");
 }
 
 /* A reader over the file's bytes buf[0 .. len) and an empty set of records. */
@@ -726,9 +821,12 @@ rcb_status rcb_uff58_read_time(rcb_meas *ms, const char *path, size_t nmap,
   R.on_time = fn;
   R.user = user;
   st = scan(&R, &S);
-  if (!st && R.ntime == 0)
+  if (!st && R.ntime == 0) {
+    char why[360];
+    skipped_text(&R, why, sizeof why);
     st = rcb_meas_fail(ms, RCB_ERR_PARSE, "%s: no dataset 58 time record (function type 1, "
-                       "abscissa data type 17)", path);
+                       "abscissa data type 17)%s", path, why);
+  }
   rcb_free(&ms->alloc, buf);
   return st;
 }
@@ -748,7 +846,7 @@ static rcb_status scan(uff_reader *R, uff_set *S) {
   while (!st && get_line(&R->c, &s, &n)) {
     uff_rec r;
     long id;
-    int used;
+    int used, got;
     if (n == 0 || !is_delim(s, n)) {
       char f[8];
       field(s, n, 0, n, f, sizeof f);
@@ -756,8 +854,11 @@ static rcb_status scan(uff_reader *R, uff_set *S) {
       return rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s:%zu: expected '    -1' starting a "
                            "dataset, got '%.40s'", R->path, R->c.line, s);
     }
-    if (!get_line(&R->c, &s, &n)) break;
-    if (is_delim(s, n)) continue; /* an empty dataset "-1", "-1" (pyuff 58b writes one) */
+    /* an empty dataset "-1", "-1" (pyuff 2.5 writes one before its 58b records,
+     * with no "-1" of its own after it): every "-1" in a row opens the next */
+    while ((got = get_line(&R->c, &s, &n)) && is_delim(s, n)) {
+    }
+    if (!got) break;
     count++;
     if (field_long(s, n, 0, 6, &id))
       return rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s:%zu: dataset id '%.10s' is not a number",
@@ -779,9 +880,16 @@ static rcb_status scan(uff_reader *R, uff_set *S) {
     rcb_free(&R->ms->alloc, r.x);
     rcb_free(&R->ms->alloc, r.y);
   }
-  if (!st && S->type < 0 && !R->on_time)
+  if (!st && S->type < 0 && !R->on_time && S->ndirskip)
+    st = rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s:%s; the model's channels are x, y, rx, ry, "
+                       "and all %zu records were skipped so: nothing to read", R->path,
+                       S->dirskip, S->ndirskip);
+  if (!st && S->type < 0 && !R->on_time) {
+    char why[360];
+    skipped_text(R, why, sizeof why);
     st = rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s: no dataset 58 record with function type 4 "
-                       "(FRF) or 1 (unbalance response) in %zu datasets", R->path, count);
+                       "(FRF) or 1 (unbalance response) in %zu datasets%s", R->path, count, why);
+  }
   return st;
 }
 

@@ -10,6 +10,7 @@
  *    compared at 0 rpm shows ~100 % error.
  * Kept apart from uff58_read.c (the record parser) so each stays small.
  */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -68,4 +69,28 @@ rcb_status rcb_uff_read_warnings(rcb_meas *ms, const char *path, size_t nmap, lo
                        path, ztype);
   if (!st && ms->type == RCB_MEAS_FRF && ztype != 19) ms->speed_warning = ms->n_warnings;
   return st;
+}
+
+/* UFF function types (dataset 58 record 6, field 1; I-DEAS/UC-SDRL). */
+void rcb_uff_function_text(long func_type, long abscissa, char *buf, size_t size) {
+  static const char *const names[] = {
+      "general or unknown", "time response", "auto spectrum", "cross spectrum",
+      "frequency response function", "transmissibility", "coherence", "auto correlation",
+      "cross correlation", "power spectral density", "energy spectral density",
+      "probability density function", "spectrum", "cumulative frequency distribution",
+      "peaks valley", "stress/cycles", "strain/cycles", "orbit", "mode indicator function",
+      "force pattern", "partial power", "partial coherence", "eigenvalue", "eigenvector",
+      "shock response spectrum", "finite impulse response filter", "multiple coherence",
+      "order function"};
+  const char *name = func_type >= 0 && func_type < (long)(sizeof names / sizeof names[0])
+                         ? names[func_type] : "not a UFF function type";
+  const char *verb = "no rcbtool command reads it";
+  if (func_type == 1 && abscissa == 17)
+    verb = "a time record: rcbtool estimate and order read it";
+  else if (func_type == 1)
+    verb = "with abscissa 18/19 an unbalance response: rcbtool convert, compare, fit, "
+           "diagnose read it";
+  else if (func_type == 4)
+    verb = "an FRF: rcbtool convert, compare, fit, diagnose read it";
+  snprintf(buf, size, "function type %ld (%s; %s)", func_type, name, verb);
 }

@@ -10,14 +10,22 @@
 
 #include "signals/signals_internal.h"
 
+/* Per bin, the sums of a least-squares line Q_r = a + b (w_r - w_mean) over
+ * its revolutions r (issue #25): the response changes across a bin's speeds
+ * near a resonance, and that change is not noise. The sums are taken about
+ * the bin's first revolution (w0, Q0), so that the residual is not the small
+ * difference of two large sums. */
 struct rcb_order {
   char errmsg[RCB_ERRMSG_MAX];
   rcb_order_opts o;
   size_t nch, nbins, nrevs;
   rcb_complex *tw;    /* norders * per_rev: e^{-i m (2 pi j / N + kp_angle)} */
   double *cnt, *wsum; /* nbins: revolutions, sum of speeds (rad/s) */
-  rcb_complex *qsum;  /* (bin * nch + ch) * norders + m - 1 */
-  double *q2sum;      /* same layout: sum |Q|^2 */
+  double *w0, *u2sum; /* nbins: first speed, sum (w - w0)^2 */
+  rcb_complex *q0;    /* (bin * nch + ch) * norders + m - 1: the first Q */
+  rcb_complex *dsum;  /* same layout: sum (Q - Q0) */
+  rcb_complex *dusum; /* same layout: sum (Q - Q0) (w - w0) */
+  double *d2sum;      /* same layout: sum |Q - Q0|^2 */
 };
 
 static size_t al16(size_t b) { return (b + 15) & ~(size_t)15; }
@@ -35,8 +43,8 @@ static size_t layout(const rcb_order_opts *o, size_t nch, size_t sz[4], size_t *
   size_t cells = nb * nch * o->norders;
   sz[0] = sizeof(struct rcb_order);
   sz[1] = o->norders * per * sizeof(rcb_complex);
-  sz[2] = 2 * nb * sizeof(double) + cells * sizeof(double);
-  sz[3] = cells * sizeof(rcb_complex);
+  sz[2] = 4 * nb * sizeof(double) + cells * sizeof(double);
+  sz[3] = 3 * cells * sizeof(rcb_complex);
   *nbins = nb;
   return 16 + al16(sz[0]) + al16(sz[1]) + al16(sz[2]) + al16(sz[3]);
 }
@@ -72,9 +80,13 @@ rcb_status rcb_order_init(rcb_order **out, const rcb_order_opts *o, size_t nch, 
   p += al16(sz[1]);
   e->cnt = (double *)(void *)p;
   e->wsum = e->cnt + nb;
-  e->q2sum = e->wsum + nb;
+  e->w0 = e->wsum + nb;
+  e->u2sum = e->w0 + nb;
+  e->d2sum = e->u2sum + nb;
   p += al16(sz[2]);
-  e->qsum = (rcb_complex *)(void *)p;
+  e->q0 = (rcb_complex *)(void *)p;
+  e->dsum = e->q0 + nb * nch * o->norders;
+  e->dusum = e->dsum + nb * nch * o->norders;
   for (m = 1; m <= o->norders; m++)
     for (j = 0; j < per; j++) {
       double th = (double)m * (2.0 * RCB_PI * (double)j / (double)per + o->kp_angle);
@@ -98,13 +110,18 @@ static double angle_time(double p, double q, double th) {
 static void revolution(rcb_order *e, double rate, double a, double b, double c,
                        const double *const *chan) {
   size_t per = e->o.per_rev, ch, j, m, bin, at;
-  double ta = a - b, tc = c - b, det = ta * tc * (tc - ta), speed = 2.0 * RCB_PI * rate / tc;
+  int first;
+  double u, ta = a - b, tc = c - b, det = ta * tc * (tc - ta), speed = 2.0 * RCB_PI * rate / tc;
   double p = -2.0 * RCB_PI * (tc * tc + ta * ta) / det, q = 2.0 * RCB_PI * (ta + tc) / det;
   if (!(speed < e->o.speed_max) || !(p > 0.0)) return;
   bin = (size_t)floor(speed / e->o.bin_width);
   if (bin >= e->nbins) return;
+  first = e->cnt[bin] == 0.0;
+  if (first) e->w0[bin] = speed;
+  u = speed - e->w0[bin];
   e->cnt[bin] += 1.0;
   e->wsum[bin] += speed;
+  e->u2sum[bin] += u * u;
   for (ch = 0; ch < e->nch; ch++) {
     rcb_complex z[8] = {0};
     for (j = 0; j < per; j++) {
@@ -115,10 +132,13 @@ static void revolution(rcb_order *e, double rate, double a, double b, double c,
       for (m = 0; m < e->o.norders; m++) z[m] += y * e->tw[m * per + j];
     }
     for (m = 0; m < e->o.norders; m++) {
-      rcb_complex Q = z[m] * (2.0 / (double)per);
+      rcb_complex d, Q = z[m] * (2.0 / (double)per);
       at = (bin * e->nch + ch) * e->o.norders + m;
-      e->qsum[at] += Q;
-      e->q2sum[at] += creal(Q) * creal(Q) + cimag(Q) * cimag(Q);
+      if (first) e->q0[at] = Q;
+      d = Q - e->q0[at];
+      e->dsum[at] += d;
+      e->dusum[at] += d * u;
+      e->d2sum[at] += creal(d) * creal(d) + cimag(d) * cimag(d);
     }
   }
   e->nrevs++;
@@ -140,7 +160,8 @@ rcb_status rcb_order_add(rcb_order *e, double rate, size_t n, const double *kp,
     trig = 0.5 * (lo + hi);
   }
   for (i = 1; i < n; i++)
-    if (kp[i - 1] < trig && kp[i] >= trig) {
+    if (e->o.kp_falling ? (kp[i - 1] > trig && kp[i] <= trig)
+                        : (kp[i - 1] < trig && kp[i] >= trig)) {
       double t = (double)(i - 1) + (trig - kp[i - 1]) / (kp[i] - kp[i - 1]);
       if (prev2 >= 0.0) revolution(e, rate, prev2, prev, t, chan);
       prev2 = prev;
@@ -148,31 +169,43 @@ rcb_status rcb_order_add(rcb_order *e, double rate, size_t n, const double *kp,
       pulses++;
     }
   if (pulses < 3)
-    return rcb_set_error(e->errmsg, RCB_ERR_ARG, "order: %zu keyphasor pulse%s (upward "
+    return rcb_set_error(e->errmsg, RCB_ERR_ARG, "order: %zu keyphasor pulse%s (%s "
                          "crossings of %g) in %zu samples; need three or more: check the "
-                         "keyphasor channel and the trigger level", pulses,
-                         pulses == 1 ? "" : "s", trig, n);
+                         "keyphasor channel, the trigger level and the edge", pulses,
+                         pulses == 1 ? "" : "s", e->o.kp_falling ? "downward" : "upward", trig, n);
   return RCB_OK;
 }
 
 size_t rcb_order_revolutions(const rcb_order *e) { return e ? e->nrevs : 0; }
 size_t rcb_order_bin_count(const rcb_order *e) { return e ? e->nbins : 0; }
 
+/* A bin's phasor is the mean of its revolutions' (the line's value at the
+ * mean speed, which the bin reports); its sd comes from the residual of the
+ * line Q_r = a + b (w_r - w_mean), sum |res|^2 = S_dd - |S_du|^2 / S_uu (sums
+ * about the means), over 2 (n - 2) degrees of freedom (Re and Im), divided by
+ * n for the mean. Two revolutions fit any line: then the scatter about the
+ * mean (n - 1 degrees of freedom) as before. */
 rcb_status rcb_order_result(const rcb_order *e, size_t bin, size_t ch, size_t m,
                             double *speed, rcb_complex *Q, double *sd, size_t *nrev) {
-  double n, var;
+  double n, ubar, suu, sdd, res;
   size_t at;
-  rcb_complex mean;
+  rcb_complex dbar, sdu;
   if (!e || bin >= e->nbins || ch >= e->nch || m < 1 || m > e->o.norders) return RCB_ERR_ARG;
   n = e->cnt[bin];
   at = (bin * e->nch + ch) * e->o.norders + m - 1;
-  mean = n > 0.0 ? e->qsum[at] / n : 0.0;
-  var = n > 1.0 ? fmax(0.0, e->q2sum[at] - n * (creal(mean) * creal(mean) +
-                                                 cimag(mean) * cimag(mean)))
-                : 0.0;
+  dbar = n > 0.0 ? e->dsum[at] / n : 0.0;
+  ubar = n > 0.0 ? e->wsum[bin] / n - e->w0[bin] : 0.0;
+  suu = e->u2sum[bin] - n * ubar * ubar;
+  sdd = e->d2sum[at] - n * (creal(dbar) * creal(dbar) + cimag(dbar) * cimag(dbar));
+  sdu = e->dusum[at] - ubar * e->dsum[at];
+  res = n > 2.0 && suu > 0.0 ? sdd - (creal(sdu) * creal(sdu) + cimag(sdu) * cimag(sdu)) / suu
+                             : sdd;
   if (speed) *speed = n > 0.0 ? e->wsum[bin] / n : (double)NAN;
-  if (Q) *Q = mean;
-  if (sd) *sd = n > 1.0 ? sqrt(var / (2.0 * n * (n - 1.0))) : (double)NAN;
+  if (Q) *Q = n > 0.0 ? e->q0[at] + dbar : 0.0;
+  if (sd)
+    *sd = n > 2.0 && suu > 0.0 ? sqrt(fmax(0.0, res) / (2.0 * n * (n - 2.0)))
+          : n > 1.0           ? sqrt(fmax(0.0, res) / (2.0 * n * (n - 1.0)))
+                              : (double)NAN;
   if (nrev) *nrev = (size_t)n;
   return RCB_OK;
 }

@@ -4,6 +4,7 @@
  */
 #include <errno.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -29,10 +30,75 @@ void rcb_signals_empty(rcb_signals *s) {
   s->rate = 0.0;
 }
 
+void rcb_signals_begin_read(rcb_signals *s) {
+  rcb_signals_empty(s);
+  s->nwarn = 0;
+}
+
+rcb_status rcb_signals_warn(rcb_signals *s, const char *fmt, ...) {
+  va_list ap;
+  if (rcb_grow(&s->alloc, (void **)&s->warnings, &s->capwarn, s->nwarn + 1, sizeof *s->warnings))
+    return rcb_signals_fail(s, RCB_ERR_NOMEM, "out of memory recording a warning");
+  va_start(ap, fmt);
+  vsnprintf(s->warnings[s->nwarn].text, RCB_WARNING_MAX, fmt, ap);
+  va_end(ap);
+  s->nwarn++;
+  return RCB_OK;
+}
+
+size_t rcb_signals_warning_count(const rcb_signals *s) { return s ? s->nwarn : 0; }
+
+const char *rcb_signals_warning(const rcb_signals *s, size_t i) {
+  return s && i < s->nwarn ? s->warnings[i].text : "";
+}
+
+rcb_status rcb_signals_set_allow_truncated(rcb_signals *s, int allow) {
+  if (!s) return RCB_ERR_ARG;
+  s->allow_truncated = allow != 0;
+  return RCB_OK;
+}
+
+rcb_status rcb_signals_set_unit(rcb_signals *s, const char *name, const char *unit) {
+  size_t i;
+  rcb_quantity q;
+  double f;
+  if (!s) return RCB_ERR_ARG;
+  if (!name || !name[0] || strlen(name) >= RCB_SIGNAL_NAME_MAX || !unit ||
+      strlen(unit) >= sizeof s->units->unit)
+    return rcb_signals_fail(s, RCB_ERR_ARG, "unit override '%.80s=%.40s': expected a channel "
+                            "name of 1 to %d characters and a unit", name ? name : "",
+                            unit ? unit : "", RCB_SIGNAL_NAME_MAX - 1);
+  if (rcb_unit_parse(unit, &q, &f)) {
+    char known[RCB_ERRMSG_MAX / 2];
+    rcb_unit_list(RCB_QTY_UNKNOWN, known, sizeof known);
+    return rcb_signals_fail(s, RCB_ERR_ARG, "unit override %s=%s: '%s' is not a unit librcb "
+                            "knows; expected one of %s", name, unit, unit, known);
+  }
+  for (i = 0; i < s->nunits && strcmp(s->units[i].name, name) != 0; i++) {
+  }
+  if (i == s->nunits) {
+    if (rcb_grow(&s->alloc, (void **)&s->units, &s->capunits, i + 1, sizeof *s->units))
+      return rcb_signals_fail(s, RCB_ERR_NOMEM, "out of memory");
+    s->nunits++;
+  }
+  snprintf(s->units[i].name, sizeof s->units[i].name, "%s", name);
+  snprintf(s->units[i].unit, sizeof s->units[i].unit, "%s", unit);
+  return RCB_OK;
+}
+
+const char *rcb_signals_unit_override(const rcb_signals *s, const char *name) {
+  size_t i;
+  for (i = 0; i < s->nunits; i++)
+    if (strcmp(s->units[i].name, name) == 0) return s->units[i].unit;
+  return NULL;
+}
+
 void rcb_signals_destroy(rcb_signals *s) {
   if (!s) return;
   rcb_signals_empty(s);
   rcb_free(&s->alloc, s->ch);
+  rcb_free(&s->alloc, s->warnings);
+  rcb_free(&s->alloc, s->units);
   rcb_free(&s->alloc, s);
 }
 
@@ -80,12 +146,12 @@ rcb_status rcb_signals_add(rcb_signals *s, const char *name, rcb_quantity q,
   if (!s || !values) return RCB_ERR_ARG;
   if (s->n == 0)
     return rcb_signals_fail(s, RCB_ERR_STATE, "add a channel after rcb_signals_reset");
-  if ((unsigned)q > RCB_QTY_VOLTAGE)
+  if ((unsigned)q > RCB_QTY_PRESSURE)
     return rcb_signals_fail(s, RCB_ERR_ARG, "channel '%s': unknown quantity %d", name, (int)q);
   for (i = 0; i < s->n; i++)
-    if (!isfinite(values[i]))
-      return rcb_signals_fail(s, RCB_ERR_ARG, "channel '%s': sample %zu is not finite", name,
-                              i + 1);
+    if (!isfinite(values[i]) || fabs(values[i]) > RCB_SIGNAL_MAX)
+      return rcb_signals_fail(s, RCB_ERR_ARG, "channel '%s': sample %zu is %g; expected a "
+                              "finite value within +-%g", name, i + 1, values[i], RCB_SIGNAL_MAX);
   v = rcb_alloc(&s->alloc, s->n * sizeof *v);
   if (!v) return rcb_signals_fail(s, RCB_ERR_NOMEM, "out of memory (%zu samples)", s->n);
   memcpy(v, values, s->n * sizeof *v);

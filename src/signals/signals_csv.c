@@ -140,6 +140,10 @@ static rcb_status parse_rows(csv_state *C, size_t nrows, double *t, double **v) 
       if (endp == q || errno == ERANGE || !isfinite(x))
         return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s:%zu: field %zu is not a finite "
                                 "number", C->path, C->line, k + 1);
+      if (k > 0 && fabs(x) > RCB_SIGNAL_MAX)
+        return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s:%zu: field %zu is %g: beyond %g, "
+                                "the largest sample librcb takes (its power would overflow); "
+                                "a corrupt field?", C->path, C->line, k + 1, x, RCB_SIGNAL_MAX);
       while (*endp == ' ' || *endp == '\t') endp++;
       if (k < C->ncol && *endp != ',')
         return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s:%zu: %zu fields; expected %zu (time "
@@ -185,11 +189,17 @@ static rcb_status take_columns(csv_state *C, double **v) {
   for (k = 0; k < C->ncol; k++) {
     rcb_quantity q = RCB_QTY_UNKNOWN;
     double f = 1.0;
-    if (C->col[k].unit[0] && rcb_unit_parse(C->col[k].unit, &q, &f))
+    const char *given = rcb_signals_unit_override(C->s, C->col[k].name);
+    if (given && (!C->col[k].unit[0] || rcb_unit_parse(C->col[k].unit, &q, &f))) {
+      rcb_unit_parse(given, &q, &f); /* checked by rcb_signals_set_unit */
+    } else if (C->col[k].unit[0] && rcb_unit_parse(C->col[k].unit, &q, &f)) {
+      char known[300];
+      rcb_unit_list(RCB_QTY_UNKNOWN, known, sizeof known);
       return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s:%zu: channel '%s': unit '%s' is not "
-                              "one librcb knows; expected m, mm, um, mil, m/s, mm/s, m/s^2, g, "
-                              "N, kN, lbf, V or mV", C->path, C->col[k].unit_line,
-                              C->col[k].name, C->col[k].unit);
+                              "one librcb knows (%s); give it: --units '%s=UNIT' "
+                              "(rcb_signals_set_unit)", C->path, C->col[k].unit_line,
+                              C->col[k].name, C->col[k].unit, known, C->col[k].name);
+    }
     for (i = 0; i < C->s->n; i++) v[k][i] *= f;
     st = rcb_signals_take(C->s, C->col[k].name, q, v[k]);
     v[k] = NULL;
@@ -242,7 +252,7 @@ rcb_status rcb_signals_read_csv(rcb_signals *s, const char *path) {
   size_t len;
   rcb_status st;
   if (!s) return RCB_ERR_ARG;
-  rcb_signals_empty(s);
+  rcb_signals_begin_read(s);
   if ((st = rcb_signals_slurp(s, path, &buf, &len))) return st;
   C = rcb_alloc(&s->alloc, sizeof *C);
   if (!C) {

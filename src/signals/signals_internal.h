@@ -33,11 +33,25 @@ double rcb_spectral_line_scale(const rcb_spectral *e, size_t k);
 
 #define RCB_SIGNAL_NAME_MAX 64
 
+/* Largest sample magnitude a reader takes, in the file's unit or SI: the
+ * estimator sums squares of segment sums (nseg samples), which overflow
+ * near 1e154; no sensor reads 1e100 of any unit. A value beyond it (a
+ * corrupt field, 1e308) is refused with its place in the file instead of
+ * surfacing as a NaN spectrum (issue #26 saw "value -nan-nani"). */
+#define RCB_SIGNAL_MAX 1e100
+
 typedef struct rcb_signal_ch {
   char name[RCB_SIGNAL_NAME_MAX];
   rcb_quantity q;
   double *v; /* n samples, SI */
 } rcb_signal_ch;
+
+/* A unit given by the caller for a channel whose file label is missing or
+ * not known (rcb_signals_set_unit; UFF readers). */
+typedef struct rcb_signal_unit {
+  char name[RCB_SIGNAL_NAME_MAX];
+  char unit[32];
+} rcb_signal_unit;
 
 struct rcb_signals {
   rcb_allocator alloc;
@@ -46,6 +60,11 @@ struct rcb_signals {
   size_t n;    /* samples per channel */
   rcb_signal_ch *ch;
   size_t nch, capch;
+  int allow_truncated;     /* rcb_signals_set_allow_truncated */
+  rcb_warning_t *warnings; /* of the last read */
+  size_t nwarn, capwarn;
+  rcb_signal_unit *units;  /* rcb_signals_set_unit */
+  size_t nunits, capunits;
 };
 
 /* The error message of rcb_signals (core/rcb_internal.h; s may be NULL: no
@@ -56,6 +75,16 @@ struct rcb_signals {
 rcb_status rcb_signals_take(rcb_signals *s, const char *name, rcb_quantity q, double *values);
 /* Drop every channel (before reading, and after a failed read). */
 void rcb_signals_empty(rcb_signals *s);
+/* Start a read: no channels, no warnings. */
+void rcb_signals_begin_read(rcb_signals *s);
+/* Record a warning of the current read (RCB_ERR_NOMEM if it cannot be kept). */
+rcb_status rcb_signals_warn(rcb_signals *s, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+/* The caller's unit for channel @p name (rcb_signals_set_unit), or NULL. */
+const char *rcb_signals_unit_override(const rcb_signals *s, const char *name);
 /* Whole file into memory through the set's allocator. */
 rcb_status rcb_signals_slurp(rcb_signals *s, const char *path, char **buf, size_t *len);
 

@@ -13,17 +13,75 @@ typedef struct uff_ctx {
   rcb_signals *s;
   const char *path;
   double dt;
-  size_t n, first;
+  size_t n, first, nskip;
   int failed; /* the message is in s, not in the scratch measurement */
 } uff_ctx;
+
+/* What the model cannot use is skipped with a warning, not fatal (issue
+ * #25): an axial or torsional channel (direction 3, 6: the model's channels
+ * are x, y, rx, ry) and a scalar channel (direction 0) that is not a voltage
+ * (a keyphasor is a voltage at direction 0; an accelerometer written without
+ * a direction is not one, and has no model channel). 1 when skipped. */
+static int skipped(uff_ctx *c, const rcb_uff_time_rec *r, rcb_quantity q, rcb_status *st) {
+  long a = r->dir < 0 ? -r->dir : r->dir;
+  const char *why = NULL;
+  if (a == 3 || a == 6)
+    why = a == 3 ? "axial (direction 3, z)" : "torsional (direction 6, rz)";
+  else if (a == 0 && q != RCB_QTY_VOLTAGE)
+    why = "scalar (direction 0) and not a voltage (a keyphasor)";
+  if (!why) return 0;
+  c->nskip++;
+  *st = rcb_signals_warn(c->s, "%s:%zu: dataset 58 record %zu ('%s', %s): skipped: %s; the "
+                         "model's channels are x, y, rx, ry", c->path, r->line + 6, r->index,
+                         r->name, rcb_quantity_name(q), why);
+  return 1;
+}
+
+/* Quantity and factor of a record whose label librcb does not know: the
+ * caller's rcb_signals_set_unit, else refused with the known units. A level
+ * in dB is logarithmic: no factor makes it a signal. */
+static rcb_status unknown_label(uff_ctx *c, const rcb_uff_time_rec *r, rcb_quantity *q,
+                                double *f) {
+  const char *u = rcb_signals_unit_override(c->s, r->name);
+  char known[300];
+  if (u && rcb_unit_parse(u, q, f) == 0) {
+    if (r->q != RCB_QTY_UNKNOWN && *q != r->q)
+      return rcb_signals_fail(c->s, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu: the unit "
+                              "given for '%s' (%s) is %s, its data type %ld says %s", c->path,
+                              r->line + 9, r->index, r->name, u, rcb_quantity_name(*q), r->spec,
+                              rcb_quantity_name(r->q));
+    return RCB_OK;
+  }
+  if (strncmp(r->label, "dB", 2) == 0)
+    return rcb_signals_fail(c->s, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu ('%s'): units "
+                            "label '%s' is a level in decibels, a logarithm of the amplitude: "
+                            "a time record needs a linear unit (export it in Pa, m/s^2, ...)",
+                            c->path, r->line + 9, r->index, r->name, r->label);
+  rcb_unit_list(r->q, known, sizeof known);
+  return rcb_signals_fail(c->s, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu: units label "
+                          "'%s' of channel '%s' is not one librcb knows (%s%s%s); give it: "
+                          "--units '%s=UNIT' (rcb_signals_set_unit)", c->path, r->line + 9,
+                          r->index, r->label, r->name,
+                          r->q != RCB_QTY_UNKNOWN ? rcb_quantity_name(r->q) : "",
+                          r->q != RCB_QTY_UNKNOWN ? ", as its data type says: " : "", known,
+                          r->name);
+}
 
 static rcb_status take_record(void *user, const rcb_uff_time_rec *r) {
   uff_ctx *c = user;
   rcb_signals *s = c->s;
-  double *v;
+  rcb_quantity q = r->q;
+  double *v, f = 1.0;
   size_t i;
-  rcb_status st;
+  rcb_status st = RCB_OK;
   c->failed = 1;
+  if (r->label_unknown && (st = unknown_label(c, r, &q, &f))) return st;
+  if (q == RCB_QTY_UNKNOWN && rcb_signals_unit_override(s, r->name))
+    rcb_unit_parse(rcb_signals_unit_override(s, r->name), &q, &f);
+  if (skipped(c, r, q, &st)) {
+    c->failed = st != RCB_OK;
+    return st;
+  }
   if (!(r->dt > 0.0))
     return rcb_signals_fail(s, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu: time step %g s; "
                             "expected > 0", c->path, r->line + 7, r->index, r->dt);
@@ -40,8 +98,18 @@ static rcb_status take_record(void *user, const rcb_uff_time_rec *r) {
   }
   v = rcb_alloc(&s->alloc, r->n * sizeof *v);
   if (!v) return rcb_signals_fail(s, RCB_ERR_NOMEM, "%s: out of memory", c->path);
-  for (i = 0; i < r->n; i++) v[i] = creal(r->y[i]);
-  if ((st = rcb_signals_take(s, r->name, r->q, v))) return st;
+  for (i = 0; i < r->n; i++) {
+    v[i] = creal(r->y[i]) * f;
+    if (fabs(v[i]) > RCB_SIGNAL_MAX) {
+      double x = v[i];
+      rcb_free(&s->alloc, v);
+      return rcb_signals_fail(s, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu, value %zu is "
+                              "%g (SI): beyond %g, the largest sample librcb takes (its power "
+                              "would overflow); a corrupt value?", c->path, r->line + 12,
+                              r->index, i + 1, x, RCB_SIGNAL_MAX);
+    }
+  }
+  if ((st = rcb_signals_take(s, r->name, q, v))) return st;
   c->failed = 0;
   return RCB_OK;
 }
@@ -52,7 +120,7 @@ rcb_status rcb_signals_read_uff(rcb_signals *s, const char *path, size_t nmap,
   uff_ctx c;
   rcb_status st;
   if (!s) return RCB_ERR_ARG;
-  rcb_signals_empty(s);
+  rcb_signals_begin_read(s);
   if (rcb_meas_create(&ms, &s->alloc))
     return rcb_signals_fail(s, RCB_ERR_NOMEM, "out of memory");
   memset(&c, 0, sizeof c);
@@ -60,6 +128,9 @@ rcb_status rcb_signals_read_uff(rcb_signals *s, const char *path, size_t nmap,
   c.path = path;
   st = rcb_uff58_read_time(ms, path, nmap, map, take_record, &c);
   if (st && !c.failed) rcb_signals_fail(s, st, "%s", rcb_meas_errmsg(ms));
+  if (!st && s->nch == 0)
+    st = rcb_signals_fail(s, RCB_ERR_PARSE, "%s: no usable time record: all %zu were skipped "
+                          "(the warnings say why)", path, c.nskip);
   if (st) rcb_signals_empty(s);
   rcb_meas_destroy(ms);
   return st;

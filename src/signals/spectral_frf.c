@@ -38,8 +38,14 @@ static void frf_siso(rcb_estimator est, double gxx, rcb_complex gxy, double gyy,
   } else if (est == RCB_EST_H2) {
     *h = gyy / conj(gxy);
   } else {
-    double d = gyy - gxx;
-    *h = (d + sqrt(d * d + 4.0 * g2)) / (2.0 * conj(gxy));
+    /* The eigenvector's closed form (d + r) / (2 conj(Gxy)), r = sqrt(d^2 +
+     * 4 |Gxy|^2), d = Gyy - Gxx, cancels when Gxx >> Gyy (force in N, response
+     * in m: d + r ~ 2 |Gxy|^2 / |d| is the difference of two numbers 1e12 times
+     * larger; issue #25 saw Hv 2.5 off and exactly 0 at some lines). Its
+     * conjugate form 2 Gxy / (r - d) adds two positive terms there; each form is
+     * used where it adds. hypot keeps r finite for any scale of the channels. */
+    double d = gyy - gxx, r = hypot(d, 2.0 * sqrt(g2));
+    *h = d >= 0.0 ? (d + r) / (2.0 * conj(gxy)) : 2.0 * gxy / (r - d);
   }
   if (c > 1.0) c = 1.0; /* rounding when the pair is exactly linear */
   *coh = c;

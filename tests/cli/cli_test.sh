@@ -664,6 +664,71 @@ for a, b in (("h1.csv", "h2.csv"), ("st1.csv", "st2.csv")):
 EOF
   run estimate "$W/s.csv" --input f=DA.x --outputs DA.x --nseg 256 --every 0 -o "$W/h3.csv"
   expect_rc 2; err_has "--every"; [ ! -e "$W/h3.csv" ] || fail "output written" ;;
+order_conventions)
+  # issue #25: --phase lag|lead and --kp-edge rising|falling, stated in the CSV
+  # and --help. A notch keyphasor (falling through 2.5 V at the shaft's angle
+  # 0, back up at 45 deg), 1500 -> 1800 rpm in 3 s, DA.x = 10 um cos(theta - 30 deg): a lag
+  # of 30 deg from the falling edge, a lead of -30 deg.
+  python3 - "$W/s.csv" <<'PY' || fail "writing the signals"
+import math, sys
+fs, n, w, al = 4096.0, 4096 * 3, 1500 * math.pi / 30, 100 * math.pi / 30
+with open(sys.argv[1], "w") as f:
+    f.write("# units = V,um\ntime_s,KP,DA.x\n")
+    for i in range(n):
+        t = i / fs; th = w * t + 0.5 * al * t * t + 0.3; a = math.remainder(th, 2 * math.pi); d = 2 * math.pi * 0.02
+        kp = 2.5 - 2.5 * a / d if abs(a) <= d else (0.0 if d < a < math.pi / 4 else 5.0)
+        f.write("%.9f,%.9g,%.12g\n" % (t, kp, 10 * math.cos(th - math.radians(30))))
+PY
+  set -- "$W/s.csv" --kp KP --outputs DA.x --bin-rpm 100 --rpm-max 3000
+  run order "$@" --kp-edge falling --phase lag -o "$W/lag.csv"; expect_rc 0
+  grep -F -q "# phase = lag (keyphasor falling edge, shaft angle 0 deg there)" "$W/lag.csv" ||
+    fail "lag.csv does not state its convention"
+  run order "$@" --kp-edge falling -o "$W/lead.csv"; expect_rc 0
+  grep -F -q "# phase = lead (keyphasor falling edge" "$W/lead.csv" || fail "lead.csv: no convention line"
+  run order "$@" -o "$W/rise.csv"; expect_rc 0
+  python3 - "$W" <<'PY' || fail "phase conventions"
+import cmath, math, sys
+def row(p):
+    ls = [l for l in open(p) if l[0].isdigit()]
+    v = [float(x) for x in ls[0].split(",")]
+    return complex(v[1], v[2])
+w = sys.argv[1]
+lag, lead, rise = row(w + "/lag.csv"), row(w + "/lead.csv"), row(w + "/rise.csv")
+# (linear resampling at 164 samples per revolution: amplitude -0.13 %)
+assert abs(abs(lag) - 10e-6) < 2e-8 and abs(math.degrees(cmath.phase(lag)) - 30) < 0.01, lag
+assert abs(lead - lag.conjugate()) < 1e-15, (lead, lag)
+# the rising edge is the notch's far end, 45 deg later (a step: within a sample, 0.9 deg)
+assert abs(math.degrees(cmath.phase(rise)) - (-30 + 45)) < 0.9, cmath.phase(rise)
+PY
+  # read back, a lag file is the model's values: the same UFF as the lead file
+  run convert "$W/lag.csv" "$W/lag.uff" --map 1=DA; expect_rc 0
+  run convert "$W/lead.csv" "$W/lead.uff" --map 1=DA; expect_rc 0
+  cmp -s "$W/lag.uff" "$W/lead.uff" || fail "the lag CSV was not read back to the model's values"
+  usage order "$@" --phase lag -o "$W/x.uff"; err_has "--phase lag applies to a .csv output"
+  usage order "$@" --kp-edge up -o "$W/x.csv"; err_has "rising | falling"
+  run order --help; expect_rc 0; out_has "LEAD"; out_has "RISING edge"; out_has "--kp-edge E" ;;
+wav_truncated)
+  # issue #25: a WAV cut short is refused with the byte counts (it was read
+  # silently); --allow-truncated reads its whole frames with a warning
+  python3 - "$W/s.wav" <<'PY' || fail "writing the WAV file"
+import random, struct, sys, wave
+random.seed(3)
+with wave.open(sys.argv[1], "wb") as w:
+    w.setnchannels(2); w.setsampwidth(2); w.setframerate(1024)
+    f = [random.uniform(-0.5, 0.5) for i in range(2048)]
+    w.writeframes(b"".join(struct.pack("<hh", int(x * 30000), int(x * 15000)) for x in f))
+PY
+  head -c $((44 + 4 * 1500 + 3)) "$W/s.wav" >"$W/cut.wav"
+  set -- --input f=DA.x --outputs DA.x --nseg 256 --wav-names f,DA.x --wav-units N,mm
+  run estimate "$W/cut.wav" "$@" -o "$W/h.csv"
+  if [ "$RC" -eq 4 ] && grep -F -q "without an FFT backend" "$W/err"; then exit 77; fi
+  expect_rc 3; err_has "cut.wav: the data chunk claims 8192 bytes, the file holds 6003"
+  err_has "--allow-truncated"; [ ! -e "$W/h.csv" ] || fail "output written from a cut file"
+  run estimate "$W/cut.wav" "$@" --allow-truncated -o "$W/h.csv"; expect_rc 0
+  err_has "warning: $W/cut.wav: the data chunk claims 8192 bytes"
+  err_has "read the 1500 whole frames"
+  run estimate "$W/s.wav" "$@" -o "$W/h2.csv"; expect_rc 0
+  [ ! -s "$W/err" ] || fail "a warning on a whole WAV file" ;;
 bad_signal_units)
   # estimate: a force without a force unit, a response in an unknown unit
   printf '# units = V,mm\ntime_s,f,DA.x\n0,1,1\n0.001,2,1\n0.002,3,2\n' >"$W/s.csv"

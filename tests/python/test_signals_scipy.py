@@ -129,3 +129,61 @@ def test_estimate_uff_time_records_from_pyuff(tmp_path: Path):
     e1 = _close(h["DA.x/C.B.y re"] + 1j * h["DA.x/C.B.y im"], (pxy / pxx)[1:], "H1 from pyuff")
     e2 = _close(s["DA.x/C.B.y coh"], coh[1:], "coherence from pyuff")
     print(f"pyuff time records: largest relative difference to SciPy {max(e1, e2):.2e}")
+
+
+def _hv_exact(gxx, gxy, gyy):
+    """Hv (the eigenvector of [Gxx Gxy; Gyx Gyy]) in 50-digit decimal arithmetic
+    from the spectra: h = (d + sqrt(d^2 + 4 |Gxy|^2)) / (2 conj(Gxy)), d = Gyy - Gxx,
+    where the cancellation of double precision costs nothing."""
+    from decimal import Decimal, localcontext
+    with localcontext() as ctx:
+        ctx.prec = 50
+        out = np.empty(len(gxx), complex)
+        for k, (a, g, b) in enumerate(zip(gxx, gxy, gyy)):
+            a, b, gr, gi = Decimal(float(a)), Decimal(float(b)), Decimal(g.real), Decimal(g.imag)
+            g2 = gr * gr + gi * gi
+            d = b - a
+            num = d + (d * d + 4 * g2).sqrt()
+            # num / (2 conj(g)) = num g / (2 |g|^2)
+            out[k] = complex(float(num * gr / (2 * g2)), float(num * gi / (2 * g2)))
+    return out
+
+
+@pytest.mark.parametrize("gain,noise", [(1e-6, 1e-8), (1e-9, 1e-11)])
+def test_hv_stable_when_force_power_dwarfs_response(tmp_path: Path, gain, noise):
+    """Issue #25 item 2, its minimal case: force 10 x noise in N, response
+    1e-6 x force + 1e-8 noise in m, 256-point segments, so Gxx/Gyy ~ 1e12
+    (the closed form was 7e-5 off); and a stiff rotor's 1e-9 m/N, Gxx/Gyy ~
+    1e18, where the closed form gave Hv = 0. Hv
+    must agree with the same estimator computed in 50-digit arithmetic from
+    SciPy's spectra to 1e-9 at every line, and lie between H1 and H2 in
+    magnitude (|H1| <= |Hv| <= |H2| holds for any spectral matrix)."""
+    exe = _rcbtool()
+    fs, n = 1024.0, 256 * 64
+    rng = np.random.default_rng(25)
+    f = 10.0 * rng.standard_normal(n)
+    y = gain * f + noise * rng.standard_normal(n)
+    sig = tmp_path / "sig.csv"
+    t = np.arange(n) / fs
+    np.savetxt(sig, np.column_stack([t, f, y]), delimiter=",", fmt="%.17g", comments="",
+               header="# units = N,m\ntime_s,F,DA.x")
+    got = {}
+    for est in ("h1", "h2", "hv"):
+        out = tmp_path / f"{est}.csv"
+        res = subprocess.run([exe, "estimate", str(sig), "--input", "F=DA.x", "--outputs", "DA.x",
+                              "--nseg", "256", "--estimator", est, "-o", str(out)],
+                             capture_output=True, text=True, timeout=120)
+        assert res.returncode == 0, res.stderr
+        h = _read(out)
+        got[est] = h["DA.x/DA.x re"] + 1j * h["DA.x/DA.x im"]
+    kw = dict(fs=fs, window="hann", nperseg=256, noverlap=128)
+    _, gxx = signal.welch(f, **kw)
+    _, gxy = signal.csd(f, y, **kw)
+    _, gyy = signal.welch(y, **kw)
+    ref = _hv_exact(gxx[1:], gxy[1:], gyy[1:])
+    err = np.max(np.abs(got["hv"] - ref) / np.abs(ref))
+    print(f"gain {gain:g} m/N: Hv vs 50-digit reference, largest relative difference {err:.2e}")
+    assert err < 1e-9, f"Hv off the 50-digit reference by {err:.3g} relative"
+    a1, av, a2 = np.abs(got["h1"]), np.abs(got["hv"]), np.abs(got["h2"])
+    assert np.all(av >= a1 * (1 - 1e-12)) and np.all(av <= a2 * (1 + 1e-12)), \
+        f"Hv outside [H1, H2] at {np.sum((av < a1 * (1 - 1e-12)) | (av > a2 * (1 + 1e-12)))} lines"

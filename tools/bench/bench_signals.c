@@ -5,7 +5,12 @@
  *    coherence + sd of the three FRFs included;
  *  - the workspace the embedded build needs for that 4-channel 4096-point
  *    estimate (besides FFTW's plan, which FFTW allocates itself);
- *  - order tracking (1X and 2X) of a 60 s, 50 kS/s run-up of 2 responses.
+ *  - order tracking (1X and 2X) of a 60 s, 50 kS/s run-up of 2 responses;
+ *  - the limits of the per-revolution DFT (issue #25): a pure 1X through a
+ *    resonance (3000 rpm, zeta 0.05, half-power band 300 rpm) at several
+ *    run-up rates, the 2X it shows (its amplitude changes within a
+ *    revolution) and its 1X against the quasi-static response at the bin's
+ *    mean speed, 20 rpm bins, 2500-3500 rpm.
  * Usage: build/tools/bench/bench_signals [seconds_of_signal]   (default 60)
  * tools/bench/bench_signals.py runs it next to SciPy. Never fails on a time.
  */
@@ -124,10 +129,69 @@ static int bench_order(void) {
   return 0;
 }
 
+static double kp_pulse(double phi) {
+  double w = fmod(phi, 2 * PI), d = 2 * PI * 0.02;
+  if (w > PI) w -= 2 * PI;
+  if (w >= -d && w <= d) return 2.5 + 2.5 * w / d;
+  return w > d && w < PI / 4 ? 5.0 : 0.0;
+}
+
+static int order_limits(void) {
+  static const double rates[] = {30, 100, 250, 500}; /* rpm/s */
+  const double w0 = 2400 * PI / 30, wn = 3000 * PI / 30, fs = 1e4;
+  size_t k, n, b;
+  for (k = 0; k < sizeof rates / sizeof rates[0]; k++) {
+    double al = rates[k] * PI / 30, T = 1200.0 / rates[k], leak = 0, e1 = 0, eph = 0, peak = 0;
+    size_t N = (size_t)(T * fs), bytes = 0;
+    double *kp = malloc(N * sizeof *kp), *y = malloc(N * sizeof *y);
+    const double *ch[1];
+    rcb_order_opts o = {0};
+    rcb_order *e = NULL;
+    void *work;
+    if (!kp || !y) exit(1);
+    for (n = 0; n < N; n++) {
+      double t = (double)n / fs, phi = w0 * t + 0.5 * al * t * t, r = (w0 + al * t) / wn;
+      rcb_complex q = 1.0 / (1 - r * r + 2 * 0.05 * r * (rcb_complex)_Complex_I);
+      kp[n] = kp_pulse(phi);
+      y[n] = creal(q * cexp((rcb_complex)_Complex_I * phi));
+    }
+    o.norders = 2;
+    o.trigger = NAN;
+    o.bin_width = 20 * PI / 30;
+    o.speed_max = 3800 * PI / 30;
+    ch[0] = y;
+    if (rcb_order_workspace_size(&o, 1, &bytes) || !(work = malloc(bytes)) ||
+        rcb_order_init(&e, &o, 1, work, bytes) || rcb_order_add(e, fs, N, kp, ch))
+      exit(1);
+    for (b = 0; b < rcb_order_bin_count(e); b++) {
+      double sp, r;
+      rcb_complex q1, q2, h;
+      size_t nr;
+      rcb_order_result(e, b, 0, 1, &sp, &q1, NULL, &nr);
+      if (nr < 2 || sp < 2500 * PI / 30 || sp > 3500 * PI / 30) continue;
+      rcb_order_result(e, b, 0, 2, NULL, &q2, NULL, NULL);
+      r = sp / wn;
+      h = 1.0 / (1 - r * r + 2 * 0.05 * r * (rcb_complex)_Complex_I);
+      peak = fmax(peak, cabs(h));
+      leak = fmax(leak, cabs(q2));
+      e1 = fmax(e1, cabs(q1 - h) / cabs(h));
+      eph = fmax(eph, fabs(carg(q1 / h)) * 180 / PI);
+    }
+    printf("order limits: pure 1X through a resonance (band 300 rpm) at %g rpm/s (%.2g rpm per "
+           "revolution at 3000 rpm): 2X shown %.3g %% of the peak 1X; 1X vs the quasi-static "
+           "response at the bin's speed %.3g %%, %.3g deg\n", rates[k], rates[k] / 50.0,
+           100 * leak / peak, 100 * e1, eph);
+    free(work);
+    free(kp);
+    free(y);
+  }
+  return 0;
+}
+
 int main(int argc, char **argv) {
   double secs = argc > 1 ? strtod(argv[1], NULL) : 60.0;
   if (!(secs > 0.1)) secs = 60.0;
-  if (bench_welch(secs) || bench_order()) {
+  if (bench_welch(secs) || bench_order() || order_limits()) {
     fprintf(stderr, "bench_signals: failed\n");
     return 1;
   }

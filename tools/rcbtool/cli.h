@@ -350,7 +350,9 @@ int cli_plot_write(const char *kind, const char *png, cli_plot_json_fn json, con
 int cli_sd_read(const char *path, const rcb_meas *ms, double **sd);
 
 /** Read SIGNALS (a->model) by extension: .csv, .uff/.unv (UFF58 time records,
- * --map), .wav (--wav-names, --wav-units, --wav-scale); exit code 0, 2, 3, 4. */
+ * --map), .wav (--wav-names, --wav-units, --wav-scale); --units CH=UNIT and
+ * --allow-truncated (the command declares them); the reader's warnings
+ * printed; exit code 0, 2, 3, 4. */
 int cli_signals_read(const cli_args *a, rcb_signals *s);
 
 /* ---- subcommands (one file each) ---- */

@@ -70,7 +70,44 @@ static int read_wav(const cli_args *a, rcb_signals *s) {
   return rc;
 }
 
+/* --units CH=UNIT,...: the unit of channels whose label is missing or unknown. */
+static int unit_overrides(const cli_args *a, rcb_signals *s) {
+  char *buf, **it;
+  size_t n, k;
+  int rc = list(a, "--units", &buf, &it, &n);
+  for (k = 0; !rc && k < n; k++) {
+    char *eq = strrchr(it[k], '=');
+    rcb_status st;
+    if (!eq || eq == it[k] || !eq[1]) {
+      rc = cli_usage(a->cmd, "--units item '%s': expected CH=UNIT (e.g. DA.x=mm)", it[k]);
+      break;
+    }
+    *eq = '\0';
+    if ((st = rcb_signals_set_unit(s, it[k], eq + 1)))
+      rc = cli_usage(a->cmd, "--units: %s", cli_msg(rcb_signals_errmsg(s), st));
+  }
+  free(buf);
+  free(it);
+  return rc;
+}
+
+/* The reader's warnings (what was skipped, a truncated file read as allowed). */
+static void warnings(const rcb_signals *s) {
+  size_t w;
+  for (w = 0; w < rcb_signals_warning_count(s); w++) cli_warn("%s", rcb_signals_warning(s, w));
+}
+
+static int read_file(const cli_args *a, rcb_signals *s);
+
 int cli_signals_read(const cli_args *a, rcb_signals *s) {
+  int rc;
+  rcb_signals_set_allow_truncated(s, cli_opt_value(a, "--allow-truncated") != NULL);
+  if ((rc = unit_overrides(a, s))) return rc;
+  if (!(rc = read_file(a, s)) || rc == CLI_EXIT_INPUT) warnings(s); /* also why nothing was read */
+  return rc;
+}
+
+static int read_file(const cli_args *a, rcb_signals *s) {
   static const char *const csv[] = {".csv", ".CSV"}, *const uff[] = {".uff", ".unv", ".uf", ".UFF", ".UNV"};
   static const char *const wav[] = {".wav", ".WAV"};
   rcb_status st;

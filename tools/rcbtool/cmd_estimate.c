@@ -21,6 +21,10 @@ const char cli_help_estimate[] =
     "                 units from the record-9 label or dataset 164; --map)\n"
     "                 .wav: PCM 16/24/32-bit or float; give --wav-names NAME,...,\n"
     "                 --wav-units U,... and --wav-scale S,... (full scale in that unit)\n"
+    "  --units CH=U,...  the unit of channels whose file label is missing or unknown\n"
+    "                 (UFF: the channel as named, STATION.DIR or #NODE.DIR)\n"
+    "  --allow-truncated read the whole frames of a WAV file cut short (or cut\n"
+    "                 mid-frame), with a warning (default: refused with the byte counts)\n"
     "  --input CH     force channel (unit N, kN or lbf); several: CH1,CH2 (H1 only)\n"
     "  --outputs LIST response channels: displacement (m, mm, um, mil), velocity\n"
     "                 (m/s, mm/s, in/s) or acceleration (m/s^2, g)\n"
@@ -492,7 +496,8 @@ int cmd_estimate(int argc, char **argv) {
                     {"--stats", "FILE", NULL},    {"--spectra", "FILE", NULL},
                     {"--map", "NODE=STATION,...", NULL}, {"--binary", NULL, NULL},
                     {"--wav-names", "LIST", NULL}, {"--wav-units", "LIST", NULL},
-                    {"--wav-scale", "LIST", NULL}, {"--plot", "FILE.png", NULL}};
+                    {"--wav-scale", "LIST", NULL}, {"--plot", "FILE.png", NULL},
+                    {"--units", "CH=UNIT,...", NULL}, {"--allow-truncated", NULL, NULL}};
   cli_args a;
   int rc = cli_parse(argc, argv, opts, sizeof opts / sizeof opts[0], &a);
   if (rc || a.help) return rc ? rc : cli_print_help(cli_help_estimate);

@@ -10,24 +10,39 @@
 const char cli_help_order[] =
     "usage: rcbtool order SIGNALS --kp CH --outputs CH,... -o OUT [options]\n"
     "\n"
-    "Order tracking of a run-up or coast-down: the keyphasor's rising crossings of\n"
-    "--trigger mark the revolutions; each revolution is resampled to 64 shaft angles\n"
-    "(the angle a quadratic in time through three pulses: constant acceleration)\n"
-    "and an exact DFT gives its 1X and 2X phasors; revolutions are averaged in speed\n"
-    "bins, the standard deviation coming from their scatter. OUT (.uff/.unv: UFF\n"
-    "dataset 58, or .csv) holds the 1X responses as an unbalance-response\n"
-    "measurement (Bode/polar data) that compare, fit and diagnose read; the phase\n"
-    "is relative to the keyphasor mark (plus --kp-angle), as the model's unbalance\n"
-    "angles are relative to the rotor's angle 0.\n"
+    "Order tracking of a run-up or coast-down: the keyphasor's crossings of --trigger\n"
+    "(rising, or falling with --kp-edge falling) mark the revolutions; each\n"
+    "revolution is resampled to 64 shaft angles (the angle a quadratic in time\n"
+    "through three pulses: constant acceleration) and a DFT gives its 1X and 2X\n"
+    "phasors; revolutions are averaged in speed bins, the standard deviation coming\n"
+    "from their scatter about a line in speed. An order whose amplitude changes\n"
+    "within a revolution leaks into the others (near a resonance about 0.4 x the\n"
+    "speed change per revolution / the half-power band: sweep slowly for 2X there;\n"
+    "docs/signals.md). OUT (.uff/.unv: UFF dataset 58, or .csv) holds the 1X\n"
+    "responses as an unbalance-response measurement (Bode/polar data) that compare,\n"
+    "fit and diagnose read; the phase is relative to the keyphasor mark (plus\n"
+    "--kp-angle), as the model's unbalance angles are relative to the rotor's angle 0.\n"
+    "Conventions (stated in the CSV's '# phase = ...' line): by default the phase is a\n"
+    "LEAD, y = |Q| cos(Omega t + phase), the model's, measured from the keyphasor's\n"
+    "RISING edge. Vibration monitors show a LAG (the response peaks that many degrees\n"
+    "after the mark; lag = -lead) and a notch keyphasor marks the revolution at its\n"
+    "FALLING edge: give --phase lag --kp-edge falling to read as they do. compare,\n"
+    "fit and diagnose read either CSV back to the model's convention.\n"
     "  SIGNALS        .csv as rcbtool transient --signals writes ('# units = V,m',\n"
     "                 'time_s,KP,DA.x,...'); responses in m, mm, um or mil; or .uff\n"
-    "                 (UFF58 time records, --map) or .wav (as rcbtool estimate)\n"
+    "                 (UFF58 time records, --map) or .wav (as rcbtool estimate);\n"
+    "                 --units CH=U,... and --allow-truncated as for rcbtool estimate\n"
     "  --kp CH        keyphasor channel\n"
     "  --outputs LIST response channels (NAME or NAME=STATION.DIR)\n"
     "  --bin-rpm W    speed bin width, rpm (default 50)\n"
     "  --rpm-max R    highest speed binned, rpm (default 20000)\n"
     "  --trigger V    keyphasor threshold (default halfway between its min and max)\n"
     "  --kp-angle DEG shaft angle at the keyphasor mark, deg (default 0)\n"
+    "  --kp-edge E    rising (default) or falling: the keyphasor edge that marks a\n"
+    "                 revolution (a notch gives a falling edge, a projection rising)\n"
+    "  --phase P      lead (default: the model's) or lag (vibration monitors'), as\n"
+    "                 the CSV written presents the phase (.csv only: UFF holds the\n"
+    "                 model's complex values)\n"
     "  --min-revs N   revolutions a bin needs (default 3)\n"
     "  --order2 FILE  write the 2X responses there too (same format as OUT)\n"
     "  --stats FILE   CSV: rpm, revolutions, per channel '<CH> 1X sd' and '<CH> 2X sd'\n"
@@ -40,8 +55,12 @@ const char cli_help_order[] =
     "Files are written atomically. Exit codes: 2 usage, 3 bad signals (no keyphasor\n"
     "pulses, a response not a displacement), 5 output not written.\n";
 
+static const char *const edge_names[] = {"rising", "falling"};
+static const char *const phase_names[] = {"lead", "lag"};
+
 typedef struct ord_job {
   const cli_args *a;
+  int edge, lag; /* --kp-edge falling, --phase lag */
   rcb_signals *sig;
   char *buf;
   char *names[257], *model[257]; /* [0] keyphasor */
@@ -100,6 +119,8 @@ static int ord_track(ord_job *j) {
       (rc = cli_opt_nonneg(j->a, "--rpm-max", "rpm", 20000.0, &rmax)) ||
       (rc = cli_opt_double(j->a, "--kp-angle", "deg", 0.0, &kpa)) ||
       (rc = cli_opt_count(j->a, "--min-revs", 3, &minrev)) ||
+      (rc = cli_opt_choice(j->a, "--kp-edge", edge_names, 2, 0, &j->edge)) ||
+      (rc = cli_opt_choice(j->a, "--phase", phase_names, 2, 0, &j->lag)) ||
       (cli_opt_value(j->a, "--trigger") &&
        (rc = cli_opt_double(j->a, "--trigger", "", 0.0, &j->o.trigger)))) {
     free(ch);
@@ -114,6 +135,7 @@ static int ord_track(ord_job *j) {
   j->o.speed_max = rmax * CLI_RPM_TO_RAD_S;
   j->o.kp_angle = kpa * CLI_PI / 180.0;
   j->o.min_revs = minrev;
+  j->o.kp_falling = j->edge;
   if (rcb_order_workspace_size(&j->o, j->q, &bytes) || !(j->work = malloc(bytes)) ||
       rcb_order_init(&j->e, &j->o, j->q, j->work, bytes)) {
     free(ch);
@@ -151,6 +173,12 @@ static int ord_write(const ord_job *j, const size_t *bins, size_t nb, size_t m, 
     for (c = 0; !st && c < j->q; c++) {
       for (i = 0; i < nb; i++) rcb_order_result(j->e, bins[i], c, m, NULL, &y[i], NULL, NULL);
       st = rcb_meas_add_channel(ms, j->model[c + 1], NULL, RCB_RECEPTANCE, y);
+    }
+    if (!st) { /* the convention, stated in the CSV */
+      char ref[80];
+      snprintf(ref, sizeof ref, "keyphasor %s edge, shaft angle %.6g deg there",
+               edge_names[j->edge], j->o.kp_angle * 180.0 / CLI_PI);
+      st = rcb_meas_set_phase(ms, j->lag ? RCB_PHASE_LAG : RCB_PHASE_LEAD, ref);
     }
     if (st) rc = cli_fail(CLI_EXIT_INPUT, "order: %s", cli_msg(rcb_meas_errmsg(ms), st));
   } else {
@@ -216,7 +244,7 @@ static void plot_json(FILE *fp, const void *ctx) {
     for (i = 0; i < nb; i++) {
       rcb_complex q;
       rcb_order_result(pc->j->e, pc->bins[i], c, 1, NULL, &q, &v[2 * nb + i], NULL);
-      v[2 * i] = creal(q), v[2 * i + 1] = cimag(q);
+      v[2 * i] = creal(q), v[2 * i + 1] = pc->j->lag ? -cimag(q) : cimag(q); /* as --phase */
     }
     fputs(c ? ",\n {\"name\": " : "\n {\"name\": ", fp);
     cli_json_str(fp, pc->j->model[c + 1]);
@@ -245,6 +273,15 @@ static int order_run(const cli_args *a) {
       (rc = cli_opt_require(a, "--outputs", "the response channels, e.g. --outputs DA.x")) ||
       (plot && (rc = cli_plot_check(a, plot))))
     return rc;
+  if (cli_opt_value(a, "--phase") && strcmp(cli_opt_value(a, "--phase"), "lag") == 0) {
+    int uff1 = 0, uff2 = 0;
+    if ((rc = cli_meas_format(a->cmd, a->output, &uff1)) ||
+        (o2 && (rc = cli_meas_format(a->cmd, o2, &uff2))))
+      return rc;
+    if (uff1 || uff2)
+      return cli_usage(a->cmd, "--phase lag applies to a .csv output: a UFF file holds the "
+                       "model's complex values (phase lead)");
+  }
   if (rcb_signals_create(&j.sig, NULL)) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   rc = cli_signals_read(a, j.sig);
   if (!rc) rc = ord_channels(&j);
@@ -278,7 +315,9 @@ int cmd_order(int argc, char **argv) {
                     {"--min-revs", "N", NULL},    {"--order2", "FILE", NULL},
                     {"--stats", "FILE", NULL},    {"--map", "NODE=STATION,...", NULL},
                     {"--wav-names", "LIST", NULL}, {"--wav-units", "LIST", NULL},
-                    {"--wav-scale", "LIST", NULL}, {"--plot", "FILE.png", NULL}};
+                    {"--wav-scale", "LIST", NULL}, {"--plot", "FILE.png", NULL},
+                    {"--units", "CH=UNIT,...", NULL}, {"--allow-truncated", NULL, NULL},
+                    {"--kp-edge", "E", NULL},     {"--phase", "P", NULL}};
   cli_args a;
   int rc = cli_parse(argc, argv, opts, sizeof opts / sizeof opts[0], &a);
   if (rc || a.help) return rc ? rc : cli_print_help(cli_help_order);
