@@ -903,7 +903,7 @@ history_not_history)
   done
   [ "$(wc -l <"$W/h.jsonl")" -eq 2 ] || fail "history should hold 2 steps"
   run history "$W/h.jsonl"; expect_rc 0; out_has "fit"
-  usage fit "$W/model.ini" "$W/meas.csv" --params coupling.C.kt --history "$W/new.ini" -o "$W/new.ini"
+  run fit "$W/model.ini" "$W/meas.csv" --params coupling.C.kt --history "$W/new.ini" -o "$W/new.ini"; expect_rc 5
   err_has "the same file"; [ ! -e "$W/new.ini" ] || fail "wrote new.ini" ;;
 signal_removes_temporaries)
   # SIGTERM / SIGINT while -o FILE is being written: no FILE.XXXXXX left, FILE intact

@@ -44,6 +44,7 @@ int cli_parse_meas_cmd(int argc, char **argv, cli_opt *opts, size_t nopts, const
   if (!(*args = malloc(((size_t)argc + 1) * sizeof **args)))
     return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   cli_split_meas(argc, argv, opts, nopts, *args, &nargs, meas);
+  cli_plan_input(*meas, "measurement"); /* checked with the rest by cli_parse */
   if ((rc = cli_parse(nargs, *args, opts, nopts, a))) return rc;
   if (a->help) return (rc = cli_print_help(help)) ? rc : -1;
   if (!*meas) return cli_usage(a->cmd, "missing the measurement file: expected %s", expected);
@@ -59,23 +60,18 @@ int cli_guard_outputs(const cli_args *a, const char *meas) {
   const char *plot = cli_opt_value(a, "--plot"), *hist = cli_opt_value(a, "--history");
   size_t i;
   int rc = 0;
-  /* before any work: the inputs are known, every output is checked against them */
-  cli_input_add(a->model, "model");
-  cli_input_add(meas, "measurement");
-  if (a->output && (rc = cli_output_check(a->output))) return rc;
-  if (hist && a->output && strcmp(hist, a->output) == 0)
-    return cli_usage(a->cmd, "--history and -o name the same file '%s'; give the history its "
-                     "own file", hist);
-  if (hist && (rc = cli_history_check(hist))) return rc;
-  for (i = 0; plot && i < sizeof plot_files / sizeof plot_files[0] && !rc; i++) {
+  /* before any work: the files --plot PREFIX writes join the run's plan */
+  cli_plan_input(meas, "measurement");
+  for (i = 0; plot && i < sizeof plot_files / sizeof plot_files[0]; i++) {
     char *name = malloc(strlen(plot) + strlen(plot_files[i]) + 1);
     if (!name) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
     strcpy(name, plot);
     strcat(name, plot_files[i]);
-    rc = cli_output_check(name);
+    cli_plan_output(name, "--plot", CLI_IO_MKDIR);
     free(name);
   }
-  return rc;
+  if ((rc = cli_plan_check())) return rc;
+  return hist ? cli_history_check(hist) : 0;
 }
 
 /* A measurement on standard input goes to a temporary file (on the signal
@@ -131,7 +127,7 @@ int cli_meas_read(const cli_args *a, const char *path, const rcb_model *m,
   } else if ((rc = cli_meas_format(a->cmd, path, &is_uff))) {
     return rc;
   }
-  cli_input_add(path, "measurement");
+  cli_plan_input(path, "measurement");
   rc = meas_read(a, path, m, is_uff, out);
   if (from_stdin) {
     if (rc) fputs("rcbtool: (the measurement came from standard input)\n", stderr);

@@ -26,7 +26,7 @@ int cli_load_model(const cli_args *a, rcb_model **out) {
       return cli_fail(CLI_EXIT_INPUT, "cannot open model file '%s': %s", a->model,
                       strerror(errno));
     fclose(probe);
-    cli_input_add(a->model, "model");
+    cli_plan_input(a->model, "model");
   }
   st = rcb_model_create(&m, NULL);
   if (st) {

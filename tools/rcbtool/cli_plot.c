@@ -104,12 +104,6 @@ int cli_plot_run(const char *kind, const char *json, const char *out, const char
 }
 
 
-int cli_plot_check(const cli_args *a, const char *path) {
-  if (!*path) return cli_usage(a->cmd, "option --plot expects a file name, e.g. out/plot.png");
-  cli_input_add(a->model, "input");
-  return cli_output_check(path);
-}
-
 int cli_plot_write(const char *kind, const char *png, cli_plot_json_fn json, const void *ctx,
                    const char *kept) {
   cli_tmpfile jt, pt;

@@ -93,7 +93,7 @@ int cli_sd_read(const char *path, const rcb_meas *ms, double **sd_out) {
   double unit = frf ? CLI_HZ_TO_RAD_S : CLI_RPM_TO_RAD_S, *v;
   const double *x = rcb_meas_grid(ms);
   *sd_out = NULL;
-  cli_input_add(path, "standard deviations"); /* never an output of the run */
+  cli_plan_input(path, "--sd"); /* never an output of the run */
   if ((rc = read_table(path, &t))) {
     table_free(&t);
     return rc;

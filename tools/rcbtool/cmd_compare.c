@@ -588,7 +588,9 @@ int cmd_compare(int argc, char **argv) {
   cli_args a;
   char **args = NULL;
   int rc;
+  static const cli_file_opt files[] = {{"--sd", CLI_IO_IN}}; /* --plot PREFIX: cli_guard_outputs */
   memset(&j, 0, sizeof j);
+  cli_plan_options(files, sizeof files / sizeof files[0]);
   if (!(rc = cli_parse_meas_cmd(argc, argv, opts, nopts, cli_help_compare,
                                 "'rcbtool compare MODEL.ini MEAS.uff|MEAS.csv'",
                                 &a, &j.meas_path, &args)) &&

@@ -439,6 +439,7 @@ static int estimate(const cli_args *a) {
   est_job j;
   est_out r;
   size_t k1 = 0, every = 1;
+  int is_uff = 0;
   const char *stats = cli_opt_value(a, "--stats"), *spectra = cli_opt_value(a, "--spectra");
   const char *plot = cli_opt_value(a, "--plot");
   int rc;
@@ -448,7 +449,7 @@ static int estimate(const cli_args *a) {
   j.kind = -1;
   if (!a->output)
     return cli_usage(a->cmd, "missing -o OUT (.uff, .unv or .csv) for the estimated FRFs");
-  if ((rc = options(&j)) || (plot && (rc = cli_plot_check(a, plot)))) return rc;
+  if ((rc = options(&j)) || (rc = cli_meas_format(a->cmd, a->output, &is_uff))) return rc;
   if (rcb_signals_create(&j.sig, NULL)) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   rc = cli_signals_read(a, j.sig);
   if (!rc) rc = channels(&j);
@@ -489,12 +490,16 @@ int cmd_estimate(int argc, char **argv) {
                     {"--estimator", "E", NULL},   {"--no-detrend", NULL, NULL},
                     {"--rpm", "R", NULL},         {"--fmax", "HZ", NULL},
                     {"--every", "N", NULL},
-                    {"--stats", "FILE", NULL},    {"--spectra", "FILE", NULL},
+                    {"--stats", "FILE", NULL}, {"--spectra", "FILE", NULL},
                     {"--map", "NODE=STATION,...", NULL}, {"--binary", NULL, NULL},
                     {"--wav-names", "LIST", NULL}, {"--wav-units", "LIST", NULL},
                     {"--wav-scale", "LIST", NULL}, {"--plot", "FILE.png", NULL}};
+  static const cli_file_opt files[] = {
+      {"--stats", CLI_IO_OUT}, {"--spectra", CLI_IO_OUT}, {"--plot", CLI_IO_OUT | CLI_IO_MKDIR}};
   cli_args a;
-  int rc = cli_parse(argc, argv, opts, sizeof opts / sizeof opts[0], &a);
+  int rc;
+  cli_plan_options(files, sizeof files / sizeof files[0]);
+  rc = cli_parse(argc, argv, opts, sizeof opts / sizeof opts[0], &a);
   if (rc || a.help) return rc ? rc : cli_print_help(cli_help_estimate);
   if (a.json) return cli_usage(a.cmd, "--json does not apply: the format follows OUT's extension");
   return estimate(&a);

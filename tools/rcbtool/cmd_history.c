@@ -1,5 +1,6 @@
 /* rcbtool history: the steps of a model-improvement session (fit, diagnose,
  * apply), their errors and parameter counts, and the error falling. */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,20 +16,6 @@ const char cli_help_history[] =
     "diagnose --history FILE': command, model, error %, noise floor %, number of\n"
     "parameters, note; then draws the error falling, one bar per step.\n"
     "FILE holds one JSON object per line; --json prints them as one JSON array.\n";
-
-/* Escape a string for JSON (quotes, backslashes, control characters). */
-static void json_str(FILE *fp, const char *s) {
-  fputc('"', fp);
-  for (; s && *s; s++) {
-    if (*s == '"' || *s == '\\')
-      fprintf(fp, "\\%c", *s);
-    else if ((unsigned char)*s < 0x20)
-      fprintf(fp, "\\u%04x", (unsigned)(unsigned char)*s);
-    else
-      fputc(*s, fp);
-  }
-  fputc('"', fp);
-}
 
 static char *slurp(const char *path, size_t *len) {
   FILE *fp = fopen(path, "rb");
@@ -84,7 +71,7 @@ int cli_history_check(const char *path) {
   size_t len = 0, bad;
   struct stat st;
   char *text;
-  if (cli_output_check(path)) return CLI_EXIT_IO;
+  if (cli_plan_check()) return CLI_EXIT_IO;
   if (stat(path, &st) != 0) return 0; /* a new history */
   if (!S_ISREG(st.st_mode))
     return cli_fail(CLI_EXIT_IO, "--history '%s': not a regular file; expected a history "
@@ -103,48 +90,47 @@ int cli_history_check(const char *path) {
 int cli_history_append(const char *path, const char *command, const char *model,
                        double error_pct, double floor_pct, size_t nparams, const char *note) {
   size_t len = 0;
-  char *old, *tmp;
+  char *old;
+  cli_tmpfile t;
   FILE *fp;
-  int ok, rc, slot = -1;
+  int ok, rc, e;
   if ((rc = cli_history_check(path))) return rc;
   old = slurp(path, &len);
-  if (!(tmp = malloc(strlen(path) + 16))) {
+  /* the whole history, old steps and the new one, in a temporary of the plan:
+   * renamed onto the history when the run succeeded */
+  if ((rc = cli_tmpfile_open(&t, path))) {
     free(old);
-    return cli_fail(CLI_EXIT_IO, "out of memory");
+    return rc;
   }
-  sprintf(tmp, "%s.tmpXXXXXX", path);
-  {
-    int fd = mkstemp(tmp);
-    if (fd >= 0) slot = cli_tmp_register(tmp);
-    fp = fd >= 0 ? fdopen(fd, "w") : NULL;
-  }
-  if (!fp) {
-    if (slot >= 0) remove(tmp);
-    cli_tmp_release(slot);
+  if (!(fp = fopen(t.write_path, "w"))) {
+    e = errno;
+    cli_tmpfile_close(&t, 0);
     free(old);
-    free(tmp);
-    return cli_fail(CLI_EXIT_IO, "history '%s': cannot write next to it", path);
+    return cli_fail(CLI_EXIT_IO, "--history '%s': cannot write it: %s", path, strerror(e));
   }
   if (old) fwrite(old, 1, len, fp);
   fputs("{\"command\": ", fp);
-  json_str(fp, command);
+  cli_json_str(fp, command);
   fputs(", \"model\": ", fp);
-  json_str(fp, model);
+  cli_json_str(fp, model);
   fputs(", \"error_pct\": ", fp);
   cli_json_num(fp, error_pct);
   fputs(", \"floor_pct\": ", fp);
   cli_json_num(fp, floor_pct);
   fprintf(fp, ", \"params\": %zu, \"note\": ", nparams);
-  json_str(fp, note);
+  cli_json_str(fp, note);
   fputs("}\n", fp);
-  ok = !ferror(fp);
-  ok = (fclose(fp) == 0) && ok;
-  if (ok) ok = rename(tmp, path) == 0;
-  if (!ok) remove(tmp);
-  cli_tmp_release(slot);
+  errno = 0;
+  ok = !ferror(fp) && fflush(fp) == 0;
+  e = errno ? errno : EIO;
+  if (fclose(fp) != 0 && ok) {
+    ok = 0;
+    e = errno ? errno : EIO;
+  }
   free(old);
-  free(tmp);
-  return ok ? 0 : cli_fail(CLI_EXIT_IO, "history '%s': write failed", path);
+  rc = cli_tmpfile_close(&t, ok);
+  if (!ok) return cli_fail(CLI_EXIT_IO, "--history '%s': cannot write it: %s", path, strerror(e));
+  return rc;
 }
 
 /* The value of "key": in a JSON line (a string or a number), copied to out. */

@@ -235,6 +235,7 @@ static void plot_json(FILE *fp, const void *ctx) {
 static int order_run(const cli_args *a) {
   ord_job j;
   size_t *bins = NULL, nb = 0;
+  int is_uff = 0;
   const char *o2 = cli_opt_value(a, "--order2"), *stats = cli_opt_value(a, "--stats");
   const char *plot = cli_opt_value(a, "--plot");
   int rc;
@@ -243,7 +244,8 @@ static int order_run(const cli_args *a) {
   if (!a->output) return cli_usage(a->cmd, "missing -o OUT (.uff, .unv or .csv) for the 1X data");
   if ((rc = cli_opt_require(a, "--kp", "the keyphasor channel, e.g. --kp KP")) ||
       (rc = cli_opt_require(a, "--outputs", "the response channels, e.g. --outputs DA.x")) ||
-      (plot && (rc = cli_plot_check(a, plot))))
+      (rc = cli_meas_format(a->cmd, a->output, &is_uff)) ||
+      (o2 && (rc = cli_meas_format(a->cmd, o2, &is_uff))))
     return rc;
   if (rcb_signals_create(&j.sig, NULL)) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   rc = cli_signals_read(a, j.sig);
@@ -279,8 +281,12 @@ int cmd_order(int argc, char **argv) {
                     {"--stats", "FILE", NULL},    {"--map", "NODE=STATION,...", NULL},
                     {"--wav-names", "LIST", NULL}, {"--wav-units", "LIST", NULL},
                     {"--wav-scale", "LIST", NULL}, {"--plot", "FILE.png", NULL}};
+  static const cli_file_opt files[] = {
+      {"--order2", CLI_IO_OUT}, {"--stats", CLI_IO_OUT}, {"--plot", CLI_IO_OUT | CLI_IO_MKDIR}};
   cli_args a;
-  int rc = cli_parse(argc, argv, opts, sizeof opts / sizeof opts[0], &a);
+  int rc;
+  cli_plan_options(files, sizeof files / sizeof files[0]);
+  rc = cli_parse(argc, argv, opts, sizeof opts / sizeof opts[0], &a);
   if (rc || a.help) return rc ? rc : cli_print_help(cli_help_order);
   if (a.json) return cli_usage(a.cmd, "--json does not apply: the format follows OUT's extension");
   return order_run(&a);

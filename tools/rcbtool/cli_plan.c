@@ -1,0 +1,512 @@
+/* rcbtool: the run's input/output plan (issue #26).
+ *
+ * Every verb declares its inputs and outputs before anything is read or
+ * written: cli_parse declares the positional argument, -o and every option
+ * whose cli_opt.io says it is a file; a verb declares what only it knows
+ * (a measurement, a series of files, a derived name). One check, cli_plan_check,
+ * refuses any output that is an input (device and inode: a symbolic link, a hard
+ * link or another spelling is the same file), two outputs that are one file,
+ * an output that is a directory, and an output whose directory is missing or
+ * not writable. Outputs are opened only here (cli_out_open, cli_tmpfile_open
+ * refuse a path the plan does not hold), each written to a temporary in its own
+ * directory; cli_plan_finish renames them all after the verb succeeded and
+ * removes them all otherwise; a signal removes them all too. */
+#define _XOPEN_SOURCE 700 /* realpath */
+#include <errno.h>
+#include <limits.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "cli.h"
+
+/* One declared file. */
+typedef struct plan_file {
+  char *path;    /* as given */
+  char *what;    /* "model", "signals", "-o", "--stats", ... */
+  unsigned io;   /* CLI_IO_IN | CLI_IO_OUT | CLI_IO_MKDIR */
+  int checked;   /* an output that passed cli_plan_check */
+} plan_file;
+
+/* A temporary written and closed, renamed onto its output when the run succeeded. */
+typedef struct plan_pending {
+  char *tmp, *path;
+  int slot;
+} plan_pending;
+
+static struct {
+  char positional[32]; /* what the first positional argument is ("model", "signals") */
+  const cli_file_opt *opts; /* the verb's file options */
+  size_t nopts;
+  plan_file *f;
+  size_t n, cap;
+  plan_pending *p;
+  size_t np, capp;
+  int nomem; /* a declaration was lost to an allocation failure */
+} plan;
+
+/* ---- temporary files removed on SIGINT, SIGTERM, SIGHUP ---- */
+
+#define CLI_TMP_SLOTS 64
+#define CLI_TMP_PATH 4096
+static char tmp_paths[CLI_TMP_SLOTS][CLI_TMP_PATH];
+static volatile sig_atomic_t tmp_live[CLI_TMP_SLOTS];
+
+/* Async-signal-safe: unlink() the live temporaries, then die of the signal
+ * (SA_RESETHAND restored the default action; the signal is delivered again
+ * when the handler returns). */
+static void on_signal(int sig) {
+  int i, e = errno;
+  for (i = 0; i < CLI_TMP_SLOTS; i++)
+    if (tmp_live[i]) unlink(tmp_paths[i]);
+  errno = e;
+  raise(sig);
+}
+
+void cli_signals_install(void) {
+  static const int sigs[] = {SIGINT, SIGTERM, SIGHUP};
+  size_t i;
+  for (i = 0; i < sizeof sigs / sizeof sigs[0]; i++) {
+    struct sigaction sa, old;
+    if (sigaction(sigs[i], NULL, &old) == 0 && old.sa_handler == SIG_IGN) continue; /* nohup */
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = (int)SA_RESETHAND;
+    sigaction(sigs[i], &sa, NULL);
+  }
+}
+
+int cli_tmp_register(const char *path) {
+  int i;
+  if (strlen(path) >= CLI_TMP_PATH) return -1;
+  for (i = 0; i < CLI_TMP_SLOTS; i++)
+    if (!tmp_live[i]) {
+      strcpy(tmp_paths[i], path);
+      tmp_live[i] = 1; /* after the copy: the handler never sees half a name */
+      return i;
+    }
+  return -1;
+}
+
+void cli_tmp_release(int slot) {
+  if (slot >= 0 && slot < CLI_TMP_SLOTS) tmp_live[slot] = 0;
+}
+
+/* ---- declarations ---- */
+
+static char *dup_str(const char *s) {
+  char *d = malloc(strlen(s) + 1);
+  if (d) strcpy(d, s);
+  return d;
+}
+
+void cli_plan_begin(const char *help) {
+  static const char usage[] = "usage: rcbtool ";
+  const char *p = help;
+  size_t n = 0;
+  snprintf(plan.positional, sizeof plan.positional, "input");
+  if (!help || strncmp(p, usage, sizeof usage - 1) != 0) return;
+  p += sizeof usage - 1;
+  p += strcspn(p, " \n");
+  while (*p == ' ') p++;
+  /* "MODEL.ini" -> "model", "SIGNALS" -> "signals"; "IN" and "FILE" stay "input" */
+  if (strncmp(p, "IN ", 3) == 0 || strncmp(p, "FILE", 4) == 0) return;
+  while (p[n] >= 'A' && p[n] <= 'Z' && n + 1 < sizeof plan.positional) {
+    plan.positional[n] = (char)(p[n] - 'A' + 'a');
+    n++;
+  }
+  if (n) plan.positional[n] = '\0';
+}
+
+static void declare(const char *path, const char *what, unsigned io) {
+  size_t i;
+  plan_file *f;
+  if (!path || !*path || strcmp(path, "-") == 0) return;
+  for (i = 0; i < plan.n; i++)
+    if (strcmp(plan.f[i].path, path) == 0 && strcmp(plan.f[i].what, what) == 0) {
+      plan.f[i].io |= io;
+      return;
+    }
+  if (plan.n == plan.cap) {
+    size_t cap = plan.cap ? 2 * plan.cap : 16;
+    plan_file *nf = realloc(plan.f, cap * sizeof *nf);
+    if (!nf) {
+      plan.nomem = 1;
+      return;
+    }
+    plan.f = nf;
+    plan.cap = cap;
+  }
+  f = &plan.f[plan.n];
+  memset(f, 0, sizeof *f);
+  f->path = dup_str(path);
+  f->what = dup_str(what);
+  f->io = io;
+  if (!f->path || !f->what) {
+    free(f->path);
+    free(f->what);
+    plan.nomem = 1;
+    return;
+  }
+  plan.n++;
+}
+
+void cli_plan_input(const char *path, const char *what) { declare(path, what, CLI_IO_IN); }
+
+void cli_plan_output(const char *path, const char *what, unsigned io) {
+  declare(path, what, io | CLI_IO_OUT);
+}
+
+void cli_plan_options(const cli_file_opt *files, size_t n) {
+  plan.opts = files;
+  plan.nopts = n;
+}
+
+int cli_plan_args(const cli_args *a) {
+  size_t i;
+  cli_plan_input(a->model, plan.positional);
+  cli_plan_output(a->output, "-o", 0);
+  for (i = 0; i < plan.nopts; i++)
+    declare(cli_opt_value(a, plan.opts[i].name), plan.opts[i].name, plan.opts[i].io);
+  return cli_plan_check();
+}
+
+/* ---- the check ---- */
+
+/* "the signals file", "the --sd file", "-o" -> "the output (-o)". */
+static void describe(const plan_file *f, char *buf, size_t size) {
+  if (f->io & CLI_IO_OUT && !(f->io & CLI_IO_IN))
+    snprintf(buf, size, "%s %s", f->what[0] == '-' ? "the output" : "the output file",
+             f->what);
+  else
+    snprintf(buf, size, "the %s file", f->what);
+}
+
+/* The directory part of @p path ("." when none) in @p buf. */
+static void dir_of(const char *path, char *buf, size_t size) {
+  const char *slash = strrchr(path, '/');
+  size_t n;
+  if (!slash) {
+    snprintf(buf, size, ".");
+    return;
+  }
+  n = slash == path ? 1 : (size_t)(slash - path);
+  if (n >= size) n = size - 1;
+  memcpy(buf, path, n);
+  buf[n] = '\0';
+}
+
+/* The path with its directory resolved (links, "./", "../"): two spellings of
+ * one new file give one name. NULL when the directory does not exist yet. */
+static char *canonical(const char *path) {
+  char dir[PATH_MAX], real[PATH_MAX], *out;
+  const char *base = strrchr(path, '/');
+  base = base ? base + 1 : path;
+  dir_of(path, dir, sizeof dir);
+  if (!realpath(dir, real)) return NULL;
+  if (!(out = malloc(strlen(real) + strlen(base) + 2))) return NULL;
+  sprintf(out, "%s/%s", strcmp(real, "/") == 0 ? "" : real, base);
+  return out;
+}
+
+/* The nearest existing directory of @p path (for outputs whose directories are
+ * made): must be writable. */
+static int check_dir(const plan_file *o) {
+  char dir[PATH_MAX], d[160];
+  struct stat st;
+  describe(o, d, sizeof d);
+  dir_of(o->path, dir, sizeof dir);
+  for (;;) {
+    if (stat(dir, &st) == 0) {
+      if (!S_ISDIR(st.st_mode))
+        return cli_fail(CLI_EXIT_IO, "cannot write %s '%s': '%s' is not a directory", d,
+                        o->path, dir);
+      if (access(dir, W_OK | X_OK) != 0)
+        return cli_fail(CLI_EXIT_IO, "cannot write %s '%s': the directory '%s' is not "
+                        "writable: %s", d, o->path, dir, strerror(errno));
+      return 0;
+    }
+    if (!(o->io & CLI_IO_MKDIR))
+      return cli_fail(CLI_EXIT_IO, "cannot write %s '%s': the directory '%s' does not exist "
+                      "(create it first, or choose another path)", d, o->path, dir);
+    if (strcmp(dir, ".") == 0 || strcmp(dir, "/") == 0) return 0;
+    {
+      char up[PATH_MAX];
+      dir_of(dir, up, sizeof up);
+      strcpy(dir, up);
+    }
+  }
+}
+
+static int check_pair(const plan_file *o, const struct stat *so, const char *co,
+                      const plan_file *g) {
+  struct stat sg;
+  char dg[160], d[160];
+  int same = 0;
+  if (stat(g->path, &sg) == 0 && so && so->st_dev == sg.st_dev && so->st_ino == sg.st_ino)
+    same = 1;
+  if (!same && co && (g->io & CLI_IO_OUT)) {
+    char *cg = canonical(g->path);
+    same = cg && strcmp(cg, co) == 0;
+    free(cg);
+  }
+  if (!same) return 0;
+  describe(o, d, sizeof d);
+  describe(g, dg, sizeof dg);
+  if (g->io & CLI_IO_IN)
+    return cli_fail(CLI_EXIT_IO, "refusing to write %s '%s' over %s '%s', an input of this "
+                    "run (the same file: a link or another spelling counts); choose another "
+                    "name for %s", d, o->path, dg, g->path, o->what);
+  /* two outputs: a device such as /dev/null may take both */
+  if (so && !S_ISREG(so->st_mode)) return 0;
+  return cli_fail(CLI_EXIT_IO, "refusing to write %s '%s' and %s '%s' to the same file; "
+                  "give each output its own name", dg, g->path, d, o->path);
+}
+
+int cli_plan_check(void) {
+  size_t i, k;
+  int rc;
+  if (plan.nomem) return cli_fail(CLI_EXIT_NUMERIC, "out of memory declaring the files of "
+                                  "this run");
+  for (i = 0; i < plan.n; i++) {
+    plan_file *o = &plan.f[i];
+    struct stat so, sl;
+    int exists;
+    char *co, d[160];
+    if (!(o->io & CLI_IO_OUT)) continue;
+    describe(o, d, sizeof d);
+    exists = stat(o->path, &so) == 0;
+    if (exists && S_ISDIR(so.st_mode))
+      return cli_fail(CLI_EXIT_IO, "cannot write %s '%s': it is a directory", d, o->path);
+    if (!exists && lstat(o->path, &sl) != 0 && (rc = check_dir(o))) return rc;
+    if (exists && S_ISREG(so.st_mode) && (rc = check_dir(o))) return rc;
+    co = canonical(o->path);
+    for (k = 0; k < plan.n; k++) {
+      if (k == i || (!(plan.f[k].io & CLI_IO_IN) && k < i)) continue;
+      if (strcmp(plan.f[k].path, o->path) == 0 && (plan.f[k].io & CLI_IO_IN) &&
+          (o->io & CLI_IO_IN))
+        continue; /* a file both read and rewritten (--history) */
+      if ((rc = check_pair(o, exists ? &so : NULL, co, &plan.f[k]))) {
+        free(co);
+        return rc;
+      }
+    }
+    free(co);
+    o->checked = 1;
+  }
+  return 0;
+}
+
+/* The declared output @p path, or an internal error (exit 5): a verb opened a
+ * file it never declared. */
+static int declared(const char *path) {
+  size_t i;
+  for (i = 0; i < plan.n; i++)
+    if ((plan.f[i].io & CLI_IO_OUT) && strcmp(plan.f[i].path, path) == 0) {
+      if (!plan.f[i].checked && cli_plan_check()) return CLI_EXIT_IO;
+      return 0;
+    }
+  return cli_fail(CLI_EXIT_IO, "internal error: the output '%s' is not in the run's plan "
+                  "(every output is declared before the work; please report this)", path);
+}
+
+/* ---- commits: all or nothing ---- */
+
+static int pend(char *tmp, const char *path, int slot) {
+  plan_pending *p;
+  if (plan.np == plan.capp) {
+    size_t cap = plan.capp ? 2 * plan.capp : 8;
+    plan_pending *np = realloc(plan.p, cap * sizeof *np);
+    if (!np) return -1;
+    plan.p = np;
+    plan.capp = cap;
+  }
+  p = &plan.p[plan.np];
+  if (!(p->path = dup_str(path))) return -1;
+  p->tmp = tmp;
+  p->slot = slot;
+  plan.np++;
+  return 0;
+}
+
+int cli_plan_finish(int rc) {
+  size_t i, done = 0;
+  for (i = 0; i < plan.np && !rc; i++, done++)
+    if (rename(plan.p[i].tmp, plan.p[i].path) != 0) {
+      int e = errno;
+      rc = cli_fail(CLI_EXIT_IO, "cannot write output file '%s': %s%s", plan.p[i].path,
+                    strerror(e), i ? " (the outputs before it were written)" : "");
+    }
+  for (i = 0; i < plan.np; i++) {
+    if (i >= done) remove(plan.p[i].tmp);
+    cli_tmp_release(plan.p[i].slot);
+    free(plan.p[i].tmp);
+    free(plan.p[i].path);
+  }
+  plan.np = 0;
+  return rc;
+}
+
+/* ---- opening outputs (only through the plan) ---- */
+
+/* The temporary file gets the mode a plain fopen would have given (0666 & ~umask). */
+static void plain_mode(int fd) {
+  mode_t mask = umask(0);
+  umask(mask);
+  (void)fchmod(fd, (mode_t)(0666 & ~mask));
+}
+
+int cli_tmpfile_open(cli_tmpfile *t, const char *path) {
+  struct stat st;
+  int fd, rc;
+  memset(t, 0, sizeof *t);
+  t->path = t->write_path = path;
+  t->slot[0] = t->slot[1] = -1;
+  if ((rc = declared(path))) return rc;
+  /* a device or pipe is written in place (a rename would replace it) */
+  if (stat(path, &st) == 0 && !S_ISREG(st.st_mode)) return 0;
+  if (!(t->tmp = malloc(strlen(path) + sizeof ".XXXXXX.tmp000")))
+    return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  strcpy(t->tmp, path);
+  strcat(t->tmp, ".XXXXXX");
+  if ((fd = mkstemp(t->tmp)) < 0) {
+    int e = errno;
+    free(t->tmp);
+    t->tmp = NULL;
+    return cli_fail(CLI_EXIT_IO, "cannot write output file '%s': %s", path, strerror(e));
+  }
+  plain_mode(fd); /* a writer that reuses the file (rcb_plots.py) keeps its mode */
+  close(fd);
+  t->slot[0] = cli_tmp_register(t->tmp);
+  /* the library's own temporary beside it: "<name>.tmp000", ours as its name is unique */
+  strcat(t->tmp, ".tmp000");
+  t->slot[1] = cli_tmp_register(t->tmp);
+  t->tmp[strlen(t->tmp) - 7] = '\0';
+  t->write_path = t->tmp;
+  return 0;
+}
+
+int cli_tmpfile_close(cli_tmpfile *t, int ok) {
+  int rc = 0;
+  cli_tmp_release(t->slot[1]);
+  if (t->tmp && ok && pend(t->tmp, t->path, t->slot[0]) == 0) {
+    t->tmp = NULL; /* the plan owns it now: renamed when the run succeeded */
+    t->slot[0] = -1;
+  } else if (t->tmp && ok) {
+    rc = cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  }
+  if (t->tmp) remove(t->tmp);
+  cli_tmp_release(t->slot[0]);
+  free(t->tmp);
+  memset(t, 0, sizeof *t);
+  t->slot[0] = t->slot[1] = -1;
+  return rc;
+}
+
+/* An existing device or pipe (e.g. /dev/stdout) is written in place: a rename
+ * would replace the device node by a plain file. */
+static int open_special(cli_out *o, const char *path) {
+  o->path = path;
+  o->fp = fopen(path, "w");
+  if (!o->fp)
+    return cli_fail(CLI_EXIT_IO, "cannot write output file '%s': %s", path, strerror(errno));
+  return 0;
+}
+
+int cli_out_open(cli_out *o, const cli_args *a) {
+  struct stat st;
+  int fd, rc;
+  memset(o, 0, sizeof *o);
+  o->slot = -1;
+  if (!a->output || strcmp(a->output, "-") == 0) {
+    o->fp = stdout;
+    return 0;
+  }
+  if ((rc = declared(a->output))) return rc;
+  if (stat(a->output, &st) == 0 && !S_ISREG(st.st_mode)) return open_special(o, a->output);
+  o->path = a->output;
+  o->tmp = malloc(strlen(a->output) + sizeof ".XXXXXX");
+  if (!o->tmp) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  strcpy(o->tmp, a->output);
+  strcat(o->tmp, ".XXXXXX");
+  fd = mkstemp(o->tmp); /* same directory, so the final rename is atomic */
+  if (fd < 0) {
+    int e = errno;
+    free(o->tmp);
+    o->tmp = NULL;
+    return cli_fail(CLI_EXIT_IO, "cannot write output file '%s': %s", a->output, strerror(e));
+  }
+  o->slot = cli_tmp_register(o->tmp);
+  plain_mode(fd);
+  o->fp = fdopen(fd, "w");
+  if (!o->fp) {
+    int e = errno;
+    close(fd);
+    cli_out_abort(o);
+    return cli_fail(CLI_EXIT_IO, "cannot write output file '%s': %s", a->output, strerror(e));
+  }
+  return 0;
+}
+
+void cli_out_abort(cli_out *o) {
+  if (o->fp && o->fp != stdout) fclose(o->fp);
+  if (o->tmp) {
+    remove(o->tmp);
+    free(o->tmp);
+  }
+  cli_tmp_release(o->slot);
+  memset(o, 0, sizeof *o);
+  o->slot = -1;
+}
+
+/* Flush the temporary file to disk; errno describes a failure. */
+static int finish_file(FILE *fp) {
+  int bad = ferror(fp) != 0;
+  if (!bad && fflush(fp) != 0) bad = 1;
+  if (!bad && fsync(fileno(fp)) != 0 && errno != EINVAL) bad = 1;
+  if (fclose(fp) != 0) bad = 1;
+  if (bad && errno == 0) errno = EIO;
+  return bad;
+}
+
+int cli_out_flush(cli_out *o) {
+  int e;
+  if (!o->fp) return 0;
+  if (o->fp == stdout) {
+    errno = 0;
+    o->fp = NULL;
+    if (fflush(stdout) != 0 || ferror(stdout))
+      return cli_fail(CLI_EXIT_IO, "cannot write to standard output: %s",
+                      strerror(errno ? errno : EIO));
+    return 0;
+  }
+  errno = 0;
+  if (finish_file(o->fp)) {
+    e = errno;
+    o->fp = NULL;
+    cli_fail(CLI_EXIT_IO, "cannot write output file '%s': %s", o->path, strerror(e));
+    cli_out_abort(o);
+    return CLI_EXIT_IO;
+  }
+  o->fp = NULL;
+  return 0;
+}
+
+int cli_out_close(cli_out *o) {
+  int rc = cli_out_flush(o);
+  if (rc) return rc;
+  if (o->tmp) {
+    if (pend(o->tmp, o->path, o->slot) != 0) {
+      cli_out_abort(o);
+      return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+    }
+    o->tmp = NULL; /* renamed by cli_plan_finish when the run succeeded */
+    o->slot = -1;
+  }
+  memset(o, 0, sizeof *o);
+  o->slot = -1;
+  return 0;
+}
