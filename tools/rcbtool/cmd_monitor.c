@@ -279,6 +279,7 @@ int cmd_monitor(int argc, char **argv) {
   }
   split_series(argc, argv, opts, nopts, args, &nargs, series, &nseries);
   cli_plan_options(files, sizeof files / sizeof files[0]);
+  for (k = 0; k < nseries; k++) cli_plan_input(series[k], "measurement"); /* a DIR too */
   if ((rc = cli_parse(nargs, args, opts, nopts, &a))) goto done;
   if (a.help) {
     rc = cli_print_help(cli_help_monitor);
