@@ -1405,6 +1405,52 @@ check_pedestal)
   expect_rc 0
   run frf "$W/ped.ini" --out B2.ped.rx --in DA.x --fmax 300 --points 4
   expect_rc 2; err_has "pedestal moves in x and y only" ;;
+# ---- issue #26: one I/O plan, all-or-nothing outputs, one escaping rule ----
+plan_all_or_nothing)
+  # the -o write fails (file size limit 16 kB, after --stats of 15.9 kB was written):
+  # exit 5 naming the output, not its temporary, and neither file is left
+  cp "$EX/signals/random_sdof.csv" "$W/sig.csv"
+  python3 -c 'import resource, signal, subprocess, sys
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit fails with EFBIG
+resource.setrlimit(resource.RLIMIT_FSIZE, (16384, 16384))
+sys.exit(subprocess.call(sys.argv[1:]))' "$T" estimate "$W/sig.csv" --input force=DA.x \
+    --outputs DA.x --nseg 512 --stats "$W/st.csv" -o "$W/o.csv" >"$W/out" 2>"$W/err"; RC=$?
+  expect_rc 5; err_has "$W/o.csv: "; err_has "File too large"
+  grep -q "o\.csv\.[A-Za-z0-9]" "$W/err" && fail "the message names the temporary"
+  [ ! -e "$W/st.csv" ] || fail "--stats was left by a failed run"
+  stray=$(ls -A "$W" | grep -v -x -e err -e out -e sig.csv)
+  [ -z "$stray" ] || fail "left behind: $stray"
+  # refusals known before the work come before it: a missing directory, a bad extension
+  run estimate "$W/sig.csv" --input force=DA.x --outputs DA.x --stats "$W/st.csv" -o "$W/no/dir/o.csv"
+  expect_rc 5; err_has "the directory '$W/no/dir' does not exist"; [ ! -e "$W/st.csv" ] || fail "st.csv"
+  run order "$W/sig.csv" --kp KP --outputs DA.x --stats "$W/st.csv" -o "$W/o.txt"
+  expect_rc 2; err_has "unknown file type"; [ ! -e "$W/st.csv" ] || fail "st.csv"
+  # --stats onto the input is named as what it is
+  run estimate "$W/sig.csv" --input force=DA.x --outputs DA.x --stats "$W/sig.csv" -o "$W/o.csv"
+  expect_rc 5; err_has "--stats"; err_has "the signals file" ;;
+escape_history)
+  # ESC, BEL, NUL (as \u0000) and invalid UTF-8 in a history file's model and note:
+  # the table shows them escaped, --json is valid JSON holding them as \u escapes
+  printf '{"command": "fit", "model": "m\\u001b[31mX\\u0007.ini", "error_pct": 3.5, "floor_pct": null, "params": 2, "note": "a \033]0;T\007 b \377 c\\u0000d"}\n' >"$W/h.jsonl"
+  run history "$W/h.jsonl"; expect_rc 0
+  out_has 'm\x1b[31mX\x07.ini'; out_has 'a \x1b]0;T\x07 b \xff c'
+  LC_ALL=C grep -q "$(printf '[\001-\010\016-\037\177]')" "$W/out" && fail "a raw control byte on stdout"
+  run history "$W/h.jsonl" --json; expect_rc 0; json_ok
+  python3 - "$W/out" <<'PYEOF' || fail "the --json strings are not the file's"
+import json, sys
+r = json.load(open(sys.argv[1]))[0]
+assert r["model"] == "m\x1b[31mX\x07.ini", r
+assert r["note"] == "a \x1b]0;T\x07 b \xff c\ufffdd", r
+assert r["error_pct"] == 3.5 and r["floor_pct"] is None and r["params"] == 2, r
+PYEOF
+  # the --history writer: a model named with ESC is written as \u001b and read back
+  run simulate "$MODEL" --frf --out C.A.x --in DA.x --fmin 200 --fmax 400 --points 21 \
+    --rpm 10000 -o "$W/meas.csv"; expect_rc 0
+  esc=$(printf 'm\033[2Jx.ini'); cp "$MODEL" "$W/$esc"
+  run fit "$W/$esc" "$W/meas.csv" --params coupling.C.kt --history "$W/h2.jsonl"; expect_rc 0
+  grep -q 'm\\u001b\[2Jx.ini' "$W/h2.jsonl" || fail "the history does not hold \\u001b"
+  run history "$W/h2.jsonl"; expect_rc 0; out_has 'm\x1b[2Jx.ini'
+  LC_ALL=C grep -q "$(printf '\033')" "$W/out" && fail "a raw ESC on stdout" ;;
 *) echo "unknown test case '$CASE'"; exit 1 ;;
 esac
 exit 0

@@ -241,6 +241,12 @@ int cli_tmpfile_open(cli_tmpfile *t, const char *path);
  * else remove it; 0 or an exit code. */
 int cli_tmpfile_close(cli_tmpfile *t, int ok);
 
+/** @p msg with every mention of the temporary @p tmp (and of the library's
+ * "<tmp>.tmp000") replaced by the output @p path, into @p buf: a message names
+ * the user's file, never our temporary. */
+void cli_path_subst(const char *msg, const char *tmp, const char *path, char *buf,
+                    size_t size);
+
 /** A rotation channel ("STATION.rx" or ".ry")? */
 int cli_is_rotation(const char *channel);
 /**
@@ -255,8 +261,16 @@ const char *cli_channel_unit(const char *resp, const char *ref, int kind, char *
 void cli_csv_num(FILE *fp, double x);
 /** Number as JSON: "%.17g", null for NaN and infinities. */
 void cli_json_num(FILE *fp, double x);
-/** String as a JSON string literal (escaped). */
+/* ---- the one escaping rule (cli_text.c): every printed field goes through one ---- */
+/** String as a JSON string literal: '"', '\\' escaped, controls and each byte of
+ * invalid UTF-8 as \u00XX: always valid JSON. */
 void cli_json_str(FILE *fp, const char *s);
+/** Terminal text (tables, messages, CSV comments, logs): control bytes (C0, DEL,
+ * C1) and invalid UTF-8 shown as \xNN, valid UTF-8 as it is. */
+void cli_put_text(FILE *fp, const char *s);
+/** cli_put_text into @p buf (cut to @p size, never in an escape); returns buf,
+ * for a padded printf field. */
+const char *cli_text(const char *s, char *buf, size_t size);
 /** JSON array of n numbers x[0], x[stride], ... */
 void cli_json_nums(FILE *fp, const double *x, size_t n, size_t stride);
 /** JSON list of the model's nodes: [{"node", "shaft", "z", "dof": [4]}, ...]. */

@@ -52,20 +52,6 @@ void cli_json_num(FILE *fp, double x) {
     fputs("null", fp);
 }
 
-void cli_json_str(FILE *fp, const char *s) {
-  fputc('"', fp);
-  for (; *s; s++) {
-    unsigned char c = (unsigned char)*s;
-    if (c == '"' || c == '\\')
-      fprintf(fp, "\\%c", c);
-    else if (c < 0x20)
-      fprintf(fp, "\\u%04x", c);
-    else
-      fputc(c, fp);
-  }
-  fputc('"', fp);
-}
-
 void cli_json_nums(FILE *fp, const double *x, size_t n, size_t stride) {
   size_t i;
   fputc('[', fp);

@@ -510,3 +510,23 @@ int cli_out_close(cli_out *o) {
   o->slot = -1;
   return 0;
 }
+
+void cli_path_subst(const char *msg, const char *tmp, const char *path, char *buf,
+                    size_t size) {
+  size_t n = 0, lt = strlen(tmp), lp = strlen(path);
+  const char *hit;
+  buf[0] = '\0';
+  while (*msg && n + 1 < size) {
+    /* the library's own temporary ("<tmp>.tmp000") is named as the output too */
+    if (lt && (hit = strstr(msg, tmp)) == msg) {
+      msg += lt;
+      if (strncmp(msg, ".tmp000", 7) == 0) msg += 7;
+      if (n + lp >= size) break;
+      memcpy(buf + n, path, lp);
+      n += lp;
+      continue;
+    }
+    buf[n++] = *msg++;
+  }
+  buf[n] = '\0';
+}

@@ -221,12 +221,16 @@ int cli_meas_write(const char *cmd, const rcb_meas *ms, const char *path, int bi
   if ((rc = cli_tmpfile_open(&tf, path))) return rc;
   st = is_uff ? rcb_meas_write_uff(ms, tf.write_path, binary, mp->n, mp->nodes)
               : rcb_meas_write_csv(ms, tf.write_path);
-  if ((rc = cli_tmpfile_close(&tf, st == RCB_OK))) return rc;
-  if (st)
+  if (st) {
+    /* the library names the file it wrote, our temporary: the user's is the output */
+    char msg[1024];
+    cli_path_subst(cli_msg(rcb_meas_errmsg(ms), st), tf.write_path, path, msg, sizeof msg);
+    cli_tmpfile_close(&tf, 0);
     return cli_fail(st == RCB_ERR_IO ? CLI_EXIT_IO : st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC
                                                                          : CLI_EXIT_INPUT,
-                    "%s", cli_msg(rcb_meas_errmsg(ms), st));
-  return 0;
+                    "%s", msg);
+  }
+  return cli_tmpfile_close(&tf, 1);
 }
 
 /* ---- convert ---- */

@@ -142,9 +142,31 @@ static int field(const char *line, const char *key, char *out, size_t size) {
   if (!(p = strstr(line, pat))) return 0;
   p += strlen(pat);
   if (*p == '"') {
-    for (p++; *p && *p != '"' && n + 1 < size; p++) {
-      if (*p == '\\' && p[1]) p++;
-      out[n++] = *p;
+    for (p++; *p && *p != '"' && n + 5 < size; p++) {
+      if (*p != '\\' || !p[1]) {
+        out[n++] = *p;
+        continue;
+      }
+      p++; /* a JSON escape: \uXXXX back to UTF-8 (cli_json_str writes them) */
+      if (*p == 'u' && strspn(p + 1, "0123456789abcdefABCDEF") >= 4) {
+        char hex[5] = {p[1], p[2], p[3], p[4], 0};
+        unsigned long cp = strtoul(hex, NULL, 16);
+        p += 4;
+        if (cp == 0) cp = 0xfffd; /* a NUL would end the text: U+FFFD, shown as such */
+        if (cp < 0x80) {
+          out[n++] = (char)cp;
+        } else if (cp < 0x800) {
+          out[n++] = (char)(0xc0 | (cp >> 6));
+          out[n++] = (char)(0x80 | (cp & 0x3f));
+        } else {
+          out[n++] = (char)(0xe0 | (cp >> 12));
+          out[n++] = (char)(0x80 | ((cp >> 6) & 0x3f));
+          out[n++] = (char)(0x80 | (cp & 0x3f));
+        }
+      } else {
+        out[n++] = *p == 'n' ? '\n' : *p == 't' ? '\t' : *p == 'r' ? '\r' : *p == 'b' ? '\b'
+                 : *p == 'f' ? '\f' : *p;
+      }
     }
   } else {
     while (*p && *p != ',' && *p != '}' && n + 1 < size) out[n++] = *p++;
@@ -184,7 +206,7 @@ static void print_steps(char *text) {
     }
     for (line = strtok_r(copy, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
       char cmd[32] = "", model[256] = "", err[64] = "", flo[64] = "", np[16] = "",
-           note[512] = "", shown[300];
+           note[512] = "", shown[300], tcmd[128], tmodel[1024], tnote[2048], tnp[64];
       double e;
       field(line, "command", cmd, sizeof cmd);
       field(line, "model", model, sizeof model);
@@ -198,12 +220,17 @@ static void print_steps(char *text) {
         if (e > emax) emax = e;
         continue;
       }
+      /* the one escaping rule (cli_text.c): a file's bytes never reach the terminal raw */
+      cli_text(cmd, tcmd, sizeof tcmd);
+      cli_text(short_name(model, shown, sizeof shown), tmodel, sizeof tmodel);
+      cli_text(note, tnote, sizeof tnote);
+      cli_text(np, tnp, sizeof tnp);
       if (strcmp(flo, "null") != 0 && flo[0])
-        printf("%-4d %-10s %-28s %10.4g %10.4g %6s  %s\n", step, cmd, short_name(model, shown, sizeof shown), e,
-               num_field(flo), np, note);
+        printf("%-4d %-10s %-28s %10.4g %10.4g %6s  %s\n", step, tcmd, tmodel, e,
+               num_field(flo), tnp, tnote);
       else
-        printf("%-4d %-10s %-28s %10.4g %10s %6s  %s\n", step, cmd, short_name(model, shown, sizeof shown), e, "-",
-               np, note);
+        printf("%-4d %-10s %-28s %10.4g %10s %6s  %s\n", step, tcmd, tmodel, e, "-", tnp,
+               tnote);
     }
     free(copy);
   }
@@ -228,6 +255,32 @@ static void print_steps(char *text) {
   }
 }
 
+/* One record written again field by field (strings through cli_json_str,
+ * numbers through cli_json_num): valid JSON whatever the line held. */
+static void print_json_record(const char *line, int first) {
+  static const char *const strs[] = {"command", "model", "note"};
+  static const char *const nums[] = {"error_pct", "floor_pct", "params"};
+  char buf[4096];
+  size_t i;
+  printf("%s\n{", first ? "" : ",");
+  for (i = 0; i < 3; i++) {
+    printf("%s\"%s\": ", i ? ", " : "", strs[i]);
+    buf[0] = '\0';
+    field(line, strs[i], buf, sizeof buf);
+    cli_json_str(stdout, buf);
+  }
+  for (i = 0; i < 3; i++) {
+    char *end;
+    double v;
+    buf[0] = '\0';
+    field(line, nums[i], buf, sizeof buf);
+    v = strtod(buf, &end);
+    printf(", \"%s\": ", nums[i]);
+    cli_json_num(stdout, end == buf ? (double)NAN : v);
+  }
+  putchar('}');
+}
+
 int cmd_history(int argc, char **argv) {
   cli_args a;
   size_t len;
@@ -244,7 +297,7 @@ int cmd_history(int argc, char **argv) {
     int first = 1;
     fputs("[", stdout);
     for (line = strtok_r(text, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
-      printf("%s\n%s", first ? "" : ",", line);
+      print_json_record(line, first);
       first = 0;
     }
     fputs("]\n", stdout);

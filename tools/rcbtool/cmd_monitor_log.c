@@ -136,7 +136,9 @@ void mon_print_json(FILE *fp, const mon_state *s) {
 }
 
 /* A CSV text field, quoted (the file and place names may hold commas). */
-static void csv_str(FILE *fp, const char *t) {
+static void csv_str(FILE *fp, const char *s) {
+  char buf[4096];
+  const char *t = cli_text(s, buf, sizeof buf); /* the one rule: no raw control byte */
   fputc('"', fp);
   for (; *t; t++) {
     if (*t == '"') fputc('"', fp);
@@ -187,8 +189,11 @@ static void csv_row(FILE *fp, const mon_state *s, size_t k) {
 
 static void print_csv(FILE *fp, const mon_state *s) {
   size_t k;
-  fprintf(fp, "# rcbtool monitor %s, commissioned on %s; SI units\n", s->a->model,
-          s->j->series.files[0]);
+  fputs("# rcbtool monitor ", fp);
+  cli_put_text(fp, s->a->model);
+  fputs(", commissioned on ", fp);
+  cli_put_text(fp, s->j->series.files[0]);
+  fputs("; SI units\n", fp);
   fputs("update,file,error_pct,change_pct,floor_pct,T,threshold,dof,p_value,alarm,"
         "cusum_alarm,flags", fp);
   for (k = 0; k < s->j->params.n; k++) {
