@@ -1413,7 +1413,7 @@ plan_all_or_nothing)
   python3 -c 'import resource, signal, subprocess, sys
 signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit fails with EFBIG
 resource.setrlimit(resource.RLIMIT_FSIZE, (16384, 16384))
-sys.exit(subprocess.call(sys.argv[1:]))' "$T" estimate "$W/sig.csv" --input force=DA.x \
+sys.exit(subprocess.call(sys.argv[1:], restore_signals=False))' "$T" estimate "$W/sig.csv" --input force=DA.x \
     --outputs DA.x --nseg 512 --stats "$W/st.csv" -o "$W/o.csv" >"$W/out" 2>"$W/err"; RC=$?
   expect_rc 5; err_has "$W/o.csv: "; err_has "File too large"
   grep -q "o\.csv\.[A-Za-z0-9]" "$W/err" && fail "the message names the temporary"
