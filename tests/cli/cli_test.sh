@@ -1451,6 +1451,38 @@ PYEOF
   grep -q 'm\\u001b\[2Jx.ini' "$W/h2.jsonl" || fail "the history does not hold \\u001b"
   run history "$W/h2.jsonl"; expect_rc 0; out_has 'm\x1b[2Jx.ini'
   LC_ALL=C grep -q "$(printf '\033')" "$W/out" && fail "a raw ESC on stdout" ;;
+plan_sd_messages)
+  # --sd of inf or 1e-300: refused by fit and diagnose as by compare (exit 3), blamed
+  # on the --sd file; fit -o into a missing directory: refused before the fit
+  cp "$EX/signals/random_sdof.csv" "$W/sig.csv"
+  run estimate "$W/sig.csv" --input force=DA.x --outputs DA.x --nseg 512 --stats "$W/st.csv" \
+    -o "$W/h1.csv"; expect_rc 0
+  for v in inf 1e-300; do
+    awk -F, -v v="$v" 'BEGIN {OFS = ","} NR == 11 {$3 = v} {print}' "$W/st.csv" >"$W/sd.csv"
+    for c in fit diagnose compare; do
+      if [ $c = compare ]; then p=""; else p="--params coupling.C.kt"; fi
+      run $c "$MODEL" "$W/h1.csv" $p --sd "$W/sd.csv"; expect_rc 3
+      err_has "--sd $W/sd.csv: column 'DA.x/DA.x sd', row 9: standard deviation $v"
+    done
+  done
+  err_has "its weight 1/sd^2 overflows"
+  run fit "$MODEL" "$W/h1.csv" --params coupling.C.kt --sd "$W/st.csv" -o "$W/missing/dir/f.ini"
+  expect_rc 5; err_has "the directory '$W/missing/dir' does not exist"; out_empty ;;
+escape_monitor_name)
+  # a series file named with ESC and BEL: the table, the CSV log and the JSON log escape it
+  esc=$(printf 'd2\033]0;T\007.csv')
+  for k in 1 2; do
+    run simulate "$MODEL" --frf --out C.A.x,C.A.y,C.B.x,C.B.y --in DA.x --fmin 100 --fmax 400 \
+      --points 61 --rpm 10000 --kind inertance --noise 10,1 --seed $k -o "$W/d$k.csv"; expect_rc 0
+  done
+  mv "$W/d2.csv" "$W/$esc"
+  run monitor "$MODEL" "$W/d1.csv" "$W/$esc" --params coupling.C.kt --noise 10,1 \
+    --log "$W/log.csv"; expect_rc 0
+  out_has 'd2\x1b]0;T\x07.csv'
+  LC_ALL=C grep -q "$(printf '[\033\007]')" "$W/out" "$W/log.csv" && fail "a raw control byte"
+  grep -q 'd2\\x1b]0;T\\x07.csv' "$W/log.csv" || fail "the CSV log does not show the name escaped"
+  run monitor "$MODEL" "$W/d1.csv" "$W/$esc" --params coupling.C.kt --noise 10,1 --json
+  expect_rc 0; json_ok ;;
 *) echo "unknown test case '$CASE'"; exit 1 ;;
 esac
 exit 0

@@ -133,11 +133,16 @@ int cli_sd_read(const char *path, const rcb_meas *ms, double **sd_out) {
     }
     for (i = 0; i < n; i++) {
       double sd = t.v[i * t.ncol + (size_t)col];
-      if (sd < 0) {
+      /* as rcb_compare_set_sd, for every verb (fit and diagnose took inf silently), and a
+       * value whose weight 1/sd^2 overflows is blamed on this file, not the noise model */
+      if (sd < 0 || isinf(sd) || (sd > 0 && !(1.0 / (sd * sd) < HUGE_VAL))) {
         table_free(&t);
         free(v);
         return cli_fail(CLI_EXIT_INPUT, "--sd %s: column '%s', row %zu: standard deviation "
-                        "%g < 0", path, name, i + 1, sd);
+                        "%g: expected >= 0 and finite%s (0 or NaN leaves the point out)",
+                        path, name, i + 1, sd,
+                        sd > 0 && !isinf(sd) ? ", and above 1e-154 (its weight 1/sd^2 "
+                                               "overflows)" : "");
       }
       v[c * n + i] = sd;
     }
