@@ -104,6 +104,9 @@ const char *cli_msg(const char *msg, rcb_status st);
 /** All of standard input, NUL-terminated (*len bytes before the terminator);
  * NULL after a printed message when it cannot be read. */
 char *cli_read_stdin(size_t *len);
+/** Exit code of a failed file operation with errno @p e: 4 for ENOMEM (out of
+ * memory, as everywhere), else 5. */
+int cli_errno_exit(int e);
 /** Exit code for a failed analysis call (numerical failure unless it is the input). */
 int cli_status_exit(rcb_status st);
 /**

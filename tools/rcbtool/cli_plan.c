@@ -313,6 +313,8 @@ static int declared(const char *path) {
                   "(every output is declared before the work; please report this)", path);
 }
 
+int cli_errno_exit(int e) { return e == ENOMEM ? CLI_EXIT_NUMERIC : CLI_EXIT_IO; }
+
 /* ---- commits: all or nothing ---- */
 
 static int pend(char *tmp, const char *path, int slot) {
@@ -376,7 +378,7 @@ int cli_tmpfile_open(cli_tmpfile *t, const char *path) {
     int e = errno;
     free(t->tmp);
     t->tmp = NULL;
-    return cli_fail(CLI_EXIT_IO, "cannot write output file '%s': %s", path, strerror(e));
+    return cli_fail(cli_errno_exit(e), "cannot write output file '%s': %s", path, strerror(e));
   }
   plain_mode(fd); /* a writer that reuses the file (rcb_plots.py) keeps its mode */
   close(fd);
@@ -412,7 +414,8 @@ static int open_special(cli_out *o, const char *path) {
   o->path = path;
   o->fp = fopen(path, "w");
   if (!o->fp)
-    return cli_fail(CLI_EXIT_IO, "cannot write output file '%s': %s", path, strerror(errno));
+    return cli_fail(cli_errno_exit(errno), "cannot write output file '%s': %s", path,
+                    strerror(errno));
   return 0;
 }
 
@@ -437,7 +440,8 @@ int cli_out_open(cli_out *o, const cli_args *a) {
     int e = errno;
     free(o->tmp);
     o->tmp = NULL;
-    return cli_fail(CLI_EXIT_IO, "cannot write output file '%s': %s", a->output, strerror(e));
+    return cli_fail(cli_errno_exit(e), "cannot write output file '%s': %s", a->output,
+                    strerror(e));
   }
   o->slot = cli_tmp_register(o->tmp);
   plain_mode(fd);
@@ -446,7 +450,8 @@ int cli_out_open(cli_out *o, const cli_args *a) {
     int e = errno;
     close(fd);
     cli_out_abort(o);
-    return cli_fail(CLI_EXIT_IO, "cannot write output file '%s': %s", a->output, strerror(e));
+    return cli_fail(cli_errno_exit(e), "cannot write output file '%s': %s", a->output,
+                    strerror(e));
   }
   return 0;
 }
@@ -487,9 +492,9 @@ int cli_out_flush(cli_out *o) {
   if (finish_file(o->fp)) {
     e = errno;
     o->fp = NULL;
-    cli_fail(CLI_EXIT_IO, "cannot write output file '%s': %s", o->path, strerror(e));
     cli_out_abort(o);
-    return CLI_EXIT_IO;
+    return cli_fail(cli_errno_exit(e), "cannot write output file '%s': %s", o->path,
+                    strerror(e));
   }
   o->fp = NULL;
   return 0;

@@ -224,11 +224,11 @@ int cli_meas_write(const char *cmd, const rcb_meas *ms, const char *path, int bi
   if (st) {
     /* the library names the file it wrote, our temporary: the user's is the output */
     char msg[1024];
+    int e = errno; /* a write the library could not start for want of memory: exit 4 */
     cli_path_subst(cli_msg(rcb_meas_errmsg(ms), st), tf.write_path, path, msg, sizeof msg);
     cli_tmpfile_close(&tf, 0);
-    return cli_fail(st == RCB_ERR_IO ? CLI_EXIT_IO : st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC
-                                                                         : CLI_EXIT_INPUT,
-                    "%s", msg);
+    return cli_fail(st == RCB_ERR_IO ? cli_errno_exit(e)
+                    : st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC : CLI_EXIT_INPUT, "%s", msg);
   }
   return cli_tmpfile_close(&tf, 1);
 }

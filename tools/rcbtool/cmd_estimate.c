@@ -299,7 +299,8 @@ static int write_meas(est_job *j, const est_out *r) {
       st = rcb_meas_add_channel(ms, j->model[j->p + o], j->model[i], (rcb_frf_kind)j->kind,
                                 r->h + (o * j->p + i) * nb + 1);
   if (st) {
-    rc = cli_fail(CLI_EXIT_INPUT, "estimate: %s", cli_msg(rcb_meas_errmsg(ms), st));
+    rc = cli_fail(st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC : CLI_EXIT_INPUT, "estimate: %s",
+                  cli_msg(rcb_meas_errmsg(ms), st));
     rcb_meas_destroy(ms);
     return rc;
   }

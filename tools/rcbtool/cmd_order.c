@@ -152,7 +152,9 @@ static int ord_write(const ord_job *j, const size_t *bins, size_t nb, size_t m, 
       for (i = 0; i < nb; i++) rcb_order_result(j->e, bins[i], c, m, NULL, &y[i], NULL, NULL);
       st = rcb_meas_add_channel(ms, j->model[c + 1], NULL, RCB_RECEPTANCE, y);
     }
-    if (st) rc = cli_fail(CLI_EXIT_INPUT, "order: %s", cli_msg(rcb_meas_errmsg(ms), st));
+    if (st)
+      rc = cli_fail(st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC : CLI_EXIT_INPUT, "order: %s",
+                    cli_msg(rcb_meas_errmsg(ms), st));
   } else {
     rc = cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   }
