@@ -491,7 +491,8 @@ compare_plot_mkdir)
   expect_rc 0
   [ -s "$W/plots/sub/walk_compare.json" ] || fail "no walk_compare.json in the new directory"
   # the plotter reads the JSON while it is still a temporary beside its target
-  grep -q "compare $W/plots/sub/walk_compare.json[.A-Za-z0-9]* $W/plots/sub/walk" "$W/py_args" ||
+  # and draws under a temporary prefix, renamed onto PREFIX_*.png after the run
+  grep -q "compare $W/plots/sub/walk_compare.json[.A-Za-z0-9]* $W/plots/sub/walk\.[A-Za-z0-9]*\$" "$W/py_args" ||
     fail "the plotter was not run on the JSON: $(cat "$W/py_args")" ;;
 fit_not_identifiable)
   # eq. 19 noise (10 %, 1 %): cR no longer shows in the data (the paper's

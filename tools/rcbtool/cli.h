@@ -189,6 +189,10 @@ void cli_plan_options(const cli_file_opt *files, size_t n);
 int cli_plan_args(const cli_args *a);
 /** The one check of the plan (see above); 0, exit 5, or 4 when out of memory. */
 int cli_plan_check(void);
+/** A file @p tmp written by another program (the plotting script) for the
+ * declared output @p path: renamed onto it by cli_plan_finish like our own
+ * temporaries, or removed. 0 or an exit code. */
+int cli_plan_adopt(const char *tmp, const char *path);
 /** End of the run (main): when @p rc is 0 rename every output's temporary onto
  * it, else remove them all; returns @p rc or exit 5. */
 int cli_plan_finish(int rc);

@@ -334,6 +334,20 @@ static int pend(char *tmp, const char *path, int slot) {
   return 0;
 }
 
+int cli_plan_adopt(const char *tmp, const char *path) {
+  char *copy;
+  int rc, slot;
+  if ((rc = declared(path))) return rc;
+  if (!(copy = dup_str(tmp))) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  slot = cli_tmp_register(copy);
+  if (pend(copy, path, slot) != 0) {
+    cli_tmp_release(slot);
+    free(copy);
+    return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  }
+  return 0;
+}
+
 int cli_plan_finish(int rc) {
   size_t i, done = 0;
   for (i = 0; i < plan.np && !rc; i++, done++)

@@ -472,33 +472,51 @@ static char *prefixed(const char *prefix, const char *suffix) {
   return strcat(s, suffix);
 }
 
-/* The JSON is committed only when the plotter succeeded; pictures it left
- * behind on a failure are removed unless they were there before. */
+/* The plotter draws under a temporary prefix beside PREFIX (PREFIX.XXXXXX_*.png,
+ * on the signal handler's list); the JSON and the pictures are handed to the
+ * plan, renamed onto PREFIX_* only when the whole run succeeded. */
 static int write_plots(const cli_args *a, const cmp_job *j, const rcb_meas *ms,
                        const rcb_compare *c, const size_t *ord) {
   static const char *const pics[2] = {"_overlay.png", "_residual_map.png"};
   cli_args pa = *a;
   cli_out o;
-  char *json = prefixed(j->plot, "_compare.json"), *pic[2] = {NULL, NULL};
-  int rc = json ? 0 : CLI_EXIT_NUMERIC, existed[2] = {1, 1}, k;
+  char *json = prefixed(j->plot, "_compare.json"), *tp = prefixed(j->plot, ".XXXXXX");
+  char *tpic[2] = {NULL, NULL}, *pic[2] = {NULL, NULL};
+  int rc = json && tp ? 0 : CLI_EXIT_NUMERIC, fd = -1, k, slot[3] = {-1, -1, -1};
+  if (!rc && (fd = mkstemp(tp)) < 0)
+    rc = cli_fail(cli_errno_exit(errno), "--plot %s: cannot write beside it: %s", j->plot,
+                  strerror(errno));
+  if (fd >= 0) {
+    close(fd);
+    slot[2] = cli_tmp_register(tp);
+  }
   for (k = 0; k < 2 && !rc; k++) {
-    if (!(pic[k] = prefixed(j->plot, pics[k]))) rc = CLI_EXIT_NUMERIC;
-    if (pic[k]) existed[k] = access(pic[k], F_OK) == 0;
+    if (!(pic[k] = prefixed(j->plot, pics[k])) || !(tpic[k] = prefixed(tp, pics[k])))
+      rc = CLI_EXIT_NUMERIC;
+    else
+      slot[k] = cli_tmp_register(tpic[k]);
   }
   pa.output = json;
   if (!rc && !(rc = cli_out_open(&o, &pa))) {
     print_json(o.fp, a, j, ms, c, ord);
     if (!(rc = cli_out_flush(&o)) &&
-        !(rc = cli_plot_run("compare", o.tmp ? o.tmp : json, j->plot, NULL, NOTHING_KEPT)))
+        !(rc = cli_plot_run("compare", o.tmp ? o.tmp : json, tp, NULL, NOTHING_KEPT)))
       rc = cli_out_close(&o);
     else
       cli_out_abort(&o);
   }
-  for (k = 0; k < 2 && rc; k++)
-    if (pic[k] && !existed[k]) remove(pic[k]);
+  for (k = 0; k < 2 && !rc; k++) /* a picture the plotter did not draw is not an output */
+    if (access(tpic[k], F_OK) == 0) rc = cli_plan_adopt(tpic[k], pic[k]);
+  for (k = 0; k < 3; k++) cli_tmp_release(slot[k]);
+  for (k = 0; k < 2; k++) /* adopted ones are on the plan's list again */
+    if (rc && tpic[k]) remove(tpic[k]);
+  if (fd >= 0) remove(tp);
   free(json);
-  free(pic[0]);
-  free(pic[1]);
+  free(tp);
+  for (k = 0; k < 2; k++) {
+    free(pic[k]);
+    free(tpic[k]);
+  }
   return rc;
 }
 

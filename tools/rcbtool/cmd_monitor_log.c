@@ -235,15 +235,8 @@ static int write_tmp(cli_tmpfile *t, const char *path, const mon_state *s,
 
 #define NOTHING_KEPT "no log, plot or output file was kept (run without --plot to get the rest)"
 
-static char *with_suffix(const char *path, const char *suffix) {
-  char *p = malloc(strlen(path) + strlen(suffix) + 1);
-  if (p) strcat(strcpy(p, path), suffix);
-  return p;
-}
-
 int mon_write_outputs(const mon_state *s) {
   cli_tmpfile log, pic, pj;
-  char *json_name = NULL;
   int rc = 0, have_log = 0, have_pic = 0;
   memset(&log, 0, sizeof log);
   if (s->j->log) {
@@ -253,10 +246,10 @@ int mon_write_outputs(const mon_state *s) {
     have_log = 1;
   }
   if (s->j->plot) {
-    /* the plotter reads the JSON from a temporary beside the picture (removed) */
-    if (!(json_name = with_suffix(s->j->plot, ".json"))) rc = cli_fail(CLI_EXIT_NUMERIC, "out of memory");
-    if (!rc) rc = cli_plot_mkdir(s->j->plot);
-    if (!rc && !(rc = write_tmp(&pj, json_name, s, mon_print_json))) {
+    /* the plotter reads the JSON from a temporary beside the picture (removed; a
+     * temporary of the declared --plot, as every file goes through the run's plan) */
+    rc = cli_plot_mkdir(s->j->plot);
+    if (!rc && !(rc = write_tmp(&pj, s->j->plot, s, mon_print_json))) {
       if (!(rc = cli_tmpfile_open(&pic, s->j->plot))) {
         have_pic = 1;
         rc = cli_plot_run("monitor", pj.write_path, pic.write_path,
@@ -264,7 +257,6 @@ int mon_write_outputs(const mon_state *s) {
       }
       cli_tmpfile_close(&pj, 0);
     }
-    free(json_name);
   }
   if (have_pic) {
     int r2;
