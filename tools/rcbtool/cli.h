@@ -203,6 +203,9 @@ void cli_signals_install(void);
  * slot (-1 if the list is full or the path too long). For temporary copies of
  * inputs (standard input); outputs get theirs from the plan. */
 int cli_tmp_register(const char *path);
+/** mkstemp(@p tmpl) and its entry on the list (*slot) as one step for the signal
+ * handler (the signals held in between); the descriptor, or -1 with errno. */
+int cli_mkstemp(char *tmpl, int *slot);
 /** Take slot @p slot off the list (after the rename or the removal); -1 is ignored. */
 void cli_tmp_release(int slot);
 

@@ -89,17 +89,17 @@ static int stdin_to_file(char *path, size_t size, int *slot, int *is_uff) {
   }
   *is_uff = p + 1 < text + len && p[0] == '-' && p[1] == '1';
   snprintf(path, size, "%s/rcbtool-stdin-XXXXXX", dir && *dir ? dir : "/tmp");
-  fp = (fd = mkstemp(path)) >= 0 ? fdopen(fd, "wb") : NULL;
+  fp = (fd = cli_mkstemp(path, slot)) >= 0 ? fdopen(fd, "wb") : NULL;
   if (!fp) {
     if (fd >= 0) {
       close(fd);
       remove(path);
+      cli_tmp_release(*slot);
     }
     free(text);
     return cli_fail(CLI_EXIT_IO, "cannot copy the measurement from standard input to a "
                     "temporary file in %s (set TMPDIR)", dir && *dir ? dir : "/tmp");
   }
-  *slot = cli_tmp_register(path);
   ok = fwrite(text, 1, len, fp) == len;
   ok = (fclose(fp) == 0) && ok;
   free(text);

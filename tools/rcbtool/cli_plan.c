@@ -95,6 +95,29 @@ void cli_tmp_release(int slot) {
   if (slot >= 0 && slot < CLI_TMP_SLOTS) tmp_live[slot] = 0;
 }
 
+/* SIGINT, SIGTERM, SIGHUP held (@p on) or restored: a file made and its entry on the
+ * list, or all the renames, happen as one step for the signal handler. */
+static void hold_signals(int on, sigset_t *old) {
+  sigset_t block;
+  sigemptyset(&block);
+  sigaddset(&block, SIGINT);
+  sigaddset(&block, SIGTERM);
+  sigaddset(&block, SIGHUP);
+  sigprocmask(on ? SIG_BLOCK : SIG_SETMASK, on ? &block : old, on ? old : NULL);
+}
+
+int cli_mkstemp(char *tmpl, int *slot) {
+  sigset_t old;
+  int fd, e;
+  hold_signals(1, &old); /* a signal between mkstemp and the list would leave the file */
+  fd = mkstemp(tmpl);
+  e = errno;
+  *slot = fd >= 0 ? cli_tmp_register(tmpl) : -1;
+  hold_signals(0, &old);
+  errno = e;
+  return fd;
+}
+
 /* ---- declarations ---- */
 
 static char *dup_str(const char *s) {
@@ -350,6 +373,10 @@ int cli_plan_adopt(const char *tmp, const char *path) {
 
 int cli_plan_finish(int rc) {
   size_t i, done = 0;
+  sigset_t old;
+  /* the renames run with SIGINT, SIGTERM and SIGHUP held: a signal then ends the
+   * process after every output was renamed, never between two of them */
+  hold_signals(1, &old);
   for (i = 0; i < plan.np && !rc; i++, done++)
     if (rename(plan.p[i].tmp, plan.p[i].path) != 0) {
       int e = errno;
@@ -363,6 +390,7 @@ int cli_plan_finish(int rc) {
     free(plan.p[i].path);
   }
   plan.np = 0;
+  hold_signals(0, &old);
   return rc;
 }
 
@@ -388,7 +416,7 @@ int cli_tmpfile_open(cli_tmpfile *t, const char *path) {
     return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   strcpy(t->tmp, path);
   strcat(t->tmp, ".XXXXXX");
-  if ((fd = mkstemp(t->tmp)) < 0) {
+  if ((fd = cli_mkstemp(t->tmp, &t->slot[0])) < 0) {
     int e = errno;
     free(t->tmp);
     t->tmp = NULL;
@@ -396,7 +424,6 @@ int cli_tmpfile_open(cli_tmpfile *t, const char *path) {
   }
   plain_mode(fd); /* a writer that reuses the file (rcb_plots.py) keeps its mode */
   close(fd);
-  t->slot[0] = cli_tmp_register(t->tmp);
   /* the library's own temporary beside it: "<name>.tmp000", ours as its name is unique */
   strcat(t->tmp, ".tmp000");
   t->slot[1] = cli_tmp_register(t->tmp);
@@ -449,7 +476,7 @@ int cli_out_open(cli_out *o, const cli_args *a) {
   if (!o->tmp) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   strcpy(o->tmp, a->output);
   strcat(o->tmp, ".XXXXXX");
-  fd = mkstemp(o->tmp); /* same directory, so the final rename is atomic */
+  fd = cli_mkstemp(o->tmp, &o->slot); /* same directory, so the final rename is atomic */
   if (fd < 0) {
     int e = errno;
     free(o->tmp);
@@ -457,7 +484,6 @@ int cli_out_open(cli_out *o, const cli_args *a) {
     return cli_fail(cli_errno_exit(e), "cannot write output file '%s': %s", a->output,
                     strerror(e));
   }
-  o->slot = cli_tmp_register(o->tmp);
   plain_mode(fd);
   o->fp = fdopen(fd, "w");
   if (!o->fp) {

@@ -483,13 +483,10 @@ static int write_plots(const cli_args *a, const cmp_job *j, const rcb_meas *ms,
   char *json = prefixed(j->plot, "_compare.json"), *tp = prefixed(j->plot, ".XXXXXX");
   char *tpic[2] = {NULL, NULL}, *pic[2] = {NULL, NULL};
   int rc = json && tp ? 0 : CLI_EXIT_NUMERIC, fd = -1, k, slot[3] = {-1, -1, -1};
-  if (!rc && (fd = mkstemp(tp)) < 0)
+  if (!rc && (fd = cli_mkstemp(tp, &slot[2])) < 0)
     rc = cli_fail(cli_errno_exit(errno), "--plot %s: cannot write beside it: %s", j->plot,
                   strerror(errno));
-  if (fd >= 0) {
-    close(fd);
-    slot[2] = cli_tmp_register(tp);
-  }
+  if (fd >= 0) close(fd);
   for (k = 0; k < 2 && !rc; k++) {
     if (!(pic[k] = prefixed(j->plot, pics[k])) || !(tpic[k] = prefixed(tp, pics[k])))
       rc = CLI_EXIT_NUMERIC;
