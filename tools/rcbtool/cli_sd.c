@@ -139,10 +139,9 @@ int cli_sd_read(const char *path, const rcb_meas *ms, double **sd_out) {
         table_free(&t);
         free(v);
         return cli_fail(CLI_EXIT_INPUT, "--sd %s: column '%s', row %zu: standard deviation "
-                        "%g: expected >= 0 and finite%s (0 or NaN leaves the point out)",
-                        path, name, i + 1, sd,
-                        sd > 0 && !isinf(sd) ? ", and above 1e-154 (its weight 1/sd^2 "
-                                               "overflows)" : "");
+                        "%g %s (0 or NaN leaves the point out)", path, name, i + 1, sd,
+                        sd < 0 ? "< 0" : isinf(sd) ? "is not finite"
+                        : "is too small: its weight 1/sd^2 overflows (expected above 1e-154)");
       }
       v[c * n + i] = sd;
     }
