@@ -559,11 +559,10 @@ int cli_out_close(cli_out *o) {
 void cli_path_subst(const char *msg, const char *tmp, const char *path, char *buf,
                     size_t size) {
   size_t n = 0, lt = strlen(tmp), lp = strlen(path);
-  const char *hit;
   buf[0] = '\0';
   while (*msg && n + 1 < size) {
     /* the library's own temporary ("<tmp>.tmp000") is named as the output too */
-    if (lt && (hit = strstr(msg, tmp)) == msg) {
+    if (lt && strncmp(msg, tmp, lt) == 0) {
       msg += lt;
       if (strncmp(msg, ".tmp000", 7) == 0) msg += 7;
       if (n + lp >= size) break;

@@ -155,19 +155,19 @@ static void write_csv(FILE *fp, const camp_job *j) {
   }
 }
 
-/* -o FILE.csv: the critical speeds also go to FILE_critical.csv; both files
- * are renamed into place together, or neither. */
 /* -o OUT.csv also writes OUT_critical.csv (NULL when out of memory). */
 static char *critical_name(const char *output) {
-  size_t n = strlen(output);
+  size_t n = output ? strlen(output) : 0;
   size_t stem = n >= 4 && strcmp(output + n - 4, ".csv") == 0 ? n - 4 : n;
-  char *name = malloc(stem + sizeof "_critical.csv");
+  char *name = output ? malloc(stem + sizeof "_critical.csv") : NULL;
   if (!name) return NULL;
   memcpy(name, output, stem);
   strcpy(name + stem, "_critical.csv");
   return name;
 }
 
+/* -o FILE.csv: the critical speeds also go to FILE_critical.csv; both files
+ * are renamed into place together (by the run's plan), or neither. */
 static int write_csv_files(const cli_args *a, const camp_job *j, cli_out *o) {
   char *name = critical_name(a->output);
   cli_args ca = *a;
