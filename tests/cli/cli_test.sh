@@ -1484,6 +1484,29 @@ escape_monitor_name)
   grep -q 'd2\\x1b]0;T\\x07.csv' "$W/log.csv" || fail "the CSV log does not show the name escaped"
   run monitor "$MODEL" "$W/d1.csv" "$W/$esc" --params coupling.C.kt --noise 10,1 --json
   expect_rc 0; json_ok ;;
+plan_write_reasons)
+  # a failed write names the file and says why (was: "write failed", "cannot write
+  # output file 'x'" without a reason); nothing of the run is left
+  run simulate "$MODEL" --frf --out C.A.x,C.A.y,C.B.x,C.B.y --in DA.x --fmin 100 --fmax 400 \
+    --points 61 --rpm 10000 --kind inertance --noise 10,1 --seed 1 -o "$W/a.csv"; expect_rc 0
+  ln -s /dev/full "$W/log.json"
+  run monitor "$MODEL" "$W/a.csv" "$W/a.csv" --params coupling.C.kt --noise 10,1 --log "$W/log.json" \
+    -o "$W/lines.txt"
+  expect_rc 5; err_has "cannot write output file '$W/log.json': No space left on device"
+  [ ! -e "$W/lines.txt" ] || fail "-o was written by a failed run"
+  # a history larger than the file-size limit: the rewrite fails with the reason
+  rec='{"command": "fit", "model": "m.ini", "error_pct": 1, "floor_pct": null, "params": 1, "note": "x"}'
+  i=0; while [ $i -lt 250 ]; do echo "$rec"; i=$((i + 1)); done >"$W/h.jsonl"
+  cp "$W/h.jsonl" "$W/h.orig"
+  python3 -c 'import resource, signal, subprocess, sys
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+resource.setrlimit(resource.RLIMIT_FSIZE, (16384, 16384))
+sys.exit(subprocess.call(sys.argv[1:], restore_signals=False))' "$T" fit "$MODEL" "$W/a.csv" \
+    --params coupling.C.kt --noise 10,1 --history "$W/h.jsonl" >"$W/out" 2>"$W/err"; RC=$?
+  expect_rc 5; err_has "--history '$W/h.jsonl': cannot write it: File too large"
+  cmp -s "$W/h.jsonl" "$W/h.orig" || fail "the history was changed by a failed run"
+  stray=$(ls -A "$W" | grep -v -x -e err -e out -e a.csv -e log.json -e h.jsonl -e h.orig)
+  [ -z "$stray" ] || fail "left behind: $stray" ;;
 *) echo "unknown test case '$CASE'"; exit 1 ;;
 esac
 exit 0

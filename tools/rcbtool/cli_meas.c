@@ -1,5 +1,6 @@
 /* Commands that take a model and a measurement (fit, compare, diagnose):
  * both positional, and the measurement read by its extension. */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -82,7 +83,7 @@ static int stdin_to_file(char *path, size_t size, int *slot, int *is_uff) {
   size_t len = 0;
   char *text;
   FILE *fp;
-  int fd, ok;
+  int fd, ok, e;
   *slot = -1;
   if (!(text = cli_read_stdin(&len))) return CLI_EXIT_INPUT;
   for (p = text; p < text + len && (*p == ' ' || *p == '\t' || *p == '\r' || *p == '\n'); p++) {
@@ -100,13 +101,20 @@ static int stdin_to_file(char *path, size_t size, int *slot, int *is_uff) {
     return cli_fail(CLI_EXIT_IO, "cannot copy the measurement from standard input to a "
                     "temporary file in %s (set TMPDIR)", dir && *dir ? dir : "/tmp");
   }
+  errno = 0;
   ok = fwrite(text, 1, len, fp) == len;
-  ok = (fclose(fp) == 0) && ok;
+  e = errno;
+  if (fclose(fp) != 0 && ok) {
+    ok = 0;
+    e = errno;
+  }
   free(text);
   if (!ok) {
     remove(path);
     cli_tmp_release(*slot);
-    return cli_fail(CLI_EXIT_IO, "cannot write a temporary copy of standard input");
+    return cli_fail(cli_errno_exit(e ? e : EIO), "cannot write a temporary copy of standard "
+                    "input in %s: %s (set TMPDIR)", dir && *dir ? dir : "/tmp",
+                    strerror(e ? e : EIO));
   }
   return 0;
 }

@@ -117,9 +117,12 @@ int cli_plot_write(const char *kind, const char *png, cli_plot_json_fn json, con
     return rc;
   }
   json(fp, ctx);
-  if (fclose(fp) != 0) {
+  errno = 0;
+  if (ferror(fp) || fclose(fp) != 0) {
+    int e = errno ? errno : EIO;
     cli_tmpfile_close(&jt, 0);
-    return cli_fail(CLI_EXIT_IO, "--plot %s: cannot write its data file", png);
+    return cli_fail(cli_errno_exit(e), "--plot %s: cannot write its data file: %s", png,
+                    strerror(e));
   }
   if ((rc = cli_tmpfile_open(&pt, png))) {
     cli_tmpfile_close(&jt, 0);

@@ -629,8 +629,10 @@ static int report(const cli_args *a, const fit_job *j, rcb_fit *f, const rcb_mod
       write_json(stdout, &r, j, a);
     else
       write_text(stdout, &r, j);
+    errno = 0;
     if (fflush(stdout) != 0 || ferror(stdout))
-      rc = cli_fail(CLI_EXIT_IO, "cannot write to standard output");
+      rc = cli_fail(CLI_EXIT_IO, "cannot write to standard output: %s",
+                    strerror(errno ? errno : EIO));
   }
   if (!rc && cli_opt_value(a, "--history")) {
     char note[160];

@@ -108,6 +108,7 @@ int cli_history_append(const char *path, const char *command, const char *model,
     free(old);
     return cli_fail(CLI_EXIT_IO, "--history '%s': cannot write it: %s", path, strerror(e));
   }
+  errno = 0; /* the first failing write sets it: its reason is the message's */
   if (old) fwrite(old, 1, len, fp);
   fputs("{\"command\": ", fp);
   cli_json_str(fp, command);
@@ -120,7 +121,6 @@ int cli_history_append(const char *path, const char *command, const char *model,
   fprintf(fp, ", \"params\": %zu, \"note\": ", nparams);
   cli_json_str(fp, note);
   fputs("}\n", fp);
-  errno = 0;
   ok = !ferror(fp) && fflush(fp) == 0;
   e = errno ? errno : EIO;
   if (fclose(fp) != 0 && ok) {

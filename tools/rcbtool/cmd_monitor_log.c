@@ -1,5 +1,6 @@
 /* rcbtool monitor: the log (JSON or CSV) and the trend plot, each written to
  * a temporary file and renamed only when all of them are complete. */
+#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -216,19 +217,26 @@ static void plain_mode(const char *path) {
 static int write_tmp(cli_tmpfile *t, const char *path, const mon_state *s,
                      void (*fn)(FILE *, const mon_state *)) {
   FILE *fp;
-  int rc = cli_tmpfile_open(t, path), bad;
+  int rc = cli_tmpfile_open(t, path), bad, e;
   if (rc) return rc;
   if (!(fp = fopen(t->write_path, "w"))) {
+    e = errno;
     cli_tmpfile_close(t, 0);
-    return cli_fail(CLI_EXIT_IO, "cannot write output file '%s'", path);
+    return cli_fail(cli_errno_exit(e), "cannot write output file '%s': %s", path, strerror(e));
   }
   plain_mode(t->write_path);
+  errno = 0; /* the first failing write sets it: its reason is the message's */
   fn(fp, s);
-  bad = ferror(fp) != 0;
-  if (fclose(fp) != 0) bad = 1;
+  bad = ferror(fp) != 0 || fflush(fp) != 0;
+  e = errno;
+  if (fclose(fp) != 0 && !bad) {
+    bad = 1;
+    e = errno;
+  }
   if (bad) {
     cli_tmpfile_close(t, 0);
-    return cli_fail(CLI_EXIT_IO, "cannot write output file '%s'", path);
+    return cli_fail(cli_errno_exit(e ? e : EIO), "cannot write output file '%s': %s", path,
+                    strerror(e ? e : EIO));
   }
   return 0;
 }
