@@ -390,6 +390,13 @@ int cli_plan_finish(int rc) {
     free(plan.p[i].path);
   }
   plan.np = 0;
+  /* a temporary a command made and neither committed nor removed (a path that
+   * forgot its abort) is removed here, as a signal would */
+  for (i = 0; i < CLI_TMP_SLOTS; i++)
+    if (tmp_live[i]) {
+      unlink(tmp_paths[i]);
+      tmp_live[i] = 0;
+    }
   hold_signals(0, &old);
   return rc;
 }
