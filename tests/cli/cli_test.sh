@@ -1451,6 +1451,10 @@ PYEOF
   run fit "$W/$esc" "$W/meas.csv" --params coupling.C.kt --history "$W/h2.jsonl"; expect_rc 0
   grep -q 'm\\u001b\[2Jx.ini' "$W/h2.jsonl" || fail "the history does not hold \\u001b"
   run history "$W/h2.jsonl"; expect_rc 0; out_has 'm\x1b[2Jx.ini'
+  LC_ALL=C grep -q "$(printf '\033')" "$W/out" && fail "a raw ESC on stdout"
+  # the file names in the comment lines of check, compare and plan
+  run check "$W/$esc"; expect_rc 0; out_has 'm\x1b[2Jx.ini: '
+  run compare "$W/$esc" "$W/meas.csv"; expect_rc 0; out_has 'm\x1b[2Jx.ini vs '
   LC_ALL=C grep -q "$(printf '\033')" "$W/out" && fail "a raw ESC on stdout" ;;
 plan_sd_messages)
   # --sd of inf or 1e-300: refused by fit and diagnose as by compare (exit 3), blamed

@@ -266,7 +266,11 @@ static void print_peaks(FILE *fp, const rcb_compare *c, const cmp_job *j) {
 
 static void print_text(FILE *fp, const cli_args *a, const cmp_job *j, const rcb_meas *ms,
                        const rcb_compare *c, const size_t *ord) {
-  fprintf(fp, "# rcbtool compare: %s vs %s\n", a->model, j->meas_path);
+  fputs("# rcbtool compare: ", fp); /* file names escaped (cli_text.c) */
+  cli_put_text(fp, a->model);
+  fputs(" vs ", fp);
+  cli_put_text(fp, j->meas_path);
+  fputc('\n', fp);
   if (rcb_meas_get_type(ms) == RCB_MEAS_UNBALANCE)
     fprintf(fp, "# unbalance responses, ");
   else if (rcb_meas_speed(ms) < 0)
