@@ -1511,6 +1511,19 @@ sys.exit(subprocess.call(sys.argv[1:], restore_signals=False))' "$T" fit "$MODEL
   cmp -s "$W/h.jsonl" "$W/h.orig" || fail "the history was changed by a failed run"
   stray=$(ls -A "$W" | grep -v -x -e err -e out -e a.csv -e log.json -e h.jsonl -e h.orig)
   [ -z "$stray" ] || fail "left behind: $stray" ;;
+history_nonfinite)
+  # a history with nan or 1e999 typed into a number: not a record (--history writes null),
+  # so history refuses to show it (exit 3, file:line) and --history to append to it (exit 5)
+  run simulate "$MODEL" --frf --out C.A.x --in DA.x --fmin 200 --fmax 400 --points 21 \
+    --rpm 10000 -o "$W/meas.csv"; expect_rc 0
+  for v in nan 1e999; do
+    printf '{"command": "fit", "model": "m.ini", "error_pct": 2, "floor_pct": null, "params": 1, "note": "a"}\n{"command": "fit", "model": "m.ini", "error_pct": %s, "floor_pct": null, "params": 1, "note": "b"}\n' "$v" >"$W/h.jsonl"
+    cp "$W/h.jsonl" "$W/h.orig"
+    run history "$W/h.jsonl"; expect_rc 3; err_has "$W/h.jsonl:2: not a history record"; out_empty
+    run fit "$MODEL" "$W/meas.csv" --params coupling.C.kt --history "$W/h.jsonl"; expect_rc 5
+    err_has "'$W/h.jsonl':2: not a history record"
+    cmp -s "$W/h.jsonl" "$W/h.orig" || fail "the history was appended to"
+  done ;;
 *) echo "unknown test case '$CASE'"; exit 1 ;;
 esac
 exit 0

@@ -40,8 +40,21 @@ static char *slurp(const char *path, size_t *len) {
 
 /* A line (@p n bytes, no newline) is a history record: one JSON object with the
  * fields cli_history_append writes. */
+static int field(const char *line, const char *key, char *out, size_t size);
+
+/* A number field as --history writes it: absent, null, or a finite number
+ * (a nan or 1e999 typed into the file is no record: cli_json_num writes null). */
+static int number_ok(const char *line, const char *key) {
+  char v[64], *end;
+  double x;
+  if (!field(line, key, v, sizeof v) || strcmp(v, "null") == 0) return 1;
+  x = strtod(v, &end);
+  return end != v && *end == '\0' && isfinite(x);
+}
+
 static int is_record(const char *line, size_t n) {
   static const char *const keys[] = {"\"command\": ", "\"model\": ", "\"error_pct\": "};
+  static const char *const nums[] = {"error_pct", "floor_pct", "params"};
   char buf[4096];
   size_t i;
   if (n < 2 || n >= sizeof buf || line[0] != '{' || line[n - 1] != '}') return 0;
@@ -49,6 +62,8 @@ static int is_record(const char *line, size_t n) {
   buf[n] = '\0';
   for (i = 0; i < sizeof keys / sizeof keys[0]; i++)
     if (!strstr(buf, keys[i])) return 0;
+  for (i = 0; i < sizeof nums / sizeof nums[0]; i++)
+    if (!number_ok(buf, nums[i])) return 0;
   return strlen(buf) == n; /* no NUL byte inside */
 }
 
@@ -283,7 +298,7 @@ static void print_json_record(const char *line, int first) {
 
 int cmd_history(int argc, char **argv) {
   cli_args a;
-  size_t len;
+  size_t len, bad;
   char *text;
   int rc = cli_parse(argc, argv, NULL, 0, &a);
   if (rc) return rc;
@@ -292,6 +307,12 @@ int cmd_history(int argc, char **argv) {
     return cli_usage(a.cmd, "missing the history file; expected rcbtool history FILE");
   if (!(text = slurp(a.model, &len)))
     return cli_fail(CLI_EXIT_INPUT, "history '%s': cannot read it", a.model);
+  if ((bad = first_bad_line(text, len))) { /* shown only when every line is a record */
+    free(text);
+    return cli_fail(CLI_EXIT_INPUT, "%s:%zu: not a history record (one JSON object per line "
+                    "with command, model and error_pct, numbers finite or null, as --history "
+                    "writes them)", a.model, bad);
+  }
   if (a.json) {
     char *line, *save = NULL;
     int first = 1;
