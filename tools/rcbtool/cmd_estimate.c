@@ -491,7 +491,7 @@ int cmd_estimate(int argc, char **argv) {
                     {"--estimator", "E", NULL},   {"--no-detrend", NULL, NULL},
                     {"--rpm", "R", NULL},         {"--fmax", "HZ", NULL},
                     {"--every", "N", NULL},
-                    {"--stats", "FILE", NULL}, {"--spectra", "FILE", NULL},
+                    {"--stats", "FILE", NULL},    {"--spectra", "FILE", NULL},
                     {"--map", "NODE=STATION,...", NULL}, {"--binary", NULL, NULL},
                     {"--wav-names", "LIST", NULL}, {"--wav-units", "LIST", NULL},
                     {"--wav-scale", "LIST", NULL}, {"--plot", "FILE.png", NULL}};
