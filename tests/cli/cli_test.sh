@@ -491,7 +491,8 @@ compare_plot_mkdir)
   expect_rc 0
   [ -s "$W/plots/sub/walk_compare.json" ] || fail "no walk_compare.json in the new directory"
   # the plotter reads the JSON while it is still a temporary beside its target
-  grep -q "compare $W/plots/sub/walk_compare.json[.A-Za-z0-9]* $W/plots/sub/walk" "$W/py_args" ||
+  # and draws under a temporary prefix, renamed onto PREFIX_*.png after the run
+  grep -q "compare $W/plots/sub/walk_compare.json[.A-Za-z0-9]* $W/plots/sub/walk\.[A-Za-z0-9]*\$" "$W/py_args" ||
     fail "the plotter was not run on the JSON: $(cat "$W/py_args")" ;;
 fit_not_identifiable)
   # eq. 19 noise (10 %, 1 %): cR no longer shows in the data (the paper's
@@ -996,7 +997,7 @@ history_not_history)
   run history "$W/notes.txt"; expect_rc 3; err_has "notes.txt':1: not a history record"
   { cat "$W/h.jsonl"; echo '{"update": 1, "file": "m1.uff"}'; } >"$W/mixed.jsonl"
   run history "$W/mixed.jsonl"; expect_rc 3; err_has "mixed.jsonl':3"
-  usage fit "$W/model.ini" "$W/meas.csv" --params coupling.C.kt --history "$W/new.ini" -o "$W/new.ini"
+  run fit "$W/model.ini" "$W/meas.csv" --params coupling.C.kt --history "$W/new.ini" -o "$W/new.ini"; expect_rc 5
   err_has "the same file"; [ ! -e "$W/new.ini" ] || fail "wrote new.ini" ;;
 signal_removes_temporaries)
   # SIGTERM / SIGINT while -o FILE is being written: no FILE.XXXXXX left, FILE intact
@@ -1498,6 +1499,124 @@ check_pedestal)
   expect_rc 0
   run frf "$W/ped.ini" --out B2.ped.rx --in DA.x --fmax 300 --points 4
   expect_rc 2; err_has "pedestal moves in x and y only" ;;
+# ---- issue #26: one I/O plan, all-or-nothing outputs, one escaping rule ----
+plan_all_or_nothing)
+  # the -o write fails (file size limit 16 kB, after --stats of 15.9 kB was written):
+  # exit 5 naming the output, not its temporary, and neither file is left
+  cp "$EX/signals/random_sdof.csv" "$W/sig.csv"
+  python3 -c 'import resource, signal, subprocess, sys
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit fails with EFBIG
+resource.setrlimit(resource.RLIMIT_FSIZE, (16384, 16384))
+sys.exit(subprocess.call(sys.argv[1:], restore_signals=False))' "$T" estimate "$W/sig.csv" --input force=DA.x \
+    --outputs DA.x --nseg 512 --stats "$W/st.csv" -o "$W/o.csv" >"$W/out" 2>"$W/err"; RC=$?
+  expect_rc 5; err_has "$W/o.csv: "; err_has "File too large"
+  grep -q "o\.csv\.[A-Za-z0-9]" "$W/err" && fail "the message names the temporary"
+  [ ! -e "$W/st.csv" ] || fail "--stats was left by a failed run"
+  stray=$(ls -A "$W" | grep -v -x -e err -e out -e sig.csv)
+  [ -z "$stray" ] || fail "left behind: $stray"
+  # refusals known before the work come before it: a missing directory, a bad extension
+  run estimate "$W/sig.csv" --input force=DA.x --outputs DA.x --stats "$W/st.csv" -o "$W/no/dir/o.csv"
+  expect_rc 5; err_has "the directory '$W/no/dir' does not exist"; [ ! -e "$W/st.csv" ] || fail "st.csv"
+  run order "$W/sig.csv" --kp KP --outputs DA.x --stats "$W/st.csv" -o "$W/o.txt"
+  expect_rc 2; err_has "unknown file type"; [ ! -e "$W/st.csv" ] || fail "st.csv"
+  # --stats onto the input is named as what it is
+  run estimate "$W/sig.csv" --input force=DA.x --outputs DA.x --stats "$W/sig.csv" -o "$W/o.csv"
+  expect_rc 5; err_has "--stats"; err_has "the signals file" ;;
+escape_history)
+  # ESC, BEL, NUL (as \u0000) and invalid UTF-8 in a history file's model and note:
+  # the table shows them escaped, --json is valid JSON holding them as \u escapes
+  printf '{"command": "fit", "model": "m\\u001b[31mX\\u0007.ini", "error_pct": 3.5, "floor_pct": null, "params": 2, "note": "a \033]0;T\007 b \377 c\\u0000d"}\n' >"$W/h.jsonl"
+  run history "$W/h.jsonl"; expect_rc 0
+  out_has 'm\x1b[31mX\x07.ini'; out_has 'a \x1b]0;T\x07 b \xff c'
+  LC_ALL=C grep -q "$(printf '[\001-\010\016-\037\177]')" "$W/out" && fail "a raw control byte on stdout"
+  run history "$W/h.jsonl" --json; expect_rc 0; json_ok
+  python3 - "$W/out" <<'PYEOF' || fail "the --json strings are not the file's"
+import json, sys
+r = json.load(open(sys.argv[1]))[0]
+assert r["model"] == "m\x1b[31mX\x07.ini", r
+assert r["note"] == "a \x1b]0;T\x07 b \xff c\ufffdd", r
+assert r["error_pct"] == 3.5 and r["floor_pct"] is None and r["params"] == 2, r
+PYEOF
+  # the --history writer: a model named with ESC is written as \u001b and read back
+  run simulate "$MODEL" --frf --out C.A.x --in DA.x --fmin 200 --fmax 400 --points 21 \
+    --rpm 10000 -o "$W/meas.csv"; expect_rc 0
+  esc=$(printf 'm\033[2Jx.ini'); cp "$MODEL" "$W/$esc"
+  run fit "$W/$esc" "$W/meas.csv" --params coupling.C.kt --history "$W/h2.jsonl"; expect_rc 0
+  grep -q 'm\\u001b\[2Jx.ini' "$W/h2.jsonl" || fail "the history does not hold \\u001b"
+  run history "$W/h2.jsonl"; expect_rc 0; out_has 'm\x1b[2Jx.ini'
+  LC_ALL=C grep -q "$(printf '\033')" "$W/out" && fail "a raw ESC on stdout"
+  # the file names in the comment lines of check, compare and plan
+  run check "$W/$esc"; expect_rc 0; out_has 'm\x1b[2Jx.ini: '
+  run compare "$W/$esc" "$W/meas.csv"; expect_rc 0; out_has 'm\x1b[2Jx.ini vs '
+  LC_ALL=C grep -q "$(printf '\033')" "$W/out" && fail "a raw ESC on stdout" ;;
+plan_sd_messages)
+  # --sd of inf or 1e-300: refused by fit and diagnose as by compare (exit 3), blamed
+  # on the --sd file; fit -o into a missing directory: refused before the fit
+  cp "$EX/signals/random_sdof.csv" "$W/sig.csv"
+  run estimate "$W/sig.csv" --input force=DA.x --outputs DA.x --nseg 512 --stats "$W/st.csv" \
+    -o "$W/h1.csv"; expect_rc 0
+  for v in inf 1e-300; do
+    awk -F, -v v="$v" 'BEGIN {OFS = ","} NR == 11 {$3 = v} {print}' "$W/st.csv" >"$W/sd.csv"
+    for c in fit diagnose compare; do
+      if [ $c = compare ]; then p=""; else p="--params coupling.C.kt"; fi
+      run $c "$MODEL" "$W/h1.csv" $p --sd "$W/sd.csv"; expect_rc 3
+      err_has "--sd $W/sd.csv: column 'DA.x/DA.x sd', row 9: standard deviation $v"
+    done
+  done
+  err_has "its weight 1/sd^2 overflows"
+  run fit "$MODEL" "$W/h1.csv" --params coupling.C.kt --sd "$W/st.csv" -o "$W/missing/dir/f.ini"
+  expect_rc 5; err_has "the directory '$W/missing/dir' does not exist"; out_empty ;;
+escape_monitor_name)
+  # a series file named with ESC and BEL: the table, the CSV log and the JSON log escape it
+  esc=$(printf 'd2\033]0;T\007.csv')
+  for k in 1 2; do
+    run simulate "$MODEL" --frf --out C.A.x,C.A.y,C.B.x,C.B.y --in DA.x --fmin 100 --fmax 400 \
+      --points 61 --rpm 10000 --kind inertance --noise 10,1 --seed $k -o "$W/d$k.csv"; expect_rc 0
+  done
+  mv "$W/d2.csv" "$W/$esc"
+  run monitor "$MODEL" "$W/d1.csv" "$W/$esc" --params coupling.C.kt --noise 10,1 \
+    --log "$W/log.csv"; expect_rc 0
+  out_has 'd2\x1b]0;T\x07.csv'
+  LC_ALL=C grep -q "$(printf '[\033\007]')" "$W/out" "$W/log.csv" && fail "a raw control byte"
+  grep -q 'd2\\x1b]0;T\\x07.csv' "$W/log.csv" || fail "the CSV log does not show the name escaped"
+  run monitor "$MODEL" "$W/d1.csv" "$W/$esc" --params coupling.C.kt --noise 10,1 --json
+  expect_rc 0; json_ok ;;
+plan_write_reasons)
+  # a failed write names the file and says why (was: "write failed", "cannot write
+  # output file 'x'" without a reason); nothing of the run is left
+  run simulate "$MODEL" --frf --out C.A.x,C.A.y,C.B.x,C.B.y --in DA.x --fmin 100 --fmax 400 \
+    --points 61 --rpm 10000 --kind inertance --noise 10,1 --seed 1 -o "$W/a.csv"; expect_rc 0
+  ln -s /dev/full "$W/log.json"
+  run monitor "$MODEL" "$W/a.csv" "$W/a.csv" --params coupling.C.kt --noise 10,1 --log "$W/log.json" \
+    -o "$W/lines.txt"
+  expect_rc 5; err_has "cannot write output file '$W/log.json': No space left on device"
+  [ ! -e "$W/lines.txt" ] || fail "-o was written by a failed run"
+  # a history larger than the file-size limit: the rewrite fails with the reason
+  rec='{"command": "fit", "model": "m.ini", "error_pct": 1, "floor_pct": null, "params": 1, "note": "x"}'
+  i=0; while [ $i -lt 250 ]; do echo "$rec"; i=$((i + 1)); done >"$W/h.jsonl"
+  cp "$W/h.jsonl" "$W/h.orig"
+  python3 -c 'import resource, signal, subprocess, sys
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+resource.setrlimit(resource.RLIMIT_FSIZE, (16384, 16384))
+sys.exit(subprocess.call(sys.argv[1:], restore_signals=False))' "$T" fit "$MODEL" "$W/a.csv" \
+    --params coupling.C.kt --noise 10,1 --history "$W/h.jsonl" >"$W/out" 2>"$W/err"; RC=$?
+  expect_rc 5; err_has "--history '$W/h.jsonl': cannot write it: File too large"
+  cmp -s "$W/h.jsonl" "$W/h.orig" || fail "the history was changed by a failed run"
+  stray=$(ls -A "$W" | grep -v -x -e err -e out -e a.csv -e log.json -e h.jsonl -e h.orig)
+  [ -z "$stray" ] || fail "left behind: $stray" ;;
+history_nonfinite)
+  # a history with nan or 1e999 typed into a number: not a record (--history writes null),
+  # so history refuses to show it (exit 3, file:line) and --history to append to it (exit 5)
+  run simulate "$MODEL" --frf --out C.A.x --in DA.x --fmin 200 --fmax 400 --points 21 \
+    --rpm 10000 -o "$W/meas.csv"; expect_rc 0
+  for v in nan 1e999; do
+    printf '{"command": "fit", "model": "m.ini", "error_pct": 2, "floor_pct": null, "params": 1, "note": "a"}\n{"command": "fit", "model": "m.ini", "error_pct": %s, "floor_pct": null, "params": 1, "note": "b"}\n' "$v" >"$W/h.jsonl"
+    cp "$W/h.jsonl" "$W/h.orig"
+    run history "$W/h.jsonl"; expect_rc 3; err_has "'$W/h.jsonl':2: not a history record"; out_empty
+    run fit "$MODEL" "$W/meas.csv" --params coupling.C.kt --history "$W/h.jsonl"; expect_rc 5
+    err_has "'$W/h.jsonl':2: not a history record"
+    cmp -s "$W/h.jsonl" "$W/h.orig" || fail "the history was appended to"
+  done ;;
 *) echo "unknown test case '$CASE'"; exit 1 ;;
 esac
 exit 0

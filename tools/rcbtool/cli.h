@@ -36,6 +36,20 @@ typedef struct cli_opt {
   const char *value; /**< filled by cli_parse: the argument, "" for a flag, NULL if absent */
 } cli_opt;
 
+/** What a file option is to the run's plan (cli_plan.c). */
+enum {
+  CLI_IO_IN = 1,    /**< a file the run reads */
+  CLI_IO_OUT = 2,   /**< a file the run writes (through the plan only) */
+  CLI_IO_MKDIR = 4, /**< an output whose missing directories are made (--plot) */
+  CLI_IO_INOUT = CLI_IO_IN | CLI_IO_OUT /**< read, then rewritten (--history) */
+};
+/** A verb's file option, e.g. {"--stats", CLI_IO_OUT}: a verb's table of these,
+ * given to cli_plan_options before cli_parse, is its declaration of its files. */
+typedef struct cli_file_opt {
+  const char *name;
+  unsigned io;
+} cli_file_opt;
+
 /** A parsed command line. */
 typedef struct cli_args {
   const char *cmd;    /**< subcommand name */
@@ -90,6 +104,9 @@ const char *cli_msg(const char *msg, rcb_status st);
 /** All of standard input, NUL-terminated (*len bytes before the terminator);
  * NULL after a printed message when it cannot be read. */
 char *cli_read_stdin(size_t *len);
+/** Exit code of a failed file operation with errno @p e: 4 for ENOMEM (out of
+ * memory, as everywhere), else 5. */
+int cli_errno_exit(int e);
 /** Exit code for a failed analysis call (numerical failure unless it is the input). */
 int cli_status_exit(rcb_status st);
 /**
@@ -148,18 +165,47 @@ void cli_channels_free(cli_channels *ch);
 
 /* ---- output (cli_output.c) ---- */
 
-/** Record @p path as an input of this run (@p what: "model", "measurement", ...);
- * "-" and missing files are ignored. */
-void cli_input_add(const char *path, const char *what);
-/** Refuse (message, exit 5) an output path that is one of the inputs (same
- * device and inode, so links and other spellings count); 0 otherwise. */
-int cli_output_check(const char *path);
+/* ---- the run's input/output plan (cli_plan.c) ----
+ * Every input and output of a run is declared before anything is read or
+ * written; cli_plan_check refuses, before the work, an output that is an input
+ * (device and inode, so links and other spellings count), two outputs that are
+ * one file, an output that is a directory or whose directory is missing or not
+ * writable (exit 5). Outputs are opened only through cli_out_open and
+ * cli_tmpfile_open, which refuse a path the plan does not hold; each is written
+ * to a temporary in its own directory, and all are renamed by cli_plan_finish
+ * only when the run succeeded (removed otherwise, and on a signal). */
+
+/** Name the run's first positional argument from the command's help text
+ * ("usage: rcbtool estimate SIGNALS ..." -> "signals"); called once, from main. */
+void cli_plan_begin(const char *help);
+/** Declare @p path an input ("model", "measurement", "--sd", ...); "-" is ignored. */
+void cli_plan_input(const char *path, const char *what);
+/** Declare @p path an output (@p what: "-o", "--stats", ...; @p io: CLI_IO_MKDIR or 0). */
+void cli_plan_output(const char *path, const char *what, unsigned io);
+/** The verb's file options (a static table; called before cli_parse). */
+void cli_plan_options(const cli_file_opt *files, size_t n);
+/** Declare the positional argument, -o and every file option given in @p a
+ * (those of cli_plan_options), then cli_plan_check (cli_parse does this). */
+int cli_plan_args(const cli_args *a);
+/** The one check of the plan (see above); 0, exit 5, or 4 when out of memory. */
+int cli_plan_check(void);
+/** A file @p tmp written by another program (the plotting script) for the
+ * declared output @p path: renamed onto it by cli_plan_finish like our own
+ * temporaries, or removed. 0 or an exit code. */
+int cli_plan_adopt(const char *tmp, const char *path);
+/** End of the run (main): when @p rc is 0 rename every output's temporary onto
+ * it, else remove them all; returns @p rc or exit 5. */
+int cli_plan_finish(int rc);
 /** SIGINT, SIGTERM, SIGHUP remove the registered temporary files, then end the
  * process by the same signal (called once, from main). */
 void cli_signals_install(void);
 /** Add a temporary file to the list the signal handler removes; returns its
- * slot (-1 if the list is full or the path too long). */
+ * slot (-1 if the list is full or the path too long). For temporary copies of
+ * inputs (standard input); outputs get theirs from the plan. */
 int cli_tmp_register(const char *path);
+/** mkstemp(@p tmpl) and its entry on the list (*slot) as one step for the signal
+ * handler (the signals held in between); the descriptor, or -1 with errno. */
+int cli_mkstemp(char *tmpl, int *slot);
 /** Take slot @p slot off the list (after the rename or the removal); -1 is ignored. */
 void cli_tmp_release(int slot);
 
@@ -179,12 +225,14 @@ typedef struct cli_out {
  * separator) is above --max-output MB; 0 or a usage error (exit 2).
  */
 int cli_check_size(const cli_args *a, double rows, double numbers);
-/** Open the destination; refuses to write over the model file. 0 or exit 5. */
+/** Open the destination -o (a->output): stdout, a device in place, or a temporary
+ * beside a declared output (an undeclared path is refused). 0 or exit 5. */
 int cli_out_open(cli_out *o, const cli_args *a);
 /** Flush and close the temporary file, not yet renamed (cli_out_close or
  * cli_out_abort follows); on error remove it, exit 5. */
 int cli_out_flush(cli_out *o);
-/** Flush and commit (rename the temporary file); on any error remove it, exit 5. */
+/** Flush and hand the temporary to the plan (renamed when the run succeeded);
+ * on any error remove it, exit 5. */
 int cli_out_close(cli_out *o);
 /** Abandon the output: the temporary file is removed, nothing is left. */
 void cli_out_abort(cli_out *o);
@@ -197,10 +245,17 @@ typedef struct cli_tmpfile {
   char *tmp;
   int slot[2];
 } cli_tmpfile;
-/** Make the temporary (on the signal handler's list); 0 or exit 5. */
+/** Make the temporary of a declared output (on the signal handler's list); 0 or exit 5. */
 int cli_tmpfile_open(cli_tmpfile *t, const char *path);
-/** Rename the temporary onto the path if @p ok, else remove it; 0 or exit 5. */
+/** If @p ok hand the temporary to the plan (renamed when the run succeeded),
+ * else remove it; 0 or an exit code. */
 int cli_tmpfile_close(cli_tmpfile *t, int ok);
+
+/** @p msg with every mention of the temporary @p tmp (and of the library's
+ * "<tmp>.tmp000") replaced by the output @p path, into @p buf: a message names
+ * the user's file, never our temporary. */
+void cli_path_subst(const char *msg, const char *tmp, const char *path, char *buf,
+                    size_t size);
 
 /** A rotation channel ("STATION.rx" or ".ry")? */
 int cli_is_rotation(const char *channel);
@@ -216,8 +271,16 @@ const char *cli_channel_unit(const char *resp, const char *ref, int kind, char *
 void cli_csv_num(FILE *fp, double x);
 /** Number as JSON: "%.17g", null for NaN and infinities. */
 void cli_json_num(FILE *fp, double x);
-/** String as a JSON string literal (escaped). */
+/* ---- the one escaping rule (cli_text.c): every printed field goes through one ---- */
+/** String as a JSON string literal: '"', '\\' escaped, controls and each byte of
+ * invalid UTF-8 as \u00XX: always valid JSON. */
 void cli_json_str(FILE *fp, const char *s);
+/** Terminal text (tables, messages, CSV comments, logs): control bytes (C0, DEL,
+ * C1) and invalid UTF-8 shown as \xNN, valid UTF-8 as it is. */
+void cli_put_text(FILE *fp, const char *s);
+/** cli_put_text into @p buf (cut to @p size, never in an escape); returns buf,
+ * for a padded printf field. */
+const char *cli_text(const char *s, char *buf, size_t size);
 /** JSON array of n numbers x[0], x[stride], ... */
 void cli_json_nums(FILE *fp, const double *x, size_t n, size_t stride);
 /** JSON list of the model's nodes: [{"node", "shaft", "z", "dof": [4]}, ...]. */
@@ -331,8 +394,6 @@ int cli_plot_mkdir(const char *path);
  * 0, or exit 5 with a message ending in @p kept (what became of the outputs). */
 int cli_plot_run(const char *kind, const char *json, const char *out, const char *format,
                  const char *kept);
-/** Before any work: --plot @p path is not empty and is none of the inputs. */
-int cli_plot_check(const cli_args *a, const char *path);
 typedef void (*cli_plot_json_fn)(FILE *fp, const void *ctx);
 /** --plot @p png (estimate, order): the data as JSON (@p json) in a temporary
  * file, rcb_plots.py KIND draws a temporary picture renamed onto @p png on

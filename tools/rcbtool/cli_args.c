@@ -131,6 +131,7 @@ int cli_parse(int argc, char **argv, cli_opt *opts, size_t nopts, cli_args *a) {
   if (!rc && !a->help && !a->model)
     rc = cli_usage(a->cmd, "missing the model file: expected 'rcbtool %s MODEL.ini [options]'",
                    a->cmd);
+  if (!rc && !a->help) rc = cli_plan_args(a); /* before any work: the run's files */
   return rc;
 }
 

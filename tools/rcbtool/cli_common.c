@@ -7,19 +7,6 @@
 
 #include "cli.h"
 
-/* Write @p s to stderr with control bytes (C0, DEL) shown as \xNN: a name or
- * value echoed from a file or the command line cannot move the cursor, clear
- * the screen or set the window title. */
-static void put_escaped(const char *s) {
-  for (; *s; s++) {
-    unsigned char c = (unsigned char)*s;
-    if (c < 0x20 || c == 0x7f)
-      fprintf(stderr, "\\x%02x", c);
-    else
-      fputc(c, stderr);
-  }
-}
-
 /* Format and print escaped (a message of any length). */
 static void vput_escaped(const char *fmt, va_list ap) {
   char small[1024], *buf = small;
@@ -32,7 +19,7 @@ static void vput_escaped(const char *fmt, va_list ap) {
   else if (n >= (int)sizeof small)
     buf = small; /* out of memory: the first 1023 bytes */
   va_end(aq);
-  if (n >= 0) put_escaped(buf);
+  if (n >= 0) cli_put_text(stderr, buf); /* the one rule: cli_text.c */
   if (buf != small) free(buf);
 }
 

@@ -1,5 +1,6 @@
 /* Commands that take a model and a measurement (fit, compare, diagnose):
  * both positional, and the measurement read by its extension. */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -44,6 +45,7 @@ int cli_parse_meas_cmd(int argc, char **argv, cli_opt *opts, size_t nopts, const
   if (!(*args = malloc(((size_t)argc + 1) * sizeof **args)))
     return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   cli_split_meas(argc, argv, opts, nopts, *args, &nargs, meas);
+  cli_plan_input(*meas, "measurement"); /* checked with the rest by cli_parse */
   if ((rc = cli_parse(nargs, *args, opts, nopts, a))) return rc;
   if (a->help) return (rc = cli_print_help(help)) ? rc : -1;
   if (!*meas) return cli_usage(a->cmd, "missing the measurement file: expected %s", expected);
@@ -59,23 +61,18 @@ int cli_guard_outputs(const cli_args *a, const char *meas) {
   const char *plot = cli_opt_value(a, "--plot"), *hist = cli_opt_value(a, "--history");
   size_t i;
   int rc = 0;
-  /* before any work: the inputs are known, every output is checked against them */
-  cli_input_add(a->model, "model");
-  cli_input_add(meas, "measurement");
-  if (a->output && (rc = cli_output_check(a->output))) return rc;
-  if (hist && a->output && strcmp(hist, a->output) == 0)
-    return cli_usage(a->cmd, "--history and -o name the same file '%s'; give the history its "
-                     "own file", hist);
-  if (hist && (rc = cli_history_check(hist))) return rc;
-  for (i = 0; plot && i < sizeof plot_files / sizeof plot_files[0] && !rc; i++) {
+  /* before any work: the files --plot PREFIX writes join the run's plan */
+  cli_plan_input(meas, "measurement");
+  for (i = 0; plot && i < sizeof plot_files / sizeof plot_files[0]; i++) {
     char *name = malloc(strlen(plot) + strlen(plot_files[i]) + 1);
     if (!name) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
     strcpy(name, plot);
     strcat(name, plot_files[i]);
-    rc = cli_output_check(name);
+    cli_plan_output(name, "--plot", CLI_IO_MKDIR);
     free(name);
   }
-  return rc;
+  if ((rc = cli_plan_check())) return rc;
+  return hist ? cli_history_check(hist) : 0;
 }
 
 /* A measurement on standard input goes to a temporary file (on the signal
@@ -86,31 +83,38 @@ static int stdin_to_file(char *path, size_t size, int *slot, int *is_uff) {
   size_t len = 0;
   char *text;
   FILE *fp;
-  int fd, ok;
+  int fd, ok, e;
   *slot = -1;
   if (!(text = cli_read_stdin(&len))) return CLI_EXIT_INPUT;
   for (p = text; p < text + len && (*p == ' ' || *p == '\t' || *p == '\r' || *p == '\n'); p++) {
   }
   *is_uff = p + 1 < text + len && p[0] == '-' && p[1] == '1';
   snprintf(path, size, "%s/rcbtool-stdin-XXXXXX", dir && *dir ? dir : "/tmp");
-  fp = (fd = mkstemp(path)) >= 0 ? fdopen(fd, "wb") : NULL;
+  fp = (fd = cli_mkstemp(path, slot)) >= 0 ? fdopen(fd, "wb") : NULL;
   if (!fp) {
     if (fd >= 0) {
       close(fd);
       remove(path);
+      cli_tmp_release(*slot);
     }
     free(text);
     return cli_fail(CLI_EXIT_IO, "cannot copy the measurement from standard input to a "
                     "temporary file in %s (set TMPDIR)", dir && *dir ? dir : "/tmp");
   }
-  *slot = cli_tmp_register(path);
+  errno = 0;
   ok = fwrite(text, 1, len, fp) == len;
-  ok = (fclose(fp) == 0) && ok;
+  e = errno;
+  if (fclose(fp) != 0 && ok) {
+    ok = 0;
+    e = errno;
+  }
   free(text);
   if (!ok) {
     remove(path);
     cli_tmp_release(*slot);
-    return cli_fail(CLI_EXIT_IO, "cannot write a temporary copy of standard input");
+    return cli_fail(cli_errno_exit(e ? e : EIO), "cannot write a temporary copy of standard "
+                    "input in %s: %s (set TMPDIR)", dir && *dir ? dir : "/tmp",
+                    strerror(e ? e : EIO));
   }
   return 0;
 }
@@ -131,7 +135,7 @@ int cli_meas_read(const cli_args *a, const char *path, const rcb_model *m,
   } else if ((rc = cli_meas_format(a->cmd, path, &is_uff))) {
     return rc;
   }
-  cli_input_add(path, "measurement");
+  cli_plan_input(path, "measurement");
   rc = meas_read(a, path, m, is_uff, out);
   if (from_stdin) {
     if (rc) fputs("rcbtool: (the measurement came from standard input)\n", stderr);

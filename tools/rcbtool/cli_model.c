@@ -22,11 +22,11 @@ int cli_load_model(const cli_args *a, rcb_model **out) {
   } else {
     /* A clear message for the commonest mistake, before the parser sees it. */
     FILE *probe = fopen(a->model, "r");
-    if (!probe)
-      return cli_fail(CLI_EXIT_INPUT, "cannot open model file '%s': %s", a->model,
-                      strerror(errno));
+    if (!probe) /* out of memory (fopen's buffer) is exit 4, as everywhere */
+      return cli_fail(errno == ENOMEM ? CLI_EXIT_NUMERIC : CLI_EXIT_INPUT,
+                      "cannot open model file '%s': %s", a->model, strerror(errno));
     fclose(probe);
-    cli_input_add(a->model, "model");
+    cli_plan_input(a->model, "model");
   }
   st = rcb_model_create(&m, NULL);
   if (st) {

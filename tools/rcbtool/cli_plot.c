@@ -104,12 +104,6 @@ int cli_plot_run(const char *kind, const char *json, const char *out, const char
 }
 
 
-int cli_plot_check(const cli_args *a, const char *path) {
-  if (!*path) return cli_usage(a->cmd, "option --plot expects a file name, e.g. out/plot.png");
-  cli_input_add(a->model, "input");
-  return cli_output_check(path);
-}
-
 int cli_plot_write(const char *kind, const char *png, cli_plot_json_fn json, const void *ctx,
                    const char *kept) {
   cli_tmpfile jt, pt;
@@ -123,9 +117,12 @@ int cli_plot_write(const char *kind, const char *png, cli_plot_json_fn json, con
     return rc;
   }
   json(fp, ctx);
-  if (fclose(fp) != 0) {
+  errno = 0;
+  if (ferror(fp) || fclose(fp) != 0) {
+    int e = errno ? errno : EIO;
     cli_tmpfile_close(&jt, 0);
-    return cli_fail(CLI_EXIT_IO, "--plot %s: cannot write its data file", png);
+    return cli_fail(cli_errno_exit(e), "--plot %s: cannot write its data file: %s", png,
+                    strerror(e));
   }
   if ((rc = cli_tmpfile_open(&pt, png))) {
     cli_tmpfile_close(&jt, 0);

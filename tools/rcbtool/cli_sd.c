@@ -93,7 +93,7 @@ int cli_sd_read(const char *path, const rcb_meas *ms, double **sd_out) {
   double unit = frf ? CLI_HZ_TO_RAD_S : CLI_RPM_TO_RAD_S, *v;
   const double *x = rcb_meas_grid(ms);
   *sd_out = NULL;
-  cli_input_add(path, "standard deviations"); /* never an output of the run */
+  cli_plan_input(path, "--sd"); /* never an output of the run */
   if ((rc = read_table(path, &t))) {
     table_free(&t);
     return rc;
@@ -133,11 +133,15 @@ int cli_sd_read(const char *path, const rcb_meas *ms, double **sd_out) {
     }
     for (i = 0; i < n; i++) {
       double sd = t.v[i * t.ncol + (size_t)col];
-      if (sd < 0) {
+      /* as rcb_compare_set_sd, for every verb (fit and diagnose took inf silently), and a
+       * value whose weight 1/sd^2 overflows is blamed on this file, not the noise model */
+      if (sd < 0 || isinf(sd) || (sd > 0 && !(1.0 / (sd * sd) < HUGE_VAL))) {
         table_free(&t);
         free(v);
         return cli_fail(CLI_EXIT_INPUT, "--sd %s: column '%s', row %zu: standard deviation "
-                        "%g < 0", path, name, i + 1, sd);
+                        "%g %s (0 or NaN leaves the point out)", path, name, i + 1, sd,
+                        sd < 0 ? "< 0" : isinf(sd) ? "is not finite"
+                        : "is too small: its weight 1/sd^2 overflows (expected above 1e-154)");
       }
       v[c * n + i] = sd;
     }

@@ -155,19 +155,26 @@ static void write_csv(FILE *fp, const camp_job *j) {
   }
 }
 
+/* -o OUT.csv also writes OUT_critical.csv (NULL when out of memory). */
+static char *critical_name(const char *output) {
+  size_t n = output ? strlen(output) : 0;
+  size_t stem = n >= 4 && strcmp(output + n - 4, ".csv") == 0 ? n - 4 : n;
+  char *name = output ? malloc(stem + sizeof "_critical.csv") : NULL;
+  if (!name) return NULL;
+  memcpy(name, output, stem);
+  strcpy(name + stem, "_critical.csv");
+  return name;
+}
+
 /* -o FILE.csv: the critical speeds also go to FILE_critical.csv; both files
- * are renamed into place together, or neither. */
+ * are renamed into place together (by the run's plan), or neither. */
 static int write_csv_files(const cli_args *a, const camp_job *j, cli_out *o) {
-  size_t n = strlen(a->output);
-  size_t stem = n >= 4 && strcmp(a->output + n - 4, ".csv") == 0 ? n - 4 : n;
-  char *name = malloc(stem + sizeof "_critical.csv");
+  char *name = critical_name(a->output);
   cli_args ca = *a;
   cli_out c;
   int rc;
   write_csv(o->fp, j);
   if (!name) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
-  memcpy(name, a->output, stem);
-  strcpy(name + stem, "_critical.csv");
   ca.output = name;
   if (!(rc = cli_out_flush(o)) && !(rc = cli_out_open(&c, &ca))) {
     write_crit_csv(c.fp, j);
@@ -265,6 +272,13 @@ int cmd_campbell(int argc, char **argv) {
   if (rc) return rc;
   if (a.help) return cli_print_help(cli_help_campbell);
   if ((rc = parse_job(&a, &j, &lo, &hi))) return rc;
+  if (a.output && !a.json && strcmp(a.output, "-") != 0) { /* the plan's side output */
+    char *crit = critical_name(a.output);
+    if (!crit) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+    cli_plan_output(crit, "-o (critical speeds)", 0);
+    free(crit);
+    if ((rc = cli_plan_check())) return rc;
+  }
   if ((rc = cli_load_model(&a, &m))) return rc;
   rc = run(&a, m, &j, lo, hi);
   free_job(&j);

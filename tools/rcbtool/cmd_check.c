@@ -45,7 +45,9 @@ static double node_z(const rcb_model *m, size_t node) {
 
 static void write_csv(FILE *fp, const rcb_model *m, const char *path) {
   size_t i, nn = rcb_model_node_count(m), ns = rcb_model_station_count(m);
-  fprintf(fp, "# %s: %zu nodes, %zu elements, %zu DOFs, %zu stations\n", path, nn,
+  fputs("# ", fp);
+  cli_put_text(fp, path); /* a file name reaches the terminal escaped (cli_text.c) */
+  fprintf(fp, ": %zu nodes, %zu elements, %zu DOFs, %zu stations\n", nn,
           rcb_model_element_count(m), rcb_model_dof_count(m), ns);
   fputs("node,shaft,z_m,dof_x,dof_y,dof_rx,dof_ry\n", fp);
   for (i = 0; i < nn; i++) {

@@ -266,7 +266,11 @@ static void print_peaks(FILE *fp, const rcb_compare *c, const cmp_job *j) {
 
 static void print_text(FILE *fp, const cli_args *a, const cmp_job *j, const rcb_meas *ms,
                        const rcb_compare *c, const size_t *ord) {
-  fprintf(fp, "# rcbtool compare: %s vs %s\n", a->model, j->meas_path);
+  fputs("# rcbtool compare: ", fp); /* file names escaped (cli_text.c) */
+  cli_put_text(fp, a->model);
+  fputs(" vs ", fp);
+  cli_put_text(fp, j->meas_path);
+  fputc('\n', fp);
   if (rcb_meas_get_type(ms) == RCB_MEAS_UNBALANCE)
     fprintf(fp, "# unbalance responses, ");
   else if (rcb_meas_speed(ms) < 0)
@@ -472,33 +476,48 @@ static char *prefixed(const char *prefix, const char *suffix) {
   return strcat(s, suffix);
 }
 
-/* The JSON is committed only when the plotter succeeded; pictures it left
- * behind on a failure are removed unless they were there before. */
+/* The plotter draws under a temporary prefix beside PREFIX (PREFIX.XXXXXX_*.png,
+ * on the signal handler's list); the JSON and the pictures are handed to the
+ * plan, renamed onto PREFIX_* only when the whole run succeeded. */
 static int write_plots(const cli_args *a, const cmp_job *j, const rcb_meas *ms,
                        const rcb_compare *c, const size_t *ord) {
   static const char *const pics[2] = {"_overlay.png", "_residual_map.png"};
   cli_args pa = *a;
   cli_out o;
-  char *json = prefixed(j->plot, "_compare.json"), *pic[2] = {NULL, NULL};
-  int rc = json ? 0 : CLI_EXIT_NUMERIC, existed[2] = {1, 1}, k;
+  char *json = prefixed(j->plot, "_compare.json"), *tp = prefixed(j->plot, ".XXXXXX");
+  char *tpic[2] = {NULL, NULL}, *pic[2] = {NULL, NULL};
+  int rc = json && tp ? 0 : CLI_EXIT_NUMERIC, fd = -1, k, slot[3] = {-1, -1, -1};
+  if (!rc && (fd = cli_mkstemp(tp, &slot[2])) < 0)
+    rc = cli_fail(cli_errno_exit(errno), "--plot %s: cannot write beside it: %s", j->plot,
+                  strerror(errno));
+  if (fd >= 0) close(fd);
   for (k = 0; k < 2 && !rc; k++) {
-    if (!(pic[k] = prefixed(j->plot, pics[k]))) rc = CLI_EXIT_NUMERIC;
-    if (pic[k]) existed[k] = access(pic[k], F_OK) == 0;
+    if (!(pic[k] = prefixed(j->plot, pics[k])) || !(tpic[k] = prefixed(tp, pics[k])))
+      rc = CLI_EXIT_NUMERIC;
+    else
+      slot[k] = cli_tmp_register(tpic[k]);
   }
   pa.output = json;
   if (!rc && !(rc = cli_out_open(&o, &pa))) {
     print_json(o.fp, a, j, ms, c, ord);
     if (!(rc = cli_out_flush(&o)) &&
-        !(rc = cli_plot_run("compare", o.tmp ? o.tmp : json, j->plot, NULL, NOTHING_KEPT)))
+        !(rc = cli_plot_run("compare", o.tmp ? o.tmp : json, tp, NULL, NOTHING_KEPT)))
       rc = cli_out_close(&o);
     else
       cli_out_abort(&o);
   }
-  for (k = 0; k < 2 && rc; k++)
-    if (pic[k] && !existed[k]) remove(pic[k]);
+  for (k = 0; k < 2 && !rc; k++) /* a picture the plotter did not draw is not an output */
+    if (access(tpic[k], F_OK) == 0) rc = cli_plan_adopt(tpic[k], pic[k]);
+  for (k = 0; k < 3; k++) cli_tmp_release(slot[k]);
+  for (k = 0; k < 2; k++) /* adopted ones are on the plan's list again */
+    if (rc && tpic[k]) remove(tpic[k]);
+  if (fd >= 0) remove(tp);
   free(json);
-  free(pic[0]);
-  free(pic[1]);
+  free(tp);
+  for (k = 0; k < 2; k++) {
+    free(pic[k]);
+    free(tpic[k]);
+  }
   return rc;
 }
 
@@ -588,7 +607,9 @@ int cmd_compare(int argc, char **argv) {
   cli_args a;
   char **args = NULL;
   int rc;
+  static const cli_file_opt files[] = {{"--sd", CLI_IO_IN}}; /* --plot PREFIX: cli_guard_outputs */
   memset(&j, 0, sizeof j);
+  cli_plan_options(files, sizeof files / sizeof files[0]);
   if (!(rc = cli_parse_meas_cmd(argc, argv, opts, nopts, cli_help_compare,
                                 "'rcbtool compare MODEL.ini MEAS.uff|MEAS.csv'",
                                 &a, &j.meas_path, &args)) &&

@@ -215,18 +215,22 @@ int cli_meas_write(const char *cmd, const rcb_meas *ms, const char *path, int bi
   int is_uff = 0, rc;
   rcb_status st;
   cli_tmpfile tf;
-  if ((rc = cli_meas_format(cmd, path, &is_uff)) || (rc = cli_output_check(path))) return rc;
+  if ((rc = cli_meas_format(cmd, path, &is_uff))) return rc;
   if (is_uff && (rc = cli_uff_automap(cmd, ms, mp))) return rc;
   /* written to a temporary file of ours (removed on a signal), renamed at the end */
   if ((rc = cli_tmpfile_open(&tf, path))) return rc;
   st = is_uff ? rcb_meas_write_uff(ms, tf.write_path, binary, mp->n, mp->nodes)
               : rcb_meas_write_csv(ms, tf.write_path);
-  if ((rc = cli_tmpfile_close(&tf, st == RCB_OK))) return rc;
-  if (st)
-    return cli_fail(st == RCB_ERR_IO ? CLI_EXIT_IO : st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC
-                                                                         : CLI_EXIT_INPUT,
-                    "%s", cli_msg(rcb_meas_errmsg(ms), st));
-  return 0;
+  if (st) {
+    /* the library names the file it wrote, our temporary: the user's is the output */
+    char msg[1024];
+    int e = errno; /* a write the library could not start for want of memory: exit 4 */
+    cli_path_subst(cli_msg(rcb_meas_errmsg(ms), st), tf.write_path, path, msg, sizeof msg);
+    cli_tmpfile_close(&tf, 0);
+    return cli_fail(st == RCB_ERR_IO ? cli_errno_exit(e)
+                    : st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC : CLI_EXIT_INPUT, "%s", msg);
+  }
+  return cli_tmpfile_close(&tf, 1);
 }
 
 /* ---- convert ---- */
@@ -264,7 +268,6 @@ static int read_input(const cli_args *a, rcb_meas *ms, const cli_uff_map *mp) {
   int is_uff = 0, rc;
   rcb_status st;
   if ((rc = cli_meas_format(a->cmd, a->model, &is_uff))) return rc;
-  cli_input_add(a->model, "input");
   st = is_uff ? rcb_meas_read_uff(ms, a->model, mp->n, mp->nodes)
               : rcb_meas_read_csv(ms, a->model);
   if (st)
@@ -320,6 +323,7 @@ int cmd_convert(int argc, char **argv) {
     free(args);
     return cli_usage(argv[0], "missing the input file: expected 'rcbtool convert IN OUT'");
   }
+  cli_plan_output(out, "OUT", 0); /* the second positional; checked by cli_parse */
   rc = cli_parse(nargs, args, opts, sizeof opts / sizeof opts[0], &a);
   if (!rc && out && a.output)
     rc = cli_usage(a.cmd, "give the output once: as OUT or as -o FILE, not both");

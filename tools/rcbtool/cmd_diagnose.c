@@ -468,7 +468,9 @@ int cmd_diagnose(int argc, char **argv) {
   cli_args a;
   char **args = NULL;
   int rc;
+  static const cli_file_opt files[] = {{"--sd", CLI_IO_IN}, {"--history", CLI_IO_INOUT}};
   memset(&j, 0, sizeof j);
+  cli_plan_options(files, sizeof files / sizeof files[0]);
   if (!(rc = cli_parse_meas_cmd(argc, argv, opts, nopts, cli_help_diagnose,
                                 "'rcbtool diagnose MODEL.ini MEAS.uff|MEAS.csv'",
                                 &a, &j.meas_path, &args)) &&

@@ -303,7 +303,8 @@ static int write_meas(est_job *j, const est_out *r) {
       st = rcb_meas_add_channel(ms, j->model[j->p + o], j->model[i], (rcb_frf_kind)j->kind,
                                 r->h + (o * j->p + i) * nb + 1);
   if (st) {
-    rc = cli_fail(CLI_EXIT_INPUT, "estimate: %s", cli_msg(rcb_meas_errmsg(ms), st));
+    rc = cli_fail(st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC : CLI_EXIT_INPUT, "estimate: %s",
+                  cli_msg(rcb_meas_errmsg(ms), st));
     rcb_meas_destroy(ms);
     return rc;
   }
@@ -443,6 +444,7 @@ static int estimate(const cli_args *a) {
   est_job j;
   est_out r;
   size_t k1 = 0, every = 1;
+  int is_uff = 0;
   const char *stats = cli_opt_value(a, "--stats"), *spectra = cli_opt_value(a, "--spectra");
   const char *plot = cli_opt_value(a, "--plot");
   int rc;
@@ -452,7 +454,7 @@ static int estimate(const cli_args *a) {
   j.kind = -1;
   if (!a->output)
     return cli_usage(a->cmd, "missing -o OUT (.uff, .unv or .csv) for the estimated FRFs");
-  if ((rc = options(&j)) || (plot && (rc = cli_plot_check(a, plot)))) return rc;
+  if ((rc = options(&j)) || (rc = cli_meas_format(a->cmd, a->output, &is_uff))) return rc;
   if (rcb_signals_create(&j.sig, NULL)) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   rc = cli_signals_read(a, j.sig);
   if (!rc) rc = channels(&j);
@@ -498,8 +500,12 @@ int cmd_estimate(int argc, char **argv) {
                     {"--wav-names", "LIST", NULL}, {"--wav-units", "LIST", NULL},
                     {"--wav-scale", "LIST", NULL}, {"--plot", "FILE.png", NULL},
                     {"--units", "CH=UNIT,...", NULL}, {"--allow-truncated", NULL, NULL}};
+  static const cli_file_opt files[] = {
+      {"--stats", CLI_IO_OUT}, {"--spectra", CLI_IO_OUT}, {"--plot", CLI_IO_OUT | CLI_IO_MKDIR}};
   cli_args a;
-  int rc = cli_parse(argc, argv, opts, sizeof opts / sizeof opts[0], &a);
+  int rc;
+  cli_plan_options(files, sizeof files / sizeof files[0]);
+  rc = cli_parse(argc, argv, opts, sizeof opts / sizeof opts[0], &a);
   if (rc || a.help) return rc ? rc : cli_print_help(cli_help_estimate);
   if (a.json) return cli_usage(a.cmd, "--json does not apply: the format follows OUT's extension");
   return estimate(&a);

@@ -264,24 +264,6 @@ static int parse_job(const cli_args *a, fit_job *j) {
   return cli_params_parse(a, "--params", &j->params);
 }
 
-/* Do two paths name the same existing file? */
-static int same_file(const char *p, const char *q) {
-  struct stat sp, sq;
-  if (!p || !q || stat(p, &sp) != 0 || stat(q, &sq) != 0) return 0;
-  return sp.st_dev == sq.st_dev && sp.st_ino == sq.st_ino;
-}
-
-/* Refuse -o onto an input before spending time on the fit. */
-static int check_output(const cli_args *a, const fit_job *j) {
-  if (same_file(a->output, a->model))
-    return cli_fail(CLI_EXIT_IO, "refusing to write the output over the model file '%s'",
-                    a->model);
-  if (same_file(a->output, j->meas_path))
-    return cli_fail(CLI_EXIT_IO, "refusing to write the output over the measurement file '%s'",
-                    j->meas_path);
-  return 0;
-}
-
 static int read_meas(const cli_args *a, fit_job *j, const rcb_model *m, rcb_meas **out) {
   int rc = strcmp(j->meas_path, "-") == 0 ? 0 : cli_meas_format(a->cmd, j->meas_path, &j->is_uff);
   return rc ? rc : cli_meas_read(a, j->meas_path, m, out);
@@ -647,8 +629,10 @@ static int report(const cli_args *a, const fit_job *j, rcb_fit *f, const rcb_mod
       write_json(stdout, &r, j, a);
     else
       write_text(stdout, &r, j);
+    errno = 0;
     if (fflush(stdout) != 0 || ferror(stdout))
-      rc = cli_fail(CLI_EXIT_IO, "cannot write to standard output");
+      rc = cli_fail(CLI_EXIT_IO, "cannot write to standard output: %s",
+                    strerror(errno ? errno : EIO));
   }
   if (!rc && cli_opt_value(a, "--history")) {
     char note[160];
@@ -691,7 +675,7 @@ static int run(const cli_args *a, fit_job *j) {
   rcb_meas *ms = NULL;
   rcb_fit *f = NULL;
   int rc;
-  if ((rc = check_output(a, j)) || (rc = cli_load_model(a, &m))) return rc;
+  if ((rc = cli_load_model(a, &m))) return rc;
   if (!(rc = read_meas(a, j, m, &ms)) && !(rc = make_fit(a, j, m, ms, &f)) &&
       !(rc = sd_weights(a, j, f, ms)) && !(rc = run_fit(a, f)))
     rc = report(a, j, f, m);
@@ -720,7 +704,9 @@ int cmd_fit(int argc, char **argv) {
   cli_args a;
   char **args = NULL;
   int rc;
+  static const cli_file_opt files[] = {{"--sd", CLI_IO_IN}, {"--history", CLI_IO_INOUT}};
   memset(&j, 0, sizeof j);
+  cli_plan_options(files, sizeof files / sizeof files[0]);
   if (!(rc = cli_parse_meas_cmd(argc, argv, opts, nopts, cli_help_fit,
                                 "'rcbtool fit MODEL.ini MEAS.uff|MEAS.csv --params ...'",
                                 &a, &j.meas_path, &args)) &&

@@ -1,5 +1,6 @@
 /* rcbtool history: the steps of a model-improvement session (fit, diagnose,
  * apply), their errors and parameter counts, and the error falling. */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,20 +18,6 @@ const char cli_help_history[] =
     "FILE holds one JSON object per line; --json prints them as one JSON array.\n"
     "A file with a line that is not such a record is refused (exit 3), naming the\n"
     "line.\n";
-
-/* Escape a string for JSON (quotes, backslashes, control characters). */
-static void json_str(FILE *fp, const char *s) {
-  fputc('"', fp);
-  for (; s && *s; s++) {
-    if (*s == '"' || *s == '\\')
-      fprintf(fp, "\\%c", *s);
-    else if ((unsigned char)*s < 0x20)
-      fprintf(fp, "\\u%04x", (unsigned)(unsigned char)*s);
-    else
-      fputc(*s, fp);
-  }
-  fputc('"', fp);
-}
 
 static char *slurp(const char *path, size_t *len) {
   FILE *fp = fopen(path, "rb");
@@ -55,8 +42,21 @@ static char *slurp(const char *path, size_t *len) {
 
 /* A line (@p n bytes, no newline) is a history record: one JSON object with the
  * fields cli_history_append writes. */
+static int field(const char *line, const char *key, char *out, size_t size);
+
+/* A number field as --history writes it: absent, null, or a finite number
+ * (a nan or 1e999 typed into the file is no record: cli_json_num writes null). */
+static int number_ok(const char *line, const char *key) {
+  char v[64], *end;
+  double x;
+  if (!field(line, key, v, sizeof v) || strcmp(v, "null") == 0) return 1;
+  x = strtod(v, &end);
+  return end != v && *end == '\0' && isfinite(x);
+}
+
 static int is_record(const char *line, size_t n) {
   static const char *const keys[] = {"\"command\": ", "\"model\": ", "\"error_pct\": "};
+  static const char *const nums[] = {"error_pct", "floor_pct", "params"};
   char buf[4096];
   size_t i;
   if (n < 2 || n >= sizeof buf || line[0] != '{' || line[n - 1] != '}') return 0;
@@ -64,6 +64,8 @@ static int is_record(const char *line, size_t n) {
   buf[n] = '\0';
   for (i = 0; i < sizeof keys / sizeof keys[0]; i++)
     if (!strstr(buf, keys[i])) return 0;
+  for (i = 0; i < sizeof nums / sizeof nums[0]; i++)
+    if (!number_ok(buf, nums[i])) return 0;
   return strlen(buf) == n; /* no NUL byte inside */
 }
 
@@ -86,7 +88,7 @@ int cli_history_check(const char *path) {
   size_t len = 0, bad;
   struct stat st;
   char *text;
-  if (cli_output_check(path)) return CLI_EXIT_IO;
+  if (cli_plan_check()) return CLI_EXIT_IO;
   if (stat(path, &st) != 0) return 0; /* a new history */
   if (!S_ISREG(st.st_mode))
     return cli_fail(CLI_EXIT_IO, "--history '%s': not a regular file; expected a history "
@@ -105,48 +107,47 @@ int cli_history_check(const char *path) {
 int cli_history_append(const char *path, const char *command, const char *model,
                        double error_pct, double floor_pct, size_t nparams, const char *note) {
   size_t len = 0;
-  char *old, *tmp;
+  char *old;
+  cli_tmpfile t;
   FILE *fp;
-  int ok, rc, slot = -1;
+  int ok, rc, e;
   if ((rc = cli_history_check(path))) return rc;
   old = slurp(path, &len);
-  if (!(tmp = malloc(strlen(path) + 16))) {
+  /* the whole history, old steps and the new one, in a temporary of the plan:
+   * renamed onto the history when the run succeeded */
+  if ((rc = cli_tmpfile_open(&t, path))) {
     free(old);
-    return cli_fail(CLI_EXIT_IO, "out of memory");
+    return rc;
   }
-  sprintf(tmp, "%s.tmpXXXXXX", path);
-  {
-    int fd = mkstemp(tmp);
-    if (fd >= 0) slot = cli_tmp_register(tmp);
-    fp = fd >= 0 ? fdopen(fd, "w") : NULL;
-  }
-  if (!fp) {
-    if (slot >= 0) remove(tmp);
-    cli_tmp_release(slot);
+  if (!(fp = fopen(t.write_path, "w"))) {
+    e = errno;
+    cli_tmpfile_close(&t, 0);
     free(old);
-    free(tmp);
-    return cli_fail(CLI_EXIT_IO, "history '%s': cannot write next to it", path);
+    return cli_fail(CLI_EXIT_IO, "--history '%s': cannot write it: %s", path, strerror(e));
   }
+  errno = 0; /* the first failing write sets it: its reason is the message's */
   if (old) fwrite(old, 1, len, fp);
   fputs("{\"command\": ", fp);
-  json_str(fp, command);
+  cli_json_str(fp, command);
   fputs(", \"model\": ", fp);
-  json_str(fp, model);
+  cli_json_str(fp, model);
   fputs(", \"error_pct\": ", fp);
   cli_json_num(fp, error_pct);
   fputs(", \"floor_pct\": ", fp);
   cli_json_num(fp, floor_pct);
   fprintf(fp, ", \"params\": %zu, \"note\": ", nparams);
-  json_str(fp, note);
+  cli_json_str(fp, note);
   fputs("}\n", fp);
-  ok = !ferror(fp);
-  ok = (fclose(fp) == 0) && ok;
-  if (ok) ok = rename(tmp, path) == 0;
-  if (!ok) remove(tmp);
-  cli_tmp_release(slot);
+  ok = !ferror(fp) && fflush(fp) == 0;
+  e = errno ? errno : EIO;
+  if (fclose(fp) != 0 && ok) {
+    ok = 0;
+    e = errno ? errno : EIO;
+  }
   free(old);
-  free(tmp);
-  return ok ? 0 : cli_fail(CLI_EXIT_IO, "history '%s': write failed", path);
+  rc = cli_tmpfile_close(&t, ok);
+  if (!ok) return cli_fail(CLI_EXIT_IO, "--history '%s': cannot write it: %s", path, strerror(e));
+  return rc;
 }
 
 /* The value of "key": in a JSON line (a string or a number), copied to out. */
@@ -158,9 +159,31 @@ static int field(const char *line, const char *key, char *out, size_t size) {
   if (!(p = strstr(line, pat))) return 0;
   p += strlen(pat);
   if (*p == '"') {
-    for (p++; *p && *p != '"' && n + 1 < size; p++) {
-      if (*p == '\\' && p[1]) p++;
-      out[n++] = *p;
+    for (p++; *p && *p != '"' && n + 5 < size; p++) {
+      if (*p != '\\' || !p[1]) {
+        out[n++] = *p;
+        continue;
+      }
+      p++; /* a JSON escape: \uXXXX back to UTF-8 (cli_json_str writes them) */
+      if (*p == 'u' && strspn(p + 1, "0123456789abcdefABCDEF") >= 4) {
+        char hex[5] = {p[1], p[2], p[3], p[4], 0};
+        unsigned long cp = strtoul(hex, NULL, 16);
+        p += 4;
+        if (cp == 0) cp = 0xfffd; /* a NUL would end the text: U+FFFD, shown as such */
+        if (cp < 0x80) {
+          out[n++] = (char)cp;
+        } else if (cp < 0x800) {
+          out[n++] = (char)(0xc0 | (cp >> 6));
+          out[n++] = (char)(0x80 | (cp & 0x3f));
+        } else {
+          out[n++] = (char)(0xe0 | (cp >> 12));
+          out[n++] = (char)(0x80 | ((cp >> 6) & 0x3f));
+          out[n++] = (char)(0x80 | (cp & 0x3f));
+        }
+      } else {
+        out[n++] = *p == 'n' ? '\n' : *p == 't' ? '\t' : *p == 'r' ? '\r' : *p == 'b' ? '\b'
+                 : *p == 'f' ? '\f' : *p;
+      }
     }
   } else {
     while (*p && *p != ',' && *p != '}' && n + 1 < size) out[n++] = *p++;
@@ -200,7 +223,7 @@ static void print_steps(char *text) {
     }
     for (line = strtok_r(copy, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
       char cmd[32] = "", model[256] = "", err[64] = "", flo[64] = "", np[16] = "",
-           note[512] = "", shown[300];
+           note[512] = "", shown[300], tcmd[128], tmodel[1024], tnote[2048], tnp[64];
       double e;
       field(line, "command", cmd, sizeof cmd);
       field(line, "model", model, sizeof model);
@@ -214,12 +237,17 @@ static void print_steps(char *text) {
         if (e > emax) emax = e;
         continue;
       }
+      /* the one escaping rule (cli_text.c): a file's bytes never reach the terminal raw */
+      cli_text(cmd, tcmd, sizeof tcmd);
+      cli_text(short_name(model, shown, sizeof shown), tmodel, sizeof tmodel);
+      cli_text(note, tnote, sizeof tnote);
+      cli_text(np, tnp, sizeof tnp);
       if (strcmp(flo, "null") != 0 && flo[0])
-        printf("%-4d %-10s %-28s %10.4g %10.4g %6s  %s\n", step, cmd, short_name(model, shown, sizeof shown), e,
-               num_field(flo), np, note);
+        printf("%-4d %-10s %-28s %10.4g %10.4g %6s  %s\n", step, tcmd, tmodel, e,
+               num_field(flo), tnp, tnote);
       else
-        printf("%-4d %-10s %-28s %10.4g %10s %6s  %s\n", step, cmd, short_name(model, shown, sizeof shown), e, "-",
-               np, note);
+        printf("%-4d %-10s %-28s %10.4g %10s %6s  %s\n", step, tcmd, tmodel, e, "-", tnp,
+               tnote);
     }
     free(copy);
   }
@@ -244,6 +272,32 @@ static void print_steps(char *text) {
   }
 }
 
+/* One record written again field by field (strings through cli_json_str,
+ * numbers through cli_json_num): valid JSON whatever the line held. */
+static void print_json_record(const char *line, int first) {
+  static const char *const strs[] = {"command", "model", "note"};
+  static const char *const nums[] = {"error_pct", "floor_pct", "params"};
+  char buf[4096];
+  size_t i;
+  printf("%s\n{", first ? "" : ",");
+  for (i = 0; i < 3; i++) {
+    printf("%s\"%s\": ", i ? ", " : "", strs[i]);
+    buf[0] = '\0';
+    field(line, strs[i], buf, sizeof buf);
+    cli_json_str(stdout, buf);
+  }
+  for (i = 0; i < 3; i++) {
+    char *end;
+    double v;
+    buf[0] = '\0';
+    field(line, nums[i], buf, sizeof buf);
+    v = strtod(buf, &end);
+    printf(", \"%s\": ", nums[i]);
+    cli_json_num(stdout, end == buf ? (double)NAN : v);
+  }
+  putchar('}');
+}
+
 int cmd_history(int argc, char **argv) {
   cli_args a;
   size_t len, bad;
@@ -258,16 +312,16 @@ int cmd_history(int argc, char **argv) {
   if ((bad = first_bad_line(text, len)) != 0) {
     free(text);
     return cli_fail(CLI_EXIT_INPUT, "history '%s':%zu: not a history record (expected one JSON "
-                    "line per step with \"command\", \"model\" and \"error_pct\", as 'rcbtool "
-                    "fit --history' and 'rcbtool diagnose --history' write them); give a "
-                    "history file", a.model, bad);
+                    "line per step with \"command\", \"model\" and \"error_pct\", numbers "
+                    "finite or null, as 'rcbtool fit --history' and 'rcbtool diagnose --history' "
+                    "write them); give a history file", a.model, bad);
   }
   if (a.json) {
     char *line, *save = NULL;
     int first = 1;
     fputs("[", stdout);
     for (line = strtok_r(text, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
-      printf("%s\n%s", first ? "" : ",", line);
+      print_json_record(line, first);
       first = 0;
     }
     fputs("]\n", stdout);

@@ -277,42 +277,12 @@ static void split_series(int argc, char **argv, const cli_opt *opts, size_t nopt
   *nargs = n;
 }
 
-/* Every output (-o, --log, --plot) is checked against every input before any work. */
-static int guard_outputs(const cli_args *a, const mon_job *j) {
-  enum { NOUT = 4 };
-  const char *outs[NOUT];
-  size_t i, k;
-  struct stat so, si;
-  int rc;
-  outs[0] = a->output;
-  outs[1] = j->log;
-  outs[2] = j->plot;
-  outs[3] = j->state;
-  cli_input_add(a->model, "model");
-  for (k = 0; k < NOUT; k++) {
-    if (!outs[k] || strcmp(outs[k], "-") == 0) continue;
-    if ((rc = cli_output_check(outs[k]))) return rc;
-    if (stat(outs[k], &so) != 0) continue;
-    for (i = 0; i < j->series.n; i++)
-      if (stat(j->series.files[i], &si) == 0 && si.st_dev == so.st_dev &&
-          si.st_ino == so.st_ino)
-        return cli_fail(CLI_EXIT_IO, "refusing to write the output '%s' over the measurement "
-                        "file '%s' (an input of this run); choose another output name",
-                        outs[k], j->series.files[i]);
-  }
-  for (k = 0; k < NOUT; k++)
-    for (i = k + 1; i < NOUT; i++)
-      if (outs[k] && outs[i] && strcmp(outs[k], outs[i]) == 0 && strcmp(outs[k], "-") != 0)
-        return cli_usage(a->cmd, "-o, --log, --plot and --state name the same file '%s'",
-                         outs[k]);
-  if (j->sd_path && (j->log || j->plot || a->output || j->state)) {
-    for (k = 0; k < NOUT; k++)
-      if (outs[k] && stat(outs[k], &so) == 0 && stat(j->sd_path, &si) == 0 &&
-          so.st_dev == si.st_dev && so.st_ino == si.st_ino)
-        return cli_fail(CLI_EXIT_IO, "refusing to write the output '%s' over the --sd file",
-                        outs[k]);
-  }
-  return 0;
+/* The series files join the run's plan (-o, --log, --plot and --sd came from the
+ * option table), checked again before any work. */
+static int guard_outputs(const mon_job *j) {
+  size_t i;
+  for (i = 0; i < j->series.n; i++) cli_plan_input(j->series.files[i], "measurement");
+  return cli_plan_check();
 }
 
 /* ---- --state: the settings' options kept in the state ---- */
@@ -408,6 +378,10 @@ int cmd_monitor(int argc, char **argv) {
   size_t nopts = sizeof opts / sizeof opts[0], nseries = 0, k;
   const char **series = NULL;
   char **args = NULL, **sargv = NULL;
+  static const cli_file_opt files[] = {{"--sd", CLI_IO_IN},
+                                       {"--log", CLI_IO_OUT},
+                                       {"--plot", CLI_IO_OUT | CLI_IO_MKDIR},
+                                       {"--state", CLI_IO_OUT}};
   int nargs = 0, rc = 0;
   mon_job j;
   mon_saved saved;
@@ -431,6 +405,8 @@ int cmd_monitor(int argc, char **argv) {
   j.nsetopts = settings_of(argc, argv, j.setopts);
   j.state = state;
   split_series(argc, argv, opts, nopts, args, &nargs, series, &nseries);
+  cli_plan_options(files, sizeof files / sizeof files[0]);
+  for (k = 0; k < nseries; k++) cli_plan_input(series[k], "measurement"); /* a DIR too */
   if ((rc = cli_parse(nargs, args, opts, nopts, &a))) goto done;
   if (a.help) {
     rc = cli_print_help(cli_help_monitor);
@@ -461,7 +437,7 @@ int cmd_monitor(int argc, char **argv) {
                    j.commission == 1 ? "s" : "");
     goto done;
   }
-  if ((rc = guard_outputs(&a, &j))) goto done;
+  if ((rc = guard_outputs(&j))) goto done;
   rc = mon_run(&a, &j);
 done:
   if (j.have_params) cli_params_free(&j.params);

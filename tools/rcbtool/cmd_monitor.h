@@ -91,8 +91,6 @@ void mon_saved_free(mon_saved *sv);
 /** Write @p sv to a temporary for @p path (written and fsync'ed; the caller
  * renames it with cli_tmpfile_close); 0 or an exit code. */
 int mon_saved_write(const char *cmd, const char *path, mon_saved *sv, cli_tmpfile *t);
-/** fsync the directory holding @p path (after a rename into it; best effort). */
-void mon_sync_dir(const char *path);
 /** FNV-1a 64 of the bytes of @p path; *ok 0 when it cannot be read. */
 uint64_t mon_file_hash(const char *path, int *ok);
 

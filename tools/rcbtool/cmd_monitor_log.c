@@ -1,5 +1,6 @@
 /* rcbtool monitor: the log (JSON or CSV) and the trend plot, each written to
  * a temporary file and renamed only when all of them are complete. */
+#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -142,7 +143,9 @@ void mon_print_json(FILE *fp, const mon_state *s) {
 }
 
 /* A CSV text field, quoted (the file and place names may hold commas). */
-static void csv_str(FILE *fp, const char *t) {
+static void csv_str(FILE *fp, const char *s) {
+  char buf[4096];
+  const char *t = cli_text(s, buf, sizeof buf); /* the one rule: no raw control byte */
   fputc('"', fp);
   for (; *t; t++) {
     if (*t == '"') fputc('"', fp);
@@ -194,8 +197,11 @@ static void csv_row(FILE *fp, const mon_state *s, size_t k) {
 
 static void print_csv(FILE *fp, const mon_state *s) {
   size_t k;
-  fprintf(fp, "# rcbtool monitor %s, commissioned on %s; SI units\n", s->a->model,
-          s->j->series.files[0]);
+  fputs("# rcbtool monitor ", fp);
+  cli_put_text(fp, s->a->model);
+  fputs(", commissioned on ", fp);
+  cli_put_text(fp, s->j->series.files[0]);
+  fputs("; SI units\n", fp);
   fputs("update,file,error_pct,change_pct,floor_pct,T,threshold,dof,p_value,alarm,"
         "cusum_alarm,flags", fp);
   for (k = 0; k < s->j->params.n; k++) {
@@ -218,34 +224,34 @@ static void plain_mode(const char *path) {
 static int write_tmp(cli_tmpfile *t, const char *path, const mon_state *s,
                      void (*fn)(FILE *, const mon_state *)) {
   FILE *fp;
-  int rc = cli_tmpfile_open(t, path), bad;
+  int rc = cli_tmpfile_open(t, path), bad, e;
   if (rc) return rc;
   if (!(fp = fopen(t->write_path, "w"))) {
+    e = errno;
     cli_tmpfile_close(t, 0);
-    return cli_fail(CLI_EXIT_IO, "cannot write output file '%s'", path);
+    return cli_fail(cli_errno_exit(e), "cannot write output file '%s': %s", path, strerror(e));
   }
   plain_mode(t->write_path);
+  errno = 0; /* the first failing write sets it: its reason is the message's */
   fn(fp, s);
-  bad = ferror(fp) != 0;
-  if (fclose(fp) != 0) bad = 1;
+  bad = ferror(fp) != 0 || fflush(fp) != 0;
+  e = errno;
+  if (fclose(fp) != 0 && !bad) {
+    bad = 1;
+    e = errno;
+  }
   if (bad) {
     cli_tmpfile_close(t, 0);
-    return cli_fail(CLI_EXIT_IO, "cannot write output file '%s'", path);
+    return cli_fail(cli_errno_exit(e ? e : EIO), "cannot write output file '%s': %s", path,
+                    strerror(e ? e : EIO));
   }
   return 0;
 }
 
 #define NOTHING_KEPT "no log, plot or output file was kept (run without --plot to get the rest)"
 
-static char *with_suffix(const char *path, const char *suffix) {
-  char *p = malloc(strlen(path) + strlen(suffix) + 1);
-  if (p) strcat(strcpy(p, path), suffix);
-  return p;
-}
-
 int mon_write_outputs(const mon_state *s) {
   cli_tmpfile log, pic, pj;
-  char *json_name = NULL;
   int rc = 0, have_log = 0, have_pic = 0;
   memset(&log, 0, sizeof log);
   if (s->j->log) {
@@ -255,10 +261,10 @@ int mon_write_outputs(const mon_state *s) {
     have_log = 1;
   }
   if (s->j->plot) {
-    /* the plotter reads the JSON from a temporary beside the picture (removed) */
-    if (!(json_name = with_suffix(s->j->plot, ".json"))) rc = cli_fail(CLI_EXIT_NUMERIC, "out of memory");
-    if (!rc) rc = cli_plot_mkdir(s->j->plot);
-    if (!rc && !(rc = write_tmp(&pj, json_name, s, mon_print_json))) {
+    /* the plotter reads the JSON from a temporary beside the picture (removed; a
+     * temporary of the declared --plot, as every file goes through the run's plan) */
+    rc = cli_plot_mkdir(s->j->plot);
+    if (!rc && !(rc = write_tmp(&pj, s->j->plot, s, mon_print_json))) {
       if (!(rc = cli_tmpfile_open(&pic, s->j->plot))) {
         have_pic = 1;
         rc = cli_plot_run("monitor", pj.write_path, pic.write_path,
@@ -266,7 +272,6 @@ int mon_write_outputs(const mon_state *s) {
       }
       cli_tmpfile_close(&pj, 0);
     }
-    free(json_name);
   }
   if (have_pic) {
     int r2;

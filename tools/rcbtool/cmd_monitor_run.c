@@ -258,7 +258,8 @@ static int create_monitor(mon_ctx *x, rcb_monitor **mon) {
 
 static void print_header(FILE *fp, const mon_state *s) {
   size_t k;
-  fprintf(fp, "# commissioned on %s", s->j->series.files[0]);
+  fputs("# commissioned on ", fp);
+  cli_put_text(fp, s->j->series.files[0]); /* the one escaping rule (cli_text.c) */
   if (s->j->commission > 1) fprintf(fp, " and the next %zu files (averaged)", s->j->commission - 1);
   fprintf(fp, "; %zu channels x %zu points; %zu candidate effects; monitor memory %zu bytes\n",
           s->channels, s->points, s->candidates, s->memory);
@@ -286,11 +287,11 @@ void mon_flags(const rcb_monitor_result *r, char *buf, size_t size) {
 
 static void print_line(FILE *fp, const mon_state *s, const mon_record *rec) {
   const rcb_monitor_result *r = &rec->r;
-  char flags[32];
+  char flags[32], name[1024];
   size_t k;
   mon_flags(r, flags, sizeof flags);
   fprintf(fp, "%6zu  %-24s %8.3f %8.3f %8.3g  %-12s", r->update,
-          base_name(s->j->series.files[rec->file]), r->error_pct, r->floor_pct,
+          cli_text(base_name(s->j->series.files[rec->file]), name, sizeof name), r->error_pct, r->floor_pct,
           r->T / r->threshold, flags);
   for (k = 0; k < r->ntracked; k++)
     fprintf(fp, "  %.6g [%.6g, %.6g] %+.4g [%+.4g, %+.4g]", r->tracked[k].value,
@@ -493,8 +494,9 @@ int mon_run(const cli_args *a, const mon_job *j) {
     goto done;
   }
   if (a->json) mon_print_json(o.fp, &s);
-  /* the state written (fsync'ed) first, then the log and the plot, then the
-   * state and -o renamed into place only when all are written */
+  /* the state written (fsync'ed) first, then the log and the plot; the run's
+   * plan renames them all, -o too, only when every one is written, and fsyncs
+   * their directories (cli_plan_finish) */
   if (j->state && (rc = save_state(&x, &s, mon, &st))) {
     cli_out_abort(&o);
     goto done;
@@ -508,7 +510,6 @@ int mon_run(const cli_args *a, const mon_job *j) {
     cli_out_abort(&o);
     goto done;
   }
-  if (j->state) mon_sync_dir(j->state);
   rc = cli_out_close(&o);
 done:
   rcb_monitor_destroy(mon);

@@ -322,22 +322,6 @@ int mon_saved_write(const char *cmd, const char *path, mon_saved *sv, cli_tmpfil
   return 0; /* renamed by the caller with the other outputs */
 }
 
-void mon_sync_dir(const char *path) {
-  const char *slash = strrchr(path, '/');
-  char *dir = NULL;
-  int fd;
-  if (slash && !(dir = malloc((size_t)(slash - path) + 2))) return;
-  if (dir) {
-    memcpy(dir, path, (size_t)(slash - path) + 1);
-    dir[slash - path + 1] = '\0';
-  }
-  fd = open(dir ? dir : ".", O_RDONLY);
-  free(dir);
-  if (fd < 0) return;
-  (void)fsync(fd); /* the rename itself on the disk; best effort */
-  close(fd);
-}
-
 uint64_t mon_file_hash(const char *path, int *ok) {
   uint64_t h = 0xcbf29ce484222325ull;
   unsigned char buf[65536];

@@ -180,7 +180,9 @@ static int ord_write(const ord_job *j, const size_t *bins, size_t nb, size_t m, 
                edge_names[j->edge], j->o.kp_angle * 180.0 / CLI_PI);
       st = rcb_meas_set_phase(ms, j->lag ? RCB_PHASE_LAG : RCB_PHASE_LEAD, ref);
     }
-    if (st) rc = cli_fail(CLI_EXIT_INPUT, "order: %s", cli_msg(rcb_meas_errmsg(ms), st));
+    if (st)
+      rc = cli_fail(st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC : CLI_EXIT_INPUT, "order: %s",
+                    cli_msg(rcb_meas_errmsg(ms), st));
   } else {
     rc = cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   }
@@ -263,6 +265,7 @@ static void plot_json(FILE *fp, const void *ctx) {
 static int order_run(const cli_args *a) {
   ord_job j;
   size_t *bins = NULL, nb = 0;
+  int is_uff = 0;
   const char *o2 = cli_opt_value(a, "--order2"), *stats = cli_opt_value(a, "--stats");
   const char *plot = cli_opt_value(a, "--plot");
   int rc;
@@ -271,7 +274,8 @@ static int order_run(const cli_args *a) {
   if (!a->output) return cli_usage(a->cmd, "missing -o OUT (.uff, .unv or .csv) for the 1X data");
   if ((rc = cli_opt_require(a, "--kp", "the keyphasor channel, e.g. --kp KP")) ||
       (rc = cli_opt_require(a, "--outputs", "the response channels, e.g. --outputs DA.x")) ||
-      (plot && (rc = cli_plot_check(a, plot))))
+      (rc = cli_meas_format(a->cmd, a->output, &is_uff)) ||
+      (o2 && (rc = cli_meas_format(a->cmd, o2, &is_uff))))
     return rc;
   if (cli_opt_value(a, "--phase") && strcmp(cli_opt_value(a, "--phase"), "lag") == 0) {
     int uff1 = 0, uff2 = 0;
@@ -318,8 +322,12 @@ int cmd_order(int argc, char **argv) {
                     {"--wav-scale", "LIST", NULL}, {"--plot", "FILE.png", NULL},
                     {"--units", "CH=UNIT,...", NULL}, {"--allow-truncated", NULL, NULL},
                     {"--kp-edge", "E", NULL},     {"--phase", "P", NULL}};
+  static const cli_file_opt files[] = {
+      {"--order2", CLI_IO_OUT}, {"--stats", CLI_IO_OUT}, {"--plot", CLI_IO_OUT | CLI_IO_MKDIR}};
   cli_args a;
-  int rc = cli_parse(argc, argv, opts, sizeof opts / sizeof opts[0], &a);
+  int rc;
+  cli_plan_options(files, sizeof files / sizeof files[0]);
+  rc = cli_parse(argc, argv, opts, sizeof opts / sizeof opts[0], &a);
   if (rc || a.help) return rc ? rc : cli_print_help(cli_help_order);
   if (a.json) return cli_usage(a.cmd, "--json does not apply: the format follows OUT's extension");
   return order_run(&a);

@@ -142,8 +142,12 @@ static void print_text(FILE *fp, const cli_args *a, const plan_job *j, const rcb
   rcb_plan_result r;
   size_t i;
   rcb_plan_get_result(p, &r);
-  fprintf(fp, "# rcbtool plan: %s vs the layout of %s (%zu channel%s x %zu points, %.6g to "
-          "%.6g Hz, %.6g rpm)\n", a->model, j->meas_path, rcb_meas_channel_count(ms),
+  fputs("# rcbtool plan: ", fp); /* file names escaped (cli_text.c) */
+  cli_put_text(fp, a->model);
+  fputs(" vs the layout of ", fp);
+  cli_put_text(fp, j->meas_path);
+  fprintf(fp, " (%zu channel%s x %zu points, %.6g to %.6g Hz, %.6g rpm)\n",
+          rcb_meas_channel_count(ms),
           rcb_meas_channel_count(ms) == 1 ? "" : "s", rcb_meas_point_count(ms),
           rcb_meas_grid(ms)[0] / CLI_HZ_TO_RAD_S,
           rcb_meas_grid(ms)[rcb_meas_point_count(ms) - 1] / CLI_HZ_TO_RAD_S,

@@ -105,5 +105,6 @@ int main(int argc, char **argv) {
       n += (size_t)snprintf(list + n, sizeof list - n, "%s, ", commands[i].name);
     return cli_usage(NULL, "unknown command '%s'; expected one of %shelp", argv[1], list);
   }
-  return c->run(argc - 1, argv + 1);
+  cli_plan_begin(c->help);
+  return cli_plan_finish(c->run(argc - 1, argv + 1));
 }
