@@ -285,6 +285,35 @@ static int guard_outputs(const mon_job *j) {
   return cli_plan_check();
 }
 
+/* An existing --state is read before the command line is parsed (its
+ * settings join it): the run's plan is checked on what the line names
+ * first, so a --state onto an input is refused as every output onto an
+ * input is (exit 5), before it is read as a state. */
+static int state_plan(int argc, char **argv, const cli_opt *opts, size_t nopts,
+                      const char *state) {
+  char **args = malloc(((size_t)argc + 1) * sizeof *args);
+  const char **series = malloc(((size_t)argc + 1) * sizeof *series);
+  size_t nseries = 0, k;
+  int nargs = 0, i, model = 0;
+  if (!args || !series) {
+    free(args), free((void *)series);
+    return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  }
+  split_series(argc, argv, opts, nopts, args, &nargs, series, &nseries);
+  for (k = 0; k < nseries; k++) cli_plan_input(series[k], "measurement");
+  for (i = 1; i < nargs; i++) {
+    if (args[i][0] == '-' && args[i][1]) {
+      if (strcmp(args[i], "--sd") == 0 && i + 1 < nargs) cli_plan_input(args[i + 1], "--sd");
+      if (takes_value(args[i], opts, nopts)) i++;
+    } else if (!model++) {
+      cli_plan_input(args[i], "model");
+    }
+  }
+  cli_plan_output(state, "--state", 0);
+  free(args), free((void *)series);
+  return cli_plan_check();
+}
+
 /* ---- --state: the settings' options kept in the state ---- */
 
 static const char *const SETTING_OPTS[] = {"--params", "--noise",  "--sd",     "--commission",
@@ -390,8 +419,11 @@ int cmd_monitor(int argc, char **argv) {
   const char *state = state_arg(argc, argv);
   memset(&j, 0, sizeof j);
   memset(&saved, 0, sizeof saved);
+  cli_plan_options(files, sizeof files / sizeof files[0]);
   if (state && stat(state, &sst) == 0) {
-    if ((rc = with_saved(argc, argv, state, &saved, &sargv, &argc))) goto done;
+    if ((rc = state_plan(argc, argv, opts, nopts, state)) ||
+        (rc = with_saved(argc, argv, state, &saved, &sargv, &argc)))
+      goto done;
     argv = sargv;
     j.saved = &saved;
   }
@@ -405,7 +437,6 @@ int cmd_monitor(int argc, char **argv) {
   j.nsetopts = settings_of(argc, argv, j.setopts);
   j.state = state;
   split_series(argc, argv, opts, nopts, args, &nargs, series, &nseries);
-  cli_plan_options(files, sizeof files / sizeof files[0]);
   for (k = 0; k < nseries; k++) cli_plan_input(series[k], "measurement"); /* a DIR too */
   if ((rc = cli_parse(nargs, args, opts, nopts, &a))) goto done;
   if (a.help) {
