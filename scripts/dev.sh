@@ -5,8 +5,16 @@
 #                               SUNDIALS, no venv), build, run the paper-system demo,
 #                               print where rcbtool is
 #   ./scripts/dev.sh test       install everything, build with every backend, run every
-#                               test: ctest, Python cross-validation against ROSS, the core
-#                               configuration (no optional backend), ASan+UBSan build
+#                               test: ctest, Python cross-validation against ROSS, the wheel
+#                               in a fresh venv, the core configuration (no optional
+#                               backend), ASan+UBSan build, valgrind, fuzz replay, lint; ends
+#                               with a table of stage times (docs/testing.md)
+#   ./scripts/dev.sh quick      build + the tests not labelled slow (ctest -LE slow, pytest
+#                               -m "not slow"): a developer's suite, under 3 min on 2 cores
+#   ./scripts/dev.sh ctest      ctest in the build tree (everything)
+#   ./scripts/dev.sh pytest     tests/python against this build (extra arguments to pytest)
+#   ./scripts/dev.sh wheel      fresh venv, pip install ./tools/python (librcb.so inside),
+#                               import and an FRF against rcbtool, no LIBRCB_PATH (needs PyPI)
 #   ./scripts/dev.sh deps       all Debian packages + the pinned Python venv (.venv)
 #   ./scripts/dev.sh build      configure + build in build/ (Release; SUNDIALS and the
 #                               tests when their packages are installed)
@@ -298,25 +306,17 @@ cmd_sanitize() {
     UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 run_ctest "$dir" -LE slow
 }
 
-# The librcb Python package (tools/python) into the venv, built from a copy in
-# the build tree (setuptools writes build/ and egg-info beside its sources);
-# its tests load the shared library of this build through LIBRCB_PATH.
-install_python_package() {
-  local src=$BUILD_DIR/python-pkg
-  rm -rf "$src"
-  mkdir -p "$src"
-  cp -r tools/python/pyproject.toml tools/python/README.md tools/python/librcb "$src/"
-  "$VENV/bin/python" -m pip install --quiet --no-build-isolation --no-index --no-deps \
-    --force-reinstall "$src"
-}
-
+# The Python tests import the package from tools/python (PYTHONPATH: no
+# install, so no build of the wheel here) with this build's library through
+# LIBRCB_PATH; the installed package is the `wheel` stage's. --durations
+# prints the slowest tests (where the minutes go). Extra arguments go to pytest.
 cmd_pytest() {
   say "Python cross-validation (tests/python, against ROSS) and the librcb package"
   local rc=0
   [[ -f $BUILD_DIR/src/librcb.so ]] || die "$BUILD_DIR/src/librcb.so was not built (RCB_BUILD_SHARED=ON)"
-  install_python_package || die "pip install ./tools/python failed"
   RCBTOOL=$(rcbtool_exe) LIBRCB_PATH=$BUILD_DIR/src/librcb.so OPENBLAS_NUM_THREADS=1 \
-    "$VENV/bin/python" -m pytest tests/python -q || rc=$?
+    PYTHONPATH=$ROOT/tools/python${PYTHONPATH:+:$PYTHONPATH} \
+    "$VENV/bin/python" -m pytest tests/python -q --durations=15 --durations-min=5 "$@" || rc=$?
   if ((rc == 5)); then
     echo "dev.sh: WARNING: pytest collected no test in tests/python" >&2
   elif ((rc != 0)); then
@@ -324,37 +324,88 @@ cmd_pytest() {
   fi
 }
 
+# The wheel as a user installs it (issue #27): fresh venv, pip install
+# ./tools/python (scikit-build-core, librcb.so inside), import and one FRF
+# against the C CLI, with no build tree and no LIBRCB_PATH (tests/wheel).
+cmd_wheel() {
+  say "Python wheel: fresh venv, pip install ./tools/python, FRF vs rcbtool"
+  local ref
+  ref=$(rcbtool_exe)
+  [[ -x $ref && -f $ref ]] || ref=
+  PYTHON3=python3 JOBS=$JOBS tests/wheel/test_wheel.sh $ref
+}
+
 cmd_ctest() {
   say "C tests (ctest, $BUILD_DIR)"
   run_ctest "$BUILD_DIR"
 }
 
-# Run every stage even when one fails, so one run shows every failure; each
-# stage runs in a subshell with errexit on.
+# Stage times (issue #27): run_stage NAME CMD... runs CMD in a subshell with
+# errexit on, records its seconds and result; stage_table prints them.
+STAGE_NAMES=()
+STAGE_SECS=()
+STAGE_RESULTS=()
+run_stage() {
+  local name=$1 t=$SECONDS rc
+  shift
+  set +e
+  (
+    set -e
+    "$@"
+  )
+  rc=$?
+  set -e
+  STAGE_NAMES+=("$name")
+  STAGE_SECS+=($((SECONDS - t)))
+  if ((rc == 0)); then STAGE_RESULTS+=(ok); else STAGE_RESULTS+=("FAILED (exit $rc)"); fi
+  return $rc
+}
+stage_table() {
+  local i total=0
+  say "stage times (s; $(nproc 2> /dev/null || echo ?) processors, JOBS=$JOBS, load average" \
+    "$(cut -d' ' -f1-3 /proc/loadavg 2> /dev/null) at the end)"
+  printf '  %-12s %7s  %s\n' stage seconds result
+  for i in "${!STAGE_NAMES[@]}"; do
+    printf '  %-12s %7d  %s\n' "${STAGE_NAMES[$i]}" "${STAGE_SECS[$i]}" "${STAGE_RESULTS[$i]}"
+    total=$((total + STAGE_SECS[i]))
+  done
+  printf '  %-12s %7d  (%d min %02d s)\n' total "$total" $((total / 60)) $((total % 60))
+}
+
+# Every stage runs even when one fails, so one run shows every failure, then
+# the table of stage times. What each stage proves: docs/testing.md.
 cmd_test() {
-  local t0=$SECONDS failed=() stage rc
-  cmd_deps
-  cmd_build full
-  local stages=(ctest pytest core)
+  local failed=() stage
+  run_stage deps cmd_deps || { stage_table; die "dependencies failed"; }
+  run_stage build cmd_build full || { stage_table; die "the build failed"; }
+  local stages=(ctest pytest wheel core)
   [[ ${RCB_SKIP_SANITIZE:-0} == 1 ]] || stages+=(sanitize)
   # issue #7: valgrind on the CLI, a libFuzzer smoke (FUZZ_SECONDS per harness)
   stages+=(valgrind fuzz_smoke)
   # issue #7: static analysis, clean (cppcheck and clang-tidy)
   stages+=(lint)
   for stage in "${stages[@]}"; do
-    set +e
-    (
-      set -e
-      "cmd_$stage"
-    )
-    rc=$?
-    set -e
-    ((rc == 0)) || failed+=("$stage")
+    run_stage "$stage" "cmd_$stage" || failed+=("$stage")
   done
+  stage_table
   if ((${#failed[@]})); then
-    die "FAILED stages: ${failed[*]} ($((SECONDS - t0)) s)"
+    die "FAILED stages: ${failed[*]}"
   fi
-  say "all tests passed: ${stages[*]} ($((SECONDS - t0)) s)"
+  say "all tests passed: ${stages[*]}"
+}
+
+# A developer's suite in under 3 minutes on 2 cores (issue #27): the build,
+# the C tests not labelled slow (ctest -LE slow), and the Python tests not
+# marked slow (pytest -m "not slow": the ROSS references of the small models,
+# the package API). `test` runs everything.
+cmd_quick() {
+  run_stage build cmd_build || { stage_table; die "the build failed"; }
+  local failed=()
+  run_stage ctest run_ctest "$BUILD_DIR" -LE slow || failed+=(ctest)
+  run_stage pytest cmd_pytest -m "not slow" || failed+=(pytest)
+  stage_table
+  ((${#failed[@]} == 0)) || die "FAILED stages: ${failed[*]}"
+  say "quick suite passed (./scripts/dev.sh test runs everything)"
 }
 
 cmd_bench() {
@@ -535,6 +586,10 @@ case ${1:-} in
   build) cmd_build ;;
   demo) cmd_demo ;;
   test) cmd_test ;;
+  quick) cmd_quick ;;
+  wheel) cmd_wheel ;;
+  pytest) shift; cmd_pytest "$@" ;;
+  ctest) cmd_ctest ;;
   core) cmd_core ;;
   sanitize) cmd_sanitize ;;
   bench) cmd_bench ;;
