@@ -192,3 +192,27 @@ def pytest_terminal_summary(terminalreporter):
     tr.section("ROSS cross-validation: max relative differences")
     for (model, quantity), v in sorted(MEASURED.items()):
         tr.write_line(f"{model:28s} {quantity:26s} {v:.3e}")
+
+
+# ---- the slow files, left out of `./scripts/dev.sh quick` ------------------
+# pytest -m "not slow" (dev.sh quick) leaves these out; every other run, and
+# `dev.sh test`, runs them. They compute ROSS truths on the diagnosis grids and
+# run whole rcbtool diagnoses, fits and time integrations: minutes in all
+# (docs/testing.md has the figures and the command that measures them).
+SLOW_FILES = {
+    "test_diag_claims.py", "test_diag_ross.py", "test_monitor_ross.py",
+    "test_signals_diagnose.py", "test_signals_paper.py", "test_signals_runup.py",
+    "test_signals_transient.py", "test_signals_scipy.py", "test_ross_runup.py",
+    "test_package_dask.py",
+}
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "slow: minutes of ROSS truth, diagnoses or time "
+                            "integration; left out by `dev.sh quick` (-m 'not slow')")
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        if item.path.name in SLOW_FILES:
+            item.add_marker(pytest.mark.slow)
