@@ -28,7 +28,7 @@ def test_wrong_librcb_path_is_a_clear_error(rcb, tmp_path):
     code = ("import librcb, sys; m = librcb.Model.from_ini(sys.argv[1]); "
             "print(m.dofs)")
     paper = str(REPO / "examples" / "paper_system.ini")
-    env = dict(os.environ, PYTHONPATH=str(PKG), LIBRCB_PATH=rcb.library_path())
+    env = dict(os.environ, PYTHONPATH=str(PKG), LIBRCB_PATH=os.path.abspath(rcb.library_path()))
     res = subprocess.run([sys.executable, "-c", code, paper], capture_output=True,
                          text=True, env=env, cwd=tmp_path, timeout=120)
     assert res.returncode == 0 and res.stdout.split() == ["88"], res.stderr
