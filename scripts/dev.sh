@@ -8,7 +8,7 @@
 #                               test: ctest, Python cross-validation against ROSS, the wheel
 #                               in a fresh venv, the core configuration (no optional
 #                               backend), ASan+UBSan build, valgrind, fuzz replay, lint; ends
-#                               with a table of stage times (docs/testing.md)
+#                               with a table of stage times (docs/reliability.md)
 #   ./scripts/dev.sh quick      build + the tests labelled neither slow nor long (ctest -LE
 #                               "slow|long", pytest -m "not slow"): a developer's suite
 #   ./scripts/dev.sh ctest      ctest in the build tree (everything)

@@ -198,7 +198,7 @@ def pytest_terminal_summary(terminalreporter):
 # pytest -m "not slow" (dev.sh quick) leaves these out; every other run, and
 # `dev.sh test`, runs them. They compute ROSS truths on the diagnosis grids and
 # run whole rcbtool diagnoses, fits and time integrations: minutes in all
-# (docs/testing.md has the figures and the command that measures them).
+# (docs/reliability.md, "Stages of ./scripts/dev.sh test": figures and commands).
 SLOW_FILES = {
     "test_diag_claims.py", "test_diag_ross.py", "test_monitor_ross.py",
     "test_signals_diagnose.py", "test_signals_paper.py", "test_signals_runup.py",
