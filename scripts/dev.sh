@@ -341,7 +341,7 @@ cmd_wheel() {
   local ref
   ref=$(rcbtool_exe)
   [[ -x $ref && -f $ref ]] || ref=
-  PYTHON3=python3 JOBS=$JOBS tests/wheel/test_wheel.sh $ref
+  PYTHON3=python3 JOBS=$JOBS tests/wheel/test_wheel.sh ${ref:+"$ref"}
 }
 
 cmd_ctest() {
