@@ -679,12 +679,14 @@ cross_deps() {
 cmd_cross() {
   local targets=(${CROSS_TARGETS:-aarch64 armhf}) t dir fw native=build-embedded/firmware.out
   command -v dpkg-query > /dev/null || die "cross needs Debian multiarch (dpkg, apt)"
+  for t in "${targets[@]}"; do
+    [[ -n ${CROSS_DEBARCH[$t]:-} ]] || die "unknown cross target $t (aarch64, armhf)"
+  done
   say "native embedded build (the reference figures)"
   cmake --preset embedded > /dev/null
   cmake --build --preset embedded -j "$JOBS"
   OPENBLAS_NUM_THREADS=1 build-embedded/examples/firmware/firmware_example > "$native"
   for t in "${targets[@]}"; do
-    [[ -n ${CROSS_DEBARCH[$t]:-} ]] || die "unknown cross target $t (aarch64, armhf)"
     cross_deps "${CROSS_DEBARCH[$t]}"
     dir=build-embedded-$t
     say "embedded-$t: cross build (${CROSS_TRIPLET[$t]}, warnings as errors)"
