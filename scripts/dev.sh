@@ -5,8 +5,16 @@
 #                               SUNDIALS, no venv), build, run the paper-system demo,
 #                               print where rcbtool is
 #   ./scripts/dev.sh test       install everything, build with every backend, run every
-#                               test: ctest, Python cross-validation against ROSS, the core
-#                               configuration (no optional backend), ASan+UBSan build
+#                               test: ctest, Python cross-validation against ROSS, the wheel
+#                               in a fresh venv, the core configuration (no optional
+#                               backend), ASan+UBSan build, valgrind, fuzz replay, lint; ends
+#                               with a table of stage times (docs/reliability.md)
+#   ./scripts/dev.sh quick      build + the tests labelled neither slow nor long (ctest -LE
+#                               "slow|long", pytest -m "not slow"): a developer's suite
+#   ./scripts/dev.sh ctest      ctest in the build tree (everything)
+#   ./scripts/dev.sh pytest     tests/python against this build (extra arguments to pytest)
+#   ./scripts/dev.sh wheel      fresh venv, pip install ./tools/python (librcb.so inside),
+#                               import and an FRF against rcbtool, no LIBRCB_PATH (needs PyPI)
 #   ./scripts/dev.sh deps       all Debian packages + the pinned Python venv (.venv)
 #   ./scripts/dev.sh build      configure + build in build/ (Release; SUNDIALS and the
 #                               tests when their packages are installed)
@@ -36,6 +44,10 @@
 #                               (.clang-tidy) on src/, tools/rcbtool/ and examples/, one file
 #                               per process, JOBS at a time (part of `test`; about 1-3 min
 #                               on 2 cores)
+#   ./scripts/dev.sh cross      the embedded presets cross-built for aarch64 and armhf (Debian
+#                               multiarch; installs what is missing unless that would upgrade
+#                               host packages), firmware example under qemu-user diffed against
+#                               the native run, C tests not labelled slow/long/threads
 #   ./scripts/dev.sh embedded   the "embedded" CMake preset (static, -Os, no optional backend,
 #                               build-embedded/): build and print the library size
 #
@@ -285,7 +297,12 @@ cmd_core() {
   say "core configuration: SuiteSparse, NLopt, SUNDIALS, threads, FFTW OFF ($dir)"
   configure_build "$dir" -DRCB_WITH_SUITESPARSE=OFF -DRCB_WITH_NLOPT=OFF \
     -DRCB_WITH_SUNDIALS=OFF -DRCB_WITH_THREADS=OFF -DRCB_WITH_FFTW=OFF
-  run_ctest "$dir"
+  # What this stage proves: the library builds and computes without any
+  # optional backend (the fallbacks behind every #if RCB_WITH_*), which every
+  # test not labelled slow exercises. The slow ones (whole diagnoses, the doc
+  # commands) run the same code above the backends and run in the ctest stage
+  # (issue #27: they were minutes here, twice).
+  run_ctest "$dir" -LE slow
 }
 
 cmd_sanitize() {
@@ -298,25 +315,17 @@ cmd_sanitize() {
     UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 run_ctest "$dir" -LE slow
 }
 
-# The librcb Python package (tools/python) into the venv, built from a copy in
-# the build tree (setuptools writes build/ and egg-info beside its sources);
-# its tests load the shared library of this build through LIBRCB_PATH.
-install_python_package() {
-  local src=$BUILD_DIR/python-pkg
-  rm -rf "$src"
-  mkdir -p "$src"
-  cp -r tools/python/pyproject.toml tools/python/README.md tools/python/librcb "$src/"
-  "$VENV/bin/python" -m pip install --quiet --no-build-isolation --no-index --no-deps \
-    --force-reinstall "$src"
-}
-
+# The Python tests import the package from tools/python (PYTHONPATH: no
+# install, so no build of the wheel here) with this build's library through
+# LIBRCB_PATH; the installed package is the `wheel` stage's. --durations
+# prints the slowest tests (where the minutes go). Extra arguments go to pytest.
 cmd_pytest() {
   say "Python cross-validation (tests/python, against ROSS) and the librcb package"
   local rc=0
   [[ -f $BUILD_DIR/src/librcb.so ]] || die "$BUILD_DIR/src/librcb.so was not built (RCB_BUILD_SHARED=ON)"
-  install_python_package || die "pip install ./tools/python failed"
   RCBTOOL=$(rcbtool_exe) LIBRCB_PATH=$BUILD_DIR/src/librcb.so OPENBLAS_NUM_THREADS=1 \
-    "$VENV/bin/python" -m pytest tests/python -q || rc=$?
+    PYTHONPATH=$ROOT/tools/python${PYTHONPATH:+:$PYTHONPATH} \
+    "$VENV/bin/python" -m pytest tests/python -q --durations=15 --durations-min=5 "$@" || rc=$?
   if ((rc == 5)); then
     echo "dev.sh: WARNING: pytest collected no test in tests/python" >&2
   elif ((rc != 0)); then
@@ -324,37 +333,140 @@ cmd_pytest() {
   fi
 }
 
+# The wheel as a user installs it (issue #27): fresh venv, pip install
+# ./tools/python (scikit-build-core, librcb.so inside), import and one FRF
+# against the C CLI, with no build tree and no LIBRCB_PATH (tests/wheel).
+cmd_wheel() {
+  say "Python wheel: fresh venv, pip install ./tools/python, FRF vs rcbtool"
+  local ref
+  ref=$(rcbtool_exe)
+  [[ -x $ref && -f $ref ]] || ref=
+  PYTHON3=python3 JOBS=$JOBS tests/wheel/test_wheel.sh ${ref:+"$ref"}
+}
+
 cmd_ctest() {
   say "C tests (ctest, $BUILD_DIR)"
   run_ctest "$BUILD_DIR"
 }
 
-# Run every stage even when one fails, so one run shows every failure; each
-# stage runs in a subshell with errexit on.
+# Stage times (issue #27): run_stage NAME CMD... runs CMD in a subshell with
+# errexit on, records its seconds and result, adds NAME to FAILED when it
+# fails, and returns 0: never call it as a condition (`run_stage ... ||`
+# would turn errexit off inside CMD). stage_table prints the times.
+STAGE_NAMES=()
+STAGE_SECS=()
+STAGE_RESULTS=()
+FAILED=()
+stage_done() { # NAME SECONDS RC
+  STAGE_NAMES+=("$1")
+  STAGE_SECS+=("$2")
+  if (($3 == 0)); then
+    STAGE_RESULTS+=(ok)
+  else
+    STAGE_RESULTS+=("FAILED (exit $3)")
+    FAILED+=("$1")
+  fi
+}
+run_stage() {
+  local name=$1 t=$SECONDS rc
+  shift
+  set +e
+  (
+    set -e
+    "$@"
+  )
+  rc=$?
+  set -e
+  stage_done "$name" $((SECONDS - t)) $rc
+}
+run_stage_bg() {
+  local name=$1 log=$BUILD_DIR/stage-$1.log
+  shift
+  rm -f "$log" "$log.rc"
+  (
+    t=$SECONDS
+    set +e
+    (
+      set -e
+      "$@"
+    ) > "$log" 2>&1
+    echo "$? $((SECONDS - t))" > "$log.rc"
+  ) &
+  BG_PID=$!
+}
+stage_wait() { # NAME PID
+  local log=$BUILD_DIR/stage-$1.log rc=1 secs=0
+  wait "$2" || true
+  [[ -f $log.rc ]] && read -r rc secs < "$log.rc"
+  cat "$log"
+  stage_done "$1 (bg)" "$secs" "$rc"
+}
+stage_table() {
+  local i total=0
+  say "stage times (s; $(nproc 2> /dev/null || echo ?) processors, JOBS=$JOBS, load average" \
+    "$(cut -d' ' -f1-3 /proc/loadavg 2> /dev/null) at the end)"
+  printf '  %-14s %7s  %s\n' stage seconds result
+  for i in "${!STAGE_NAMES[@]}"; do
+    printf '  %-14s %7d  %s\n' "${STAGE_NAMES[$i]}" "${STAGE_SECS[$i]}" "${STAGE_RESULTS[$i]}"
+    total=$((total + STAGE_SECS[i]))
+  done
+  printf '  %-14s %7d  (%d min %02d s; stages marked bg ran beside the others)\n' \
+    "sum of stages" "$total" $((total / 60)) $((total % 60))
+  printf '  %-14s %7d  (%d min %02d s)\n' wall $((SECONDS - STAGE_T0)) \
+    $(((SECONDS - STAGE_T0) / 60)) $(((SECONDS - STAGE_T0) % 60))
+}
+STAGE_T0=$SECONDS
+
+# Every stage runs even when one fails, so one run shows every failure, then
+# the table of stage times. What each stage proves: docs/reliability.md,
+# "Stages of ./scripts/dev.sh test". pytest is one process on one core for its
+# whole run (ROSS and rcbtool one at a time, one BLAS thread): it runs in the
+# background beside the other stages, which use the other core, and its output
+# is printed when it ends; RCB_TEST_SERIAL=1 runs it in line instead.
 cmd_test() {
-  local t0=$SECONDS failed=() stage rc
-  cmd_deps
-  cmd_build full
-  local stages=(ctest pytest core)
+  local stage pytest_pid=
+  run_stage deps cmd_deps
+  ((${#FAILED[@]} == 0)) || { stage_table; die "dependencies failed"; }
+  run_stage build cmd_build full
+  ((${#FAILED[@]} == 0)) || { stage_table; die "the build failed"; }
+  local stages=(ctest wheel core)
+  if [[ ${RCB_TEST_SERIAL:-0} == 1 ]]; then
+    stages=(ctest pytest wheel core)
+  else
+    say "pytest starts in the background (its output comes when it ends)"
+    run_stage_bg pytest cmd_pytest
+    pytest_pid=$BG_PID
+  fi
   [[ ${RCB_SKIP_SANITIZE:-0} == 1 ]] || stages+=(sanitize)
   # issue #7: valgrind on the CLI, a libFuzzer smoke (FUZZ_SECONDS per harness)
   stages+=(valgrind fuzz_smoke)
   # issue #7: static analysis, clean (cppcheck and clang-tidy)
   stages+=(lint)
   for stage in "${stages[@]}"; do
-    set +e
-    (
-      set -e
-      "cmd_$stage"
-    )
-    rc=$?
-    set -e
-    ((rc == 0)) || failed+=("$stage")
+    run_stage "$stage" "cmd_$stage"
   done
-  if ((${#failed[@]})); then
-    die "FAILED stages: ${failed[*]} ($((SECONDS - t0)) s)"
+  if [[ -n $pytest_pid ]]; then
+    say "pytest (ran in the background)"
+    stage_wait pytest "$pytest_pid"
   fi
-  say "all tests passed: ${stages[*]} ($((SECONDS - t0)) s)"
+  stage_table
+  ((${#FAILED[@]} == 0)) || die "FAILED stages: ${FAILED[*]}"
+  say "all tests passed"
+}
+
+# A developer's suite in under 3 minutes on 2 cores (issue #27): the build,
+# the C tests labelled neither slow nor long (ctest -LE "slow|long"), and the
+# Python tests not marked slow (pytest -m "not slow": the ROSS references of
+# the small models, the package API; tests/python/conftest.py marks the slow
+# files). `test` runs everything.
+cmd_quick() {
+  run_stage build cmd_build
+  ((${#FAILED[@]} == 0)) || { stage_table; die "the build failed"; }
+  run_stage ctest run_ctest "$BUILD_DIR" -LE "slow|long"
+  run_stage pytest cmd_pytest -m "not slow"
+  stage_table
+  ((${#FAILED[@]} == 0)) || die "FAILED stages: ${FAILED[*]}"
+  say "quick suite passed (./scripts/dev.sh test runs everything)"
 }
 
 cmd_bench() {
@@ -528,6 +640,73 @@ cmd_embedded() {
   OPENBLAS_NUM_THREADS=1 "$fw" | tail -n 1 | sed 's/^/  /'
 }
 
+# ARM, cross-compiled on Debian multiarch and run under qemu-user (issue #27):
+# for each target (aarch64 = Debian arm64, armhf), install what is missing
+# (crossbuild-essential, qemu-user, the target's -dev packages), build the
+# preset embedded-<target> (warnings are errors), run examples/firmware under
+# qemu and diff its figures against the native run (the init line, arena sizes
+# from the pointer width, apart), then the C tests labelled neither slow, long
+# nor threads. CROSS_TARGETS (default "aarch64 armhf") picks the targets.
+declare -A CROSS_DEBARCH=([aarch64]=arm64 [armhf]=armhf)
+declare -A CROSS_QEMU=([aarch64]=qemu-aarch64 [armhf]=qemu-arm)
+declare -A CROSS_TRIPLET=([aarch64]=aarch64-linux-gnu [armhf]=arm-linux-gnueabihf)
+
+# Foreign-architecture packages must carry the host's versions of the shared
+# ones (libc6, libgcc...): when the host is behind its archive, apt would
+# upgrade host packages to install them. That is left to the administrator:
+# the simulation is checked first and nothing is installed then.
+cross_deps() {
+  local arch=$1 missing=() p plan
+  local want=("crossbuild-essential-$arch" qemu-user "liblapacke-dev:$arch"
+    "libopenblas-dev:$arch" "libinih-dev:$arch" "libkissfft-dev:$arch" "libcmocka-dev:$arch")
+  for p in "${want[@]}"; do deb_installed "$p" || missing+=("$p"); done
+  ((${#missing[@]})) || return 0
+  if ! dpkg --print-foreign-architectures | grep -qx "$arch"; then
+    say "dpkg --add-architecture $arch"
+    as_root dpkg --add-architecture "$arch"
+  fi
+  as_root apt-get update
+  plan=$(as_root apt-get -s install --no-install-recommends "${missing[@]}" 2>&1) ||
+    { echo "$plan" | tail -n 20; die "apt cannot install: ${missing[*]}"; }
+  if grep -E '^(Inst [^ ]+ \[|Remv )' <<< "$plan"; then
+    die "installing ${missing[*]} would upgrade or remove the host packages above (the host is behind its archive): upgrade the host first (apt-get upgrade), then run cross again (dpkg --remove-architecture $arch undoes the added architecture)"
+  fi
+  say "installing: ${missing[*]}"
+  as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends \
+    "${missing[@]}"
+}
+
+cmd_cross() {
+  local targets=(${CROSS_TARGETS:-aarch64 armhf}) t dir fw native=build-embedded/firmware.out
+  command -v dpkg-query > /dev/null || die "cross needs Debian multiarch (dpkg, apt)"
+  for t in "${targets[@]}"; do
+    [[ -n ${CROSS_DEBARCH[$t]:-} ]] || die "unknown cross target $t (aarch64, armhf)"
+  done
+  say "native embedded build (the reference figures)"
+  cmake --preset embedded > /dev/null
+  cmake --build --preset embedded -j "$JOBS"
+  OPENBLAS_NUM_THREADS=1 build-embedded/examples/firmware/firmware_example > "$native"
+  for t in "${targets[@]}"; do
+    cross_deps "${CROSS_DEBARCH[$t]}"
+    dir=build-embedded-$t
+    say "embedded-$t: cross build (${CROSS_TRIPLET[$t]}, warnings as errors)"
+    cmake --preset "embedded-$t" > /dev/null
+    cmake --build --preset "embedded-$t" -j "$JOBS"
+    size "$dir/src/librcb.a" | awk 'NR > 1 { t += $1 } END { printf "  library text %d bytes\n", t }'
+    say "embedded-$t: examples/firmware under ${CROSS_QEMU[$t]}, against the native figures"
+    fw=$dir/examples/firmware/firmware_example
+    OPENBLAS_NUM_THREADS=1 "${CROSS_QEMU[$t]}" -L "/usr/${CROSS_TRIPLET[$t]}" "$fw" > "$dir/firmware.out"
+    grep '^init:' "$native" "$dir/firmware.out" | sed 's/^/  /'
+    diff <(grep -v '^init:' "$native") <(grep -v '^init:' "$dir/firmware.out") ||
+      die "embedded-$t: the firmware example's figures differ from the native run (above)"
+    echo "  the same figures as the native run (apart from the init line)"
+    say "embedded-$t: C tests under qemu (ctest -LE 'slow|long|threads')"
+    (cd "$dir" && ctest -N -L threads | sed -n 's/^ *Test *#[0-9]*: /  skipped under qemu-user (its user mode hangs or crashes in guest pthread_create, qemu 7.2): /p')
+    run_ctest "$dir" -LE "slow|long|threads"
+  done
+  say "cross: ${targets[*]} passed"
+}
+
 usage() { awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$ROOT/scripts/dev.sh"; }
 
 case ${1:-} in
@@ -535,6 +714,10 @@ case ${1:-} in
   build) cmd_build ;;
   demo) cmd_demo ;;
   test) cmd_test ;;
+  quick) cmd_quick ;;
+  wheel) cmd_wheel ;;
+  pytest) shift; cmd_pytest "$@" ;;
+  ctest) cmd_ctest ;;
   core) cmd_core ;;
   sanitize) cmd_sanitize ;;
   bench) cmd_bench ;;
@@ -546,6 +729,7 @@ case ${1:-} in
   valgrind) cmd_valgrind ;;
   lint) cmd_lint ;;
   embedded) cmd_embedded ;;
+  cross) cmd_cross ;;
   -h | --help | help) usage ;;
   *) usage >&2; exit 2 ;;
 esac

@@ -34,7 +34,7 @@ static void test_defaults(void **state) {
   rcb_fit *f = make(&m, &ms);
   double lo, hi, a, b, w[14], ftol, xtol;
   size_t it, n;
-  unsigned long seed;
+  uint64_t seed;
   const char *alg = NULL;
   int (*cb)(void *, size_t, size_t, double) = progress_cb;
   void *user = &lo;
@@ -70,7 +70,7 @@ static void test_set_then_get(void **state) {
   rcb_fit *f = make(&m, &ms);
   double lo, hi, a, b, w[14], wb[14], ftol, xtol;
   size_t it, n, i;
-  unsigned long seed;
+  uint64_t seed;
   int lg, user_data = 0;
   const char *alg = NULL;
   int (*cb)(void *, size_t, size_t, double) = NULL;

@@ -152,10 +152,11 @@ RCB_API rcb_status rcb_fit_set_progress(rcb_fit *f,
  * @brief Guard against local minima: when a fit ends unsure (above the noise
  * floor of the noise model, or not converged), try up to n - 1 further
  * starting points, drawn log-uniformly (uniformly for linear parameters)
- * within the bounds from a PRNG seeded by @p seed, and keep the best result.
+ * within the bounds from a PRNG seeded by @p seed (64 bits on every platform,
+ * so armhf draws the starts x86_64 draws), and keep the best result.
  * n = 1 (default) tries only the model's own start.
  */
-RCB_API rcb_status rcb_fit_set_starts(rcb_fit *f, size_t n, unsigned long seed);
+RCB_API rcb_status rcb_fit_set_starts(rcb_fit *f, size_t n, uint64_t seed);
 /**
  * @brief The first of the n starting points of rcb_fit_set_starts that
  * rcb_fit_run tries: 0 (default) the model's own start, then the random ones;
@@ -222,7 +223,7 @@ RCB_API rcb_status rcb_fit_get_progress(const rcb_fit *f,
                                                    double objective),
                                         void **user);
 /** @brief Starting points (default 1) and the PRNG seed of the further ones (default 0). */
-RCB_API rcb_status rcb_fit_get_starts(const rcb_fit *f, size_t *n, unsigned long *seed);
+RCB_API rcb_status rcb_fit_get_starts(const rcb_fit *f, size_t *n, uint64_t *seed);
 /** @brief The first starting point tried (default 0, see rcb_fit_set_first_start). */
 RCB_API size_t rcb_fit_get_first_start(const rcb_fit *f);
 /** @brief Whether rcb_fit_run computes the uncertainties (default 1). */

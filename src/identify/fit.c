@@ -395,7 +395,7 @@ rcb_status rcb_fit_get_progress(const rcb_fit *f,
   return RCB_OK;
 }
 
-rcb_status rcb_fit_get_starts(const rcb_fit *f, size_t *n, unsigned long *seed) {
+rcb_status rcb_fit_get_starts(const rcb_fit *f, size_t *n, uint64_t *seed) {
   if (!f || !n || !seed) return RCB_ERR_ARG;
   *n = f->nstarts ? f->nstarts : 1, *seed = f->seed;
   return RCB_OK;
@@ -407,11 +407,11 @@ int rcb_fit_get_uncertainty(const rcb_fit *f) { return f ? !f->no_uncertainty : 
 
 /* ---- run and results ---- */
 
-rcb_status rcb_fit_set_starts(rcb_fit *f, size_t n, unsigned long seed) {
+rcb_status rcb_fit_set_starts(rcb_fit *f, size_t n, uint64_t seed) {
   if (!f || n == 0) return RCB_ERR_ARG;
   f->nstarts = n;
   f->seed = seed;
-  f->rng = (unsigned long long)seed * 0x9E3779B97F4A7C15ull + 1ull;
+  f->rng = seed * 0x9E3779B97F4A7C15ull + 1ull;
   return RCB_OK;
 }
 

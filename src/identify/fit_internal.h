@@ -112,7 +112,7 @@ struct rcb_fit {
   rcb_frf_condition cond; /* condition of the final evaluation's solves */
   size_t nstarts, starts_used;
   size_t first_start;         /* rcb_fit_set_first_start */
-  unsigned long seed;    /* as given to rcb_fit_set_starts */
+  uint64_t seed;         /* as given to rcb_fit_set_starts */
   unsigned long long rng;
   double *cov, *corr;    /* np x np */
 };

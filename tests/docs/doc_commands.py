@@ -32,6 +32,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import time
 
 FENCE = re.compile(r"^```(\S*)\s*$")
 MARK = re.compile(r"^<!--\s*doc-test:\s*((?:(?:skip|venv|sundials|fft|matplotlib|slow)\b\s*)+)(.*?)\s*-->\s*$")
@@ -158,6 +159,7 @@ def main():
             script += [f"echo '@@ {where}' >&2", text]
         env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
         env.pop("RCB_PLOTS", None)
+        t0 = time.monotonic()
         try:
             r = subprocess.run(["bash", "-c", "\n".join(script)], env=env, cwd=d,
                                capture_output=True, text=True, timeout=args.timeout)
@@ -168,12 +170,12 @@ def main():
         marks = re.findall(r"^@@ (\S+)$", err, re.M)
         if rc == 0:
             ran += len(todo)
-            print(f"ok   {page}: {len(todo)} block(s)")
+            print(f"ok   {page}: {len(todo)} block(s), {time.monotonic() - t0:.1f} s")
         else:
             bad = marks[-1] if marks else page
             ran += len(marks) - 1 if marks else 0
             failed.append(bad)
-            print(f"FAIL {bad} (exit {rc}); the tail of its output:")
+            print(f"FAIL {bad} (exit {rc}, {time.monotonic() - t0:.1f} s); the tail of its output:")
             tail = (out[-1500:] + "\n--- stderr:\n" + err.split(f"@@ {bad}")[-1][-2500:])
             print("    " + tail.replace("\n", "\n    "))
         shutil.rmtree(d, ignore_errors=True)

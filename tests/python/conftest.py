@@ -192,3 +192,35 @@ def pytest_terminal_summary(terminalreporter):
     tr.section("ROSS cross-validation: max relative differences")
     for (model, quantity), v in sorted(MEASURED.items()):
         tr.write_line(f"{model:28s} {quantity:26s} {v:.3e}")
+
+
+# ---- the slow files, left out of `./scripts/dev.sh quick` ------------------
+# pytest -m "not slow" (dev.sh quick) leaves these out; every other run, and
+# `dev.sh test`, runs them. They compute ROSS truths on the diagnosis grids and
+# run whole rcbtool diagnoses, fits and time integrations: minutes in all
+# (docs/reliability.md, "Stages of ./scripts/dev.sh test": figures and commands).
+SLOW_FILES = {
+    "test_diag_claims.py", "test_diag_ross.py", "test_monitor_ross.py",
+    "test_signals_diagnose.py", "test_signals_paper.py", "test_signals_runup.py",
+    "test_signals_transient.py", "test_signals_scipy.py", "test_ross_runup.py",
+    "test_package_dask.py", "test_plots.py", "test_ross_bridge.py",
+}
+# single tests of the other files that took 74-123 s each under a load of ~9
+# on 2 cores (about a tenth of that quiet): ROSS rotors rebuilt per speed
+# (synchronous FRF, unbalance of the speed-dependent bearings), damped modes.
+SLOW_TESTS = {
+    "test_ross_frf.py::test_frf_synchronous", "test_ross_modes.py::test_damped_modes",
+    "test_ross_unbalance.py::test_unbalance_response",
+}
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "slow: minutes of ROSS truth, diagnoses or time "
+                            "integration; left out by `dev.sh quick` (-m 'not slow')")
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        if (item.path.name in SLOW_FILES
+                or f"{item.path.name}::{item.originalname}" in SLOW_TESTS):
+            item.add_marker(pytest.mark.slow)

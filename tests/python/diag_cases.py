@@ -217,12 +217,29 @@ def _speed():
     return RPM * math.pi / 30.0
 
 
+# ross_inertance's results in this process, by (text, model_edit, freq, ins):
+# the same truth (the base model's, a case's) is asked for by several tests
+# and files; each costs a ROSS rotor and up to 1101 solves (issue #27). The
+# key holds the model_edit object itself (identity: the cases' edits live as
+# long as the module), and a copy goes out.
+_ROSS_CACHE = {}
+
+
 def ross_inertance(text, model_edit=None, check=True, freq=None, ins=(IN,)):
     """Inertances (len(ins) * len(OUTS) x len(freq), m/s^2/N; the channels of
     input ins[q] are rows q * len(OUTS) ...) of the ROSS rotor built from INI
     text; model_edit(model) changes the parsed Python model first. freq: Hz,
-    FREQ_HZ by default."""
+    FREQ_HZ by default. Computed once per process (_ROSS_CACHE); with check,
+    once checked against ROSS's transfer_matrix."""
     freq = FREQ_HZ if freq is None else freq
+    key = (text, model_edit, np.asarray(freq, dtype=float).tobytes(), tuple(ins))
+    hit = _ROSS_CACHE.get(key)
+    if hit is None or (check and not hit[1]):
+        _ROSS_CACHE[key] = hit = (_ross_inertance(text, model_edit, check, freq, ins), check)
+    return hit[0].copy()
+
+
+def _ross_inertance(text, model_edit, check, freq, ins):
     model = rm.Model(text)
     if model_edit:
         model_edit(model)

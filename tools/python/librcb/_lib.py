@@ -287,7 +287,7 @@ _PROTOTYPES = {
     "rcb_fit_set_noise_model": (c_int, [c_void_p, c_double, c_double]),
     "rcb_fit_set_method": (c_int, [c_void_p, c_int, c_char_p]),
     "rcb_fit_set_limits": (c_int, [c_void_p, c_size_t, c_double, c_double]),
-    "rcb_fit_set_starts": (c_int, [c_void_p, c_size_t, ctypes.c_ulong]),
+    "rcb_fit_set_starts": (c_int, [c_void_p, c_size_t, ctypes.c_uint64]),
     "rcb_fit_run": (c_int, [c_void_p]),
     "rcb_fit_get_report": (c_int, [c_void_p, ctypes.POINTER(FitReport)]),
     "rcb_fit_param_count": (c_size_t, [c_void_p]),
