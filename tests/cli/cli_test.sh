@@ -21,6 +21,8 @@ json_ok() {
   python3 -c 'import json,sys; json.load(open(sys.argv[1]))' "$W/out" || fail "stdout is not valid JSON"
 }
 usage() { run "$@"; expect_rc 2; out_empty; }
+# the last run needed an FFT backend this build lacks (the core configuration): skip
+no_fft() { [ "$RC" -eq 4 ] && grep -F -q "without an FFT backend" "$W/err"; }
 
 case $CASE in
 # ---- usage errors: exit 2, a message saying what is expected ----
@@ -725,7 +727,7 @@ PY
   if [ "$RC" -eq 4 ] && grep -F -q "without an FFT backend" "$W/err"; then exit 77; fi
   expect_rc 3; err_has "cut.wav: the data chunk claims 8192 bytes, the file holds 6003"
   err_has "--allow-truncated"; [ ! -e "$W/h.csv" ] || fail "output written from a cut file"
-  run estimate "$W/cut.wav" "$@" --allow-truncated -o "$W/h.csv"; expect_rc 0
+  run estimate "$W/cut.wav" "$@" --allow-truncated -o "$W/h.csv"; no_fft && exit 77; expect_rc 0
   err_has "warning: $W/cut.wav: the data chunk claims 8192 bytes"
   err_has "read the 1500 whole frames"
   run estimate "$W/s.wav" "$@" -o "$W/h2.csv"; expect_rc 0
@@ -1509,6 +1511,7 @@ signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit fails wi
 resource.setrlimit(resource.RLIMIT_FSIZE, (16384, 16384))
 sys.exit(subprocess.call(sys.argv[1:], restore_signals=False))' "$T" estimate "$W/sig.csv" --input force=DA.x \
     --outputs DA.x --nseg 512 --stats "$W/st.csv" -o "$W/o.csv" >"$W/out" 2>"$W/err"; RC=$?
+  no_fft && exit 77
   expect_rc 5; err_has "$W/o.csv: "; err_has "File too large"
   grep -q "o\.csv\.[A-Za-z0-9]" "$W/err" && fail "the message names the temporary"
   [ ! -e "$W/st.csv" ] || fail "--stats was left by a failed run"
@@ -1554,7 +1557,7 @@ plan_sd_messages)
   # on the --sd file; fit -o into a missing directory: refused before the fit
   cp "$EX/signals/random_sdof.csv" "$W/sig.csv"
   run estimate "$W/sig.csv" --input force=DA.x --outputs DA.x --nseg 512 --stats "$W/st.csv" \
-    -o "$W/h1.csv"; expect_rc 0
+    -o "$W/h1.csv"; no_fft && exit 77; expect_rc 0
   for v in inf 1e-300; do
     awk -F, -v v="$v" 'BEGIN {OFS = ","} NR == 11 {$3 = v} {print}' "$W/st.csv" >"$W/sd.csv"
     for c in fit diagnose compare; do
