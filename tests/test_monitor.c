@@ -468,6 +468,28 @@ static void test_kt_change(void **state) {
   free(fs2);
 }
 
+/* rcb_monitor_named is the diagnosis' one rule on the first two candidates'
+ * BIC changes -score + dof ln n (n = 2 x channels x points): checked on
+ * update r as it came, and on r with the second moved within and beyond 10
+ * of the first, and with one candidate only. */
+static void named_rule(const rcb_monitor *mon, const rcb_monitor_result *r) {
+  rcb_monitor_result t = *r;
+  double ln_n = log(2.0 * (double)NPT);
+  int want = -1;
+  if (r->ntop >= 2)
+    want = fabs((-r->top[0].score + (double)r->top[0].dof * ln_n) -
+                (-r->top[1].score + (double)r->top[1].dof * ln_n)) > 10.0;
+  assert_int_equal(rcb_monitor_named(mon, r), want);
+  if (r->ntop < 2) return;
+  t.top[1].dof = t.top[0].dof;
+  t.top[1].score = t.top[0].score - 9.5; /* within 10: the data cannot choose */
+  assert_int_equal(rcb_monitor_named(mon, &t), 0);
+  t.top[1].score = t.top[0].score - 10.5;
+  assert_int_equal(rcb_monitor_named(mon, &t), 1);
+  t.ntop = 1;
+  assert_int_equal(rcb_monitor_named(mon, &t), -1);
+}
+
 /* A cross-coupled stiffness appears at bearing B2. */
 static void cross_case(fixture *f, int reweight, size_t relin, double kc /* N/m */) {
   rcb_monitor_param tp[3];
@@ -503,6 +525,7 @@ static void cross_case(fixture *f, int reweight, size_t relin, double kc /* N/m 
     /* the truth is possible; impossible sizes rank after every possible one */
     assert_int_equal(r.top[0].implausible, 0);
     for (t = 1; t < r.ntop; t++) assert_true(r.top[t].implausible >= r.top[t - 1].implausible);
+    named_rule(mon, &r);
     assert_int_equal(rcb_monitor_candidate_info_get(mon, r.top[0].index, &ci), RCB_OK);
     if (r.top[0].effect == RCB_EFFECT_BEARING_CROSS_COUPLING && strcmp(ci.place, "bearing B2") == 0) {
       named++;

@@ -323,6 +323,16 @@ typedef struct rcb_monitor_candidate_info {
   const char *params;      /**< its parameter names, comma separated */
   size_t np;               /**< parameters */
 } rcb_monitor_candidate_info;
+/**
+ * @brief Whether an alarmed update's first candidate is told apart from its
+ * second by the data, by the diagnosis' one rule (rcb_evidence_separable):
+ * each candidate's BIC change is -score + dof ln n (n: the update's real
+ * residuals, 2 x channels x points), and they are separable when those
+ * differ by more than 10. 1: the first may be named alone; 0: "A or B: not
+ * separable on these channels" (the data cannot choose); -1: fewer than two
+ * candidates ranked (nothing to tell apart) or a bad argument.
+ */
+RCB_API int rcb_monitor_named(const rcb_monitor *mon, const rcb_monitor_result *r);
 /** @brief Candidates laid out at create (scored or not). */
 RCB_API size_t rcb_monitor_candidate_count(const rcb_monitor *mon);
 /** @brief Description of candidate @p i (0-based, as rcb_monitor_candidate.index);

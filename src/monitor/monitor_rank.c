@@ -228,3 +228,12 @@ rcb_status rcb_mon_rank_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
   transpose_q(mon, J);
   return RCB_OK;
 }
+
+int rcb_monitor_named(const rcb_monitor *mon, const rcb_monitor_result *r) {
+  double ln_n, b0, b1;
+  if (!mon || !r || r->ntop < 2) return -1;
+  ln_n = log((double)mon->n);
+  b0 = -r->top[0].score + (double)r->top[0].dof * ln_n;
+  b1 = -r->top[1].score + (double)r->top[1].dof * ln_n;
+  return rcb_evidence_separable(b0, b1);
+}

@@ -11,6 +11,7 @@
 """
 
 import json
+import math
 import os
 import subprocess
 
@@ -66,6 +67,7 @@ def test_package_and_rcbtool_agree(rcb, tmp_path):
     with rcb.Model.from_ini(ini) as m, rcb.Meas.from_bytes(paths[0].read_bytes(),
                                                             uff_map=UFF_MAP) as setup, \
             rcb.Monitor(m, setup, PARAMS, noise=(10, 1), alpha=0.01) as mon:
+        setup_shape = mon._shape  # channels, points
         py = []
         for p in paths[1:]:
             with rcb.Meas.from_bytes(p.read_bytes(), uff_map=UFF_MAP) as ms:
@@ -82,6 +84,12 @@ def test_package_and_rcbtool_agree(rcb, tmp_path):
             [(c["effect"], c["place"]) for c in b["top"]]
         for ca, cb in zip(a["top"], b["top"]):
             assert ca["size"] == pytest.approx(cb["size"], rel=1e-12)
+        # one rule in both (rcb_monitor_named): BIC changes -score + dof ln n within 10
+        assert a["separable"] == b["separable"]
+        if len(a["top"]) >= 2:
+            n = 2 * setup_shape[0] * setup_shape[1]
+            bic = [-c["score"] + c["dof"] * math.log(n) for c in a["top"][:2]]
+            assert a["separable"] == (abs(bic[0] - bic[1]) > 10.0)
     assert py[-1]["alarm"]  # the cross-coupled day is a change
 
 

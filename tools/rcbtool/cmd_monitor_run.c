@@ -303,6 +303,11 @@ static void print_line(FILE *fp, const mon_state *s, const mon_record *rec) {
     if (rcb_monitor_candidate_info_get(s->mon, c->index, &ci) == RCB_OK)
       fprintf(fp, "  -> %s at %s: %s %.6g [%.6g, %.6g]", rcb_effect_name(ci.effect), ci.place,
               ci.params, c->size[0], c->ci_lo[0], c->ci_hi[0]);
+    /* the one rule: the data may not tell the first from the second */
+    if (rcb_monitor_named(s->mon, r) == 0 &&
+        rcb_monitor_candidate_info_get(s->mon, r->top[1].index, &ci) == RCB_OK)
+      fprintf(fp, ", or %s at %s: not separable on these channels (rcbtool plan)",
+              rcb_effect_name(ci.effect), ci.place);
   }
   fputc('\n', fp);
 }

@@ -170,10 +170,14 @@ class Monitor(Handle):
                       "ci_hi": list(c.ci_hi[:c.np]), "score": c.score, "dof": c.dof,
                       "p_value": c.p_value, "implausible": bool(c.implausible)})
             top.append(d)
+        named = _lib.lib().rcb_monitor_named(self.handle, ctypes.byref(r))
         return {"update": r.update, "error_pct": r.error_pct, "change_pct": r.change_pct,
                 "floor_pct": r.floor_pct, "T": r.T, "dof": r.dof, "threshold": r.threshold,
                 "p_value": r.p_value, "alarm": bool(r.alarm),
-                "cusum_alarm": bool(r.cusum_alarm), "tracked": tracked, "top": top}
+                "cusum_alarm": bool(r.cusum_alarm), "tracked": tracked, "top": top,
+                # the one rule (rcb_monitor_named): the first candidate told apart from
+                # the second; None with fewer than two ranked
+                "separable": None if named < 0 else bool(named)}
 
     def __repr__(self):
         if not self._h:
