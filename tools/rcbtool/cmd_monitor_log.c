@@ -96,9 +96,10 @@ static void json_update(FILE *fp, const mon_state *s, size_t k) {
     if (i) fputs(",\n    ", fp);
     json_candidate(fp, s, &r->top[i]);
   }
-  /* rcb_monitor_named: the first told apart from the second (null: < 2 ranked) */
-  i = (size_t)(rcb_monitor_named(s->mon, r) + 1);
-  fprintf(fp, "], \"separable\": %s}", i == 0 ? "null" : i == 2 ? "true" : "false");
+  { /* rcb_monitor_named: the first told apart from the second (null: < 2 ranked) */
+    int named = rcb_monitor_named(s->mon, r);
+    fprintf(fp, "], \"separable\": %s}", named < 0 ? "null" : named ? "true" : "false");
+  }
 }
 
 void mon_print_json(FILE *fp, const mon_state *s) {
