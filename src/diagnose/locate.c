@@ -75,7 +75,7 @@ static size_t intern(const char **list, size_t *n, const char *name) {
 /* One block for every array (sizes known from the fit's layout). */
 static rcb_status locate_alloc(rcb_diag *d, locate_ws *w, size_t npts) {
   size_t n = w->nres, nc = w->nch ? w->nch : 1, nn = w->nn ? w->nn : 1, nin = 2 * nn + nc;
-  size_t bytes = 5 * n * sizeof(size_t) + 2 * nc * sizeof(size_t) + (npts + 1) * sizeof(size_t) +
+  size_t bytes = 2 * n * sizeof(size_t) + 2 * nc * sizeof(size_t) + (npts + 1) * sizeof(size_t) +
                  n * sizeof(double) + 2 * nn * sizeof(double) + nc * sizeof(int) +
                  nc * nin * sizeof(rcb_complex) + (nc + nin) * sizeof(rcb_dof) +
                  2 * nc * sizeof(char *) + n + 64 +
@@ -133,7 +133,6 @@ static rcb_status locate_channels(rcb_diag *d, locate_ws *w) {
   return RCB_OK;
 }
 
-/* sum += J_rows^T J_rows (nb x nb) and J_rows^T b, over rows of J (row-major). */
 #define RCB_PLACE_MAXB 16 /* fitted parameters the placement takes along (more: not placed) */
 
 /* Solve the SPD system G X = B (k x k, nrhs columns) in place, with a ridge
