@@ -196,8 +196,10 @@ static void print_adequacy(FILE *fp, const rcb_diag *d) {
             "excess %", "");
     for (k = 0; k < n && k < 8; k++) {
       rcb_diag_misfit s;
+      char name[256];
       rcb_diag_misfit_get(d, k, &s);
-      fprintf(fp, "%-14s %12.6g %12.6g %9.1f  %s\n", s.sensor, s.chi2, s.expected,
+      fprintf(fp, "%-14s %12.6g %12.6g %9.1f  %s\n", cli_text(s.sensor, name, sizeof name),
+              s.chi2, s.expected,
               s.excess_pct, s.concentrated ? "<- the misfit concentrates here" : "");
     }
   }
@@ -218,16 +220,24 @@ static void print_text(FILE *fp, const diag_job *j, const rcb_diag *d, const cha
           "error %", "dBIC", "fitted");
   for (k = 0; k < n && k < j->top; k++) {
     rcb_diag_candidate c;
+    char desc[1024];
     rcb_diag_candidate_get(d, k, &c);
-    fprintf(fp, "%-4zu %-8s %-58.58s %9.3g ", k + 1, rcb_claim_str(c.claim), c.description,
-            c.predicted_pct);
-    if (c.refitted)
-      fprintf(fp, "%9.4g %+10.1f  %s%s\n", c.error_pct, c.delta_bic, c.fitted,
-              c.screened_only ? " (screened: dBIC an upper bound)" : "");
-    else
-      fprintf(fp, "%9s %10s  %s\n", "-", "-", c.fitted[0] ? c.fitted : "(not refitted)");
+    /* names from the model file: escaped by the one rule (cli_text) */
+    fprintf(fp, "%-4zu %-8s %-58.58s %9.3g ", k + 1, rcb_claim_str(c.claim),
+            cli_text(c.description, desc, sizeof desc), c.predicted_pct);
+    if (c.refitted) {
+      fprintf(fp, "%9.4g %+10.1f  ", c.error_pct, c.delta_bic);
+      cli_put_text(fp, c.fitted);
+      fprintf(fp, "%s\n", c.screened_only ? " (screened: dBIC an upper bound)" : "");
+    } else {
+      fprintf(fp, "%9s %10s  ", "-", "-");
+      cli_put_text(fp, c.fitted[0] ? c.fitted : "(not refitted)");
+      fputc('\n', fp);
+    }
   }
-  fprintf(fp, "\n%s\n", explain);
+  fputc('\n', fp);
+  cli_put_text(fp, explain);
+  fputc('\n', fp);
 }
 
 /* "adequacy" and "misfit" (per sensor) of the model as it is. */
