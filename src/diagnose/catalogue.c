@@ -133,6 +133,21 @@ double *rcb_diag_grid_weights(rcb_diag *d) {
 }
 
 
+/* The frequency subset the fits are screened on before their polish on all
+ * points: rcb_diag_grid_weights, where it keeps at most half of the points
+ * (32 x 1101: 150 points); else NULL, all points (8 x 151: 150 of 151 points
+ * would screen for nothing). */
+rcb_status rcb_diag_subset_weights(rcb_diag *d, double **out) {
+  size_t n = rcb_meas_point_count(d->meas), i, kept = 0;
+  double *w = rcb_diag_grid_weights(d);
+  *out = NULL;
+  if (!w) return rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
+  for (i = 0; i < n; i++) kept += w[i] > 0;
+  if (2 * kept > n) rcb_free(&d->alloc, w);
+  else *out = w;
+  return RCB_OK;
+}
+
 rcb_status rcb_diag_catalogue(rcb_diag *d, const rcb_model *m) {
   size_t k;
   rcb_status st;

@@ -160,6 +160,9 @@ rcb_status rcb_diag_copy_model(rcb_diag *d, const rcb_model *src, rcb_model **ou
 /* Weights (channel-major, 0 or 1) keeping a subset of the measured
  * frequencies: one every 2.5 % in frequency, at least 150 (caller frees). */
 double *rcb_diag_grid_weights(rcb_diag *d);
+/* rcb_diag_grid_weights where it keeps at most half of the points, else
+ * *out = NULL (all points); RCB_ERR_NOMEM with the message set. */
+rcb_status rcb_diag_subset_weights(rcb_diag *d, double **out);
 /* The candidate's model: a copy of the base model from (the fitted base, or
  * the nominal model), edited, finalized, the edit's starting values set
  * (caller destroys). */

@@ -230,21 +230,6 @@ static rcb_status objective(rcb_diag *d, rcb_fit *f, double *r, double *F, doubl
   return RCB_OK;
 }
 
-/* The frequency subset the fits are screened on before their polish on all
- * points: rcb_diag_grid_weights, where it keeps at most half of the points
- * (32 x 1101: 150 points); else NULL, all points (8 x 151: 150 of 151 points
- * would screen for nothing). */
-static rcb_status subset(rcb_diag *d, double **out) {
-  size_t n = rcb_meas_point_count(d->meas), i, kept = 0;
-  double *w = rcb_diag_grid_weights(d);
-  *out = NULL;
-  if (!w) return rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
-  for (i = 0; i < n; i++) kept += w[i] > 0;
-  if (2 * kept > n) rcb_free(&d->alloc, w);
-  else *out = w;
-  return RCB_OK;
-}
-
 /* A baseline fit that a missing effect has pulled far from the nominal model
  * is itself a finding: a parameter moved by more than this factor from its
  * nominal value (or onto a bound that far away). With 0.07 kg per hub hidden
@@ -430,7 +415,7 @@ static rcb_status baseline(rcb_diag *d) {
     double *w = NULL;
     /* screened on the subset, polished on all points from there (not when
      * the screen stopped because it ran off) */
-    st = subset(d, &w);
+    st = rcb_diag_subset_weights(d, &w);
     if (w) st = baseline_screen(d, f, w);
     rcb_free(&d->alloc, w);
     if (!st && !d->far) st = rcb_fit_run(f);
@@ -1371,7 +1356,7 @@ static rcb_status refit_best(rcb_diag *d) {
   cand_jobs j;
   rcb_status st;
   memset(&j, 0, sizeof j);
-  if ((st = subset(d, &j.w))) return st;
+  if ((st = rcb_diag_subset_weights(d, &j.w))) return st;
   /* on the subset (32 x 1101) none: the three refits from the run-off fit
    * of the 0.15 kg hub case took 4.3 s and ended at 72-92 %, and the 0.07 kg
    * hub reaches the same optimum from its pre-fit; the other coupling models
@@ -1528,7 +1513,7 @@ static rcb_status placed_refits(rcb_diag *d) {
   if (nspan > RCB_DIAG_PLACED_SPAN) return RCB_OK;
   for (k = 0; k < d->ncand; k++)
     if (d->cand[k].refitted && d->cand[k].claim == RCB_CLAIM_EXPLAINS) return RCB_OK;
-  if ((st = subset(d, &w))) return st;
+  if ((st = rcb_diag_subset_weights(d, &w))) return st;
   for (k = 0; !st && k < d->ncand; k++) {
     diag_cand *c = &d->cand[k];
     if (c->np != 1 || c->refit_only || (c->fam->flags & (DIAG_FAM_CHAIN | DIAG_FAM_ADDS_DOFS)) ||

@@ -360,11 +360,7 @@ rcb_status rcb_diag_locate(rcb_diag *d) {
    * every 2.5 %, at least 150): every frequency costs a factorisation and
    * 2 x nodes solves, 1.5-2 s of CPU on all 1101, and the subset places
    * as well (every frequency is one more check of the same place) */
-  if (!st && (gw = rcb_diag_grid_weights(d)) != NULL) {
-    size_t kept = 0;
-    for (i = 0; i < npts; i++) kept += gw[i] > 0;
-    if (2 * kept > npts) rcb_free(&d->alloc, gw), gw = NULL;
-  }
+  if (!st) st = rcb_diag_subset_weights(d, &gw);
   for (i = 0; !st && i < npts; i++) {
     double speed = rcb_meas_speed_given(d->meas) ? rcb_meas_speed(d->meas) : grid[i];
     if (w.first[i] == w.first[i + 1] || (gw && !(gw[i] > 0))) continue;
