@@ -74,7 +74,10 @@ MODEL=examples/paper_system.ini
 # MPI and hypre by its own Depends (162 packages, ~475 MB more), and the demo
 # runs no time integration. No Python: the demo draws no picture (matplotlib
 # for `rcbtool compare --plot` comes with the venv of `test`).
-DEB_DEMO=(build-essential cmake pkg-config libopenblas-dev liblapacke-dev
+# libopenblas0-serial: the serial OpenBLAS that rcbtool, the tests and the
+# benchmarks run on (cmake/RcbSerialBlas.cmake; the system's default BLAS
+# stays the alternatives' choice).
+DEB_DEMO=(build-essential cmake pkg-config libopenblas-dev libopenblas0-serial liblapacke-dev
   libsuitesparse-dev libnlopt-dev libinih-dev libfftw3-dev)
 # The rest, for `test` (and `deps`): SUNDIALS, cmocka, the Python venv's
 # prerequisites, sanitizer/fuzzer runtime, valgrind, linters.

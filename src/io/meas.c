@@ -327,8 +327,9 @@ rcb_status rcb_meas_slurp(rcb_meas *ms, const char *path, char **buf, size_t *le
   *len = 0;
   if (!path || !path[0]) return rcb_meas_fail(ms, RCB_ERR_ARG, "no file name given");
   fp = fopen(path, "rb");
-  if (!fp)
-    return rcb_meas_fail(ms, RCB_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+  if (!fp) /* out of memory (fopen's buffer) is RCB_ERR_NOMEM, as everywhere */
+    return rcb_meas_fail(ms, errno == ENOMEM ? RCB_ERR_NOMEM : RCB_ERR_IO, "%s: cannot open: %s", path,
+                          strerror(errno));
   for (;;) {
     size_t got;
     if (n + 1 >= cap) {

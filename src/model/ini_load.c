@@ -504,9 +504,9 @@ rcb_status rcb_model_load_file(rcb_model *m, const char *path) {
                           "rcb_model_create",
                           path);
   f = fopen(path, "rb");
-  if (!f)
-    return rcb_model_fail(m, RCB_ERR_IO, "%s: cannot open the model file (%s)", path,
-                          strerror(errno));
+  if (!f) /* out of memory (fopen's buffer) is RCB_ERR_NOMEM, as everywhere */
+    return rcb_model_fail(m, errno == ENOMEM ? RCB_ERR_NOMEM : RCB_ERR_IO,
+                          "%s: cannot open the model file (%s)", path, strerror(errno));
   do {
     if (rcb_grow(&m->alloc, (void **)&buf, &cap, len + 4096 + 1, 1)) {
       fclose(f);

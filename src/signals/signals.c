@@ -190,8 +190,9 @@ rcb_status rcb_signals_slurp(rcb_signals *s, const char *path, char **buf, size_
   *len = 0;
   if (!path || !path[0]) return rcb_signals_fail(s, RCB_ERR_ARG, "no file name given");
   fp = fopen(path, "rb");
-  if (!fp)
-    return rcb_signals_fail(s, RCB_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+  if (!fp) /* out of memory (fopen's buffer) is RCB_ERR_NOMEM, as everywhere */
+    return rcb_signals_fail(s, errno == ENOMEM ? RCB_ERR_NOMEM : RCB_ERR_IO, "%s: cannot open: %s", path,
+                          strerror(errno));
   if (fseek(fp, 0, SEEK_END) || (size = ftell(fp)) < 0 || fseek(fp, 0, SEEK_SET)) {
     fclose(fp);
     return rcb_signals_fail(s, RCB_ERR_IO, "%s: cannot read: not a regular file", path);
