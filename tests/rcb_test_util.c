@@ -148,7 +148,7 @@ rcb_meas *rcb_test_unbalance_meas(const rcb_model *m, const char *const *outs, s
                                   double r0, double r1, size_t n) {
   rcb_meas *ms = NULL;
   rcb_frf *fr = NULL;
-  rcb_dof od[8];
+  rcb_dof od[8] = {{0}};
   double *x = calloc(n, sizeof *x);
   rcb_complex *Q = calloc(n * no, sizeof *Q), *col = calloc(n, sizeof *col);
   size_t i, o;

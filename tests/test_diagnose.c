@@ -225,17 +225,15 @@ static void test_hidden_coupling_rotational_damping(void **state) {
   hidden("coupling.C.cr", 0.02, RCB_EFFECT_COUPLING_ROTATIONAL_DAMPING, "coupling C");
 }
 
-/* A pedestal under bearing B2 (its mode in the band), and one under B3. */
+/* A pedestal under bearing B2 (its mode in the band). Pedestals elsewhere
+ * are the ROSS-made cases of tests/python/test_diag_ross.py (B4, moderate and
+ * large): a second one here (B3) was 50 s of CPU on data of our own code. */
 static void test_hidden_pedestal(void **state) {
   (void)state;
   hidden_in(rcb_test_model_edited("paper_system.ini", "[bearing B2]",
                                   "pedestal_mass = 10\npedestal_kxx = 3e7\npedestal_kyy = 3e7\n"
                                   "pedestal_cxx = 500\npedestal_cyy = 500"),
             "pedestal under B2 (10 kg on 3e7 N/m)", RCB_EFFECT_FLEXIBLE_SUPPORT, "bearing B2");
-  hidden_in(rcb_test_model_edited("paper_system.ini", "[bearing B3]",
-                                  "pedestal_mass = 6\npedestal_kxx = 4e7\npedestal_kyy = 4e7\n"
-                                  "pedestal_cxx = 300\npedestal_cyy = 300"),
-            "pedestal under B3 (6 kg on 4e7 N/m)", RCB_EFFECT_FLEXIBLE_SUPPORT, "bearing B3");
 }
 
 /* The rotor turns 20 % faster than the measurement says. */

@@ -164,7 +164,10 @@ def test_large_baseline_runs_off(tool, tmp_path, case):
     dc.write_case_uff(meas, case, H, SEED)
     model = tmp_path / "as_is.ini"
     model.write_text(dc.model_ini())
-    fit = tool.json("fit", model, meas, "--params", dc.FIT_PARAMS, "--log", "--noise", "10,1")
+    # one start, the nominal model's (the random restarts, up to 8, cost 4413
+    # sweeps and 120 s of CPU on the 0.07 kg hub, and end on the bound too)
+    fit = tool.json("fit", model, meas, "--params", dc.FIT_PARAMS, "--log", "--noise", "10,1",
+                    "--starts", 1)
     kr = next(p for p in fit["params"] if p["name"] == "coupling.C.kr")
     assert kr["fitted"] < 0.01 * kr["start"], kr  # the collapse itself
     (step,) = _run(tool, tmp_path, case, 1)
