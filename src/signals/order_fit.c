@@ -109,8 +109,10 @@ void rcb_order_fit_result(const rcb_order *e, size_t bin, size_t ch, size_t m, d
     rcb_complex v = 0.0;
     double uk = 1.0;
     /* y = Re(Q e^{i m th}) = Re Q cos(m th) - Im Q sin(m th) */
-    for (k = 0; k * ng < np; k++, uk *= ubar)
+    for (k = 0; k * ng < np; k++) {
       v += uk * CMPLX(beta[k * ng + 2 * m - 1], -beta[k * ng + 2 * m]);
+      uk *= ubar;
+    }
     *Q = v;
   }
   if (sd) {
@@ -118,7 +120,10 @@ void rcb_order_fit_result(const rcb_order *e, size_t bin, size_t ch, size_t m, d
     for (part = 0; part < 2; part++) { /* Re Q, then Im Q */
       double uk = 1.0;
       memset(x, 0, np * sizeof *x);
-      for (k = 0; k * ng < np; k++, uk *= ubar) x[k * ng + 2 * m - 1 + part] = uk;
+      for (k = 0; k * ng < np; k++) {
+        x[k * ng + 2 * m - 1 + part] = uk;
+        uk *= ubar;
+      }
       var += quad(a, d, np, x);
     }
     *sd = sqrt(fmax(0.0, rss) / (n - (double)np) * var / 2.0);
