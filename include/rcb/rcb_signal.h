@@ -265,7 +265,13 @@ typedef enum rcb_order_method {
    * reported phasor, at the bin's mean speed, has no curvature bias. The
    * bin is the window: its speed width and the run-up rate set how many
    * revolutions it spans (at least 3 advised). sd: from the fit's residual,
-   * taken as white noise. A bin at one steady speed fits lower degrees. */
+   * taken as white noise. A bin at one steady speed fits lower degrees. An
+   * order present in the signal and not fitted leaks into the fitted ones
+   * when a bin spans few revolutions (a 5X of 10 % of a 1X resonance's peak,
+   * 4 revolutions per bin: 2X 4 % off with norders 4): fit every order
+   * present (norders up to 8). Orders at or above 0.45 x the sample rate at
+   * a bin's top speed (bin + 1.5 bin widths: whole revolutions) are left out
+   * of its fit (they alias onto lower ones): their Q is 0 and sd NaN. */
   RCB_ORDER_FIT = 0,
   /** Per-revolution DFT (before issue #25): each revolution resampled
    * (linear interpolation) to @c per_rev angles, an exact DFT gives Q_m =

@@ -159,6 +159,7 @@ rcb_status rcb_order_add(rcb_order *e, double rate, size_t n, const double *kp,
   if (!e || !kp || !chan || n < 2 || !isfinite(rate) || !(rate > 0.0)) return RCB_ERR_ARG;
   for (c = 0; c < e->nch; c++)
     if (!chan[c]) return rcb_set_error(e->errmsg, RCB_ERR_ARG, "order: channel %zu is NULL", c);
+  if (!(e->rate > 0.0) || rate < e->rate) e->rate = rate;
   trig = e->o.trigger;
   if (isnan(trig)) {
     for (lo = hi = kp[0], i = 1; i < n; i++) {

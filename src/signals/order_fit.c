@@ -49,16 +49,17 @@ void rcb_order_fit_revolution(rcb_order *e, double rate, double b, double c, dou
   }
 }
 
-/* The normal matrix of envelope degree deg, scaled to a unit diagonal, and
- * its Cholesky factor in a (column-major, np x np); 0 if it is well
- * conditioned (pivots of the scaled matrix above 1e-10: a bin at one steady
- * speed has no spread in u, and then the lower degrees are fitted). */
-static int normal(const double *mom, size_t ng, size_t ngg, size_t deg, double *a, double *d) {
-  size_t np = ng * (deg + 1), r, c;
+/* The normal matrix of the first nf angle functions (orders 0..(nf - 1) / 2)
+ * at envelope degree deg, parameter r = k nf + i for g_i u^k, scaled to a
+ * unit diagonal, and its Cholesky factor in a (column-major, np x np); 0 if
+ * it is well conditioned (pivots of the scaled matrix above 1e-10: a bin at
+ * one steady speed has no spread in u, and then the lower degrees are fitted). */
+static int normal(const double *mom, size_t nf, size_t ngg, size_t deg, double *a, double *d) {
+  size_t np = nf * (deg + 1), r, c;
   for (r = 0; r < np; r++)
     for (c = 0; c < np; c++) {
-      size_t i = r % ng, j = c % ng, lo = i < j ? i : j, hi = i < j ? j : i;
-      a[c * np + r] = mom[(r / ng + c / ng) * ngg + hi * (hi + 1) / 2 + lo];
+      size_t i = r % nf, j = c % nf, lo = i < j ? i : j, hi = i < j ? j : i;
+      a[c * np + r] = mom[(r / nf + c / nf) * ngg + hi * (hi + 1) / 2 + lo];
     }
   for (r = 0; r < np; r++) d[r] = a[r * np + r] > 0.0 ? 1.0 / sqrt(a[r * np + r]) : 0.0;
   for (r = 0; r < np; r++)
@@ -80,37 +81,47 @@ static double quad(const double *a, const double *d, size_t np, double *x) {
   return s;
 }
 
+/* Orders fitted in a bin: those below 0.45 x the sample rate at the bin's
+ * top speed (an order above the Nyquist frequency aliases onto a lower one
+ * and makes the normal matrix singular). */
+static size_t orders_resolved(const rcb_order *e, size_t bin) {
+  double top = ((double)bin + 1.5) * e->o.bin_width / (2.0 * RCB_PI); /* rev/s */
+  double mmax = 0.45 * e->rate / top;
+  return mmax >= (double)e->o.norders ? e->o.norders : (size_t)mmax;
+}
+
 void rcb_order_fit_result(const rcb_order *e, size_t bin, size_t ch, size_t m, double *speed,
                           rcb_complex *Q, double *sd) {
   size_t ng = e->ng, ngg = e->ngg, ny = ng * (RCB_ORDER_FIT_DEG + 1) + 1, deg, np = 0, r, k;
+  size_t nf = 2 * orders_resolved(e, bin) + 1;
   const double *mom = e->mom + bin * RCB_ORDER_FIT_POW * ngg;
   const double *ys = e->ysum + (bin * e->nch + ch) * ny;
   double a[MAXP * MAXP], d[MAXP], beta[MAXP], x[MAXP], n = mom[0], ubar, rss, var = 0.0;
   int ok = 0;
   ubar = n > 0.0 ? mom[ngg] / n : 0.0;
   if (speed) *speed = n > 0.0 ? ((double)bin + 0.5 + ubar) * e->o.bin_width : (double)NAN;
-  for (deg = RCB_ORDER_FIT_DEG + 1; !ok && deg-- > 0;) {
-    np = ng * (deg + 1);
-    ok = n > (double)np && normal(mom, ng, ngg, deg, a, d) == 0;
+  for (deg = RCB_ORDER_FIT_DEG + 1; !ok && m < (nf + 1) / 2 && deg-- > 0;) {
+    np = nf * (deg + 1);
+    ok = n > (double)np && normal(mom, nf, ngg, deg, a, d) == 0;
   }
   if (!ok) {
     if (Q) *Q = 0.0;
     if (sd) *sd = (double)NAN;
     return;
   }
-  for (r = 0; r < np; r++) beta[r] = ys[r] * d[r];
+  for (r = 0; r < np; r++) beta[r] = ys[r / nf * ng + r % nf] * d[r];
   LAPACKE_dpotrs_work(LAPACK_COL_MAJOR, 'L', (lapack_int)np, 1, a, (lapack_int)np, beta,
                       (lapack_int)np);
   for (rss = ys[ny - 1], r = 0; r < np; r++) {
     beta[r] *= d[r];
-    rss -= beta[r] * ys[r];
+    rss -= beta[r] * ys[r / nf * ng + r % nf];
   }
   if (Q) {
     rcb_complex v = 0.0;
     double uk = 1.0;
     /* y = Re(Q e^{i m th}) = Re Q cos(m th) - Im Q sin(m th) */
-    for (k = 0; k * ng < np; k++) {
-      v += uk * CMPLX(beta[k * ng + 2 * m - 1], -beta[k * ng + 2 * m]);
+    for (k = 0; k * nf < np; k++) {
+      v += uk * CMPLX(beta[k * nf + 2 * m - 1], -beta[k * nf + 2 * m]);
       uk *= ubar;
     }
     *Q = v;
@@ -120,8 +131,8 @@ void rcb_order_fit_result(const rcb_order *e, size_t bin, size_t ch, size_t m, d
     for (part = 0; part < 2; part++) { /* Re Q, then Im Q */
       double uk = 1.0;
       memset(x, 0, np * sizeof *x);
-      for (k = 0; k * ng < np; k++) {
-        x[k * ng + 2 * m - 1 + part] = uk;
+      for (k = 0; k * nf < np; k++) {
+        x[k * nf + 2 * m - 1 + part] = uk;
         uk *= ubar;
       }
       var += quad(a, d, np, x);

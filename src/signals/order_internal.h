@@ -18,6 +18,7 @@ struct rcb_order {
   char errmsg[RCB_ERRMSG_MAX];
   rcb_order_opts o;
   size_t nch, nbins, nrevs;
+  double rate;        /* lowest sample rate given to rcb_order_add, samples/s */
   double *cnt, *wsum; /* nbins: revolutions, sum of their speeds (rad/s) */
   /* RCB_ORDER_REV_DFT: per bin, the sums of a least-squares line
    * Q_r = a + b (w_r - w_mean) over its revolutions r, taken about the bin's

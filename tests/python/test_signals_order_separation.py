@@ -3,10 +3,11 @@
 The signal is written in closed form with NumPy, independently of librcb: a
 run-up 2400 -> 3600 rpm at 250 rpm/s (5 rpm per revolution at 3000 rpm) of a
 single-dof rotor with a 5 %-damped 1X resonance at 3000 rpm,
-    y = Re(Q1(w) e^{i th}) + Re(Q2(w) e^{2 i th}),
+    y = Re(Q1(w) e^{i th}) + Re(Q2(w) e^{2 i th}) + 1 um cos(3 th + 0.3),
 Q1 = 10 um H(w / 3000 rpm) (peak 100 um, changing within a revolution near the
 resonance) and Q2 = 1 um H(2 w / 9000 rpm) e^{0.7 i} / |H(6000 / 9000)| (100 times
-smaller than the 1X peak), H(r) = 1 / (1 - r^2 + 2 i 0.05 r), th the shaft angle
+smaller than the 1X peak) and a constant 3X as large as 2X (fitted with the others:
+unfitted, it would leak), H(r) = 1 / (1 - r^2 + 2 i 0.05 r), th the shaft angle
 (constant acceleration), with a keyphasor pulse per revolution whose rising edge
 crosses 2.5 V at th = 0. Noise-free: what is measured is the method's bias.
 
@@ -52,7 +53,7 @@ def _signals(path, rate=250.0, fs=1e4):
     t = np.arange(int(1200.0 / rate * fs)) / fs
     th = w0 * t + 0.5 * al * t * t
     q1, q2 = _truth(w0 + al * t)
-    y = (q1 * np.exp(1j * th)).real + (q2 * np.exp(2j * th)).real
+    y = (q1 * np.exp(1j * th)).real + (q2 * np.exp(2j * th)).real + 1e-6 * np.cos(3 * th + 0.3)
     d = 2 * np.pi * 0.02  # rising edge over +-7.2 deg, then high to 45 deg
     ph = np.mod(th + np.pi, 2 * np.pi) - np.pi
     kp = np.where(np.abs(ph) <= d, 2.5 + 2.5 * ph / d,

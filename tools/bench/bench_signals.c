@@ -90,7 +90,7 @@ static int bench_welch(double secs) {
 
 static int bench_order(void) {
   const double fs = 50000.0, T = 60.0, w1 = 15000 * PI / 30, al = w1 / T;
-  size_t n = (size_t)(T * fs), k, bytes = 0;
+  size_t n = (size_t)(T * fs), k, bytes = 0, cfg;
   double *kp = malloc(n * sizeof *kp), *y[2], t0, t1;
   rcb_order_opts o = {0};
   rcb_order *e = NULL;
@@ -105,23 +105,26 @@ static int bench_order(void) {
     y[0][k] = 1e-5 * cos(phi + 0.2) + 1e-6 * noise();
     y[1][k] = 2e-5 * sin(phi) + 3e-6 * cos(2 * phi) + 1e-6 * noise();
   }
-  o.norders = 2;
   o.trigger = NAN;
   o.bin_width = 50 * PI / 30;
   o.speed_max = 16000 * PI / 30;
-  rcb_order_workspace_size(&o, 2, &bytes);
-  work = malloc(bytes);
-  if (!work) exit(1);
-  t0 = now();
-  if (rcb_order_init(&e, &o, 2, work, bytes) ||
-      rcb_order_add(e, fs, n, kp, (const double *const *)y))
-    exit(1);
-  t1 = now();
-  printf("order tracking: 0 -> 15000 rpm in 60 s at 50 kS/s, keyphasor + 2 responses "
-         "(%zu samples each): %.3f s, %zu revolutions, %.3g samples/s per channel; "
-         "workspace %zu bytes\n", n, t1 - t0, rcb_order_revolutions(e), (double)n / (t1 - t0),
-         bytes);
-  free(work);
+  for (cfg = 0; cfg < 3; cfg++) { /* fit of 8 orders (rcbtool's default), of 2; rev-dft */
+    o.norders = cfg ? 2 : 8;
+    o.method = cfg == 2 ? RCB_ORDER_REV_DFT : RCB_ORDER_FIT;
+    rcb_order_workspace_size(&o, 2, &bytes);
+    work = malloc(bytes);
+    if (!work) exit(1);
+    t0 = now();
+    if (rcb_order_init(&e, &o, 2, work, bytes) ||
+        rcb_order_add(e, fs, n, kp, (const double *const *)y))
+      exit(1);
+    t1 = now();
+    printf("order tracking (%s, %zu orders): 0 -> 15000 rpm in 60 s at 50 kS/s, keyphasor + "
+           "2 responses (%zu samples each): %.3f s, %zu revolutions, %.3g samples/s per "
+           "channel; workspace %zu bytes\n", cfg == 2 ? "rev-dft" : "fit", o.norders, n, t1 - t0,
+           rcb_order_revolutions(e), (double)n / (t1 - t0), bytes);
+    free(work);
+  }
   free(kp);
   free(y[0]);
   free(y[1]);
