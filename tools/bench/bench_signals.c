@@ -174,7 +174,7 @@ static int order_limits(void) {
         rcb_order_opts o = {0};
         rcb_order *e = NULL;
         void *work;
-        o.norders = 2;
+        o.norders = meth ? 2 : 8; /* as rcbtool order's defaults */
         o.trigger = NAN;
         o.bin_width = bins[ib] * PI / 30;
         o.speed_max = 3800 * PI / 30;
