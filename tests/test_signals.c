@@ -726,6 +726,88 @@ static void test_order_kp_edge(void **state) {
   free(y);
 }
 
+/* The joint fit at a low sample rate (issue #25): 6000 -> 9000 rpm in 3 s
+ * at 2000 S/s (13 to 20 samples per revolution), 8 orders asked for. Orders
+ * above 0.45 x the sample rate alias onto the lower ones; they are left out
+ * of a bin's fit (sd NaN) and 1X and 2X stay exact: 2 e^{0.3i} and 0.5 e^{-i}
+ * to 1e-5. The keyphasor is a ramp in the shaft angle (0 at the mark, 2 pi
+ * just before the next), so that its crossing of pi, interpolated between
+ * samples, is nearly exact (3e-6 rad: the angle is quadratic in time); the
+ * mark is angle pi. */
+static void test_order_fit_nyquist(void **state) {
+  enum { N = 3 * 2000 };
+  const double fs = 2000.0, w0 = 6000 * PI / 30, al = 1000 * PI / 30;
+  double *kp = malloc(N * sizeof *kp), *y = malloc(N * sizeof *y);
+  const double *ch[1];
+  rcb_order_opts o;
+  rcb_order *e;
+  size_t bytes, b, n, reported = 0, nr;
+  void *work;
+  (void)state;
+  for (n = 0; n < N; n++) {
+    double t = (double)n / fs, phi = w0 * t + 0.5 * al * t * t;
+    kp[n] = fmod(phi, 2 * PI);
+    y[n] = 2 * cos(phi + 0.3) + 0.5 * cos(2 * phi - 1.0);
+  }
+  ch[0] = y;
+  memset(&o, 0, sizeof o);
+  o.norders = 8;
+  o.trigger = PI;
+  o.kp_angle = PI;
+  o.bin_width = 300 * PI / 30;
+  o.speed_max = 10000 * PI / 30;
+  assert_int_equal(rcb_order_workspace_size(&o, 1, &bytes), RCB_OK);
+  work = malloc(bytes);
+  assert_int_equal(rcb_order_init(&e, &o, 1, work, bytes), RCB_OK);
+  assert_int_equal(rcb_order_add(e, fs, N, kp, ch), RCB_OK);
+  for (b = 0; b < rcb_order_bin_count(e); b++) {
+    rcb_complex q1, q2, q;
+    double sd, speed;
+    size_t m, fitted = 0;
+    rcb_order_result(e, b, 0, 1, &speed, &q1, NULL, &nr);
+    if (nr < 3) continue;
+    reported++;
+    rcb_order_result(e, b, 0, 2, NULL, &q2, NULL, NULL);
+    if (cabs(q1 - 2 * cexp(CMPLX(0, 0.3))) > 1e-5 * 2 ||
+        cabs(q2 - 0.5 * cexp(CMPLX(0, -1.0))) > 1e-5 * 0.5)
+      fail_msg("bin %zu: 1X error %g, 2X error %g", b, cabs(q1 - 2 * cexp(CMPLX(0, 0.3))) / 2,
+               cabs(q2 - 0.5 * cexp(CMPLX(0, -1.0))) / 0.5);
+    for (m = 1; m <= 8; m++) {
+      rcb_order_result(e, b, 0, m, NULL, &q, &sd, NULL);
+      fitted += !isnan(sd);
+    }
+    /* the bin's top speed (plus half a bin: whole revolutions) sets the orders */
+    assert_int_equal(fitted, (size_t)fmin(8.0, floor(0.45 * fs * 60 / (((double)b + 1.5) * 300))));
+    if (b == 29) assert_int_equal(fitted, 5); /* 8700-9000 rpm */
+  }
+  assert_int_equal(reported, 10);
+  /* steady at 8000 rpm, 15 samples per revolution exactly: 8X and 7X are the
+   * same samples, so 8 orders would make the normal matrix singular; 6 are
+   * fitted, and with no speed spread the phasors are constants */
+  for (n = 0; n < N / 2; n++) {
+    double phi = 2 * PI * (double)n / 15.0;
+    kp[n] = fmod(phi, 2 * PI);
+    y[n] = 2 * cos(phi + 0.3) + 0.5 * cos(2 * phi - 1.0);
+  }
+  assert_int_equal(rcb_order_init(&e, &o, 1, work, bytes), RCB_OK);
+  assert_int_equal(rcb_order_add(e, fs, N / 2, kp, ch), RCB_OK);
+  {
+    rcb_complex q1, q2;
+    double sd6, sd7;
+    rcb_order_result(e, 26, 0, 1, NULL, &q1, NULL, &nr);
+    rcb_order_result(e, 26, 0, 2, NULL, &q2, NULL, NULL);
+    rcb_order_result(e, 26, 0, 6, NULL, NULL, &sd6, NULL);
+    rcb_order_result(e, 26, 0, 7, NULL, NULL, &sd7, NULL);
+    assert_int_equal(nr, 198);
+    assert_true(cabs(q1 - 2 * cexp(CMPLX(0, 0.3))) < 1e-9 &&
+                cabs(q2 - 0.5 * cexp(CMPLX(0, -1.0))) < 1e-9);
+    assert_true(!isnan(sd6) && isnan(sd7));
+  }
+  free(work);
+  free(kp);
+  free(y);
+}
+
 /* A slow run-up through a 1X resonance: 2700 -> 3300 rpm at 30 rpm/s, y =
  * Re(Q(w) e^{i theta}) + noise, Q(w) = 1 / (1 - r^2 + 2 i zeta r), r = w /
  * (3000 rpm), zeta 0.05 (half-power band 300 rpm), 20 rpm bins (33
@@ -879,6 +961,7 @@ int main(void) {
       cmocka_unit_test(test_frf_units),
       cmocka_unit_test(test_order_runup),
       cmocka_unit_test(test_order_kp_edge),
+      cmocka_unit_test(test_order_fit_nyquist),
       cmocka_unit_test(test_order_sd_near_resonance),
       cmocka_unit_test(test_uff_time_records),
   };

@@ -243,32 +243,50 @@ RCB_API rcb_status rcb_spectral_frf(rcb_spectral *e, rcb_estimator est, size_t o
 /* --------------------------------------------------- order tracking -- */
 
 /**
- * @brief Order-tracking settings. Method: computed order tracking, one
- * revolution at a time. Keyphasor pulses (upward crossings of @c trigger,
- * or downward with @c kp_falling, interpolated between samples) bound each
- * revolution; its samples are
- * resampled (linear interpolation in time) to @c per_rev equally spaced
- * shaft angles, the angle taken as a quadratic in time through the pulses
- * before, at and after the revolution (constant angular acceleration; Fyfe
- * & Munck 1997, so the first revolution is not reported), and an exact
- * per_rev-point DFT gives the order-m phasor Q_m = (2/N) sum_j y_j
- * e^{-i m theta_j}, y = Re(Q_m e^{i m theta}), theta from the keyphasor mark
- * plus @c kp_angle: arg Q_m is a phase lead (the model's convention; a
- * vibration monitor's phase lag is -arg Q_m, see rcb_meas_set_phase).
- * Revolutions are grouped into speed bins of width @c bin_width; a bin
- * reports the mean phasor, the mean speed and the standard deviation of the
- * mean from the residual of a line in speed through its revolutions (so the
- * response's change across the bin near a resonance is not counted as
- * noise). Limits: an order whose amplitude changes within a revolution leaks
- * into the others, about 0.42 x (speed change per revolution / half-power
- * band) of the peak near a resonance (docs/signals.md has the measured table).
- * Why not Vold-Kalman so far: the per-revolution DFT needs no tuning of a
- * filter bandwidth, runs in O(samples) and gives the revolution-to-revolution
- * scatter that the statistics need.
+ * @brief How a speed bin's order phasors are estimated from its revolutions.
+ *
+ * Both take the revolutions from the keyphasor pulses (upward crossings of
+ * @c trigger, or downward with @c kp_falling, interpolated between samples),
+ * the shaft angle in each as the quadratic in time through the pulses before,
+ * at and after it (constant angular acceleration; Fyfe & Munck 1997, so the
+ * first revolution is not used), theta from the keyphasor mark plus
+ * @c kp_angle, and put each revolution into the speed bin of its mean speed.
+ * The phasor Q_m of order m is such that y = Re(Q_m e^{i m theta}): arg Q_m
+ * is a phase lead (the model's convention; a vibration monitor's phase lag
+ * is -arg Q_m, see rcb_meas_set_phase).
  */
+typedef enum rcb_order_method {
+  /** Joint least squares (issue #25; the default): every sample of the
+   * bin's revolutions, at its own angle (no resampling), fitted with
+   * sum_{m=0..norders} Re(Q_m(u) e^{i m theta}), each Q_m a quadratic in the
+   * sample's speed u across the bin (all orders together, order 0 the
+   * offset). An order that changes within a revolution (a 1X near a
+   * resonance) is modelled instead of leaking into the others, and the
+   * reported phasor, at the bin's mean speed, has no curvature bias. The
+   * bin is the window: its speed width and the run-up rate set how many
+   * revolutions it spans (at least 3 advised). sd: from the fit's residual,
+   * taken as white noise. A bin at one steady speed fits lower degrees. An
+   * order present in the signal and not fitted leaks into the fitted ones
+   * when a bin spans few revolutions (a 5X of 10 % of a 1X resonance's peak,
+   * 4 revolutions per bin: 2X 4 % off with norders 4): fit every order
+   * present (norders up to 8). Orders at or above 0.45 x the sample rate at
+   * a bin's top speed (bin + 1.5 bin widths: whole revolutions) are left out
+   * of its fit (they alias onto lower ones): their Q is 0 and sd NaN. */
+  RCB_ORDER_FIT = 0,
+  /** Per-revolution DFT (before issue #25): each revolution resampled
+   * (linear interpolation) to @c per_rev angles, an exact DFT gives Q_m =
+   * (2/N) sum_j y_j e^{-i m theta_j}, the bin reports the mean over its
+   * revolutions and the sd from their residual about a line in speed. An
+   * order whose amplitude changes within a revolution leaks into the others,
+   * about 0.42 x (speed change per revolution / half-power band) of the peak
+   * near a resonance (docs/signals.md has the measured table). */
+  RCB_ORDER_REV_DFT = 1
+} rcb_order_method;
+
+/** @brief Order-tracking settings (zero-initialise: the joint fit). */
 typedef struct rcb_order_opts {
   size_t norders;   /**< orders 1..norders (1 to 8) */
-  size_t per_rev;   /**< angle samples per revolution (>= 4 norders; 0: 64) */
+  size_t per_rev;   /**< RCB_ORDER_REV_DFT: angle samples per revolution (>= 4 norders; 0: 64) */
   double trigger;   /**< keyphasor threshold in its unit (NaN: halfway between its min and max) */
   double kp_angle;  /**< shaft angle at the keyphasor mark, rad */
   double bin_width; /**< speed bin, rad/s (> 0) */
@@ -277,6 +295,7 @@ typedef struct rcb_order_opts {
   int kp_falling;   /**< 0: revolutions marked by the keyphasor's upward crossings of
                          @c trigger (a projection passing the probe); 1: downward (a
                          notch, as most proximity-probe keyphasors) */
+  rcb_order_method method; /**< RCB_ORDER_FIT (0, default) or RCB_ORDER_REV_DFT */
 } rcb_order_opts;
 
 typedef struct rcb_order rcb_order;
@@ -301,11 +320,16 @@ RCB_API size_t rcb_order_revolutions(const rcb_order *e);
 RCB_API size_t rcb_order_bin_count(const rcb_order *e);
 /**
  * @brief One bin's result for channel @p ch and order @p m (1-based).
- * @param speed mean speed of its revolutions, rad/s
- * @param Q mean phasor (channel unit) @param sd standard deviation of Re Q and
- * of Im Q of the mean, sqrt(sum |Q_r - a - b (w_r - w_mean)|^2 / (2 n (n - 2)))
- * from the line a + b (w - w_mean) fitted through the bin's revolutions
- * (n = 2: sqrt(sum |Q_r - Q|^2 / (2 n (n - 1))), the scatter about the mean)
+ * @param speed RCB_ORDER_FIT: the mean speed of the bin's samples;
+ * RCB_ORDER_REV_DFT: of its revolutions; rad/s
+ * @param Q phasor at that speed (channel unit): RCB_ORDER_FIT the fitted
+ * quadratic there; RCB_ORDER_REV_DFT the mean over the revolutions
+ * @param sd standard deviation of Re Q and of Im Q (the root mean of their
+ * two variances). RCB_ORDER_FIT: sigma^2 c' (X'X)^-1 c from the fit, sigma^2
+ * the residual sum of squares over (samples - parameters). RCB_ORDER_REV_DFT:
+ * sqrt(sum |Q_r - a - b (w_r - w_mean)|^2 / (2 n (n - 2))) from the line
+ * a + b (w - w_mean) fitted through the bin's revolutions (n = 2:
+ * sqrt(sum |Q_r - Q|^2 / (2 n (n - 1))), the scatter about the mean)
  * @param nrev revolutions in the bin (results valid when >= min_revs)
  */
 RCB_API rcb_status rcb_order_result(const rcb_order *e, size_t bin, size_t ch, size_t m,

@@ -1,32 +1,16 @@
 /*
- * Order tracking: keyphasor -> revolutions -> per-revolution resampling to
- * shaft angle -> exact DFT of orders 1..norders -> speed bins with the
- * scatter over revolutions (method and why: rcb_signal.h). Everything in the
- * caller's workspace: [object][twiddles][per-bin sums], nothing allocated.
+ * Order tracking: keyphasor -> revolutions (constant acceleration in each)
+ * -> speed bins, and per bin either the joint least-squares fit of all
+ * orders (order_fit.c, the default) or the exact DFT of each revolution
+ * resampled to shaft angle with the scatter over revolutions (method and
+ * why: rcb_signal.h). Everything in the caller's workspace: [object]
+ * [twiddles][per-bin sums], nothing allocated.
  */
 #include <math.h>
 #include <stdint.h>
 #include <string.h>
 
-#include "signals/signals_internal.h"
-
-/* Per bin, the sums of a least-squares line Q_r = a + b (w_r - w_mean) over
- * its revolutions r (issue #25): the response changes across a bin's speeds
- * near a resonance, and that change is not noise. The sums are taken about
- * the bin's first revolution (w0, Q0), so that the residual is not the small
- * difference of two large sums. */
-struct rcb_order {
-  char errmsg[RCB_ERRMSG_MAX];
-  rcb_order_opts o;
-  size_t nch, nbins, nrevs;
-  rcb_complex *tw;    /* norders * per_rev: e^{-i m (2 pi j / N + kp_angle)} */
-  double *cnt, *wsum; /* nbins: revolutions, sum of speeds (rad/s) */
-  double *w0, *u2sum; /* nbins: first speed, sum (w - w0)^2 */
-  rcb_complex *q0;    /* (bin * nch + ch) * norders + m - 1: the first Q */
-  rcb_complex *dsum;  /* same layout: sum (Q - Q0) */
-  rcb_complex *dusum; /* same layout: sum (Q - Q0) (w - w0) */
-  double *d2sum;      /* same layout: sum |Q - Q0|^2 */
-};
+#include "signals/order_internal.h"
 
 static size_t al16(size_t b) { return (b + 15) & ~(size_t)15; }
 
@@ -35,16 +19,24 @@ static int opts_ok(const rcb_order_opts *o, size_t nch) {
   return o && nch >= 1 && nch <= 4096 && o->norders >= 1 && o->norders <= 8 &&
          per >= 4 * o->norders && per <= 65536 && isfinite(o->bin_width) && o->bin_width > 0.0 &&
          isfinite(o->speed_max) && o->speed_max > 0.0 && o->speed_max / o->bin_width < 1e6 &&
-         isfinite(o->kp_angle);
+         isfinite(o->kp_angle) &&
+         (o->method == RCB_ORDER_FIT || o->method == RCB_ORDER_REV_DFT);
 }
 
+/* [object][twiddles (DFT)][per-bin doubles][per-bin, channel and order sums] */
 static size_t layout(const rcb_order_opts *o, size_t nch, size_t sz[4], size_t *nbins) {
   size_t per = o->per_rev ? o->per_rev : 64, nb = (size_t)ceil(o->speed_max / o->bin_width);
   size_t cells = nb * nch * o->norders;
   sz[0] = sizeof(struct rcb_order);
-  sz[1] = o->norders * per * sizeof(rcb_complex);
-  sz[2] = 4 * nb * sizeof(double) + cells * sizeof(double);
-  sz[3] = 3 * cells * sizeof(rcb_complex);
+  if (o->method == RCB_ORDER_FIT) {
+    sz[1] = 0;
+    sz[3] = rcb_order_fit_bytes(o, nch, nb, &sz[2]);
+    sz[2] += 2 * nb * sizeof(double);
+  } else {
+    sz[1] = o->norders * per * sizeof(rcb_complex);
+    sz[2] = 4 * nb * sizeof(double) + cells * sizeof(double);
+    sz[3] = 3 * cells * sizeof(rcb_complex);
+  }
   *nbins = nb;
   return 16 + al16(sz[0]) + al16(sz[1]) + al16(sz[2]) + al16(sz[3]);
 }
@@ -80,6 +72,15 @@ rcb_status rcb_order_init(rcb_order **out, const rcb_order_opts *o, size_t nch, 
   p += al16(sz[1]);
   e->cnt = (double *)(void *)p;
   e->wsum = e->cnt + nb;
+  if (o->method == RCB_ORDER_FIT) {
+    e->ng = 2 * o->norders + 1;
+    e->ngg = e->ng * (e->ng + 1) / 2;
+    e->mom = e->wsum + nb;
+    p += al16(sz[2]);
+    e->ysum = (double *)(void *)p;
+    *out = e;
+    return RCB_OK;
+  }
   e->w0 = e->wsum + nb;
   e->u2sum = e->w0 + nb;
   e->d2sum = e->u2sum + nb;
@@ -116,6 +117,13 @@ static void revolution(rcb_order *e, double rate, double a, double b, double c,
   if (!(speed < e->o.speed_max) || !(p > 0.0)) return;
   bin = (size_t)floor(speed / e->o.bin_width);
   if (bin >= e->nbins) return;
+  if (e->o.method == RCB_ORDER_FIT) {
+    e->cnt[bin] += 1.0;
+    e->wsum[bin] += speed;
+    e->nrevs++;
+    rcb_order_fit_revolution(e, rate, b, c, p, q, bin, chan);
+    return;
+  }
   first = e->cnt[bin] == 0.0;
   if (first) e->w0[bin] = speed;
   u = speed - e->w0[bin];
@@ -151,6 +159,7 @@ rcb_status rcb_order_add(rcb_order *e, double rate, size_t n, const double *kp,
   if (!e || !kp || !chan || n < 2 || !isfinite(rate) || !(rate > 0.0)) return RCB_ERR_ARG;
   for (c = 0; c < e->nch; c++)
     if (!chan[c]) return rcb_set_error(e->errmsg, RCB_ERR_ARG, "order: channel %zu is NULL", c);
+  if (!(e->rate > 0.0) || rate < e->rate) e->rate = rate;
   trig = e->o.trigger;
   if (isnan(trig)) {
     for (lo = hi = kp[0], i = 1; i < n; i++) {
@@ -192,6 +201,11 @@ rcb_status rcb_order_result(const rcb_order *e, size_t bin, size_t ch, size_t m,
   rcb_complex dbar, sdu;
   if (!e || bin >= e->nbins || ch >= e->nch || m < 1 || m > e->o.norders) return RCB_ERR_ARG;
   n = e->cnt[bin];
+  if (nrev) *nrev = (size_t)n;
+  if (e->o.method == RCB_ORDER_FIT) {
+    rcb_order_fit_result(e, bin, ch, m, speed, Q, sd);
+    return RCB_OK;
+  }
   at = (bin * e->nch + ch) * e->o.norders + m - 1;
   dbar = n > 0.0 ? e->dsum[at] / n : 0.0;
   ubar = n > 0.0 ? e->wsum[bin] / n - e->w0[bin] : 0.0;
@@ -206,6 +220,5 @@ rcb_status rcb_order_result(const rcb_order *e, size_t bin, size_t ch, size_t m,
     *sd = n > 2.0 && suu > 0.0 ? sqrt(fmax(0.0, res) / (2.0 * n * (n - 2.0)))
           : n > 1.0           ? sqrt(fmax(0.0, res) / (2.0 * n * (n - 1.0)))
                               : (double)NAN;
-  if (nrev) *nrev = (size_t)n;
   return RCB_OK;
 }

@@ -11,14 +11,23 @@ const char cli_help_order[] =
     "usage: rcbtool order SIGNALS --kp CH --outputs CH,... -o OUT [options]\n"
     "\n"
     "Order tracking of a run-up or coast-down: the keyphasor's crossings of --trigger\n"
-    "(rising, or falling with --kp-edge falling) mark the revolutions; each\n"
-    "revolution is resampled to 64 shaft angles (the angle a quadratic in time\n"
-    "through three pulses: constant acceleration) and a DFT gives its 1X and 2X\n"
-    "phasors; revolutions are averaged in speed bins, the standard deviation coming\n"
-    "from their scatter about a line in speed. An order whose amplitude changes\n"
-    "within a revolution leaks into the others (near a resonance about 0.4 x the\n"
-    "speed change per revolution / the half-power band: sweep slowly for 2X there;\n"
-    "docs/signals.md). OUT (.uff/.unv: UFF dataset 58, or .csv) holds the 1X\n"
+    "(rising, or falling with --kp-edge falling) mark the revolutions (the shaft\n"
+    "angle a quadratic in time through three pulses: constant acceleration), each\n"
+    "revolution goes to the speed bin of its mean speed, and per bin (--method):\n"
+    "  fit (default) every sample of the bin's revolutions, at its own shaft angle,\n"
+    "      is fitted by least squares with the offset and 1X..8X (--orders) together,\n"
+    "      each phasor a quadratic in speed across the bin, reported at the bin's\n"
+    "      mean speed; the sd from the fit's residual (white noise assumed). Orders are\n"
+    "      separated when they change within a revolution (a 1X resonance does not\n"
+    "      leak into 2X). The bin is the fit's window: keep 3 or more revolutions in\n"
+    "      it (run-up rate in rpm/s x 60 / rpm = rpm per revolution); docs/signals.md\n"
+    "      gives the measured errors against bin width and run-up rate\n"
+    "  rev-dft  each revolution resampled to 64 angles and its DFT taken (1X, 2X),\n"
+    "      averaged over the bin, the sd from the revolutions' scatter about a line\n"
+    "      in speed (before issue #25). An order that changes within a revolution\n"
+    "      leaks into the others: near a resonance about 0.4 x (speed change per\n"
+    "      revolution / half-power band) of the peak 1X shows at 2X\n"
+    "OUT (.uff/.unv: UFF dataset 58, or .csv) holds the 1X\n"
     "responses as an unbalance-response measurement (Bode/polar data) that compare,\n"
     "fit and diagnose read; the phase is relative to the keyphasor mark (plus\n"
     "--kp-angle), as the model's unbalance angles are relative to the rotor's angle 0.\n"
@@ -44,6 +53,13 @@ const char cli_help_order[] =
     "                 the CSV written presents the phase (.csv only: UFF holds the\n"
     "                 model's complex values)\n"
     "  --min-revs N   revolutions a bin needs (default 3)\n"
+    "  --method M     fit (default) or rev-dft: how a bin's orders are estimated (above)\n"
+    "  --orders N     fit: orders fitted together, 1X..NX (2 to 8, default 8; those\n"
+    "                 above 0.45 x the sample rate left out); an order in the signal\n"
+    "                 and not fitted leaks into 1X and 2X when a bin holds few\n"
+    "                 revolutions (a 5X of 10 % of the peak 1X, 4 revolutions per\n"
+    "                 bin: 2X 4.1 % off with N = 4, 0.09 % with 8); 1X and 2X are\n"
+    "                 written\n"
     "  --order2 FILE  write the 2X responses there too (same format as OUT)\n"
     "  --stats FILE   CSV: rpm, revolutions, per channel '<CH> 1X sd' and '<CH> 2X sd'\n"
     "                 (m, of Re and of Im of the bin's mean phasor)\n"
@@ -57,10 +73,11 @@ const char cli_help_order[] =
 
 static const char *const edge_names[] = {"rising", "falling"};
 static const char *const phase_names[] = {"lead", "lag"};
+static const char *const method_names[] = {"fit", "rev-dft"}; /* as rcb_order_method */
 
 typedef struct ord_job {
   const cli_args *a;
-  int edge, lag; /* --kp-edge falling, --phase lag */
+  int edge, lag, method; /* --kp-edge falling, --phase lag, --method */
   rcb_signals *sig;
   char *buf;
   char *names[257], *model[257]; /* [0] keyphasor */
@@ -108,7 +125,7 @@ static int ord_channels(ord_job *j) {
 
 static int ord_track(ord_job *j) {
   double w = 50.0, rmax = 20000.0, kpa = 0.0;
-  size_t bytes = 0, minrev = 3, i;
+  size_t bytes = 0, minrev = 3, nord = 8, i;
   const double *kp, **ch = calloc(j->q, sizeof *ch);
   rcb_status st;
   int rc;
@@ -119,8 +136,10 @@ static int ord_track(ord_job *j) {
       (rc = cli_opt_nonneg(j->a, "--rpm-max", "rpm", 20000.0, &rmax)) ||
       (rc = cli_opt_double(j->a, "--kp-angle", "deg", 0.0, &kpa)) ||
       (rc = cli_opt_count(j->a, "--min-revs", 3, &minrev)) ||
+      (rc = cli_opt_count(j->a, "--orders", 8, &nord)) ||
       (rc = cli_opt_choice(j->a, "--kp-edge", edge_names, 2, 0, &j->edge)) ||
       (rc = cli_opt_choice(j->a, "--phase", phase_names, 2, 0, &j->lag)) ||
+      (rc = cli_opt_choice(j->a, "--method", method_names, 2, 0, &j->method)) ||
       (cli_opt_value(j->a, "--trigger") &&
        (rc = cli_opt_double(j->a, "--trigger", "", 0.0, &j->o.trigger)))) {
     free(ch);
@@ -130,12 +149,17 @@ static int ord_track(ord_job *j) {
     free(ch);
     return cli_usage(j->a->cmd, "--bin-rpm must be > 0 and below --rpm-max");
   }
-  j->o.norders = 2;
+  if (nord < 2 || nord > 8) {
+    free(ch);
+    return cli_usage(j->a->cmd, "--orders must be 2 to 8 (1X and 2X are written)");
+  }
+  j->o.norders = j->method ? 2 : nord;
   j->o.bin_width = w * CLI_RPM_TO_RAD_S;
   j->o.speed_max = rmax * CLI_RPM_TO_RAD_S;
   j->o.kp_angle = kpa * CLI_PI / 180.0;
   j->o.min_revs = minrev;
   j->o.kp_falling = j->edge;
+  j->o.method = j->method ? RCB_ORDER_REV_DFT : RCB_ORDER_FIT;
   if (rcb_order_workspace_size(&j->o, j->q, &bytes) || !(j->work = malloc(bytes)) ||
       rcb_order_init(&j->e, &j->o, j->q, j->work, bytes)) {
     free(ch);
@@ -321,7 +345,8 @@ int cmd_order(int argc, char **argv) {
                     {"--wav-names", "LIST", NULL}, {"--wav-units", "LIST", NULL},
                     {"--wav-scale", "LIST", NULL}, {"--plot", "FILE.png", NULL},
                     {"--units", "CH=UNIT,...", NULL}, {"--allow-truncated", NULL, NULL},
-                    {"--kp-edge", "E", NULL},     {"--phase", "P", NULL}};
+                    {"--kp-edge", "E", NULL},     {"--phase", "P", NULL},
+                    {"--method", "M", NULL},      {"--orders", "N", NULL}};
   static const cli_file_opt files[] = {
       {"--order2", CLI_IO_OUT}, {"--stats", CLI_IO_OUT}, {"--plot", CLI_IO_OUT | CLI_IO_MKDIR}};
   cli_args a;
