@@ -553,16 +553,28 @@ cmd_fuzz() {
     > "$dir/configure.log" 2>&1 || { cat "$dir/configure.log"; die "cmake configure failed in $dir"; }
   cmake --build "$dir" -j "$JOBS"
   mkdir -p "$dir/crashes"
+  # the three harnesses at once (each one process on one core, for a fixed
+  # time: together they take the time of one); each writes its own log
+  local pids=() t_of=()
+  say "fuzz_ini, fuzz_csv, fuzz_uff at once: replay fuzz/corpus/NAME, then ${secs} s each"
   for t in ini csv uff; do
-    say "fuzz_$t: replay fuzz/corpus/$t, then ${secs} s"
     rm -rf "$dir/work_$t"
     cp -r "fuzz/corpus/$t" "$dir/work_$t"
-    UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 "$dir/fuzz/fuzz_$t" -runs=0 \
-      "fuzz/corpus/$t" 2>&1 | tail -n 1 || rc=1
-    UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 "$dir/fuzz/fuzz_$t" "$dir/work_$t" \
-      -max_total_time="$secs" -max_len=8192 -timeout=10 -rss_limit_mb=2048 \
-      -artifact_prefix="$dir/crashes/fuzz_${t}-" -print_final_stats=1 > "$dir/fuzz_$t.log" 2>&1 || rc=1
-    grep -E '^stat::number_of_executed_units|^SUMMARY' "$dir/fuzz_$t.log" || true
+    (
+      UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 "$dir/fuzz/fuzz_$t" -runs=0 \
+        "fuzz/corpus/$t" > "$dir/replay_$t.log" 2>&1 &&
+        UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 "$dir/fuzz/fuzz_$t" "$dir/work_$t" \
+          -max_total_time="$secs" -max_len=8192 -timeout=10 -rss_limit_mb=2048 \
+          -artifact_prefix="$dir/crashes/fuzz_${t}-" -print_final_stats=1 > "$dir/fuzz_$t.log" 2>&1
+    ) &
+    pids+=($!)
+    t_of+=("$t")
+  done
+  for i in "${!pids[@]}"; do
+    t=${t_of[$i]}
+    wait "${pids[$i]}" || rc=1
+    echo "fuzz_$t: replay: $(tail -n 1 "$dir/replay_$t.log")"
+    grep -E '^stat::number_of_executed_units|^SUMMARY' "$dir/fuzz_$t.log" 2> /dev/null || true
   done
   ((rc == 0)) || die "a fuzzer failed: see $dir/fuzz_*.log and $dir/crashes/ (reproduce: $dir/fuzz/fuzz_NAME FILE)"
   say "fuzz smoke passed (crash-free, ${secs} s per harness)"
