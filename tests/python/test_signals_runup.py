@@ -11,8 +11,10 @@ about 0.4 % (at 500 rpm/s 0.7 %), the physics of a sweep, not an error of
 the tracking. The integration takes minutes (16 min wall on the shared
 2-core machine where it was measured); at --rtol 1e-6 --atol 1e-11,1e-8
 (the defaults are 1e-7 and 1e-13,1e-10; 0.6 of the CPU on a 3 s run-up)
-the worst bin away from the criticals is within 0.25 % and 0.3 deg (DB.x),
-inside the 1 % and 1 degree asserted, and the peak lag is 0.36-0.38 %.
+the worst bin away from the criticals is within 0.16 % and 0.19 deg with
+`order`'s default (the least-squares fit of 8 orders; 0.25 % and 0.3 deg with
+--method rev-dft), inside the 1 % and 1 degree asserted, and the peak lag is
+0.38 %.
 """
 
 import csv
