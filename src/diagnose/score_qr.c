@@ -94,7 +94,10 @@ rcb_status rcb_diag_basis_init(rcb_diag *d, diag_basis *b, const double *J0, siz
     return rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory (score test)");
   b->rt = b->qr + n * (nb ? nb : 1), b->r2 = b->rt + n, b->tau = b->r2 + n;
   b->tau_c = b->tau + nb;
-  lwork = work_query(n, ncol, ncol, b->qr, b->tau);
+  /* at most n reflectors on n rows (DORMQR's argument 5: 1 channel x 21
+   * points with 88 columns asked for 88, an illegal argument that LAPACK's
+   * xerbla printed) */
+  lwork = work_query(n, ncol < n ? ncol : n, ncol, b->qr, b->tau);
   if (!lwork) {
     rcb_diag_basis_free(d, b);
     return rcb_diag_fail(d, RCB_ERR_LAPACK, "score test: LAPACK workspace query failed");
