@@ -1,6 +1,6 @@
 /*
- * rcb_strtod (core/numparse.c) against the C library's strtod: the same
- * value bit for bit, the same end pointer and the same errno, over a fixed
+ * rcb_strtod and rcb_strtod_in (core/numparse.c) against the C library's
+ * strtod: the same value bit for bit, the same end pointer and the same errno, over a fixed
  * set of awkward spellings and a million fuzzed ones (fixed seed): random
  * digit counts with leading zeros, signs, e/E exponents with +/-, leading and
  * trailing '.', 17-20 significant digits, printf'd doubles of every
@@ -35,23 +35,36 @@ static uint64_t next(rng *r) { /* splitmix64 */
 
 static int below(rng *r, int n) { return (int)(next(r) % (uint64_t)n); }
 
-/* 1 when rcb_strtod and strtod agree on s; prints the first disagreement. */
+static int same(const char *s, const char *what, double a, ptrdiff_t ea, int erra, double b,
+                ptrdiff_t eb, int errb) {
+  if (memcmp(&a, &b, sizeof a) == 0 && ea == eb && erra == errb) return 1;
+  print_error("'%s': %s %.17g (end +%td, errno %d), strtod %.17g (end +%td, errno %d)\n", s,
+              what, a, ea, erra, b, eb, errb);
+  return 0;
+}
+
+/* 1 when rcb_strtod, rcb_strtod_in (the string followed by digits up to its
+ * lim, which it must not take as part of the number) and strtod agree on s;
+ * prints a disagreement. */
 static int agree(const char *s) {
-  char *e1, *e2;
-  double a, b;
-  int err1, err2;
+  char *e1, *e2, *e3, pad[1100];
+  double a, b, c;
+  int err1, err2, err3;
+  size_t n = strlen(s);
+  assert_true(n < sizeof pad);
+  memset(pad, '7', sizeof pad);
+  memcpy(pad, s, n + 1);
   errno = 0;
   a = rcb_strtod(s, &e1);
   err1 = errno;
   errno = 0;
+  c = rcb_strtod_in(pad, pad + sizeof pad, &e3);
+  err3 = errno;
+  errno = 0;
   b = strtod(s, &e2);
   err2 = errno;
-  if (memcmp(&a, &b, sizeof a) != 0 || e1 != e2 || err1 != err2) {
-    print_error("'%s': rcb_strtod %.17g (end +%td, errno %d), strtod %.17g (end +%td, "
-                "errno %d)\n", s, a, e1 - s, err1, b, e2 - s, err2);
-    return 0;
-  }
-  return 1;
+  return same(s, "rcb_strtod", a, e1 - s, err1, b, e2 - s, err2) &&
+         same(s, "rcb_strtod_in", c, e3 - pad, err3, b, e2 - s, err2);
 }
 
 static void test_fixed_spellings(void **state) {
@@ -76,6 +89,19 @@ static void test_fixed_spellings(void **state) {
   int k;
   (void)state;
   for (i = 0; i < sizeof cases / sizeof *cases; i++) bad += !agree(cases[i]);
+  /* a byte next to the digits ('0' - 1, '9' + 1 .. '9' + 6) at each place of
+   * an eight-digit block */
+  for (j = 0; j < 8; j++) {
+    static const char near[] = "/:;<=>?";
+    for (i = 0; near[i]; i++) {
+      snprintf(buf, sizeof buf, "0.1234567890123456789");
+      buf[2 + j] = near[i];
+      bad += !agree(buf);
+      snprintf(buf, sizeof buf, "12345678901234567");
+      buf[j + 1] = near[i];
+      bad += !agree(buf);
+    }
+  }
   /* every power of ten of the exact paths' table (|k| <= 44) and past it */
   for (j = 0; j < sizeof mantissas / sizeof *mantissas; j++)
     for (k = -70; k <= 70; k++) {

@@ -199,58 +199,86 @@ static int dd_scale(uint64_t m, int k, double *out) {
 
 static int is_digit(char c) { return (unsigned)(c - '0') < 10u; }
 
-/* The value of 8 digits s[0..7] (s[0] the most significant), as 4 pairs, 2
- * quads, then the whole in one 64-bit word: 3 multiplications instead of a
- * chain of 8. The bytes are assembled explicitly, so any byte order works. */
-static uint64_t eight_digits(const char *s) {
-  uint64_t v = 0;
-  int i;
-  for (i = 7; i >= 0; i--) v = (v << 8) | (unsigned char)s[i];
-  v -= 0x3030303030303030ull;                                  /* byte i: digit i */
-  v = (v * 10u + (v >> 8)) & 0x00FF00FF00FF00FFull;            /* pairs */
-  v = (v * 100u + (v >> 16)) & 0x0000FFFF0000FFFFull;          /* quads */
+/* Bytes s[0..7] as one word, s[0] the lowest byte (assembled explicitly, so
+ * any byte order works; compilers make it one load). */
+static uint64_t load8(const char *s) {
+  const unsigned char *u = (const unsigned char *)s;
+  return (uint64_t)u[0] | (uint64_t)u[1] << 8 | (uint64_t)u[2] << 16 | (uint64_t)u[3] << 24 |
+         (uint64_t)u[4] << 32 | (uint64_t)u[5] << 40 | (uint64_t)u[6] << 48 |
+         (uint64_t)u[7] << 56;
+}
+
+/* Each byte of w is '0'..'9': high nibble 3, and still 3 after adding 6. */
+static int eight_are_digits(uint64_t w) {
+  const uint64_t hi = 0xF0F0F0F0F0F0F0F0ull, three = 0x3030303030303030ull;
+  return (w & hi) == three && ((w + 0x0606060606060606ull) & hi) == three;
+}
+
+/* The value of 8 digit bytes (first byte the most significant): 4 pairs,
+ * 2 quads, then the whole, in 3 multiplications instead of a chain of 8. */
+static uint64_t eight_value(uint64_t w) {
+  uint64_t v = w - 0x3030303030303030ull;
+  v = (v * 10u + (v >> 8)) & 0x00FF00FF00FF00FFull;
+  v = (v * 100u + (v >> 16)) & 0x0000FFFF0000FFFFull;
   return (v * 10000u + (v >> 32)) & 0xFFFFFFFFull;
 }
 
-/* m after appending the n digits at s (the result below 10^19). */
-static uint64_t append_digits(uint64_t m, const char *s, size_t n) {
-  for (; n >= 8; s += 8, n -= 8) m = m * 100000000u + eight_digits(s);
-  for (; n > 0; s++, n--) m = m * 10u + (uint64_t)(*s - '0');
-  return m;
+/* Appends the digits at *pp to *m, *nd the significant digits so far: 0, or
+ * -1 past 19 of them. Eight at a time while [*pp, lim) holds eight bytes. */
+static int take_digits(const char **pp, const char *lim, uint64_t *m, int *nd) {
+  const char *p = *pp;
+  uint64_t v = *m;
+  int n = *nd;
+  while (n <= 11 && lim - p >= 8) {
+    uint64_t w = load8(p);
+    if (!eight_are_digits(w)) break;
+    v = v * 100000000u + eight_value(w);
+    p += 8;
+    n += 8;
+  }
+  for (; is_digit(*p); p++, n++) {
+    if (n == 19) return -1;
+    v = v * 10u + (uint64_t)(*p - '0');
+  }
+  *pp = p;
+  *m = v;
+  *nd = n;
+  return 0;
 }
 
-double rcb_strtod(const char *str, char **endp) {
-  const char *p = str, *lead, *ip, *fp = NULL;
-  size_t ni, nf = 0, fz = 0; /* integer digits, fraction digits, fraction's leading zeros */
-  uint64_t m;
-  int k, neg = 0, any;
+double rcb_strtod(const char *str, char **endp) { return rcb_strtod_in(str, NULL, endp); }
+
+double rcb_strtod_in(const char *str, const char *lim, char **endp) {
+  const char *p = str, *q;
+  uint64_t m = 0;
+  int k = 0, nd = 0, neg = 0, any;
   double v;
   if (!NUMPARSE_FAST) return strtod(str, endp);
+  if (!lim) lim = str;
   while (*p == ' ' || *p == '\t') p++;
   if (*p == '-' || *p == '+') neg = *p++ == '-';
   if (p[0] == '0' && (p[1] == 'x' || p[1] == 'X')) return strtod(str, endp);
-  lead = p;
+  q = p;
   while (*p == '0') p++;
-  ip = p;
-  while (is_digit(*p)) p++;
-  ni = (size_t)(p - ip);
-  any = p > lead;
+  if (take_digits(&p, lim, &m, &nd)) return strtod(str, endp);
+  any = p > q;
   if (*p == '.') {
-    const char *q = ++p;
-    if (ni == 0)
+    const char *f = ++p;
+    int n0;
+    if (nd == 0) {
       while (*p == '0') p++;
-    fz = (size_t)(p - q);
-    fp = p;
-    while (is_digit(*p)) p++;
-    nf = (size_t)(p - fp);
-    any = any || p > q;
+      if (p - f > 400) return strtod(str, endp); /* k stays far from INT_MIN */
+      k = -(int)(p - f);
+    }
+    n0 = nd;
+    if (take_digits(&p, lim, &m, &nd)) return strtod(str, endp);
+    k -= nd - n0;
+    any = any || p > f;
   }
-  if (!any || ni + nf > 19 || fz > 400) return strtod(str, endp); /* inf, nan, ".", long */
-  m = append_digits(append_digits(0, ip, ni), fp, nf);
-  k = -(int)(fz + nf);
+  if (!any) return strtod(str, endp); /* inf, nan, ".", "" */
   if (*p == 'e' || *p == 'E') {
-    const char *q = p + 1;
     int eneg = 0, e = 0;
+    q = p + 1;
     if (*q == '-' || *q == '+') eneg = *q++ == '-';
     if (!is_digit(*q)) return strtod(str, endp); /* "1e": strtod ends before the e */
     for (; is_digit(*q); q++)

@@ -180,7 +180,7 @@ static rcb_status parse_row(csv_state *C, char *l, size_t r, double *t, double *
   for (k = 0; k <= C->ncol; k++) {
     double x;
     errno = 0;
-    x = rcb_strtod(q, &endp);
+    x = rcb_strtod_in(q, C->buf + C->cap + 1, &endp);
     if (endp == q || errno == ERANGE || !isfinite(x))
       return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s:%zu: field %zu is not a finite "
                               "number", C->path, C->line, k + 1);

@@ -10,7 +10,8 @@ job: H1 of the 7 responses to the force, with coherence, 4096-point Hann
 segments, 50 % overlap (rcbtool's defaults; SciPy: welch(x), csd(x, y),
 welch(y) per response, as scipy.signal.coherence calls them). Times are the
 best of --repeat runs of the whole process (rcbtool) or of load + estimate
-(SciPy), wall clock. Also checks that the '%.18e' CSV and the WAV give the
+(SciPy), as wall clock and as CPU time (user + sys: on a shared machine the
+steadier figure; the ratios use it). Also checks that the '%.18e' CSV and the WAV give the
 same output bytes (the CSV numbers read back exactly).
 
     python tools/bench/bench_csv.py build/tools/rcbtool [--repeat 5]
@@ -18,6 +19,7 @@ same output bytes (the CSV numbers read back exactly).
 
 import argparse
 import os
+import resource
 import subprocess
 import tempfile
 import time
@@ -61,12 +63,16 @@ def rcbtool_run(exe, path, out):
     if path.endswith(".wav"):
         cmd += ["--wav-names", ",".join(NAMES), "--wav-units", ",".join(UNITS),
                 "--wav-scale", ",".join(["1"] * 8)]
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     subprocess.run(cmd, check=True, capture_output=True)
-    return time.perf_counter() - t0
+    t1 = time.perf_counter()
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return t1 - t0, (r1.ru_utime + r1.ru_stime) - (r0.ru_utime + r0.ru_stime)
 
 
 def scipy_run(path):
+    c0 = time.process_time()
     t0 = time.perf_counter()
     data = np.loadtxt(path, delimiter=",", skiprows=2)
     x = data[:, 1]
@@ -76,7 +82,13 @@ def scipy_run(path):
         _, pxy = signal.csd(x, data[:, i], **kw)
         _, pyy = signal.welch(data[:, i], **kw)
         _h1, _coh = pxy / pxx, np.abs(pxy) ** 2 / (pxx * pyy)
-    return time.perf_counter() - t0
+    return time.perf_counter() - t0, time.process_time() - c0
+
+
+def best(runs):
+    """(best wall time, best CPU time) over runs of (wall, cpu)."""
+    runs = list(runs)
+    return min(r[0] for r in runs), min(r[1] for r in runs)
 
 
 def main():
@@ -90,19 +102,22 @@ def main():
         rcb, outs = {}, {}
         for label, p in paths.items():
             outs[label] = os.path.join(d, "out_" + os.path.basename(p) + ".csv")
-            rcb[label] = min(rcbtool_run(a.rcbtool, p, outs[label]) for _ in range(a.repeat))
-        sp = {label: min(scipy_run(p) for _ in range(max(1, a.repeat // 2)))
+            rcb[label] = best(rcbtool_run(a.rcbtool, p, outs[label]) for _ in range(a.repeat))
+        sp = {label: best(scipy_run(p) for _ in range(max(1, a.repeat // 2)))
               for label, p in paths.items() if label.startswith("csv")}
         same = open(outs["csv %.18e"], "rb").read() == open(outs["wav float64"], "rb").read()
         print(f"record: {a.seconds:g} s, 8 channels at {FS:g} S/s; best of {a.repeat} "
               f"(SciPy: of {max(1, a.repeat // 2)}); SciPy {scipy.__version__}, "
               f"NumPy {np.__version__}")
+        print("wall s / CPU s (user + sys) of the whole run; ratios of CPU time")
         for label, p in paths.items():
             mb = os.path.getsize(p) / 1e6
-            line = f"{label:12s} {mb:5.1f} MB  rcbtool estimate {rcb[label]:.3f} s"
+            w, c = rcb[label]
+            line = f"{label:12s} {mb:5.1f} MB  rcbtool estimate {w:.3f} / {c:.3f} s"
             if label in sp:
-                line += (f"  SciPy+loadtxt {sp[label]:.3f} s  ({sp[label] / rcb[label]:.1f}x, "
-                         f"goal 3x)  vs WAV {rcb[label] / rcb['wav float64']:.2f}x (goal <= 2)")
+                line += (f"  SciPy+loadtxt {sp[label][0]:.3f} / {sp[label][1]:.3f} s  "
+                         f"({sp[label][1] / c:.1f}x faster, goal 3x)  "
+                         f"{c / rcb['wav float64'][1]:.2f}x the WAV run (goal <= 2)")
             print(line)
         print(f"'%.18e' CSV and WAV give the same output bytes: {same}")
         if not same:
