@@ -18,6 +18,9 @@
  *  3. Everything else (20 or more significant digits, larger exponents, hex,
  *     inf, nan, leading white space other than blanks, "1e" with no exponent
  *     digits, x87 arithmetic): strtod on the same bytes, not copied.
+ * Digits are read eight at a time (one word: checked, then valued in three
+ * multiplications) where the caller says the bytes past the field are
+ * readable (rcb_strtod_in: the CSV reader's buffer), one at a time otherwise.
  * The results of paths 1 and 2 are normal doubles, so strtod would not set
  * errno there either; tests/test_numparse.c checks value, end and errno
  * against strtod over a million fuzzed spellings.

@@ -173,11 +173,11 @@ static rcb_status apply_units(csv_state *C) {
   return RCB_OK;
 }
 
-/* One row of numbers into t[r] and v[k][r]. */
-static rcb_status parse_row(csv_state *C, char *l, size_t r, double *t, double **v) {
+/* One row of numbers into t[r] and v[k][r], k < nc (the channel columns). */
+static rcb_status parse_row(csv_state *C, size_t nc, char *l, size_t r, double *t, double **v) {
   char *q = l, *endp;
   size_t k;
-  for (k = 0; k <= C->ncol; k++) {
+  for (k = 0; k <= nc; k++) {
     double x;
     errno = 0;
     x = rcb_strtod_in(q, C->buf + C->cap + 1, &endp);
@@ -189,13 +189,13 @@ static rcb_status parse_row(csv_state *C, char *l, size_t r, double *t, double *
                               "the largest sample librcb takes (its power would overflow); "
                               "a corrupt field?", C->path, C->line, k + 1, x, RCB_SIGNAL_MAX);
     while (*endp == ' ' || *endp == '\t') endp++;
-    if (k < C->ncol && *endp != ',')
+    if (k < nc && *endp != ',')
       return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s:%zu: %zu fields; expected %zu (time "
-                              "and %zu channels)", C->path, C->line, k + 1, C->ncol + 1,
-                              C->ncol);
-    if (k == C->ncol && *endp != '\0')
+                              "and %zu channels)", C->path, C->line, k + 1, nc + 1,
+                              nc);
+    if (k == nc && *endp != '\0')
       return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s:%zu: more than %zu fields", C->path,
-                              C->line, C->ncol + 1);
+                              C->line, nc + 1);
     if (k == 0)
       t[r] = x;
     else
@@ -207,6 +207,7 @@ static rcb_status parse_row(csv_state *C, char *l, size_t r, double *t, double *
 
 /* Every row, the arrays doubled as they fill: *nrows rows. */
 static rcb_status parse_rows(csv_state *C, double **t, double **v, size_t *nrows) {
+  const size_t nc = C->ncol;
   size_t r = 0, cap = 0, k;
   char *l;
   rcb_status st;
@@ -218,7 +219,7 @@ static rcb_status parse_rows(csv_state *C, double **t, double **v, size_t *nrows
       size_t c = cap;
       if (rcb_grow(&C->s->alloc, (void **)t, &c, r + 1, sizeof **t))
         return rcb_signals_fail(C->s, RCB_ERR_NOMEM, "%s:%zu: out of memory", C->path, C->line);
-      for (k = 0; k < C->ncol; k++) {
+      for (k = 0; k < nc; k++) {
         size_t ck = cap;
         if (rcb_grow(&C->s->alloc, (void **)&v[k], &ck, r + 1, sizeof **v))
           return rcb_signals_fail(C->s, RCB_ERR_NOMEM, "%s:%zu: out of memory", C->path,
@@ -226,7 +227,7 @@ static rcb_status parse_rows(csv_state *C, double **t, double **v, size_t *nrows
       }
       cap = c;
     }
-    if ((st = parse_row(C, l, r, *t, v))) return st;
+    if ((st = parse_row(C, nc, l, r, *t, v))) return st;
     r++;
   }
   *nrows = r;

@@ -11,7 +11,7 @@ segments, 50 % overlap (rcbtool's defaults; SciPy: welch(x), csd(x, y),
 welch(y) per response, as scipy.signal.coherence calls them). Times are the
 best of --repeat runs of the whole process (rcbtool) or of load + estimate
 (SciPy), as wall clock and as CPU time (user + sys: on a shared machine the
-steadier figure; the ratios use it). Also checks that the '%.18e' CSV and the WAV give the
+steadier figure; the ratios use it); the rcbtool runs are interleaved. Also checks that the '%.18e' CSV and the WAV give the
 same output bytes (the CSV numbers read back exactly).
 
     python tools/bench/bench_csv.py build/tools/rcbtool [--repeat 5]
@@ -99,10 +99,13 @@ def main():
     a = ap.parse_args()
     with tempfile.TemporaryDirectory() as d:
         paths = write_files(d, *make_record(a.seconds))
-        rcb, outs = {}, {}
-        for label, p in paths.items():
-            outs[label] = os.path.join(d, "out_" + os.path.basename(p) + ".csv")
-            rcb[label] = best(rcbtool_run(a.rcbtool, p, outs[label]) for _ in range(a.repeat))
+        outs = {label: os.path.join(d, "out_" + os.path.basename(p) + ".csv")
+                for label, p in paths.items()}
+        runs = {label: [] for label in paths}
+        for _ in range(a.repeat):  # interleaved, so that the machine's load falls on all
+            for label, p in paths.items():
+                runs[label].append(rcbtool_run(a.rcbtool, p, outs[label]))
+        rcb = {label: best(r) for label, r in runs.items()}
         sp = {label: best(scipy_run(p) for _ in range(max(1, a.repeat // 2)))
               for label, p in paths.items() if label.startswith("csv")}
         same = open(outs["csv %.18e"], "rb").read() == open(outs["wav float64"], "rb").read()
