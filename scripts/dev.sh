@@ -540,7 +540,7 @@ cmd_diag_success() {
 # libFuzzer smoke: every seed replayed, then FUZZ_SECONDS of fuzzing per
 # harness on a scratch copy of the corpus (fuzz/corpus stays as committed).
 # Not part of `test`: it needs clang with its runtime (Debian: clang,
-# libclang-rt-14-dev) and takes FUZZ_SECONDS x 3 plus a build.
+# libclang-rt-14-dev) and takes FUZZ_SECONDS x 4 plus a build.
 cmd_fuzz() {
   local dir=$BUILD_DIR-fuzz secs=${FUZZ_SECONDS:-30} t rc=0
   command -v clang > /dev/null ||
@@ -553,11 +553,11 @@ cmd_fuzz() {
     > "$dir/configure.log" 2>&1 || { cat "$dir/configure.log"; die "cmake configure failed in $dir"; }
   cmake --build "$dir" -j "$JOBS"
   mkdir -p "$dir/crashes"
-  # the three harnesses at once (each one process on one core, for a fixed
-  # time: together they take the time of one); each writes its own log
+  # the four harnesses at once (each one process on one core, for a fixed
+  # time: together they take the time of two); each writes its own log
   local pids=() t_of=()
-  say "fuzz_ini, fuzz_csv, fuzz_uff at once: replay fuzz/corpus/NAME, then ${secs} s each"
-  for t in ini csv uff; do
+  say "fuzz_ini, fuzz_csv, fuzz_uff, fuzz_strtod at once: replay fuzz/corpus/NAME, then ${secs} s each"
+  for t in ini csv uff strtod; do
     rm -rf "$dir/work_$t"
     cp -r "fuzz/corpus/$t" "$dir/work_$t"
     (

@@ -56,6 +56,15 @@ rcb_status rcb_set_error(char *buf, rcb_status st, const char *fmt, ...)
 #endif
 #define rcb_fail(obj, st, ...) rcb_set_error((obj)->errmsg, (st), __VA_ARGS__)
 
+/* ---- core/numparse.c ---- */
+/* strtod(str, endp) as in the "C" locale, bit for bit (value, *endp, errno),
+ * fast on plain decimals of up to 19 significant digits: the text readers'
+ * number parser (no allocation, no copy). */
+double rcb_strtod(const char *str, char **endp);
+/* The same, reading eight bytes at a time where they lie before lim: the
+ * end of the memory readable from str (past the string's NUL; NULL: none). */
+double rcb_strtod_in(const char *str, const char *lim, char **endp);
+
 /* ---- core/text.c ---- */
 /* Case-insensitive Levenshtein distance of two names ((size_t)-1 beyond 160
  * characters), for "did you mean" suggestions. */

@@ -77,7 +77,7 @@ static int parse_num(const char *s, double *v) {
   char *end;
   if (!*s) return -1;
   errno = 0;
-  *v = strtod(s, &end);
+  *v = rcb_strtod(s, &end); /* strtod, bit for bit (core/numparse.c) */
   return (*end != '\0' || errno == ERANGE) ? -1 : 0;
 }
 
