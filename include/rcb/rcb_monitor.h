@@ -229,6 +229,20 @@ typedef struct rcb_monitor_tracked {
                             sqrt(stderr_^2 + the baseline's variance) */
   double change;       /**< value - baseline, parameter units */
   double change_lo, change_hi; /**< its 95 % interval: change -+ 1.96 stderr_ */
+  int named;           /**< while cusum_alarm: whether the accumulated change is
+                            this parameter's (the attribution in the method
+                            above, by the one rule of rcb_monitor_named): 1 this
+                            parameter alone (also when there is no candidate to
+                            compare, rival_dof 0); 0 this parameter or candidate
+                            rival, not separable on these channels; -1 candidate
+                            rival, told apart from this parameter. 1 without
+                            an alarm */
+  size_t rival;        /**< the candidate that explains the accumulated change
+                            best (index as rcb_monitor_candidate.index) */
+  size_t rival_dof;    /**< its parameters (0: no candidate compared) */
+  double rival_rate[RCB_MONITOR_MAXP]; /**< its parameters' change per update
+                            over the window, parameter units per update (its
+                            sign: rising or falling) */
 } rcb_monitor_tracked;
 
 /** @brief What one update found. Plain value type, owns nothing. */
@@ -249,6 +263,17 @@ typedef struct rcb_monitor_result {
   rcb_monitor_candidate top[RCB_MONITOR_TOP]; /**< best first (smallest p) */
   size_t ntracked;    /**< tracked parameters */
   rcb_monitor_tracked tracked[RCB_MONITOR_MAX_TRACKED];
+  /* the drift test (the method above): the candidate whose drift is best
+   * supported, whether or not it alarms */
+  double drift_glr;   /**< its window GLR (-), chi-square(drift_dof) for one onset */
+  size_t drift_dof;   /**< its degrees of freedom (0: no candidate scored) */
+  double drift_p;     /**< its p-value over every candidate and onset (-):
+                           Bonferroni, min(1, p x candidates x window) */
+  int drift_alarm;    /**< 1 when drift_p < alpha */
+  size_t drift_index; /**< the candidate (as rcb_monitor_candidate.index) */
+  size_t drift_onset; /**< updates since the drift's onset (1 .. window) */
+  double drift_rate[RCB_MONITOR_MAXP]; /**< its parameters' change per update,
+                           parameter units per update */
 } rcb_monitor_result;
 
 typedef struct rcb_monitor rcb_monitor;
@@ -369,15 +394,20 @@ RCB_API rcb_status rcb_monitor_thresholds(const rcb_monitor *mon, double *alpha,
  * alpha, CUSUM k and h, noise, averages, re-linearisation, reweighting,
  * tracked ranges), the update count u64, the reference-started flag u32,
  * then per tracked parameter S+, S-, reference sum and weight (IEEE-754
- * binary64) and the frozen flag, and last the CRC-32 (IEEE 802.3,
+ * binary64) and the frozen flag, then the drift window (version 2: the
+ * rank k, tracked count and window u32, the ring's count and newest slot
+ * u32, the updates in its sums u64, the free-offset flag u32, the sums of
+ * the rank-space change y (k) and of the re-linearised tracked steps, and
+ * per slot of the window its y and step), and last the CRC-32 (IEEE 802.3,
  * reflected 0xEDB88320, as zlib's crc32) of everything before it. Neither
  * call allocates. */
 
 /** @brief Format version of the saved state. */
-#define RCB_MONITOR_STATE_VERSION 1u
+#define RCB_MONITOR_STATE_VERSION 2u
 
-/** @brief Bytes rcb_monitor_save writes for this monitor (76 + 40 per
- * tracked parameter); 0 for a monitor not created successfully. */
+/** @brief Bytes rcb_monitor_save writes for this monitor (108 + 40 per
+ * tracked parameter + 264 (k + tracked parameters), k its rank
+ * (rcb_monitor_rank)); 0 for a monitor not created successfully. */
 RCB_API size_t rcb_monitor_state_size(const rcb_monitor *mon);
 /**
  * @brief Save the monitor's accumulated state into @p buf.

@@ -193,7 +193,7 @@ static void transpose_q(rcb_monitor *mon, double *Qr) {
 
 /* J (n x ncol >= n x k) is used up: Q moves into its block. */
 rcb_status rcb_mon_rank_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl, double *J) {
-  size_t k = mon->k, nt = mon->nt, pmax = nt + RCB_MONITOR_MAXP, lw;
+  size_t k = mon->k, nt = mon->nt, pmax = nt + RCB_MONITOR_MAXP, lw, pq;
   double q1 = 0, q2 = 0;
   mon_small *w = &mon->sw;
   rcb_status st;
@@ -214,9 +214,11 @@ rcb_status rcb_mon_rank_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
   mon->ncand = pl->ncand;
   mon->tdir = mon->test + (nt ? nt : 1) * k;
   w->R = w->A + k * pmax, w->Ri = w->R + pmax * pmax, w->tau = w->Ri + pmax * pmax;
-  LAPACKE_dgeqrf_work(LAPACK_COL_MAJOR, (lapack_int)k, (lapack_int)pmax, w->A, (lapack_int)k,
+  /* the small QRs have p <= k columns (rcb_mon_small_qr): dorgqr needs N <= M */
+  pq = pmax < k ? pmax : k;
+  LAPACKE_dgeqrf_work(LAPACK_COL_MAJOR, (lapack_int)k, (lapack_int)pq, w->A, (lapack_int)k,
                       w->tau, &q1, -1);
-  LAPACKE_dorgqr_work(LAPACK_COL_MAJOR, (lapack_int)k, (lapack_int)pmax, (lapack_int)pmax, w->A,
+  LAPACKE_dorgqr_work(LAPACK_COL_MAJOR, (lapack_int)k, (lapack_int)pq, (lapack_int)pq, w->A,
                       (lapack_int)k, w->tau, &q2, -1);
   lw = (size_t)fmax(fmax(q1, q2), (double)pmax);
   if (!(w->work = rcb_mon_alloc(mon, lw, sizeof *w->work)))
@@ -229,11 +231,13 @@ rcb_status rcb_mon_rank_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
   return RCB_OK;
 }
 
+/* The one naming rule's BIC change: -score + dof ln n (n real residuals). */
+double rcb_mon_bic(const rcb_monitor *mon, double score, size_t dof) {
+  return -score + (double)dof * log((double)mon->n);
+}
+
 int rcb_monitor_named(const rcb_monitor *mon, const rcb_monitor_result *r) {
-  double ln_n, b0, b1;
   if (!mon || !r || r->ntop < 2) return -1;
-  ln_n = log((double)mon->n);
-  b0 = -r->top[0].score + (double)r->top[0].dof * ln_n;
-  b1 = -r->top[1].score + (double)r->top[1].dof * ln_n;
-  return rcb_evidence_separable(b0, b1);
+  return rcb_evidence_separable(rcb_mon_bic(mon, r->top[0].score, r->top[0].dof),
+                                rcb_mon_bic(mon, r->top[1].score, r->top[1].dof));
 }
