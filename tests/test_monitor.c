@@ -890,7 +890,8 @@ static double rng_normal(uint64_t *s) {
 
 /* 1. A noise-free drift s_t = b (t - tau) for the m0 newest of count
  * updates, no shared noise: the GLR of onset m is (w.s)^2 / w.w with
- * w_j = m - j, so by Cauchy-Schwarz its largest is at m = m0, where it is
+ * w_j = m - j, so by Cauchy-Schwarz its largest is at m = m0 (an onset of
+ * the grid), where it is
  * ||s||^2 = |b|^2 m0 (m0 + 1) (2 m0 + 1) / 6, and the rate is b.
  * 2. A constant offset with a free offset (after a reset): GLR 0.
  * 3. Under "no change" with the commissioning's shared noise (share rho),
@@ -898,7 +899,7 @@ static double rng_normal(uint64_t *s) {
  * (the GLS in the compound-symmetric covariance): its mean and its rate
  * above the 0.99 quantile (9.2103) against their sampling bounds. */
 static void test_drift_glr(void **state) {
-  enum { W = 32, DOF = 2, COUNT = 25, M0 = 11, NREP = 20000, NALL = 20 };
+  enum { W = 32, DOF = 2, COUNT = 25, M0 = 14, NREP = 20000, NALL = 20 };
   static double ring[W * DOF];
   const double b[DOF] = {0.3, -0.2}, rho = 0.2;
   double sall[DOF] = {0, 0}, rate[DOF], g, q = M0 * (M0 + 1.0) * (2 * M0 + 1.0) / 6.0, mean = 0;

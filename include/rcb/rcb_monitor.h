@@ -101,6 +101,41 @@
  *    only seeds it, u = 0). A drift is caught as a run of innovations of one
  *    sign: the running mean trails a linear drift by half its length. With a
  *    noise-free reference (setup_averages HUGE_VAL) m stays 0 and u = z.
+ *  - Drift test (window GLR, beside the instant test). Per scored candidate,
+ *    s_t = D_c y_t, its orthonormal directions beyond the tracked columns
+ *    (the tracked parameters free at every update: nuisance), over the last
+ *    32 updates (a ring kept with the state). Model: s_t grows linearly,
+ *    b (t - tau), from an onset m = t - tau updates ago; the commissioning
+ *    noise every update shares is a common offset with the known share
+ *    rho = (1/N) / (1 + 1/N) of an update's variance, so the updates of one
+ *    direction have covariance (1 - rho) I + rho 1 1^T over the n updates
+ *    since commissioning, whose inverse needs only the sums of y over them.
+ *    For onset m with weights w_j = m - j on the m newest updates, the GLS
+ *    GLR is ||sum w_j s_j - kappa (sum w) S||^2 / ((1 - rho) (sum w^2 -
+ *    kappa (sum w)^2)), S the sum of s over the n updates and kappa =
+ *    rho / (1 - rho + n rho) (1 / n after rcb_monitor_reset_cusum: the
+ *    offset is then free), chi-square(dof) under "no drift" for each m
+ *    (exact for Gaussian noise; test_monitor's test_drift_glr). The largest
+ *    over the onsets m in {1, 2, 3, 5, 7, 10, 14, 19, 25, 32} (ramps of
+ *    neighbours correlate 0.96 or more) is the candidate's; the candidate
+ *    with the smallest chi-square p-value is reported, and alarms when that
+ *    p-value times the scored candidates times the 10 onsets (Bonferroni:
+ *    a false-alarm probability per update of at most alpha, the instant
+ *    test's) is below alpha. Its drift rate per update, in parameter units,
+ *    is the candidate's estimator on the same GLS combination of y. The
+ *    statistic is taken in the commissioning's noise (opts.reweight does
+ *    not apply to it: a drift is small while it is being caught).
+ *  - Attribution of CUSUM alarms. While a tracked parameter a's CUSUM
+ *    alarms, the accumulated change (the ramp-weighted GLS combination of
+ *    the whole window, as above, of y plus the tracked columns times the
+ *    re-linearised steps: the change from the baseline, linearly) is
+ *    fitted by a's column and, in turn, by each scored candidate's columns,
+ *    the other tracked parameters free in both (nuisance); each fit's GLR
+ *    (the explained sum of squares beyond the nuisance) gives the BIC
+ *    change -GLR + dof ln n of rcb_monitor_named's one rule, and the best
+ *    candidate is compared with a by rcb_evidence_separable:
+ *    rcb_monitor_tracked.named says a alone, "a or the candidate: not
+ *    separable on these channels", or the candidate told apart from a.
  */
 #ifndef RCB_MONITOR_H
 #define RCB_MONITOR_H
@@ -268,10 +303,11 @@ typedef struct rcb_monitor_result {
   double drift_glr;   /**< its window GLR (-), chi-square(drift_dof) for one onset */
   size_t drift_dof;   /**< its degrees of freedom (0: no candidate scored) */
   double drift_p;     /**< its p-value over every candidate and onset (-):
-                           Bonferroni, min(1, p x candidates x window) */
+                           Bonferroni, min(1, p x scored candidates x 10 onsets) */
   int drift_alarm;    /**< 1 when drift_p < alpha */
   size_t drift_index; /**< the candidate (as rcb_monitor_candidate.index) */
-  size_t drift_onset; /**< updates since the drift's onset (1 .. window) */
+  size_t drift_onset; /**< updates since the drift's onset (one of 1, 2, 3, 5,
+                           7, 10, 14, 19, 25, 32) */
   double drift_rate[RCB_MONITOR_MAXP]; /**< its parameters' change per update,
                            parameter units per update */
 } rcb_monitor_result;

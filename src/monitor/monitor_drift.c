@@ -27,6 +27,20 @@ static double dot(const double *a, const double *b, size_t n) {
   return s;
 }
 
+/* The onsets tried (updates ago): a geometric grid (ratio ~1.4) over the
+ * window, so that the Bonferroni factor is MON_DRIFT_NONSET, not the
+ * window's length; neighbouring ramps correlate at 0.96 or more (10 and 14:
+ * 605 / sqrt(385 x 1015) = 0.968), so a drift whose onset falls between
+ * two loses at most ~6 % of its GLR. */
+static const size_t onsets[MON_DRIFT_NONSET] = {1, 2, 3, 5, 7, 10, 14, 19, 25, 32};
+
+static int tried(size_t m) {
+  size_t i;
+  for (i = 0; i < MON_DRIFT_NONSET; i++)
+    if (onsets[i] == m) return 1;
+  return 0;
+}
+
 static double kappa_of(double rho, size_t nall, int free_off) {
   if (!nall) return 0.0;
   return free_off ? 1.0 / (double)nall : rho / (1.0 - rho + (double)nall * rho);
@@ -47,7 +61,7 @@ double rcb_mon_drift_glr(const double *ring, size_t ld, size_t w, size_t head, s
     for (i = 0; i < dof; i++) A[i] += s[i], C[i] += (double)j * s[i];
     /* weights m - j' for the m newest (j' = 0 .. m - 1): sum w s = m A - C */
     den = q - kappa * sw * sw;
-    if (!(den > 0)) continue;
+    if (!tried(j + 1) || !(den > 0)) continue;
     for (i = 0; i < dof; i++) {
       num[i] = m * A[i] - C[i] - kappa * sw * sall[i];
       g += num[i] * num[i];
@@ -127,7 +141,7 @@ static void drift_test(rcb_monitor *mon, rcb_monitor_result *res) {
   if (!nsc) return;
   {
     const mon_cand *c = &mon->cand[best];
-    double den = accumulate(mon, mb, mon->dY), lq = lbest + log((double)nsc * MON_DRIFT_WINDOW);
+    double den = accumulate(mon, mb, mon->dY), lq = lbest + log((double)nsc * MON_DRIFT_NONSET);
     res->drift_glr = gbest;
     res->drift_dof = c->dof;
     res->drift_p = lq < 0 ? exp(lq) : 1.0;

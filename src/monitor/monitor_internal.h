@@ -186,8 +186,10 @@ struct rcb_monitor {
   double *dY;          /* k: work, the accumulated change */
 };
 
-/* Updates the drift test looks back over (onsets 1 .. this many updates ago). */
+/* Updates the drift test looks back over, and the onsets it tries within
+ * them (1 .. MON_DRIFT_WINDOW updates ago, monitor_drift.c). */
 #define MON_DRIFT_WINDOW 32
+#define MON_DRIFT_NONSET 10
 
 #define rcb_mon_fail(mon, st, ...) rcb_fail((mon), (st), __VA_ARGS__)
 
@@ -249,7 +251,7 @@ void rcb_mon_gls_step(const mon_small *w, const double *qz, size_t p, size_t fir
                       double *x, double *se);
 
 /* monitor_drift.c: the window GLR of a drift growing linearly from an
- * onset m = 1 .. count updates ago, on dof components of s (component i of
+ * onset m updates ago (m <= count, on the grid of onsets), on dof components of s (component i of
  * lag j at ring[((head + w - j) % w) * ld + i]), with the commissioning's
  * shared noise (a common offset, share rho of the variance; free: no prior)
  * taken out through sall (the sums of s over nall updates). Returns the

@@ -106,7 +106,10 @@ def test_state_restart(rcb, tmp_path):
                 with rcb.Meas.read(p, uff_map=UFF_MAP) as ms:
                     a.update(ms)
             state = a.save_state()
-            assert len(state) == 76 + 40 * len(PARAMS) and state[:4] == b"RCBM"
+            # rcb_monitor.h's layout: header, per tracked, the drift window
+            k = a.rank[0]
+            assert len(state) == 108 + 40 * len(PARAMS) + 264 * (k + len(PARAMS))
+            assert state[:4] == b"RCBM"
             b.load_state(state)
             with rcb.Meas.read(paths[3], uff_map=UFF_MAP) as ms:
                 ra, rb = a.update(ms), b.update(ms)

@@ -361,6 +361,7 @@ _PROTOTYPES = {
     "rcb_monitor_point_count": (c_size_t, [c_void_p]),
     "rcb_monitor_memory": (c_size_t, [c_void_p]),
     "rcb_monitor_candidate_count": (c_size_t, [c_void_p]),
+    "rcb_monitor_rank": (c_int, [c_void_p, ctypes.POINTER(c_size_t), ctypes.POINTER(c_size_t)]),
     "rcb_monitor_named": (c_int, [c_void_p, c_void_p]),
     "rcb_monitor_candidate_info_get": (c_int, [c_void_p, c_size_t,
                                                ctypes.POINTER(MonitorCandidateInfo)]),

@@ -110,6 +110,13 @@ class Monitor(Handle):
                                     dtype=np.complex128)
 
     @property
+    def rank(self):
+        """(k, k_t): the rank of all columns and of the tracked ones."""
+        k, kt = ctypes.c_size_t(), ctypes.c_size_t()
+        self.check(_lib.lib().rcb_monitor_rank(self.handle, ctypes.byref(k), ctypes.byref(kt)))
+        return k.value, kt.value
+
+    @property
     def memory(self):
         """Bytes the monitor holds (all from its allocator)."""
         return int(_lib.lib().rcb_monitor_memory(self.handle))
