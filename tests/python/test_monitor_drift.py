@@ -30,7 +30,7 @@ only (a few ms each). Asserted against binomial bounds:
   named alone (the issue's "kr falling", 5 of 5 before) in at most 20 %
   (binomial 99 % upper bound), and names B4 kyy (the drift test, the instant
   test's first candidate, or a CUSUM alarm whose attribution gives B4 kyy as
-  its rival, not separable or told apart) in at least 40 % (lower bound): kr
+  its rival, not separable or told apart) in at least 30 % (lower bound): kr
   and B4 kyy, and a few added masses at shaft B's nodes, are near collinear on
   these channels, and which of those the accumulated change fits best is
   then the noise's choice (the message says they are not separable).
@@ -237,7 +237,7 @@ def test_drift_detected_and_attributed(groups):
           f"from a tracked parameter), {firsts['alone']} a tracked parameter alone, "
           f"{firsts['other']} another effect, {firsts[None]} none; delays {delays}")
     # at least 80 % detected in time; the first message, a tracked parameter
-    # named alone, in at most 20 %; B4 kyy in the first message in at least 40 %
+    # named alone, in at most 20 %; B4 kyy in the first message in at least 30 %
     assert detected >= stats.binom.ppf(0.01, R, 0.8)
     assert firsts["alone"] <= stats.binom.ppf(0.99, R, 0.2)
-    assert firsts["b4"] >= stats.binom.ppf(0.01, R, 0.4)
+    assert firsts["b4"] >= stats.binom.ppf(0.01, R, 0.3)
