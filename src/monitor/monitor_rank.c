@@ -152,7 +152,16 @@ rcb_status rcb_mon_factor(rcb_monitor *mon, rcb_diag *d, const double *J, size_t
   diag_basis b;
   double q = 0;
   lapack_int info;
-  rcb_status st = rcb_diag_basis_init(d, &b, J, mon->n, ncol, mon->r);
+  rcb_status st;
+  /* score_qr.c's workspace query asks dormqr for ncol reflectors on n rows,
+   * an illegal argument (LAPACK's xerbla prints it) when ncol > n: refused
+   * here with the fix, until that query asks for min(ncol, n) */
+  if (ncol > mon->n)
+    return rcb_mon_fail(mon, RCB_ERR_ARG, "the set-up has %zu real residuals (2 x %zu channels "
+                        "x %zu points), fewer than the %zu sensitivity columns of the tracked "
+                        "parameters and the candidates: add channels or points, or choose fewer "
+                        "effects (opts.effects)", mon->n, mon->nch, mon->npts, ncol);
+  st = rcb_diag_basis_init(d, &b, J, mon->n, ncol, mon->r);
   if (st) return rcb_mon_fail(mon, st, "%s", rcb_diag_errmsg(d));
   mon->k = b.rank;
   mon->Q = b.qr; /* the block is the monitor's allocator's (d was made with it) */

@@ -120,3 +120,18 @@ def test_state_restart(rcb, tmp_path):
             bad[40] ^= 1
             with pytest.raises(rcb.RcbError):
                 b.load_state(bytes(bad))
+
+
+def test_small_setup_refused_without_printing(rcb, capfd):
+    """1 channel x 21 points and one tracked parameter: fewer residuals (42) than
+    sensitivity columns. It failed with "LAPACK workspace query failed" after
+    LAPACK's DORMQR printed to stdout (a query for more reflectors than rows, an
+    illegal argument); now refused with what to change, and nothing printed."""
+    f = np.linspace(100, 400, 21)
+    with rcb.Model.from_ini(PAPER) as m, \
+            rcb.simulate(m, ["DA.x"], ["DA.x"], f, rpm=10000, kind="inertance",
+                         noise=(10, 1), seed=1) as ms:
+        with pytest.raises(rcb.RcbError, match="42 real residuals"):
+            rcb.Monitor(m, ms, ["coupling.C.kt"], noise=(10, 1))
+    out = capfd.readouterr()
+    assert "DORMQR" not in out.out + out.err and out.out == ""
