@@ -122,9 +122,15 @@
  *    p-value times the scored candidates times the 10 onsets (Bonferroni:
  *    a false-alarm probability per update of at most alpha, the instant
  *    test's) is below alpha. Its drift rate per update, in parameter units,
- *    is the candidate's estimator on the same GLS combination of y. The
- *    statistic is taken in the commissioning's noise (opts.reweight does
- *    not apply to it: a drift is small while it is being caught).
+ *    is the rate of s taken back through the candidate's triangular factor
+ *    at create. With opts.reweight (or an update's sd) s is taken in the
+ *    update's own noise: the candidate's orthonormal components beyond the
+ *    tracked columns in the instant test's metric (its GLS), on what the
+ *    re-linearised tracked step leaves; without, in the commissioning's (on
+ *    a 2.6 % wear of kt the commissioning's metric made the drift test alarm
+ *    on a pedestal at B3, GLR 700 at one onset, as it makes T alarm; in the
+ *    update's own it stayed below 9). The attribution below takes the
+ *    commissioning's metric on either path.
  *  - Attribution of CUSUM alarms. While a tracked parameter a's CUSUM
  *    alarms, the accumulated change (the ramp-weighted GLS combination of
  *    the whole window, as above, of y plus the tracked columns times the
@@ -433,8 +439,9 @@ RCB_API rcb_status rcb_monitor_thresholds(const rcb_monitor *mon, double *alpha,
  * binary64) and the frozen flag, then the drift window (version 2: the
  * rank k, tracked count and window u32, the ring's count and newest slot
  * u32, the updates in its sums u64, the free-offset flag u32, the sums of
- * the rank-space change y (k) and of the re-linearised tracked steps, and
- * per slot of the window its y and step), and last the CRC-32 (IEEE 802.3,
+ * the rank-space change y (k), of the re-linearised tracked steps and of
+ * each scored candidate's drift input s, and per slot of the window its y,
+ * step and s), and last the CRC-32 (IEEE 802.3,
  * reflected 0xEDB88320, as zlib's crc32) of everything before it. Neither
  * call allocates. */
 
@@ -442,8 +449,9 @@ RCB_API rcb_status rcb_monitor_thresholds(const rcb_monitor *mon, double *alpha,
 #define RCB_MONITOR_STATE_VERSION 2u
 
 /** @brief Bytes rcb_monitor_save writes for this monitor (108 + 40 per
- * tracked parameter + 264 (k + tracked parameters), k its rank
- * (rcb_monitor_rank)); 0 for a monitor not created successfully. */
+ * tracked parameter + 264 (k + tracked parameters + the scored candidates'
+ * ranks), k its rank (rcb_monitor_rank)); 0 for a monitor not created
+ * successfully. */
 RCB_API size_t rcb_monitor_state_size(const rcb_monitor *mon);
 /**
  * @brief Save the monitor's accumulated state into @p buf.

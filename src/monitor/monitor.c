@@ -444,7 +444,7 @@ rcb_status rcb_monitor_update(rcb_monitor *mon, const rcb_complex *values, const
   if ((st = joint_relin(mon, gls, res, dth, se))) return st;
   for (a = 0; a < mon->nt; a++) theta[a] += dth[a];
   tracked_result(mon, theta, se, res);
-  rcb_mon_drift_update(mon, threl, res);
+  rcb_mon_drift_update(mon, threl, gls, res);
   return RCB_OK;
 }
 

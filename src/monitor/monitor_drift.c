@@ -90,15 +90,20 @@ static double accumulate(const rcb_monitor *mon, size_t m, double *v) {
   return q - kappa * sw * sw;
 }
 
-static void push(rcb_monitor *mon, const double *theta) {
+static void push(rcb_monitor *mon, const double *theta, int gls) {
   size_t k = mon->k, nt = mon->nt, j, a, W = MON_DRIFT_WINDOW, ld = mon->ncand * RCB_MONITOR_MAXP;
   size_t slot = mon->dcount ? (mon->dhead + 1) % W : 0;
   double *s = mon->ds + slot * ld;
   memcpy(mon->dy + slot * k, mon->y, k * sizeof *mon->dy);
   memcpy(mon->dth + slot * RCB_MONITOR_MAX_TRACKED, theta, nt * sizeof *mon->dth);
-  for (j = 0; j < mon->ncand; j++)
-    for (a = 0; a < mon->cand[j].dof; a++)
-      s[j * RCB_MONITOR_MAXP + a] = dot(mon->cand[j].dir + a * k, mon->y, k);
+  for (j = 0; j < mon->ncand; j++) {
+    const mon_cand *c = &mon->cand[j];
+    for (a = 0; a < c->dof; a++) {
+      double v = gls ? c->xd[a] : dot(c->dir + a * k, mon->y, k);
+      s[j * RCB_MONITOR_MAXP + a] = v;
+      mon->dssum[j * RCB_MONITOR_MAXP + a] += v;
+    }
+  }
   for (a = 0; a < k; a++) mon->dysum[a] += mon->y[a];
   for (a = 0; a < nt; a++) mon->dthsum[a] += theta[a];
   mon->dhead = slot;
@@ -106,19 +111,11 @@ static void push(rcb_monitor *mon, const double *theta) {
   mon->dall++;
 }
 
-void rcb_mon_drift_refresh(rcb_monitor *mon) {
-  size_t slot, j, a, k = mon->k, ld = mon->ncand * RCB_MONITOR_MAXP;
-  for (slot = 0; slot < mon->dcount; slot++)
-    for (j = 0; j < mon->ncand; j++)
-      for (a = 0; a < mon->cand[j].dof; a++)
-        mon->ds[slot * ld + j * RCB_MONITOR_MAXP + a] =
-            dot(mon->cand[j].dir + a * k, mon->dy + slot * k, k);
-}
-
 void rcb_mon_drift_reset(rcb_monitor *mon) {
   mon->dcount = mon->dhead = mon->dall = 0;
   mon->dfree = 1;
   if (mon->dysum) memset(mon->dysum, 0, mon->k * sizeof *mon->dysum);
+  if (mon->dssum) memset(mon->dssum, 0, mon->ncand * RCB_MONITOR_MAXP * sizeof *mon->dssum);
   memset(mon->dthsum, 0, sizeof mon->dthsum);
 }
 
@@ -126,30 +123,39 @@ void rcb_mon_drift_reset(rcb_monitor *mon) {
  * supported (smallest p) into res, Bonferroni over candidates and onsets. */
 static void drift_test(rcb_monitor *mon, rcb_monitor_result *res) {
   size_t j, a, ld = mon->ncand * RCB_MONITOR_MAXP, nsc = 0, best = 0, mb = 0;
-  double sall[RCB_MONITOR_MAXP], rate[RCB_MONITOR_MAXP], lbest = 0, gbest = 0;
+  double sall[RCB_MONITOR_MAXP], rate[RCB_MONITOR_MAXP], rbest[RCB_MONITOR_MAXP] = {0};
+  double lbest = 0, gbest = 0;
   for (j = 0; j < mon->ncand; j++) {
     const mon_cand *c = &mon->cand[j];
     size_t m;
     double g, lp;
     if (!c->dof) continue;
-    for (a = 0; a < c->dof; a++) sall[a] = dot(c->dir + a * mon->k, mon->dysum, mon->k);
+    for (a = 0; a < c->dof; a++) sall[a] = mon->dssum[j * RCB_MONITOR_MAXP + a];
     g = rcb_mon_drift_glr(mon->ds + j * RCB_MONITOR_MAXP, ld, MON_DRIFT_WINDOW, mon->dhead,
                           mon->dcount, c->dof, sall, mon->dall, mon->rho, mon->dfree, &m, rate);
     lp = rcb_mon_chi2_logsf(g, (double)c->dof);
-    if (!nsc++ || lp < lbest || (lp == lbest && g > gbest)) lbest = lp, gbest = g, best = j, mb = m;
+    if (!nsc++ || lp < lbest || (lp == lbest && g > gbest)) {
+      lbest = lp, gbest = g, best = j, mb = m;
+      memcpy(rbest, rate, sizeof rbest);
+    }
   }
   if (!nsc) return;
   {
     const mon_cand *c = &mon->cand[best];
-    double den = accumulate(mon, mb, mon->dY), lq = lbest + log((double)nsc * MON_DRIFT_NONSET);
+    double lq = lbest + log((double)nsc * MON_DRIFT_NONSET);
+    size_t b;
     res->drift_glr = gbest;
     res->drift_dof = c->dof;
     res->drift_p = lq < 0 ? exp(lq) : 1.0;
     res->drift_alarm = lq < log(mon->alpha);
     res->drift_index = best;
     res->drift_onset = mb;
-    for (a = 0; a < c->np && den > 0; a++)
-      res->drift_rate[a] = dot(c->est + a * mon->k, mon->dY, mon->k) / den;
+    /* the parameters' rate: r0^-1 times the rate of s (back substitution) */
+    for (a = c->np; a-- > 0;) {
+      double v = rbest[a];
+      for (b = a + 1; b < c->np; b++) v -= c->r0[a * RCB_MONITOR_MAXP + b] * res->drift_rate[b];
+      res->drift_rate[a] = v / c->r0[a * RCB_MONITOR_MAXP + a];
+    }
   }
 }
 
@@ -214,9 +220,10 @@ static void attribute(rcb_monitor *mon, size_t a, rcb_monitor_tracked *t) {
   else t->named = 0;
 }
 
-void rcb_mon_drift_update(rcb_monitor *mon, const double *theta, rcb_monitor_result *res) {
+void rcb_mon_drift_update(rcb_monitor *mon, const double *theta, int gls,
+                          rcb_monitor_result *res) {
   size_t a;
-  push(mon, theta);
+  push(mon, theta, gls);
   drift_test(mon, res);
   for (a = 0; a < mon->nt; a++) {
     res->tracked[a].named = 1;

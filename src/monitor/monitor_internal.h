@@ -52,6 +52,13 @@ typedef struct mon_cand {
                         neutral values (rcb_model_set_param on mon->model):
                         the joint step can be re-linearised */
   char pname[RCB_MONITOR_MAXP][RCB_MONITOR_NAME]; /* their names (settable) */
+  double r0[RCB_MONITOR_MAXP * RCB_MONITOR_MAXP]; /* the upper triangle of its block
+                        of R at create (row-major): s = r0 x for parameter steps x,
+                        so that est = r0^-1 dir */
+  double xd[RCB_MONITOR_MAXP]; /* the reweighted path: this update's s, its
+                        orthonormal components beyond the tracked columns in the
+                        update's own noise, on the re-linearised y (the drift
+                        test's input; dir y on the other path) */
 } mon_cand;
 
 /* Most DOFs of P for the low-rank re-evaluation (monitor_lowrank.c). */
@@ -180,8 +187,10 @@ struct rcb_monitor {
                           re-linearised tracked step) */
   double *dth;         /* MON_DRIFT_WINDOW x RCB_MONITOR_MAX_TRACKED: that step */
   double *ds;          /* MON_DRIFT_WINDOW x ncand x RCB_MONITOR_MAXP: each
-                          candidate's s = dir y (recomputed on load) */
+                          candidate's s = dir y (on the reweighted path xd: the
+                          same in the update's own noise) */
   double *dysum;       /* k: sum of y over dall updates */
+  double *dssum;       /* ncand x RCB_MONITOR_MAXP: sum of each candidate's s */
   double dthsum[RCB_MONITOR_MAX_TRACKED]; /* sum of the steps */
   double *dY;          /* k: work, the accumulated change */
 };
@@ -261,10 +270,9 @@ double rcb_mon_drift_glr(const double *ring, size_t ld, size_t w, size_t head, s
                          size_t *mbest, double *rate);
 /* The update's part: push this update (y, the re-linearised step theta),
  * the drift test into res, and the attribution of every CUSUM alarm. */
-void rcb_mon_drift_update(rcb_monitor *mon, const double *theta, rcb_monitor_result *res);
+void rcb_mon_drift_update(rcb_monitor *mon, const double *theta, int gls,
+                          rcb_monitor_result *res);
 void rcb_mon_drift_reset(rcb_monitor *mon);
-/* Every candidate's s of every slot from the ring's y (after a load). */
-void rcb_mon_drift_refresh(rcb_monitor *mon);
 /* The one naming rule's BIC change of a score with dof degrees of freedom. */
 double rcb_mon_bic(const rcb_monitor *mon, double score, size_t dof);
 

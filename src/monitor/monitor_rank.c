@@ -128,6 +128,8 @@ static rcb_status cand_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
     mc->test_t = mc->dir + c.np * k;
     mc->dof = c.np;
     estimator(w->A, w->Ri, k, p, nt, c.np, mc->est, mc->se);
+    for (a = 0; a < c.np; a++)
+      for (i = a; i < c.np; i++) mc->r0[a * RCB_MONITOR_MAXP + i] = w->R[(nt + a) + p * (nt + i)];
     estimator(w->A, w->Ri, k, p, 0, nt, mc->test_t, mc->se_t);
     for (a = 0; a < c.np; a++)
       for (i = 0; i < k; i++) mc->dir[a * k + i] = w->A[i + k * (nt + a)];

@@ -151,11 +151,31 @@ static int ready(const rcb_monitor *mon) { return mon && mon->k > 0 && mon->y; }
 
 /* The drift window after the tracked parameters: its dimensions (k, nt,
  * window; u32 each), the ring's count and newest slot (u32), the updates in
- * the sums (u64), the free-offset flag (u32), the sums of y (k) and of the
- * steps (nt), then per slot of the window y (k) and the step (nt). */
+ * the sums (u64), the free-offset flag (u32), the sums of y (k), of the
+ * steps (nt) and of each scored candidate's s (its rank), then per slot of
+ * the window the same three. */
 #define ST_DRIFT_HEAD 32u
+static size_t cand_dofs(const rcb_monitor *mon) {
+  size_t j, n = 0;
+  for (j = 0; j < mon->ncand; j++) n += mon->cand[j].dof;
+  return n;
+}
 static size_t drift_bytes(const rcb_monitor *mon) {
-  return ST_DRIFT_HEAD + 8u * (MON_DRIFT_WINDOW + 1u) * (mon->k + mon->nt);
+  return ST_DRIFT_HEAD + 8u * (MON_DRIFT_WINDOW + 1u) * (mon->k + mon->nt + cand_dofs(mon));
+}
+/* The candidates' s of one slot (or their sums) written at q or read from
+ * r; the bytes after. */
+static unsigned char *put_s(const rcb_monitor *mon, const double *s, unsigned char *q) {
+  size_t j, a;
+  for (j = 0; j < mon->ncand; j++)
+    for (a = 0; a < mon->cand[j].dof; a++, q += 8) put_f64(q, s[j * RCB_MONITOR_MAXP + a]);
+  return q;
+}
+static const unsigned char *get_s(const rcb_monitor *mon, double *s, const unsigned char *r) {
+  size_t j, a;
+  for (j = 0; j < mon->ncand; j++)
+    for (a = 0; a < mon->cand[j].dof; a++, r += 8) s[j * RCB_MONITOR_MAXP + a] = get_f64(r);
+  return r;
 }
 
 size_t rcb_monitor_state_size(const rcb_monitor *mon) {
@@ -170,15 +190,17 @@ static void save_drift(const rcb_monitor *mon, unsigned char *q) {
   q += ST_DRIFT_HEAD;
   for (i = 0; i < k; i++, q += 8) put_f64(q, mon->dysum[i]);
   for (i = 0; i < nt; i++, q += 8) put_f64(q, mon->dthsum[i]);
+  q = put_s(mon, mon->dssum, q);
   for (s = 0; s < MON_DRIFT_WINDOW; s++) {
     for (i = 0; i < k; i++, q += 8) put_f64(q, mon->dy[s * k + i]);
     for (i = 0; i < nt; i++, q += 8) put_f64(q, mon->dth[s * RCB_MONITOR_MAX_TRACKED + i]);
+    q = put_s(mon, mon->ds + s * mon->ncand * RCB_MONITOR_MAXP, q);
   }
 }
 
 /* Checked before anything is changed: 0 or the first bad field. */
 static const char *check_drift(const rcb_monitor *mon, const unsigned char *q) {
-  size_t i, n = (MON_DRIFT_WINDOW + 1u) * (mon->k + mon->nt);
+  size_t i, n = (MON_DRIFT_WINDOW + 1u) * (mon->k + mon->nt + cand_dofs(mon));
   if (get_u32(q) != mon->k || get_u32(q + 4) != mon->nt || get_u32(q + 8) != MON_DRIFT_WINDOW)
     return "drift window's dimensions";
   if (get_u32(q + 12) > MON_DRIFT_WINDOW || get_u32(q + 16) >= MON_DRIFT_WINDOW ||
@@ -197,11 +219,12 @@ static void load_drift(rcb_monitor *mon, const unsigned char *q) {
   for (i = 0; i < k; i++, q += 8) mon->dysum[i] = get_f64(q);
   memset(mon->dthsum, 0, sizeof mon->dthsum);
   for (i = 0; i < nt; i++, q += 8) mon->dthsum[i] = get_f64(q);
+  q = get_s(mon, mon->dssum, q);
   for (s = 0; s < MON_DRIFT_WINDOW; s++) {
     for (i = 0; i < k; i++, q += 8) mon->dy[s * k + i] = get_f64(q);
     for (i = 0; i < nt; i++, q += 8) mon->dth[s * RCB_MONITOR_MAX_TRACKED + i] = get_f64(q);
+    q = get_s(mon, mon->ds + s * mon->ncand * RCB_MONITOR_MAXP, q);
   }
-  rcb_mon_drift_refresh(mon);
 }
 
 rcb_status rcb_monitor_save(const rcb_monitor *mon, void *buf, size_t size, size_t *written) {
