@@ -310,7 +310,10 @@ typedef struct rcb_monitor_result {
   size_t drift_dof;   /**< its degrees of freedom (0: no candidate scored) */
   double drift_p;     /**< its p-value over every candidate and onset (-):
                            Bonferroni, min(1, p x scored candidates x 10 onsets) */
-  int drift_alarm;    /**< 1 when drift_p < alpha */
+  int drift_alarm;    /**< 1 when drift_p < alpha and the instant test does
+                           not fire (then it names the change, re-linearised: on
+                           ROSS's step of cross-coupling at B3 the best linear
+                           drift was a pedestal at B1) */
   size_t drift_index; /**< the candidate (as rcb_monitor_candidate.index) */
   size_t drift_onset; /**< updates since the drift's onset (one of 1, 2, 3, 5,
                            7, 10, 14, 19, 25, 32) */

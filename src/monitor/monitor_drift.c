@@ -147,7 +147,9 @@ static void drift_test(rcb_monitor *mon, rcb_monitor_result *res) {
     res->drift_glr = gbest;
     res->drift_dof = c->dof;
     res->drift_p = lq < 0 ? exp(lq) : 1.0;
-    res->drift_alarm = lq < log(mon->alpha);
+    /* while the instant test fires it names the change (re-linearised):
+     * a step is no drift, and its best linear drift may be another effect */
+    res->drift_alarm = !res->alarm && lq < log(mon->alpha);
     res->drift_index = best;
     res->drift_onset = mb;
     /* the parameters' rate: r0^-1 times the rate of s (back substitution) */
