@@ -183,7 +183,7 @@ static double explained(rcb_monitor *mon, size_t a, size_t col, size_t q, double
  * explained by a candidate than by a, the other tracked parameters free? */
 static void attribute(rcb_monitor *mon, size_t a, rcb_monitor_tracked *t) {
   size_t k = mon->k, nt = mon->nt, i, b, j, m = mon->dcount;
-  double den, x[RCB_MONITOR_MAXP], ga, ba, bbest = 0, scale;
+  double den, x[RCB_MONITOR_MAXP] = {0}, ga, ba, bbest = 0, scale;
   int have = 0;
   if (!m) return;
   den = accumulate(mon, m, mon->dY);

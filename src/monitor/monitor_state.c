@@ -161,7 +161,7 @@ static size_t cand_dofs(const rcb_monitor *mon) {
   return n;
 }
 static size_t drift_bytes(const rcb_monitor *mon) {
-  return ST_DRIFT_HEAD + 8u * (MON_DRIFT_WINDOW + 1u) * (mon->k + mon->nt + cand_dofs(mon));
+  return ST_DRIFT_HEAD + (size_t)8 * (MON_DRIFT_WINDOW + 1u) * (mon->k + mon->nt + cand_dofs(mon));
 }
 /* The candidates' s of one slot (or their sums) written at q or read from
  * r; the bytes after. */
