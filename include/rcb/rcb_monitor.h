@@ -367,8 +367,10 @@ RCB_API const char *rcb_monitor_errmsg(const rcb_monitor *mon);
 RCB_API rcb_status rcb_monitor_update(rcb_monitor *mon, const rcb_complex *values,
                                       const double *sd, rcb_monitor_result *res);
 
-/** @brief Forget the CUSUM sums (after maintenance, or once an alarm is
- * acknowledged); the update count and the baseline stay. */
+/** @brief Forget the CUSUM sums and the drift test's window (after
+ * maintenance, or once an alarm is acknowledged; the drift test's common
+ * offset is then free, as the CUSUM's reference starts afresh); the update
+ * count and the baseline stay. */
 RCB_API void rcb_monitor_reset_cusum(rcb_monitor *mon);
 
 /** @brief Values one update takes: channels x points of the set-up. */
