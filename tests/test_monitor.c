@@ -741,6 +741,13 @@ static int same_result(const rcb_monitor_result *a, const rcb_monitor_result *b)
       return 0;
   for (k = 0; k < a->ntracked; k++)
     if (memcmp(&a->tracked[k], &b->tracked[k], sizeof a->tracked[k]) != 0) return 0;
+  /* the drift test: its window came through the state */
+  if (memcmp(&a->drift_glr, &b->drift_glr, sizeof a->drift_glr) != 0 ||
+      memcmp(&a->drift_p, &b->drift_p, sizeof a->drift_p) != 0 ||
+      a->drift_alarm != b->drift_alarm || a->drift_index != b->drift_index ||
+      a->drift_onset != b->drift_onset ||
+      memcmp(a->drift_rate, b->drift_rate, sizeof a->drift_rate) != 0)
+    return 0;
   return 1;
 }
 
@@ -769,7 +776,7 @@ static void test_state_restart(void **state) {
   rcb_model *m2 = edited(f->truth, KT_NAME, (1 + DK) * f->kt);
   rcb_meas *ms = frf_of(m2), *setup, *setup2;
   rcb_complex *acc = calloc(NPT, sizeof *acc), *dh = malloc(NPT * sizeof *dh);
-  unsigned char buf[512], buf2[512], keep[512];
+  static unsigned char buf[1 << 15], buf2[1 << 15], keep[1 << 15];
   size_t u, i, n = 0, n2 = 0, before, first_alarm = 0;
   double cusum_at_restart = 0;
   uint64_t seed = 99;
@@ -789,7 +796,12 @@ static void test_state_restart(void **state) {
   /* a small catalogue: five creates, each a fraction of the full one's time */
   o.effects = (1u << RCB_EFFECT_BEARING_CROSS_COUPLING) | (1u << RCB_EFFECT_BEARING_STIFFNESS);
   assert_int_equal(rcb_monitor_create(&a, f->base, setup, &o, NULL), RCB_OK);
-  assert_int_equal(rcb_monitor_state_size(a), 76 + 40);
+  {
+    size_t kr = 0, dofs = 0, j; /* rcb_monitor.h's layout: header, one tracked, the window */
+    assert_int_equal(rcb_monitor_rank(a, &kr, NULL), RCB_OK);
+    for (j = 0; j < a->ncand; j++) dofs += a->cand[j].dof;
+    assert_int_equal(rcb_monitor_state_size(a), 108 + 40 + 264 * (kr + 1 + dofs));
+  }
   for (u = 0; u < N; u++) {
     /* kt falls by 0.2 standard errors per update from update 26 */
     double dkt = u < 25 ? 0.0 : -0.2 * se * (double)(u - 24);
@@ -803,7 +815,7 @@ static void test_state_restart(void **state) {
       assert_int_equal(rcb_monitor_save(a, buf, 10, &n), RCB_ERR_WORKSPACE);
       assert_int_equal(rcb_monitor_save(a, buf, sizeof buf, &n), RCB_OK);
       assert_int_equal(n, rcb_monitor_state_size(a));
-      assert_memory_equal(buf, "RCBM\1\0\0\0", 8); /* magic, version 1 little-endian */
+      assert_memory_equal(buf, "RCBM\2\0\0\0", 8); /* magic, version 2 little-endian */
       assert_int_equal(buf[56], N1);                /* the update count, low byte first */
       assert_int_equal(rcb_monitor_create(&b, f->base, setup, &o, &al), RCB_OK);
       before = cnt.allocs;
@@ -834,7 +846,7 @@ static void test_state_restart(void **state) {
   memcpy(buf, keep, n);
   assert_int_equal(rcb_monitor_load(b, buf, n - 1), RCB_ERR_CORRUPT); /* truncated */
   assert_int_equal(rcb_monitor_load(b, "hello", 5), RCB_ERR_CORRUPT);
-  buf[4] = 2;
+  buf[4] = 3;
   rewrite_crc(buf, n);
   assert_int_equal(rcb_monitor_load(b, buf, n), RCB_ERR_VERSION);
   memcpy(buf, keep, n);
@@ -868,6 +880,68 @@ static void test_state_restart(void **state) {
   rcb_model_destroy(m2);
   free(acc);
   free(dh);
+}
+
+/* ---- the drift test's window GLR (monitor_drift.c) against closed forms ---- */
+
+static double rng_normal(uint64_t *s) {
+  double u1 = rng_uniform(s), u2 = rng_uniform(s);
+  return sqrt(-2.0 * log(u1 > 0 ? u1 : 0x1.0p-53)) * cos(6.283185307179586 * u2);
+}
+
+/* 1. A noise-free drift s_t = b (t - tau) for the m0 newest of count
+ * updates, no shared noise: the GLR of onset m is (w.s)^2 / w.w with
+ * w_j = m - j, so by Cauchy-Schwarz its largest is at m = m0 (an onset of
+ * the grid), where it is
+ * ||s||^2 = |b|^2 m0 (m0 + 1) (2 m0 + 1) / 6, and the rate is b.
+ * 2. A constant offset with a free offset (after a reset): GLR 0.
+ * 3. Under "no change" with the commissioning's shared noise (share rho),
+ * one onset (count 1) after 20 updates in the sums: chi-square(2), exactly
+ * (the GLS in the compound-symmetric covariance): its mean and its rate
+ * above the 0.99 quantile (9.2103) against their sampling bounds. */
+static void test_drift_glr(void **state) {
+  enum { W = 32, DOF = 2, COUNT = 25, M0 = 14, NREP = 20000, NALL = 20 };
+  static double ring[W * DOF];
+  const double b[DOF] = {0.3, -0.2}, rho = 0.2;
+  double sall[DOF] = {0, 0}, rate[DOF], g, q = M0 * (M0 + 1.0) * (2 * M0 + 1.0) / 6.0, mean = 0;
+  size_t j, i, m, over = 0, r;
+  uint64_t seed = 7;
+  (void)state;
+  for (j = 0; j < COUNT; j++) /* slot j: update j (the newest at COUNT - 1) */
+    for (i = 0; i < DOF; i++) {
+      double t = (double)j - (double)(COUNT - 1 - M0);
+      ring[j * DOF + i] = t > 0 ? b[i] * t : 0.0;
+      sall[i] += ring[j * DOF + i];
+    }
+  g = rcb_mon_drift_glr(ring, DOF, W, COUNT - 1, COUNT, DOF, sall, COUNT, 0.0, 0, &m, rate);
+  assert_int_equal(m, M0);
+  assert_true(fabs(g - (b[0] * b[0] + b[1] * b[1]) * q) <= 1e-12 * g);
+  assert_true(fabs(rate[0] - b[0]) < 1e-14);
+  assert_true(fabs(rate[1] - b[1]) < 1e-14);
+  for (j = 0; j < COUNT; j++)
+    for (i = 0; i < DOF; i++) ring[j * DOF + i] = 1.5 + (double)i;
+  sall[0] = 1.5 * COUNT, sall[1] = 2.5 * COUNT;
+  g = rcb_mon_drift_glr(ring, DOF, W, COUNT - 1, COUNT, DOF, sall, COUNT, 0.0, 1, &m, rate);
+  assert_true(fabs(g) < 1e-20);
+  for (r = 0; r < NREP; r++) {
+    double e0[DOF];
+    for (i = 0; i < DOF; i++) e0[i] = sqrt(rho) * rng_normal(&seed), sall[i] = 0;
+    for (j = 0; j < NALL; j++) /* the newest in slot 0 */
+      for (i = 0; i < DOF; i++) {
+        double v = e0[i] + sqrt(1 - rho) * rng_normal(&seed);
+        sall[i] += v;
+        if (j == NALL - 1) ring[i] = v;
+      }
+    g = rcb_mon_drift_glr(ring, DOF, W, 0, 1, DOF, sall, NALL, rho, 0, &m, rate);
+    mean += g / NREP;
+    over += g > 9.21034037197618;
+  }
+  /* mean of chi2(2): 2, sd of the mean 2 / sqrt(NREP) = 0.014; the rate 0.01:
+   * binomial 99.9 % bounds [0.0074, 0.0128] */
+  print_message("drift GLR under the null (rho %.1f, one onset): mean %.4f, %zu of %d above "
+                "the 0.99 quantile\n", rho, mean, over, (int)NREP);
+  assert_true(fabs(mean - 2.0) < 0.06);
+  assert_true(over >= 148 && over <= 256);
 }
 
 /* ---- bad input ---- */
@@ -926,6 +1000,7 @@ static void test_bad_input(void **state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_chi2),
+      cmocka_unit_test(test_drift_glr),
       cmocka_unit_test(test_null),
       cmocka_unit_test(test_null_reweighted),
       cmocka_unit_test(test_null_phase),

@@ -114,7 +114,8 @@ static const char MODEL_INI[] =
 #define N_COMMISSION 16  /* FRF tests averaged into the commissioning values */
 #define PI 3.14159265358979323846
 #define REBOOT_DAY 182   /* the host restarts before this day's test */
-#define STATE_MAX 1024   /* bytes of "flash" for the monitor's state */
+#define STATE_MAX 65536  /* bytes of "flash" for the monitor's state (the drift
+                            window: 264 bytes per rank-space dimension) */
 
 static const char *const OUTS[NOUT] = {"DA.x", "DA.y", "DB.x", "DB.y"};
 

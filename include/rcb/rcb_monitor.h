@@ -101,6 +101,47 @@
  *    only seeds it, u = 0). A drift is caught as a run of innovations of one
  *    sign: the running mean trails a linear drift by half its length. With a
  *    noise-free reference (setup_averages HUGE_VAL) m stays 0 and u = z.
+ *  - Drift test (window GLR, beside the instant test). Per scored candidate,
+ *    s_t = D_c y_t, its orthonormal directions beyond the tracked columns
+ *    (the tracked parameters free at every update: nuisance), over the last
+ *    32 updates (a ring kept with the state). Model: s_t grows linearly,
+ *    b (t - tau), from an onset m = t - tau updates ago; the commissioning
+ *    noise every update shares is a common offset with the known share
+ *    rho = (1/N) / (1 + 1/N) of an update's variance, so the updates of one
+ *    direction have covariance (1 - rho) I + rho 1 1^T over the n updates
+ *    since commissioning, whose inverse needs only the sums of y over them.
+ *    For onset m with weights w_j = m - j on the m newest updates, the GLS
+ *    GLR is ||sum w_j s_j - kappa (sum w) S||^2 / ((1 - rho) (sum w^2 -
+ *    kappa (sum w)^2)), S the sum of s over the n updates and kappa =
+ *    rho / (1 - rho + n rho) (1 / n after rcb_monitor_reset_cusum: the
+ *    offset is then free), chi-square(dof) under "no drift" for each m
+ *    (exact for Gaussian noise; test_monitor's test_drift_glr). The largest
+ *    over the onsets m in {1, 2, 3, 5, 7, 10, 14, 19, 25, 32} (ramps of
+ *    neighbours correlate 0.96 or more) is the candidate's; the candidate
+ *    with the smallest chi-square p-value is reported, and alarms when that
+ *    p-value times the scored candidates times the 10 onsets (Bonferroni:
+ *    a false-alarm probability per update of at most alpha, the instant
+ *    test's) is below alpha. Its drift rate per update, in parameter units,
+ *    is the rate of s taken back through the candidate's triangular factor
+ *    at create. With opts.reweight (or an update's sd) s is taken in the
+ *    update's own noise: the candidate's orthonormal components beyond the
+ *    tracked columns in the instant test's metric (its GLS), on what the
+ *    re-linearised tracked step leaves; without, in the commissioning's (on
+ *    a 2.6 % wear of kt the commissioning's metric made the drift test alarm
+ *    on a pedestal at B3, GLR 700 at one onset, as it makes T alarm; in the
+ *    update's own it stayed below 9). The attribution below takes the
+ *    commissioning's metric on either path.
+ *  - Attribution of CUSUM alarms. While a tracked parameter a's CUSUM
+ *    alarms, the accumulated change (the ramp-weighted GLS combination of
+ *    the whole window, as above, of y plus the tracked columns times the
+ *    re-linearised steps: the change from the baseline, linearly) is
+ *    fitted by a's column and, in turn, by each scored candidate's columns,
+ *    the other tracked parameters free in both (nuisance); each fit's GLR
+ *    (the explained sum of squares beyond the nuisance) gives the BIC
+ *    change -GLR + dof ln n of rcb_monitor_named's one rule, and the best
+ *    candidate is compared with a by rcb_evidence_separable:
+ *    rcb_monitor_tracked.named says a alone, "a or the candidate: not
+ *    separable on these channels", or the candidate told apart from a.
  */
 #ifndef RCB_MONITOR_H
 #define RCB_MONITOR_H
@@ -229,6 +270,20 @@ typedef struct rcb_monitor_tracked {
                             sqrt(stderr_^2 + the baseline's variance) */
   double change;       /**< value - baseline, parameter units */
   double change_lo, change_hi; /**< its 95 % interval: change -+ 1.96 stderr_ */
+  int named;           /**< while cusum_alarm: whether the accumulated change is
+                            this parameter's (the attribution in the method
+                            above, by the one rule of rcb_monitor_named): 1 this
+                            parameter alone (also when there is no candidate to
+                            compare, rival_dof 0); 0 this parameter or candidate
+                            rival, not separable on these channels; -1 candidate
+                            rival, told apart from this parameter. 1 without
+                            an alarm */
+  size_t rival;        /**< the candidate that explains the accumulated change
+                            best (index as rcb_monitor_candidate.index) */
+  size_t rival_dof;    /**< its parameters (0: no candidate compared) */
+  double rival_rate[RCB_MONITOR_MAXP]; /**< its parameters' change per update
+                            over the window, parameter units per update (its
+                            sign: rising or falling) */
 } rcb_monitor_tracked;
 
 /** @brief What one update found. Plain value type, owns nothing. */
@@ -249,6 +304,21 @@ typedef struct rcb_monitor_result {
   rcb_monitor_candidate top[RCB_MONITOR_TOP]; /**< best first (smallest p) */
   size_t ntracked;    /**< tracked parameters */
   rcb_monitor_tracked tracked[RCB_MONITOR_MAX_TRACKED];
+  /* the drift test (the method above): the candidate whose drift is best
+   * supported, whether or not it alarms */
+  double drift_glr;   /**< its window GLR (-), chi-square(drift_dof) for one onset */
+  size_t drift_dof;   /**< its degrees of freedom (0: no candidate scored) */
+  double drift_p;     /**< its p-value over every candidate and onset (-):
+                           Bonferroni, min(1, p x scored candidates x 10 onsets) */
+  int drift_alarm;    /**< 1 when drift_p < alpha and the instant test does
+                           not fire (then it names the change, re-linearised: on
+                           ROSS's step of cross-coupling at B3 the best linear
+                           drift was a pedestal at B1) */
+  size_t drift_index; /**< the candidate (as rcb_monitor_candidate.index) */
+  size_t drift_onset; /**< updates since the drift's onset (one of 1, 2, 3, 5,
+                           7, 10, 14, 19, 25, 32) */
+  double drift_rate[RCB_MONITOR_MAXP]; /**< its parameters' change per update,
+                           parameter units per update */
 } rcb_monitor_result;
 
 typedef struct rcb_monitor rcb_monitor;
@@ -297,8 +367,10 @@ RCB_API const char *rcb_monitor_errmsg(const rcb_monitor *mon);
 RCB_API rcb_status rcb_monitor_update(rcb_monitor *mon, const rcb_complex *values,
                                       const double *sd, rcb_monitor_result *res);
 
-/** @brief Forget the CUSUM sums (after maintenance, or once an alarm is
- * acknowledged); the update count and the baseline stay. */
+/** @brief Forget the CUSUM sums and the drift test's window (after
+ * maintenance, or once an alarm is acknowledged; the drift test's common
+ * offset is then free, as the CUSUM's reference starts afresh); the update
+ * count and the baseline stay. */
 RCB_API void rcb_monitor_reset_cusum(rcb_monitor *mon);
 
 /** @brief Values one update takes: channels x points of the set-up. */
@@ -369,15 +441,22 @@ RCB_API rcb_status rcb_monitor_thresholds(const rcb_monitor *mon, double *alpha,
  * alpha, CUSUM k and h, noise, averages, re-linearisation, reweighting,
  * tracked ranges), the update count u64, the reference-started flag u32,
  * then per tracked parameter S+, S-, reference sum and weight (IEEE-754
- * binary64) and the frozen flag, and last the CRC-32 (IEEE 802.3,
+ * binary64) and the frozen flag, then the drift window (version 2: the
+ * rank k, tracked count and window u32, the ring's count and newest slot
+ * u32, the updates in its sums u64, the free-offset flag u32, the sums of
+ * the rank-space change y (k), of the re-linearised tracked steps and of
+ * each scored candidate's drift input s, and per slot of the window its y,
+ * step and s), and last the CRC-32 (IEEE 802.3,
  * reflected 0xEDB88320, as zlib's crc32) of everything before it. Neither
  * call allocates. */
 
 /** @brief Format version of the saved state. */
-#define RCB_MONITOR_STATE_VERSION 1u
+#define RCB_MONITOR_STATE_VERSION 2u
 
-/** @brief Bytes rcb_monitor_save writes for this monitor (76 + 40 per
- * tracked parameter); 0 for a monitor not created successfully. */
+/** @brief Bytes rcb_monitor_save writes for this monitor (108 + 40 per
+ * tracked parameter + 264 (k + tracked parameters + the scored candidates'
+ * ranks), k its rank (rcb_monitor_rank)); 0 for a monitor not created
+ * successfully. */
 RCB_API size_t rcb_monitor_state_size(const rcb_monitor *mon);
 /**
  * @brief Save the monitor's accumulated state into @p buf.

@@ -33,6 +33,7 @@ void rcb_monitor_destroy(rcb_monitor *mon) {
   rcb_free(&mon->alloc, mon->sw.A);
   rcb_free(&mon->alloc, mon->sw.work);
   rcb_free(&mon->alloc, mon->y);
+  rcb_free(&mon->alloc, mon->dy);
   rcb_fit_destroy(mon->fit);
   rcb_model_destroy(mon->model);
   rcb_meas_destroy(mon->setup);
@@ -398,7 +399,7 @@ static rcb_status joint_relin(rcb_monitor *mon, int gls, rcb_monitor_result *res
 rcb_status rcb_monitor_update(rcb_monitor *mon, const rcb_complex *values, const double *sd,
                               rcb_monitor_result *res) {
   double theta[RCB_MONITOR_MAX_TRACKED], dth[RCB_MONITOR_MAX_TRACKED] = {0},
-      se[RCB_MONITOR_MAX_TRACKED] = {0}, T;
+      se[RCB_MONITOR_MAX_TRACKED] = {0}, T, threl[RCB_MONITOR_MAX_TRACKED];
   size_t p, a;
   int gls;
   rcb_status st;
@@ -418,6 +419,7 @@ rcb_status rcb_monitor_update(rcb_monitor *mon, const rcb_complex *values, const
   to_rank(mon, mon->r, mon->y);
   memcpy(mon->y0, mon->y, mon->k * sizeof *mon->y0);
   if ((st = tracked_step(mon, theta))) return st;
+  memcpy(threl, theta, sizeof threl);
   if (gls) {
     if ((st = rcb_mon_gls(mon, values, sd, dth, se, &T))) return st;
   } else {
@@ -442,6 +444,7 @@ rcb_status rcb_monitor_update(rcb_monitor *mon, const rcb_complex *values, const
   if ((st = joint_relin(mon, gls, res, dth, se))) return st;
   for (a = 0; a < mon->nt; a++) theta[a] += dth[a];
   tracked_result(mon, theta, se, res);
+  rcb_mon_drift_update(mon, threl, gls, res);
   return RCB_OK;
 }
 
@@ -453,6 +456,7 @@ void rcb_monitor_reset_cusum(rcb_monitor *mon) {
   memset(mon->ref_w, 0, sizeof mon->ref_w);
   memset(mon->ref_frozen, 0, sizeof mon->ref_frozen);
   mon->ref_started = 1; /* the next update starts the reference afresh */
+  rcb_mon_drift_reset(mon); /* and the drift test its window */
 }
 
 size_t rcb_monitor_point_count(const rcb_monitor *mon) { return ready(mon) ? mon->npt : 0; }

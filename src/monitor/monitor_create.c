@@ -395,6 +395,23 @@ static rcb_status commission(rcb_monitor *mon, const rcb_model *base, const rcb_
       mon->order = (size_t *)(void *)(mon->pscore + (mon->ncand ? mon->ncand : 1));
     }
   }
+  if (!st) {
+    size_t W = MON_DRIFT_WINDOW, kr = mon->k;
+    mon->dy = rcb_mon_alloc(mon, W * kr + W * RCB_MONITOR_MAX_TRACKED +
+                            (W + 1) * (mon->ncand ? mon->ncand : 1) * RCB_MONITOR_MAXP + 2 * kr,
+                            sizeof *mon->dy);
+    if (!mon->dy) st = rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (drift window)");
+    else {
+      mon->dth = mon->dy + W * kr;
+      mon->ds = mon->dth + W * RCB_MONITOR_MAX_TRACKED;
+      mon->dysum = mon->ds + W * (mon->ncand ? mon->ncand : 1) * RCB_MONITOR_MAXP;
+      mon->dY = mon->dysum + kr;
+      mon->dssum = mon->dY + kr;
+      memset(mon->dysum, 0, kr * sizeof *mon->dysum);
+      memset(mon->dssum, 0, (mon->ncand ? mon->ncand : 1) * RCB_MONITOR_MAXP * sizeof *mon->dssum);
+      mon->rho = mon->navg_inv / (1.0 + mon->navg_inv);
+    }
+  }
   if (!st) st = rcb_mon_lowrank_init(mon);
   if (!st) {
     size_t dof = mon->k > mon->nt ? mon->k - mon->nt : 0;

@@ -124,8 +124,14 @@ static rcb_status candidates_gls(rcb_monitor *mon) {
       memcpy(c->se_now, c->se, sizeof c->se_now);
       memset(c->th_now, 0, sizeof c->th_now);
       memcpy(c->set_now, c->se_t, sizeof c->set_now);
+      memset(c->xd, 0, sizeof c->xd);
       continue;
     }
+    /* the drift test's input: the candidate's orthonormal components beyond
+     * the tracked columns in this update's noise, on y (what the
+     * re-linearised tracked step leaves; mon->z = U^-T y) */
+    (void)rcb_mon_gls_explained(&mon->sw, mon->z, k, nt, nt + c->np, qz);
+    memcpy(c->xd, qz + nt, c->np * sizeof *c->xd);
     c->score_now = rcb_mon_gls_explained(&mon->sw, mon->z0, k, nt, nt + c->np, qz);
     rcb_mon_gls_step(&mon->sw, qz, nt + c->np, nt, c->np, c->size_now, c->se_now);
     rcb_mon_gls_step(&mon->sw, qz, nt + c->np, 0, nt, c->th_now, c->set_now);

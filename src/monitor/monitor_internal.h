@@ -52,6 +52,13 @@ typedef struct mon_cand {
                         neutral values (rcb_model_set_param on mon->model):
                         the joint step can be re-linearised */
   char pname[RCB_MONITOR_MAXP][RCB_MONITOR_NAME]; /* their names (settable) */
+  double r0[RCB_MONITOR_MAXP * RCB_MONITOR_MAXP]; /* the upper triangle of its block
+                        of R at create (row-major): s = r0 x for parameter steps x,
+                        so that est = r0^-1 dir */
+  double xd[RCB_MONITOR_MAXP]; /* the reweighted path: this update's s, its
+                        orthonormal components beyond the tracked columns in the
+                        update's own noise, on the re-linearised y (the drift
+                        test's input; dir y on the other path) */
 } mon_cand;
 
 /* Most DOFs of P for the low-rank re-evaluation (monitor_lowrank.c). */
@@ -166,7 +173,32 @@ struct rcb_monitor {
   double *pscore;      /* ncand: log p-value of each candidate's score */
   size_t *order;       /* ncand */
   size_t updates;
+
+  /* the drift test and the CUSUM alarms' attribution (monitor_drift.c):
+   * the last MON_DRIFT_WINDOW updates in a ring, and the sums since
+   * commissioning (or rcb_monitor_reset_cusum) that carry the commissioning
+   * noise every update shares */
+  size_t dcount, dhead; /* updates in the ring, the newest's slot */
+  size_t dall;         /* updates in the sums */
+  int dfree;           /* 1 after a reset: the common offset is free (no prior) */
+  double rho;          /* the share of the commissioning noise in an update's
+                          variance (-): (1/N) / (1 + 1/N) */
+  double *dy;          /* MON_DRIFT_WINDOW x k: y of each update (after the
+                          re-linearised tracked step) */
+  double *dth;         /* MON_DRIFT_WINDOW x RCB_MONITOR_MAX_TRACKED: that step */
+  double *ds;          /* MON_DRIFT_WINDOW x ncand x RCB_MONITOR_MAXP: each
+                          candidate's s = dir y (on the reweighted path xd: the
+                          same in the update's own noise) */
+  double *dysum;       /* k: sum of y over dall updates */
+  double *dssum;       /* ncand x RCB_MONITOR_MAXP: sum of each candidate's s */
+  double dthsum[RCB_MONITOR_MAX_TRACKED]; /* sum of the steps */
+  double *dY;          /* k: work, the accumulated change */
 };
+
+/* Updates the drift test looks back over, and the onsets it tries within
+ * them (1 .. MON_DRIFT_WINDOW updates ago, monitor_drift.c). */
+#define MON_DRIFT_WINDOW 32
+#define MON_DRIFT_NONSET 10
 
 #define rcb_mon_fail(mon, st, ...) rcb_fail((mon), (st), __VA_ARGS__)
 
@@ -226,5 +258,22 @@ double rcb_mon_gls_explained(const mon_small *w, const double *z, size_t k, size
                              size_t p, double *qz);
 void rcb_mon_gls_step(const mon_small *w, const double *qz, size_t p, size_t first, size_t q,
                       double *x, double *se);
+
+/* monitor_drift.c: the window GLR of a drift growing linearly from an
+ * onset m updates ago (m <= count, on the grid of onsets), on dof components of s (component i of
+ * lag j at ring[((head + w - j) % w) * ld + i]), with the commissioning's
+ * shared noise (a common offset, share rho of the variance; free: no prior)
+ * taken out through sall (the sums of s over nall updates). Returns the
+ * largest GLR, its m and the drift rate per update of each component. */
+double rcb_mon_drift_glr(const double *ring, size_t ld, size_t w, size_t head, size_t count,
+                         size_t dof, const double *sall, size_t nall, double rho, int free_off,
+                         size_t *mbest, double *rate);
+/* The update's part: push this update (y, the re-linearised step theta),
+ * the drift test into res, and the attribution of every CUSUM alarm. */
+void rcb_mon_drift_update(rcb_monitor *mon, const double *theta, int gls,
+                          rcb_monitor_result *res);
+void rcb_mon_drift_reset(rcb_monitor *mon);
+/* The one naming rule's BIC change of a score with dof degrees of freedom. */
+double rcb_mon_bic(const rcb_monitor *mon, double score, size_t dof);
 
 #endif

@@ -128,6 +128,8 @@ static rcb_status cand_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
     mc->test_t = mc->dir + c.np * k;
     mc->dof = c.np;
     estimator(w->A, w->Ri, k, p, nt, c.np, mc->est, mc->se);
+    for (a = 0; a < c.np; a++)
+      for (i = a; i < c.np; i++) mc->r0[a * RCB_MONITOR_MAXP + i] = w->R[(nt + a) + p * (nt + i)];
     estimator(w->A, w->Ri, k, p, 0, nt, mc->test_t, mc->se_t);
     for (a = 0; a < c.np; a++)
       for (i = 0; i < k; i++) mc->dir[a * k + i] = w->A[i + k * (nt + a)];
@@ -152,7 +154,16 @@ rcb_status rcb_mon_factor(rcb_monitor *mon, rcb_diag *d, const double *J, size_t
   diag_basis b;
   double q = 0;
   lapack_int info;
-  rcb_status st = rcb_diag_basis_init(d, &b, J, mon->n, ncol, mon->r);
+  rcb_status st;
+  /* score_qr.c's workspace query asks dormqr for ncol reflectors on n rows,
+   * an illegal argument (LAPACK's xerbla prints it) when ncol > n: refused
+   * here with the fix, until that query asks for min(ncol, n) */
+  if (ncol > mon->n)
+    return rcb_mon_fail(mon, RCB_ERR_ARG, "the set-up has %zu real residuals (2 x %zu channels "
+                        "x %zu points), fewer than the %zu sensitivity columns of the tracked "
+                        "parameters and the candidates: add channels or points, or choose fewer "
+                        "effects (opts.effects)", mon->n, mon->nch, mon->npts, ncol);
+  st = rcb_diag_basis_init(d, &b, J, mon->n, ncol, mon->r);
   if (st) return rcb_mon_fail(mon, st, "%s", rcb_diag_errmsg(d));
   mon->k = b.rank;
   mon->Q = b.qr; /* the block is the monitor's allocator's (d was made with it) */
@@ -193,7 +204,7 @@ static void transpose_q(rcb_monitor *mon, double *Qr) {
 
 /* J (n x ncol >= n x k) is used up: Q moves into its block. */
 rcb_status rcb_mon_rank_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl, double *J) {
-  size_t k = mon->k, nt = mon->nt, pmax = nt + RCB_MONITOR_MAXP, lw;
+  size_t k = mon->k, nt = mon->nt, pmax = nt + RCB_MONITOR_MAXP, lw, pq;
   double q1 = 0, q2 = 0;
   mon_small *w = &mon->sw;
   rcb_status st;
@@ -214,9 +225,11 @@ rcb_status rcb_mon_rank_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
   mon->ncand = pl->ncand;
   mon->tdir = mon->test + (nt ? nt : 1) * k;
   w->R = w->A + k * pmax, w->Ri = w->R + pmax * pmax, w->tau = w->Ri + pmax * pmax;
-  LAPACKE_dgeqrf_work(LAPACK_COL_MAJOR, (lapack_int)k, (lapack_int)pmax, w->A, (lapack_int)k,
+  /* the small QRs have p <= k columns (rcb_mon_small_qr): dorgqr needs N <= M */
+  pq = pmax < k ? pmax : k;
+  LAPACKE_dgeqrf_work(LAPACK_COL_MAJOR, (lapack_int)k, (lapack_int)pq, w->A, (lapack_int)k,
                       w->tau, &q1, -1);
-  LAPACKE_dorgqr_work(LAPACK_COL_MAJOR, (lapack_int)k, (lapack_int)pmax, (lapack_int)pmax, w->A,
+  LAPACKE_dorgqr_work(LAPACK_COL_MAJOR, (lapack_int)k, (lapack_int)pq, (lapack_int)pq, w->A,
                       (lapack_int)k, w->tau, &q2, -1);
   lw = (size_t)fmax(fmax(q1, q2), (double)pmax);
   if (!(w->work = rcb_mon_alloc(mon, lw, sizeof *w->work)))
@@ -229,11 +242,13 @@ rcb_status rcb_mon_rank_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
   return RCB_OK;
 }
 
+/* The one naming rule's BIC change: -score + dof ln n (n real residuals). */
+double rcb_mon_bic(const rcb_monitor *mon, double score, size_t dof) {
+  return -score + (double)dof * log((double)mon->n);
+}
+
 int rcb_monitor_named(const rcb_monitor *mon, const rcb_monitor_result *r) {
-  double ln_n, b0, b1;
   if (!mon || !r || r->ntop < 2) return -1;
-  ln_n = log((double)mon->n);
-  b0 = -r->top[0].score + (double)r->top[0].dof * ln_n;
-  b1 = -r->top[1].score + (double)r->top[1].dof * ln_n;
-  return rcb_evidence_separable(b0, b1);
+  return rcb_evidence_separable(rcb_mon_bic(mon, r->top[0].score, r->top[0].dof),
+                                rcb_mon_bic(mon, r->top[1].score, r->top[1].dof));
 }

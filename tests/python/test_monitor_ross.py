@@ -123,6 +123,26 @@ def test_null_cusum_silent(tool, name):
     assert not cusum, FIGURES[f"{name} CUSUM"]
 
 
+@pytest.mark.parametrize("name", ["null", "kt_wear"])
+def test_drift_test_quiet(tool, name):
+    """The drift test (issue #24) on series where no untracked effect changes: at
+    most alpha per update (its Bonferroni bound), within the binomial 99 % upper
+    bound; on kt_wear a tracked parameter wears 10 % (the drift test's candidates
+    are beyond the tracked columns, in each update's own noise with --reweight).
+    And kt's CUSUM alarms there are attributed to kt alone (the attribution's
+    rule: no candidate explains the accumulated change as well)."""
+    log, truth = monitor(tool, name, "--alpha", 0.01)
+    ups = log["updates"]
+    drift = [u["update"] for u in ups if u["drift"] and u["drift"]["alarm"]]
+    hi = stats.binom.ppf(0.99, len(ups), 0.01)
+    FIGURES[f"{name} drift"] = f"drift alarms at updates {drift} of {len(ups)} (at most {hi:.0f})"
+    assert len(drift) <= hi, FIGURES[f"{name} drift"]
+    if name == "kt_wear":
+        k = PARAMS.split(",").index("coupling.C.kt")
+        named = [u["tracked"][k]["named"] for u in ups if u["tracked"][k]["cusum_alarm"]]
+        assert named and all(v == 1 for v in named), named
+
+
 def test_kt_wear(tool):
     log, truth = monitor(tool, "kt_wear", "--alpha", 0.01)
     k = PARAMS.split(",").index("coupling.C.kt")

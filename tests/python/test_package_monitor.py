@@ -106,7 +106,12 @@ def test_state_restart(rcb, tmp_path):
                 with rcb.Meas.read(p, uff_map=UFF_MAP) as ms:
                     a.update(ms)
             state = a.save_state()
-            assert len(state) == 76 + 40 * len(PARAMS) and state[:4] == b"RCBM"
+            # rcb_monitor.h's layout: header, per tracked, the drift window
+            # (264 bytes per rank-space dimension, tracked parameter and scored
+            # candidate parameter)
+            rest = len(state) - 108 - 40 * len(PARAMS) - 264 * (a.rank[0] + len(PARAMS))
+            assert rest > 0 and rest % 264 == 0
+            assert state[:4] == b"RCBM"
             b.load_state(state)
             with rcb.Meas.read(paths[3], uff_map=UFF_MAP) as ms:
                 ra, rb = a.update(ms), b.update(ms)
@@ -117,3 +122,18 @@ def test_state_restart(rcb, tmp_path):
             bad[40] ^= 1
             with pytest.raises(rcb.RcbError):
                 b.load_state(bytes(bad))
+
+
+def test_small_setup_refused_without_printing(rcb, capfd):
+    """1 channel x 21 points and one tracked parameter: fewer residuals (42) than
+    sensitivity columns. It failed with "LAPACK workspace query failed" after
+    LAPACK's DORMQR printed to stdout (a query for more reflectors than rows, an
+    illegal argument); now refused with what to change, and nothing printed."""
+    f = np.linspace(100, 400, 21)
+    with rcb.Model.from_ini(PAPER) as m, \
+            rcb.simulate(m, ["DA.x"], ["DA.x"], f, rpm=10000, kind="inertance",
+                         noise=(10, 1), seed=1) as ms:
+        with pytest.raises(rcb.RcbError, match="42 real residuals"):
+            rcb.Monitor(m, ms, ["coupling.C.kt"], noise=(10, 1))
+    out = capfd.readouterr()
+    assert "DORMQR" not in out.out + out.err and out.out == ""

@@ -107,11 +107,14 @@ static void values(const rcb_meas *ms, rcb_complex *v) {
 /* The state's save and load (each the mean of NSTATE calls), seconds. */
 #define NSTATE 200
 static int state_times(rcb_monitor *mon, double *ts, double *tl, size_t *n) {
-  static unsigned char buf[4096];
+  static unsigned char buf[1 << 16]; /* k = 83: 23 kB with the drift window */
   size_t i;
   double t0 = now();
   for (i = 0; i < NSTATE; i++)
-    if (rcb_monitor_save(mon, buf, sizeof buf, n)) return 1;
+    if (rcb_monitor_save(mon, buf, sizeof buf, n)) {
+      fprintf(stderr, "save: %zu bytes needed\n", rcb_monitor_state_size(mon));
+      return 1;
+    }
   *ts = (now() - t0) / NSTATE;
   t0 = now();
   for (i = 0; i < NSTATE; i++)

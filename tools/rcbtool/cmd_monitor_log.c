@@ -54,7 +54,23 @@ static void json_candidate(FILE *fp, const mon_state *s, const rcb_monitor_candi
   fputc('}', fp);
 }
 
-static void json_tracked(FILE *fp, const rcb_monitor_tracked *t, const char *name) {
+/* A candidate by index: effect, place, params and its rate per update. */
+static void json_rate(FILE *fp, const mon_state *s, size_t index, const double *rate) {
+  rcb_monitor_candidate_info ci;
+  memset(&ci, 0, sizeof ci);
+  rcb_monitor_candidate_info_get(s->mon, index, &ci);
+  fputs("{\"effect\": ", fp);
+  cli_json_str(fp, rcb_effect_name(ci.effect));
+  fputs(", \"place\": ", fp);
+  cli_json_str(fp, ci.place ? ci.place : "");
+  fputs(", \"params\": ", fp);
+  cli_json_str(fp, ci.params ? ci.params : "");
+  fputs(", \"rate\": ", fp);
+  cli_json_nums(fp, rate, ci.np, 1);
+}
+
+static void json_tracked(FILE *fp, const mon_state *s, const rcb_monitor_tracked *t,
+                         const char *name) {
   fputs("{\"name\": ", fp);
   cli_json_str(fp, name);
   json_key_num(fp, "value", t->value);
@@ -69,8 +85,18 @@ static void json_tracked(FILE *fp, const rcb_monitor_tracked *t, const char *nam
   json_key_num(fp, "u", t->u);
   json_key_num(fp, "cusum_up", t->cusum_up);
   json_key_num(fp, "cusum_down", t->cusum_down);
-  fprintf(fp, ", \"cusum_alarm\": %d, \"out_of_range\": %s}", t->cusum_alarm,
+  fprintf(fp, ", \"cusum_alarm\": %d, \"out_of_range\": %s", t->cusum_alarm,
           t->out_of_range ? "true" : "false");
+  /* a CUSUM alarm's attribution (the one rule): 1 this parameter, 0 it or
+   * the rival (not separable), -1 the rival */
+  fprintf(fp, ", \"named\": %d, \"rival\": ", t->named);
+  if (t->cusum_alarm && t->rival_dof) {
+    json_rate(fp, s, t->rival, t->rival_rate);
+    fputc('}', fp);
+  } else {
+    fputs("null", fp);
+  }
+  fputc('}', fp);
 }
 
 static void json_update(FILE *fp, const mon_state *s, size_t k) {
@@ -89,7 +115,7 @@ static void json_update(FILE *fp, const mon_state *s, size_t k) {
           r->alarm ? "true" : "false", r->cusum_alarm ? "true" : "false");
   for (i = 0; i < r->ntracked; i++) {
     if (i) fputs(", ", fp);
-    json_tracked(fp, &r->tracked[i], s->j->params.items[i].name);
+    json_tracked(fp, s, &r->tracked[i], s->j->params.items[i].name);
   }
   fputs("],\n   \"top\": [", fp);
   for (i = 0; i < r->ntop; i++) {
@@ -98,7 +124,18 @@ static void json_update(FILE *fp, const mon_state *s, size_t k) {
   }
   { /* rcb_monitor_named: the first told apart from the second (null: < 2 ranked) */
     int named = rcb_monitor_named(s->mon, r);
-    fprintf(fp, "], \"separable\": %s}", named < 0 ? "null" : named ? "true" : "false");
+    fprintf(fp, "], \"separable\": %s", named < 0 ? "null" : named ? "true" : "false");
+  }
+  fputs(",\n   \"drift\": ", fp); /* the drift test's best supported candidate */
+  if (!r->drift_dof) {
+    fputs("null}", fp);
+  } else {
+    json_rate(fp, s, r->drift_index, r->drift_rate);
+    json_key_num(fp, "glr", r->drift_glr);
+    fprintf(fp, ", \"dof\": %zu", r->drift_dof);
+    json_key_num(fp, "p_value", r->drift_p);
+    fprintf(fp, ", \"alarm\": %s, \"onset\": %zu}}", r->drift_alarm ? "true" : "false",
+            r->drift_onset);
   }
 }
 

@@ -285,6 +285,32 @@ void mon_flags(const rcb_monitor_result *r, char *buf, size_t size) {
            !r->alarm && !down && !up ? "-" : "");
 }
 
+/* A CUSUM alarm of tracked parameter k and what the attribution said (the
+ * one rule, rcb_monitor_tracked.named): "kr falling", "kr falling, or
+ * <candidate> falling: not separable on these channels", or the candidate
+ * told apart from kr. */
+static void print_attribution(FILE *fp, const mon_state *s, const rcb_monitor_result *r,
+                              size_t k) {
+  const rcb_monitor_tracked *t = &r->tracked[k];
+  const char *dir = t->cusum_alarm < 0 ? "falling" : "rising";
+  rcb_monitor_candidate_info ci;
+  char name[1024];
+  if (!t->cusum_alarm) return;
+  cli_text(s->j->params.items[k].name, name, sizeof name);
+  if (t->named == 1 || !t->rival_dof ||
+      rcb_monitor_candidate_info_get(s->mon, t->rival, &ci) != RCB_OK) {
+    fprintf(fp, "  %s %s", name, dir);
+    return;
+  }
+  if (t->named == 0)
+    fprintf(fp, "  %s %s, or %s at %s: %s %s: not separable on these channels", name, dir,
+            rcb_effect_name(ci.effect), ci.place, ci.params,
+            t->rival_rate[0] < 0 ? "falling" : "rising");
+  else
+    fprintf(fp, "  %s at %s: %s %s (told apart from %s)", rcb_effect_name(ci.effect), ci.place,
+            ci.params, t->rival_rate[0] < 0 ? "falling" : "rising", name);
+}
+
 static void print_line(FILE *fp, const mon_state *s, const mon_record *rec) {
   const rcb_monitor_result *r = &rec->r;
   char flags[32], name[1024];
@@ -308,6 +334,14 @@ static void print_line(FILE *fp, const mon_state *s, const mon_record *rec) {
         rcb_monitor_candidate_info_get(s->mon, r->top[1].index, &ci) == RCB_OK)
       fprintf(fp, ", or %s at %s: not separable on these channels (rcbtool plan)",
               rcb_effect_name(ci.effect), ci.place);
+  }
+  for (k = 0; k < r->ntracked; k++)
+    print_attribution(fp, s, r, k);
+  if (r->drift_alarm) {
+    rcb_monitor_candidate_info ci;
+    if (rcb_monitor_candidate_info_get(s->mon, r->drift_index, &ci) == RCB_OK)
+      fprintf(fp, "  drift: %s at %s: %s %+.4g per update over %zu updates", rcb_effect_name(ci.effect),
+              ci.place, ci.params, r->drift_rate[0], r->drift_onset);
   }
   fputc('\n', fp);
 }

@@ -189,7 +189,8 @@ class MonitorTracked(ctypes.Structure):
                 ("cusum_up", c_double),
                 ("cusum_down", c_double), ("cusum_alarm", c_int), ("out_of_range", c_int),
                 ("abs_stderr", c_double), ("change", c_double), ("change_lo", c_double),
-                ("change_hi", c_double)]
+                ("change_hi", c_double), ("named", c_int), ("rival", c_size_t),
+                ("rival_dof", c_size_t), ("rival_rate", c_double * MONITOR_MAXP)]
 
 
 class MonitorResult(ctypes.Structure):
@@ -198,7 +199,10 @@ class MonitorResult(ctypes.Structure):
                 ("threshold", c_double), ("p_value", c_double), ("alarm", c_int),
                 ("cusum_alarm", c_int), ("ntop", c_size_t),
                 ("top", MonitorCandidate * MONITOR_TOP), ("ntracked", c_size_t),
-                ("tracked", MonitorTracked * MONITOR_MAX_TRACKED)]
+                ("tracked", MonitorTracked * MONITOR_MAX_TRACKED),
+                ("drift_glr", c_double), ("drift_dof", c_size_t), ("drift_p", c_double),
+                ("drift_alarm", c_int), ("drift_index", c_size_t), ("drift_onset", c_size_t),
+                ("drift_rate", c_double * MONITOR_MAXP)]
 
 
 class MonitorCandidateInfo(ctypes.Structure):
@@ -357,6 +361,7 @@ _PROTOTYPES = {
     "rcb_monitor_point_count": (c_size_t, [c_void_p]),
     "rcb_monitor_memory": (c_size_t, [c_void_p]),
     "rcb_monitor_candidate_count": (c_size_t, [c_void_p]),
+    "rcb_monitor_rank": (c_int, [c_void_p, ctypes.POINTER(c_size_t), ctypes.POINTER(c_size_t)]),
     "rcb_monitor_named": (c_int, [c_void_p, c_void_p]),
     "rcb_monitor_candidate_info_get": (c_int, [c_void_p, c_size_t,
                                                ctypes.POINTER(MonitorCandidateInfo)]),

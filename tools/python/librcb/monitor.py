@@ -110,6 +110,13 @@ class Monitor(Handle):
                                     dtype=np.complex128)
 
     @property
+    def rank(self):
+        """(k, k_t): the rank of all columns and of the tracked ones."""
+        k, kt = ctypes.c_size_t(), ctypes.c_size_t()
+        self.check(_lib.lib().rcb_monitor_rank(self.handle, ctypes.byref(k), ctypes.byref(kt)))
+        return k.value, kt.value
+
+    @property
     def memory(self):
         """Bytes the monitor holds (all from its allocator)."""
         return int(_lib.lib().rcb_monitor_memory(self.handle))
@@ -120,7 +127,7 @@ class Monitor(Handle):
                                                              ctypes.byref(info)))
         return {"effect": _lib.text(_lib.lib().rcb_effect_name(info.effect)),
                 "place": _lib.text(info.place), "description": _lib.text(info.description),
-                "params": _lib.text(info.params)}
+                "params": _lib.text(info.params), "np": info.np}
 
     def save_state(self):
         """The monitor's accumulated state (CUSUMs, references, update count) as
@@ -161,7 +168,13 @@ class Monitor(Handle):
                             "z": t.z, "u": t.u, "cusum_up": t.cusum_up, "cusum_down": t.cusum_down,
                             "cusum_alarm": t.cusum_alarm, "out_of_range": bool(t.out_of_range),
                             "abs_stderr": t.abs_stderr, "change": t.change,
-                            "change_lo": t.change_lo, "change_hi": t.change_hi})
+                            "change_lo": t.change_lo, "change_hi": t.change_hi,
+                            # a CUSUM alarm's attribution (the one rule): 1 this
+                            # parameter, 0 it or the rival (not separable), -1 the rival
+                            "named": t.named,
+                            "rival": (dict(self.candidate(t.rival),
+                                           rate=list(t.rival_rate[:t.rival_dof]))
+                                      if t.cusum_alarm and t.rival_dof else None)})
         top = []
         for k in range(r.ntop):
             c = r.top[k]
@@ -177,7 +190,13 @@ class Monitor(Handle):
                 "cusum_alarm": bool(r.cusum_alarm), "tracked": tracked, "top": top,
                 # the one rule (rcb_monitor_named): the first candidate told apart from
                 # the second; None with fewer than two ranked
-                "separable": None if named < 0 else bool(named)}
+                "separable": None if named < 0 else bool(named),
+                # the drift test: the candidate whose linear drift is best supported
+                "drift": (None if not r.drift_dof else
+                          dict(self.candidate(r.drift_index), glr=r.drift_glr,
+                               dof=r.drift_dof, p_value=r.drift_p,
+                               alarm=bool(r.drift_alarm), onset=r.drift_onset,
+                               rate=list(r.drift_rate[:self.candidate(r.drift_index)["np"]])))}
 
     def __repr__(self):
         if not self._h:
