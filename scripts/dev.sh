@@ -554,7 +554,7 @@ cmd_fuzz() {
   cmake --build "$dir" -j "$JOBS"
   mkdir -p "$dir/crashes"
   # the four harnesses at once (each one process on one core, for a fixed
-  # time: together they take the time of two); each writes its own log
+  # time: together they take the time of one); each writes its own log
   local pids=() t_of=()
   say "fuzz_ini, fuzz_csv, fuzz_uff, fuzz_strtod at once: replay fuzz/corpus/NAME, then ${secs} s each"
   for t in ini csv uff strtod; do
