@@ -84,7 +84,7 @@ static int field_double(const char *s, size_t n, size_t from, size_t width, doub
     if (*p == 'D' || *p == 'd') *p = 'E';
   if (!f[0]) return -1;
   errno = 0;
-  *v = strtod(f, &end);
+  *v = rcb_strtod(f, &end); /* strtod, bit for bit (core/numparse.c) */
   return (*end || errno == ERANGE) ? -1 : 0;
 }
 
