@@ -48,6 +48,9 @@
 #                               multiarch; installs what is missing unless that would upgrade
 #                               host packages), firmware example under qemu-user diffed against
 #                               the native run, C tests not labelled slow/long/threads
+#   ./scripts/dev.sh cross-chroot  `cross` inside a Debian 12 root made in .chroot/bookworm
+#                               (mmdebstrap or debootstrap; root; for hosts that are not
+#                               Debian 12 or must not change): nothing is installed on the host
 #   ./scripts/dev.sh embedded   the "embedded" CMake preset (static, -Os, no optional backend,
 #                               build-embedded/): build and print the library size
 #
