@@ -745,9 +745,9 @@ cmd_cross() {
 # `cross` in a Debian 12 root, for a host that is not Debian 12 or whose
 # packages must not change (multiarch would upgrade them, see cross_deps):
 # mmdebstrap (or debootstrap) makes a minbase bookworm root in RCB_CHROOT
-# (default .chroot/bookworm, git-ignored; about 80 s and 160 MB, then 1.5 GB
+# (default .chroot/bookworm, git-ignored; about 100 s for the root, 1.9 GB
 # with the cross packages), the working tree (tracked and untracked files, not
-# the ignored ones) is copied to its /src, /proc and /dev are bind-mounted, and
+# the ignored ones) is copied to its /src, /proc, /dev and /dev/pts are mounted, and
 # `./scripts/dev.sh cross` runs there as root, installing what it needs inside
 # the root only. The mounts are undone on every exit. Needs root on the host.
 CHROOT=${RCB_CHROOT:-$ROOT/.chroot/bookworm}
