@@ -285,6 +285,15 @@ void mon_flags(const rcb_monitor_result *r, char *buf, size_t size) {
            !r->alarm && !down && !up ? "-" : "");
 }
 
+/* "<effect> at <place>[: <params>]" of a candidate, its names through the
+ * one escaping rule (cli_text), as the tracked names are. */
+static void put_cand(FILE *fp, const rcb_monitor_candidate_info *ci, int with_params) {
+  char place[512], params[1024];
+  fprintf(fp, "%s at %s", rcb_effect_name(ci->effect),
+          cli_text(ci->place ? ci->place : "", place, sizeof place));
+  if (with_params) fprintf(fp, ": %s", cli_text(ci->params ? ci->params : "", params, sizeof params));
+}
+
 /* A CUSUM alarm of tracked parameter k and what the attribution said (the
  * one rule, rcb_monitor_tracked.named): "kr falling", "kr falling, or
  * <candidate> falling: not separable on these channels", or the candidate
@@ -293,6 +302,7 @@ static void print_attribution(FILE *fp, const mon_state *s, const rcb_monitor_re
                               size_t k) {
   const rcb_monitor_tracked *t = &r->tracked[k];
   const char *dir = t->cusum_alarm < 0 ? "falling" : "rising";
+  const char *rdir = t->rival_rate[0] < 0 ? "falling" : "rising";
   rcb_monitor_candidate_info ci;
   char name[1024];
   if (!t->cusum_alarm) return;
@@ -302,13 +312,15 @@ static void print_attribution(FILE *fp, const mon_state *s, const rcb_monitor_re
     fprintf(fp, "  %s %s", name, dir);
     return;
   }
-  if (t->named == 0)
-    fprintf(fp, "  %s %s, or %s at %s: %s %s: not separable on these channels", name, dir,
-            rcb_effect_name(ci.effect), ci.place, ci.params,
-            t->rival_rate[0] < 0 ? "falling" : "rising");
-  else
-    fprintf(fp, "  %s at %s: %s %s (told apart from %s)", rcb_effect_name(ci.effect), ci.place,
-            ci.params, t->rival_rate[0] < 0 ? "falling" : "rising", name);
+  if (t->named == 0) {
+    fprintf(fp, "  %s %s, or ", name, dir);
+    put_cand(fp, &ci, 1);
+    fprintf(fp, " %s: not separable on these channels", rdir);
+  } else {
+    fputs("  ", fp);
+    put_cand(fp, &ci, 1);
+    fprintf(fp, " %s (told apart from %s)", rdir, name);
+  }
 }
 
 static void print_line(FILE *fp, const mon_state *s, const mon_record *rec) {
@@ -326,22 +338,28 @@ static void print_line(FILE *fp, const mon_state *s, const mon_record *rec) {
   if (r->alarm && r->ntop > 0) {
     const rcb_monitor_candidate *c = &r->top[0];
     rcb_monitor_candidate_info ci;
-    if (rcb_monitor_candidate_info_get(s->mon, c->index, &ci) == RCB_OK)
-      fprintf(fp, "  -> %s at %s: %s %.6g [%.6g, %.6g]", rcb_effect_name(ci.effect), ci.place,
-              ci.params, c->size[0], c->ci_lo[0], c->ci_hi[0]);
+    if (rcb_monitor_candidate_info_get(s->mon, c->index, &ci) == RCB_OK) {
+      fputs("  -> ", fp);
+      put_cand(fp, &ci, 1);
+      fprintf(fp, " %.6g [%.6g, %.6g]", c->size[0], c->ci_lo[0], c->ci_hi[0]);
+    }
     /* the one rule: the data may not tell the first from the second */
     if (rcb_monitor_named(s->mon, r) == 0 &&
-        rcb_monitor_candidate_info_get(s->mon, r->top[1].index, &ci) == RCB_OK)
-      fprintf(fp, ", or %s at %s: not separable on these channels (rcbtool plan)",
-              rcb_effect_name(ci.effect), ci.place);
+        rcb_monitor_candidate_info_get(s->mon, r->top[1].index, &ci) == RCB_OK) {
+      fputs(", or ", fp);
+      put_cand(fp, &ci, 0);
+      fputs(": not separable on these channels (rcbtool plan)", fp);
+    }
   }
   for (k = 0; k < r->ntracked; k++)
     print_attribution(fp, s, r, k);
   if (r->drift_alarm) {
     rcb_monitor_candidate_info ci;
-    if (rcb_monitor_candidate_info_get(s->mon, r->drift_index, &ci) == RCB_OK)
-      fprintf(fp, "  drift: %s at %s: %s %+.4g per update over %zu updates", rcb_effect_name(ci.effect),
-              ci.place, ci.params, r->drift_rate[0], r->drift_onset);
+    if (rcb_monitor_candidate_info_get(s->mon, r->drift_index, &ci) == RCB_OK) {
+      fputs("  drift: ", fp);
+      put_cand(fp, &ci, 1);
+      fprintf(fp, " %+.4g per update over %zu updates", r->drift_rate[0], r->drift_onset);
+    }
   }
   fputc('\n', fp);
 }
