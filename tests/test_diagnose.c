@@ -160,13 +160,15 @@ static void apply_reaches_floor(rcb_diag *d, double floor0) {
 }
 
 /* Diagnose data from truth (which holds the hidden effect `what`) over the
- * seeds; destroys truth. */
+ * seeds; destroys truth. One noise seed per case (RCB_DIAG_SEEDS=N: N); the
+ * success rate over seeds is measured by ./scripts/dev.sh diag-success, and
+ * the second seed here was 100 s of the test command (issue #27). */
 static void hidden_in(rcb_model *truth, const char *what, rcb_effect want, const char *place) {
   rcb_diag_candidate best;
   rcb_diag *d;
   double err0, floor0;
   unsigned seed;
-  for (seed = 1; seed <= (getenv("RCB_DIAG_SEEDS") ? (unsigned)atoi(getenv("RCB_DIAG_SEEDS")) : 2u); seed++) {
+  for (seed = 1; seed <= (getenv("RCB_DIAG_SEEDS") ? (unsigned)atoi(getenv("RCB_DIAG_SEEDS")) : 1u); seed++) {
     diagnose(truth, seed, &best, &err0, &floor0, &d);
     print_message("  hidden %s: first '%s' (%s), predicted %.1f %%, error %.3g -> %.3g "
                   "%% (floor %.3g), BIC %+.1f, %s\n",

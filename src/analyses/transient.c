@@ -211,47 +211,55 @@ int rcb_transient_rhs(sunrealtype tt, N_Vector y, N_Vector ydot, void *user) {
   return 0;
 }
 
-/* Tabulated bearings: J(n + :, col) -= M^-1 e_row k (or c) for each entry. */
-static void jac_bearings(const rcb_transient *t, double W, SUNMatrix J) {
+/* Tabulated bearings at speed W (rad/s): Kt(:, col) += M^-1 e_row k and
+ * Dt(:, col) += M^-1 e_row c for each entry (1/s^2, 1/s). */
+static void add_bearings(const rcb_transient *t, double W, double *Kt, double *Dt) {
   size_t b, i, k, n = t->n;
   for (b = 0; b < t->ntab; b++) {
     rcb_entry e[RCB_BEARING_ENTRIES_MAX];
     rcb_bearing_entries(t->m, t->tab[b], W, e);
     for (k = 0; k < 4; k++) {
       const double *bc = t->MiB + n * (2 * b + k / 2);
-      double *jq = SUNDenseMatrix_Column(J, (sunindextype)e[k].col) + n;
-      double *jv = SUNDenseMatrix_Column(J, (sunindextype)(n + e[k].col)) + n;
+      double *kq = Kt + n * e[k].col, *dv = Dt + n * e[k].col;
       for (i = 0; i < n; i++) {
-        jq[i] -= bc[i] * e[k].k;
-        jv[i] -= bc[i] * e[k].c;
+        kq[i] += bc[i] * e[k].k;
+        dv[i] += bc[i] * e[k].c;
       }
     }
   }
 }
 
-int rcb_transient_jac(sunrealtype tt, N_Vector y, N_Vector fy, SUNMatrix J, void *user,
-                      N_Vector tmp1, N_Vector tmp2, N_Vector tmp3) {
-  const rcb_transient *t = user;
-  size_t i, j, n = t->n;
-  double W, al, phi;
+/* CVODE's linear system (CVodeSetLinSysFn). The Jacobian of the first-order
+ * form is J = [0 I; -Kt, -Dt] with Kt = M^-1 K and Dt = M^-1 (C + Omega G)
+ * at the speed of time tt; the Schur solver (transient_linsol.c) needs only
+ * Kt and S = I + gamma Dt + gamma^2 Kt. So these are formed here, n x n,
+ * and A (2n x 2n) is left untouched: CVODE's own linear system copied a
+ * saved J into A and scaled it at every setup, 4n^2 entries twice, 30 % of
+ * a run's time at n = 88 (issue #27). Kt and Dt are re-evaluated when CVODE
+ * asks for a new Jacobian (jok false), as its saved J was; S at every call. */
+int rcb_transient_linsys(sunrealtype tt, N_Vector y, N_Vector fy, SUNMatrix A,
+                         sunbooleantype jok, sunbooleantype *jcur, sunrealtype gamma,
+                         void *user, N_Vector tmp1, N_Vector tmp2, N_Vector tmp3) {
+  rcb_transient *t = user;
+  size_t i, nn = t->n * t->n;
+  double g2 = gamma * gamma;
   (void)y;
   (void)fy;
+  (void)A;
   (void)tmp1;
   (void)tmp2;
   (void)tmp3;
-  rcb_profile_eval(&t->prof, tt, &W, &al, &phi);
-  SUNMatZero(J);
-  for (j = 0; j < n; j++) {
-    double *jq = SUNDenseMatrix_Column(J, (sunindextype)j);
-    double *jv = SUNDenseMatrix_Column(J, (sunindextype)(n + j));
-    const double *kc = t->MiK + n * j, *cc = t->MiC + n * j, *gc = t->MiG + n * j;
-    jv[j] = 1.0; /* dq'/dv = I */
-    for (i = 0; i < n; i++) {
-      jq[n + i] = -kc[i];
-      jv[n + i] = -(cc[i] + W * gc[i]);
-    }
+  if (!jok) {
+    double W, al, phi;
+    rcb_profile_eval(&t->prof, tt, &W, &al, &phi);
+    memcpy(t->Kt, t->MiK, nn * sizeof *t->Kt);
+    for (i = 0; i < nn; i++) t->Dt[i] = t->MiC[i] + W * t->MiG[i];
+    add_bearings(t, W, t->Kt, t->Dt);
   }
-  jac_bearings(t, W, J);
+  *jcur = !jok;
+  for (i = 0; i < nn; i++) t->S[i] = gamma * t->Dt[i] + g2 * t->Kt[i];
+  for (i = 0; i < t->n; i++) t->S[i * (t->n + 1)] += 1.0;
+  t->gamma = gamma;
   return 0;
 }
 
@@ -271,8 +279,10 @@ static rcb_status setup_cvode(rcb_transient *t) {
   t->abstol = N_VNew_Serial(N, t->ctx);
   t->J = SUNDenseMatrix(N, N, t->ctx);
   t->S = tr_alloc(t, t->n * t->n * sizeof *t->S);
+  t->Kt = tr_alloc(t, t->n * t->n * sizeof *t->Kt);
+  t->Dt = tr_alloc(t, t->n * t->n * sizeof *t->Dt);
   t->ipiv = tr_alloc(t, (t->n ? t->n : 1) * sizeof *t->ipiv);
-  t->LS = t->S && t->ipiv ? rcb_transient_linsol(t) : NULL;
+  t->LS = t->S && t->Kt && t->Dt && t->ipiv ? rcb_transient_linsol(t) : NULL;
   t->cvode = CVodeCreate(CV_BDF, t->ctx);
   if (!t->y || !t->abstol || !t->J || !t->LS || !t->cvode)
     return rcb_set_error(t->errmsg, RCB_ERR_NOMEM,
@@ -293,6 +303,8 @@ static void free_cvode(rcb_transient *t) {
   if (t->abstol) N_VDestroy(t->abstol);
   rcb_sun_context_free(&t->ctx);
   rcb_free(&t->alloc, t->S);
+  rcb_free(&t->alloc, t->Kt);
+  rcb_free(&t->alloc, t->Dt);
   rcb_free(&t->alloc, t->ipiv);
 }
 #endif /* RCB_WITH_SUNDIALS */

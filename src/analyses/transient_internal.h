@@ -49,6 +49,9 @@ struct rcb_transient {
   SUNMatrix J;
   SUNLinearSolver LS;
   rcb_sun_route route;
+  double *Kt, *Dt; /* M^-1 K and M^-1 (C + Omega G) at the last Jacobian's speed,
+                      n x n: 1/s^2, 1/s (rcb_transient_linsys) */
+  double gamma;     /* CVODE's gamma of S (s) */
   double *S;      /* Schur complement of I - gamma J, n x n, LU-factored */
   lapack_int *ipiv; /* its pivots */
   char sunmsg[256]; /* last SUNDIALS message */
@@ -68,8 +71,10 @@ void rcb_profile_eval(const rcb_speed_profile *p, double t, double *speed, doubl
 int rcb_transient_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void *user);
 /* The Schur-complement linear solver for CVODE (transient_linsol.c). */
 SUNLinearSolver rcb_transient_linsol(rcb_transient *t);
-int rcb_transient_jac(sunrealtype t, N_Vector y, N_Vector fy, SUNMatrix J, void *user,
-                      N_Vector tmp1, N_Vector tmp2, N_Vector tmp3);
+/* CVODE's linear system function (transient.c): Kt, Dt and S, A untouched. */
+int rcb_transient_linsys(sunrealtype t, N_Vector y, N_Vector fy, SUNMatrix A,
+                         sunbooleantype jok, sunbooleantype *jcur, sunrealtype gamma,
+                         void *user, N_Vector tmp1, N_Vector tmp2, N_Vector tmp3);
 #endif
 
 #endif

@@ -50,7 +50,8 @@ static rcb_status cv_start(rcb_transient *t, const double *q0, const double *v0)
         (st = cv_check(t, CVodeSetUserData(t->cvode, t), "CVodeSetUserData")) ||
         (st = cv_check(t, CVodeSetLinearSolver(t->cvode, t->LS, t->J),
                        "CVodeSetLinearSolver")) ||
-        (st = cv_check(t, CVodeSetJacFn(t->cvode, rcb_transient_jac), "CVodeSetJacFn")) ||
+        (st = cv_check(t, CVodeSetLinSysFn(t->cvode, rcb_transient_linsys),
+                       "CVodeSetLinSysFn")) ||
         (st = cv_check(t, CVodeSetMaxNumSteps(t->cvode, 1000000), "CVodeSetMaxNumSteps")) ||
         (st = cv_check(t, CVodeSetMaxOrd(t->cvode, RCB_TRANSIENT_MAX_ORDER), "CVodeSetMaxOrd")))
       return st;
