@@ -725,6 +725,143 @@ static void test_baseline_cov(void **state) {
   rcb_meas_destroy(small);
 }
 
+/* The CUSUM when the baseline is itself an estimate (issue #24 item 2):
+ * replicas whose baseline kt and ct are the truth plus a draw of
+ * N(0, S0), S0 = diag(sb_kt^2, sb_ct^2), the machine's kt wearing from
+ * update 1 on while ct stays. A baseline off by d takes kt's wear partly as
+ * a change of ct (the response's curvature, E H[d, D]): an error in ct's
+ * steps growing with the wear, the same in every update, which a CUSUM sums
+ * into a false alarm. Counted per replica: ct's CUSUM alarming at all within
+ * N updates, with and without opts.baseline_cov = S0 on the same data. The
+ * rate the allowance states: at most alpha (the baseline's share) + 2 N /
+ * ARL0 (the CUSUM's own, both sides); asserted against its binomial 99 %
+ * upper bound, which the plain CUSUM exceeds. Then a step of ct of DSTEP
+ * change standard errors at update NSTEP is caught within MAXDELAY updates
+ * in every replica with the allowance. */
+static void wear_series(const rcb_model *truth, const char *name, double v0, double rate,
+                        size_t N, const char *const *outs, size_t nch, size_t npts,
+                        size_t nstep, double step, rcb_complex *fs) {
+  size_t u;
+  double ct;
+  assert_int_equal(rcb_model_get_param(truth, "coupling.C.ct", &ct), RCB_OK);
+  for (u = 0; u < N; u++) {
+    rcb_model *m0 = edited(truth, name, v0 * (1 - rate * (double)(u + 1)));
+    rcb_model *m = edited(m0, "coupling.C.ct", ct + (u + 1 >= nstep ? step : 0.0));
+    rcb_meas *ms = rcb_test_frf_meas(m, outs, nch, INS, 1, 20.0, 400.0, npts, 10000.0,
+                                     RCB_RECEPTANCE);
+    values_of(ms, fs + u * nch * npts);
+    rcb_meas_destroy(ms);
+    rcb_model_destroy(m);
+    rcb_model_destroy(m0);
+  }
+}
+
+static void test_baseline_cusum(void **state) {
+  fixture *f = *state;
+  enum { NREP = 40, N = 40, NC = 4, NP = 60 };
+  const char *const outs[NC] = {"DA.x", "DA.y", "DB.x", "DB.y"};
+  const double RATE = 0.002; /* kt's wear per update, fraction of kt */
+  const double SB = 0.002;   /* the baseline's standard error, fraction of kt and of ct */
+  rcb_monitor_param tp[2];
+  rcb_monitor_opts o = opts_kt(tp, f->kt);
+  rcb_meas *setup = rcb_test_frf_meas(f->base, outs, NC, INS, 1, 20.0, 400.0, NP, 10000.0,
+                                      RCB_RECEPTANCE);
+  rcb_complex *fs = malloc((size_t)N * NC * NP * sizeof *fs), *v = malloc(NC * NP * sizeof *v),
+              *fs2 = malloc((size_t)N * NC * NP * sizeof *fs);
+  const size_t NSTEP = 21, MAXDELAY = 3; /* updates */
+  const double DSTEP = 0.1;              /* ct's step, N s/m: 0.9 %, about 14 change se */
+  size_t delay_new = 0, delay_exact = 0, miss_new = 0, miss_exact = 0, worst = 0;
+  double ct, S0[4] = {0}, rate_b, lim;
+  uint64_t seed = 2424;
+  size_t r, u, lo, hi, alarm_old = 0, alarm_new = 0, first_old = 0;
+  assert_non_null(fs), assert_non_null(v);
+  assert_int_equal(rcb_model_get_param(f->base, "coupling.C.ct", &ct), RCB_OK);
+  tp[1].name = "coupling.C.ct", tp[1].lo = 0.5 * ct, tp[1].hi = 1.5 * ct;
+  o.ntracked = 2;
+  o.alpha = 0.01;
+  o.setup_averages = HUGE_VAL;
+  o.relinearise = 2;
+  o.effects = 1u << RCB_EFFECT_BEARING_CROSS_COUPLING;
+  S0[0] = SB * SB * f->kt * f->kt, S0[3] = SB * SB * ct * ct;
+  wear_series(f->base, KT_NAME, f->kt, RATE, N, outs, NC, NP, N + 1, 0.0, fs);
+  wear_series(f->base, KT_NAME, f->kt, RATE, N, outs, NC, NP, NSTEP, DSTEP, fs2);
+  for (r = 0; r < NREP; r++) {
+    double d[2];
+    rcb_model *b, *b1;
+    rcb_monitor *mo = NULL, *mn = NULL;
+    rcb_monitor_result ro, rn;
+    int ao = 0, an = 0;
+    for (u = 0; u < 2; u++)
+      d[u] = sqrt(-2 * log(1 - rng_uniform(&seed))) * cos(2 * 3.14159265358979323846 *
+                                                          rng_uniform(&seed));
+    b1 = edited(f->base, KT_NAME, f->kt * (1 + SB * d[0]));
+    b = edited(b1, "coupling.C.ct", ct * (1 + SB * d[1]));
+    rcb_model_destroy(b1);
+    o.baseline_cov = NULL;
+    assert_int_equal(rcb_monitor_create(&mo, b, setup, &o, NULL), RCB_OK);
+    o.baseline_cov = S0;
+    assert_int_equal(rcb_monitor_create(&mn, b, setup, &o, NULL), RCB_OK);
+    for (u = 0; u < N; u++) {
+      eq19n(fs + u * NC * NP, v, NC, NP, &seed);
+      assert_int_equal(rcb_monitor_update(mo, v, NULL, &ro), RCB_OK);
+      assert_int_equal(rcb_monitor_update(mn, v, NULL, &rn), RCB_OK);
+      if (ro.tracked[1].cusum_alarm && !ao) ao = 1, first_old += u + 1;
+      an |= rn.tracked[1].cusum_alarm != 0;
+    }
+    if (r < 3)
+      print_message("  replica %zu: d = %.2f %.2f sd; ct step %.4g (se %.3g), allowance %.2f; "
+                    "CUSUM old %.1f/%.1f new %.1f/%.1f\n", r, d[0], d[1], rn.tracked[1].change,
+                    rn.tracked[1].stderr_, rn.tracked[1].cusum_allow, ro.tracked[1].cusum_up,
+                    ro.tracked[1].cusum_down, rn.tracked[1].cusum_up, rn.tracked[1].cusum_down);
+    alarm_old += (size_t)ao, alarm_new += (size_t)an;
+    rcb_monitor_destroy(mo);
+    rcb_monitor_destroy(mn);
+    /* the step of ct on the same wear: with the allowance, and on an exact
+     * baseline without it (the delay the allowance costs) */
+    {
+      size_t dn = 0, dx = 0;
+      assert_int_equal(rcb_monitor_create(&mn, b, setup, &o, NULL), RCB_OK);
+      o.baseline_cov = NULL;
+      assert_int_equal(rcb_monitor_create(&mo, f->base, setup, &o, NULL), RCB_OK);
+      for (u = 0; u < N; u++) {
+        eq19n(fs2 + u * NC * NP, v, NC, NP, &seed);
+        assert_int_equal(rcb_monitor_update(mn, v, NULL, &rn), RCB_OK);
+        assert_int_equal(rcb_monitor_update(mo, v, NULL, &ro), RCB_OK);
+        if (u + 1 >= NSTEP && !dn && rn.tracked[1].cusum_alarm == 1) dn = u + 2 - NSTEP;
+        if (u + 1 >= NSTEP && !dx && ro.tracked[1].cusum_alarm == 1) dx = u + 2 - NSTEP;
+      }
+      if (dn) delay_new += dn; else miss_new++;
+      worst = dn > worst ? dn : worst;
+      if (dx) delay_exact += dx; else miss_exact++;
+      rcb_monitor_destroy(mo);
+      rcb_monitor_destroy(mn);
+    }
+    rcb_model_destroy(b);
+  }
+  print_message("ct step %g at update %zu: with the allowance caught in %zu (mean delay %.2f, "
+                "worst %zu), exact baseline without it %zu (%.2f)\n", DSTEP, NSTEP,
+                NREP - miss_new,
+                NREP > miss_new ? (double)delay_new / (double)(NREP - miss_new) : 0.0, worst,
+                NREP - miss_exact,
+                NREP > miss_exact ? (double)delay_exact / (double)(NREP - miss_exact) : 0.0);
+  rate_b = o.alpha + 2.0 * N / rcb_cusum_arl0(0.5, 8.0);
+  binom99(NREP, rate_b, &lo, &hi);
+  lim = (double)hi;
+  print_message("baseline off by N(0, (%g %%)^2) in kt and ct, kt wearing %g %% per update: "
+                "ct's CUSUM false-alarmed in %zu of %d replicas with the baseline's allowance, "
+                "%zu without (first at update %.1f on average); stated rate %.4f, binomial "
+                "99 %% upper bound %zu\n", 100 * SB, 100 * RATE, alarm_new, (int)NREP, alarm_old,
+                alarm_old ? (double)first_old / (double)alarm_old : 0.0, rate_b, hi);
+  assert_true((double)alarm_new <= lim);
+  assert_true((double)alarm_old > lim);
+  assert_int_equal(miss_new, 0);
+  assert_true(worst <= MAXDELAY);
+  rcb_meas_destroy(setup);
+  free(fs);
+  free(fs2);
+  free(v);
+}
+
 /* ---- state that survives a restart (issue #24) ---- */
 
 /* Every field of two results the same, bit for bit (doubles compared as
@@ -780,7 +917,7 @@ static void test_state_restart(void **state) {
   size_t u, i, n = 0, n2 = 0, before, first_alarm = 0;
   double cusum_at_restart = 0;
   uint64_t seed = 99;
-  double se = 0;
+  double se = 0, bvar = 1e-6 * f->kt * f->kt; /* (0.1 % of kt)^2, N^2/m^2 */
   static const unsigned char check[] = "123456789";
   /* the CRC-32 check value of the catalogue of parametrised CRCs */
   assert_int_equal(rcb_monitor_crc32(0, check, 9), 0xCBF43926ul);
@@ -793,6 +930,7 @@ static void test_state_restart(void **state) {
   setup = with_values(f->setup, acc, 1.0);
   o.setup_averages = NAVG;
   o.relinearise = 2;
+  o.baseline_cov = &bvar; /* the baseline's share of the allowance, saved with the state */
   /* a small catalogue: five creates, each a fraction of the full one's time */
   o.effects = (1u << RCB_EFFECT_BEARING_CROSS_COUPLING) | (1u << RCB_EFFECT_BEARING_STIFFNESS);
   assert_int_equal(rcb_monitor_create(&a, f->base, setup, &o, NULL), RCB_OK);
@@ -800,7 +938,7 @@ static void test_state_restart(void **state) {
     size_t kr = 0, dofs = 0, j; /* rcb_monitor.h's layout: header, one tracked, the window */
     assert_int_equal(rcb_monitor_rank(a, &kr, NULL), RCB_OK);
     for (j = 0; j < a->ncand; j++) dofs += a->cand[j].dof;
-    assert_int_equal(rcb_monitor_state_size(a), 108 + 40 + 264 * (kr + 1 + dofs));
+    assert_int_equal(rcb_monitor_state_size(a), 108 + 40 + 8 + 264 * (kr + 1 + dofs));
   }
   for (u = 0; u < N; u++) {
     /* kt falls by 0.2 standard errors per update from update 26 */
@@ -815,7 +953,7 @@ static void test_state_restart(void **state) {
       assert_int_equal(rcb_monitor_save(a, buf, 10, &n), RCB_ERR_WORKSPACE);
       assert_int_equal(rcb_monitor_save(a, buf, sizeof buf, &n), RCB_OK);
       assert_int_equal(n, rcb_monitor_state_size(a));
-      assert_memory_equal(buf, "RCBM\2\0\0\0", 8); /* magic, version 2 little-endian */
+      assert_memory_equal(buf, "RCBM\3\0\0\0", 8); /* magic, version 3 little-endian */
       assert_int_equal(buf[56], N1);                /* the update count, low byte first */
       assert_int_equal(rcb_monitor_create(&b, f->base, setup, &o, &al), RCB_OK);
       before = cnt.allocs;
@@ -846,7 +984,7 @@ static void test_state_restart(void **state) {
   memcpy(buf, keep, n);
   assert_int_equal(rcb_monitor_load(b, buf, n - 1), RCB_ERR_CORRUPT); /* truncated */
   assert_int_equal(rcb_monitor_load(b, "hello", 5), RCB_ERR_CORRUPT);
-  buf[4] = 3;
+  buf[4] = 2; /* the format before the baseline's share of the allowance */
   rewrite_crc(buf, n);
   assert_int_equal(rcb_monitor_load(b, buf, n), RCB_ERR_VERSION);
   memcpy(buf, keep, n);
@@ -1016,6 +1154,7 @@ int main(void) {
       cmocka_unit_test(test_bad_input),
       cmocka_unit_test(test_state_restart),
       cmocka_unit_test(test_baseline_cov),
+      cmocka_unit_test(test_baseline_cusum),
   };
   return cmocka_run_group_tests(tests, fixture_setup, fixture_teardown);
 }

@@ -101,6 +101,30 @@
  *    only seeds it, u = 0). A drift is caught as a run of innovations of one
  *    sign: the running mean trails a linear drift by half its length. With a
  *    noise-free reference (setup_averages HUGE_VAL) m stays 0 and u = z.
+ *  - The baseline's error in the CUSUM (opts.baseline_cov S). A baseline off
+ *    the truth by d is linearised at the wrong point: a change D of the
+ *    tracked parameters comes out as the step D - E H[d, D] (E the tracked
+ *    estimator, H the curvature of the whitened response in the rank space,
+ *    by nt (nt + 3) / 2 model re-evaluations at create), so a's step is off
+ *    by g . d, g_i = sum_j dE_a H_ij D_j; the same d in every update, so the
+ *    error grows with the other parameters' change and the CUSUM sums it
+ *    (test_monitor's test_baseline_cusum: a baseline 0.2 % off in kt and ct
+ *    and kt wearing 0.2 % per update made ct's plain CUSUM alarm in 37 of 40
+ *    replicas). With S, a's allowance is raised to k + q sqrt(g^T S g) /
+ *    sd(u), D taken as each tracked step minus its mean over a's reference
+ *    (what u sees), q the normal quantile at 1 - alpha / 2: while the
+ *    baseline's error is within q of its standard deviations along g (1 -
+ *    alpha of baselines when the change keeps one direction), u - k - the
+ *    allowance is below the exact baseline's u - k, and the ARL0 holds. The
+ *    false-alarm rate per tracked parameter over the baselines is then at
+ *    most alpha + 2 n / ARL0 over n updates (0 of 40 replicas above). The
+ *    cost: a's changes smaller than the allowance go unseen while the others
+ *    move (the allowance is reported, rcb_monitor_tracked.cusum_allow; 0
+ *    k while nothing changes); a step of ct of 0.9 % (14 of its
+ *    standard errors) half-way through that wear was caught within 2
+ *    updates (1 on an exact baseline), one of 0.37 % (5.7) within the 20
+ *    updates left in 9 of 40 replicas (40, at 1.8 updates, on an exact
+ *    baseline).
  *  - Drift test (window GLR, beside the instant test). Per scored candidate,
  *    s_t = D_c y_t, its orthonormal directions beyond the tracked columns
  *    (the tracked parameters free at every update: nuisance), over the last
@@ -284,6 +308,9 @@ typedef struct rcb_monitor_tracked {
   double rival_rate[RCB_MONITOR_MAXP]; /**< its parameters' change per update
                             over the window, parameter units per update (its
                             sign: rising or falling) */
+  double cusum_allow;  /**< the CUSUM's allowance this update (-): opts.cusum_k,
+                            raised with opts.baseline_cov by the baseline's
+                            share (the sequential detector above) */
 } rcb_monitor_tracked;
 
 /** @brief What one update found. Plain value type, owns nothing. */
@@ -439,9 +466,12 @@ RCB_API rcb_status rcb_monitor_thresholds(const rcb_monitor *mon, double *alpha,
  * another BLAS's last bits do not refuse a state), the set-up's (u64 of its
  * grid, speed, channels and commissioning values), the settings' (u64 of
  * alpha, CUSUM k and h, noise, averages, re-linearisation, reweighting,
- * tracked ranges), the update count u64, the reference-started flag u32,
+ * tracked ranges, opts.baseline_cov), the update count u64, the reference-started flag u32,
  * then per tracked parameter S+, S-, reference sum and weight (IEEE-754
- * binary64) and the frozen flag, then the drift window (version 2: the
+ * binary64) and the frozen flag, then (version 3) per tracked parameter
+ * its reference's sums of every tracked step (binary64 x tracked count;
+ * the baseline's share of the CUSUM allowance), then the drift window
+ * (version 2: the
  * rank k, tracked count and window u32, the ring's count and newest slot
  * u32, the updates in its sums u64, the free-offset flag u32, the sums of
  * the rank-space change y (k), of the re-linearised tracked steps and of
@@ -451,10 +481,10 @@ RCB_API rcb_status rcb_monitor_thresholds(const rcb_monitor *mon, double *alpha,
  * call allocates. */
 
 /** @brief Format version of the saved state. */
-#define RCB_MONITOR_STATE_VERSION 2u
+#define RCB_MONITOR_STATE_VERSION 3u
 
 /** @brief Bytes rcb_monitor_save writes for this monitor (108 + 40 per
- * tracked parameter + 264 (k + tracked parameters + the scored candidates'
+ * tracked parameter + 8 per pair of tracked parameters + 264 (k + tracked parameters + the scored candidates'
  * ranks), k its rank (rcb_monitor_rank)); 0 for a monitor not created
  * successfully. */
 RCB_API size_t rcb_monitor_state_size(const rcb_monitor *mon);

@@ -190,7 +190,8 @@ class MonitorTracked(ctypes.Structure):
                 ("cusum_down", c_double), ("cusum_alarm", c_int), ("out_of_range", c_int),
                 ("abs_stderr", c_double), ("change", c_double), ("change_lo", c_double),
                 ("change_hi", c_double), ("named", c_int), ("rival", c_size_t),
-                ("rival_dof", c_size_t), ("rival_rate", c_double * MONITOR_MAXP)]
+                ("rival_dof", c_size_t), ("rival_rate", c_double * MONITOR_MAXP),
+                ("cusum_allow", c_double)]
 
 
 class MonitorResult(ctypes.Structure):

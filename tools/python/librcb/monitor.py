@@ -166,7 +166,8 @@ class Monitor(Handle):
             tracked.append({"name": self.tracked[k]["name"], "value": t.value,
                             "ci_lo": t.ci_lo, "ci_hi": t.ci_hi, "stderr": t.stderr_,
                             "z": t.z, "u": t.u, "cusum_up": t.cusum_up, "cusum_down": t.cusum_down,
-                            "cusum_alarm": t.cusum_alarm, "out_of_range": bool(t.out_of_range),
+                            "cusum_alarm": t.cusum_alarm, "cusum_allow": t.cusum_allow,
+                            "out_of_range": bool(t.out_of_range),
                             "abs_stderr": t.abs_stderr, "change": t.change,
                             "change_lo": t.change_lo, "change_hi": t.change_hi,
                             # a CUSUM alarm's attribution (the one rule): 1 this
