@@ -862,6 +862,171 @@ static void test_baseline_cusum(void **state) {
   free(v);
 }
 
+/* ---- naming the measurement that would separate (issue #24 item 3) ---- */
+
+/* Index of the candidate whose parameters are params, or, with params
+ * NULL, the first of effect e (as rcb_monitor_candidate_info). */
+static size_t find_cand(const rcb_monitor *mon, rcb_effect e, const char *params) {
+  size_t j;
+  for (j = 0; j < rcb_monitor_candidate_count(mon); j++) {
+    rcb_monitor_candidate_info ci;
+    assert_int_equal(rcb_monitor_candidate_info_get(mon, j, &ci), RCB_OK);
+    if (ci.effect == e && (!params || strcmp(ci.params, params) == 0)) return j;
+  }
+  fail_msg("no candidate %d %s", (int)e, params ? params : "");
+  return 0;
+}
+
+/* The smallest angle (deg) between candidate parameter cname's column and
+ * the span of the tracked kt and kr, by forward differences (1e-4 relative)
+ * of model m's FRFs on channels outs per excitation ins (one each, or the
+ * set-up's and one more), weighted as eq. 19's noise at the model's values
+ * (proportional beta_a, additive beta_s of the channel's RMS): an
+ * independent computation of what the plan figures (its own is on the
+ * log10 scale). */
+static double column_angle(const rcb_model *m, const char *const *outs, const char *const *ins,
+                           size_t nch, const char *cname) {
+  enum { NPA = 40 };
+  const char *const names[3] = {KT_NAME, "coupling.C.kr", cname};
+  double J[3][4 * NPA], w[4 * NPA], g[3][3], c, pn;
+  rcb_complex h0[2 * NPA];
+  size_t ch, i, a, b;
+  for (ch = 0; ch < nch; ch++) {
+    rcb_meas *ms = rcb_test_frf_meas(m, outs + ch, 1, ins + ch, 1, 20.0, 400.0, NPA, 10000.0,
+                                     RCB_RECEPTANCE);
+    double s2 = 0, add;
+    values_of(ms, h0 + ch * NPA);
+    rcb_meas_destroy(ms);
+    for (i = 0; i < NPA; i++) s2 += creal(h0[ch * NPA + i] * conj(h0[ch * NPA + i]));
+    add = sqrt(s2) / NPA * BETA_S / 100.0;
+    for (i = 0; i < NPA; i++) {
+      double sd2 = pow(BETA_A / 100.0 * cabs(h0[ch * NPA + i]), 2) / 3 + add * add / 6;
+      w[2 * (ch * NPA + i)] = w[2 * (ch * NPA + i) + 1] = 1 / sqrt(sd2);
+    }
+  }
+  for (a = 0; a < 3; a++) {
+    double v;
+    rcb_model *e;
+    assert_int_equal(rcb_model_get_param(m, names[a], &v), RCB_OK);
+    e = edited(m, names[a], v * (1 + 1e-4));
+    for (ch = 0; ch < nch; ch++) {
+      rcb_meas *ms = rcb_test_frf_meas(e, outs + ch, 1, ins + ch, 1, 20.0, 400.0, NPA, 10000.0,
+                                       RCB_RECEPTANCE);
+      rcb_complex h1[NPA];
+      values_of(ms, h1);
+      rcb_meas_destroy(ms);
+      for (i = 0; i < NPA; i++) {
+        rcb_complex d = h1[i] - h0[ch * NPA + i];
+        J[a][2 * (ch * NPA + i)] = creal(d) * w[2 * (ch * NPA + i)];
+        J[a][2 * (ch * NPA + i) + 1] = cimag(d) * w[2 * (ch * NPA + i)];
+      }
+    }
+    rcb_model_destroy(e);
+  }
+  for (a = 0; a < 3; a++)
+    for (b = 0; b < 3; b++) {
+      g[a][b] = 0;
+      for (i = 0; i < 2 * nch * NPA; i++) g[a][b] += J[a][i] * J[b][i];
+    }
+  /* ||P j||^2 of the candidate's column j on span(kt, kr), 2 x 2 normal equations */
+  c = g[0][0] * g[1][1] - g[0][1] * g[0][1];
+  pn = (g[1][1] * g[0][2] * g[0][2] - 2 * g[0][1] * g[0][2] * g[1][2] +
+        g[0][0] * g[1][2] * g[1][2]) / c;
+  return acos(fmin(1.0, sqrt(pn / g[2][2]))) * 180 / 3.14159265358979323846;
+}
+
+/* rcb_monitor_separating on the paper system, kt and kr tracked:
+ *  - measured on DB.y alone (per DA.x), B4's kyy is not separable from kr
+ *    (kt free) by the plan's figure, and the plan names a channel; the
+ *    named channel is checked to separate them: the plan on the set-up with
+ *    it added says so, and an independent computation (the angle between
+ *    kyy's column and span(kt, kr), forward differences, eq. 19 weights in
+ *    the complex plane) crosses the plan's line, S sin^2(angle) = 10 at
+ *    S = 25 (39.2 deg), with it: 23.2 deg on DB.y, 84.2 with the channel;
+ *  - measured on DA.x alone, B4's kyy is separable already: nothing is
+ *    proposed (found 0, present_separable 1);
+ *  - a pedestal (not a model parameter) and a bad index are refused. */
+static void test_separating(void **state) {
+  fixture *f = *state;
+  const char *outs[2] = {"DB.y", NULL}, *ins[2] = {"DA.x", NULL};
+  rcb_meas *setup = rcb_test_frf_meas(f->base, outs, 1, INS, 1, 20.0, 400.0, 60, 10000.0,
+                                      RCB_RECEPTANCE), *both = NULL;
+  rcb_monitor_param tp[2];
+  rcb_monitor_opts o = opts_kt(tp, f->kt);
+  rcb_monitor *mon = NULL, *mon2 = NULL;
+  rcb_monitor_separator sep, sep2;
+  double kr, a1, a2;
+  size_t c;
+  assert_int_equal(rcb_model_get_param(f->base, "coupling.C.kr", &kr), RCB_OK);
+  tp[1].name = "coupling.C.kr", tp[1].lo = 0.5 * kr, tp[1].hi = 1.5 * kr;
+  o.ntracked = 2;
+  o.setup_averages = HUGE_VAL;
+  o.effects = (1u << RCB_EFFECT_BEARING_STIFFNESS) | (1u << RCB_EFFECT_FLEXIBLE_SUPPORT);
+  assert_int_equal(rcb_monitor_create(&mon, f->base, setup, &o, NULL), RCB_OK);
+  c = find_cand(mon, RCB_EFFECT_BEARING_STIFFNESS, "bearing.B4.kyy");
+  assert_int_equal(rcb_monitor_separating(mon, 1, c, NULL, 0, &sep), RCB_OK);
+  assert_int_equal(sep.present_separable, 0);
+  assert_int_equal(sep.found, 1);
+  assert_true(sep.chi2_after > 10);
+  outs[1] = sep.response, ins[1] = sep.reference;
+  a1 = column_angle(f->base, outs, ins, 1, "bearing.B4.kyy");
+  a2 = column_angle(f->base, outs, ins, 2, "bearing.B4.kyy");
+  print_message("kr (kt free) or B4 kyy on DB.y per DA.x: plan angle %.1f deg, chi-square %.2f "
+                "-> measure %s per %s at %.1f rad/s (chi-square %.0f, %.1f dB); independent "
+                "angle %.1f deg on DB.y, %.1f deg with it\n", sep.angle_deg, sep.chi2_present,
+                sep.response, sep.reference, sep.speed, sep.chi2_after, sep.level_db, a1, a2);
+  /* the plan's verdict, S sin^2(angle) against 10 at S = 25 (39.2 deg), on
+   * the independent angles */
+  assert_true(25 * pow(sin(a1 * 3.14159265358979323846 / 180), 2) < 10);
+  assert_true(25 * pow(sin(a2 * 3.14159265358979323846 / 180), 2) > 10);
+  /* the plan on the set-up with the named channel: separable there */
+  {
+    rcb_meas *m1 = rcb_test_frf_meas(f->base, outs + 1, 1, ins + 1, 1, 20.0, 400.0, 60,
+                                     sep.speed * 30 / 3.14159265358979323846, RCB_RECEPTANCE);
+    rcb_meas_channel_info ci;
+    both = with_values(setup, NULL, 1.0);
+    assert_int_equal(rcb_meas_channel(m1, 0, &ci), RCB_OK);
+    assert_int_equal(rcb_meas_add_channel(both, ci.response, ci.reference, ci.kind, ci.data),
+                     RCB_OK);
+    rcb_meas_destroy(m1);
+  }
+  assert_int_equal(rcb_monitor_create(&mon2, f->base, both, &o, NULL), RCB_OK);
+  assert_int_equal(rcb_monitor_separating(mon2, 1, find_cand(mon2, RCB_EFFECT_BEARING_STIFFNESS,
+                                                             "bearing.B4.kyy"),
+                                          NULL, 0, &sep2), RCB_OK);
+  print_message("  with %s per %s added: plan angle %.1f deg, chi-square %.1f, separable %d\n",
+                sep.response, sep.reference, sep2.angle_deg, sep2.chi2_present,
+                sep2.present_separable);
+  assert_int_equal(sep2.present_separable, 1);
+  assert_int_equal(sep2.found, 0);
+  /* refused: a pedestal (not the model's parameter), a bad index */
+  assert_int_equal(rcb_monitor_separating(mon, 1, find_cand(mon, RCB_EFFECT_FLEXIBLE_SUPPORT,
+                                                            NULL), NULL, 0, &sep2),
+                   RCB_ERR_ARG);
+  assert_non_null(strstr(rcb_monitor_errmsg(mon), "not a parameter"));
+  assert_int_equal(rcb_monitor_separating(mon, 2, c, NULL, 0, &sep2), RCB_ERR_ARG);
+  rcb_monitor_destroy(mon);
+  rcb_monitor_destroy(mon2);
+  rcb_meas_destroy(setup);
+  rcb_meas_destroy(both);
+  /* the null case: on DA.x alone kr and B4's kyy are told apart; nothing proposed */
+  outs[0] = "DA.x";
+  setup = rcb_test_frf_meas(f->base, outs, 1, INS, 1, 20.0, 400.0, 60, 10000.0, RCB_RECEPTANCE);
+  assert_int_equal(rcb_monitor_create(&mon, f->base, setup, &o, NULL), RCB_OK);
+  assert_int_equal(rcb_monitor_separating(mon, 1, find_cand(mon, RCB_EFFECT_BEARING_STIFFNESS,
+                                                            "bearing.B4.kyy"), NULL, 0, &sep),
+                   RCB_OK);
+  a1 = column_angle(f->base, outs, ins, 1, "bearing.B4.kyy");
+  print_message("on DA.x: plan angle %.1f deg, chi-square %.1f, separable %d, found %d; "
+                "independent angle %.1f deg\n", sep.angle_deg, sep.chi2_present,
+                sep.present_separable, sep.found, a1);
+  assert_int_equal(sep.present_separable, 1);
+  assert_int_equal(sep.found, 0);
+  assert_true(25 * pow(sin(a1 * 3.14159265358979323846 / 180), 2) > 10);
+  rcb_monitor_destroy(mon);
+  rcb_meas_destroy(setup);
+}
+
 /* ---- state that survives a restart (issue #24) ---- */
 
 /* Every field of two results the same, bit for bit (doubles compared as
@@ -1155,6 +1320,7 @@ int main(void) {
       cmocka_unit_test(test_state_restart),
       cmocka_unit_test(test_baseline_cov),
       cmocka_unit_test(test_baseline_cusum),
+      cmocka_unit_test(test_separating),
   };
   return cmocka_run_group_tests(tests, fixture_setup, fixture_teardown);
 }

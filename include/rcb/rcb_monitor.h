@@ -432,6 +432,50 @@ typedef struct rcb_monitor_candidate_info {
  * candidates ranked (nothing to tell apart) or a bad argument.
  */
 RCB_API int rcb_monitor_named(const rcb_monitor *mon, const rcb_monitor_result *r);
+/** @brief The measurement that would tell a tracked parameter from a
+ * candidate effect (rcb_monitor_separating). */
+typedef struct rcb_monitor_separator {
+  int found;          /**< 1: the channel below separates them; 0: none does
+                           (see present_separable) */
+  int present_separable; /**< 1: the set-up's own channels already separate
+                           them at the plan's size (a larger change will
+                           show it; nothing to add) */
+  double chi2_present; /**< the plan's separating chi-square on the set-up's
+                           channels (-), S sin^2(angle) */
+  double angle_deg;   /**< the plan's smallest principal angle there, deg */
+  char response[64];  /**< the channel to add: its response DOF, "B4.y" */
+  char reference[64]; /**< and its excitation, "DA.x" */
+  double speed;       /**< at this rotor speed, rad/s */
+  double chi2_after;  /**< the separating chi-square with it added (-); found
+                           when rcb_evidence_separable(chi2_after, 0) */
+  double level_db;    /**< its RMS level against the strongest present
+                           channel's, dB (rcb_plan_candidate.level_db) */
+} rcb_monitor_separator;
+/**
+ * @brief Name the channel or speed that would separate tracked parameter
+ * @p tracked from candidate @p cand (as rcb_monitor_tracked.rival, e.g.
+ * after "kr falling, or B4 kyy falling: not separable on these channels"),
+ * by the diagnosis' plan (rcb_plan, rcbtool plan): the candidate's
+ * parameters make the data (side A), every tracked parameter is fitted to
+ * them (side B: the others are free in the monitor's attribution too), on
+ * the set-up's layout and the eq. 19 noise model of opts.beta_a, beta_s;
+ * the plan's candidate channels are x and y of every named station of the
+ * baseline model per an excitation at every station, at the set-up's speed
+ * and each of @p speeds. The best of them (the largest gain) is reported
+ * when it separates them. Not for the update loop: it runs the plan, which
+ * allocates (from the monitor's allocator, all freed before return) and
+ * sweeps the model once per candidate excitation and speed.
+ * @param speeds other rotor speeds to try, rad/s (may be NULL with
+ * @p nspeeds 0)
+ * @return RCB_ERR_ARG for a bad index, a candidate whose parameters are
+ * not the model's own (a pedestal, a new mass: the plan cannot vary them),
+ * no eq. 19 noise model (a monitor given sd only) or a set-up the plan
+ * does not take (1X responses); the plan's errors otherwise; the message
+ * (rcb_monitor_errmsg) says which
+ */
+RCB_API rcb_status rcb_monitor_separating(rcb_monitor *mon, size_t tracked, size_t cand,
+                                          const double *speeds, size_t nspeeds,
+                                          rcb_monitor_separator *out);
 /** @brief Candidates laid out at create (scored or not). */
 RCB_API size_t rcb_monitor_candidate_count(const rcb_monitor *mon);
 /** @brief Description of candidate @p i (0-based, as rcb_monitor_candidate.index);

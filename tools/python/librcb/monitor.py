@@ -12,6 +12,7 @@ Units: SI; parameter values in their own units (N/m, N s/m, ...).
 """
 
 import ctypes
+import math
 
 import numpy as np
 
@@ -129,6 +130,27 @@ class Monitor(Handle):
                 "place": _lib.text(info.place), "description": _lib.text(info.description),
                 "params": _lib.text(info.params), "np": info.np}
 
+    def separate_by(self, tracked, cand):
+        """The measurement that would tell tracked parameter `tracked` from
+        candidate `cand` (rcb_monitor_separating: the diagnosis' plan on the
+        model's stations at the set-up's speed): {"response", "reference", "rpm",
+        "chi2_present", "chi2_after", "level_db"}, or None when no channel does,
+        the set-up's channels already do, or the plan cannot vary the candidate.
+        Asked once per pair (the plan sweeps the model)."""
+        cache = self.__dict__.setdefault("_seps", {})
+        if (tracked, cand) not in cache:
+            sep = _lib.MonitorSeparator()
+            st = _lib.lib().rcb_monitor_separating(self.handle, tracked, cand, None, 0,
+                                                    ctypes.byref(sep))
+            cache[(tracked, cand)] = (None if st or not sep.found else
+                                      {"response": _lib.text(sep.response),
+                                       "reference": _lib.text(sep.reference),
+                                       "rpm": sep.speed * 30.0 / math.pi,
+                                       "chi2_present": sep.chi2_present,
+                                       "chi2_after": sep.chi2_after,
+                                       "level_db": sep.level_db})
+        return cache[(tracked, cand)]
+
     def save_state(self):
         """The monitor's accumulated state (CUSUMs, references, update count) as
         bytes: little-endian, versioned, with a CRC-32 (rcb_monitor_save)."""
@@ -175,7 +197,10 @@ class Monitor(Handle):
                             "named": t.named,
                             "rival": (dict(self.candidate(t.rival),
                                            rate=list(t.rival_rate[:t.rival_dof]))
-                                      if t.cusum_alarm and t.rival_dof else None)})
+                                      if t.cusum_alarm and t.rival_dof else None),
+                            # not separable: the measurement the plan names
+                            "separate_by": self.separate_by(k, t.rival)
+                            if t.cusum_alarm and t.named == 0 and t.rival_dof else None})
         top = []
         for k in range(r.ntop):
             c = r.top[k]
