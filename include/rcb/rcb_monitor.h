@@ -165,7 +165,9 @@
  *    change -GLR + dof ln n of rcb_monitor_named's one rule, and the best
  *    candidate is compared with a by rcb_evidence_separable:
  *    rcb_monitor_tracked.named says a alone, "a or the candidate: not
- *    separable on these channels", or the candidate told apart from a.
+ *    separable on these channels", or the candidate told apart from a; in
+ *    the second case rcb_monitor_separating names the channel or speed that
+ *    would separate them (the diagnosis' plan).
  */
 #ifndef RCB_MONITOR_H
 #define RCB_MONITOR_H
