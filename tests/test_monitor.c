@@ -968,6 +968,13 @@ static void test_separating(void **state) {
   assert_int_equal(sep.present_separable, 0);
   assert_int_equal(sep.found, 1);
   assert_true(sep.chi2_after > 10);
+  { /* another speed adds candidates: the best can only gain */
+    const double w[1] = {300.0}; /* rad/s */
+    assert_int_equal(rcb_monitor_separating(mon, 1, c, w, 1, &sep2), RCB_OK);
+    assert_int_equal(sep2.found, 1);
+    assert_true(sep2.chi2_after >= sep.chi2_after);
+    assert_true(sep2.chi2_present == sep.chi2_present);
+  }
   outs[1] = sep.response, ins[1] = sep.reference;
   a1 = column_angle(f->base, outs, ins, 1, "bearing.B4.kyy");
   a2 = column_angle(f->base, outs, ins, 2, "bearing.B4.kyy");

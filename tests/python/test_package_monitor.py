@@ -207,3 +207,17 @@ def test_separate_by(rcb, tmp_path):
     first = json.loads(plan.stdout)["candidates"][0]
     assert (first["response"], first["reference"]) == (sa["response"], sa["reference"])
     assert first["chi2_after"] == pytest.approx(sa["chi2_after"], rel=1e-9)
+    # and with another speed, as rcbtool plan --rpm-list
+    plan = subprocess.run([exe, "plan", str(ini), str(paths[0]), "--between", rival,
+                           ",".join([params[k], *others]), "--noise", "2,2", "--rpm-list",
+                           "3000", "--json"], capture_output=True, text=True, timeout=300)
+    assert plan.returncode == 0, plan.stderr
+    first = json.loads(plan.stdout)["candidates"][0]
+    with rcb.Model.from_ini(ini) as m, rcb.Meas.read(paths[0], uff_map=umap) as setup, \
+            rcb.Monitor(m, setup, params, noise=(2, 2), alpha=0.01) as mon:
+        idx = next(i for i in range(mon.candidate_count())
+                   if mon.candidate(i)["params"] == rival)
+        s3 = mon.separate_by(k, idx, rpms=[3000])
+    assert (first["response"], first["reference"]) == (s3["response"], s3["reference"])
+    assert first["rpm"] == pytest.approx(s3["rpm"], rel=1e-9)
+    assert s3["chi2_after"] >= sa["chi2_after"] * (1 - 1e-9)

@@ -122,6 +122,10 @@ class Monitor(Handle):
         """Bytes the monitor holds (all from its allocator)."""
         return int(_lib.lib().rcb_monitor_memory(self.handle))
 
+    def candidate_count(self):
+        """Candidates laid out at create (indices for candidate(), separate_by())."""
+        return int(_lib.lib().rcb_monitor_candidate_count(self.handle))
+
     def candidate(self, i):
         info = _lib.MonitorCandidateInfo()
         self.check(_lib.lib().rcb_monitor_candidate_info_get(self.handle, i,
@@ -130,26 +134,29 @@ class Monitor(Handle):
                 "place": _lib.text(info.place), "description": _lib.text(info.description),
                 "params": _lib.text(info.params), "np": info.np}
 
-    def separate_by(self, tracked, cand):
+    def separate_by(self, tracked, cand, rpms=()):
         """The measurement that would tell tracked parameter `tracked` from
         candidate `cand` (rcb_monitor_separating: the diagnosis' plan on the
-        model's stations at the set-up's speed): {"response", "reference", "rpm",
-        "chi2_present", "chi2_after", "level_db"}, or None when no channel does,
-        the set-up's channels already do, or the plan cannot vary the candidate.
-        Asked once per pair (the plan sweeps the model)."""
+        model's stations at the set-up's speed and each of `rpms`, rpm):
+        {"response", "reference", "rpm", "chi2_present", "chi2_after",
+        "level_db"}, or None when no channel does, the set-up's channels already
+        do, or the plan cannot vary the candidate. Asked once per pair and speeds
+        (the plan sweeps the model)."""
         cache = self.__dict__.setdefault("_seps", {})
-        if (tracked, cand) not in cache:
+        key = (tracked, cand, tuple(float(r) for r in rpms))
+        if key not in cache:
             sep = _lib.MonitorSeparator()
-            st = _lib.lib().rcb_monitor_separating(self.handle, tracked, cand, None, 0,
+            w = (ctypes.c_double * max(len(key[2]), 1))(*[r * math.pi / 30.0 for r in key[2]])
+            st = _lib.lib().rcb_monitor_separating(self.handle, tracked, cand, w, len(key[2]),
                                                     ctypes.byref(sep))
-            cache[(tracked, cand)] = (None if st or not sep.found else
+            cache[key] = (None if st or not sep.found else
                                       {"response": _lib.text(sep.response),
                                        "reference": _lib.text(sep.reference),
                                        "rpm": sep.speed * 30.0 / math.pi,
                                        "chi2_present": sep.chi2_present,
                                        "chi2_after": sep.chi2_after,
                                        "level_db": sep.level_db})
-        return cache[(tracked, cand)]
+        return cache[key]
 
     def save_state(self):
         """The monitor's accumulated state (CUSUMs, references, update count) as
