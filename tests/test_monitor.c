@@ -725,6 +725,315 @@ static void test_baseline_cov(void **state) {
   rcb_meas_destroy(small);
 }
 
+/* The CUSUM when the baseline is itself an estimate (issue #24 item 2):
+ * replicas whose baseline kt and ct are the truth plus a draw of
+ * N(0, S0), S0 = diag(sb_kt^2, sb_ct^2), the machine's kt wearing from
+ * update 1 on while ct stays. A baseline off by d takes kt's wear partly as
+ * a change of ct (the response's curvature, E H[d, D]): an error in ct's
+ * steps growing with the wear, the same in every update, which a CUSUM sums
+ * into a false alarm. Counted per replica: ct's CUSUM alarming at all within
+ * N updates, with and without opts.baseline_cov = S0 on the same data. The
+ * rate the allowance states: at most alpha (the baseline's share) + 2 N /
+ * ARL0 (the CUSUM's own, both sides); asserted against its binomial 99 %
+ * upper bound, which the plain CUSUM exceeds. Then a step of ct of DSTEP
+ * change standard errors at update NSTEP is caught within MAXDELAY updates
+ * in every replica with the allowance. */
+static void wear_series(const rcb_model *truth, const char *name, double v0, double rate,
+                        size_t N, const char *const *outs, size_t nch, size_t npts,
+                        size_t nstep, double step, rcb_complex *fs) {
+  size_t u;
+  double ct;
+  assert_int_equal(rcb_model_get_param(truth, "coupling.C.ct", &ct), RCB_OK);
+  for (u = 0; u < N; u++) {
+    rcb_model *m0 = edited(truth, name, v0 * (1 - rate * (double)(u + 1)));
+    rcb_model *m = edited(m0, "coupling.C.ct", ct + (u + 1 >= nstep ? step : 0.0));
+    rcb_meas *ms = rcb_test_frf_meas(m, outs, nch, INS, 1, 20.0, 400.0, npts, 10000.0,
+                                     RCB_RECEPTANCE);
+    values_of(ms, fs + u * nch * npts);
+    rcb_meas_destroy(ms);
+    rcb_model_destroy(m);
+    rcb_model_destroy(m0);
+  }
+}
+
+static void test_baseline_cusum(void **state) {
+  fixture *f = *state;
+  enum { NREP = 40, N = 40, NC = 4, NP = 60 };
+  const char *const outs[NC] = {"DA.x", "DA.y", "DB.x", "DB.y"};
+  const double RATE = 0.002; /* kt's wear per update, fraction of kt */
+  const double SB = 0.002;   /* the baseline's standard error, fraction of kt and of ct */
+  rcb_monitor_param tp[2];
+  rcb_monitor_opts o = opts_kt(tp, f->kt);
+  rcb_meas *setup = rcb_test_frf_meas(f->base, outs, NC, INS, 1, 20.0, 400.0, NP, 10000.0,
+                                      RCB_RECEPTANCE);
+  rcb_complex *fs = malloc((size_t)N * NC * NP * sizeof *fs), *v = malloc(NC * NP * sizeof *v),
+              *fs2 = malloc((size_t)N * NC * NP * sizeof *fs);
+  const size_t NSTEP = 21, MAXDELAY = 3; /* updates */
+  const double DSTEP = 0.1;              /* ct's step, N s/m: 0.9 %, about 14 change se */
+  size_t delay_new = 0, delay_exact = 0, miss_new = 0, miss_exact = 0, worst = 0;
+  double ct, S0[4] = {0}, rate_b, lim;
+  uint64_t seed = 2424;
+  size_t r, u, lo, hi, alarm_old = 0, alarm_new = 0, first_old = 0;
+  assert_non_null(fs), assert_non_null(v);
+  assert_int_equal(rcb_model_get_param(f->base, "coupling.C.ct", &ct), RCB_OK);
+  tp[1].name = "coupling.C.ct", tp[1].lo = 0.5 * ct, tp[1].hi = 1.5 * ct;
+  o.ntracked = 2;
+  o.alpha = 0.01;
+  o.setup_averages = HUGE_VAL;
+  o.relinearise = 2;
+  o.effects = 1u << RCB_EFFECT_BEARING_CROSS_COUPLING;
+  S0[0] = SB * SB * f->kt * f->kt, S0[3] = SB * SB * ct * ct;
+  wear_series(f->base, KT_NAME, f->kt, RATE, N, outs, NC, NP, N + 1, 0.0, fs);
+  wear_series(f->base, KT_NAME, f->kt, RATE, N, outs, NC, NP, NSTEP, DSTEP, fs2);
+  for (r = 0; r < NREP; r++) {
+    double d[2];
+    rcb_model *b, *b1;
+    rcb_monitor *mo = NULL, *mn = NULL;
+    rcb_monitor_result ro, rn;
+    int ao = 0, an = 0;
+    for (u = 0; u < 2; u++)
+      d[u] = sqrt(-2 * log(1 - rng_uniform(&seed))) * cos(2 * 3.14159265358979323846 *
+                                                          rng_uniform(&seed));
+    b1 = edited(f->base, KT_NAME, f->kt * (1 + SB * d[0]));
+    b = edited(b1, "coupling.C.ct", ct * (1 + SB * d[1]));
+    rcb_model_destroy(b1);
+    o.baseline_cov = NULL;
+    assert_int_equal(rcb_monitor_create(&mo, b, setup, &o, NULL), RCB_OK);
+    o.baseline_cov = S0;
+    assert_int_equal(rcb_monitor_create(&mn, b, setup, &o, NULL), RCB_OK);
+    for (u = 0; u < N; u++) {
+      eq19n(fs + u * NC * NP, v, NC, NP, &seed);
+      assert_int_equal(rcb_monitor_update(mo, v, NULL, &ro), RCB_OK);
+      assert_int_equal(rcb_monitor_update(mn, v, NULL, &rn), RCB_OK);
+      if (ro.tracked[1].cusum_alarm && !ao) ao = 1, first_old += u + 1;
+      an |= rn.tracked[1].cusum_alarm != 0;
+    }
+    if (r < 3)
+      print_message("  replica %zu: d = %.2f %.2f sd; ct step %.4g (se %.3g), allowance %.2f; "
+                    "CUSUM old %.1f/%.1f new %.1f/%.1f\n", r, d[0], d[1], rn.tracked[1].change,
+                    rn.tracked[1].stderr_, rn.tracked[1].cusum_allow, ro.tracked[1].cusum_up,
+                    ro.tracked[1].cusum_down, rn.tracked[1].cusum_up, rn.tracked[1].cusum_down);
+    alarm_old += (size_t)ao, alarm_new += (size_t)an;
+    rcb_monitor_destroy(mo);
+    rcb_monitor_destroy(mn);
+    /* the step of ct on the same wear: with the allowance, and on an exact
+     * baseline without it (the delay the allowance costs) */
+    {
+      size_t dn = 0, dx = 0;
+      assert_int_equal(rcb_monitor_create(&mn, b, setup, &o, NULL), RCB_OK);
+      o.baseline_cov = NULL;
+      assert_int_equal(rcb_monitor_create(&mo, f->base, setup, &o, NULL), RCB_OK);
+      for (u = 0; u < N; u++) {
+        eq19n(fs2 + u * NC * NP, v, NC, NP, &seed);
+        assert_int_equal(rcb_monitor_update(mn, v, NULL, &rn), RCB_OK);
+        assert_int_equal(rcb_monitor_update(mo, v, NULL, &ro), RCB_OK);
+        if (u + 1 >= NSTEP && !dn && rn.tracked[1].cusum_alarm == 1) dn = u + 2 - NSTEP;
+        if (u + 1 >= NSTEP && !dx && ro.tracked[1].cusum_alarm == 1) dx = u + 2 - NSTEP;
+      }
+      if (dn) delay_new += dn; else miss_new++;
+      worst = dn > worst ? dn : worst;
+      if (dx) delay_exact += dx; else miss_exact++;
+      rcb_monitor_destroy(mo);
+      rcb_monitor_destroy(mn);
+    }
+    rcb_model_destroy(b);
+  }
+  print_message("ct step %g at update %zu: with the allowance caught in %zu (mean delay %.2f, "
+                "worst %zu), exact baseline without it %zu (%.2f)\n", DSTEP, NSTEP,
+                NREP - miss_new,
+                NREP > miss_new ? (double)delay_new / (double)(NREP - miss_new) : 0.0, worst,
+                NREP - miss_exact,
+                NREP > miss_exact ? (double)delay_exact / (double)(NREP - miss_exact) : 0.0);
+  rate_b = o.alpha + 2.0 * N / rcb_cusum_arl0(0.5, 8.0);
+  binom99(NREP, rate_b, &lo, &hi);
+  lim = (double)hi;
+  print_message("baseline off by N(0, (%g %%)^2) in kt and ct, kt wearing %g %% per update: "
+                "ct's CUSUM false-alarmed in %zu of %d replicas with the baseline's allowance, "
+                "%zu without (first at update %.1f on average); stated rate %.4f, binomial "
+                "99 %% upper bound %zu\n", 100 * SB, 100 * RATE, alarm_new, (int)NREP, alarm_old,
+                alarm_old ? (double)first_old / (double)alarm_old : 0.0, rate_b, hi);
+  assert_true((double)alarm_new <= lim);
+  assert_true((double)alarm_old > lim);
+  assert_int_equal(miss_new, 0);
+  assert_true(worst <= MAXDELAY);
+  rcb_meas_destroy(setup);
+  free(fs);
+  free(fs2);
+  free(v);
+}
+
+/* ---- naming the measurement that would separate (issue #24 item 3) ---- */
+
+/* Index of the candidate whose parameters are params, or, with params
+ * NULL, the first of effect e (as rcb_monitor_candidate_info). */
+static size_t find_cand(const rcb_monitor *mon, rcb_effect e, const char *params) {
+  size_t j;
+  for (j = 0; j < rcb_monitor_candidate_count(mon); j++) {
+    rcb_monitor_candidate_info ci;
+    assert_int_equal(rcb_monitor_candidate_info_get(mon, j, &ci), RCB_OK);
+    if (ci.effect == e && (!params || strcmp(ci.params, params) == 0)) return j;
+  }
+  fail_msg("no candidate %d %s", (int)e, params ? params : "");
+  return 0;
+}
+
+/* The smallest angle (deg) between candidate parameter cname's column and
+ * the span of the tracked kt and kr, by forward differences (1e-4 relative)
+ * of model m's FRFs on channels outs per excitation ins (one each, or the
+ * set-up's and one more), weighted as eq. 19's noise at the model's values
+ * (proportional beta_a, additive beta_s of the channel's RMS): an
+ * independent computation of what the plan figures (its own is on the
+ * log10 scale). */
+static double column_angle(const rcb_model *m, const char *const *outs, const char *const *ins,
+                           size_t nch, const char *cname) {
+  enum { NPA = 40 };
+  const char *const names[3] = {KT_NAME, "coupling.C.kr", cname};
+  double J[3][4 * NPA], w[4 * NPA], g[3][3], c, pn;
+  rcb_complex h0[2 * NPA];
+  size_t ch, i, a, b;
+  for (ch = 0; ch < nch; ch++) {
+    rcb_meas *ms = rcb_test_frf_meas(m, outs + ch, 1, ins + ch, 1, 20.0, 400.0, NPA, 10000.0,
+                                     RCB_RECEPTANCE);
+    double s2 = 0, add;
+    values_of(ms, h0 + ch * NPA);
+    rcb_meas_destroy(ms);
+    for (i = 0; i < NPA; i++) s2 += creal(h0[ch * NPA + i] * conj(h0[ch * NPA + i]));
+    add = sqrt(s2) / NPA * BETA_S / 100.0;
+    for (i = 0; i < NPA; i++) {
+      double sd2 = pow(BETA_A / 100.0 * cabs(h0[ch * NPA + i]), 2) / 3 + add * add / 6;
+      w[2 * (ch * NPA + i)] = w[2 * (ch * NPA + i) + 1] = 1 / sqrt(sd2);
+    }
+  }
+  for (a = 0; a < 3; a++) {
+    double v;
+    rcb_model *e;
+    assert_int_equal(rcb_model_get_param(m, names[a], &v), RCB_OK);
+    e = edited(m, names[a], v * (1 + 1e-4));
+    for (ch = 0; ch < nch; ch++) {
+      rcb_meas *ms = rcb_test_frf_meas(e, outs + ch, 1, ins + ch, 1, 20.0, 400.0, NPA, 10000.0,
+                                       RCB_RECEPTANCE);
+      rcb_complex h1[NPA];
+      values_of(ms, h1);
+      rcb_meas_destroy(ms);
+      for (i = 0; i < NPA; i++) {
+        rcb_complex d = h1[i] - h0[ch * NPA + i];
+        J[a][2 * (ch * NPA + i)] = creal(d) * w[2 * (ch * NPA + i)];
+        J[a][2 * (ch * NPA + i) + 1] = cimag(d) * w[2 * (ch * NPA + i)];
+      }
+    }
+    rcb_model_destroy(e);
+  }
+  for (a = 0; a < 3; a++)
+    for (b = 0; b < 3; b++) {
+      g[a][b] = 0;
+      for (i = 0; i < 2 * nch * NPA; i++) g[a][b] += J[a][i] * J[b][i];
+    }
+  /* ||P j||^2 of the candidate's column j on span(kt, kr), 2 x 2 normal equations */
+  c = g[0][0] * g[1][1] - g[0][1] * g[0][1];
+  pn = (g[1][1] * g[0][2] * g[0][2] - 2 * g[0][1] * g[0][2] * g[1][2] +
+        g[0][0] * g[1][2] * g[1][2]) / c;
+  return acos(fmin(1.0, sqrt(pn / g[2][2]))) * 180 / 3.14159265358979323846;
+}
+
+/* rcb_monitor_separating on the paper system, kt and kr tracked:
+ *  - measured on DB.y alone (per DA.x), B4's kyy is not separable from kr
+ *    (kt free) by the plan's figure, and the plan names a channel; the
+ *    named channel is checked to separate them: the plan on the set-up with
+ *    it added says so, and an independent computation (the angle between
+ *    kyy's column and span(kt, kr), forward differences, eq. 19 weights in
+ *    the complex plane) crosses the plan's line, S sin^2(angle) = 10 at
+ *    S = 25 (39.2 deg), with it: 23.2 deg on DB.y, 84.2 with the channel;
+ *  - measured on DA.x alone, B4's kyy is separable already: nothing is
+ *    proposed (found 0, present_separable 1);
+ *  - a pedestal (not a model parameter) and a bad index are refused. */
+static void test_separating(void **state) {
+  fixture *f = *state;
+  const char *outs[2] = {"DB.y", NULL}, *ins[2] = {"DA.x", NULL};
+  rcb_meas *setup = rcb_test_frf_meas(f->base, outs, 1, INS, 1, 20.0, 400.0, 60, 10000.0,
+                                      RCB_RECEPTANCE), *both = NULL;
+  rcb_monitor_param tp[2];
+  rcb_monitor_opts o = opts_kt(tp, f->kt);
+  rcb_monitor *mon = NULL, *mon2 = NULL;
+  rcb_monitor_separator sep, sep2;
+  double kr, a1, a2;
+  size_t c;
+  assert_int_equal(rcb_model_get_param(f->base, "coupling.C.kr", &kr), RCB_OK);
+  tp[1].name = "coupling.C.kr", tp[1].lo = 0.5 * kr, tp[1].hi = 1.5 * kr;
+  o.ntracked = 2;
+  o.setup_averages = HUGE_VAL;
+  o.effects = (1u << RCB_EFFECT_BEARING_STIFFNESS) | (1u << RCB_EFFECT_FLEXIBLE_SUPPORT);
+  assert_int_equal(rcb_monitor_create(&mon, f->base, setup, &o, NULL), RCB_OK);
+  c = find_cand(mon, RCB_EFFECT_BEARING_STIFFNESS, "bearing.B4.kyy");
+  assert_int_equal(rcb_monitor_separating(mon, 1, c, NULL, 0, &sep), RCB_OK);
+  assert_int_equal(sep.present_separable, 0);
+  assert_int_equal(sep.found, 1);
+  assert_true(sep.chi2_after > 10);
+  { /* another speed adds candidates: the best can only gain */
+    const double w[1] = {300.0}; /* rad/s */
+    assert_int_equal(rcb_monitor_separating(mon, 1, c, w, 1, &sep2), RCB_OK);
+    assert_int_equal(sep2.found, 1);
+    assert_true(sep2.chi2_after >= sep.chi2_after);
+    assert_true(sep2.chi2_present == sep.chi2_present);
+  }
+  outs[1] = sep.response, ins[1] = sep.reference;
+  a1 = column_angle(f->base, outs, ins, 1, "bearing.B4.kyy");
+  a2 = column_angle(f->base, outs, ins, 2, "bearing.B4.kyy");
+  print_message("kr (kt free) or B4 kyy on DB.y per DA.x: plan angle %.1f deg, chi-square %.2f "
+                "-> measure %s per %s at %.1f rad/s (chi-square %.0f, %.1f dB); independent "
+                "angle %.1f deg on DB.y, %.1f deg with it\n", sep.angle_deg, sep.chi2_present,
+                sep.response, sep.reference, sep.speed, sep.chi2_after, sep.level_db, a1, a2);
+  /* the plan's verdict, S sin^2(angle) against 10 at S = 25 (39.2 deg), on
+   * the independent angles */
+  assert_true(25 * pow(sin(a1 * 3.14159265358979323846 / 180), 2) < 10);
+  assert_true(25 * pow(sin(a2 * 3.14159265358979323846 / 180), 2) > 10);
+  /* the plan on the set-up with the named channel: separable there */
+  {
+    rcb_meas *m1 = rcb_test_frf_meas(f->base, outs + 1, 1, ins + 1, 1, 20.0, 400.0, 60,
+                                     sep.speed * 30 / 3.14159265358979323846, RCB_RECEPTANCE);
+    rcb_meas_channel_info ci;
+    both = with_values(setup, NULL, 1.0);
+    assert_int_equal(rcb_meas_channel(m1, 0, &ci), RCB_OK);
+    assert_int_equal(rcb_meas_add_channel(both, ci.response, ci.reference, ci.kind, ci.data),
+                     RCB_OK);
+    rcb_meas_destroy(m1);
+  }
+  assert_int_equal(rcb_monitor_create(&mon2, f->base, both, &o, NULL), RCB_OK);
+  assert_int_equal(rcb_monitor_separating(mon2, 1, find_cand(mon2, RCB_EFFECT_BEARING_STIFFNESS,
+                                                             "bearing.B4.kyy"),
+                                          NULL, 0, &sep2), RCB_OK);
+  print_message("  with %s per %s added: plan angle %.1f deg, chi-square %.1f, separable %d\n",
+                sep.response, sep.reference, sep2.angle_deg, sep2.chi2_present,
+                sep2.present_separable);
+  assert_int_equal(sep2.present_separable, 1);
+  assert_int_equal(sep2.found, 0);
+  /* refused: a pedestal (not the model's parameter), a bad index */
+  assert_int_equal(rcb_monitor_separating(mon, 1, find_cand(mon, RCB_EFFECT_FLEXIBLE_SUPPORT,
+                                                            NULL), NULL, 0, &sep2),
+                   RCB_ERR_ARG);
+  assert_non_null(strstr(rcb_monitor_errmsg(mon), "not a parameter"));
+  assert_int_equal(rcb_monitor_separating(mon, 2, c, NULL, 0, &sep2), RCB_ERR_ARG);
+  rcb_monitor_destroy(mon);
+  rcb_monitor_destroy(mon2);
+  rcb_meas_destroy(setup);
+  rcb_meas_destroy(both);
+  /* the null case: on DA.x alone kr and B4's kyy are told apart; nothing proposed */
+  outs[0] = "DA.x";
+  setup = rcb_test_frf_meas(f->base, outs, 1, INS, 1, 20.0, 400.0, 60, 10000.0, RCB_RECEPTANCE);
+  assert_int_equal(rcb_monitor_create(&mon, f->base, setup, &o, NULL), RCB_OK);
+  assert_int_equal(rcb_monitor_separating(mon, 1, find_cand(mon, RCB_EFFECT_BEARING_STIFFNESS,
+                                                            "bearing.B4.kyy"), NULL, 0, &sep),
+                   RCB_OK);
+  a1 = column_angle(f->base, outs, ins, 1, "bearing.B4.kyy");
+  print_message("on DA.x: plan angle %.1f deg, chi-square %.1f, separable %d, found %d; "
+                "independent angle %.1f deg\n", sep.angle_deg, sep.chi2_present,
+                sep.present_separable, sep.found, a1);
+  assert_int_equal(sep.present_separable, 1);
+  assert_int_equal(sep.found, 0);
+  assert_true(25 * pow(sin(a1 * 3.14159265358979323846 / 180), 2) > 10);
+  rcb_monitor_destroy(mon);
+  rcb_meas_destroy(setup);
+}
+
 /* ---- state that survives a restart (issue #24) ---- */
 
 /* Every field of two results the same, bit for bit (doubles compared as
@@ -780,7 +1089,7 @@ static void test_state_restart(void **state) {
   size_t u, i, n = 0, n2 = 0, before, first_alarm = 0;
   double cusum_at_restart = 0;
   uint64_t seed = 99;
-  double se = 0;
+  double se = 0, bvar = 1e-6 * f->kt * f->kt; /* (0.1 % of kt)^2, N^2/m^2 */
   static const unsigned char check[] = "123456789";
   /* the CRC-32 check value of the catalogue of parametrised CRCs */
   assert_int_equal(rcb_monitor_crc32(0, check, 9), 0xCBF43926ul);
@@ -793,6 +1102,7 @@ static void test_state_restart(void **state) {
   setup = with_values(f->setup, acc, 1.0);
   o.setup_averages = NAVG;
   o.relinearise = 2;
+  o.baseline_cov = &bvar; /* the baseline's share of the allowance, saved with the state */
   /* a small catalogue: five creates, each a fraction of the full one's time */
   o.effects = (1u << RCB_EFFECT_BEARING_CROSS_COUPLING) | (1u << RCB_EFFECT_BEARING_STIFFNESS);
   assert_int_equal(rcb_monitor_create(&a, f->base, setup, &o, NULL), RCB_OK);
@@ -800,7 +1110,7 @@ static void test_state_restart(void **state) {
     size_t kr = 0, dofs = 0, j; /* rcb_monitor.h's layout: header, one tracked, the window */
     assert_int_equal(rcb_monitor_rank(a, &kr, NULL), RCB_OK);
     for (j = 0; j < a->ncand; j++) dofs += a->cand[j].dof;
-    assert_int_equal(rcb_monitor_state_size(a), 108 + 40 + 264 * (kr + 1 + dofs));
+    assert_int_equal(rcb_monitor_state_size(a), 108 + 40 + 8 + 264 * (kr + 1 + dofs));
   }
   for (u = 0; u < N; u++) {
     /* kt falls by 0.2 standard errors per update from update 26 */
@@ -815,7 +1125,7 @@ static void test_state_restart(void **state) {
       assert_int_equal(rcb_monitor_save(a, buf, 10, &n), RCB_ERR_WORKSPACE);
       assert_int_equal(rcb_monitor_save(a, buf, sizeof buf, &n), RCB_OK);
       assert_int_equal(n, rcb_monitor_state_size(a));
-      assert_memory_equal(buf, "RCBM\2\0\0\0", 8); /* magic, version 2 little-endian */
+      assert_memory_equal(buf, "RCBM\3\0\0\0", 8); /* magic, version 3 little-endian */
       assert_int_equal(buf[56], N1);                /* the update count, low byte first */
       assert_int_equal(rcb_monitor_create(&b, f->base, setup, &o, &al), RCB_OK);
       before = cnt.allocs;
@@ -846,7 +1156,7 @@ static void test_state_restart(void **state) {
   memcpy(buf, keep, n);
   assert_int_equal(rcb_monitor_load(b, buf, n - 1), RCB_ERR_CORRUPT); /* truncated */
   assert_int_equal(rcb_monitor_load(b, "hello", 5), RCB_ERR_CORRUPT);
-  buf[4] = 3;
+  buf[4] = 2; /* the format before the baseline's share of the allowance */
   rewrite_crc(buf, n);
   assert_int_equal(rcb_monitor_load(b, buf, n), RCB_ERR_VERSION);
   memcpy(buf, keep, n);
@@ -1016,6 +1326,8 @@ int main(void) {
       cmocka_unit_test(test_bad_input),
       cmocka_unit_test(test_state_restart),
       cmocka_unit_test(test_baseline_cov),
+      cmocka_unit_test(test_baseline_cusum),
+      cmocka_unit_test(test_separating),
   };
   return cmocka_run_group_tests(tests, fixture_setup, fixture_teardown);
 }

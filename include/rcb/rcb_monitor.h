@@ -101,6 +101,30 @@
  *    only seeds it, u = 0). A drift is caught as a run of innovations of one
  *    sign: the running mean trails a linear drift by half its length. With a
  *    noise-free reference (setup_averages HUGE_VAL) m stays 0 and u = z.
+ *  - The baseline's error in the CUSUM (opts.baseline_cov S). A baseline off
+ *    the truth by d is linearised at the wrong point: a change D of the
+ *    tracked parameters comes out as the step D - E H[d, D] (E the tracked
+ *    estimator, H the curvature of the whitened response in the rank space,
+ *    by nt (nt + 3) / 2 model re-evaluations at create), so a's step is off
+ *    by g . d, g_i = sum_j dE_a H_ij D_j; the same d in every update, so the
+ *    error grows with the other parameters' change and the CUSUM sums it
+ *    (test_monitor's test_baseline_cusum: a baseline 0.2 % off in kt and ct
+ *    and kt wearing 0.2 % per update made ct's plain CUSUM alarm in 37 of 40
+ *    replicas). With S, a's allowance is raised to k + q sqrt(g^T S g) /
+ *    sd(u), D taken as each tracked step minus its mean over a's reference
+ *    (what u sees), q the normal quantile at 1 - alpha / 2: while the
+ *    baseline's error is within q of its standard deviations along g (1 -
+ *    alpha of baselines when the change keeps one direction), u - k - the
+ *    allowance is below the exact baseline's u - k, and the ARL0 holds. The
+ *    false-alarm rate per tracked parameter over the baselines is then at
+ *    most alpha + 2 n / ARL0 over n updates (0 of 40 replicas above). The
+ *    cost: a's changes smaller than the allowance go unseen while the others
+ *    move (the allowance is reported, rcb_monitor_tracked.cusum_allow; 0
+ *    k while nothing changes); a step of ct of 0.9 % (14 of its
+ *    standard errors) half-way through that wear was caught within 2
+ *    updates (1 on an exact baseline), one of 0.37 % (5.7) within the 20
+ *    updates left in 9 of 40 replicas (40, at 1.8 updates, on an exact
+ *    baseline).
  *  - Drift test (window GLR, beside the instant test). Per scored candidate,
  *    s_t = D_c y_t, its orthonormal directions beyond the tracked columns
  *    (the tracked parameters free at every update: nuisance), over the last
@@ -141,7 +165,9 @@
  *    change -GLR + dof ln n of rcb_monitor_named's one rule, and the best
  *    candidate is compared with a by rcb_evidence_separable:
  *    rcb_monitor_tracked.named says a alone, "a or the candidate: not
- *    separable on these channels", or the candidate told apart from a.
+ *    separable on these channels", or the candidate told apart from a; in
+ *    the second case rcb_monitor_separating names the channel or speed that
+ *    would separate them (the diagnosis' plan).
  */
 #ifndef RCB_MONITOR_H
 #define RCB_MONITOR_H
@@ -284,6 +310,9 @@ typedef struct rcb_monitor_tracked {
   double rival_rate[RCB_MONITOR_MAXP]; /**< its parameters' change per update
                             over the window, parameter units per update (its
                             sign: rising or falling) */
+  double cusum_allow;  /**< the CUSUM's allowance this update (-): opts.cusum_k,
+                            raised with opts.baseline_cov by the baseline's
+                            share (the sequential detector above) */
 } rcb_monitor_tracked;
 
 /** @brief What one update found. Plain value type, owns nothing. */
@@ -405,6 +434,50 @@ typedef struct rcb_monitor_candidate_info {
  * candidates ranked (nothing to tell apart) or a bad argument.
  */
 RCB_API int rcb_monitor_named(const rcb_monitor *mon, const rcb_monitor_result *r);
+/** @brief The measurement that would tell a tracked parameter from a
+ * candidate effect (rcb_monitor_separating). */
+typedef struct rcb_monitor_separator {
+  int found;          /**< 1: the channel below separates them; 0: none does
+                           (see present_separable) */
+  int present_separable; /**< 1: the set-up's own channels already separate
+                           them at the plan's size (a larger change will
+                           show it; nothing to add) */
+  double chi2_present; /**< the plan's separating chi-square on the set-up's
+                           channels (-), S sin^2(angle) */
+  double angle_deg;   /**< the plan's smallest principal angle there, deg */
+  char response[64];  /**< the channel to add: its response DOF, "B4.y" */
+  char reference[64]; /**< and its excitation, "DA.x" */
+  double speed;       /**< at this rotor speed, rad/s */
+  double chi2_after;  /**< the separating chi-square with it added (-); found
+                           when rcb_evidence_separable(chi2_after, 0) */
+  double level_db;    /**< its RMS level against the strongest present
+                           channel's, dB (rcb_plan_candidate.level_db) */
+} rcb_monitor_separator;
+/**
+ * @brief Name the channel or speed that would separate tracked parameter
+ * @p tracked from candidate @p cand (as rcb_monitor_tracked.rival, e.g.
+ * after "kr falling, or B4 kyy falling: not separable on these channels"),
+ * by the diagnosis' plan (rcb_plan, rcbtool plan): the candidate's
+ * parameters make the data (side A), every tracked parameter is fitted to
+ * them (side B: the others are free in the monitor's attribution too), on
+ * the set-up's layout and the eq. 19 noise model of opts.beta_a, beta_s;
+ * the plan's candidate channels are x and y of every named station of the
+ * baseline model per an excitation at every station, at the set-up's speed
+ * and each of @p speeds. The best of them (the largest gain) is reported
+ * when it separates them. Not for the update loop: it runs the plan, which
+ * allocates (from the monitor's allocator, all freed before return) and
+ * sweeps the model once per candidate excitation and speed.
+ * @param speeds other rotor speeds to try, rad/s (may be NULL with
+ * @p nspeeds 0)
+ * @return RCB_ERR_ARG for a bad index, a candidate whose parameters are
+ * not the model's own (a pedestal, a new mass: the plan cannot vary them),
+ * no eq. 19 noise model (a monitor given sd only) or a set-up the plan
+ * does not take (1X responses); the plan's errors otherwise; the message
+ * (rcb_monitor_errmsg) says which
+ */
+RCB_API rcb_status rcb_monitor_separating(rcb_monitor *mon, size_t tracked, size_t cand,
+                                          const double *speeds, size_t nspeeds,
+                                          rcb_monitor_separator *out);
 /** @brief Candidates laid out at create (scored or not). */
 RCB_API size_t rcb_monitor_candidate_count(const rcb_monitor *mon);
 /** @brief Description of candidate @p i (0-based, as rcb_monitor_candidate.index);
@@ -439,9 +512,12 @@ RCB_API rcb_status rcb_monitor_thresholds(const rcb_monitor *mon, double *alpha,
  * another BLAS's last bits do not refuse a state), the set-up's (u64 of its
  * grid, speed, channels and commissioning values), the settings' (u64 of
  * alpha, CUSUM k and h, noise, averages, re-linearisation, reweighting,
- * tracked ranges), the update count u64, the reference-started flag u32,
+ * tracked ranges, opts.baseline_cov), the update count u64, the reference-started flag u32,
  * then per tracked parameter S+, S-, reference sum and weight (IEEE-754
- * binary64) and the frozen flag, then the drift window (version 2: the
+ * binary64) and the frozen flag, then (version 3) per tracked parameter
+ * its reference's sums of every tracked step (binary64 x tracked count;
+ * the baseline's share of the CUSUM allowance), then the drift window
+ * (version 2: the
  * rank k, tracked count and window u32, the ring's count and newest slot
  * u32, the updates in its sums u64, the free-offset flag u32, the sums of
  * the rank-space change y (k), of the re-linearised tracked steps and of
@@ -451,10 +527,10 @@ RCB_API rcb_status rcb_monitor_thresholds(const rcb_monitor *mon, double *alpha,
  * call allocates. */
 
 /** @brief Format version of the saved state. */
-#define RCB_MONITOR_STATE_VERSION 2u
+#define RCB_MONITOR_STATE_VERSION 3u
 
 /** @brief Bytes rcb_monitor_save writes for this monitor (108 + 40 per
- * tracked parameter + 264 (k + tracked parameters + the scored candidates'
+ * tracked parameter + 8 per pair of tracked parameters + 264 (k + tracked parameters + the scored candidates'
  * ranks), k its rank (rcb_monitor_rank)); 0 for a monitor not created
  * successfully. */
 RCB_API size_t rcb_monitor_state_size(const rcb_monitor *mon);

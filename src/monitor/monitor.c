@@ -169,6 +169,67 @@ static rcb_status tracked_step(rcb_monitor *mon, double *theta) {
   return RCB_OK;
 }
 
+/* The curvature of the tracked steps in the baseline (rcb_monitor.h,
+ * sequential detector): a baseline off the truth by d, linearised there,
+ * takes a change D of the tracked parameters as the step D - E H[d, D]
+ * (E the tracked estimator, H the second derivatives of the model's
+ * whitened change in the rank space), so tracked a's step is off by
+ * -sum_ij bM[a, i, j] d_i D_j. bM by model re-evaluations at steps h_i
+ * (the baseline's standard error, or the change's where that is 0): the
+ * mixed differences of E ym, (E ym(h_i e_i + h_j e_j) - E ym(h_i e_i) -
+ * E ym(h_j e_j)) / (h_i h_j), ym(0) = 0. */
+rcb_status rcb_mon_curvature(rcb_monitor *mon) {
+  enum { MT = RCB_MONITOR_MAX_TRACKED };
+  double h[MT], p1[MT][MT], th[MT], pij;
+  size_t a, i, j, nt = mon->nt, k = mon->k;
+  rcb_status st = RCB_OK;
+  for (i = 0; i < nt; i++) h[i] = mon->tbv[i] > 0 ? sqrt(mon->tbv[i]) : mon->tse[i];
+  memset(th, 0, sizeof th);
+  for (i = 0; !st && i < nt; i++) {
+    th[i] = h[i];
+    if (!(st = model_change(mon, th, NULL, NULL)))
+      for (a = 0; a < nt; a++) p1[i][a] = dot(mon->test + a * k, mon->ym, k);
+    th[i] = 0;
+  }
+  for (i = 0; !st && i < nt; i++)
+    for (j = i; !st && j < nt; j++) {
+      th[i] += h[i], th[j] += h[j];
+      if (!(st = model_change(mon, th, NULL, NULL)))
+        for (a = 0; a < nt; a++) {
+          pij = (dot(mon->test + a * k, mon->ym, k) - p1[i][a] - p1[j][a]) / (h[i] * h[j]);
+          mon->bM[(a * MT + i) * MT + j] = mon->bM[(a * MT + j) * MT + i] = pij;
+        }
+      th[i] = th[j] = 0;
+    }
+  rcb_mon_model_restore(mon, NULL);
+  return st;
+}
+
+/* The baseline's share of tracked a's CUSUM allowance: bq standard
+ * deviations, over the baselines' distribution (opts.baseline_cov S), of
+ * the error the baseline's error makes in a's innovation u: g^T d / sd(u),
+ * g_i = sum_j bM[a, i, j] (theta_j - the mean of step j over a's
+ * reference), var g^T S g. One baseline error d is shared by every update:
+ * while |g^T d| <= bq sqrt(g^T S g) (probability 1 - alpha when the changes
+ * keep one direction), u - k - this allowance is below what it is on an
+ * exact baseline, and the CUSUM's run length is at least its ARL0. */
+static double baseline_allowance(const rcb_monitor *mon, size_t a, const double *theta,
+                                 double v) {
+  enum { MT = RCB_MONITOR_MAX_TRACKED };
+  double g[MT], w = mon->ref_w[a], s2 = 0;
+  int fin = isfinite(w);
+  size_t i, j, nt = mon->nt;
+  if (!mon->bcurv || !(w > 0)) return 0.0;
+  for (i = 0; i < nt; i++) {
+    g[i] = 0;
+    for (j = 0; j < nt; j++)
+      g[i] += mon->bM[(a * MT + i) * MT + j] * (theta[j] - (fin ? mon->bref[a * MT + j] / w : 0));
+  }
+  for (i = 0; i < nt; i++)
+    for (j = 0; j < nt; j++) s2 += g[i] * mon->bcov[i * nt + j] * g[j];
+  return mon->bq * sqrt(fmax(s2, 0.0) / (fin ? v + 1.0 / w : v));
+}
+
 /* The self-starting CUSUM's input for tracked parameter a with step theta
  * (parameter units) and standard error se (with the commissioning's share):
  * u = (theta - m) / sqrt(v + 1 / W), m and W the reference's weighted mean
@@ -184,6 +245,7 @@ static double innovation(rcb_monitor *mon, size_t a, double theta, double se, do
   if (!mon->ref_started) {
     mon->ref_w[a] = nu > 0 ? 1.0 / (*v * nu) : (double)INFINITY;
     mon->ref_sum[a] = 0;
+    memset(mon->bref + a * RCB_MONITOR_MAX_TRACKED, 0, sizeof(double) * RCB_MONITOR_MAX_TRACKED);
   }
   w = mon->ref_w[a];
   if (!(w > 0)) return 0.0;
@@ -197,7 +259,8 @@ static void tracked_result(rcb_monitor *mon, const double *theta, const double *
   res->cusum_alarm = 0;
   for (a = 0; a < mon->nt; a++) {
     rcb_monitor_tracked *t = &res->tracked[a];
-    double se = sev[a], v, u = innovation(mon, a, theta[a], se, &v);
+    double se = sev[a], v, u = innovation(mon, a, theta[a], se, &v),
+           kb = mon->cusum_k + baseline_allowance(mon, a, theta, v);
     t->value = mon->t0[a] + theta[a];
     t->stderr_ = se;
     t->abs_stderr = sqrt(se * se + mon->tbv[a]);
@@ -206,16 +269,21 @@ static void tracked_result(rcb_monitor *mon, const double *theta, const double *
     t->change_lo = theta[a] - MON_Z95 * se, t->change_hi = theta[a] + MON_Z95 * se;
     t->z = theta[a] / se;
     t->u = u;
-    mon->cus_up[a] = fmax(0.0, mon->cus_up[a] + u - mon->cusum_k);
-    mon->cus_dn[a] = fmax(0.0, mon->cus_dn[a] - u - mon->cusum_k);
+    mon->cus_up[a] = fmax(0.0, mon->cus_up[a] + u - kb);
+    mon->cus_dn[a] = fmax(0.0, mon->cus_dn[a] - u - kb);
+    t->cusum_allow = kb;
     t->cusum_up = mon->cus_up[a], t->cusum_down = mon->cus_dn[a];
     t->cusum_alarm = t->cusum_up > mon->cusum_h ? 1 : t->cusum_down > mon->cusum_h ? -1 : 0;
     t->out_of_range = t->value < mon->tlo[a] || t->value > mon->thi[a];
     if (t->cusum_alarm) res->cusum_alarm = 1, mon->ref_frozen[a] = 1;
     /* in control: the step joins the reference (not while the instant test
      * fires: the step is then fitted jointly with a candidate) */
-    if (!mon->ref_frozen[a] && !res->alarm)
+    if (!mon->ref_frozen[a] && !res->alarm) {
+      size_t j;
       mon->ref_sum[a] += theta[a] / v, mon->ref_w[a] += 1.0 / v;
+      for (j = 0; mon->bcurv && j < mon->nt; j++)
+        mon->bref[a * RCB_MONITOR_MAX_TRACKED + j] += theta[j] / v;
+    }
   }
   mon->ref_started = 1;
 }
@@ -455,6 +523,7 @@ void rcb_monitor_reset_cusum(rcb_monitor *mon) {
   memset(mon->ref_sum, 0, sizeof mon->ref_sum);
   memset(mon->ref_w, 0, sizeof mon->ref_w);
   memset(mon->ref_frozen, 0, sizeof mon->ref_frozen);
+  memset(mon->bref, 0, sizeof mon->bref);
   mon->ref_started = 1; /* the next update starts the reference afresh */
   rcb_mon_drift_reset(mon); /* and the drift test its window */
 }

@@ -341,11 +341,23 @@ static rcb_status settings(rcb_monitor *mon, const rcb_monitor_opts *o) {
     return rcb_mon_fail(mon, RCB_ERR_ARG, "options: %zu tracked parameters (at most %d, and "
                         "opts.tracked must list them)", mon->nt, RCB_MONITOR_MAX_TRACKED);
   for (k = 0; o->baseline_cov && k < mon->nt; k++) {
+    size_t j;
     mon->tbv[k] = o->baseline_cov[k * mon->nt + k];
     if (!(mon->tbv[k] >= 0) || !isfinite(mon->tbv[k]))
       return rcb_mon_fail(mon, RCB_ERR_ARG, "options: baseline_cov[%zu][%zu] = %g: a variance "
                           "must be finite >= 0 (parameter units^2)", k, k, mon->tbv[k]);
+    for (j = 0; j < mon->nt; j++) {
+      double c = o->baseline_cov[k * mon->nt + j];
+      if (!isfinite(c))
+        return rcb_mon_fail(mon, RCB_ERR_ARG, "options: baseline_cov[%zu][%zu] = %g: a "
+                            "covariance must be finite (parameter units^2)", k, j, c);
+      mon->bcov[k * mon->nt + j] = c;
+    }
   }
+  mon->bcurv = o->baseline_cov && mon->nt > 0;
+  /* the allowance's quantile: the baseline's share of false CUSUM alarms is
+   * at most alpha per tracked parameter over the baselines' distribution */
+  mon->bq = sqrt(rcb_chi2_quantile(1.0 - mon->alpha, 1.0));
   return RCB_OK;
 }
 
@@ -413,6 +425,7 @@ static rcb_status commission(rcb_monitor *mon, const rcb_model *base, const rcb_
     }
   }
   if (!st) st = rcb_mon_lowrank_init(mon);
+  if (!st && mon->bcurv) st = rcb_mon_curvature(mon);
   if (!st) {
     size_t dof = mon->k > mon->nt ? mon->k - mon->nt : 0;
     mon->threshold = dof ? rcb_chi2_quantile(1.0 - mon->alpha, (double)dof) : (double)INFINITY;

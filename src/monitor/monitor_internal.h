@@ -130,6 +130,18 @@ struct rcb_monitor {
    * commissioning's pseudo-observation is in (or a reset dropped it) */
   double ref_sum[RCB_MONITOR_MAX_TRACKED], ref_w[RCB_MONITOR_MAX_TRACKED];
   int ref_started, ref_frozen[RCB_MONITOR_MAX_TRACKED];
+  /* the baseline's error in the CUSUM (rcb_monitor.h, sequential detector;
+   * monitor.c, rcb_mon_curvature): opts.baseline_cov (nt x nt row-major,
+   * parameter units^2), bM[(a * MAX + i) * MAX + j] the error of tracked a's
+   * step per unit error of i's baseline value per unit change of j (1 /
+   * parameter j's units), bq the normal quantile the allowance is raised by
+   * (-), bcurv 1 when opts.baseline_cov was given; bref[a * MAX + j]: the
+   * sum of step j / var over a's reference (as ref_sum) */
+  double bcov[RCB_MONITOR_MAX_TRACKED * RCB_MONITOR_MAX_TRACKED];
+  double bM[RCB_MONITOR_MAX_TRACKED * RCB_MONITOR_MAX_TRACKED * RCB_MONITOR_MAX_TRACKED];
+  double bq;
+  int bcurv;
+  double bref[RCB_MONITOR_MAX_TRACKED * RCB_MONITOR_MAX_TRACKED];
 
   /* rank space */
   size_t k;            /* rank of all columns */
@@ -230,6 +242,11 @@ rcb_status rcb_mon_lowrank_init(rcb_monitor *mon);
 rcb_status rcb_mon_lowrank_change(rcb_monitor *mon, const double *theta, const mon_cand *c,
                                   const double *s, rcb_complex *dm);
 void rcb_mon_lowrank_free(rcb_monitor *mon, mon_lowrank *lr);
+
+/* monitor.c: with opts.baseline_cov, the curvature of the tracked steps in
+ * the baseline (mon->bM, by model re-evaluations at create: nt (nt + 3) / 2
+ * of them); called last in create. */
+rcb_status rcb_mon_curvature(rcb_monitor *mon);
 
 /* monitor_rank.c: the QR of the whitened columns J (n x ncol; the basis
  * made explicit in mon->Q), then the rank space; J's block becomes mon->Q. */

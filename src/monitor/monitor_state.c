@@ -142,6 +142,7 @@ static uint64_t settings_hash(const rcb_monitor *mon) {
   h = fnv_u64(fnv_u64(fnv_u64(h, mon->top), mon->relin), (uint64_t)mon->reweight);
   for (i = 0; i < mon->nt; i++)
     h = fnv_f64(fnv_f64(fnv_f64(h, mon->tlo[i]), mon->thi[i]), mon->tbv[i]);
+  for (i = 0; i < mon->nt * mon->nt; i++) h = fnv_f64(h, mon->bcov[i]); /* version 3 */
   h = fnv_u64(h, (uint64_t)mon->have_sd0);
   for (i = 0; mon->have_sd0 && i < mon->npt; i++) h = fnv_f64(h, mon->sd0[i]);
   return h;
@@ -178,8 +179,14 @@ static const unsigned char *get_s(const rcb_monitor *mon, double *s, const unsig
   return r;
 }
 
+/* Version 3: after the tracked parameters, each one's reference sums of
+ * every tracked step (the baseline's share of the allowance, bref), nt x nt
+ * binary64. */
+static size_t bref_bytes(const rcb_monitor *mon) { return (size_t)8 * mon->nt * mon->nt; }
+
 size_t rcb_monitor_state_size(const rcb_monitor *mon) {
-  return ready(mon) ? ST_HEAD + ST_PER * mon->nt + drift_bytes(mon) + ST_CRC : 0;
+  return ready(mon) ? ST_HEAD + ST_PER * mon->nt + bref_bytes(mon) + drift_bytes(mon) + ST_CRC
+                    : 0;
 }
 
 static void save_drift(const rcb_monitor *mon, unsigned char *q) {
@@ -253,6 +260,8 @@ rcb_status rcb_monitor_save(const rcb_monitor *mon, void *buf, size_t size, size
     put_f64(q + 24, mon->ref_w[a]);
     put_u32(q + 32, (uint32_t)mon->ref_frozen[a]);
   }
+  for (a = 0; a < mon->nt * mon->nt; a++, q += 8)
+    put_f64(q, mon->bref[(a / mon->nt) * RCB_MONITOR_MAX_TRACKED + a % mon->nt]);
   save_drift(mon, q);
   put_u32(b + need - ST_CRC, (uint32_t)rcb_monitor_crc32(0, b, need - ST_CRC));
   if (written) *written = need;
@@ -322,13 +331,20 @@ rcb_status rcb_monitor_load(rcb_monitor *mon, const void *buf, size_t size) {
                           "reference %g / %g: not a state the monitor writes", a + 1, v[0],
                           v[1], v[2], v[3]);
   }
+  for (a = 0, q = b + ST_HEAD + ST_PER * mon->nt; a < mon->nt * mon->nt; a++, q += 8)
+    if (!isfinite(get_f64(q)))
+      return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: the reference's sums are not a state "
+                          "the monitor writes");
   {
-    const char *bad = check_drift(mon, b + ST_HEAD + ST_PER * mon->nt);
+    const char *bad = check_drift(mon, b + ST_HEAD + ST_PER * mon->nt + bref_bytes(mon));
     if (bad)
       return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: the %s are not a state the monitor "
                           "writes", bad);
   }
-  load_drift(mon, b + ST_HEAD + ST_PER * mon->nt);
+  load_drift(mon, b + ST_HEAD + ST_PER * mon->nt + bref_bytes(mon));
+  memset(mon->bref, 0, sizeof mon->bref);
+  for (a = 0, q = b + ST_HEAD + ST_PER * mon->nt; a < mon->nt * mon->nt; a++, q += 8)
+    mon->bref[(a / mon->nt) * RCB_MONITOR_MAX_TRACKED + a % mon->nt] = get_f64(q);
   mon->updates = (size_t)get_u64(b + 56);
   mon->ref_started = get_u32(b + 64) != 0;
   for (a = 0, q = b + ST_HEAD; a < mon->nt; a++, q += ST_PER) {

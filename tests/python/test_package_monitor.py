@@ -106,10 +106,11 @@ def test_state_restart(rcb, tmp_path):
                 with rcb.Meas.read(p, uff_map=UFF_MAP) as ms:
                     a.update(ms)
             state = a.save_state()
-            # rcb_monitor.h's layout: header, per tracked, the drift window
-            # (264 bytes per rank-space dimension, tracked parameter and scored
-            # candidate parameter)
-            rest = len(state) - 108 - 40 * len(PARAMS) - 264 * (a.rank[0] + len(PARAMS))
+            # rcb_monitor.h's layout: header, per tracked, per pair of tracked
+            # (version 3), the drift window (264 bytes per rank-space dimension,
+            # tracked parameter and scored candidate parameter)
+            rest = (len(state) - 108 - 40 * len(PARAMS) - 8 * len(PARAMS) ** 2
+                    - 264 * (a.rank[0] + len(PARAMS)))
             assert rest > 0 and rest % 264 == 0
             assert state[:4] == b"RCBM"
             b.load_state(state)
@@ -137,3 +138,86 @@ def test_small_setup_refused_without_printing(rcb, capfd):
             rcb.Monitor(m, ms, ["coupling.C.kt"], noise=(10, 1))
     out = capfd.readouterr()
     assert "DORMQR" not in out.out + out.err and out.out == ""
+
+
+def test_separate_by(rcb, tmp_path):
+    """Issue #24 item 3: when a CUSUM alarm's attribution is "kt falling, or <a
+    bearing> ...: not separable on these channels", the measurement that would
+    separate them is named, by the diagnosis' plan (rcb_monitor_separating), the
+    same in Python (`separate_by`) and in rcbtool monitor's JSON and text; and it
+    is `rcbtool plan`'s first candidate channel for that pair. A B4 kyy drift
+    measured on DB.y per DA.x only (librcb's own model: a unit test of the
+    wiring; tests/test_monitor.c checks the named channel separates them)."""
+    exe = os.environ.get("RCBTOOL")
+    if not exe:
+        pytest.skip("RCBTOOL is not set")
+    umap = {16: "DB", 3: "DA"}
+    f = np.linspace(20, 400, 60)
+    paths = []
+    with rcb.Model.from_ini(PAPER) as m:
+        k0 = m.get("bearing.B4.kyy")
+        for k in range(23):  # falling 0.4 % per update from update 6
+            m.set("bearing.B4.kyy", k0 * (1 - 0.004 * max(k - 5, 0)))
+            with rcb.simulate(m, ["DB.y"], ["DA.x"], f, rpm=10000, kind="receptance",
+                              noise=(2, 2), seed=5 + k) as ms:
+                paths.append(tmp_path / f"d{k:02d}.uff")
+                ms.write(paths[-1], uff_map=umap)
+    ini = tmp_path / "model.ini"
+    ini.write_text(PAPER.read_text() + "\n[uff]\nmap = 16 DB, 3 DA\n")
+    params = ["coupling.C.kt", "coupling.C.kr"]
+    args = [exe, "monitor", str(ini), *map(str, paths), "--params", ",".join(params),
+            "--noise", "2,2", "--alpha", "0.01"]
+    res = subprocess.run(args + ["--json"], capture_output=True, text=True, timeout=300)
+    assert res.returncode == 0, res.stderr
+    cli = json.loads(res.stdout)["updates"]
+    text = subprocess.run(args, capture_output=True, text=True, timeout=300)
+    assert text.returncode == 0, text.stderr
+    with rcb.Model.from_ini(ini) as m, rcb.Meas.read(paths[0], uff_map=umap) as setup, \
+            rcb.Monitor(m, setup, params, noise=(2, 2), alpha=0.01) as mon:
+        py = []
+        for p in paths[1:]:
+            with rcb.Meas.read(p, uff_map=umap) as ms:
+                py.append(mon.update(ms))
+    named = []
+    for a, b in zip(py, cli):
+        for k, (ta, tb) in enumerate(zip(a["tracked"], b["tracked"])):
+            assert ta["named"] == tb["named"]
+            assert ta["cusum_allow"] == pytest.approx(tb["cusum_allow"], rel=1e-12)
+            sa, sb = ta["separate_by"], tb["separate_by"]
+            assert (sa is None) == (sb is None)
+            if ta["named"] != 0 or not ta["cusum_alarm"]:
+                assert sa is None  # nothing proposed where the attribution separates
+            if sa is not None:
+                assert (sa["response"], sa["reference"]) == (sb["response"], sb["reference"])
+                for key in ("rpm", "chi2_present", "chi2_after", "level_db"):
+                    assert sa[key] == pytest.approx(sb[key], rel=1e-9), key
+                assert sa["chi2_present"] <= 10.0 < sa["chi2_after"]  # the plan's verdict
+                named.append((a["update"], k, ta["rival"]["params"], sa))
+    assert named, "no not-separable attribution in the series"
+    update, k, rival, sa = named[0]
+    line = next(ln for ln in text.stdout.splitlines() if ln.lstrip().startswith(f"{update} "))
+    assert "not separable on these channels" in line
+    assert f"{sa['response']} per {sa['reference']} at 10000 rpm would separate them" in line
+    # rcbtool plan's first candidate for the pair: the same measurement (one rule)
+    others = [p for i, p in enumerate(params) if i != k]
+    plan = subprocess.run([exe, "plan", str(ini), str(paths[0]), "--between", rival,
+                           ",".join([params[k], *others]), "--noise", "2,2", "--json"],
+                          capture_output=True, text=True, timeout=300)
+    assert plan.returncode == 0, plan.stderr
+    first = json.loads(plan.stdout)["candidates"][0]
+    assert (first["response"], first["reference"]) == (sa["response"], sa["reference"])
+    assert first["chi2_after"] == pytest.approx(sa["chi2_after"], rel=1e-9)
+    # and with another speed, as rcbtool plan --rpm-list
+    plan = subprocess.run([exe, "plan", str(ini), str(paths[0]), "--between", rival,
+                           ",".join([params[k], *others]), "--noise", "2,2", "--rpm-list",
+                           "3000", "--json"], capture_output=True, text=True, timeout=300)
+    assert plan.returncode == 0, plan.stderr
+    first = json.loads(plan.stdout)["candidates"][0]
+    with rcb.Model.from_ini(ini) as m, rcb.Meas.read(paths[0], uff_map=umap) as setup, \
+            rcb.Monitor(m, setup, params, noise=(2, 2), alpha=0.01) as mon:
+        idx = next(i for i in range(mon.candidate_count())
+                   if mon.candidate(i)["params"] == rival)
+        s3 = mon.separate_by(k, idx, rpms=[3000])
+    assert (first["response"], first["reference"]) == (s3["response"], s3["reference"])
+    assert first["rpm"] == pytest.approx(s3["rpm"], rel=1e-9)
+    assert s3["chi2_after"] >= sa["chi2_after"] * (1 - 1e-9)

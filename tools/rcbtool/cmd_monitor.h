@@ -59,6 +59,15 @@ typedef struct mon_job {
   size_t resume;       /**< first file of the series to update (0: after commissioning) */
 } mon_job;
 
+/** The measurement that would separate tracked parameter @c tracked from
+ * candidate @c cand (rcb_monitor_separating, asked once per pair: the plan
+ * sweeps the model). */
+typedef struct mon_sep {
+  size_t tracked, cand;
+  int ok; /**< 0: the plan could not be made (a candidate not the model's) */
+  rcb_monitor_separator sep;
+} mon_sep;
+
 /** A finished (or interrupted) run: what the outputs are written from. */
 typedef struct mon_state {
   const cli_args *a;
@@ -71,6 +80,8 @@ typedef struct mon_state {
   double rpm;      /**< test speed of the series, rpm (NaN: unbalance data) */
   const char *kind; /**< "frf" or "unbalance" */
   size_t channels, points;
+  mon_sep *seps;   /**< the pairs asked so far */
+  size_t nseps;
 } mon_state;
 
 /** Add a file, or every measurement file of a directory sorted by name
@@ -97,6 +108,11 @@ uint64_t mon_file_hash(const char *path, int *ok);
 /** Commission, update over the series, print; then the log and the plot. */
 int mon_run(const cli_args *a, const mon_job *j);
 
+/** The measurement that would separate tracked parameter @p k of update
+ * @p r from its rival, when the attribution says "not separable" and the
+ * plan names one (found); NULL otherwise. */
+const rcb_monitor_separator *mon_separator(const mon_state *s, const rcb_monitor_result *r,
+                                           size_t k);
 /** The alarm flags of an update: "-", "TEST", "CUSUM-", "TEST,CUSUM+", ... */
 void mon_flags(const rcb_monitor_result *r, char *buf, size_t size);
 /** The log as JSON (also --json on standard output). */

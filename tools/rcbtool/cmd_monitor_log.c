@@ -70,7 +70,7 @@ static void json_rate(FILE *fp, const mon_state *s, size_t index, const double *
 }
 
 static void json_tracked(FILE *fp, const mon_state *s, const rcb_monitor_tracked *t,
-                         const char *name) {
+                         const char *name, const rcb_monitor_separator *sep) {
   fputs("{\"name\": ", fp);
   cli_json_str(fp, name);
   json_key_num(fp, "value", t->value);
@@ -96,6 +96,22 @@ static void json_tracked(FILE *fp, const mon_state *s, const rcb_monitor_tracked
   } else {
     fputs("null", fp);
   }
+  json_key_num(fp, "cusum_allow", t->cusum_allow);
+  /* not separable: the measurement the plan names (rcb_monitor_separating) */
+  fputs(", \"separate_by\": ", fp);
+  if (sep) {
+    fputs("{\"response\": ", fp);
+    cli_json_str(fp, sep->response);
+    fputs(", \"reference\": ", fp);
+    cli_json_str(fp, sep->reference);
+    json_key_num(fp, "rpm", sep->speed / CLI_RPM_TO_RAD_S);
+    json_key_num(fp, "chi2_present", sep->chi2_present);
+    json_key_num(fp, "chi2_after", sep->chi2_after);
+    json_key_num(fp, "level_db", sep->level_db);
+    fputc('}', fp);
+  } else {
+    fputs("null", fp);
+  }
   fputc('}', fp);
 }
 
@@ -115,7 +131,7 @@ static void json_update(FILE *fp, const mon_state *s, size_t k) {
           r->alarm ? "true" : "false", r->cusum_alarm ? "true" : "false");
   for (i = 0; i < r->ntracked; i++) {
     if (i) fputs(", ", fp);
-    json_tracked(fp, s, &r->tracked[i], s->j->params.items[i].name);
+    json_tracked(fp, s, &r->tracked[i], s->j->params.items[i].name, mon_separator(s, r, i));
   }
   fputs("],\n   \"top\": [", fp);
   for (i = 0; i < r->ntop; i++) {

@@ -313,9 +313,15 @@ static void print_attribution(FILE *fp, const mon_state *s, const rcb_monitor_re
     return;
   }
   if (t->named == 0) {
+    const rcb_monitor_separator *sp = mon_separator(s, r, k);
+    char resp[256], ref[256];
     fprintf(fp, "  %s %s, or ", name, dir);
     put_cand(fp, &ci, 1);
     fprintf(fp, " %s: not separable on these channels", rdir);
+    if (sp)
+      fprintf(fp, "; %s per %s at %.6g rpm would separate them", cli_text(sp->response, resp,
+              sizeof resp), cli_text(sp->reference, ref, sizeof ref),
+              sp->speed / CLI_RPM_TO_RAD_S);
   } else {
     fputs("  ", fp);
     put_cand(fp, &ci, 1);
@@ -364,7 +370,41 @@ static void print_line(FILE *fp, const mon_state *s, const mon_record *rec) {
   fputc('\n', fp);
 }
 
-static int keep(mon_state *s, size_t file, const rcb_monitor_result *r) {
+/* The separating measurement of every not-separable attribution of r
+ * (rcb_monitor_separating, the diagnosis' plan), asked once per pair. */
+static int separators(mon_state *s, rcb_monitor *mon, const rcb_monitor_result *r) {
+  size_t k, i;
+  for (k = 0; k < r->ntracked; k++) {
+    const rcb_monitor_tracked *t = &r->tracked[k];
+    mon_sep *p;
+    if (!t->cusum_alarm || t->named != 0 || !t->rival_dof) continue;
+    for (i = 0; i < s->nseps; i++)
+      if (s->seps[i].tracked == k && s->seps[i].cand == t->rival) break;
+    if (i < s->nseps) continue;
+    if (!(p = realloc(s->seps, (s->nseps + 1) * sizeof *p)))
+      return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+    s->seps = p;
+    p += s->nseps++;
+    p->tracked = k, p->cand = t->rival;
+    p->ok = rcb_monitor_separating(mon, k, t->rival, NULL, 0, &p->sep) == RCB_OK;
+  }
+  return 0;
+}
+
+const rcb_monitor_separator *mon_separator(const mon_state *s, const rcb_monitor_result *r,
+                                           size_t k) {
+  const rcb_monitor_tracked *t = &r->tracked[k];
+  size_t i;
+  if (!t->cusum_alarm || t->named != 0 || !t->rival_dof) return NULL;
+  for (i = 0; i < s->nseps; i++)
+    if (s->seps[i].tracked == k && s->seps[i].cand == t->rival)
+      return s->seps[i].ok && s->seps[i].sep.found ? &s->seps[i].sep : NULL;
+  return NULL;
+}
+
+static int keep(mon_state *s, rcb_monitor *mon, size_t file, const rcb_monitor_result *r) {
+  int rc;
+  if ((rc = separators(s, mon, r))) return rc;
   if (s->nrec == s->cap) {
     size_t cap = s->cap ? 2 * s->cap : 64;
     mon_record *p = realloc(s->rec, cap * sizeof *p);
@@ -419,7 +459,7 @@ static int one_update(mon_ctx *x, mon_state *s, rcb_monitor *mon, size_t k) {
   if ((st = rcb_monitor_update(mon, x->values, have_sd ? x->sd : NULL, &r)))
     return cli_fail(st == RCB_ERR_ARG ? CLI_EXIT_INPUT : cli_status_exit(st), "%s: '%s': %s",
                     x->a->cmd, x->j->series.files[k], cli_msg(rcb_monitor_errmsg(mon), st));
-  if ((rc = keep(s, k, &r))) return rc;
+  if ((rc = keep(s, mon, k, &r))) return rc;
   s->rec[s->nrec - 1].hash = hash;
   return 0;
 }
@@ -486,7 +526,7 @@ static int resume(const mon_ctx *x, mon_state *s, rcb_monitor *mon) {
                     st == RCB_ERR_OTHER_MODEL ? " (give the baseline model the series was "
                                                 "started with)" : "");
   for (k = 0; k < sv->nrec; k++) {
-    if ((rc = keep(s, sv->ncomm + k, &sv->rec[k].r))) return rc;
+    if ((rc = keep(s, mon, sv->ncomm + k, &sv->rec[k].r))) return rc;
     s->rec[s->nrec - 1].hash = sv->rec[k].hash;
   }
   return 0;
@@ -578,5 +618,6 @@ done:
   free(x.values);
   free(x.sd);
   free(s.rec);
+  free(s.seps);
   return rc;
 }

@@ -190,7 +190,15 @@ class MonitorTracked(ctypes.Structure):
                 ("cusum_down", c_double), ("cusum_alarm", c_int), ("out_of_range", c_int),
                 ("abs_stderr", c_double), ("change", c_double), ("change_lo", c_double),
                 ("change_hi", c_double), ("named", c_int), ("rival", c_size_t),
-                ("rival_dof", c_size_t), ("rival_rate", c_double * MONITOR_MAXP)]
+                ("rival_dof", c_size_t), ("rival_rate", c_double * MONITOR_MAXP),
+                ("cusum_allow", c_double)]
+
+
+class MonitorSeparator(ctypes.Structure):
+    _fields_ = [("found", c_int), ("present_separable", c_int), ("chi2_present", c_double),
+                ("angle_deg", c_double), ("response", ctypes.c_char * 64),
+                ("reference", ctypes.c_char * 64), ("speed", c_double),
+                ("chi2_after", c_double), ("level_db", c_double)]
 
 
 class MonitorResult(ctypes.Structure):
@@ -363,6 +371,8 @@ _PROTOTYPES = {
     "rcb_monitor_candidate_count": (c_size_t, [c_void_p]),
     "rcb_monitor_rank": (c_int, [c_void_p, ctypes.POINTER(c_size_t), ctypes.POINTER(c_size_t)]),
     "rcb_monitor_named": (c_int, [c_void_p, c_void_p]),
+    "rcb_monitor_separating": (c_int, [c_void_p, c_size_t, c_size_t, c_void_p, c_size_t,
+                                       ctypes.POINTER(MonitorSeparator)]),
     "rcb_monitor_candidate_info_get": (c_int, [c_void_p, c_size_t,
                                                ctypes.POINTER(MonitorCandidateInfo)]),
     "rcb_monitor_tracked_info": (c_int, [c_void_p, c_size_t, ctypes.POINTER(c_char_p),

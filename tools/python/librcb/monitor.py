@@ -12,6 +12,7 @@ Units: SI; parameter values in their own units (N/m, N s/m, ...).
 """
 
 import ctypes
+import math
 
 import numpy as np
 
@@ -121,6 +122,10 @@ class Monitor(Handle):
         """Bytes the monitor holds (all from its allocator)."""
         return int(_lib.lib().rcb_monitor_memory(self.handle))
 
+    def candidate_count(self):
+        """Candidates laid out at create (indices for candidate(), separate_by())."""
+        return int(_lib.lib().rcb_monitor_candidate_count(self.handle))
+
     def candidate(self, i):
         info = _lib.MonitorCandidateInfo()
         self.check(_lib.lib().rcb_monitor_candidate_info_get(self.handle, i,
@@ -128,6 +133,30 @@ class Monitor(Handle):
         return {"effect": _lib.text(_lib.lib().rcb_effect_name(info.effect)),
                 "place": _lib.text(info.place), "description": _lib.text(info.description),
                 "params": _lib.text(info.params), "np": info.np}
+
+    def separate_by(self, tracked, cand, rpms=()):
+        """The measurement that would tell tracked parameter `tracked` from
+        candidate `cand` (rcb_monitor_separating: the diagnosis' plan on the
+        model's stations at the set-up's speed and each of `rpms`, rpm):
+        {"response", "reference", "rpm", "chi2_present", "chi2_after",
+        "level_db"}, or None when no channel does, the set-up's channels already
+        do, or the plan cannot vary the candidate. Asked once per pair and speeds
+        (the plan sweeps the model)."""
+        cache = self.__dict__.setdefault("_seps", {})
+        key = (tracked, cand, tuple(float(r) for r in rpms))
+        if key not in cache:
+            sep = _lib.MonitorSeparator()
+            w = (ctypes.c_double * max(len(key[2]), 1))(*[r * math.pi / 30.0 for r in key[2]])
+            st = _lib.lib().rcb_monitor_separating(self.handle, tracked, cand, w, len(key[2]),
+                                                    ctypes.byref(sep))
+            cache[key] = (None if st or not sep.found else
+                                      {"response": _lib.text(sep.response),
+                                       "reference": _lib.text(sep.reference),
+                                       "rpm": sep.speed * 30.0 / math.pi,
+                                       "chi2_present": sep.chi2_present,
+                                       "chi2_after": sep.chi2_after,
+                                       "level_db": sep.level_db})
+        return cache[key]
 
     def save_state(self):
         """The monitor's accumulated state (CUSUMs, references, update count) as
@@ -166,7 +195,8 @@ class Monitor(Handle):
             tracked.append({"name": self.tracked[k]["name"], "value": t.value,
                             "ci_lo": t.ci_lo, "ci_hi": t.ci_hi, "stderr": t.stderr_,
                             "z": t.z, "u": t.u, "cusum_up": t.cusum_up, "cusum_down": t.cusum_down,
-                            "cusum_alarm": t.cusum_alarm, "out_of_range": bool(t.out_of_range),
+                            "cusum_alarm": t.cusum_alarm, "cusum_allow": t.cusum_allow,
+                            "out_of_range": bool(t.out_of_range),
                             "abs_stderr": t.abs_stderr, "change": t.change,
                             "change_lo": t.change_lo, "change_hi": t.change_hi,
                             # a CUSUM alarm's attribution (the one rule): 1 this
@@ -174,7 +204,10 @@ class Monitor(Handle):
                             "named": t.named,
                             "rival": (dict(self.candidate(t.rival),
                                            rate=list(t.rival_rate[:t.rival_dof]))
-                                      if t.cusum_alarm and t.rival_dof else None)})
+                                      if t.cusum_alarm and t.rival_dof else None),
+                            # not separable: the measurement the plan names
+                            "separate_by": self.separate_by(k, t.rival)
+                            if t.cusum_alarm and t.named == 0 and t.rival_dof else None})
         top = []
         for k in range(r.ntop):
             c = r.top[k]
