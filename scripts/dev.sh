@@ -373,16 +373,20 @@ cmd_ctest_stage() {
 }
 
 # Stage times (issue #27): run_stage NAME CMD... runs CMD in a subshell with
-# errexit on, records its seconds and result, adds NAME to FAILED when it
-# fails, and returns 0: never call it as a condition (`run_stage ... ||`
-# would turn errexit off inside CMD). stage_table prints the times.
+# errexit on, records its seconds (wall, and CPU: user + system of the stage's
+# processes, from the shell's `times`, which holds on a loaded machine),
+# its result, adds NAME to FAILED when it fails, and returns 0: never call it
+# as a condition (`run_stage ... ||` would turn errexit off inside CMD).
+# stage_table prints the times.
 STAGE_NAMES=()
 STAGE_SECS=()
+STAGE_CPU=()
 STAGE_RESULTS=()
 FAILED=()
-stage_done() { # NAME SECONDS RC
+stage_done() { # NAME SECONDS RC CPU_SECONDS
   STAGE_NAMES+=("$1")
   STAGE_SECS+=("$2")
+  STAGE_CPU+=("${4:-0}")
   if (($3 == 0)); then
     STAGE_RESULTS+=(ok)
   else
@@ -390,53 +394,66 @@ stage_done() { # NAME SECONDS RC
     FAILED+=("$1")
   fi
 }
+# CPU seconds (rounded) of a `times` output: the shell's and its children's
+# user and system times ("0m1.250s 0m0.031s" per line).
+cpu_secs() {
+  awk '{ for (i = 1; i <= 2; i++) { split($i, a, /[ms]/); s += a[1] * 60 + a[2] } }
+       END { printf "%d\n", s + 0.5 }' "$1" 2> /dev/null || echo 0
+}
 run_stage() {
-  local name=$1 t=$SECONDS rc
+  local name=$1 t=$SECONDS rc cpuf
   shift
+  cpuf=$(mktemp)
   set +e
   (
+    trap 'times > "$cpuf"' EXIT
     set -e
     "$@"
   )
   rc=$?
   set -e
-  stage_done "$name" $((SECONDS - t)) $rc
+  stage_done "$name" $((SECONDS - t)) $rc "$(cpu_secs "$cpuf")"
+  rm -f "$cpuf"
 }
 run_stage_bg() {
   local name=$1 log=$BUILD_DIR/stage-$1.log
   shift
-  rm -f "$log" "$log.rc"
+  rm -f "$log" "$log.rc" "$log.cpu"
   (
     t=$SECONDS
     set +e
     (
+      trap 'times > "$log.cpu"' EXIT
       set -e
       "$@"
     ) > "$log" 2>&1
-    echo "$? $((SECONDS - t))" > "$log.rc"
+    echo "$? $((SECONDS - t)) $(cpu_secs "$log.cpu")" > "$log.rc"
   ) &
   BG_PID=$!
 }
 stage_wait() { # NAME PID
-  local log=$BUILD_DIR/stage-$1.log rc=1 secs=0
+  local log=$BUILD_DIR/stage-$1.log rc=1 secs=0 cpu=0
   wait "$2" || true
-  [[ -f $log.rc ]] && read -r rc secs < "$log.rc"
+  [[ -f $log.rc ]] && read -r rc secs cpu < "$log.rc"
   cat "$log"
-  stage_done "$1 (bg)" "$secs" "$rc"
+  stage_done "$1 (bg)" "$secs" "$rc" "$cpu"
 }
 stage_table() {
-  local i total=0
-  say "stage times (s; $(nproc 2> /dev/null || echo ?) processors, JOBS=$JOBS, load average" \
+  local i total=0 cpu=0 np
+  np=$(nproc 2> /dev/null || echo 1)
+  say "stage times (s; $np processors, JOBS=$JOBS, load average" \
     "$(cut -d' ' -f1-3 /proc/loadavg 2> /dev/null) at the end)"
-  printf '  %-14s %7s  %s\n' stage seconds result
+  printf '  %-14s %7s %7s  %s\n' stage wall cpu result
   for i in "${!STAGE_NAMES[@]}"; do
-    printf '  %-14s %7d  %s\n' "${STAGE_NAMES[$i]}" "${STAGE_SECS[$i]}" "${STAGE_RESULTS[$i]}"
+    printf '  %-14s %7d %7d  %s\n' "${STAGE_NAMES[$i]}" "${STAGE_SECS[$i]}" "${STAGE_CPU[$i]}" \
+      "${STAGE_RESULTS[$i]}"
     total=$((total + STAGE_SECS[i]))
+    cpu=$((cpu + STAGE_CPU[i]))
   done
-  printf '  %-14s %7d  (%d min %02d s; stages marked bg ran beside the others)\n' \
-    "sum of stages" "$total" $((total / 60)) $((total % 60))
-  printf '  %-14s %7d  (%d min %02d s)\n' wall $((SECONDS - STAGE_T0)) \
-    $(((SECONDS - STAGE_T0) / 60)) $(((SECONDS - STAGE_T0) % 60))
+  printf '  %-14s %7d %7d  (stages marked bg ran beside the others)\n' "sum of stages" "$total" "$cpu"
+  printf '  %-14s %7d %7s  (%d min %02d s; the CPU seconds over %d processors: %d s at the least)\n' \
+    wall $((SECONDS - STAGE_T0)) "" $(((SECONDS - STAGE_T0) / 60)) $(((SECONDS - STAGE_T0) % 60)) \
+    "$np" $((cpu / np))
 }
 STAGE_T0=$SECONDS
 
