@@ -21,7 +21,9 @@
  * Prints wall and CPU time, model sweeps, candidates scored, refits, and the
  * first three of the ranking.
  *
- * usage: bench_diagnose MODEL.ini [--large] [--hub] [--hub-mass KG] [--phase DEG] [--refits N]
+ * --two-rounds also hides 1.3 kg at disk DB and runs two rounds: diagnose,
+ * apply the first candidate, diagnose again (issue #23: two rounds under 10 s).
+ * usage: bench_diagnose MODEL.ini [--large] [--hub] [--hub-mass KG] [--two-rounds] [--phase DEG] [--refits N]
  *        [--threads N] [--repeats R]
  *        (run with OPENBLAS_NUM_THREADS=1)
  */
@@ -126,9 +128,10 @@ static int on_progress(void *user, size_t done, size_t total) {
   return 0;
 }
 
-/* One diagnosis; prints its figures. */
+/* One diagnosis; prints its figures. applied (NULL: not wanted) receives the
+ * model with the first candidate applied, for a second round; cpu its CPU s. */
 static int run(const rcb_model *m, const rcb_meas *ms, size_t nrefit, size_t threads,
-               int verbose, double *wall) {
+               int verbose, double *wall, double *cpu, rcb_model **applied) {
   rcb_diag *d = NULL;
   rcb_diag_stats s;
   steps sp;
@@ -153,8 +156,13 @@ static int run(const rcb_model *m, const rcb_meas *ms, size_t nrefit, size_t thr
     die("diag_run", rcb_diag_errmsg(d));
     goto done;
   }
+  if (applied && rcb_diag_apply_model(d, 0, NULL, applied)) {
+    die("diag_apply_model", rcb_diag_errmsg(d));
+    goto done;
+  }
   c1 = now_s(CLOCK_PROCESS_CPUTIME_ID);
   *wall = now_s(CLOCK_MONOTONIC) - w0;
+  *cpu = c1 - c0;
   rcb_diag_get_stats(d, &s);
   rcb_diag_baseline(d, &err0, NULL, &floor0);
   printf("  wall %.3f s, CPU %.3f s; %zu model sweeps, %zu candidates scored, %zu refits; "
@@ -185,16 +193,17 @@ int main(int argc, char **argv) {
   rcb_meas *ms = NULL;
   size_t nrefit = 5, nin = 1, npts = 151, threads = 1;
   double f0 = 100.0, f1 = 400.0, best = HUGE_VAL, phase = 0.0, hub_kg = 0.07; /* Hz; deg; kg */
-  int large = 0, hub = 0, repeats = 1, r, a, rc = 1;
+  int large = 0, hub = 0, two = 0, repeats = 1, r, a, rc = 1;
   if (argc < 2) {
     fprintf(stderr, "usage: bench_diagnose MODEL.ini [--large] [--hub] [--hub-mass KG] "
-                    "[--phase DEG] [--refits N] [--threads N] [--repeats R]\n");
+                    "[--two-rounds] [--phase DEG] [--refits N] [--threads N] [--repeats R]\n");
     return 2;
   }
   for (a = 2; a < argc; a++) {
     if (strcmp(argv[a], "--large") == 0) large = 1;
     else if (strcmp(argv[a], "--hub") == 0) hub = 1;
     else if (strcmp(argv[a], "--hub-mass") == 0 && a + 1 < argc) hub = 1, hub_kg = atof(argv[++a]);
+    else if (strcmp(argv[a], "--two-rounds") == 0) two = 1;
     else if (strcmp(argv[a], "--threads") == 0 && a + 1 < argc) threads = (size_t)atoi(argv[++a]);
     else if (strcmp(argv[a], "--phase") == 0 && a + 1 < argc) phase = atof(argv[++a]);
     else if (strcmp(argv[a], "--refits") == 0 && a + 1 < argc) nrefit = (size_t)atoi(argv[++a]);
@@ -206,7 +215,8 @@ int main(int argc, char **argv) {
     return die(argv[1], rcb_model_errmsg(m));
   if (rcb_model_create(&truth, NULL) || rcb_model_load_file(truth, argv[1]) ||
       (hub ? rcb_model_set_param(truth, "coupling.C.hub_mass", hub_kg)
-           : rcb_model_set_param(truth, "bearing.B2.kcross", 2e7))) {
+           : rcb_model_set_param(truth, "bearing.B2.kcross", 2e7)) ||
+      (two && rcb_model_set_param(truth, "disk.DB.mass", 1.3))) {
     die("truth", rcb_model_errmsg(truth));
     goto done;
   }
@@ -218,10 +228,21 @@ int main(int argc, char **argv) {
          "phase +-%g deg, top %zu refitted, %zu thread(s)\n",
          argv[1], rcb_meas_channel_count(ms), npts, f0, f1,
          hub ? "hub mass at C" : "kcross = 2e7 N/m at B2", phase, nrefit, threads);
+  if (two) printf("and disk DB's mass 1.3 kg: two rounds (diagnose, apply the first, diagnose)\n");
   if (hub) printf("hub mass %g kg per station\n", hub_kg);
   for (r = 0; r < repeats; r++) {
-    double wall;
-    if (run(m, ms, nrefit, threads, r == 0, &wall)) goto done;
+    double wall, cpu, wall2, cpu2;
+    rcb_model *m1 = NULL;
+    if (run(m, ms, nrefit, threads, r == 0, &wall, &cpu, two ? &m1 : NULL)) goto done;
+    if (two) {
+      printf(" round 2, on the model with the first candidate applied:\n");
+      rc = run(m1, ms, nrefit, threads, r == 0, &wall2, &cpu2, NULL);
+      rcb_model_destroy(m1);
+      if (rc) goto done;
+      rc = 1;
+      wall += wall2;
+      printf("  two rounds: wall %.3f s, CPU %.3f s\n", wall, cpu + cpu2);
+    }
     if (wall < best) best = wall;
   }
   printf("best wall time of %d: %.3f s\n", repeats, best);
