@@ -137,6 +137,7 @@ static double complex dh_adjoint(const rcb_fit_dz *p, const double *z, const rcb
  * one parameter's dZ entries. */
 typedef struct adj_ws {
   rcb_complex *Y, *dH; /* n x nout, nch */
+  rcb_complex *g;      /* the point's residuals' coefficients (rcb_fit_res_coef) */
   double *z;           /* 2 x the most entries of any parameter */
 } adj_ws;
 
@@ -152,6 +153,8 @@ static rcb_status score_point(rcb_fit *f, size_t i, const rcb_fit_dz *dz, size_t
   if ((st = rcb_frf_solve_adjoint(f->frf, ws->Y)))
     return rcb_fit_fail(f, st, "adjoint solve at %g rad/s: %s", w, rcb_frf_errmsg(f->frf));
   X = rcb_frf_solution(f->frf, 0); /* not NULL: the adjoint solve found the factors */
+  for (jj = f->pt_first[i]; jj < f->pt_first[i + 1]; jj++)
+    ws->g[jj - f->pt_first[i]] = rcb_fit_res_coef(f, f->pt_res[jj]);
   for (k = 0; k < ndz; k++) {
     dz_values(&dz[k], w, W, ws->z);
     for (c = 0; c < f->nch; c++) {
@@ -161,7 +164,8 @@ static rcb_status score_point(rcb_fit *f, size_t i, const rcb_fit_dz *dz, size_t
     }
     for (jj = f->pt_first[i]; jj < f->pt_first[i + 1]; jj++) {
       size_t j = f->pt_res[jj];
-      J[j + f->nres * k] = rcb_fit_res_deriv(f, j, ws->dH[f->res_ch[j]]);
+      rcb_complex g = ws->g[jj - f->pt_first[i]], dh = ws->dH[f->res_ch[j]];
+      J[j + f->nres * k] = creal(g) * creal(dh) - cimag(g) * cimag(dh); /* Re(g dh) */
     }
   }
   return RCB_OK;
@@ -177,13 +181,15 @@ static rcb_status sweep_adjoint(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, do
   ws.Y = rcb_alloc(&f->alloc, n * (f->nout ? f->nout : 1) * sizeof *ws.Y);
   ws.dH = rcb_alloc(&f->alloc, (f->nch ? f->nch : 1) * sizeof *ws.dH);
   ws.z = rcb_alloc(&f->alloc, 2 * ne * sizeof *ws.z);
-  st = (ws.Y && ws.dH && ws.z) ? RCB_OK
+  ws.g = rcb_alloc(&f->alloc, 2 * (f->nch ? f->nch : 1) * sizeof *ws.g); /* 2 parts per channel */
+  st = (ws.Y && ws.dH && ws.z && ws.g) ? RCB_OK
                                : rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory (adjoint)");
   for (i = 0; !st && i < f->npts; i++)
     if (f->pt_used[i]) st = score_point(f, i, dz, ndz, &ws, J);
   rcb_free(&f->alloc, ws.Y);
   rcb_free(&f->alloc, ws.dH);
   rcb_free(&f->alloc, ws.z);
+  rcb_free(&f->alloc, ws.g);
   return st;
 }
 
