@@ -177,6 +177,9 @@ double rcb_fit_noise_var(const rcb_fit *f, double complex e, double a, int part)
 rcb_status rcb_fit_solve_point(rcb_fit *f, size_t i);
 double rcb_fit_point_speed(const rcb_fit *f, double w);
 double rcb_fit_res_deriv(const rcb_fit *f, size_t j, double complex dh);
+/* The same as a coefficient g, dr_j/dp = Re(g dh), taken once per residual
+ * for all the parameters of a sweep (after the point's solve). */
+double complex rcb_fit_res_coef(const rcb_fit *f, size_t j);
 rcb_status rcb_fit_derivative_matrices(rcb_fit *f);
 
 /* The same from f->dmat, f->dF (after rcb_fit_derivative_matrices). */

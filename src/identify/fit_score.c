@@ -108,28 +108,59 @@ static void dz_values(const rcb_fit_dz *p, double w, double W, double *z) {
   }
 }
 
-/* dH_oq/dp of one parameter: Y_o^T (w^2 dF - dZ X_q) (unbalance: the force
- * term, at unit speed as in jac_point), dZ's entries from dz_values. The
- * sum, the diagnosis' innermost loop, is in real arithmetic: the products
- * and sums of the complex (y z) x, without the compiler's NaN-recovery
- * branches. */
-static double complex dh_adjoint(const rcb_fit_dz *p, const double *z, const rcb_complex *y,
-                                 const rcb_complex *x, double w, int unbalance, size_t n) {
-  double sr = 0.0, si = 0.0;
-  double complex s;
-  size_t a;
-  for (a = 0; a < p->ne; a++) {
-    const rcb_fit_dz_entry *e = &p->e[a];
-    double zr = z[2 * a], zi = z[2 * a + 1];
-    double yr = creal(y[e->row]), yi = cimag(y[e->row]);
-    double xr = creal(x[e->col]), xi = cimag(x[e->col]);
-    double tr = yr * zr - yi * zi, ti = yr * zi + yi * zr; /* y z */
-    sr -= tr * xr - ti * xi;
-    si -= tr * xi + ti * xr;
+/* The products y z of one parameter's entries (z from dz_values) with each
+ * output's adjoint solution y = Y_o (rows of the entries), t: 2 ne values
+ * per output, o-major: taken once for all the channels of an output. */
+static void yz_products(const rcb_fit_dz *p, const double *z, const rcb_complex *Y, size_t n,
+                        size_t nout, double *t) {
+  size_t o, a;
+  for (o = 0; o < nout; o++) {
+    const rcb_complex *y = Y + n * o;
+    double *to = t + 2 * p->ne * o;
+    for (a = 0; a < p->ne; a++) {
+      double zr = z[2 * a], zi = z[2 * a + 1];
+      double yr = creal(y[p->e[a].row]), yi = cimag(y[p->e[a].row]);
+      to[2 * a] = yr * zr - yi * zi, to[2 * a + 1] = yr * zi + yi * zr; /* y z */
+    }
   }
-  s = CMPLX(sr, si);
-  if (unbalance && p->dF)
-    for (a = 0; a < n; a++) s += y[a] * (w * w) * p->dF[a];
+}
+
+/* dH_oq/dp of one parameter, -Y_o^T dZ X_q, for every output o and input
+ * q < nq into dh[o * nq + q], t the outputs' products y z (yz_products),
+ * xg work (2 ne nq). The sum, the diagnosis' innermost loop, is in real
+ * arithmetic: the products and sums of the complex (y z) x, without the
+ * compiler's NaN-recovery branches; each (o, q) sums its entries in order,
+ * the inputs side by side (independent sums, the same figures as one at a
+ * time). The unbalance's force term is the caller's. */
+static void dh_adjoint(const rcb_fit_dz *p, const double *t, const rcb_complex *X, size_t n,
+                       size_t nout, size_t nq, double *xg, rcb_complex *dh) {
+  size_t o, q, a, ne = p->ne;
+  for (a = 0; a < ne; a++)
+    for (q = 0; q < nq; q++) {
+      rcb_complex x = X[n * q + p->e[a].col];
+      xg[2 * (a * nq + q)] = creal(x), xg[2 * (a * nq + q) + 1] = cimag(x);
+    }
+  for (o = 0; o < nout; o++) {
+    const double *to = t + 2 * ne * o;
+    double *acc = (double *)(dh + o * nq); /* re, im of each q */
+    for (q = 0; q < 2 * nq; q++) acc[q] = 0.0;
+    for (a = 0; a < ne; a++) {
+      double tr = to[2 * a], ti = to[2 * a + 1];
+      const double *xa = xg + 2 * a * nq;
+      for (q = 0; q < nq; q++) {
+        double xr = xa[2 * q], xi = xa[2 * q + 1];
+        acc[2 * q] -= tr * xr - ti * xi;
+        acc[2 * q + 1] -= tr * xi + ti * xr;
+      }
+    }
+  }
+}
+
+/* The unbalance's force term of dH_o/dp, Y_o^T w^2 dF, added to s. */
+static double complex dh_force(const rcb_fit_dz *p, const rcb_complex *y, double w, size_t n,
+                               double complex s) {
+  size_t a;
+  for (a = 0; a < n; a++) s += y[a] * (w * w) * p->dF[a];
   return s;
 }
 
@@ -137,14 +168,18 @@ static double complex dh_adjoint(const rcb_fit_dz *p, const double *z, const rcb
  * one parameter's dZ entries. */
 typedef struct adj_ws {
   rcb_complex *Y, *dH; /* n x nout, nch */
+  rcb_complex *g;      /* the point's residuals' coefficients (rcb_fit_res_coef) */
   double *z;           /* 2 x the most entries of any parameter */
+  double *t;           /* the same per output: the products y z (yz_products) */
+  double *xg;          /* the inputs' solutions at the entries' columns (dh_adjoint) */
+  rcb_complex *dho;    /* nout x the inputs: one parameter's dH of every pair */
 } adj_ws;
 
 /* One point: the model solve, the adjoint solutions with its factorisation
  * (rcb_frf_solve_adjoint), then every column. */
 static rcb_status score_point(rcb_fit *f, size_t i, const rcb_fit_dz *dz, size_t ndz,
                               const adj_ws *ws, double *J) {
-  size_t n = f->m->ndof, k, c, jj;
+  size_t n = f->m->ndof, k, c, jj, nq = f->unbalance || !f->nin ? 1 : f->nin;
   double w = f->grid[i], W = rcb_fit_point_speed(f, w);
   const rcb_complex *X;
   rcb_status st;
@@ -152,16 +187,22 @@ static rcb_status score_point(rcb_fit *f, size_t i, const rcb_fit_dz *dz, size_t
   if ((st = rcb_frf_solve_adjoint(f->frf, ws->Y)))
     return rcb_fit_fail(f, st, "adjoint solve at %g rad/s: %s", w, rcb_frf_errmsg(f->frf));
   X = rcb_frf_solution(f->frf, 0); /* not NULL: the adjoint solve found the factors */
+  for (jj = f->pt_first[i]; jj < f->pt_first[i + 1]; jj++)
+    ws->g[jj - f->pt_first[i]] = rcb_fit_res_coef(f, f->pt_res[jj]);
   for (k = 0; k < ndz; k++) {
     dz_values(&dz[k], w, W, ws->z);
+    yz_products(&dz[k], ws->z, ws->Y, n, f->nout, ws->t);
+    dh_adjoint(&dz[k], ws->t, X, n, f->nout, nq, ws->xg, ws->dho);
     for (c = 0; c < f->nch; c++) {
       size_t q = f->unbalance ? 0 : f->ch_in[c];
-      ws->dH[c] = dh_adjoint(&dz[k], ws->z, ws->Y + n * f->ch_out[c], X + n * q, w,
-                             f->unbalance, n);
+      ws->dH[c] = ws->dho[f->ch_out[c] * nq + q];
+      if (f->unbalance && dz[k].dF)
+        ws->dH[c] = dh_force(&dz[k], ws->Y + n * f->ch_out[c], w, n, ws->dH[c]);
     }
     for (jj = f->pt_first[i]; jj < f->pt_first[i + 1]; jj++) {
       size_t j = f->pt_res[jj];
-      J[j + f->nres * k] = rcb_fit_res_deriv(f, j, ws->dH[f->res_ch[j]]);
+      rcb_complex g = ws->g[jj - f->pt_first[i]], dh = ws->dH[f->res_ch[j]];
+      J[j + f->nres * k] = creal(g) * creal(dh) - cimag(g) * cimag(dh); /* Re(g dh) */
     }
   }
   return RCB_OK;
@@ -170,20 +211,28 @@ static rcb_status score_point(rcb_fit *f, size_t i, const rcb_fit_dz *dz, size_t
 /* Every point: columns d r / d p of dz[0 .. ndz) into J, the model values
  * into Hmod. */
 static rcb_status sweep_adjoint(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, double *J) {
-  size_t i, n = f->m->ndof, ne = 1, k;
+  size_t i, n = f->m->ndof, ne = 1, k, nq = f->unbalance || !f->nin ? 1 : f->nin;
   adj_ws ws;
   rcb_status st;
   for (k = 0; k < ndz; k++) ne = dz[k].ne > ne ? dz[k].ne : ne;
   ws.Y = rcb_alloc(&f->alloc, n * (f->nout ? f->nout : 1) * sizeof *ws.Y);
   ws.dH = rcb_alloc(&f->alloc, (f->nch ? f->nch : 1) * sizeof *ws.dH);
   ws.z = rcb_alloc(&f->alloc, 2 * ne * sizeof *ws.z);
-  st = (ws.Y && ws.dH && ws.z) ? RCB_OK
+  ws.t = rcb_alloc(&f->alloc, 2 * ne * (f->nout ? f->nout : 1) * sizeof *ws.t);
+  ws.xg = rcb_alloc(&f->alloc, 2 * ne * nq * sizeof *ws.xg);
+  ws.dho = rcb_alloc(&f->alloc, (f->nout ? f->nout : 1) * nq * sizeof *ws.dho);
+  ws.g = rcb_alloc(&f->alloc, 2 * (f->nch ? f->nch : 1) * sizeof *ws.g); /* 2 parts per channel */
+  st = (ws.Y && ws.dH && ws.z && ws.t && ws.xg && ws.dho && ws.g) ? RCB_OK
                                : rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory (adjoint)");
   for (i = 0; !st && i < f->npts; i++)
     if (f->pt_used[i]) st = score_point(f, i, dz, ndz, &ws, J);
   rcb_free(&f->alloc, ws.Y);
   rcb_free(&f->alloc, ws.dH);
   rcb_free(&f->alloc, ws.z);
+  rcb_free(&f->alloc, ws.g);
+  rcb_free(&f->alloc, ws.t);
+  rcb_free(&f->alloc, ws.xg);
+  rcb_free(&f->alloc, ws.dho);
   return st;
 }
 

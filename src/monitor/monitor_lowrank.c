@@ -108,11 +108,61 @@ done:
   return st;
 }
 
+/* The structure of dZ (na x na on the active DOFs, column-major) for this
+ * evaluation: for each row q, its columns holding an entry, ascending,
+ * cols[q * MON_LOWRANK_MAXP ..], ncol[q] of them. */
+static void dz_pattern(const mon_lowrank *lr, size_t nt, const mon_cand *c, size_t na,
+                       unsigned char *cols, unsigned char *ncol) {
+  unsigned char hit[MON_LOWRANK_MAXP * MON_LOWRANK_MAXP];
+  const size_t *loc = lr->loc;
+  size_t j, a, e = 0, q;
+  memset(hit, 0, na * na);
+  for (j = 0; j < nt; j++)
+    for (a = 0; a < lr->dz[j].ne; a++, e++)
+      hit[loc[lr->ep[2 * e]] + na * loc[lr->ep[2 * e + 1]]] = 1;
+  for (j = 0, e = 0; c && j < c->np; j++)
+    for (a = 0; a < c->dz[j].ne; a++, e++)
+      hit[loc[c->ep[2 * e]] + na * loc[c->ep[2 * e + 1]]] = 1;
+  for (q = 0; q < na; q++) {
+    ncol[q] = 0;
+    for (a = 0; a < na; a++)
+      if (hit[q + na * a]) cols[q * MON_LOWRANK_MAXP + ncol[q]++] = (unsigned char)a;
+  }
+}
+
+/* A hint to fetch the cache line at p ahead of its use (no effect on any
+ * value): the next point's entries of H0_PP and H0_oP, scattered over blocks
+ * of |P| x |P| and nch x |P| values, are otherwise each a cache miss. */
+#if defined(__GNUC__)
+#define LR_PREFETCH(p) __builtin_prefetch(p)
+#else
+#define LR_PREFETCH(p) ((void)(p))
+#endif
+
+/* The next point's entries of the blocks (point i + 1) ahead of their use. */
+static void prefetch_point(const rcb_monitor *mon, const mon_lowrank *lr, size_t i, size_t na) {
+  size_t np = lr->np, q, r, ch;
+  const rcb_complex *hpp = lr->hpp + i * np * np;
+  if (i >= mon->npts) return;
+  for (r = 0; r < na; r++)
+    for (q = 0; q < na; q++) LR_PREFETCH(hpp + lr->act[q] + np * lr->act[r]);
+  for (ch = 0; ch < mon->nch; ch++)
+    for (q = 0; q < na; q++) LR_PREFETCH(lr->a + (ch * mon->npts + i) * np + lr->act[q]);
+}
+
+/* v + x y in real arithmetic: the same products and sums as C's complex
+ * multiply, without its NaN-recovery branch (the values are finite). */
+static rcb_complex cmac(rcb_complex v, rcb_complex x, rcb_complex y) {
+  double xr = creal(x), xi = cimag(x), yr = creal(y), yi = cimag(y);
+  return CMPLX(creal(v) + (xr * yr - xi * yi), cimag(v) + (xr * yi + xi * yr));
+}
+
 rcb_status rcb_mon_lowrank_change(rcb_monitor *mon, const double *theta, const mon_cand *c,
                                   const double *s, rcb_complex *dm) {
   mon_lowrank *lr = mon->lr;
-  size_t nin = lr->nin, np = lr->np, na, i, j, a, q, r, ch, e0;
+  size_t nin = lr->nin, np = lr->np, na, i, j, a, q, r, ch, e0, t;
   size_t *act = lr->act, *loc = lr->loc;
+  unsigned char cols[MON_LOWRANK_MAXP * MON_LOWRANK_MAXP], ncol[MON_LOWRANK_MAXP];
   /* this evaluation's DOFs: the tracked parameters', then c's */
   na = lr->npt;
   for (q = 0; q < np; q++) loc[q] = q < na ? q : (size_t)-1, act[q] = q;
@@ -121,11 +171,15 @@ rcb_status rcb_mon_lowrank_change(rcb_monitor *mon, const double *theta, const m
       size_t pos = c->ep[2 * e0 + q];
       if (loc[pos] == (size_t)-1) loc[pos] = na, act[na++] = pos;
     }
+  /* dZ's entries: the products below skip its structural zeros, whose
+   * terms (0 x a finite value) would leave every sum as it is */
+  dz_pattern(lr, mon->nt, c, na, cols, ncol);
   for (i = 0; i < mon->npts; i++) {
     double w = lr->w[i], W = lr->speed < 0 ? w : lr->speed;
     const rcb_complex *hpp = lr->hpp + i * np * np, *b = lr->b + i * nin * np;
     rcb_complex *dZ = lr->dZ, *M = lr->M, *X = lr->X;
     size_t e = 0;
+    prefetch_point(mon, lr, i + 1, na);
     memset(dZ, 0, na * na * sizeof *dZ);
     for (j = 0; j < mon->nt; j++)
       for (a = 0; a < lr->dz[j].ne; a++, e++) {
@@ -142,13 +196,16 @@ rcb_status rcb_mon_lowrank_change(rcb_monitor *mon, const double *theta, const m
     for (r = 0; r < na; r++) /* M = I + dZ H0_PP, X = dZ H0_Pi (on the active DOFs) */
       for (q = 0; q < na; q++) {
         rcb_complex v = q == r ? 1.0 : 0.0;
-        for (a = 0; a < na; a++) v += dZ[q + na * a] * hpp[act[a] + np * act[r]];
+        const unsigned char *cq = cols + q * MON_LOWRANK_MAXP;
+        for (t = 0; t < ncol[q]; t++)
+          v = cmac(v, dZ[q + na * cq[t]], hpp[act[cq[t]] + np * act[r]]);
         M[q + na * r] = v;
       }
     for (r = 0; r < nin; r++)
       for (q = 0; q < na; q++) {
         rcb_complex v = 0;
-        for (a = 0; a < na; a++) v += dZ[q + na * a] * b[r * np + act[a]];
+        const unsigned char *cq = cols + q * MON_LOWRANK_MAXP;
+        for (t = 0; t < ncol[q]; t++) v = cmac(v, dZ[q + na * cq[t]], b[r * np + act[cq[t]]]);
         X[q + na * r] = v;
       }
     if (LAPACKE_zgesv_work(LAPACK_COL_MAJOR, (lapack_int)na, (lapack_int)nin, M, (lapack_int)na,
@@ -158,7 +215,7 @@ rcb_status rcb_mon_lowrank_change(rcb_monitor *mon, const double *theta, const m
     for (ch = 0; ch < mon->nch; ch++) {
       const rcb_complex *ac = lr->a + (ch * mon->npts + i) * np, *x = X + na * lr->ch_in[ch];
       rcb_complex v = 0;
-      for (q = 0; q < na; q++) v += ac[act[q]] * x[q];
+      for (q = 0; q < na; q++) v = cmac(v, ac[act[q]], x[q]);
       dm[ch * mon->npts + i] = -v;
     }
   }
