@@ -195,7 +195,8 @@ def _first_message(r):
     parameter's CUSUM alarm attributed to it alone: the issue's "kr
     falling"), 'b4' (every alarm names B4 kyy: the drift test, the instant
     test's first candidate, or a CUSUM alarm with B4 kyy as its rival, not
-    separable or told apart), else 'other'."""
+    separable or told apart, or as the rival's not-separable runner-up,
+    rival2), else 'other'."""
     msgs = []
     if r["drift"]["alarm"]:
         msgs.append("b4" if _b4(r["drift"]) else "other")
@@ -203,7 +204,8 @@ def _first_message(r):
         msgs.append("b4" if _b4(r["top"][0]) else "other")
     for t in r["tracked"]:
         if t["cusum_alarm"]:
-            msgs.append("alone" if t["named"] == 1 else "b4" if _b4(t["rival"]) else "other")
+            msgs.append("alone" if t["named"] == 1 else
+                        "b4" if _b4(t["rival"]) or _b4(t.get("rival2")) else "other")
     if not msgs:
         return None
     return "alone" if "alone" in msgs else "b4" if all(m == "b4" for m in msgs) else "other"
