@@ -250,7 +250,7 @@ def _attributions(rcb, meas):
     return rows
 
 
-def test_told_apart_only_when_supported(rcb):
+def test_told_apart_only_when_supported(rcb, tmp_path):
     """Issue #24: on one channel (DB.y per DA.x, kt and kr tracked) a B4 kyy drift
     carried on to 30 updates was, from update 22, reported as "bearing B1 kxx
     falling (told apart from kr)": B1 kxx and B4 kyy explain the accumulated change
@@ -263,13 +263,34 @@ def test_told_apart_only_when_supported(rcb):
     counter cases: with DB.x beside DB.y the drift is B4 kyy told apart from
     every other candidate (rival2 None) at the end of the series; with no drift
     there is no CUSUM alarm and so no claim."""
-    rows = _attributions(rcb, _b4_series(rcb, ["DB.y"], 0.004))
+    meas = _b4_series(rcb, ["DB.y"], 0.004)
+    paths = []
+    for k, ms in enumerate(meas):
+        paths.append(tmp_path / f"d{k:02d}.uff")
+        ms.write(paths[-1], uff_map={16: "DB", 3: "DA"})
+    rows = _attributions(rcb, meas)
     apart = [(u, t) for u, t in rows if t["named"] == -1]
     assert apart, "no told-apart attribution in the one-channel series"
     for u, t in apart:
         names = {t["rival"]["params"], t["rival2"] and t["rival2"]["params"]}
         assert "bearing.B4.kyy" in names, (u, t["rival"], t["rival2"])
     assert any(t["rival2"] is not None for u, t in apart)
+    exe = os.environ.get("RCBTOOL")
+    if exe:  # rcbtool monitor's text says the same
+        ini = tmp_path / "model.ini"
+        ini.write_text(PAPER.read_text() + "\n[uff]\nmap = 16 DB, 3 DA\n")
+        res = subprocess.run([exe, "monitor", str(ini), *map(str, paths), "--params",
+                              "coupling.C.kt,coupling.C.kr", "--noise", "2,2", "--alpha",
+                              "0.01"], capture_output=True, text=True, timeout=300)
+        assert res.returncode == 0, res.stderr
+        lines = {int(ln.split()[0]): ln for ln in res.stdout.splitlines()
+                 if ln.strip() and ln.split()[0].isdigit()}
+        for u, t in apart:
+            if t["rival2"] is not None:
+                assert (f"{t['rival']['params']} falling, or " in lines[u] and
+                        "not separable on these channels; the first told apart from" in
+                        lines[u]), lines[u]
+        assert "bearing.B1.kxx falling (told apart" not in res.stdout
     # counter case: a second channel separates the bearings
     rows = _attributions(rcb, _b4_series(rcb, ["DB.y", "DB.x"], 0.004))
     last = [t for u, t in rows if u == 30]
