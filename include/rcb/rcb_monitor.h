@@ -167,7 +167,10 @@
  *    rcb_monitor_tracked.named says a alone, "a or the candidate: not
  *    separable on these channels", or the candidate told apart from a; in
  *    the second case rcb_monitor_separating names the channel or speed that
- *    would separate them (the diagnosis' plan).
+ *    would separate them (the diagnosis' plan). The candidate is told apart
+ *    alone only when the runner-up candidate is told apart from it too; else
+ *    both are given (rival2: on one channel a B4 kyy drift and B1 kxx fit
+ *    the change within 1.5 of BIC, so "not kr" holds but not which bearing).
  */
 #ifndef RCB_MONITOR_H
 #define RCB_MONITOR_H
@@ -313,6 +316,14 @@ typedef struct rcb_monitor_tracked {
   double cusum_allow;  /**< the CUSUM's allowance this update (-): opts.cusum_k,
                             raised with opts.baseline_cov by the baseline's
                             share (the sequential detector above) */
+  size_t rival2;       /**< when named is -1: the runner-up candidate whose
+                            explanation of the accumulated change is not
+                            separable from the rival's by the one rule (the
+                            data say "not this parameter" but not which of
+                            the two: "rival, or rival2: not separable on these
+                            channels"); index as rival */
+  size_t rival2_dof;   /**< its parameters; 0 when the rival is told apart
+                            from every other candidate too (or named is not -1) */
 } rcb_monitor_tracked;
 
 /** @brief What one update found. Plain value type, owns nothing. */

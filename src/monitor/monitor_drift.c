@@ -183,8 +183,9 @@ static double explained(rcb_monitor *mon, size_t a, size_t col, size_t q, double
  * explained by a candidate than by a, the other tracked parameters free? */
 static void attribute(rcb_monitor *mon, size_t a, rcb_monitor_tracked *t) {
   size_t k = mon->k, nt = mon->nt, i, b, j, m = mon->dcount;
-  double den, x[RCB_MONITOR_MAXP] = {0}, ga, ba, bbest = 0, scale;
-  int have = 0;
+  double den, x[RCB_MONITOR_MAXP] = {0}, ga, ba, bbest = 0, b2 = 0, scale;
+  size_t r2 = 0;
+  int have = 0, have2 = 0;
   if (!m) return;
   den = accumulate(mon, m, mon->dY);
   if (!(den > 0)) return;
@@ -213,13 +214,20 @@ static void attribute(rcb_monitor *mon, size_t a, rcb_monitor_tracked *t) {
     if (!c->dof || (g = explained(mon, a, c->col, c->np, x)) < 0) continue;
     bj = rcb_mon_bic(mon, g, c->dof);
     if (!have || bj < bbest) {
+      if (have) have2 = 1, b2 = bbest, r2 = t->rival;
       have = 1, bbest = bj, t->rival = j, t->rival_dof = c->np;
       for (b = 0; b < c->np; b++) t->rival_rate[b] = x[b] / (den * scale);
+    } else if (!have2 || bj < b2) {
+      have2 = 1, b2 = bj, r2 = j;
     }
   }
   if (!have) return;
   if (rcb_evidence_separable(ba, bbest)) t->named = ba <= bbest ? 1 : -1;
   else t->named = 0;
+  /* the rival named alone only when the runner-up is told apart from it too:
+   * on few channels two candidates can fit the change equally well */
+  if (t->named == -1 && have2 && !rcb_evidence_separable(bbest, b2))
+    t->rival2 = r2, t->rival2_dof = mon->cand[r2].np;
 }
 
 void rcb_mon_drift_update(rcb_monitor *mon, const double *theta, int gls,

@@ -22,7 +22,10 @@ only (a few ms each). Asserted against binomial bounds:
   Bonferroni over candidates and onsets): the replicas below 0.1 are within
   the binomial 99 % upper bound at rate 0.1; the replicas with any drift
   alarm in NULL_UPDATES updates within the bound at the union rate
-  NULL_UPDATES x alpha;
+  NULL_UPDATES x alpha; the replicas with any CUSUM alarm within the bound at
+  2 x 3 x NULL_UPDATES / ARL0 (Siegmund's, k 0.5, h 8); each tracked
+  parameter's change interval holding 0 at the last update in at least the
+  binomial 1 % quantile of 95 %;
 * drift: detected and named (a drift alarm on B4 kyy, or the instant test
   naming it first) before its size reaches 3 standard deviations in at least
   80 % of replicas (the count above the binomial 1 % quantile at 0.8);
@@ -168,26 +171,38 @@ def test_sd_of_b4_kyy(groups):
 
 def test_null_false_alarms(groups):
     H, gs = groups
-    last_p, any_alarm, alarms, n = [], 0, 0, 0
+    last_p, any_alarm, alarms, n, cusum, cover = [], 0, 0, 0, 0, [0] * len(PARAMS)
     for gi, (mon, fresh) in enumerate(gs):
         for rep in range(NULL_REPLICAS):
             mon.load_state(fresh)
-            hit = False
+            hit = hit_c = False
             for u in range(NULL_UPDATES):
                 with _meas(_eq19(H[0], 1000000 * (gi + 1) + 1000 * rep + u)) as ms:
                     r = mon.update(ms)
                 n += 1
                 alarms += r["drift"]["alarm"]
                 hit |= r["drift"]["alarm"]
+                hit_c |= any(t["cusum_alarm"] for t in r["tracked"])
             last_p.append(r["drift"]["p_value"])
             any_alarm += hit
+            cusum += hit_c
+            # nothing changed: each change interval at the last update holds 0
+            for k, t in enumerate(r["tracked"]):
+                cover[k] += t["change_lo"] <= 0.0 <= t["change_hi"]
     R = len(last_p)
     below = sum(p < 0.1 for p in last_p)
-    FIGURES["null"] = (alarms, n, any_alarm, R, below)
+    # the CUSUMs: per side Siegmund's ARL0 (k 0.5, h 8: 19110 updates), both sides
+    # of every tracked parameter over NULL_UPDATES updates
+    p_cusum = min(1.0, 2 * len(PARAMS) * NULL_UPDATES / 19110.0)
+    FIGURES["null"] = (alarms, n, any_alarm, R, below, cusum, cover)
     print(f"null: {alarms} drift alarms in {n} updates (alpha {ALPHA}); replicas with any: "
-          f"{any_alarm} of {R}; last p < 0.1 in {below} of {R}")
+          f"{any_alarm} of {R}; last p < 0.1 in {below} of {R}; replicas with a CUSUM alarm "
+          f"{cusum} (99 % bound {stats.binom.ppf(0.99, R, p_cusum):.0f}); change intervals "
+          f"holding 0 at the last update {cover} of {R}")
     assert below <= stats.binom.ppf(0.99, R, 0.1)
     assert any_alarm <= stats.binom.ppf(0.99, R, min(1.0, NULL_UPDATES * ALPHA))
+    assert cusum <= stats.binom.ppf(0.99, R, p_cusum)
+    assert min(cover) >= stats.binom.ppf(0.01, R, 0.95)
 
 
 def _first_message(r):
@@ -195,7 +210,8 @@ def _first_message(r):
     parameter's CUSUM alarm attributed to it alone: the issue's "kr
     falling"), 'b4' (every alarm names B4 kyy: the drift test, the instant
     test's first candidate, or a CUSUM alarm with B4 kyy as its rival, not
-    separable or told apart), else 'other'."""
+    separable or told apart, or as the rival's not-separable runner-up,
+    rival2), else 'other'."""
     msgs = []
     if r["drift"]["alarm"]:
         msgs.append("b4" if _b4(r["drift"]) else "other")
@@ -203,7 +219,8 @@ def _first_message(r):
         msgs.append("b4" if _b4(r["top"][0]) else "other")
     for t in r["tracked"]:
         if t["cusum_alarm"]:
-            msgs.append("alone" if t["named"] == 1 else "b4" if _b4(t["rival"]) else "other")
+            msgs.append("alone" if t["named"] == 1 else
+                        "b4" if _b4(t["rival"]) or _b4(t.get("rival2")) else "other")
     if not msgs:
         return None
     return "alone" if "alone" in msgs else "b4" if all(m == "b4" for m in msgs) else "other"

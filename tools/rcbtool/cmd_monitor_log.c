@@ -65,8 +65,10 @@ static void json_rate(FILE *fp, const mon_state *s, size_t index, const double *
   cli_json_str(fp, ci.place ? ci.place : "");
   fputs(", \"params\": ", fp);
   cli_json_str(fp, ci.params ? ci.params : "");
-  fputs(", \"rate\": ", fp);
-  cli_json_nums(fp, rate, ci.np, 1);
+  if (rate) {
+    fputs(", \"rate\": ", fp);
+    cli_json_nums(fp, rate, ci.np, 1);
+  }
 }
 
 static void json_tracked(FILE *fp, const mon_state *s, const rcb_monitor_tracked *t,
@@ -92,6 +94,14 @@ static void json_tracked(FILE *fp, const mon_state *s, const rcb_monitor_tracked
   fprintf(fp, ", \"named\": %d, \"rival\": ", t->named);
   if (t->cusum_alarm && t->rival_dof) {
     json_rate(fp, s, t->rival, t->rival_rate);
+    fputc('}', fp);
+  } else {
+    fputs("null", fp);
+  }
+  /* named -1 but the runner-up not separable from the rival: both, no rate */
+  fputs(", \"rival2\": ", fp);
+  if (t->cusum_alarm && t->named == -1 && t->rival2_dof) {
+    json_rate(fp, s, t->rival2, NULL);
     fputc('}', fp);
   } else {
     fputs("null", fp);

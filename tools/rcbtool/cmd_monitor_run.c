@@ -296,14 +296,16 @@ static void put_cand(FILE *fp, const rcb_monitor_candidate_info *ci, int with_pa
 
 /* A CUSUM alarm of tracked parameter k and what the attribution said (the
  * one rule, rcb_monitor_tracked.named): "kr falling", "kr falling, or
- * <candidate> falling: not separable on these channels", or the candidate
- * told apart from kr. */
+ * <candidate> falling: not separable on these channels", the candidate
+ * told apart from kr, or, when a runner-up fits as well as that candidate,
+ * "<candidate> falling, or <runner-up>: not separable on these channels;
+ * the first told apart from kr". */
 static void print_attribution(FILE *fp, const mon_state *s, const rcb_monitor_result *r,
                               size_t k) {
   const rcb_monitor_tracked *t = &r->tracked[k];
   const char *dir = t->cusum_alarm < 0 ? "falling" : "rising";
   const char *rdir = t->rival_rate[0] < 0 ? "falling" : "rising";
-  rcb_monitor_candidate_info ci;
+  rcb_monitor_candidate_info ci, ci2;
   char name[1024];
   if (!t->cusum_alarm) return;
   cli_text(s->j->params.items[k].name, name, sizeof name);
@@ -322,6 +324,13 @@ static void print_attribution(FILE *fp, const mon_state *s, const rcb_monitor_re
       fprintf(fp, "; %s per %s at %.6g rpm would separate them", cli_text(sp->response, resp,
               sizeof resp), cli_text(sp->reference, ref, sizeof ref),
               sp->speed / CLI_RPM_TO_RAD_S);
+  } else if (t->rival2_dof && rcb_monitor_candidate_info_get(s->mon, t->rival2, &ci2) == RCB_OK) {
+    /* not this parameter, but the data do not say which of the two */
+    fputs("  ", fp);
+    put_cand(fp, &ci, 1);
+    fprintf(fp, " %s, or ", rdir);
+    put_cand(fp, &ci2, 1);
+    fprintf(fp, ": not separable on these channels; the first told apart from %s", name);
   } else {
     fputs("  ", fp);
     put_cand(fp, &ci, 1);

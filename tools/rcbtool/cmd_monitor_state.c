@@ -18,7 +18,7 @@
 #include "cmd_monitor.h"
 
 #define ST_MAGIC "RCBTOOL-MONSTATE"
-#define ST_VERSION 3u
+#define ST_VERSION 4u
 
 /* A growing or consumed byte buffer: one codec writes and reads. */
 typedef struct st_buf {
@@ -145,6 +145,7 @@ static void io_result(st_buf *b, rcb_monitor_result *r) {
     io_int(b, &t->named), io_size(b, &t->rival), io_size(b, &t->rival_dof);
     io_f64s(b, t->rival_rate, RCB_MONITOR_MAXP);
     io_f64(b, &t->cusum_allow); /* version 3 */
+    io_size(b, &t->rival2), io_size(b, &t->rival2_dof); /* version 4 */
   }
   io_f64(b, &r->drift_glr), io_size(b, &r->drift_dof), io_f64(b, &r->drift_p);
   io_int(b, &r->drift_alarm), io_size(b, &r->drift_index), io_size(b, &r->drift_onset);

@@ -205,6 +205,12 @@ class Monitor(Handle):
                             "rival": (dict(self.candidate(t.rival),
                                            rate=list(t.rival_rate[:t.rival_dof]))
                                       if t.cusum_alarm and t.rival_dof else None),
+                            # named -1 but a runner-up not separable from the rival
+                            # (the change is not this parameter's; which of the two,
+                            # the data do not say)
+                            "rival2": (self.candidate(t.rival2)
+                                       if t.cusum_alarm and t.named == -1 and t.rival2_dof
+                                       else None),
                             # not separable: the measurement the plan names
                             "separate_by": self.separate_by(k, t.rival)
                             if t.cusum_alarm and t.named == 0 and t.rival_dof else None})
