@@ -243,11 +243,8 @@ def test_wear_from_fitted_baseline_with_restart(wear):
     assert w["change"] >= w["lo95"], FIGURES["wear"]
 
 
-@pytest.mark.xfail(strict=False, reason="the fit's kt standard error is about 1.3x optimistic "
-                   "on these ROSS files (rms error 1.29 standard errors over 40 null fits, "
-                   "33 of 40 95 % intervals covering), so the value interval, which carries "
-                   "it as baseline_sd, under-covers: 10 of 16 at 40 updates (docs/monitoring.md)")
-def test_wear_value_interval_coverage(wear):
-    """kt's value interval (the baseline's sd carried) holds the truth at the last
-    update in at least the binomial 1 % quantile of 95 % of replicas."""
-    assert wear["value"] >= wear["lo95"], FIGURES["wear"]
+# kt's value interval (the baseline's sd carried) is not asserted: it does not
+# hold at 40 updates (10 of 16 against 13), because the fit's kt standard error
+# is optimistic on these ROSS files (docs/monitoring.md, "Rates with replicas");
+# a test marked to pass either way would assert nothing. FIGURES["wear"] prints
+# its count.
