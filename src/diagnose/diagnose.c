@@ -1063,7 +1063,7 @@ static int at_neutral(const diag_cand *c) {
 static rcb_status cannot_lead(rcb_diag *d, const diag_cand *c, rcb_fit *f, int *out) {
   const diag_cand *L = d->lead < d->ncand ? &d->cand[d->lead] : NULL;
   size_t n = rcb_fit_residual_count(f), np = rcb_fit_param_count(f), nb, k;
-  double *J, *r, pred = 0.0, Fb, N = (double)d->nres, dbic;
+  double *J, *r, pred = 0.0, own = 0.0, Fb, N = (double)d->nres, dbic;
   diag_basis b;
   rcb_status st;
   *out = 0;
@@ -1081,12 +1081,12 @@ static rcb_status cannot_lead(rcb_diag *d, const diag_cand *c, rcb_fit *f, int *
   st = rcb_diag_basis_init(d, &b, J, n, nb, r);
   if (!st) {
     for (k = 0; k < b.rank; k++) pred += b.rt[k] * b.rt[k]; /* the base's columns */
-    st = rcb_diag_explained(d, &b, J + n * nb, c->np, &dbic);
-    pred += st ? 0.0 : dbic;
+    st = rcb_diag_explained(d, &b, J + n * nb, c->np, &own); /* its own, beyond */
+    pred += own;
     rcb_diag_basis_free(d, &b);
   }
   rcb_free(&d->alloc, J);
-  if (st) return st;
+  if (st) return st == RCB_ERR_NOMEM ? st : RCB_OK; /* the polish runs */
   Fb = c->F - RCB_DIAG_GN_SLACK * pred;
   if (!(Fb > 0.0)) return RCB_OK;
   dbic = chi2(d) ? (Fb - d->F0) + (double)c->np * log(N)
