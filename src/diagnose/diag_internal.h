@@ -104,7 +104,9 @@ struct rcb_diag {
   int far;                          /* the baseline fit ran off from the nominal model */
   double pre_best;                  /* the lowest pre-fit objective (far baseline), or HUGE_VAL */
   double best_F;                    /* the lowest objective of the refits on all points */
+  size_t lead;                      /* the refit polished first (refit_best), or ncand */
   int screen_floor;                 /* a refit's screen ended at the noise floor */
+  int node_crawl; /* added masses' pre-fits under the subset's limits (prefit_selected) */
   char drift[256];                  /* which parameter ran off, in words */
   double F0, err0, floor0;
   rcb_fit_adequacy adeq0;           /* the adequacy test of the model as it is */
