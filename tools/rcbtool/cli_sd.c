@@ -62,7 +62,8 @@ static int read_table(const char *path, sd_table *t) {
       return cli_fail(CLI_EXIT_INPUT, "%s:%zu: %s fields; the header has %zu", path, lineno,
                       "a different number of", t->ncol);
     if (t->nrow == cap) {
-      double *v = realloc(t->v, (cap ? 2 * cap : 256) * t->ncol * sizeof *v);
+      size_t ncol = t->ncol > 0 ? t->ncol : 1; /* >= 1: the header has a column */
+      double *v = realloc(t->v, (cap ? 2 * cap : 256) * ncol * sizeof *v);
       if (!v) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
       t->v = v;
       cap = cap ? 2 * cap : 256;
