@@ -1062,11 +1062,14 @@ static int at_neutral(const diag_cand *c) {
  * that cannot be told (a failed Jacobian: the polish runs). */
 static rcb_status cannot_lead(rcb_diag *d, const diag_cand *c, rcb_fit *f, int *out) {
   const diag_cand *L = d->lead < d->ncand ? &d->cand[d->lead] : NULL;
-  size_t n = rcb_fit_residual_count(f), np = rcb_fit_param_count(f), nb, k;
+  size_t n, np = rcb_fit_param_count(f), nb, k;
   double *J, *r, pred = 0.0, own = 0.0, Fb, N = (double)d->nres, dbic;
   diag_basis b;
-  rcb_status st;
+  rcb_status st = rcb_fit_prepare(f); /* the residual layout (it allocates) */
   *out = 0;
+  if (st == RCB_ERR_NOMEM) return rcb_diag_fail(d, st, "out of memory");
+  if (st) return RCB_OK; /* the polish runs, and says what failed */
+  n = rcb_fit_residual_count(f);
   if (!L || L == c || !L->polished || L->claim != RCB_CLAIM_EXPLAINS || np < c->np ||
       n != d->nres || !n)
     return RCB_OK;
@@ -1074,8 +1077,10 @@ static rcb_status cannot_lead(rcb_diag *d, const diag_cand *c, rcb_fit *f, int *
   if (!(J = rcb_alloc(&d->alloc, (n * np + n) * sizeof *J)))
     return rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
   r = J + n * np;
-  if (rcb_fit_residuals(f, r) || rcb_fit_jacobian(f, 1, J)) {
+  if ((st = rcb_fit_residuals(f, r)) || (st = rcb_fit_jacobian(f, 1, J))) {
     rcb_free(&d->alloc, J);
+    if (st == RCB_ERR_NOMEM) /* out of memory fails the run; anything else: the polish runs */
+      return rcb_diag_fail(d, st, "out of memory");
     return RCB_OK;
   }
   st = rcb_diag_basis_init(d, &b, J, n, nb, r);
