@@ -66,9 +66,7 @@ import test_monitor_drift as td  # noqa: E402  (eq. 19 draws, the measurement wr
 pytest.importorskip("ross")
 rcb = pytest.importorskip("librcb")
 
-PARAMS = mc.FIT_PARAMS.split(",")  # coupling.C.kt, kr, ct
-COMMISSION = 10
-ALPHA = 0.01
+PARAMS, COMMISSION, ALPHA = td.PARAMS, td.COMMISSION, td.ALPHA  # the drift test's set-up
 OPTS = dict(noise=mc.NOISE, setup_averages=COMMISSION, alpha=ALPHA, relinearise=8,
             reweight=True)
 STEP_REPLICAS = int(os.environ.get("RCB_STEP_REPLICAS", "16"))
