@@ -46,7 +46,8 @@ struct rcb_transient {
   SUNContext ctx;
   void *cvode;
   N_Vector y, abstol;
-  SUNMatrix J;
+  SUNMatrix J; /* 2n x 2n: CVODE requires one for a direct solver; never filled
+                  (rcb_transient_linsys forms the n x n blocks instead) */
   SUNLinearSolver LS;
   rcb_sun_route route;
   double *Kt, *Dt; /* M^-1 K and M^-1 (C + Omega G) at the last Jacobian's speed,
