@@ -1,4 +1,4 @@
-#define _POSIX_C_SOURCE 200809L /* mkdtemp */
+#define _POSIX_C_SOURCE 200809L /* mkdtemp, fork, setenv */
 #include "rcb_test_util.h"
 
 #include <math.h>
@@ -8,6 +8,10 @@
 #include <stdlib.h>
 #include <string.h>
 #include <cmocka.h>
+#include <sys/resource.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #define TEST_PI 3.14159265358979323846
 
@@ -84,9 +88,60 @@ rcb_allocator rcb_test_counting_allocator(rcb_test_counter *c) {
   return a;
 }
 
+/* Fork at allocation f->allocs: returns 1 in the child (its allocation
+ * fails), 0 in the parent once the child has ended. */
+static int walk_fork(rcb_test_failing *f) {
+  rcb_test_walk *w = f->walk;
+  int ws = 0;
+  pid_t pid;
+  fflush(NULL); /* nothing buffered is written twice */
+  pid = fork();
+  if (pid < 0) {
+    perror("rcb_test walk: fork");
+    abort();
+  }
+  if (pid == 0) {
+    struct rlimit none = {0, 0};
+    setrlimit(RLIMIT_CORE, &none);        /* an abort dumps no core */
+    setenv("CMOCKA_TEST_ABORT", "1", 1); /* an assertion ends the child */
+    w->in_child = 1;
+    return 1;
+  }
+  while (waitpid(pid, &ws, 0) < 0)
+    ;
+  w->forks++;
+  if (!WIFEXITED(ws) || WEXITSTATUS(ws) != 0) w->failed_at = f->allocs, w->status = ws;
+  return 0;
+}
+
+size_t rcb_test_walk_stride(void) {
+  const char *s = getenv("RCB_ALLOC_WALK_STRIDE");
+  long v = s ? strtol(s, NULL, 10) : 1;
+  return v > 1 ? (size_t)v : 1;
+}
+
+void rcb_test_walk_child_end(const rcb_test_failing *f, const char *name, rcb_status st,
+                             int msg_ok) {
+  const char *why = NULL;
+  if (!f->walk || !f->walk->in_child) return;
+  if (f->live != 0) why = "blocks leaked";
+  else if (st == RCB_OK) why = "the run returned RCB_OK";
+  else if (st > 0) why = "a status that is not an error";
+  else if (!msg_ok) why = "no error message";
+  if (why)
+    fprintf(stderr, "%s: allocation %zu failing: %s (status %s, %zu blocks live)\n", name,
+            f->fail_at, why, rcb_status_str(st), f->live);
+  fflush(NULL);
+  _exit(why ? 1 : 0);
+}
+
 static void *failing_alloc(void *user, size_t size) {
   rcb_test_failing *f = user;
   f->allocs++;
+  if (f->walk && !f->walk->in_child && !f->walk->failed_at && f->allocs >= f->walk->from &&
+      (f->walk->stride < 2 || (f->allocs - f->walk->from) % f->walk->stride == 0) &&
+      walk_fork(f))
+    f->fail_at = f->allocs;
   if (f->fail_at && f->allocs == f->fail_at) {
     f->hit = 1;
     return NULL;

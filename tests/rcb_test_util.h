@@ -28,9 +28,37 @@ typedef struct rcb_test_failing {
   size_t frees;   /* free calls on pointers it handed out */
   size_t live;    /* allocated and not yet freed */
   int hit;        /* the failing allocation was reached */
+  struct rcb_test_walk *walk; /* when set: each allocation from walk->from forks */
 } rcb_test_failing;
 /* Allocator hooks over *f (which must outlive every object made with them). */
 rcb_allocator rcb_test_failing_allocator(rcb_test_failing *f);
+
+/* The allocation-failure walk by fork (issue #27). One run of a scenario with
+ * f->walk set: at each allocation k >= from the process forks; the child
+ * fails allocation k and goes on from there to the scenario's end, where
+ * rcb_test_walk_child_end checks it and exits; the parent waits for it, then
+ * allocates and goes on. Every allocation fails in turn at the cost of about
+ * one run, where a run per allocation re-ran everything before it (the
+ * diagnosis's ~4800 allocations: 8 minutes). The first child that fails
+ * stops the forking. In a child, a cmocka assertion aborts it
+ * (CMOCKA_TEST_ABORT), so the parent sees it. */
+typedef struct rcb_test_walk {
+  size_t from;      /* the first allocation failed (1-based) */
+  size_t stride;    /* then every stride-th (0 or 1: every one) */
+  size_t forks;     /* children run */
+  size_t failed_at; /* the allocation whose child failed; 0: none */
+  int status;       /* that child's wait status */
+  int in_child;     /* this process is the child of allocation failing_at */
+} rcb_test_walk;
+/* The stride of the walks: RCB_ALLOC_WALK_STRIDE, else 1. The sanitizer
+ * stage of ./scripts/dev.sh test sets it: a fork there copies ASan's shadow
+ * mappings (about 10 ms of system time each, against 0.4 ms without). */
+size_t rcb_test_walk_stride(void);
+/* In a child (w->in_child): exits 0 when the scenario ended in an error
+ * (status st < 0, message non-empty: msg_ok) with nothing of f's live, else
+ * prints why and exits 1. In the parent: returns. */
+void rcb_test_walk_child_end(const rcb_test_failing *f, const char *name, rcb_status st,
+                             int msg_ok);
 /* Noise-free FRFs of m (the given kind) at outs x ins, n points evenly on
  * [f0, f1] Hz at rpm, as a measurement (aborts the test on failure). */
 rcb_meas *rcb_test_frf_meas(const rcb_model *m, const char *const *outs, size_t no,

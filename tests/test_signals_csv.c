@@ -119,7 +119,7 @@ static void test_csv_alloc_fail(void **state) {
     fprintf(fp, "%g,%zu,1\n", (double)k / 10.0, k);
   fclose(fp);
   for (k = 1;; k++) {
-    rcb_test_failing f = {k, 0, 0, 0, 0};
+    rcb_test_failing f = {k, 0, 0, 0, 0, NULL};
     rcb_allocator a = rcb_test_failing_allocator(&f);
     rcb_signals *s = NULL;
     rcb_status st = rcb_signals_create(&s, &a);
