@@ -249,13 +249,22 @@ static int fixture_teardown(void **state) {
   return 0;
 }
 
+/* RCB_TEST_FAST=1 (the sanitizer build, tests/CMakeLists.txt): the null
+ * series and the replica tests run a tenth of their updates or replicas,
+ * for memory errors on their paths, and leave their rates to the builds
+ * without sanitizers (the core stage runs them in full). */
+static int fast_mode(void) {
+  const char *s = getenv("RCB_TEST_FAST");
+  return s && s[0] == '1';
+}
+
 static void null_case(fixture *f, int reweight, double phase_deg) {
   rcb_monitor_param tp;
   rcb_monitor_opts o = opts_kt(&tp, f->kt);
   rcb_monitor *mon = NULL;
   rcb_meas *setup = f->setup;
   rcb_monitor_result r;
-  const size_t N = 400;
+  const size_t N = fast_mode() ? 40 : 400;
   size_t u, alarms = 0, cover = 0, cusum = 0, lo, hi, k, kt;
   double sumT = 0, sumz = 0, sumz2 = 0, tol, ch2 = 0, fl2 = 0;
   uint64_t seed = 20261125, pseed = 14;
@@ -288,15 +297,20 @@ static void null_case(fixture *f, int reweight, double phase_deg) {
      * alone, whose radial sd the floor states (|e| - |e_0| ~ radial noise) */
     ch2 += r.change_pct * r.change_pct, fl2 += r.floor_pct * r.floor_pct;
   }
-  /* mean square change against the floor's: a few peak points dominate
-   * both sums, so only the mean over the updates is close */
-  assert_true(phase_deg > 0 || fabs(ch2 / fl2 - 1) < 0.1); /* the floor is radial */
   binom99(N, o.alpha, &lo, &hi);
   print_message("null (reweight %d, phase +-%g deg): %zu alarms in %zu updates (alpha %g: 99 %% "
                 "interval [%zu, %zu]); mean T %.2f (dof %zu); z mean %.3f var %.3f; CI cover "
                 "%zu\n", reweight, phase_deg,
                 alarms, N, o.alpha, lo, hi, sumT / (double)N, r.dof, sumz / (double)N,
                 sumz2 / (double)N - (sumz / (double)N) * (sumz / (double)N), cover);
+  if (fast_mode()) {
+    rcb_monitor_destroy(mon);
+    if (setup != f->setup) rcb_meas_destroy(setup);
+    return; /* rates: in the builds without sanitizers */
+  }
+  /* mean square change against the floor's: a few peak points dominate
+   * both sums, so only the mean over the updates is close */
+  assert_true(phase_deg > 0 || fabs(ch2 / fl2 - 1) < 0.1); /* the floor is radial */
   assert_true(alarms >= lo && alarms <= hi);
   /* mean of chi-square(dof): sd of the mean sqrt(2 dof / N), 4 of them */
   tol = 4 * sqrt(2.0 * (double)r.dof / (double)N);
@@ -677,7 +691,7 @@ static void test_alloc_walk(void **state) {
  * covers the true change, 0, as a 95 % interval should. */
 static void test_baseline_cov(void **state) {
   fixture *f = *state;
-  enum { NREP = 60 };
+  const size_t NREP = fast_mode() ? 6 : 60;
   const char *const outs[2] = {"DA.x", "DB.y"};
   rcb_meas *small = rcb_test_frf_meas(f->base, outs, 2, INS, 1, 50.0, 300.0, 24, 10000.0,
                                       RCB_RECEPTANCE), *setup;
@@ -716,9 +730,11 @@ static void test_baseline_cov(void **state) {
                 "covers the truth in %zu of %d replicas (binomial 99 %% [%zu, %zu]), the "
                 "change's interval around the value in %zu; the change's covers 0 in %zu\n",
                 cover, (int)NREP, lo, hi, narrow, change);
-  assert_true(cover >= lo && cover <= hi);
-  assert_true(change >= lo && change <= hi);
-  assert_true(narrow < lo);
+  if (!fast_mode()) { /* rates: in the builds without sanitizers */
+    assert_true(cover >= lo && cover <= hi);
+    assert_true(change >= lo && change <= hi);
+    assert_true(narrow < lo);
+  }
   /* a negative variance is refused, naming it */
   {
     rcb_monitor *mon = NULL;
@@ -763,7 +779,8 @@ static void wear_series(const rcb_model *truth, const char *name, double v0, dou
 
 static void test_baseline_cusum(void **state) {
   fixture *f = *state;
-  enum { NREP = 40, N = 40, NC = 4, NP = 60 };
+  enum { N = 40, NC = 4, NP = 60 };
+  const size_t NREP = fast_mode() ? 4 : 40;
   const char *const outs[NC] = {"DA.x", "DA.y", "DB.x", "DB.y"};
   const double RATE = 0.002; /* kt's wear per update, fraction of kt */
   const double SB = 0.002;   /* the baseline's standard error, fraction of kt and of ct */
@@ -857,10 +874,12 @@ static void test_baseline_cusum(void **state) {
                 "%zu without (first at update %.1f on average); stated rate %.4f, binomial "
                 "99 %% upper bound %zu\n", 100 * SB, 100 * RATE, alarm_new, (int)NREP, alarm_old,
                 alarm_old ? (double)first_old / (double)alarm_old : 0.0, rate_b, hi);
-  assert_true((double)alarm_new <= lim);
-  assert_true((double)alarm_old > lim);
-  assert_int_equal(miss_new, 0);
-  assert_true(worst <= MAXDELAY);
+  if (!fast_mode()) { /* rates: in the builds without sanitizers */
+    assert_true((double)alarm_new <= lim);
+    assert_true((double)alarm_old > lim);
+    assert_int_equal(miss_new, 0);
+    assert_true(worst <= MAXDELAY);
+  }
   rcb_meas_destroy(setup);
   free(fs);
   free(fs2);
