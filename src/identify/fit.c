@@ -506,6 +506,86 @@ static rcb_status log_magnitude_stage(rcb_fit *f, double *x, size_t *it, size_t 
   return st;
 }
 
+/* Weights at the model (issue #24). The eq. 19 noise is proportional to the
+ * true value, and its variance on the linear and complex scales is
+ * (beta_a/100)^2 x^2 / 3 with x the true value's part there. A weight
+ * computed from the measured value correlates with that point's own noise
+ * (a value pulled towards zero by its noise gets a larger weight), which
+ * biases the estimate: on the monitoring rig (8 inertances x 400 lines,
+ * 10 %/1 %) by -0.45, +0.56 and -0.43 of the standard errors of kt, kr and
+ * ct, so that the 95 % intervals held the truth in 91-92 % of replicas.
+ * The fix: once fitted, the weights are recomputed at the model's predicted
+ * values, and the fit is refined from there, until a pass moves the
+ * parameters by less than RCB_REWEIGHT_TOL of their standard errors (each
+ * pass moves them about ten times less than the one before: 2, 0.15, 0 at
+ * 30 % noise, where the optimiser's own resolution is 0.1), at most
+ * RCB_REWEIGHT_MAX passes. On the log scales the proportional part's variance does not
+ * depend on the value, and the measured weights are kept. */
+#define RCB_REWEIGHT_MAX 4
+#define RCB_REWEIGHT_TOL 0.25
+
+static int reweights(const rcb_fit *f) {
+  return !f->no_uncertainty && f->beta_a > 0 && !f->sd &&
+         (f->scale == RCB_SCALE_LINEAR || f->scale == RCB_SCALE_COMPLEX);
+}
+
+/* res_sqrtw at the predictions Hmod of the last evaluation (the residuals'
+ * set and their user weights unchanged). */
+static void weights_at_model(rcb_fit *f) {
+  size_t j, c = (size_t)-1;
+  double a = 0.0;
+  for (j = 0; j < f->nres; j++) {
+    size_t pt = f->res_pt[j];
+    double wu = f->wuser ? f->wuser[f->res_ch[j] * f->npts + pt] : 1.0;
+    double complex h = f->Hmod[f->res_ch[j] * f->npts + pt];
+    if (f->res_ch[j] != c) {
+      rcb_meas_channel_info ci;
+      c = f->res_ch[j];
+      rcb_meas_channel(f->meas, c, &ci);
+      a = rcb_noise_level(ci.data, f->npts, f->beta_s); /* as the layout's */
+    }
+    f->res_sqrtw[j] = sqrt(wu / rcb_fit_noise_var(f, h, a, f->res_part[j]));
+  }
+}
+
+/* Refits with the weights at the model until the parameters settle (the
+ * scale of a move: the square root of the diagonal of (J^T J)^-1 in the
+ * optimiser's coordinates, taken as its Gauss-Newton step's size). */
+static rcb_status refit_at_model(rcb_fit *f) {
+  size_t pass, k, it = f->iterations, ev = f->evaluations;
+  double *x0 = rcb_alloc(&f->alloc, 2 * f->np * sizeof *x0), *x1;
+  rcb_status st = RCB_OK;
+  if (!x0) return rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory");
+  x1 = x0 + f->np;
+  for (pass = 0; pass < RCB_REWEIGHT_MAX && !st; pass++) {
+    double move = 0.0;
+    rcb_fit_get_x(f, x0);
+    if ((st = rcb_fit_eval(f, f->r))) break;
+    weights_at_model(f);
+    f->wmodel = 1;
+    f->evaluations = 0;
+    f->stalled = 0;
+    st = f->method == RCB_FIT_NLOPT ? rcb_fit_run_nlopt(f) : rcb_fit_run_paper(f);
+    it += f->iterations, ev += f->evaluations + 1;
+    if (st) break;
+    rcb_fit_get_x(f, x1);
+    if ((st = rcb_fit_eval_jac(f, f->r, f->J))) break;
+    ev++;
+    for (k = 0; k < f->np; k++) {
+      double jj = 0.0;
+      size_t i;
+      for (i = 0; i < f->nres; i++) jj += f->J[i + f->nres * k] * f->J[i + f->nres * k];
+      /* a move against the parameter's scale alone, sqrt(1 / (J^T J)_kk), a
+       * lower bound of its standard error: conservative */
+      if (jj > 0) move = fmax(move, fabs(x1[k] - x0[k]) * sqrt(jj));
+    }
+    if (move < RCB_REWEIGHT_TOL) break;
+  }
+  f->iterations = it, f->evaluations = ev;
+  rcb_free(&f->alloc, x0);
+  return st;
+}
+
 rcb_status rcb_fit_run(rcb_fit *f) {
   rcb_status st;
   size_t k, it0 = 0, ev0 = 0;
@@ -517,6 +597,7 @@ rcb_status rcb_fit_run(rcb_fit *f) {
     return rcb_fit_fail(f, RCB_ERR_ARG, "first start %zu of %zu starting points: nothing to try",
                         f->first_start, f->nstarts ? f->nstarts : 1);
   for (k = 0; k < f->np; k++) f->par[k].value = f->par[k].start = rcb_fit_par_get(f, k);
+  if (f->wmodel) f->prepared = 0; /* a run starts from the measured weights */
   if ((st = rcb_fit_prepare(f))) return st;
   rcb_frf_refresh(f->frf); /* the caller may have changed the model */
   f->iterations = f->evaluations = 0;
@@ -530,6 +611,7 @@ rcb_status rcb_fit_run(rcb_fit *f) {
     return rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory");
   st = f->scale == RCB_SCALE_COMPLEX ? log_magnitude_stage(f, x, &it0, &ev0) : RCB_OK;
   if (!st) st = multistart(f, x, x + f->np);
+  if (!st && reweights(f)) st = refit_at_model(f);
   f->iterations += it0, f->evaluations += ev0 + 1;
   rcb_free(&f->alloc, x);
   if (st) return st;
