@@ -469,20 +469,22 @@ static void test_random_starts_alone(void **state) {
 
 /* The standard errors against replicas (issue #24): the paper system's
  * inertances at the coupling (4 x 101 lines, 200-400 Hz, 10000 rpm), eq. 19
- * noise of 30 % and 1 % (rcb_meas_add_noise, 30 seeds), kt, kr, ct fitted on
+ * noise of 30 % and 1 % (rcb_meas_add_noise, 40 seeds), kt, kr, ct fitted on
  * the complex scale with the noise model, from the truth. For each parameter:
- * its 95 % interval holds the truth in at least 25 of 30 replicas (the
- * binomial 1 % quantile of 95 %: P(X < 25) = 0.0033), and the mean of
- * (value - truth) / se is within 3 / sqrt(30) = 0.55 of zero (its sd is
- * 1 / sqrt(30)). With the weights at the measured values (before the
+ * its 95 % interval holds the truth in at least 34 of 40 replicas (the
+ * binomial 1 % quantile of 95 %: P(X < 34) = 0.0034), and the mean of
+ * (value - truth) / se is within 3 / sqrt(40) = 0.47 of zero (its sd is
+ * 1 / sqrt(40)). With the weights at the measured values (before the
  * reweighting at the model, fit.c) the means were -1.15, +0.72 and -0.74 and
  * kt's interval held the truth in 22 of 30 (numpy draws of the same noise);
- * the bias grows with beta_a, hence 30 % here, so that 30 replicas see it. */
+ * the bias grows with beta_a, hence 30 % here, so that 40 replicas see it.
+ * (The ideal weighted least squares, weights at the true values, covers
+ * 94.2, 95.1, 94.8 % here: 4000 linearised replicas.) */
 static void test_interval_coverage_complex(void **state) {
   rcb_model *m = rcb_test_model_from_example("paper_system.ini");
   const char *outs[] = {"C.A.x", "C.A.y", "C.B.x", "C.B.y"}, *ins[] = {"DA.x"};
   const char *names[] = {"coupling.C.kt", "coupling.C.kr", "coupling.C.ct"};
-  enum { R = 30 };
+  enum { R = 40 };
   double tv[3], zsum[3] = {0, 0, 0};
   unsigned cover[3] = {0, 0, 0}, seed;
   size_t k;
@@ -511,7 +513,7 @@ static void test_interval_coverage_complex(void **state) {
   for (k = 0; k < 3; k++) {
     print_message("%s: 95 %% interval holds the truth in %u of %d, mean z %+.3f\n", names[k],
                   cover[k], R, zsum[k] / R);
-    assert_true(cover[k] >= 25);
+    assert_true(cover[k] >= 34);
     assert_true(fabs(zsum[k] / R) <= 3.0 / sqrt((double)R));
   }
   rcb_model_destroy(m);

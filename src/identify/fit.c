@@ -548,9 +548,12 @@ static void weights_at_model(rcb_fit *f) {
   }
 }
 
-/* Refits with the weights at the model until the parameters settle (the
- * scale of a move: the square root of the diagonal of (J^T J)^-1 in the
- * optimiser's coordinates, taken as its Gauss-Newton step's size). */
+/* Refits with the weights at the model until the parameters settle. A
+ * pass's move is measured per parameter as |dx_k| sqrt((J^T J)_kk) at the
+ * new point: in standard errors when the weights are inverse variances, and
+ * never less than the move in standard errors (1 / sqrt((J^T J)_kk) is at
+ * most sqrt((J^T J)^-1_kk)), so the test is on the safe side. The weights of
+ * the last pass are those at its start (within RCB_REWEIGHT_TOL). */
 static rcb_status refit_at_model(rcb_fit *f) {
   size_t pass, k, it = f->iterations, ev = f->evaluations;
   double *x0 = rcb_alloc(&f->alloc, 2 * f->np * sizeof *x0), *x1;
@@ -565,7 +568,10 @@ static rcb_status refit_at_model(rcb_fit *f) {
     f->wmodel = 1;
     f->evaluations = 0;
     f->stalled = 0;
-    st = f->method == RCB_FIT_NLOPT ? rcb_fit_run_nlopt(f) : rcb_fit_run_paper(f);
+    f->converged = 0;
+    /* a local refinement from the fitted point, whatever the method (a global
+     * NLopt method would search its whole box again) */
+    st = rcb_fit_run_paper(f);
     it += f->iterations, ev += f->evaluations + 1;
     if (st) break;
     rcb_fit_get_x(f, x1);
@@ -575,8 +581,6 @@ static rcb_status refit_at_model(rcb_fit *f) {
       double jj = 0.0;
       size_t i;
       for (i = 0; i < f->nres; i++) jj += f->J[i + f->nres * k] * f->J[i + f->nres * k];
-      /* a move against the parameter's scale alone, sqrt(1 / (J^T J)_kk), a
-       * lower bound of its standard error: conservative */
       if (jj > 0) move = fmax(move, fabs(x1[k] - x0[k]) * sqrt(jj));
     }
     if (move < RCB_REWEIGHT_TOL) break;
@@ -584,6 +588,21 @@ static rcb_status refit_at_model(rcb_fit *f) {
   f->iterations = it, f->evaluations = ev;
   rcb_free(&f->alloc, x0);
   return st;
+}
+
+/* F at the start on the final weights, so that the report's F0 -> F compares
+ * like with like (x: 2 np of workspace; the model is left at the fit). */
+static rcb_status objective_at_start(rcb_fit *f, double *x) {
+  double *xs = x + f->np;
+  size_t k;
+  rcb_status st;
+  rcb_fit_get_x(f, x);
+  for (k = 0; k < f->np; k++)
+    xs[k] = f->par[k].log_param ? log(f->par[k].start) : f->par[k].start / f->par[k].scale;
+  if ((st = rcb_fit_set_x(f, xs)) || (st = rcb_fit_eval(f, f->r))) return st;
+  f->obj0 = rcb_fit_sumsq(f->r, f->nres);
+  f->evaluations++;
+  return rcb_fit_set_x(f, x);
 }
 
 rcb_status rcb_fit_run(rcb_fit *f) {
@@ -612,6 +631,7 @@ rcb_status rcb_fit_run(rcb_fit *f) {
   st = f->scale == RCB_SCALE_COMPLEX ? log_magnitude_stage(f, x, &it0, &ev0) : RCB_OK;
   if (!st) st = multistart(f, x, x + f->np);
   if (!st && reweights(f)) st = refit_at_model(f);
+  if (!st && f->wmodel) st = objective_at_start(f, x);
   f->iterations += it0, f->evaluations += ev0 + 1;
   rcb_free(&f->alloc, x);
   if (st) return st;
