@@ -513,14 +513,14 @@ static rcb_status log_magnitude_stage(rcb_fit *f, double *x, size_t *it, size_t 
  * (a value pulled towards zero by its noise gets a larger weight), which
  * biases the estimate: on the monitoring rig (8 inertances x 400 lines,
  * 10 %/1 %) by -0.45, +0.56 and -0.43 of the standard errors of kt, kr and
- * ct, so that the 95 % intervals held the truth in 91-92 % of replicas.
- * The fix: once fitted, the weights are recomputed at the model's predicted
- * values, and the fit is refined from there, until a pass moves the
- * parameters by less than RCB_REWEIGHT_TOL of their standard errors (each
- * pass moves them about ten times less than the one before: 2, 0.15, 0 at
- * 30 % noise, where the optimiser's own resolution is 0.1), at most
- * RCB_REWEIGHT_MAX passes. On the log scales the proportional part's variance does not
- * depend on the value, and the measured weights are kept. */
+ * ct (2000 linearised replicas), so that the 95 % intervals held the truth
+ * in 92-93 % of them. The fix: once fitted, the weights are recomputed at
+ * the model's predicted values, and the fit is refined from there, until a
+ * pass moves the parameters by less than RCB_REWEIGHT_TOL of their standard
+ * errors (each pass moves them about ten times less than the one before: 2,
+ * 0.15, 0 at 30 % noise, where the optimiser's own resolution is 0.1), at
+ * most RCB_REWEIGHT_MAX passes. On the log scales the proportional part's
+ * variance does not depend on the value: the measured weights are kept. */
 #define RCB_REWEIGHT_MAX 4
 #define RCB_REWEIGHT_TOL 0.25
 
@@ -538,13 +538,15 @@ static void weights_at_model(rcb_fit *f) {
     size_t pt = f->res_pt[j];
     double wu = f->wuser ? f->wuser[f->res_ch[j] * f->npts + pt] : 1.0;
     double complex h = f->Hmod[f->res_ch[j] * f->npts + pt];
+    double v;
     if (f->res_ch[j] != c) {
       rcb_meas_channel_info ci;
       c = f->res_ch[j];
       rcb_meas_channel(f->meas, c, &ci);
       a = rcb_noise_level(ci.data, f->npts, f->beta_s); /* as the layout's */
     }
-    f->res_sqrtw[j] = sqrt(wu / rcb_fit_noise_var(f, h, a, f->res_part[j]));
+    v = rcb_fit_noise_var(f, h, a, f->res_part[j]);
+    if (v > 0 && isfinite(v)) f->res_sqrtw[j] = sqrt(wu / v); /* else the measured one's */
   }
 }
 
