@@ -113,6 +113,12 @@ RCB_API rcb_status rcb_fit_set_weights(rcb_fit *f, const double *w);
  * @brief Noise-aware weights from the eq. 19 noise model: each point weighted
  * by the inverse variance of its residual on the chosen scale, and points whose
  * measured magnitude lies near the channel's additive noise floor dropped.
+ * The variance is taken at the measured value; on the linear and complex
+ * scales (where it grows with the value) a run with the uncertainty step
+ * (rcb_fit_set_uncertainty) then recomputes it at the model's predicted
+ * values and refines the fit from there, which removes the bias the
+ * measured values' own noise puts into their weights; rcb_fit_residuals and
+ * the adequacy test after such a run use those weights.
  * @param beta_a random factor, % @param beta_s systematic factor, %
  */
 RCB_API rcb_status rcb_fit_set_noise_model(rcb_fit *f, double beta_a, double beta_s);
@@ -169,11 +175,13 @@ RCB_API rcb_status rcb_fit_set_first_start(rcb_fit *f, size_t first);
 
 /**
  * @brief Whether rcb_fit_run ends with the uncertainty step (standard errors,
- * confidence intervals, correlation, identifiability; default 1). With 0 the
- * fit and its report are the same, but rcb_fit_get_param's stderr_, ci_lo,
- * ci_hi, identifiable and rcb_fit_correlation are not updated by the run (a
- * caller that compares objectives only, as the diagnosis' refits, saves
- * that step).
+ * confidence intervals, correlation, identifiability; default 1). With 0
+ * rcb_fit_get_param's stderr_, ci_lo, ci_hi, identifiable and
+ * rcb_fit_correlation are not updated by the run, and the noise model's
+ * weights stay at the measured values (no refinement at the model's values:
+ * rcb_fit_set_noise_model), so that a caller that compares objectives only,
+ * as the diagnosis' refits, saves both; otherwise the fit and its report are
+ * the same.
  */
 RCB_API rcb_status rcb_fit_set_uncertainty(rcb_fit *f, int compute);
 
@@ -237,7 +245,7 @@ typedef struct rcb_fit_report {
   size_t iterations;   /**< outer iterations */
   size_t evaluations;  /**< model evaluations (each a full sweep), Jacobians included */
   size_t residuals;    /**< residuals used (after band and weights) */
-  double objective0;   /**< F at the start */
+  double objective0;   /**< F at the start (on the final weights) */
   double objective;    /**< F at the end */
   double error0_pct;   /**< paper's error % at the start (see rcb_fit_error) */
   double error_pct;    /**< the same at the end */

@@ -9,7 +9,9 @@
  * value at the residual's point, each weighted as the fit weights a measured
  * value, io/noise.c's generator), since on a log scale and with uniform
  * r1, r2 they are not 1 and 2 (uniform r1: the variance of the square is 0.8,
- * not 2) and the weight itself comes from the noisy value.
+ * not 2) and the weight itself comes from the noisy value (or from the
+ * model's value, when the fit moved its weights there: fit.c,
+ * refit_at_model).
  */
 #include <math.h>
 #include <string.h>
@@ -40,7 +42,7 @@ static size_t draw_point(const rcb_fit *f, size_t j, double a, rcb_rng *rng, dou
     double t = 0.0;
     for (p = 0; p < parts; p++) {
       double z = rcb_fit_on_scale(f, e, (int)p) - rcb_fit_on_scale(f, h, (int)p);
-      double q = wu * z * z / rcb_fit_noise_var(f, e, a, (int)p);
+      double q = wu * z * z / rcb_fit_noise_var(f, f->wmodel ? h : e, a, (int)p);
       s1[p] += q, t += q;
     }
     t1 += t, t2 += t * t;

@@ -180,6 +180,7 @@ rcb_status rcb_fit_prepare(rcb_fit *f) {
   }
   f->nres = layout(f, 1);
   index_points(f);
+  f->wmodel = 0; /* the weights at the measured values (fit.c may move them to the model) */
   f->prepared = 1;
   return RCB_OK;
 }

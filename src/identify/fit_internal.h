@@ -98,6 +98,8 @@ struct rcb_fit {
   rcb_complex *rhs;      /* n x (np * max(nin, 1)): sensitivity right-hand sides */
   rcb_complex *dF;       /* n x (np + 1): dF/dp at unit speed, then F itself */
   int prepared;          /* residual layout matches the settings */
+  int wmodel;            /* res_sqrtw at the model's predictions, not the
+                            measured values (fit.c, refit_at_model) */
 
   /* results */
   size_t iterations, evaluations;
