@@ -30,6 +30,8 @@ void rcb_monitor_destroy(rcb_monitor *mon) {
   rcb_free(&mon->alloc, mon->Q);
   rcb_free(&mon->alloc, mon->G);
   rcb_free(&mon->alloc, mon->C);
+  rcb_free(&mon->alloc, mon->Cfix);
+  rcb_free(&mon->alloc, mon->tres);
   rcb_free(&mon->alloc, mon->sw.A);
   rcb_free(&mon->alloc, mon->sw.work);
   rcb_free(&mon->alloc, mon->y);
@@ -87,11 +89,12 @@ void rcb_mon_model_restore(rcb_monitor *mon, const mon_cand *c) {
   for (k = 0; c && k < c->np; k++) rcb_model_set_param(mon->model, c->pname[k], c->neutral[k]);
 }
 
-/* ym = Q^T W (m(theta, s) - m(0, 0)) for tracked values t0 + theta and,
- * with c, candidate c's parameters at neutral + s (c->settable). The
- * parameters stay set: the caller restores them (rcb_mon_model_restore). */
-static rcb_status model_change(rcb_monitor *mon, const double *theta, const mon_cand *c,
-                               const double *s) {
+/* rm = W (m(theta, s) - m(0, 0)) (the whitened change, n values) for
+ * tracked values t0 + theta and, with c, candidate c's parameters at
+ * neutral + s (c->settable). The parameters stay set: the caller restores
+ * them (rcb_mon_model_restore). */
+static rcb_status model_resid(rcb_monitor *mon, const double *theta, const mon_cand *c,
+                              const double *s) {
   size_t k, p;
   rcb_status st = RCB_OK;
   if (mon->lr && (!c || c->ep)) { /* without a sweep */
@@ -102,7 +105,6 @@ static rcb_status model_change(rcb_monitor *mon, const double *theta, const mon_
       mon->rm[2 * p] = creal(g) * mon->winv[2 * p];
       mon->rm[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
     }
-    to_rank(mon, mon->rm, mon->ym);
     return RCB_OK;
   }
   for (k = 0; !st && k < mon->nt; k++)
@@ -125,8 +127,15 @@ static rcb_status model_change(rcb_monitor *mon, const double *theta, const mon_
     mon->rm[2 * p] = creal(g) * mon->winv[2 * p];
     mon->rm[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
   }
-  to_rank(mon, mon->rm, mon->ym);
   return RCB_OK;
+}
+
+/* ym = Q^T rm: model_resid taken to the rank space. */
+static rcb_status model_change(rcb_monitor *mon, const double *theta, const mon_cand *c,
+                               const double *s) {
+  rcb_status st = model_resid(mon, theta, c, s);
+  if (!st) to_rank(mon, mon->rm, mon->ym);
+  return st;
 }
 
 /* The re-linearised tracked step theta (chord iterations re-evaluating the
@@ -136,17 +145,16 @@ static rcb_status model_change(rcb_monitor *mon, const double *theta, const mon_
  * parameter; on return mon->y holds the change the model at baseline +
  * theta does not explain (y itself without): after a converged correction
  * d, y - ym(theta) - G_t d (the baseline's columns carry so small a step
- * exactly enough), else one more evaluation. */
+ * exactly enough), else one more evaluation. On entry theta is the linear
+ * estimate and mon->ym its first evaluation (rcb_monitor_update's pass). */
 static rcb_status tracked_step(rcb_monitor *mon, double *theta) {
   size_t a, it, i, k = mon->k, nt = mon->nt;
   double d[RCB_MONITOR_MAX_TRACKED];
   rcb_status st;
   int small = 0;
-  memset(theta, 0, sizeof(double) * RCB_MONITOR_MAX_TRACKED);
   if (!mon->relin || !nt) return RCB_OK;
-  for (a = 0; a < nt; a++) theta[a] = dot(mon->test + a * k, mon->y, k);
   for (it = 0; !small && it < mon->relin; it++) {
-    if ((st = model_change(mon, theta, NULL, NULL))) return st;
+    if (it && (st = model_change(mon, theta, NULL, NULL))) return st;
     for (i = 0; i < k; i++) mon->ym[i] = mon->y[i] - mon->ym[i];
     small = 1;
     for (a = 0; a < nt; a++) {
@@ -358,12 +366,11 @@ static void candidates(rcb_monitor *mon, int gls, rcb_monitor_result *res) {
 
 /* Paper's error %, change % and the noise floor % of this measurement. */
 static void errors(const rcb_monitor *mon, const rcb_complex *v, rcb_monitor_result *res) {
-  double em = 0, ec = 0, ee = 0, fl = 0;
+  double em = 0, ec = 0, ee = 0, fl = mon->floor2;
   size_t p;
   for (p = 0; p < mon->npt; p++) {
-    double av = cabs(v[p]), dm = mon->h0abs[p] - av, dc = cabs(mon->e0[p]) - av;
+    double av = cabs(v[p]), dm = mon->h0abs[p] - av, dc = mon->e0abs[p] - av;
     em += dm * dm, ec += dc * dc, ee += av * av;
-    fl += mon->sd_new_rad[p] * mon->sd_new_rad[p];
   }
   ee = ee > 0 ? sqrt(ee) : 1.0;
   res->error_pct = 100.0 * sqrt(em) / ee;
@@ -484,12 +491,24 @@ rcb_status rcb_monitor_update(rcb_monitor *mon, const rcb_complex *values, const
     mon->r[2 * p] = creal(g) * mon->winv[2 * p];
     mon->r[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
   }
-  to_rank(mon, mon->r, mon->y);
+  /* the linear tracked step from the residuals (E Q^T r) and its first
+   * evaluation, so that one pass over Q gives y, ym and the covariance */
+  memset(theta, 0, sizeof theta);
+  for (a = 0; mon->relin && a < mon->nt; a++)
+    theta[a] = dot(mon->tres + a * mon->n, mon->r, mon->n);
+  if (mon->relin && mon->nt && (st = model_resid(mon, theta, NULL, NULL))) {
+    rcb_mon_model_restore(mon, NULL);
+    return st;
+  }
+  rcb_mon_pass(mon, values, sd, gls, mon->relin && mon->nt);
   memcpy(mon->y0, mon->y, mon->k * sizeof *mon->y0);
-  if ((st = tracked_step(mon, theta))) return st;
+  if ((st = tracked_step(mon, theta))) {
+    rcb_mon_model_restore(mon, NULL);
+    return st;
+  }
   memcpy(threl, theta, sizeof threl);
   if (gls) {
-    if ((st = rcb_mon_gls(mon, values, sd, dth, se, &T))) return st;
+    if ((st = rcb_mon_gls(mon, dth, se, &T))) return st;
   } else {
     /* instant test: the part of y beyond the tracked directions */
     T = dot(mon->y, mon->y, mon->k);
