@@ -32,6 +32,7 @@ void rcb_monitor_destroy(rcb_monitor *mon) {
   rcb_free(&mon->alloc, mon->C);
   rcb_free(&mon->alloc, mon->Cfix);
   rcb_free(&mon->alloc, mon->tres);
+  rcb_free(&mon->alloc, mon->rmx);
   rcb_free(&mon->alloc, mon->sw.A);
   rcb_free(&mon->alloc, mon->sw.work);
   rcb_free(&mon->alloc, mon->y);
@@ -56,6 +57,20 @@ static void to_rank(const rcb_monitor *mon, const double *r, double *out) {
     const double *q = mon->Q + k * i;
     double ri = r[i];
     for (a = 0; a < k; a++) out[a] += q[a] * ri;
+  }
+}
+
+/* out = Q^T R for the m columns of R (n x m) into out (k x m), both
+ * column-major: each column as to_rank, Q read once for all. */
+static void to_rank_many(const rcb_monitor *mon, const double *R, size_t m, double *out) {
+  size_t a, i, j, n = mon->n, k = mon->k;
+  memset(out, 0, k * m * sizeof *out);
+  for (i = 0; i < n; i++) {
+    const double *q = mon->Q + k * i;
+    for (j = 0; j < m; j++) {
+      double ri = R[i + n * j], *o = out + k * j;
+      for (a = 0; a < k; a++) o[a] += q[a] * ri;
+    }
   }
 }
 
@@ -89,12 +104,12 @@ void rcb_mon_model_restore(rcb_monitor *mon, const mon_cand *c) {
   for (k = 0; c && k < c->np; k++) rcb_model_set_param(mon->model, c->pname[k], c->neutral[k]);
 }
 
-/* rm = W (m(theta, s) - m(0, 0)) (the whitened change, n values) for
+/* out = W (m(theta, s) - m(0, 0)) (the whitened change, n values) for
  * tracked values t0 + theta and, with c, candidate c's parameters at
  * neutral + s (c->settable). The parameters stay set: the caller restores
  * them (rcb_mon_model_restore). */
 static rcb_status model_resid(rcb_monitor *mon, const double *theta, const mon_cand *c,
-                              const double *s) {
+                              const double *s, double *out) {
   size_t k, p;
   rcb_status st = RCB_OK;
   if (mon->lr && (!c || c->ep)) { /* without a sweep */
@@ -102,8 +117,8 @@ static rcb_status model_resid(rcb_monitor *mon, const double *theta, const mon_c
     if ((st = rcb_mon_lowrank_change(mon, theta, c, s, dm))) return st;
     for (p = 0; p < mon->npt; p++) {
       double complex g = conj(mon->u[p]) * dm[p];
-      mon->rm[2 * p] = creal(g) * mon->winv[2 * p];
-      mon->rm[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
+      out[2 * p] = creal(g) * mon->winv[2 * p];
+      out[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
     }
     return RCB_OK;
   }
@@ -115,17 +130,17 @@ static rcb_status model_resid(rcb_monitor *mon, const double *theta, const mon_c
     if ((st = rcb_model_set_param(mon->model, c->pname[k], c->neutral[k] + s[k])))
       rcb_mon_fail(mon, st, "re-linearising at %s = %g: %s", c->pname[k], c->neutral[k] + s[k],
                    rcb_model_errmsg(mon->model));
-  if (!st && (st = rcb_fit_residuals(mon->fit, mon->rm)))
+  if (!st && (st = rcb_fit_residuals(mon->fit, out)))
     rcb_mon_fail(mon, st, "re-linearising at the tracked estimate: %s", rcb_fit_errmsg(mon->fit));
   if (st) {
     rcb_mon_model_restore(mon, c);
     return st;
   }
   for (p = 0; p < mon->npt; p++) {
-    double complex g = conj(mon->u[p]) * CMPLX(mon->rm[2 * p] - mon->rbase[2 * p],
-                                               mon->rm[2 * p + 1] - mon->rbase[2 * p + 1]);
-    mon->rm[2 * p] = creal(g) * mon->winv[2 * p];
-    mon->rm[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
+    double complex g = conj(mon->u[p]) * CMPLX(out[2 * p] - mon->rbase[2 * p],
+                                               out[2 * p + 1] - mon->rbase[2 * p + 1]);
+    out[2 * p] = creal(g) * mon->winv[2 * p];
+    out[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
   }
   return RCB_OK;
 }
@@ -133,7 +148,7 @@ static rcb_status model_resid(rcb_monitor *mon, const double *theta, const mon_c
 /* ym = Q^T rm: model_resid taken to the rank space. */
 static rcb_status model_change(rcb_monitor *mon, const double *theta, const mon_cand *c,
                                const double *s) {
-  rcb_status st = model_resid(mon, theta, c, s);
+  rcb_status st = model_resid(mon, theta, c, s, mon->rm);
   if (!st) to_rank(mon, mon->rm, mon->ym);
   return st;
 }
@@ -405,19 +420,24 @@ static rcb_status joint_gn(rcb_monitor *mon, const mon_cand *c, int gls, double 
   size_t a, i, k = mon->k, nt = mon->nt, p = nt + c->np;
   double qz[RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP], dx[RCB_MONITOR_MAX_TRACKED +
                                                             RCB_MONITOR_MAXP];
-  double *w = mon->z, *J = mon->Jx;
+  double *w = mon->z, *J = mon->Jx, *Rm = mon->rmx, *Ym = Rm + mon->n * (1 + p),
+         h[RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP];
   rcb_status st;
   *ok = 0;
-  if (model_change(mon, x, c, x + nt)) return RCB_OK;
-  for (i = 0; i < k; i++) w[i] = mon->y0[i] - mon->ym[i];
+  /* the 1 + p evaluations first, then Q read once for their projections */
+  if (model_resid(mon, x, c, x + nt, Rm)) return RCB_OK;
   for (a = 0; a < p; a++) {
-    double h = 0.1 * sd[a], keep = x[a];
-    x[a] += h;
-    st = model_change(mon, x, c, x + nt);
+    double keep = x[a];
+    h[a] = 0.1 * sd[a];
+    x[a] += h[a];
+    st = model_resid(mon, x, c, x + nt, Rm + mon->n * (1 + a));
     x[a] = keep;
     if (st) return RCB_OK;
-    for (i = 0; i < k; i++) J[i + k * a] = (mon->ym[i] - mon->y0[i] + w[i]) / h;
   }
+  to_rank_many(mon, Rm, 1 + p, Ym);
+  for (i = 0; i < k; i++) w[i] = mon->y0[i] - Ym[i];
+  for (a = 0; a < p; a++)
+    for (i = 0; i < k; i++) J[i + k * a] = (Ym[i + k * (1 + a)] - mon->y0[i] + w[i]) / h[a];
   if (gls && (rcb_mon_gls_solve(mon, w, 1) || rcb_mon_gls_solve(mon, J, p)))
     return rcb_mon_fail(mon, RCB_ERR_LAPACK, "re-linearising the joint step: triangular "
                         "solve failed");
@@ -496,7 +516,7 @@ rcb_status rcb_monitor_update(rcb_monitor *mon, const rcb_complex *values, const
   memset(theta, 0, sizeof theta);
   for (a = 0; mon->relin && a < mon->nt; a++)
     theta[a] = dot(mon->tres + a * mon->n, mon->r, mon->n);
-  if (mon->relin && mon->nt && (st = model_resid(mon, theta, NULL, NULL))) {
+  if (mon->relin && mon->nt && (st = model_resid(mon, theta, NULL, NULL, mon->rm))) {
     rcb_mon_model_restore(mon, NULL);
     return st;
   }

@@ -69,8 +69,8 @@ static void fixed_part(rcb_monitor *mon, size_t p0, size_t p1, int share, double
   }
 }
 
-/* Create: the tracked estimator on the residuals (mon->tres, with
- * re-linearisation) and, on eq. 19 noise without a phase term, the parts of
+/* Create: the joint step's workspace and the tracked estimator on the
+ * residuals (mon->rmx, mon->tres, with re-linearisation) and, on eq. 19 noise without a phase term, the parts of
  * the reweighted covariance that depend on the set-up only (mon->Cfix).
  * There a point's whitened covariance is W (var0 / N + a_c^2 / 6 I + s^2 g
  * g^T) W, g = conj(u) v in the radial frame, s = beta_a / (100 sqrt 3), a_c
@@ -78,6 +78,9 @@ static void fixed_part(rcb_monitor *mon, size_t p0, size_t p1, int share, double
  * C_c + the update's rank-one terms, one column per point instead of two. */
 rcb_status rcb_mon_pass_init(rcb_monitor *mon) {
   size_t k = mon->k, nt = mon->nt, n = mon->n, a, i, c;
+  if (mon->relin &&
+      !(mon->rmx = rcb_mon_alloc(mon, (1 + nt + RCB_MONITOR_MAXP) * (n + k), sizeof *mon->rmx)))
+    return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (joint re-linearisation)");
   if (mon->relin && nt) {
     if (!(mon->tres = rcb_mon_alloc(mon, nt * n, sizeof *mon->tres)))
       return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (tracked estimator)");

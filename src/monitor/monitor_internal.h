@@ -160,6 +160,9 @@ struct rcb_monitor {
   rcb_meas *setup;
   rcb_fit *fit;
   double *rbase;       /* n */
+  double *rmx;         /* with opts.relinearise: n x (1 + nt + MAXP) then k x (1 +
+                          nt + MAXP), column-major: the joint Gauss-Newton step's
+                          evaluations and their projections (monitor.c, joint_gn) */
   double *tres;        /* nt x n row-major (with opts.relinearise): Q test^T, the
                           tracked estimator applied to the whitened residuals, so
                           the first re-evaluation needs no pass over Q */
