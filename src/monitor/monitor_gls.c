@@ -161,7 +161,7 @@ void rcb_mon_pass(rcb_monitor *mon, const rcb_complex *v, const double *sd, int 
       for (a = 0; a < k; a++) b1[a] = l11 * q1[a] + l21 * q2[a], b2[a] = l22 * q2[a];
     }
     nb += (size_t)per;
-    if (nb == 2 * MON_SYRK_POINTS || p + 1 == mon->npt) syrk(mon, B, nb, mon->C), nb = 0;
+    if (nb == (size_t)2 * MON_SYRK_POINTS || p + 1 == mon->npt) syrk(mon, B, nb, mon->C), nb = 0;
   }
 }
 
