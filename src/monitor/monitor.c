@@ -30,6 +30,9 @@ void rcb_monitor_destroy(rcb_monitor *mon) {
   rcb_free(&mon->alloc, mon->Q);
   rcb_free(&mon->alloc, mon->G);
   rcb_free(&mon->alloc, mon->C);
+  rcb_free(&mon->alloc, mon->Cfix);
+  rcb_free(&mon->alloc, mon->tres);
+  rcb_free(&mon->alloc, mon->rmx);
   rcb_free(&mon->alloc, mon->sw.A);
   rcb_free(&mon->alloc, mon->sw.work);
   rcb_free(&mon->alloc, mon->y);
@@ -54,6 +57,20 @@ static void to_rank(const rcb_monitor *mon, const double *r, double *out) {
     const double *q = mon->Q + k * i;
     double ri = r[i];
     for (a = 0; a < k; a++) out[a] += q[a] * ri;
+  }
+}
+
+/* out = Q^T R for the m columns of R (n x m) into out (k x m), both
+ * column-major: each column as to_rank, Q read once for all. */
+static void to_rank_many(const rcb_monitor *mon, const double *R, size_t m, double *out) {
+  size_t a, i, j, n = mon->n, k = mon->k;
+  memset(out, 0, k * m * sizeof *out);
+  for (i = 0; i < n; i++) {
+    const double *q = mon->Q + k * i;
+    for (j = 0; j < m; j++) {
+      double ri = R[i + n * j], *o = out + k * j;
+      for (a = 0; a < k; a++) o[a] += q[a] * ri;
+    }
   }
 }
 
@@ -87,11 +104,12 @@ void rcb_mon_model_restore(rcb_monitor *mon, const mon_cand *c) {
   for (k = 0; c && k < c->np; k++) rcb_model_set_param(mon->model, c->pname[k], c->neutral[k]);
 }
 
-/* ym = Q^T W (m(theta, s) - m(0, 0)) for tracked values t0 + theta and,
- * with c, candidate c's parameters at neutral + s (c->settable). The
- * parameters stay set: the caller restores them (rcb_mon_model_restore). */
-static rcb_status model_change(rcb_monitor *mon, const double *theta, const mon_cand *c,
-                               const double *s) {
+/* out = W (m(theta, s) - m(0, 0)) (the whitened change, n values) for
+ * tracked values t0 + theta and, with c, candidate c's parameters at
+ * neutral + s (c->settable). The parameters stay set: the caller restores
+ * them (rcb_mon_model_restore). */
+static rcb_status model_resid(rcb_monitor *mon, const double *theta, const mon_cand *c,
+                              const double *s, double *out) {
   size_t k, p;
   rcb_status st = RCB_OK;
   if (mon->lr && (!c || c->ep)) { /* without a sweep */
@@ -99,10 +117,9 @@ static rcb_status model_change(rcb_monitor *mon, const double *theta, const mon_
     if ((st = rcb_mon_lowrank_change(mon, theta, c, s, dm))) return st;
     for (p = 0; p < mon->npt; p++) {
       double complex g = conj(mon->u[p]) * dm[p];
-      mon->rm[2 * p] = creal(g) * mon->winv[2 * p];
-      mon->rm[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
+      out[2 * p] = creal(g) * mon->winv[2 * p];
+      out[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
     }
-    to_rank(mon, mon->rm, mon->ym);
     return RCB_OK;
   }
   for (k = 0; !st && k < mon->nt; k++)
@@ -113,20 +130,27 @@ static rcb_status model_change(rcb_monitor *mon, const double *theta, const mon_
     if ((st = rcb_model_set_param(mon->model, c->pname[k], c->neutral[k] + s[k])))
       rcb_mon_fail(mon, st, "re-linearising at %s = %g: %s", c->pname[k], c->neutral[k] + s[k],
                    rcb_model_errmsg(mon->model));
-  if (!st && (st = rcb_fit_residuals(mon->fit, mon->rm)))
+  if (!st && (st = rcb_fit_residuals(mon->fit, out)))
     rcb_mon_fail(mon, st, "re-linearising at the tracked estimate: %s", rcb_fit_errmsg(mon->fit));
   if (st) {
     rcb_mon_model_restore(mon, c);
     return st;
   }
   for (p = 0; p < mon->npt; p++) {
-    double complex g = conj(mon->u[p]) * CMPLX(mon->rm[2 * p] - mon->rbase[2 * p],
-                                               mon->rm[2 * p + 1] - mon->rbase[2 * p + 1]);
-    mon->rm[2 * p] = creal(g) * mon->winv[2 * p];
-    mon->rm[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
+    double complex g = conj(mon->u[p]) * CMPLX(out[2 * p] - mon->rbase[2 * p],
+                                               out[2 * p + 1] - mon->rbase[2 * p + 1]);
+    out[2 * p] = creal(g) * mon->winv[2 * p];
+    out[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
   }
-  to_rank(mon, mon->rm, mon->ym);
   return RCB_OK;
+}
+
+/* ym = Q^T rm: model_resid taken to the rank space. */
+static rcb_status model_change(rcb_monitor *mon, const double *theta, const mon_cand *c,
+                               const double *s) {
+  rcb_status st = model_resid(mon, theta, c, s, mon->rm);
+  if (!st) to_rank(mon, mon->rm, mon->ym);
+  return st;
 }
 
 /* The re-linearised tracked step theta (chord iterations re-evaluating the
@@ -136,17 +160,16 @@ static rcb_status model_change(rcb_monitor *mon, const double *theta, const mon_
  * parameter; on return mon->y holds the change the model at baseline +
  * theta does not explain (y itself without): after a converged correction
  * d, y - ym(theta) - G_t d (the baseline's columns carry so small a step
- * exactly enough), else one more evaluation. */
+ * exactly enough), else one more evaluation. On entry theta is the linear
+ * estimate and mon->ym its first evaluation (rcb_monitor_update's pass). */
 static rcb_status tracked_step(rcb_monitor *mon, double *theta) {
   size_t a, it, i, k = mon->k, nt = mon->nt;
   double d[RCB_MONITOR_MAX_TRACKED];
   rcb_status st;
   int small = 0;
-  memset(theta, 0, sizeof(double) * RCB_MONITOR_MAX_TRACKED);
   if (!mon->relin || !nt) return RCB_OK;
-  for (a = 0; a < nt; a++) theta[a] = dot(mon->test + a * k, mon->y, k);
   for (it = 0; !small && it < mon->relin; it++) {
-    if ((st = model_change(mon, theta, NULL, NULL))) return st;
+    if (it && (st = model_change(mon, theta, NULL, NULL))) return st;
     for (i = 0; i < k; i++) mon->ym[i] = mon->y[i] - mon->ym[i];
     small = 1;
     for (a = 0; a < nt; a++) {
@@ -358,12 +381,11 @@ static void candidates(rcb_monitor *mon, int gls, rcb_monitor_result *res) {
 
 /* Paper's error %, change % and the noise floor % of this measurement. */
 static void errors(const rcb_monitor *mon, const rcb_complex *v, rcb_monitor_result *res) {
-  double em = 0, ec = 0, ee = 0, fl = 0;
+  double em = 0, ec = 0, ee = 0, fl = mon->floor2;
   size_t p;
   for (p = 0; p < mon->npt; p++) {
-    double av = cabs(v[p]), dm = mon->h0abs[p] - av, dc = cabs(mon->e0[p]) - av;
+    double av = cabs(v[p]), dm = mon->h0abs[p] - av, dc = mon->e0abs[p] - av;
     em += dm * dm, ec += dc * dc, ee += av * av;
-    fl += mon->sd_new_rad[p] * mon->sd_new_rad[p];
   }
   ee = ee > 0 ? sqrt(ee) : 1.0;
   res->error_pct = 100.0 * sqrt(em) / ee;
@@ -398,19 +420,24 @@ static rcb_status joint_gn(rcb_monitor *mon, const mon_cand *c, int gls, double 
   size_t a, i, k = mon->k, nt = mon->nt, p = nt + c->np;
   double qz[RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP], dx[RCB_MONITOR_MAX_TRACKED +
                                                             RCB_MONITOR_MAXP];
-  double *w = mon->z, *J = mon->Jx;
+  double *w = mon->z, *J = mon->Jx, *Rm = mon->rmx, *Ym = Rm + mon->n * (1 + p),
+         h[RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP];
   rcb_status st;
   *ok = 0;
-  if (model_change(mon, x, c, x + nt)) return RCB_OK;
-  for (i = 0; i < k; i++) w[i] = mon->y0[i] - mon->ym[i];
+  /* the 1 + p evaluations first, then Q read once for their projections */
+  if (model_resid(mon, x, c, x + nt, Rm)) return RCB_OK;
   for (a = 0; a < p; a++) {
-    double h = 0.1 * sd[a], keep = x[a];
-    x[a] += h;
-    st = model_change(mon, x, c, x + nt);
+    double keep = x[a];
+    h[a] = 0.1 * sd[a];
+    x[a] += h[a];
+    st = model_resid(mon, x, c, x + nt, Rm + mon->n * (1 + a));
     x[a] = keep;
     if (st) return RCB_OK;
-    for (i = 0; i < k; i++) J[i + k * a] = (mon->ym[i] - mon->y0[i] + w[i]) / h;
   }
+  to_rank_many(mon, Rm, 1 + p, Ym);
+  for (i = 0; i < k; i++) w[i] = mon->y0[i] - Ym[i];
+  for (a = 0; a < p; a++)
+    for (i = 0; i < k; i++) J[i + k * a] = (Ym[i + k * (1 + a)] - mon->y0[i] + w[i]) / h[a];
   if (gls && (rcb_mon_gls_solve(mon, w, 1) || rcb_mon_gls_solve(mon, J, p)))
     return rcb_mon_fail(mon, RCB_ERR_LAPACK, "re-linearising the joint step: triangular "
                         "solve failed");
@@ -484,12 +511,24 @@ rcb_status rcb_monitor_update(rcb_monitor *mon, const rcb_complex *values, const
     mon->r[2 * p] = creal(g) * mon->winv[2 * p];
     mon->r[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
   }
-  to_rank(mon, mon->r, mon->y);
+  /* the linear tracked step from the residuals (E Q^T r) and its first
+   * evaluation, so that one pass over Q gives y, ym and the covariance */
+  memset(theta, 0, sizeof theta);
+  for (a = 0; mon->relin && a < mon->nt; a++)
+    theta[a] = dot(mon->tres + a * mon->n, mon->r, mon->n);
+  if (mon->relin && mon->nt && (st = model_resid(mon, theta, NULL, NULL, mon->rm))) {
+    rcb_mon_model_restore(mon, NULL);
+    return st;
+  }
+  rcb_mon_pass(mon, values, sd, gls, mon->relin && mon->nt);
   memcpy(mon->y0, mon->y, mon->k * sizeof *mon->y0);
-  if ((st = tracked_step(mon, theta))) return st;
+  if ((st = tracked_step(mon, theta))) {
+    rcb_mon_model_restore(mon, NULL);
+    return st;
+  }
   memcpy(threl, theta, sizeof threl);
   if (gls) {
-    if ((st = rcb_mon_gls(mon, values, sd, dth, se, &T))) return st;
+    if ((st = rcb_mon_gls(mon, dth, se, &T))) return st;
   } else {
     /* instant test: the part of y beyond the tracked directions */
     T = dot(mon->y, mon->y, mon->k);

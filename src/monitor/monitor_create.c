@@ -130,12 +130,14 @@ static rcb_status noise(rcb_monitor *mon, const rcb_monitor_opts *o) {
                             "deviation (commissioning value 0 and beta_s = 0); give beta_s > 0 "
                             "or opts.sd", c + 1, i + 1);
       mon->sd_new_rad[p] = sqrt(vr);
+      mon->e0abs[p] = ae;
       mon->var0[2 * p] = vr, mon->var0[2 * p + 1] = vt;
       if (o->sd) mon->sd0[p] = o->sd[p];
       mon->winv[2 * p] = 1.0 / sqrt(vr * f0);
       mon->winv[2 * p + 1] = 1.0 / sqrt(vt * f0);
     }
   }
+  for (i = 0; i < mon->npt; i++) mon->floor2 += mon->sd_new_rad[i] * mon->sd_new_rad[i];
   return RCB_OK;
 }
 
@@ -307,7 +309,7 @@ void rcb_mon_whiten(const rcb_monitor *mon, const rcb_complex *dv, double *r) {
 static rcb_status buffers(rcb_monitor *mon) {
   size_t npt = mon->npt, n = mon->n;
   mon->e0 = rcb_mon_alloc(mon, 2 * npt, sizeof *mon->e0);
-  mon->h0abs = rcb_mon_alloc(mon, 3 * npt + 5 * n, sizeof *mon->h0abs);
+  mon->h0abs = rcb_mon_alloc(mon, 4 * npt + 5 * n, sizeof *mon->h0abs);
   if (!mon->e0 || !mon->h0abs) return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (set-up)");
   mon->u = mon->e0 + npt;
   mon->sd_new_rad = mon->h0abs + npt;
@@ -317,6 +319,7 @@ static rcb_status buffers(rcb_monitor *mon) {
   mon->rm = mon->r + n;
   mon->var0 = mon->rm + n;
   mon->sd0 = mon->var0 + n;
+  mon->e0abs = mon->sd0 + npt;
   return RCB_OK;
 }
 
@@ -424,6 +427,7 @@ static rcb_status commission(rcb_monitor *mon, const rcb_model *base, const rcb_
       mon->rho = mon->navg_inv / (1.0 + mon->navg_inv);
     }
   }
+  if (!st) st = rcb_mon_pass_init(mon);
   if (!st) st = rcb_mon_lowrank_init(mon);
   if (!st && mon->bcurv) st = rcb_mon_curvature(mon);
   if (!st) {

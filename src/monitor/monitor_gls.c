@@ -39,32 +39,129 @@ static void point_cov(const rcb_monitor *mon, const rcb_complex *v, const double
   *d11 = s11 * w1 * w1, *d12 = s12 * w1 * w2, *d22 = s22 * w2 * w2;
 }
 
-/* C = Q^T D Q (upper triangle), D = L L^T per point: the rows L^T Q of
- * MON_SYRK_POINTS points at a time into B (k x 2 MON_SYRK_POINTS,
- * column-major: one row per column), then C += B B^T (BLAS dsyrk). */
-static void build_c(rcb_monitor *mon, const rcb_complex *v, const double *sd) {
+/* C += B B^T over the first m columns of B (k x m, column-major; upper). */
+static void syrk(const rcb_monitor *mon, const double *B, size_t m, double *C) {
+  cblas_dsyrk(CblasColMajor, CblasUpper, CblasNoTrans, (blasint)mon->k, (blasint)m, 1.0, B,
+              (blasint)mon->k, 1.0, C, (blasint)mon->k);
+}
+
+/* Eq. 19 additive amplitude of channel c in values v. */
+static double amplitude(const rcb_monitor *mon, const rcb_complex *v, size_t c) {
+  double s2 = 0;
+  size_t p;
+  for (p = c * mon->npts; p < (c + 1) * mon->npts; p++) s2 += creal(v[p] * conj(v[p]));
+  return mon->beta_s / 100.0 * sqrt(s2) / (double)mon->npts;
+}
+
+/* Points p0 .. p1 into C (k x k, upper, added to): each point's whitened
+ * rows scaled by f[0], f[1] per unit (the commissioning's share: sqrt(var0
+ * / N), else 1). */
+static void fixed_part(rcb_monitor *mon, size_t p0, size_t p1, int share, double *C) {
+  size_t k = mon->k, p, a, nb = 0;
+  for (p = p0; p < p1; p++) {
+    const double *q1 = mon->Q + k * (2 * p), *q2 = q1 + k;
+    double *b1 = mon->b1 + k * (2 * nb), *b2 = b1 + k;
+    double f1 = mon->winv[2 * p], f2 = mon->winv[2 * p + 1];
+    if (share)
+      f1 *= sqrt(mon->var0[2 * p] * mon->navg_inv), f2 *= sqrt(mon->var0[2 * p + 1] * mon->navg_inv);
+    for (a = 0; a < k; a++) b1[a] = f1 * q1[a], b2[a] = f2 * q2[a];
+    if (++nb == MON_SYRK_POINTS || p + 1 == p1) syrk(mon, mon->b1, 2 * nb, C), nb = 0;
+  }
+}
+
+/* Create: the joint step's workspace and the tracked estimator on the
+ * residuals (mon->rmx, mon->tres, with re-linearisation) and, on eq. 19 noise without a phase term, the parts of
+ * the reweighted covariance that depend on the set-up only (mon->Cfix).
+ * There a point's whitened covariance is W (var0 / N + a_c^2 / 6 I + s^2 g
+ * g^T) W, g = conj(u) v in the radial frame, s = beta_a / (100 sqrt 3), a_c
+ * its channel's additive amplitude (point_cov): C = C_0 + sum_c a_c^2 / 6
+ * C_c + the update's rank-one terms, one column per point instead of two. */
+rcb_status rcb_mon_pass_init(rcb_monitor *mon) {
+  size_t k = mon->k, nt = mon->nt, n = mon->n, a, i, c;
+  if (mon->relin &&
+      !(mon->rmx = rcb_mon_alloc(mon, (1 + nt + RCB_MONITOR_MAXP) * (n + k), sizeof *mon->rmx)))
+    return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (joint re-linearisation)");
+  if (mon->relin && nt) {
+    if (!(mon->tres = rcb_mon_alloc(mon, nt * n, sizeof *mon->tres)))
+      return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (tracked estimator)");
+    for (a = 0; a < nt; a++)
+      for (i = 0; i < n; i++) {
+        const double *q = mon->Q + k * i, *e = mon->test + a * k;
+        double s = 0;
+        size_t j;
+        for (j = 0; j < k; j++) s += q[j] * e[j];
+        mon->tres[a * n + i] = s;
+      }
+  }
+  if (!mon->reweight || mon->have_sd0 || mon->phase_var > 0) return RCB_OK;
+  if (!(mon->Cfix = rcb_mon_alloc(mon, (1 + mon->nch) * k * k, sizeof *mon->Cfix)))
+    return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (reweighted covariance)");
+  memset(mon->Cfix, 0, (1 + mon->nch) * k * k * sizeof *mon->Cfix);
+  if (mon->navg_inv > 0) fixed_part(mon, 0, mon->npt, 1, mon->Cfix);
+  for (c = 0; c < mon->nch; c++)
+    fixed_part(mon, c * mon->npts, (c + 1) * mon->npts, 0, mon->Cfix + (1 + c) * k * k);
+  return RCB_OK;
+}
+
+/* C (upper) = the set-up's parts (mon->Cfix) for this update's channel
+ * amplitudes. */
+static void fixed_c(rcb_monitor *mon) {
+  size_t k = mon->k, c, i, j;
+  memcpy(mon->C, mon->Cfix, k * k * sizeof *mon->C);
+  for (c = 0; c < mon->nch; c++) {
+    const double *Cc = mon->Cfix + (1 + c) * k * k;
+    double f = mon->achan[c] * mon->achan[c] / 6.0;
+    for (j = 0; j < k; j++)
+      for (i = 0; i <= j; i++) mon->C[i + k * j] += f * Cc[i + k * j];
+  }
+}
+
+/* The update's one pass over Q (row-major, read once): y = Q^T r, with
+ * proj ym = Q^T rm, and with gls C = Q^T D Q (upper triangle), D the
+ * update's whitened noise covariance (2 x 2 per point): the rows of B^T =
+ * L^T Q (D = L L^T), or with mon->Cfix only the rank-one columns s W g
+ * (rcb_mon_pass_init), 2 MON_SYRK_POINTS columns of B at a time, then C +=
+ * B B^T (BLAS dsyrk). */
+void rcb_mon_pass(rcb_monitor *mon, const rcb_complex *v, const double *sd, int gls, int proj) {
   size_t k = mon->k, p, a, c = 0, nb = 0;
-  double *B = mon->b1;
-  if (!sd && !mon->have_sd0)
-    for (c = 0; c < mon->nch; c++) { /* eq. 19 additive amplitude of this update */
-      double s2 = 0;
-      for (p = c * mon->npts; p < (c + 1) * mon->npts; p++) s2 += creal(v[p] * conj(v[p]));
-      mon->achan[c] = mon->beta_s / 100.0 * sqrt(s2) / (double)mon->npts;
-    }
-  memset(mon->C, 0, k * k * sizeof *mon->C);
+  int split = gls && !sd && mon->Cfix, per = split ? 1 : 2;
+  double *restrict B = mon->b1, *restrict y = mon->y, *restrict ym = mon->ym;
+  double s = mon->beta_a / 100.0 / sqrt(3.0);
+  const double *r = mon->r, *rm = mon->rm;
+  memset(y, 0, k * sizeof *y);
+  if (proj) memset(ym, 0, k * sizeof *ym);
+  if (gls && !sd && !mon->have_sd0)
+    for (c = 0; c < mon->nch; c++) mon->achan[c] = amplitude(mon, v, c);
+  if (split) fixed_c(mon);
+  else if (gls) memset(mon->C, 0, k * k * sizeof *mon->C);
   c = 0;
   for (p = 0; p < mon->npt; p++) {
-    const double *q1 = mon->Q + k * (2 * p), *q2 = q1 + k;
-    double d11, d12, d22, l11, l21, l22, *b1 = B + k * (2 * nb), *b2 = b1 + k;
-    if (p && p == (c + 1) * mon->npts) c++; /* the channel of point p */
-    point_cov(mon, v, sd, p, mon->achan[c], &d11, &d12, &d22);
-    l11 = sqrt(d11), l21 = d12 / l11, l22 = sqrt(fmax(d22 - l21 * l21, 0.0));
-    for (a = 0; a < k; a++) b1[a] = l11 * q1[a] + l21 * q2[a], b2[a] = l22 * q2[a];
-    if (++nb == MON_SYRK_POINTS || p + 1 == mon->npt) {
-      cblas_dsyrk(CblasColMajor, CblasUpper, CblasNoTrans, (blasint)k, (blasint)(2 * nb), 1.0,
-                  B, (blasint)k, 1.0, mon->C, (blasint)k);
-      nb = 0;
+    const double *restrict q1 = mon->Q + k * (2 * p), *restrict q2 = q1 + k;
+    double r1 = r[2 * p], r2 = r[2 * p + 1], *restrict b1 = B + k * nb;
+    /* the same products and order as a pass residual by residual */
+    if (proj) {
+      double m1 = rm[2 * p], m2 = rm[2 * p + 1];
+      for (a = 0; a < k; a++) {
+        y[a] = y[a] + q1[a] * r1 + q2[a] * r2;
+        ym[a] = ym[a] + q1[a] * m1 + q2[a] * m2;
+      }
+    } else {
+      for (a = 0; a < k; a++) y[a] = y[a] + q1[a] * r1 + q2[a] * r2;
     }
+    if (!gls) continue;
+    if (split) {
+      double complex g = conj(mon->u[p]) * v[p];
+      double f1 = s * creal(g) * mon->winv[2 * p], f2 = s * cimag(g) * mon->winv[2 * p + 1];
+      for (a = 0; a < k; a++) b1[a] = f1 * q1[a] + f2 * q2[a];
+    } else {
+      double d11, d12, d22, l11, l21, l22, *b2 = b1 + k;
+      if (p && p == (c + 1) * mon->npts) c++; /* the channel of point p */
+      point_cov(mon, v, sd, p, mon->achan[c], &d11, &d12, &d22);
+      l11 = sqrt(d11), l21 = d12 / l11, l22 = sqrt(fmax(d22 - l21 * l21, 0.0));
+      for (a = 0; a < k; a++) b1[a] = l11 * q1[a] + l21 * q2[a], b2[a] = l22 * q2[a];
+    }
+    nb += (size_t)per;
+    if (nb == (size_t)2 * MON_SYRK_POINTS || p + 1 == mon->npt) syrk(mon, B, nb, mon->C), nb = 0;
   }
 }
 
@@ -114,9 +211,7 @@ static rcb_status candidates_gls(rcb_monitor *mon) {
     int ok;
     if (!c->dof) continue;
     memcpy(mon->sw.A, mon->Atw, k * nt * sizeof *mon->sw.A);
-    memcpy(mon->sw.A + k * nt, mon->G + k * c->col, k * c->np * sizeof *mon->sw.A);
-    if (rcb_mon_gls_solve(mon, mon->sw.A + k * nt, c->np))
-      return rcb_mon_fail(mon, RCB_ERR_LAPACK, "reweighted update: triangular solve failed");
+    memcpy(mon->sw.A + k * nt, mon->Atw + k * c->col, k * c->np * sizeof *mon->sw.A);
     if ((st = rcb_mon_small_qr(mon, &mon->sw, k, nt + c->np, &ok))) return st;
     if (!ok) { /* dependent in this metric: no evidence */
       c->score_now = 0;
@@ -139,14 +234,12 @@ static rcb_status candidates_gls(rcb_monitor *mon) {
   return RCB_OK;
 }
 
-rcb_status rcb_mon_gls(rcb_monitor *mon, const rcb_complex *v, const double *sd,
-                       double *dtheta, double *se, double *T) {
+rcb_status rcb_mon_gls(rcb_monitor *mon, double *dtheta, double *se, double *T) {
   size_t k = mon->k, nt = mon->nt, a;
   double qz[RCB_MONITOR_MAX_TRACKED];
   lapack_int info;
   int ok = 1;
   rcb_status st;
-  build_c(mon, v, sd);
   info = LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'U', (lapack_int)k, mon->C, (lapack_int)k);
   if (info)
     return rcb_mon_fail(mon, RCB_ERR_SINGULAR, "reweighted update %zu: the noise covariance in "
@@ -154,9 +247,10 @@ rcb_status rcb_mon_gls(rcb_monitor *mon, const rcb_complex *v, const double *sd,
                         mon->updates + 1, (int)info);
   memcpy(mon->z, mon->y, k * sizeof *mon->z);
   memcpy(mon->z0, mon->y0, k * sizeof *mon->z0);
-  memcpy(mon->Atw, mon->G, k * nt * sizeof *mon->Atw);
+  /* every column at once (one blocked solve, not one per candidate) */
+  memcpy(mon->Atw, mon->G, k * mon->ncol * sizeof *mon->Atw);
   if (rcb_mon_gls_solve(mon, mon->z, 1) || rcb_mon_gls_solve(mon, mon->z0, 1) ||
-      (nt && rcb_mon_gls_solve(mon, mon->Atw, nt)))
+      (mon->ncol && rcb_mon_gls_solve(mon, mon->Atw, mon->ncol)))
     return rcb_mon_fail(mon, RCB_ERR_LAPACK, "reweighted update: triangular solve failed");
   *T = 0;
   for (a = 0; a < k; a++) *T += mon->z[a] * mon->z[a];

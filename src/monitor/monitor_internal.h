@@ -107,6 +107,8 @@ struct rcb_monitor {
   double *winv;        /* 2 per point: 1 / sd of the radial, tangential residual */
   double *sd_new_rad;  /* radial sd of one new measurement per point (floor %) */
   double e0norm2;      /* sum |e_0|^2 */
+  double *e0abs;       /* |e_0|, npt */
+  double floor2;       /* sum of sd_new_rad^2 (the noise floor's square) */
 
   /* settings */
   double alpha, cusum_k, cusum_h, threshold;
@@ -158,6 +160,12 @@ struct rcb_monitor {
   rcb_meas *setup;
   rcb_fit *fit;
   double *rbase;       /* n */
+  double *rmx;         /* with opts.relinearise: n x (1 + nt + MAXP) then k x (1 +
+                          nt + MAXP), column-major: the joint Gauss-Newton step's
+                          evaluations and their projections (monitor.c, joint_gn) */
+  double *tres;        /* nt x n row-major (with opts.relinearise): Q test^T, the
+                          tracked estimator applied to the whitened residuals, so
+                          the first re-evaluation needs no pass over Q */
   mon_lowrank *lr;     /* the evaluations without a sweep, NULL: by sweeps */
   struct rcb_fit_dz *cdz; /* the batched candidates' derivative matrices, ncdz
                           (kept with opts.relinearise) */
@@ -170,7 +178,14 @@ struct rcb_monitor {
   double *var0;        /* 2 per point: radial, tangential variance of one
                           measurement at the commissioning values */
   double *sd0;         /* opts.sd copied (have_sd0), npt */
-  double *C, *z, *z0, *Atw, *b1; /* k x k, k, k, k x nt, k x 2 MON_SYRK_POINTS */
+  double *C, *z, *z0, *Atw, *b1; /* k x k, k, k, k x ncol (U^-T G: every column in
+                          this update's metric, the tracked ones first), k x 2
+                          MON_SYRK_POINTS */
+  double *Cfix;        /* NULL, or (1 + nch) x k x k (upper triangles): with
+                          opts.reweight on eq. 19 noise without a phase term and
+                          without sd, the parts of C that depend on the set-up only
+                          (monitor_gls.c, rcb_mon_pass): the commissioning's share,
+                          then each channel's additive noise per unit variance */
   double *achan;       /* nch: eq. 19 additive amplitude of this update */
   double *Jx;          /* k x (nt + MAXP), column-major: the joint columns of the
                           tracked parameters and the best candidate at the
@@ -258,14 +273,19 @@ void rcb_mon_whiten(const rcb_monitor *mon, const rcb_complex *d, double *r);
 /* Thin QR of A (k x p, column-major, overwritten by its Q) with R and R^-1
  * (p x p); *ok = 0 for a dependent column. No allocation. */
 rcb_status rcb_mon_small_qr(rcb_monitor *mon, mon_small *w, size_t k, size_t p, int *ok);
-/* monitor_gls.c: the statistics in the update's own covariance, on y (the
- * change the re-linearised tracked step leaves): the tracked step dtheta
- * beyond the re-linearised one and its standard errors, T, and every
- * candidate's score and estimates. */
-rcb_status rcb_mon_gls(rcb_monitor *mon, const rcb_complex *v, const double *sd,
-                       double *dtheta, double *se, double *T);
+/* monitor_gls.c: what create prepares for the update's one pass over Q
+ * (mon->tres, mon->Cfix; after the rank space), and that pass: y = Q^T r
+ * (mon->r), with proj ym = Q^T rm (mon->rm), with gls the covariance C
+ * (upper triangle) of the reweighted path. */
+rcb_status rcb_mon_pass_init(rcb_monitor *mon);
+void rcb_mon_pass(rcb_monitor *mon, const rcb_complex *v, const double *sd, int gls, int proj);
+/* monitor_gls.c: the statistics in the update's own covariance (mon->C from
+ * rcb_mon_pass), on y (the change the re-linearised tracked step leaves):
+ * the tracked step dtheta beyond the re-linearised one and its standard
+ * errors, T, and every candidate's score and estimates. */
+rcb_status rcb_mon_gls(rcb_monitor *mon, double *dtheta, double *se, double *T);
 /* Its pieces, for the joint re-linearisation of monitor.c (after
- * rcb_mon_gls, whose Cholesky factor U stays in mon->C): X (k x m,
+ * rcb_mon_pass and rcb_mon_gls, whose Cholesky factor U stays in mon->C): X (k x m,
  * column-major) <- U^-T X (0 or LAPACK's info); with w->A = Qa (k x p) and
  * w->Ri from rcb_mon_small_qr, qz = Qa^T z and the sum of squares of its
  * entries first .. p; rows first .. first + q of Ri qz and their standard

@@ -212,13 +212,13 @@ rcb_status rcb_mon_rank_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
   w->A = rcb_mon_alloc(mon, k * pmax + 3 * pmax * pmax + pmax, sizeof *w->A);
   mon->test = rcb_mon_alloc(mon, 2 * (nt ? nt : 1) * k, sizeof *mon->test);
   mon->cand = rcb_mon_alloc(mon, pl->ncand ? pl->ncand : 1, sizeof *mon->cand);
-  /* the reweighted path: C, z, z0, U^-T G_t, two rows, the channels' amplitudes */
-  mon->C = rcb_mon_alloc(mon, k * k + 2 * k + k * (nt ? nt : 1) + 2 * k * MON_SYRK_POINTS +
-                         mon->nch + k * pmax, sizeof *mon->C);
+  /* the reweighted path: C, z, z0, U^-T G, two rows, the channels' amplitudes */
+  mon->C = rcb_mon_alloc(mon, k * k + 2 * k + k * (pl->ncol ? pl->ncol : 1) +
+                         2 * k * MON_SYRK_POINTS + mon->nch + k * pmax, sizeof *mon->C);
   if (!mon->G || !w->A || !mon->test || !mon->cand || !mon->C)
     return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (rank space)");
   mon->z = mon->C + k * k, mon->z0 = mon->z + k, mon->Atw = mon->z0 + k;
-  mon->b1 = mon->Atw + k * (nt ? nt : 1);
+  mon->b1 = mon->Atw + k * (pl->ncol ? pl->ncol : 1);
   mon->achan = mon->b1 + 2 * k * MON_SYRK_POINTS;
   mon->Jx = mon->achan + mon->nch;
   mon->ncol = pl->ncol;

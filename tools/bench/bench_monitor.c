@@ -11,6 +11,10 @@
  * updates of eq. 19 noise (rcb_meas_add_noise, 2 % + 2 %): the wall time
  * and the thread's CPU time (user + system) per update.
  *   OPENBLAS_NUM_THREADS=1 build/tools/bench/bench_monitor examples/paper_system.ini
+ * An optional second argument runs one row only, with an optional update
+ * count (for profiling: valgrind --tool=callgrind, perf stat):
+ *   bench_monitor examples/paper_system.ini ross [N]   (reweighted + re-lin. 8)
+ *   bench_monitor examples/paper_system.ini changed [N] (the same, changed)
  */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
@@ -205,6 +209,8 @@ static int noisy_of(const rcb_model *m, unsigned long seed, rcb_complex **out) {
 }
 
 int main(int argc, char **argv) {
+  const char *only = argc > 2 ? argv[2] : NULL;
+  size_t nonly = argc > 3 ? (size_t)strtoul(argv[3], NULL, 10) : 0;
   rcb_model *m = NULL, *m2 = NULL;
   rcb_meas *setup;
   rcb_complex *noisy[NNOISY], *changed[NNOISY];
@@ -245,6 +251,16 @@ int main(int argc, char **argv) {
   if (rc) goto done;
   printf("paper system, %zu channels x %zu frequencies, kt tracked, eq. 19 noise 2 %% + 2 %%\n",
          NCH, NPTS);
+  if (only && (!strcmp(only, "ross") || !strcmp(only, "changed"))) {
+    int ch = !strcmp(only, "changed");
+    rc = run(m, setup, ch ? changed : noisy, ch ? "the same, changed" : "reweighted + re-lin. 8",
+             8, 1, nonly ? nonly : 50, 0);
+    goto done;
+  } else if (only) {
+    fprintf(stderr, "bench_monitor: unknown row '%s' (ross or changed)\n", only);
+    rc = 2;
+    goto done;
+  }
   rc |= run(m, setup, noisy, "linear", 0, 0, 400, 0);
   rc |= run(m, setup, noisy, "reweighted", 0, 1, 100, 0);
   rc |= run(m, setup, noisy, "re-linearised (<= 8)", 8, 0, 50, 0);
