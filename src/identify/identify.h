@@ -86,6 +86,16 @@ rcb_status rcb_fit_jacobian_dz(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, dou
 #define RCB_CHAIN_PHASE 2
 int rcb_fit_param_is_chain(const char *name);
 
+/* Columns d r / d p (parameter units, nres x n column-major) of the chain
+ * parameters names[0 .. n) (sensor.<response>.gain or .phase of a measured
+ * response; they need not be parameters of f) at f's last evaluation, as
+ * if they were added to f at the sensors' current values: the same columns
+ * as rcb_fit_jacobian of a fit of those parameters on f's model, without
+ * a sweep (a sensor parameter scales the model's values, it has no dZ/dp;
+ * the score test of the sensor gains). RCB_ERR_STATE before an evaluation,
+ * RCB_ERR_ARG for a name that is not a measured sensor's. */
+rcb_status rcb_fit_chain_jacobian(rcb_fit *f, const char *const *names, size_t n, double *J);
+
 /* The sensors of f's measurement chain: one per distinct measured response,
  * in order of first appearance among the channels; the response name
  * (owned by the measurement), NULL past the end. */
