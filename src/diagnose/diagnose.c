@@ -501,6 +501,9 @@ typedef struct score_ws {
   size_t batch;         /* parameters per sweep */
   rcb_fit_dz dz[RCB_DIAG_BATCH];
   size_t which[RCB_DIAG_BATCH], ncand, npar; /* candidates of the batch, their parameters */
+  size_t nlead;         /* the fitted parameters' columns ahead of the batch's (first sweep) */
+  int ready;            /* the basis is made (the first sweep done) */
+  double *r;            /* nres: the weighted residual of the base model */
   int nominal;          /* scoring at the nominal model: into predicted_nom */
 } score_ws;
 
@@ -528,11 +531,18 @@ static rcb_status progress(rcb_diag *d) {
   return RCB_OK;
 }
 
+/* A batch swept: its columns, and on the first sweep the base model's
+ * residual and the basis of the fitted parameters' columns (its first
+ * w->nlead), then each candidate's score. */
 static rcb_status flush_batch(rcb_diag *d, score_ws *w) {
-  size_t b, off = 0;
+  size_t b, off = w->nlead;
   rcb_status st = RCB_OK;
-  if (w->npar && (st = rcb_fit_jacobian_dz(w->f, w->dz, w->npar, w->J)))
+  if ((w->npar || !w->ready) && (st = rcb_fit_jacobian_dz(w->f, w->dz, w->npar, w->J)))
     rcb_diag_fail(d, st, "scoring the candidates: %s", rcb_fit_errmsg(w->f));
+  if (!st && !w->ready && (st = rcb_fit_last_residuals(w->f, w->r)))
+    rcb_diag_fail(d, st, "scoring the candidates: %s", rcb_fit_errmsg(w->f));
+  if (!st && !w->ready) st = rcb_diag_basis_init(d, &w->basis, w->J, d->nres, w->nlead, w->r);
+  w->ready |= !st;
   for (b = 0; !st && b < w->ncand; b++) {
     diag_cand *c = &d->cand[w->which[b]];
     st = rcb_diag_explained(d, &w->basis, w->J + d->nres * off, c->np,
@@ -541,7 +551,38 @@ static rcb_status flush_batch(rcb_diag *d, score_ws *w) {
     if (!st) st = progress(d);
   }
   rcb_fit_dz_free(&d->alloc, w->dz, w->npar);
-  w->ncand = w->npar = 0;
+  w->ncand = w->npar = w->nlead = 0;
+  return st;
+}
+
+/* The fitted parameters' columns go in the first batch sweep, which gives
+ * the residual too (rcb_fit_last_residuals): the residual and the Jacobian
+ * of the fitted parameters took two sweeps of their own per score step
+ * before. Not when one of them is a sensor's (no dZ/dp) or they do not fit
+ * in a batch: then the two sweeps, and the basis before any batch. */
+static rcb_status score_base(rcb_diag *d, score_ws *w) {
+  size_t k, nb = rcb_fit_param_count(w->f), n = d->nres;
+  int lead = nb < w->batch;
+  rcb_status st;
+  double *Q0;
+  for (k = 0; lead && k < nb; k++) {
+    rcb_fit_param p;
+    lead = !rcb_fit_get_param(w->f, k, &p) && !rcb_fit_param_is_chain(p.name);
+  }
+  if (lead) {
+    if ((st = rcb_fit_dz_get(w->f, &d->alloc, w->dz)))
+      return rcb_diag_fail(d, st, "scoring the candidates: %s", rcb_fit_errmsg(w->f));
+    w->npar = w->nlead = nb;
+    return RCB_OK;
+  }
+  if (!(Q0 = rcb_alloc(&d->alloc, n * (nb ? nb : 1) * sizeof *Q0)))
+    return rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
+  st = rcb_fit_residuals(w->f, w->r);
+  if (!st && nb) st = rcb_fit_jacobian(w->f, 1, Q0);
+  if (st) rcb_diag_fail(d, st, "scoring the candidates: %s", rcb_fit_errmsg(w->f));
+  if (!st) st = rcb_diag_basis_init(d, &w->basis, Q0, n, nb, w->r);
+  w->ready = !st;
+  rcb_free(&d->alloc, Q0);
   return st;
 }
 
@@ -551,9 +592,10 @@ static rcb_status flush_batch(rcb_diag *d, score_ws *w) {
 static rcb_status score_all(rcb_diag *d, int nominal) {
   rcb_model *m = NULL;
   score_ws w;
-  size_t n = d->nres, k, ndof = rcb_model_dof_count(d->m);
-  double *r = rcb_alloc(&d->alloc, n * sizeof *r);
-  double *Q0 = rcb_alloc(&d->alloc, n * (d->nbase + 1) * sizeof *Q0);
+  size_t n = d->nres, k, ndof = rcb_model_dof_count(d->m), nlater = 0;
+  /* scored after the batches, which give the basis and the model values:
+   * a sensor's gain (from those values) and a model with other DOFs */
+  size_t *later = rcb_alloc(&d->alloc, (d->ncand ? d->ncand : 1) * sizeof *later);
   rcb_status st;
   memset(&w, 0, sizeof w);
   w.batch = n ? RCB_DIAG_BATCH_VALUES / n : RCB_DIAG_BATCH;
@@ -561,38 +603,38 @@ static rcb_status score_all(rcb_diag *d, int nominal) {
             : w.batch > RCB_DIAG_BATCH  ? RCB_DIAG_BATCH
                                         : w.batch;
   w.J = rcb_alloc(&d->alloc, n * w.batch * sizeof *w.J);
+  w.r = rcb_alloc(&d->alloc, (n ? n : 1) * sizeof *w.r);
   w.nominal = nominal;
-  st = (r && Q0 && w.J) ? RCB_OK : rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
+  st = (later && w.r && w.J) ? RCB_OK : rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
   if (!st) st = rcb_diag_copy_model(d, d->base_model, &m);
   if (!st) ndof = rcb_model_dof_count(m);
   if (!st) st = make_fit(d, m, 1, NULL, &w.f);
-  if (!st) st = rcb_fit_residuals(w.f, r);
-  if (!st && d->nbase) st = rcb_fit_jacobian(w.f, 1, Q0);
-  if (!st) st = rcb_diag_basis_init(d, &w.basis, Q0, n, d->nbase, r);
+  if (!st) st = score_base(d, &w);
   for (k = 0; !st && k < d->ncand; k++) {
     diag_cand *c = &d->cand[k];
-    int same;
+    int same = 0;
     if (c->refit_only) continue;
     d->stats.scored += !nominal;
     if (w.npar + c->np > w.batch && (st = flush_batch(d, &w))) break;
-    if ((c->fam->flags & DIAG_FAM_CHAIN) && c->np) {
-      if (!(st = score_chain(d, c, &w, w.J + n * w.npar))) st = progress(d);
-      continue;
-    }
-    if ((st = candidate_dz(d, c, ndof, w.dz + w.npar, &same))) break;
-    if (same) {
-      w.which[w.ncand++] = k, w.npar += c->np;
-    } else if (!(st = score_alone(d, c, &w.basis, w.J + n * w.npar, nominal))) {
-      st = progress(d);
-    }
+    if (!((c->fam->flags & DIAG_FAM_CHAIN) && c->np) &&
+        (st = candidate_dz(d, c, ndof, w.dz + w.npar, &same)))
+      break;
+    if (same) w.which[w.ncand++] = k, w.npar += c->np;
+    else later[nlater++] = k;
   }
   if (!st) st = flush_batch(d, &w);
+  for (k = 0; !st && k < nlater; k++) {
+    diag_cand *c = &d->cand[later[k]];
+    st = (c->fam->flags & DIAG_FAM_CHAIN) ? score_chain(d, c, &w, w.J)
+                                          : score_alone(d, c, &w.basis, w.J, nominal);
+    if (!st) st = progress(d);
+  }
   rcb_fit_dz_free(&d->alloc, w.dz, w.npar);
   rcb_diag_basis_free(d, &w.basis);
   drop_fit(d, w.f);
   rcb_model_destroy(m);
-  rcb_free(&d->alloc, r);
-  rcb_free(&d->alloc, Q0);
+  rcb_free(&d->alloc, later);
+  rcb_free(&d->alloc, w.r);
   rcb_free(&d->alloc, w.J);
   return st;
 }

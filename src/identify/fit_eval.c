@@ -257,6 +257,14 @@ rcb_status rcb_fit_eval(rcb_fit *f, double *r) {
   return RCB_OK;
 }
 
+rcb_status rcb_fit_last_residuals(rcb_fit *f, double *r) {
+  if (!f || !r) return RCB_ERR_ARG;
+  if (!f->prepared || !f->sweeps)
+    return rcb_fit_fail(f, RCB_ERR_STATE, "residuals: no evaluation of the model yet");
+  residuals_from_model(f, r);
+  return RCB_OK;
+}
+
 rcb_status rcb_fit_residual_channels(const rcb_fit *f, size_t *ch) {
   return ch ? rcb_fit_residual_layout(f, ch, NULL, NULL, NULL) : RCB_ERR_ARG;
 }

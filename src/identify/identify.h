@@ -76,6 +76,12 @@ void rcb_fit_dz_free(const rcb_allocator *a, rcb_fit_dz *dz, size_t n);
  * all of them (fit_score.c). One sweep. */
 rcb_status rcb_fit_jacobian_dz(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, double *J);
 
+/* The weighted residuals (nres values) of the model values of f's last
+ * sweep, rcb_fit_jacobian_dz's included, without another: what
+ * rcb_fit_residuals would give at the same point. RCB_ERR_STATE before a
+ * sweep. */
+rcb_status rcb_fit_last_residuals(rcb_fit *f, double *r);
+
 /* Whether a parameter name belongs to the measurement chain rather than the
  * model (sensor.<response>.gain or .phase, rcb_identify.h): such a
  * parameter has no dZ/dp (rcb_fit_dz_get refuses it), and its column comes
