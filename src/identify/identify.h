@@ -82,6 +82,17 @@ rcb_status rcb_fit_jacobian_dz(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, dou
  * sweep. */
 rcb_status rcb_fit_last_residuals(rcb_fit *f, double *r);
 
+/* The residuals r (nres) of f from the model values of src's last sweep,
+ * without a sweep of f's own: f and src fit the same model (at the same
+ * point) to the same measurement with the same settings, f's measurement
+ * chain may be edited (a sign, a swap: each of its channels reads a pair
+ * of output and input some channel of src reads, with the same kind),
+ * src's is not swapped. Afterwards f's model values are those of the
+ * residuals (rcb_fit_error_pct). RCB_ERR_STATE when src cannot serve (then
+ * rcb_fit_residuals), nothing changed. The diagnosis scores a sign or a
+ * swap of the probes this way. */
+rcb_status rcb_fit_residuals_from(rcb_fit *f, const rcb_fit *src, double *r);
+
 /* Whether a parameter name belongs to the measurement chain rather than the
  * model (sensor.<response>.gain or .phase, rcb_identify.h): such a
  * parameter has no dZ/dp (rcb_fit_dz_get refuses it), and its column comes
