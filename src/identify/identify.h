@@ -96,7 +96,8 @@ rcb_status rcb_fit_residuals_from(rcb_fit *f, const rcb_fit *src, double *r);
 /* Whether a parameter name belongs to the measurement chain rather than the
  * model (sensor.<response>.gain or .phase, rcb_identify.h): such a
  * parameter has no dZ/dp (rcb_fit_dz_get refuses it), and its column comes
- * from the fit's own Jacobian (rcb_fit_jacobian). 0: not a chain
+ * from the fit's own Jacobian (rcb_fit_jacobian, or rcb_fit_chain_jacobian
+ * without a sweep). 0: not a chain
  * parameter, RCB_CHAIN_GAIN or RCB_CHAIN_PHASE. Syntactic only: whether the
  * response is measured is checked by rcb_fit_add_param. */
 #define RCB_CHAIN_GAIN 1
