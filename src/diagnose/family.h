@@ -30,8 +30,9 @@ struct rcb_diag;
 #define DIAG_FAM_ADDS_DOFS 1u   /* its models have DOFs the base model lacks (a pedestal):
                                    scored on their own sweep, one start, and on the
                                    frequency subset its start is a grid (refit_start) */
-#define DIAG_FAM_SCORE_ALONE 2u /* its parameters have no dZ/dp (a sensor's gain): scored
-                                   on the Jacobian of its own fit, not in a batch */
+#define DIAG_FAM_SCORE_ALONE 2u /* its parameters have no dZ/dp (a sensor's gain): not in
+                                   a batch; a chain family's columns come from the model
+                                   values of the base fit's sweep (rcb_fit_chain_jacobian) */
 #define DIAG_FAM_CHAIN 4u       /* it edits the measurement chain, not the model: the
                                    model of its candidates is the base model, and
                                    --apply refuses (nothing in the model to change) */

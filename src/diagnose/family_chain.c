@@ -13,9 +13,11 @@
  * The model of every candidate is the base model unchanged (no edit, no
  * start): the fit reads the measurement through the edited chain
  * (rcb_fit_set_sensor, rcb_fit_swap_sensors, the sensor parameters of
- * rcb_identify.h). Sensor parameters have no dZ/dp, so a gain is scored on
- * its own fit's Jacobian (DIAG_FAM_SCORE_ALONE); the sign and the swap have
- * no neutral value and are refitted only.
+ * rcb_identify.h). Sensor parameters have no dZ/dp, so a gain is not scored
+ * in a batch (DIAG_FAM_SCORE_ALONE): its columns are the base model's values
+ * (rcb_fit_chain_jacobian, no sweep); the sign and the swap have no neutral
+ * value: they are scored by F with the edit (from the same values,
+ * rcb_fit_residuals_from) and refitted only when it falls.
  */
 #include <math.h>
 #include <stdio.h>

@@ -170,30 +170,46 @@ rcb_status rcb_fit_par_set(rcb_fit *f, size_t k, double v) {
   return RCB_OK;
 }
 
+/* One sensor parameter's column (which: RCB_CHAIN_GAIN or _PHASE, sensor s)
+ * at f's last evaluation, into Jk (nres values, parameter units). */
+static void chain_column(const rcb_fit *f, int which, size_t s, double *Jk) {
+  const rcb_fit_sensor *p = &f->sens[s];
+  double complex u = p->gain * cexp(CMPLX(0.0, p->phase + p->fphase));
+  size_t j;
+  for (j = 0; j < f->nres; j++) {
+    size_t c = f->res_ch[j], idx = c * f->npts + f->res_pt[j];
+    double complex dp;
+    if (f->ch_sens[c] != s) {
+      Jk[j] = 0.0;
+      continue;
+    }
+    dp = which == RCB_CHAIN_GAIN ? u * f->Hraw[idx] : CMPLX(0.0, 1.0) * f->Hmod[idx];
+    Jk[j] = rcb_fit_res_deriv_pred(f, j, dp);
+  }
+}
+
 /* d r_j / d p of the chain parameters (parameter units: per unit of gain,
  * per rad of phase) into their columns of J (nres x np): the prediction
  * P = g0 e^{i(phi0 + phi)} g H, so dP/dg = P / g (taken as g0 e^{i(phi0 +
  * phi)} H, defined at g = 0 too) and dP/dphi = i P. */
 void rcb_fit_chain_columns(const rcb_fit *f, double *J) {
-  size_t k, j;
-  for (k = 0; k < f->np; k++) {
-    const rcb_fit_par *p = &f->par[k];
-    const rcb_fit_sensor *s;
-    double complex u;
-    if (!p->chain) continue;
-    s = &f->sens[p->sensor];
-    u = s->gain * cexp(CMPLX(0.0, s->phase + s->fphase));
-    for (j = 0; j < f->nres; j++) {
-      size_t c = f->res_ch[j], idx = c * f->npts + f->res_pt[j];
-      double complex dp;
-      if (f->ch_sens[c] != p->sensor) {
-        J[j + f->nres * k] = 0.0;
-        continue;
-      }
-      dp = p->chain == RCB_CHAIN_GAIN ? u * f->Hraw[idx] : CMPLX(0.0, 1.0) * f->Hmod[idx];
-      J[j + f->nres * k] = rcb_fit_res_deriv_pred(f, j, dp);
-    }
+  size_t k;
+  for (k = 0; k < f->np; k++)
+    if (f->par[k].chain) chain_column(f, f->par[k].chain, f->par[k].sensor, J + f->nres * k);
+}
+
+rcb_status rcb_fit_chain_jacobian(rcb_fit *f, const char *const *names, size_t n, double *J) {
+  size_t k, s;
+  int which;
+  rcb_status st;
+  if (!f || (!names && n) || !J) return RCB_ERR_ARG;
+  if (!f->prepared || !f->sweeps)
+    return rcb_fit_fail(f, RCB_ERR_STATE, "chain columns: no evaluation of the model yet");
+  for (k = 0; k < n; k++) {
+    if ((st = chain_lookup(f, names[k], &which, &s))) return st;
+    chain_column(f, which, s, J + f->nres * k);
   }
+  return RCB_OK;
 }
 
 /* ---- fixed edits (public API) ---- */

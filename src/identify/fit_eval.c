@@ -258,6 +258,56 @@ rcb_status rcb_fit_eval(rcb_fit *f, double *r) {
   return RCB_OK;
 }
 
+rcb_status rcb_fit_last_residuals(rcb_fit *f, double *r) {
+  if (!f || !r) return RCB_ERR_ARG;
+  if (!f->prepared || !f->sweeps)
+    return rcb_fit_fail(f, RCB_ERR_STATE, "residuals: no evaluation of the model yet");
+  residuals_from_model(f, r);
+  return RCB_OK;
+}
+
+/* The channel of src that reads output o with input q and kind k (src
+ * unswapped: its channels read their own outputs); nch when none. */
+static size_t same_channel(const rcb_fit *src, size_t o, size_t q, rcb_frf_kind k) {
+  size_t c;
+  for (c = 0; c < src->nch; c++)
+    if (src->ch_out[c] == o && (src->unbalance || src->ch_in[c] == q) && src->ch_kind[c] == k)
+      return c;
+  return src->nch;
+}
+
+rcb_status rcb_fit_residuals_from(rcb_fit *f, const rcb_fit *src, double *r) {
+  size_t c, i, *from;
+  rcb_status st;
+  if (!f || !src || !r) return RCB_ERR_ARG;
+  if (!src->prepared || !src->sweeps || src->meas != f->meas || src->npts != f->npts ||
+      src->nout != f->nout || src->nin != f->nin || src->unbalance != f->unbalance)
+    return RCB_ERR_STATE;
+  for (c = 0; c < src->nch; c++)
+    if (src->ch_out[c] != src->sens[src->ch_sens[c]].out) return RCB_ERR_STATE; /* swapped */
+  if ((st = rcb_fit_prepare(f))) return st;
+  for (i = 0; i < f->npts; i++)
+    if (f->pt_used[i] && !src->pt_used[i]) return RCB_ERR_STATE;
+  if (!(from = rcb_alloc(&f->alloc, (f->nch ? f->nch : 1) * sizeof *from))) return RCB_ERR_NOMEM;
+  for (c = 0; c < f->nch; c++) {
+    from[c] = same_channel(src, f->ch_out[c], f->ch_in[c], f->ch_kind[c]);
+    if (from[c] == src->nch) {
+      rcb_free(&f->alloc, from);
+      return RCB_ERR_STATE;
+    }
+  }
+  for (c = 0; c < f->nch; c++)
+    for (i = 0; i < f->npts; i++) {
+      if (!f->pt_used[i]) continue;
+      f->Hraw[c * f->npts + i] = src->Hraw[from[c] * f->npts + i];
+      f->Hmod[c * f->npts + i] = f->ch_fac[c] * f->Hraw[c * f->npts + i];
+    }
+  rcb_free(&f->alloc, from);
+  residuals_from_model(f, r);
+  f->evaluations++;
+  return RCB_OK;
+}
+
 rcb_status rcb_fit_residual_channels(const rcb_fit *f, size_t *ch) {
   return ch ? rcb_fit_residual_layout(f, ch, NULL, NULL, NULL) : RCB_ERR_ARG;
 }

@@ -108,49 +108,51 @@ static void dz_values(const rcb_fit_dz *p, double w, double W, double *z) {
   }
 }
 
-/* The products y z of one parameter's entries (z from dz_values) with each
- * output's adjoint solution y = Y_o (rows of the entries), t: 2 ne values
- * per output, o-major: taken once for all the channels of an output. */
-static void yz_products(const rcb_fit_dz *p, const double *z, const rcb_complex *Y, size_t n,
-                        size_t nout, double *t) {
-  size_t o, a;
-  for (o = 0; o < nout; o++) {
-    const rcb_complex *y = Y + n * o;
-    double *to = t + 2 * p->ne * o;
-    for (a = 0; a < p->ne; a++) {
-      double zr = z[2 * a], zi = z[2 * a + 1];
-      double yr = creal(y[p->e[a].row]), yi = cimag(y[p->e[a].row]);
-      to[2 * a] = yr * zr - yi * zi, to[2 * a + 1] = yr * zi + yi * zr; /* y z */
-    }
+/* The distinct rows of one parameter's entries: rows[0 .. *nr) and each
+ * entry's index among them, slot[a]. */
+static void entry_rows(const rcb_fit_dz *p, size_t *slot, size_t *rows, size_t *nr) {
+  size_t a, r;
+  *nr = 0;
+  for (a = 0; a < p->ne; a++) {
+    for (r = 0; r < *nr && rows[r] != p->e[a].row; r++) continue;
+    if (r == *nr) rows[(*nr)++] = p->e[a].row;
+    slot[a] = r;
   }
 }
 
 /* dH_oq/dp of one parameter, -Y_o^T dZ X_q, for every output o and input
- * q < nq into dh[o * nq + q], t the outputs' products y z (yz_products),
- * xg work (2 ne nq). The sum, the diagnosis' innermost loop, is in real
- * arithmetic: the products and sums of the complex (y z) x, without the
- * compiler's NaN-recovery branches; each (o, q) sums its entries in order,
- * the inputs side by side (independent sums, the same figures as one at a
- * time). The unbalance's force term is the caller's. */
-static void dh_adjoint(const rcb_fit_dz *p, const double *t, const rcb_complex *X, size_t n,
-                       size_t nout, size_t nq, double *xg, rcb_complex *dh) {
-  size_t o, q, a, ne = p->ne;
-  for (a = 0; a < ne; a++)
+ * q < nq into dh[o * nq + q], grouped by the rows of dZ's entries: first
+ * s_q = dZ X_q on those rows (ne nq products), then -Y_o^T s_q (nr nout nq):
+ * a shaft element's 64 entries on 8 rows take 512 complex products per
+ * point for 8 outputs and 4 inputs, where the entry-wise sum Y_o(row) z
+ * X_q(col) took 2560. z from dz_values; s work (2 nr nq). The sums in real
+ * arithmetic, without the compiler's NaN-recovery branches of complex
+ * products. The unbalance's force term is the caller's. */
+static void dh_adjoint(const rcb_fit_dz *p, const size_t *slot, const size_t *rows, size_t nr,
+                       const double *z, const rcb_complex *X, const rcb_complex *Y, size_t n,
+                       size_t nout, size_t nq, double *sq, rcb_complex *dh) {
+  size_t o, q, a, r;
+  for (a = 0; a < 2 * nr * nq; a++) sq[a] = 0.0;
+  for (a = 0; a < p->ne; a++) {
+    double zr = z[2 * a], zi = z[2 * a + 1];
+    const rcb_complex *x = X + p->e[a].col;
+    double *t = sq + 2 * slot[a] * nq;
     for (q = 0; q < nq; q++) {
-      rcb_complex x = X[n * q + p->e[a].col];
-      xg[2 * (a * nq + q)] = creal(x), xg[2 * (a * nq + q) + 1] = cimag(x);
+      double xr = creal(x[n * q]), xi = cimag(x[n * q]);
+      t[2 * q] += zr * xr - zi * xi;
+      t[2 * q + 1] += zr * xi + zi * xr;
     }
+  }
   for (o = 0; o < nout; o++) {
-    const double *to = t + 2 * ne * o;
+    const rcb_complex *y = Y + n * o;
     double *acc = (double *)(dh + o * nq); /* re, im of each q */
     for (q = 0; q < 2 * nq; q++) acc[q] = 0.0;
-    for (a = 0; a < ne; a++) {
-      double tr = to[2 * a], ti = to[2 * a + 1];
-      const double *xa = xg + 2 * a * nq;
+    for (r = 0; r < nr; r++) {
+      double yr = creal(y[rows[r]]), yi = cimag(y[rows[r]]);
+      const double *t = sq + 2 * r * nq;
       for (q = 0; q < nq; q++) {
-        double xr = xa[2 * q], xi = xa[2 * q + 1];
-        acc[2 * q] -= tr * xr - ti * xi;
-        acc[2 * q + 1] -= tr * xi + ti * xr;
+        acc[2 * q] -= yr * t[2 * q] - yi * t[2 * q + 1];
+        acc[2 * q + 1] -= yr * t[2 * q + 1] + yi * t[2 * q];
       }
     }
   }
@@ -165,14 +167,15 @@ static double complex dh_force(const rcb_fit_dz *p, const rcb_complex *y, double
 }
 
 /* Work of the adjoint sweep: adjoint solutions, one point's dH per channel,
- * one parameter's dZ entries. */
+ * one parameter's dZ entries, and the rows of every parameter's entries. */
 typedef struct adj_ws {
   rcb_complex *Y, *dH; /* n x nout, nch */
   rcb_complex *g;      /* the point's residuals' coefficients (rcb_fit_res_coef) */
   double *z;           /* 2 x the most entries of any parameter */
-  double *t;           /* the same per output: the products y z (yz_products) */
-  double *xg;          /* the inputs' solutions at the entries' columns (dh_adjoint) */
+  double *sq;          /* 2 x the most rows x the inputs: dZ X_q on the rows (dh_adjoint) */
   rcb_complex *dho;    /* nout x the inputs: one parameter's dH of every pair */
+  size_t *slot, *rows; /* per parameter, from off[k]: entry_rows' slot and rows */
+  size_t *off, *nr;    /* ndz each: the parameter's first entry in slot, rows; its rows */
 } adj_ws;
 
 /* One point: the model solve, the adjoint solutions with its factorisation
@@ -191,8 +194,8 @@ static rcb_status score_point(rcb_fit *f, size_t i, const rcb_fit_dz *dz, size_t
     ws->g[jj - f->pt_first[i]] = rcb_fit_res_coef(f, f->pt_res[jj]);
   for (k = 0; k < ndz; k++) {
     dz_values(&dz[k], w, W, ws->z);
-    yz_products(&dz[k], ws->z, ws->Y, n, f->nout, ws->t);
-    dh_adjoint(&dz[k], ws->t, X, n, f->nout, nq, ws->xg, ws->dho);
+    dh_adjoint(&dz[k], ws->slot + ws->off[k], ws->rows + ws->off[k], ws->nr[k], ws->z, X,
+               ws->Y, n, f->nout, nq, ws->sq, ws->dho);
     for (c = 0; c < f->nch; c++) {
       size_t q = f->unbalance ? 0 : f->ch_in[c];
       ws->dH[c] = ws->dho[f->ch_out[c] * nq + q];
@@ -208,31 +211,58 @@ static rcb_status score_point(rcb_fit *f, size_t i, const rcb_fit_dz *dz, size_t
   return RCB_OK;
 }
 
+static void adj_free(rcb_fit *f, adj_ws *ws) {
+  rcb_free(&f->alloc, ws->Y);
+  rcb_free(&f->alloc, ws->dH);
+  rcb_free(&f->alloc, ws->z);
+  rcb_free(&f->alloc, ws->g);
+  rcb_free(&f->alloc, ws->sq);
+  rcb_free(&f->alloc, ws->dho);
+  rcb_free(&f->alloc, ws->slot);
+  rcb_free(&f->alloc, ws->rows);
+  rcb_free(&f->alloc, ws->off);
+  rcb_free(&f->alloc, ws->nr);
+}
+
+/* The sweep's work, and the rows of every parameter's entries. */
+static rcb_status adj_alloc(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, adj_ws *ws) {
+  size_t n = f->m->ndof, ne = 1, tot = 0, nrmax = 1, k;
+  size_t nq = f->unbalance || !f->nin ? 1 : f->nin, nout = f->nout ? f->nout : 1;
+  memset(ws, 0, sizeof *ws);
+  for (k = 0; k < ndz; k++) ne = dz[k].ne > ne ? dz[k].ne : ne, tot += dz[k].ne;
+  ws->slot = rcb_alloc(&f->alloc, (tot ? tot : 1) * sizeof *ws->slot);
+  ws->rows = rcb_alloc(&f->alloc, (tot ? tot : 1) * sizeof *ws->rows);
+  ws->off = rcb_alloc(&f->alloc, (ndz ? ndz : 1) * sizeof *ws->off);
+  ws->nr = rcb_alloc(&f->alloc, (ndz ? ndz : 1) * sizeof *ws->nr);
+  if (ws->slot && ws->rows && ws->off && ws->nr)
+    for (k = 0, tot = 0; k < ndz; tot += dz[k].ne, k++) {
+      ws->off[k] = tot;
+      entry_rows(&dz[k], ws->slot + tot, ws->rows + tot, &ws->nr[k]);
+      nrmax = ws->nr[k] > nrmax ? ws->nr[k] : nrmax;
+    }
+  ws->Y = rcb_alloc(&f->alloc, n * nout * sizeof *ws->Y);
+  ws->dH = rcb_alloc(&f->alloc, (f->nch ? f->nch : 1) * sizeof *ws->dH);
+  ws->z = rcb_alloc(&f->alloc, 2 * ne * sizeof *ws->z);
+  ws->sq = rcb_alloc(&f->alloc, 2 * nrmax * nq * sizeof *ws->sq);
+  ws->dho = rcb_alloc(&f->alloc, nout * nq * sizeof *ws->dho);
+  ws->g = rcb_alloc(&f->alloc, 2 * (f->nch ? f->nch : 1) * sizeof *ws->g); /* 2 parts per channel */
+  if (ws->Y && ws->dH && ws->z && ws->sq && ws->dho && ws->g && ws->slot && ws->rows &&
+      ws->off && ws->nr)
+    return RCB_OK;
+  adj_free(f, ws);
+  return rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory (adjoint)");
+}
+
 /* Every point: columns d r / d p of dz[0 .. ndz) into J, the model values
  * into Hmod. */
 static rcb_status sweep_adjoint(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, double *J) {
-  size_t i, n = f->m->ndof, ne = 1, k, nq = f->unbalance || !f->nin ? 1 : f->nin;
+  size_t i;
   adj_ws ws;
-  rcb_status st;
-  for (k = 0; k < ndz; k++) ne = dz[k].ne > ne ? dz[k].ne : ne;
-  ws.Y = rcb_alloc(&f->alloc, n * (f->nout ? f->nout : 1) * sizeof *ws.Y);
-  ws.dH = rcb_alloc(&f->alloc, (f->nch ? f->nch : 1) * sizeof *ws.dH);
-  ws.z = rcb_alloc(&f->alloc, 2 * ne * sizeof *ws.z);
-  ws.t = rcb_alloc(&f->alloc, 2 * ne * (f->nout ? f->nout : 1) * sizeof *ws.t);
-  ws.xg = rcb_alloc(&f->alloc, 2 * ne * nq * sizeof *ws.xg);
-  ws.dho = rcb_alloc(&f->alloc, (f->nout ? f->nout : 1) * nq * sizeof *ws.dho);
-  ws.g = rcb_alloc(&f->alloc, 2 * (f->nch ? f->nch : 1) * sizeof *ws.g); /* 2 parts per channel */
-  st = (ws.Y && ws.dH && ws.z && ws.t && ws.xg && ws.dho && ws.g) ? RCB_OK
-                               : rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory (adjoint)");
+  rcb_status st = adj_alloc(f, dz, ndz, &ws);
+  if (st) return st;
   for (i = 0; !st && i < f->npts; i++)
     if (f->pt_used[i]) st = score_point(f, i, dz, ndz, &ws, J);
-  rcb_free(&f->alloc, ws.Y);
-  rcb_free(&f->alloc, ws.dH);
-  rcb_free(&f->alloc, ws.z);
-  rcb_free(&f->alloc, ws.g);
-  rcb_free(&f->alloc, ws.t);
-  rcb_free(&f->alloc, ws.xg);
-  rcb_free(&f->alloc, ws.dho);
+  adj_free(f, &ws);
   return st;
 }
 

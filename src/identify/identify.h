@@ -76,15 +76,43 @@ void rcb_fit_dz_free(const rcb_allocator *a, rcb_fit_dz *dz, size_t n);
  * all of them (fit_score.c). One sweep. */
 rcb_status rcb_fit_jacobian_dz(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, double *J);
 
+/* The weighted residuals (nres values) of the model values of f's last
+ * sweep, rcb_fit_jacobian_dz's included, without another: what
+ * rcb_fit_residuals would give at the same point. RCB_ERR_STATE before a
+ * sweep. */
+rcb_status rcb_fit_last_residuals(rcb_fit *f, double *r);
+
+/* The residuals r (nres) of f from the model values of src's last sweep,
+ * without a sweep of f's own: f and src fit the same model (at the same
+ * point) to the same measurement with the same settings, f's measurement
+ * chain may be edited (a sign, a swap: each of its channels reads a pair
+ * of output and input some channel of src reads, with the same kind),
+ * src's is not swapped. Afterwards f's model values are those of the
+ * residuals (rcb_fit_error_pct). RCB_ERR_STATE when src cannot serve (then
+ * rcb_fit_residuals), nothing changed. The diagnosis scores a sign or a
+ * swap of the probes this way. */
+rcb_status rcb_fit_residuals_from(rcb_fit *f, const rcb_fit *src, double *r);
+
 /* Whether a parameter name belongs to the measurement chain rather than the
  * model (sensor.<response>.gain or .phase, rcb_identify.h): such a
  * parameter has no dZ/dp (rcb_fit_dz_get refuses it), and its column comes
- * from the fit's own Jacobian (rcb_fit_jacobian). 0: not a chain
+ * from the fit's own Jacobian (rcb_fit_jacobian, or rcb_fit_chain_jacobian
+ * without a sweep). 0: not a chain
  * parameter, RCB_CHAIN_GAIN or RCB_CHAIN_PHASE. Syntactic only: whether the
  * response is measured is checked by rcb_fit_add_param. */
 #define RCB_CHAIN_GAIN 1
 #define RCB_CHAIN_PHASE 2
 int rcb_fit_param_is_chain(const char *name);
+
+/* Columns d r / d p (parameter units, nres x n column-major) of the chain
+ * parameters names[0 .. n) (sensor.<response>.gain or .phase of a measured
+ * response; they need not be parameters of f) at f's last evaluation, as
+ * if they were added to f at the sensors' current values: the same columns
+ * as rcb_fit_jacobian of a fit of those parameters on f's model, without
+ * a sweep (a sensor parameter scales the model's values, it has no dZ/dp;
+ * the score test of the sensor gains). RCB_ERR_STATE before an evaluation,
+ * RCB_ERR_ARG for a name that is not a measured sensor's. */
+rcb_status rcb_fit_chain_jacobian(rcb_fit *f, const char *const *names, size_t n, double *J);
 
 /* The sensors of f's measurement chain: one per distinct measured response,
  * in order of first appearance among the channels; the response name
