@@ -1,6 +1,7 @@
 #define _POSIX_C_SOURCE 200809L /* mkdtemp, fork, setenv */
 #include "rcb_test_util.h"
 
+#include <errno.h>
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -108,7 +109,10 @@ static int walk_fork(rcb_test_failing *f) {
     return 1;
   }
   while (waitpid(pid, &ws, 0) < 0)
-    ;
+    if (errno != EINTR) {
+      perror("rcb_test walk: waitpid");
+      abort();
+    }
   w->forks++;
   if (!WIFEXITED(ws) || WEXITSTATUS(ws) != 0) w->failed_at = f->allocs, w->status = ws;
   return 0;
