@@ -48,7 +48,7 @@ typedef struct rcb_test_walk {
   size_t forks;     /* children run */
   size_t failed_at; /* the allocation whose child failed; 0: none */
   int status;       /* that child's wait status */
-  int in_child;     /* this process is the child of allocation failing_at */
+  int in_child;     /* this process is a child: its allocation fail_at failed */
 } rcb_test_walk;
 /* The stride of the walks: RCB_ALLOC_WALK_STRIDE, else 1. The sanitizer
  * stage of ./scripts/dev.sh test sets it: a fork there copies ASan's shadow
