@@ -320,10 +320,11 @@ cmd_sanitize() {
   say "AddressSanitizer + UBSan build ($dir)"
   configure_build "$dir" -DCMAKE_BUILD_TYPE=Debug -DRCB_ENABLE_SANITIZERS=ON
   # The tests labelled "slow" (many full fits) run in the Release builds only.
-  # The allocation-failure walks fail every 7th allocation here (every one in
+  # The allocation-failure walks fail every 13th allocation here (every one in
   # the Release and core builds): each is a fork, and a fork copies ASan's
-  # shadow mappings (10 ms of system time: 107 s for test_alloc_fail's 10300).
-  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 RCB_ALLOC_WALK_STRIDE=7 \
+  # shadow mappings (10 ms of system time: 107 s for test_alloc_fail's 10300;
+  # every 7th took 41 s of the stage beside the others).
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 RCB_ALLOC_WALK_STRIDE=13 \
     UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 run_ctest "$dir" -LE slow
 }
 
@@ -619,9 +620,9 @@ cmd_fuzz() {
   say "fuzz smoke passed (crash-free, ${secs} s per harness)"
 }
 
-# The fuzz stage of `test`: shorter runs (FUZZ_SECONDS, default 10 s each: the
+# The fuzz stage of `test`: shorter runs (FUZZ_SECONDS, default 5 s each: the
 # four harnesses at once on 2 cores; `fuzz` gives each 30 s).
-cmd_fuzz_smoke() { FUZZ_SECONDS=${FUZZ_SECONDS:-10} cmd_fuzz; }
+cmd_fuzz_smoke() { FUZZ_SECONDS=${FUZZ_SECONDS:-5} cmd_fuzz; }
 
 # valgrind memcheck on small CLI runs of the examples, in the Release build.
 # Exit 99 on any memcheck error or definite leak (OpenBLAS on one thread:

@@ -484,7 +484,11 @@ static void test_interval_coverage_complex(void **state) {
   rcb_model *m = rcb_test_model_from_example("paper_system.ini");
   const char *outs[] = {"C.A.x", "C.A.y", "C.B.x", "C.B.y"}, *ins[] = {"DA.x"};
   const char *names[] = {"coupling.C.kt", "coupling.C.kr", "coupling.C.ct"};
-  enum { R = 40 };
+  /* RCB_TEST_FAST=1 (the sanitizer build, tests/CMakeLists.txt): 4 replicas
+   * for memory errors on the path, the coverage asserted in the builds without
+   * sanitizers (40 took 15 s of the sanitizer stage) */
+  const char *fast = getenv("RCB_TEST_FAST");
+  const unsigned R = fast && fast[0] == '1' ? 4 : 40;
   double tv[3], zsum[3] = {0, 0, 0};
   unsigned cover[3] = {0, 0, 0}, seed;
   size_t k;
@@ -511,8 +515,9 @@ static void test_interval_coverage_complex(void **state) {
     rcb_meas_destroy(ms);
   }
   for (k = 0; k < 3; k++) {
-    print_message("%s: 95 %% interval holds the truth in %u of %d, mean z %+.3f\n", names[k],
+    print_message("%s: 95 %% interval holds the truth in %u of %u, mean z %+.3f\n", names[k],
                   cover[k], R, zsum[k] / R);
+    if (R < 40) continue; /* fast: no rate */
     assert_true(cover[k] >= 34);
     assert_true(fabs(zsum[k] / R) <= 3.0 / sqrt((double)R));
   }
