@@ -599,8 +599,7 @@ static rcb_status objective_at_start(rcb_fit *f, double *x) {
   size_t k;
   rcb_status st;
   rcb_fit_get_x(f, x);
-  for (k = 0; k < f->np; k++)
-    xs[k] = f->par[k].log_param ? log(f->par[k].start) : f->par[k].start / f->par[k].scale;
+  for (k = 0; k < f->np; k++) xs[k] = rcb_fit_x_of(f, k, f->par[k].start);
   if ((st = rcb_fit_set_x(f, xs)) || (st = rcb_fit_eval(f, f->r))) return st;
   f->obj0 = rcb_fit_sumsq(f->r, f->nres);
   f->evaluations++;

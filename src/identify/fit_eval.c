@@ -187,12 +187,13 @@ rcb_status rcb_fit_prepare(rcb_fit *f) {
 
 /* ---- parameters <-> internal coordinates ---- */
 
+double rcb_fit_x_of(const rcb_fit *f, size_t k, double v) {
+  return f->par[k].log_param ? log(v) : v / f->par[k].scale;
+}
+
 void rcb_fit_get_x(const rcb_fit *f, double *x) {
   size_t k;
-  for (k = 0; k < f->np; k++) {
-    double v = rcb_fit_par_get(f, k);
-    x[k] = f->par[k].log_param ? log(v) : v / f->par[k].scale;
-  }
+  for (k = 0; k < f->np; k++) x[k] = rcb_fit_x_of(f, k, rcb_fit_par_get(f, k));
 }
 
 /* The model is evaluated at x projected onto the bounds (the optimisers'

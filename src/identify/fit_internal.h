@@ -150,6 +150,8 @@ double rcb_fit_res_deriv_pred(const rcb_fit *f, size_t j, double complex dP);
 
 /* Parameters <-> internal coordinates. set_x writes the model and refreshes
  * the FRF workspace. */
+/* Parameter k's internal coordinate for its value v (log, or value / scale). */
+double rcb_fit_x_of(const rcb_fit *f, size_t k, double v);
 void rcb_fit_get_x(const rcb_fit *f, double *x);
 rcb_status rcb_fit_set_x(rcb_fit *f, const double *x);
 /* Weighted residuals at the current model (counts one evaluation). */
