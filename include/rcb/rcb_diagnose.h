@@ -56,24 +56,38 @@ typedef enum rcb_effect {
 RCB_API const char *rcb_effect_name(rcb_effect e);
 
 /**
- * @brief What the data let a tool say of an edit of a model (issue #23): the
- * one rule behind every word ("significant", "explains", "at the floor") in
- * the library's explanation, rcbtool's text, table, JSON, --apply and
- * history, and the Python package, which all call these functions.
+ * @brief What the data let a tool say of an edit of a model (issues #23,
+ * #33): the one rule behind every word ("significant", "explains", "at the
+ * floor", "white") in the library's explanation, rcbtool's text, table,
+ * JSON, --apply and history, and the Python package, which all call these
+ * functions.
  *
- * - significant: BIC falls by more than 10 ("strong" evidence, Kass &
- *   Raftery); when the noise is unknown (chi2_limit NaN: F is not a
- *   chi-square, BIC is N ln F + k ln N) the error % must also fall by at
- *   least 2 % of itself. With a known noise the BIC test stands alone: the
- *   unweighted error % can rise while the weighted F falls (a sensor's gain
- *   on data already at the floor: error 5.39 -> 5.44 %, BIC -1663);
+ * - the calibrated BIC change (rcb_evidence_dbic): with a known noise F is a
+ *   chi-square, and its drop is divided by the dispersion phi = max(1,
+ *   chi2 / expected) of the model with the edit (quasi-likelihood: a noise
+ *   larger than declared inflates every drop by phi; an edit's own misfit
+ *   left over does the same), so dBIC = (F - F0) / phi + k ln N; without a
+ *   known noise delta_bic as given (N ln(F / F0) + k ln N);
+ * - significant: the calibrated dBIC below -10 ("strong" evidence, Kass &
+ *   Raftery) and, with a known noise, the calibrated drop (F0 - F) / phi
+ *   beyond the chi-square quantile of k degrees of freedom at 1 % / tried
+ *   (Bonferroni over the candidates tried: at most 1 % of null data sets
+ *   get any candidate past it); when the noise is unknown (chi2_limit NaN)
+ *   the error % must also fall by at least 2 % of itself. With a known
+ *   noise the unweighted error % can rise while the weighted F falls (a
+ *   sensor's gain on data already at the floor: error 5.39 -> 5.44 %);
  * - adequate: the model with the edit passes the adequacy test of
- *   rcb_fit_get_adequacy (chi2 <= chi2_limit, 1 % false rejections); unknown
- *   when the noise is unknown (chi2_limit NaN);
+ *   rcb_fit_get_adequacy (chi2 <= chi2_limit, 1 % false rejections), or
+ *   fails it with a white residual (white = 1: no structure along
+ *   frequency, rcb_fit_adequacy.white), which is noise larger than
+ *   declared (dispersion phi), not a missing effect; unknown when the noise
+ *   is unknown (chi2_limit NaN);
  * - the claim: RCB_CLAIM_EXPLAINS when significant and adequate,
  *   RCB_CLAIM_IMPROVES when significant only (it lowers the misfit, and
  *   something is still missing, or the noise is unknown), else
  *   RCB_CLAIM_NONE.
+ * The fields after chi2_limit were added by issue #33; all 0 gives the rule
+ * of issue #23 (phi 1, one candidate tried, no whiteness test).
  */
 typedef enum rcb_claim {
   RCB_CLAIM_NONE = 0,     /**< not significant: nothing may be said of it */
@@ -81,14 +95,25 @@ typedef enum rcb_claim {
   RCB_CLAIM_EXPLAINS = 2  /**< significant, and consistent with the data */
 } rcb_claim;
 typedef struct rcb_evidence {
-  double delta_bic;        /**< BIC change of the edit (-; negative is better) */
+  double delta_bic;        /**< BIC change of the edit on the declared noise, F - F0 + k ln N
+                                (N ln(F / F0) + k ln N when the noise is unknown) (-) */
   double error_before_pct; /**< error % without the edit */
   double error_after_pct;  /**< error % with it */
   double chi2;             /**< F with the edit (-) */
   double chi2_limit;       /**< the adequacy test's limit (-); NaN: the noise is unknown */
+  double params;           /**< k: parameters the edit adds (-) */
+  double residuals;        /**< N: residuals of the fit (-) */
+  double dispersion;       /**< chi2 / expected of the model with the edit (-); <= 1: 1 */
+  double tried;            /**< candidates tried for this claim (-); <= 1: one */
+  int white;               /**< 1: the residual with the edit is white (rcb_fit_adequacy) */
 } rcb_evidence;
 #define RCB_BIC_SIGNIFICANT (-10.0) /**< dBIC below this is significant */
 #define RCB_ERROR_FALL 0.98         /**< and, noise unknown, the error below this fraction */
+#define RCB_FALSE_ALARM 0.01        /**< the family-wise false-alarm rate of "significant" */
+/** @brief The calibrated BIC change (see rcb_evidence; negative is better). */
+RCB_API double rcb_evidence_dbic(const rcb_evidence *e);
+/** @brief The dispersion the rule divides by: max(1, e->dispersion). */
+RCB_API double rcb_evidence_phi(const rcb_evidence *e);
 /** @brief 1 when significant, else 0. */
 RCB_API int rcb_evidence_significant(const rcb_evidence *e);
 /** @brief 1 adequate, 0 not, -1 unknown (no noise model, no standard deviations). */
@@ -125,6 +150,8 @@ RCB_API rcb_status rcb_diag_add_fitted_param(rcb_diag *d, const char *name, doub
 /** @brief Objective settings, as rcb_fit_set_scale / _set_noise_model / _set_band. */
 RCB_API rcb_status rcb_diag_set_scale(rcb_diag *d, rcb_fit_scale scale);
 RCB_API rcb_status rcb_diag_set_noise_model(rcb_diag *d, double beta_a, double beta_s);
+/** @brief The noise model's phase term, rad (rcb_fit_set_noise_phase; 0: none). */
+RCB_API rcb_status rcb_diag_set_noise_phase(rcb_diag *d, double phase_rad);
 RCB_API rcb_status rcb_diag_set_band(rcb_diag *d, double lo, double hi);
 /**
  * @brief Known standard deviations of the measured values (as
@@ -178,8 +205,9 @@ typedef struct rcb_diag_candidate {
   int refitted;             /**< 1 when actually refitted */
   double error_pct;         /**< error % after the refit (NaN if not refitted) */
   double objective_drop_pct; /**< real reduction of F, % (NaN if not refitted) */
-  double delta_bic;         /**< BIC change (negative is better; NaN if not refitted) */
-  int significant;          /**< refitted, BIC falls by > 10 and the error falls */
+  double delta_bic;         /**< calibrated BIC change (rcb_evidence_dbic; negative is
+                                 better; NaN if not refitted) */
+  int significant;          /**< refitted and significant (rcb_evidence_significant) */
   const char *fitted;       /**< "name = value, ..." of the refit (candidate's params) */
   rcb_claim claim;          /**< what may be said of it (rcb_evidence_claim) */
   int adequate;             /**< 1: the model with it passes the adequacy test, 0: not,
@@ -193,6 +221,10 @@ typedef struct rcb_diag_candidate {
                                  as 32 x 1101): delta_bic is then an upper bound and
                                  objective_drop_pct a lower bound, which a fit on all points
                                  would only improve; error_pct is the screened point's */
+  double dispersion;        /**< chi2 / expected of the model with it (-; NaN: unknown) */
+  double white_z;           /**< the whiteness statistic of its residual (rcb_fit_adequacy) */
+  int white;                /**< 1: its residual is white (no structure along frequency),
+                                 0: not, -1: unknown */
 } rcb_diag_candidate;
 
 RCB_API size_t rcb_diag_candidate_count(const rcb_diag *d);

@@ -123,6 +123,39 @@ RCB_API rcb_status rcb_fit_set_weights(rcb_fit *f, const double *w);
  */
 RCB_API rcb_status rcb_fit_set_noise_model(rcb_fit *f, double beta_a, double beta_s);
 /**
+ * @brief The noise model's phase term (issue #33): each measured value also
+ * turned by a phase uniform in +-@p phase_rad (a trigger's jitter, a
+ * sensor's phase error), which adds phase_rad^2 / 3 times the other part
+ * squared to the variance of each part on the complex scale (the modulus,
+ * and so the linear and log scales, are unchanged). 0 (default): none.
+ * @param phase_rad rad, 0 to pi
+ */
+RCB_API rcb_status rcb_fit_set_noise_phase(rcb_fit *f, double phase_rad);
+/** @brief The noise model's phase term, rad (0: none). */
+RCB_API double rcb_fit_get_noise_phase(const rcb_fit *f);
+/**
+ * @brief Where the noise model is evaluated (issue #33): the variance of
+ * each point, each channel's additive level and the noise-floor gate are
+ * computed from these values instead of the measured ones. A weight or a
+ * gate taken from the measured value correlates with that value's own
+ * noise (a value pulled towards zero weighs more; one pushed above the
+ * floor is kept), which biases F by far more than chance at 32 x 1101; a
+ * reference free of the measurement's noise (the fitted model's
+ * predictions, rcb_fit_predictions) removes it, and fits that share one
+ * reference share their weights, so their F compare as chi-squares.
+ * @param h nch * npts values in channel-major order (h[c * npoints + i]),
+ * the measurement's units; a non-finite value drops its point; NULL: the
+ * measured values again
+ */
+RCB_API rcb_status rcb_fit_set_noise_reference(rcb_fit *f, const rcb_complex *h);
+/**
+ * @brief The model's predictions at its current values (one sweep), with the
+ * measurement chain applied, in the measurement's kind and units: nch *
+ * npts values in channel-major order; NaN at the points the fit leaves out
+ * (band, zero weight, the noise floor).
+ */
+RCB_API rcb_status rcb_fit_predictions(rcb_fit *f, rcb_complex *h);
+/**
  * @brief Known standard deviations of the measured values (an estimate's own
  * statistics: rcb_spectral_frf's sd, the order tracker's sd), instead of the
  * eq. 19 noise model: each point weighted by the inverse variance of its
@@ -282,6 +315,15 @@ typedef struct rcb_fit_adequacy {
   double sd;       /**< F's standard deviation under the noise alone (-) */
   double limit;    /**< expected + RCB_ADEQUACY_Z sd (-); NaN when not known */
   int adequate;    /**< known and chi2 <= limit */
+  /* issue #33: is what the fit leaves noise of another level or form, or a
+   * misfit? */
+  double white_z;    /**< lag-1 statistic of the weighted residuals along frequency
+                          (per channel and part; N(0, 1) for any white noise, declared
+                          or not; large when the misfit is smooth: a missing effect) (-) */
+  int white;         /**< known and white_z <= RCB_ADEQUACY_Z: no structure along
+                          frequency at 1 % */
+  double dispersion; /**< chi2 / expected: the residual's variance over the declared
+                          noise's (-); NaN when not known */
 } rcb_fit_adequacy;
 /** One-sided normal quantile of the adequacy test: 1 % false rejections. */
 #define RCB_ADEQUACY_Z 2.3263478740408408

@@ -122,6 +122,14 @@ RCB_API rcb_status rcb_meas_convert(rcb_meas *ms, rcb_frf_kind kind);
  */
 RCB_API rcb_status rcb_meas_add_noise(rcb_meas *ms, double beta_a, double beta_s,
                                       uint64_t seed);
+/**
+ * @brief rcb_meas_add_noise with a phase term: each noisy value then turned
+ * by e^{i phase_rad r3}, r3 uniform in [-1, 1] (a phase noise uniform in
+ * +-phase_rad, drawn after eq. 19's three numbers: phase_rad = 0 gives
+ * rcb_meas_add_noise's values). @param phase_rad rad, 0 to pi
+ */
+RCB_API rcb_status rcb_meas_add_noise_phase(rcb_meas *ms, double beta_a, double beta_s,
+                                            double phase_rad, uint64_t seed);
 
 /** @brief UFF node number <-> model station, for dataset 58 files. */
 typedef struct rcb_uff_node {

@@ -68,7 +68,9 @@ typedef struct diag_cand {
   double chi2_limit;                /* the adequacy limit of its refit (NaN: unknown) */
   int polished;                     /* refitted on all points (0: evaluated where its
                                        screen ended: F and dbic upper bounds) */
-  double F, err, dbic;
+  double F, err, dbic;              /* dbic: calibrated (rcb_evidence_dbic) */
+  double dispersion;                /* F / its expectation with the candidate (NaN: unknown) */
+  double white_z;                   /* whiteness of its residual (rcb_fit_white_z) */
   char fitted[RCB_DIAG_MAXP * (RCB_DIAG_NAME + 32)];
   rcb_model *model;                 /* refitted model (owned, finalized) */
 } diag_cand;
@@ -86,6 +88,10 @@ struct rcb_diag {
   const rcb_meas *meas;
   rcb_fit_scale scale;
   double beta_a, beta_s, band_lo, band_hi;
+  double phase;                     /* the noise model's phase term, rad */
+  rcb_complex *nref;                /* the noise model's reference: the fitted model's
+                                       predictions as it is (nch * npts), shared by every
+                                       fit after the baseline's first (issue #33) */
   int have_band;
   double *sd;                       /* known standard deviations (rcb_diag_set_sd), NULL:
                                        none; every fit weights by them */
@@ -156,6 +162,11 @@ void rcb_diag_drop_fit(rcb_diag *d, rcb_fit *f);
  * (locate.c): fills d->place / d->nplace when the noise is known and the
  * model as it is fails the adequacy test; nothing otherwise. */
 rcb_status rcb_diag_locate(rcb_diag *d);
+
+/* Whether the model as it is fits the data to their noise, by the one rule
+ * (rcb_evidence_adequate on its adequacy test: within the limit, or beyond
+ * it with a white residual): 1 yes, 0 no, -1 unknown (diagnose.c). */
+int rcb_diag_base_adequate(const rcb_diag *d);
 
 /* A finalized copy of model src with the diagnosis' allocator (caller destroys). */
 rcb_status rcb_diag_copy_model(rcb_diag *d, const rcb_model *src, rcb_model **out);

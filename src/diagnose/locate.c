@@ -336,7 +336,7 @@ rcb_status rcb_diag_locate(rcb_diag *d) {
   const double *grid = rcb_meas_grid(d->meas);
   double *gw = NULL; /* the frequency subset (large sets), NULL: every point */
   rcb_status st;
-  if (!d->adeq0.known || d->adeq0.adequate || rcb_meas_get_type(d->meas) != RCB_MEAS_FRF)
+  if (rcb_diag_base_adequate(d) != 0 || rcb_meas_get_type(d->meas) != RCB_MEAS_FRF)
     return RCB_OK;
   memset(&w, 0, sizeof w);
   w.nch = rcb_meas_channel_count(d->meas);

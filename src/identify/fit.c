@@ -159,6 +159,7 @@ void rcb_fit_destroy(rcb_fit *f) {
   rcb_free(&a, f->Hwork);
   rcb_free(&a, f->wuser);
   rcb_free(&a, f->sd);
+  rcb_free(&a, f->nref);
   rcb_free(&a, f->par);
   rcb_free(&a, f);
 }
@@ -286,6 +287,46 @@ rcb_status rcb_fit_set_noise_model(rcb_fit *f, double beta_a, double beta_s) {
   f->beta_a = beta_a;
   f->beta_s = beta_s;
   f->prepared = 0;
+  return RCB_OK;
+}
+
+rcb_status rcb_fit_set_noise_phase(rcb_fit *f, double phase_rad) {
+  if (!f) return RCB_ERR_ARG;
+  if (!(phase_rad >= 0) || !isfinite(phase_rad) || phase_rad > RCB_PI)
+    return rcb_fit_fail(f, RCB_ERR_ARG, "phase noise %g rad (%g deg): expected 0 to pi rad",
+                        phase_rad, phase_rad * 180.0 / RCB_PI);
+  f->phase = phase_rad;
+  f->prepared = 0;
+  return RCB_OK;
+}
+
+double rcb_fit_get_noise_phase(const rcb_fit *f) { return f ? f->phase : (double)NAN; }
+
+rcb_status rcb_fit_set_noise_reference(rcb_fit *f, const rcb_complex *h) {
+  size_t n;
+  if (!f) return RCB_ERR_ARG;
+  n = f->nch * f->npts;
+  if (!h) {
+    rcb_free(&f->alloc, f->nref);
+    f->nref = NULL;
+    f->prepared = 0;
+    return RCB_OK;
+  }
+  if (!f->nref && !(f->nref = rcb_alloc(&f->alloc, (n ? n : 1) * sizeof *f->nref)))
+    return rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory");
+  memcpy(f->nref, h, n * sizeof *h);
+  f->prepared = 0;
+  return RCB_OK;
+}
+
+rcb_status rcb_fit_predictions(rcb_fit *f, rcb_complex *h) {
+  size_t c, i;
+  rcb_status st;
+  if (!f || !h) return RCB_ERR_ARG;
+  if ((st = rcb_fit_prepare(f)) || (st = rcb_fit_eval(f, f->r))) return st;
+  for (c = 0; c < f->nch; c++)
+    for (i = 0; i < f->npts; i++)
+      h[c * f->npts + i] = f->pt_used[i] ? f->Hmod[c * f->npts + i] : CMPLX(NAN, NAN);
   return RCB_OK;
 }
 
@@ -525,7 +566,7 @@ static rcb_status log_magnitude_stage(rcb_fit *f, double *x, size_t *it, size_t 
 #define RCB_REWEIGHT_TOL 0.25
 
 static int reweights(const rcb_fit *f) {
-  return !f->no_uncertainty && f->beta_a > 0 && !f->sd &&
+  return !f->no_uncertainty && f->beta_a > 0 && !f->sd && !f->nref &&
          (f->scale == RCB_SCALE_LINEAR || f->scale == RCB_SCALE_COMPLEX);
 }
 
@@ -539,12 +580,7 @@ static void weights_at_model(rcb_fit *f) {
     double wu = f->wuser ? f->wuser[f->res_ch[j] * f->npts + pt] : 1.0;
     double complex h = f->Hmod[f->res_ch[j] * f->npts + pt];
     double v;
-    if (f->res_ch[j] != c) {
-      rcb_meas_channel_info ci;
-      c = f->res_ch[j];
-      rcb_meas_channel(f->meas, c, &ci);
-      a = rcb_noise_level(ci.data, f->npts, f->beta_s); /* as the layout's */
-    }
+    if (f->res_ch[j] != c) a = rcb_fit_noise_level(f, c = f->res_ch[j]); /* as the layout's */
     v = rcb_fit_noise_var(f, h, a, f->res_part[j]);
     if (v > 0 && isfinite(v)) f->res_sqrtw[j] = sqrt(wu / v); /* else the measured one's */
   }

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "identify/fit_internal.h"
+#include "io/io.h"
 
 double rcb_fit_sumsq(const double *r, size_t n) {
   double s = 0.0;
@@ -66,17 +67,36 @@ static double on_scale_d(rcb_fit_scale s, double complex h, double complex dh, i
 
 /* Variance of a measured value on the scale under the eq. 19 noise model:
  * proportional part (beta_a |e| r1, r1 uniform: variance 1/3) and additive
- * part of amplitude a (random phase: 1/6 per component). */
+ * part of amplitude a (random phase: 1/6 per component); with a phase term
+ * (e turned by theta uniform in +-phase rad: i e theta to first order) the
+ * complex scale's parts gain phase^2 / 3 times the other part squared
+ * (the modulus, and so the other scales, are unchanged). */
 static double noise_var(const rcb_fit *f, double complex e, double a, int part) {
   double ba = f->beta_a / 100.0, mag = modulus(e), v;
   if (f->scale == RCB_SCALE_COMPLEX) {
-    double c = part ? cimag(e) : creal(e);
-    return ba * ba * c * c / 3.0 + a * a / 6.0;
+    double c = part ? cimag(e) : creal(e), o = part ? creal(e) : cimag(e);
+    return ba * ba * c * c / 3.0 + a * a / 6.0 + f->phase * f->phase * o * o / 3.0;
   }
   v = ba * ba * mag * mag / 3.0 + a * a / 6.0;
   if (f->scale == RCB_SCALE_LINEAR) return v;
   v /= mag * mag * log(10.0) * log(10.0);
   return f->scale == RCB_SCALE_DB ? 400.0 * v : v;
+}
+
+double rcb_fit_noise_level(const rcb_fit *f, size_t c) {
+  rcb_meas_channel_info ci;
+  if (f->nref) return rcb_noise_level(f->nref + c * f->npts, f->npts, f->beta_s);
+  rcb_meas_channel(f->meas, c, &ci);
+  return rcb_noise_level(ci.data, f->npts, f->beta_s);
+}
+
+double rcb_fit_log_bias(const rcb_fit *f) {
+  double b = f->beta_a / 100.0, m;
+  if (!(f->scale == RCB_SCALE_LOG10 || f->scale == RCB_SCALE_DB) || !(b > 0)) return 0.0;
+  /* E ln(1 + b r1), r1 uniform in [-1, 1] (b < 1); -b^2/6 to second order */
+  m = b < 1e-4 ? -b * b / 6.0
+               : ((1.0 + b) * log1p(b) - (1.0 - b) * log1p(-b)) / (2.0 * b) - 1.0;
+  return (f->scale == RCB_SCALE_DB ? 20.0 : 1.0) * m / log(10.0);
 }
 
 /* Variance on the scale of a measured value e whose Re and Im (and so |e|)
@@ -99,25 +119,33 @@ static double base_weight(const rcb_fit *f, size_t c, size_t i, double complex e
   return w;
 }
 
-/* Walk every residual; fill the layout when fill != 0. Returns the count. */
+/* Walk every residual; fill the layout when fill != 0. Returns the count.
+ * The noise model's variances, the channel's additive level a and the floor
+ * gate are evaluated at the reference (rcb_fit_set_noise_reference) when one
+ * is set: a weight or a gate computed from the measured value correlates
+ * with that value's own noise (a value pulled towards zero weighs more, one
+ * pushed above the gate is kept), which biases F and every comparison made
+ * on it (issue #33). On the log scales the measured value is moved by the
+ * declared noise's mean on that scale (rcb_fit_log_bias). */
 static size_t layout(rcb_fit *f, int fill) {
   size_t c, i, n = 0;
   int part, nparts = f->scale == RCB_SCALE_COMPLEX ? 2 : 1;
   int noisy = f->beta_a > 0 || f->beta_s > 0;
+  double bias = noisy ? rcb_fit_log_bias(f) : 0.0;
   for (c = 0; c < f->nch; c++) {
     rcb_meas_channel_info ci;
-    double s2 = 0.0, a;
+    double a = rcb_fit_noise_level(f, c); /* eq. 19 additive amplitude */
+    const rcb_complex *ref = f->nref ? f->nref + c * f->npts : NULL;
     rcb_meas_channel(f->meas, c, &ci);
-    for (i = 0; i < f->npts; i++) s2 += creal(ci.data[i] * conj(ci.data[i]));
-    a = f->beta_s / 100.0 * sqrt(s2) / (double)f->npts; /* eq. 19 additive amplitude */
     for (i = 0; i < f->npts; i++) {
-      double complex e = ci.data[i];
+      double complex e = ci.data[i], v = ref && noisy ? ref[i] : e;
       double w = base_weight(f, c, i, e);
       if (w == 0.0) continue;
+      if (!isfinite(creal(v)) || !isfinite(cimag(v))) continue; /* no reference there */
       /* points at the additive noise floor carry no information on the model */
-      if (noisy && modulus(e) < 2.0 * a) continue;
+      if (noisy && modulus(v) < 2.0 * a) continue;
       for (part = 0; part < nparts; part++, n++) {
-        double wp = noisy     ? w / noise_var(f, e, a, part)
+        double wp = noisy     ? w / noise_var(f, v, a, part)
                     : f->sd ? w / sd_var(f->scale, e, f->sd[c * f->npts + i])
                             : w;
         if (!fill) continue;
@@ -125,7 +153,7 @@ static size_t layout(rcb_fit *f, int fill) {
         f->res_pt[n] = i;
         f->res_part[n] = (unsigned char)part;
         f->res_sqrtw[n] = sqrt(wp);
-        f->res_meas[n] = on_scale(f->scale, e, part);
+        f->res_meas[n] = on_scale(f->scale, e, part) - bias;
         f->pt_used[i] = 1;
       }
     }

@@ -65,6 +65,10 @@ struct rcb_fit {
   double band_lo, band_hi; /* rad/s */
   double *wuser;         /* nch * npts user weights, NULL: 1 */
   double beta_a, beta_s; /* noise model, %, both 0: none */
+  double phase;          /* the noise model's phase term: uniform in +-phase, rad (0: none) */
+  rcb_complex *nref;     /* nch * npts values the noise model is evaluated at (its
+                            variances, each channel's additive level, the floor gate),
+                            rcb_fit_set_noise_reference; NULL: the measured values */
   double *sd;            /* nch * npts known standard deviations, NULL: none */
   rcb_fit_method method;
   char algorithm[64];
@@ -172,6 +176,16 @@ int rcb_fit_chi2(const rcb_fit *f);
  * amplitude a (fit_eval.c; adequacy.c draws its null distribution). */
 double rcb_fit_on_scale(const rcb_fit *f, double complex h, int part);
 double rcb_fit_noise_var(const rcb_fit *f, double complex e, double a, int part);
+/* The eq. 19 additive amplitude of channel c (the measurement's units), from
+ * the noise reference when set, else from the measured values. */
+double rcb_fit_noise_level(const rcb_fit *f, size_t c);
+/* The declared noise's mean on the log scales, E log10(1 + beta_a r1) (x 20
+ * on dB; 0 on the others): the bias of a log magnitude the proportional part
+ * puts in (-7.2e-4 at 10 %). The additive part of random phase adds none
+ * where it is below the value (E ln|1 + u| = 0 for |u| < 1 and a uniform
+ * phase), which the floor gate (2 a) keeps. */
+double rcb_fit_log_bias(const rcb_fit *f);
+
 
 /* Pieces of the analytic Jacobian (fit_eval.c) for fit_score.c: the model
  * solve at point i (factors and solutions left in the FRF workspace); the

@@ -81,6 +81,10 @@ rcb_status rcb_fit_jacobian_dz(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, dou
  * rcb_fit_residuals would give at the same point. RCB_ERR_STATE before a
  * sweep. */
 rcb_status rcb_fit_last_residuals(rcb_fit *f, double *r);
+/* The adequacy test's whiteness statistic (rcb_fit_adequacy.white_z) of the
+ * residuals r of fit f (rcb_fit_residual_count values, as rcb_fit_residuals
+ * orders them; identify/adequacy.c). */
+double rcb_fit_white_z(const rcb_fit *f, const double *r);
 
 /* The residuals r (nres) of f from the model values of src's last sweep,
  * without a sweep of f's own: f and src fit the same model (at the same

@@ -42,7 +42,9 @@ void rcb_rng_seed(rcb_rng *r, uint64_t seed);
  * (the measurement's units). */
 double rcb_noise_level(const rcb_complex *f, size_t n, double beta_s);
 /* One noisy value: fs (1 + beta_a/100 r1) + level r2 e^{i phi}; r1, r2
- * uniform in [-1, 1], phi in [0, 2 pi), drawn in that order. */
-rcb_complex rcb_noise_draw(rcb_rng *r, rcb_complex fs, double beta_a, double level);
+ * uniform in [-1, 1], phi in [0, 2 pi), drawn in that order; with phase > 0
+ * (rad) then turned by e^{i phase r3}, r3 uniform in [-1, 1] drawn last. */
+rcb_complex rcb_noise_draw(rcb_rng *r, rcb_complex fs, double beta_a, double level,
+                           double phase);
 
 #endif /* RCB_IO_H */

@@ -63,23 +63,37 @@ double rcb_noise_level(const rcb_complex *f, size_t n, double beta_s) {
   return n ? sqrt(sum) / (double)n * (beta_s / 100.0) : 0.0;
 }
 
-rcb_complex rcb_noise_draw(rng *r, rcb_complex fs, double beta_a, double level) {
+rcb_complex rcb_noise_draw(rng *r, rcb_complex fs, double beta_a, double level,
+                           double phase) {
   double r1 = uniform_pm1(r), r2 = uniform_pm1(r), phi = 2.0 * RCB_PI * uniform01(r);
-  return fs * (1.0 + beta_a / 100.0 * r1) + level * r2 * CMPLX(cos(phi), sin(phi));
+  rcb_complex e = fs * (1.0 + beta_a / 100.0 * r1) + level * r2 * CMPLX(cos(phi), sin(phi));
+  if (phase > 0) { /* drawn after the three of eq. 19: without it, the same stream */
+    double t = phase * uniform_pm1(r);
+    e *= CMPLX(cos(t), sin(t));
+  }
+  return e;
 }
 
 rcb_status rcb_meas_add_noise(rcb_meas *ms, double beta_a, double beta_s, uint64_t seed) {
+  return rcb_meas_add_noise_phase(ms, beta_a, beta_s, 0.0, seed);
+}
+
+rcb_status rcb_meas_add_noise_phase(rcb_meas *ms, double beta_a, double beta_s, double phase_rad,
+                                    uint64_t seed) {
   rng r;
   size_t c, i;
   if (!ms) return RCB_ERR_ARG;
   if (!isfinite(beta_a) || beta_a < 0.0 || !isfinite(beta_s) || beta_s < 0.0)
     return rcb_meas_fail(ms, RCB_ERR_ARG, "noise: beta_a = %g %%, beta_s = %g %%: expected "
                          "finite percentages >= 0", beta_a, beta_s);
+  if (!(phase_rad >= 0) || !isfinite(phase_rad) || phase_rad > RCB_PI)
+    return rcb_meas_fail(ms, RCB_ERR_ARG, "noise: phase %g rad (%g deg): expected 0 to pi rad",
+                         phase_rad, phase_rad * 180.0 / RCB_PI);
   seed_rng(&r, seed);
   for (c = 0; c < ms->nch; c++) {
     rcb_complex *f = ms->ch[c].data;
     double level = rcb_noise_level(f, ms->n, beta_s);
-    for (i = 0; i < ms->n; i++) f[i] = rcb_noise_draw(&r, f[i], beta_a, level);
+    for (i = 0; i < ms->n; i++) f[i] = rcb_noise_draw(&r, f[i], beta_a, level, phase_rad);
   }
   return RCB_OK;
 }

@@ -132,6 +132,14 @@ int cli_opt_double(const cli_args *a, const char *name, const char *unit, double
                    double *out);
 /** A whole number >= 1 from option @p name (default @p def when absent). */
 int cli_opt_count(const cli_args *a, const char *name, size_t def, size_t *out);
+/**
+ * @brief The noise model option (--noise A,S[,P] of fit, diagnose, simulate,
+ * monitor): A, S the eq. 19 factors in %, P a phase noise in degrees
+ * (uniform in +-P; 0 when not given). 0 when absent (outputs untouched), 2
+ * (usage) on a malformed value.
+ */
+int cli_noise_opt(const cli_args *a, const char *opt, double *beta_a, double *beta_s,
+                  double *phase_deg);
 /** Like cli_opt_double, also requires the value to be >= 0. */
 int cli_opt_nonneg(const cli_args *a, const char *name, const char *unit, double def,
                    double *out);

@@ -160,6 +160,23 @@ int cli_opt_double(const cli_args *a, const char *name, const char *unit, double
   return 0;
 }
 
+int cli_noise_opt(const cli_args *a, const char *opt, double *x, double *y, double *ph) {
+  const char *s = cli_opt_value(a, opt), *t = s ? strchr(s, ',') : NULL, *u;
+  char *e1, *e2, *e3 = NULL;
+  if (!s) return 0;
+  if (!t) return cli_usage(a->cmd, "option %s expects A,S or A,S,P (numbers separated by "
+                           "',')", opt);
+  u = strchr(t + 1, ',');
+  *x = strtod(s, &e1);
+  *y = strtod(t + 1, &e2);
+  *ph = u ? strtod(u + 1, &e3) : 0.0;
+  if (e1 != t || (u ? e2 != u || *e3 : *e2 != 0) || !(*x >= 0) || !(*y >= 0) ||
+      !isfinite(*x) || !isfinite(*y) || !(*ph >= 0 && *ph < 90))
+    return cli_usage(a->cmd, "option %s expects A,S[,P]: A, S >= 0 (%%), P phase noise "
+                     "0 <= P < 90 (degrees), got '%s'", opt, s);
+  return 0;
+}
+
 int cli_opt_nonneg(const cli_args *a, const char *name, const char *unit, double def,
                    double *out) {
   int rc = cli_opt_double(a, name, unit, def, out);

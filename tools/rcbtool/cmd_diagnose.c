@@ -46,7 +46,8 @@ const char cli_help_diagnose[] =
     "polished on all points. The others are marked \"screened\" (\"screened_only\"\n"
     "in JSON): their dBIC is an upper bound, their error the screened point's.\n"
     "  --noise A,S    the eq. 19 noise model (random A %, systematic S %): weights\n"
-    "                 and the noise floor (strongly recommended)\n"
+    "                 and the noise floor (strongly recommended); A,S,P adds a\n"
+    "                 phase noise uniform in +-P degrees (complex scale)\n"
     "  --sd FILE      instead of --noise: weights and the noise floor from the\n"
     "                 standard deviations of the --stats file of rcbtool estimate\n"
     "                 or order written with the measurement; the objective is\n"
@@ -87,6 +88,7 @@ typedef struct diag_job {
   cli_params params;
   int have_params, log_all, scale, have_noise, have_band, have_sd;
   double beta_a, beta_s, band_lo, band_hi;
+  double phase_deg; /* the noise model's phase term, degrees */
   size_t refits, top, apply, threads;
   int force;
   const char *history;
@@ -116,9 +118,8 @@ static int parse_job(const cli_args *a, diag_job *j) {
       (rc = cli_opt_count(a, "--threads", 1, &j->threads)) ||
       (rc = cli_opt_count(a, "--apply", 0, &j->apply)))
     return rc;
-  if ((j->have_noise = cli_opt_value(a, "--noise") != NULL) &&
-      (rc = pair(a, "--noise", ',', &j->beta_a, &j->beta_s)))
-    return rc;
+  j->have_noise = cli_opt_value(a, "--noise") != NULL;
+  if ((rc = cli_noise_opt(a, "--noise", &j->beta_a, &j->beta_s, &j->phase_deg))) return rc;
   if ((j->have_band = cli_opt_value(a, "--band") != NULL) &&
       (rc = pair(a, "--band", ':', &j->band_lo, &j->band_hi)))
     return rc;
@@ -137,6 +138,7 @@ static int setup(const cli_args *a, const diag_job *j, const rcb_model *m, const
   rcb_status st = rcb_diag_set_scale(d, (rcb_fit_scale)j->scale);
   size_t k;
   if (!st && j->have_noise) st = rcb_diag_set_noise_model(d, j->beta_a, j->beta_s);
+  if (!st && j->have_noise) st = rcb_diag_set_noise_phase(d, j->phase_deg * CLI_PI / 180.0);
   if (!st && cli_opt_value(a, "--sd")) {
     double *sd = NULL;
     int rc;
@@ -191,6 +193,9 @@ static void print_adequacy(FILE *fp, const rcb_diag *d) {
   fprintf(fp, "adequacy test of the model as it is: chi-square %.6g, %s the 1 %% limit %.6g "
           "(the noise alone: %.6g +- %.3g; %.0f degrees of freedom)\n",
           t.chi2, t.adequate ? "within" : "ABOVE", t.limit, t.expected, t.sd, t.dof);
+  fprintf(fp, "the residual along frequency: %s (lag-1 statistic %.3g, 1 %% limit %.3g); "
+          "chi-square / expected %.4g\n",
+          t.white ? "white" : "STRUCTURED", t.white_z, RCB_ADEQUACY_Z, t.dispersion);
   if (!t.adequate && n) {
     fprintf(fp, "%-14s %12s %12s %9s  %s\n", "sensor", "chi-square", "noise alone",
             "excess %", "");
@@ -255,7 +260,12 @@ static void json_adequacy(FILE *fp, const rcb_diag *d) {
   cli_json_num(fp, t.known ? t.sd : (double)NAN);
   fputs(", \"limit\": ", fp);
   cli_json_num(fp, t.limit);
-  fprintf(fp, ", \"adequate\": %s}", !t.known ? "null" : t.adequate ? "true" : "false");
+  fprintf(fp, ", \"adequate\": %s, \"white_z\": ",
+          !t.known ? "null" : t.adequate ? "true" : "false");
+  cli_json_num(fp, t.known ? t.white_z : (double)NAN);
+  fprintf(fp, ", \"white\": %s, \"dispersion\": ", !t.known ? "null" : t.white ? "true" : "false");
+  cli_json_num(fp, t.dispersion);
+  fputs("}", fp);
   fputs(",\n\"misfit\": {\"sensors\": [", fp);
   for (k = 0; k < n; k++) {
     rcb_diag_misfit s;
@@ -334,6 +344,11 @@ static void print_json(FILE *fp, const diag_job *j, const rcb_diag *d, const cha
     cli_json_num(fp, c.chi2);
     fputs(", \"chi2_limit\": ", fp);
     cli_json_num(fp, c.chi2_limit);
+    fputs(", \"dispersion\": ", fp);
+    cli_json_num(fp, c.dispersion);
+    fputs(", \"white_z\": ", fp);
+    cli_json_num(fp, c.white_z);
+    fprintf(fp, ", \"white\": %s", c.white < 0 ? "null" : c.white ? "true" : "false");
     fprintf(fp, ", \"chain\": %s, \"screened_only\": %s, \"fitted\": ",
             c.chain ? "true" : "false", c.screened_only ? "true" : "false");
     cli_json_str(fp, c.fitted);
@@ -462,7 +477,7 @@ int cmd_diagnose(int argc, char **argv) {
   cli_opt opts[] = {{"--params", "NAME[:LO:HI],...", NULL},
                     {"--log", NULL, NULL},
                     {"--scale", "SCALE", NULL},
-                    {"--noise", "BETA_A,BETA_S", NULL},
+                    {"--noise", "BETA_A,BETA_S[,PHASE_DEG]", NULL},
                     {"--sd", "FILE", NULL},
                     {"--band", "LO:HI", NULL},
                     {"--map", "NODE=STATION,...", NULL},

@@ -37,7 +37,8 @@ const char cli_help_fit[] =
     "                 for unbalance responses\n"
     "  --noise A,S    noise-aware weights from the paper's eq. 19 noise model (random\n"
     "                 factor A %, systematic factor S %); points at the noise floor\n"
-    "                 are left out\n"
+    "                 are left out; A,S,P adds a phase noise uniform in +-P degrees\n"
+    "                 (its variance on the complex scale)\n"
     "  --sd FILE      weight each point by 1 / its variance from the --stats file\n"
     "                 of rcbtool estimate or rcbtool order written with the\n"
     "                 measurement, instead of --noise; the noise floor reported\n"
@@ -201,6 +202,7 @@ typedef struct fit_job {
   int have_band, have_noise;
   double band_lo, band_hi; /* Hz (FRF) or rpm (unbalance) */
   double beta_a, beta_s;   /* % */
+  double phase_deg;        /* the noise model's phase term, degrees */
   size_t max_iter, starts;
   int is_uff; /* the measurement is a UFF file (set by read_meas) */
   int have_sd;          /* --sd: weights and the noise floor from the standard deviations */
@@ -249,15 +251,8 @@ static int parse_job(const cli_args *a, fit_job *j) {
                        j->band_hi);
     j->have_band = 1;
   }
-  if (cli_opt_value(a, "--noise")) {
-    if ((rc = parse_pair(a, "--noise", ',', "BETA_A,BETA_S: two percentages >= 0 (e.g. 10,1)",
-                         &j->beta_a, &j->beta_s)))
-      return rc;
-    if (j->beta_a < 0 || j->beta_s < 0)
-      return cli_usage(a->cmd, "option --noise expects percentages >= 0, got %g,%g", j->beta_a,
-                       j->beta_s);
-    j->have_noise = 1;
-  }
+  if ((rc = cli_noise_opt(a, "--noise", &j->beta_a, &j->beta_s, &j->phase_deg))) return rc;
+  j->have_noise = cli_opt_value(a, "--noise") != NULL;
   if (a->output && strcmp(a->output, "-") == 0)
     return cli_usage(a->cmd, "-o - is not supported: the report goes to standard output; give "
                      "a file for the fitted model");
@@ -303,6 +298,7 @@ static int settings(const cli_args *a, const fit_job *j, rcb_fit *f, const rcb_m
   rcb_status st = rcb_fit_set_scale(f, (rcb_fit_scale)j->scale);
   if (!st && j->have_band) st = rcb_fit_set_band(f, j->band_lo * unit, j->band_hi * unit);
   if (!st && j->have_noise) st = rcb_fit_set_noise_model(f, j->beta_a, j->beta_s);
+  if (!st && j->have_noise) st = rcb_fit_set_noise_phase(f, j->phase_deg * CLI_PI / 180.0);
   if (!st)
     st = rcb_fit_set_method(f, j->method_nlopt ? RCB_FIT_NLOPT : RCB_FIT_PAPER, j->algorithm);
   if (!st) st = rcb_fit_set_analytic(f, cli_opt_value(a, "--fd") == NULL);
@@ -691,7 +687,7 @@ int cmd_fit(int argc, char **argv) {
                     {"--method", "paper|nlopt:ALG", NULL},
                     {"--scale", "SCALE", NULL},
                     {"--band", "LO:HI", NULL},
-                    {"--noise", "BETA_A,BETA_S", NULL},
+                    {"--noise", "BETA_A,BETA_S[,PHASE_DEG]", NULL},
                     {"--sd", "FILE", NULL},
                     {"--fd", NULL, NULL},
                     {"--max-iter", "N", NULL},

@@ -93,22 +93,6 @@ const char cli_help_monitor[] =
     "not written (no partial log or plot is ever left).\n";
 
 /* --noise A,S[,P]: eq. 19's two numbers, then the phase noise in degrees. */
-static int noise_opt(const cli_args *a, const char *opt, double *x, double *y, double *ph) {
-  const char *s = cli_opt_value(a, opt), *t = s ? strchr(s, ',') : NULL, *u;
-  char *e1, *e2, *e3 = NULL;
-  if (!t) return cli_usage(a->cmd, "option %s expects A,S or A,S,P (numbers separated by "
-                           "',')", opt);
-  u = strchr(t + 1, ',');
-  *x = strtod(s, &e1);
-  *y = strtod(t + 1, &e2);
-  *ph = u ? strtod(u + 1, &e3) : 0.0;
-  if (e1 != t || (u ? e2 != u || *e3 : *e2 != 0) || !(*x >= 0) || !(*y >= 0) ||
-      !isfinite(*x) || !isfinite(*y) || !(*ph >= 0 && *ph < 90))
-    return cli_usage(a->cmd, "option %s expects A,S[,P]: A, S >= 0 (%%), P phase noise "
-                     "0 <= P < 90 (degrees), got '%s'", opt, s);
-  return 0;
-}
-
 /* --baseline-sd SD,...: one standard error >= 0 per tracked parameter. */
 static int baseline_sd_opt(const cli_args *a, mon_job *j) {
   const char *s = cli_opt_value(a, "--baseline-sd"), *p = s;
@@ -162,7 +146,7 @@ static int parse_job(const cli_args *a, mon_job *j) {
   if (cli_opt_value(a, "--noise") && j->sd_path)
     return cli_usage(a->cmd, "--noise and --sd exclude each other: give the eq. 19 model or "
                      "the per-point standard deviations");
-  if (cli_opt_value(a, "--noise") && (rc = noise_opt(a, "--noise", &j->beta_a, &j->beta_s, &j->phase_deg)))
+  if (cli_opt_value(a, "--noise") && (rc = cli_noise_opt(a, "--noise", &j->beta_a, &j->beta_s, &j->phase_deg)))
     return rc;
   if (!cli_opt_value(a, "--noise") && !j->sd_path)
     return cli_usage(a->cmd, "the monitor needs the measurement noise: give --noise A,S (eq. "

@@ -11,7 +11,7 @@ const char cli_help_simulate[] =
     "usage: rcbtool simulate MODEL.ini --frf --out CH,... --in CH,... --fmax HZ\n"
     "                        [--fmin HZ] [--points N] [--rpm R | --synchronous]\n"
     "                        [--kind receptance|mobility|inertance]\n"
-    "                        [--noise BETA_A,BETA_S] [--seed S] [--map NODE=STATION,...]\n"
+    "                        [--noise A,S[,P]] [--seed S] [--map NODE=STATION,...]\n"
     "                        -o FILE.uff|FILE.csv [--binary] [--solver S] [--progress]\n"
     "       rcbtool simulate MODEL.ini --unbalance --out CH,... --rpm-max B\n"
     "                        [--rpm-min A] [--points N] [noise, map, output as above]\n"
@@ -26,7 +26,8 @@ const char cli_help_simulate[] =
     "  --noise A,S    the paper's eq. 19 noise, in %: per channel\n"
     "                 f_e = f_s (1 + A/100 r1) + (||f_s||_2/n) (S/100) r2 e^{i phi},\n"
     "                 r1, r2 uniform in [-1, 1], phi uniform in [0, 2 pi)\n"
-    "                 (default: no noise)\n"
+    "                 (default: no noise); A,S,P also turns each value by a\n"
+    "                 phase uniform in +-P degrees (a phase noise)\n"
     "  --seed S       noise seed, a whole number >= 0 (default 1): the same seed\n"
     "                 gives the same data on every platform\n"
     "  --map LIST     UFF node numbers of the stations, e.g. 10=DA,20=C.A; stations\n"
@@ -45,6 +46,7 @@ typedef struct sim_job {
   double lo, hi, rpm;    /* Hz or rpm (grid), rpm (FRF test speed) */
   size_t npts;
   double noise_a, noise_s; /* % */
+  double noise_p;          /* phase noise, degrees (uniform in +-noise_p) */
   int noise;
   unsigned long long seed;
   cli_channels out, in;
@@ -61,19 +63,8 @@ static int parse_noise(const cli_args *a, sim_job *j) {
       return cli_usage(a->cmd, "option --seed expects a whole number >= 0, got '%s'", seed);
   }
   if (!s) return 0;
-  errno = 0;
-  j->noise_a = strtod(s, &end);
-  if (end != s && *end == ',') {
-    const char *t = end + 1;
-    j->noise_s = strtod(t, &end);
-    if (end != t && *end == '\0' && !errno && j->noise_a >= 0.0 && j->noise_s >= 0.0 &&
-        j->noise_a < 1e6 && j->noise_s < 1e6) {
-      j->noise = 1;
-      return 0;
-    }
-  }
-  return cli_usage(a->cmd, "option --noise expects BETA_A,BETA_S: two percentages >= 0 "
-                   "(e.g. 10,1), got '%s'", s);
+  j->noise = 1;
+  return cli_noise_opt(a, "--noise", &j->noise_a, &j->noise_s, &j->noise_p);
 }
 
 static int parse_frf(const cli_args *a, sim_job *j) {
@@ -169,7 +160,9 @@ static int fill(const cli_args *a, sim_job *j, const rcb_model *m, rcb_meas *ms,
     st = rcb_meas_add_channel(ms, j->out.names[o], j->frf ? j->in.names[c % j->in.n] : NULL,
                               (rcb_frf_kind)j->kind, data + c * j->npts);
   }
-  if (!st && j->noise) st = rcb_meas_add_noise(ms, j->noise_a, j->noise_s, j->seed);
+  if (!st && j->noise)
+    st = rcb_meas_add_noise_phase(ms, j->noise_a, j->noise_s, j->noise_p * CLI_PI / 180.0,
+                                  j->seed);
   if (st) return cli_fail(cli_status_exit(st), "simulate: %s", cli_msg(rcb_meas_errmsg(ms), st));
   return 0;
 }
@@ -214,7 +207,7 @@ int cmd_simulate(int argc, char **argv) {
                     {"--points", "N", NULL},        {"--rpm", "R", NULL},
                     {"--synchronous", NULL, NULL},  {"--kind", "KIND", NULL},
                     {"--rpm-min", "A", NULL},       {"--rpm-max", "B", NULL},
-                    {"--noise", "BETA_A,BETA_S", NULL}, {"--seed", "S", NULL},
+                    {"--noise", "BETA_A,BETA_S[,PHASE_DEG]", NULL}, {"--seed", "S", NULL},
                     {"--map", "NODE=STATION,...", NULL}, {"--binary", NULL, NULL},
                     {"--solver", "SOLVER", NULL}};
   sim_job j;
