@@ -398,7 +398,7 @@ static void test_modal_fit_paper(void **state) {
                   r.meas_freq / TWO_PI, r.model_zeta, r.meas_zeta, r.meas_zeta_hp);
     matched++;
     assert_true(ef < 0.25);
-    (void)eh; /* reported: on this system the two are comparable (docs/diagnosis.md) */
+    (void)eh; /* reported: on this system the two are comparable (docs/rcbtool.md, Peak damping) */
   }
   assert_true(matched >= 1);
   rcb_compare_destroy(c);
@@ -469,7 +469,7 @@ static void gyro_errors(const rcb_compare *c, const rcb_mode *modes, size_t nm, 
  * there (error 56 % RMS, worst 59 %); the shared-pole fit is asserted below
  * 30 % RMS and 36 % worst (measured 24.9 % and 30.3 %: low, as the pair's
  * split and damping trade off under this noise). The peak near 161 Hz, a
- * peak of the noisy data only, is reported: docs/diagnosis.md. */
+ * peak of the noisy data only, is reported: docs/rcbtool.md, Peak damping. */
 static void test_modal_fit_gyroscopic(void **state) {
   static const char *const outs[] = {"DA.x", "DA.y", "DB.x", "DB.y"};
   static const char *const ins[] = {"DA.x", "DA.x", "DA.x", "DA.x"};
