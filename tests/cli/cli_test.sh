@@ -477,7 +477,14 @@ EOF
   expect_rc 0; out_has "as rcbtool compare reports it"
   out_has "what the fit minimises: squared residuals on log10 |H|, weighted by the --noise model"
   out_has "note: E rose"; out_has "--scale linear without --noise minimises E itself"
-  grep -q '"fit: error 6.53 % -> 6.888 % (objective -' "$W/h.jsonl" || fail "history note: $(cat "$W/h.jsonl")"
+  # the note states the run's own figures (E0 as compare's, E1 as the --json run's)
+  python3 - "$W/h.jsonl" "$e" <<'EOF' || fail "history note: $(cat "$W/h.jsonl")"
+import json, re, sys
+h = json.loads(open(sys.argv[1]).readline())
+m = re.match(r"fit: error ([0-9.]+) % -> ([0-9.]+) % \(objective -", h["note"])
+assert m and abs(float(m.group(1)) - float(sys.argv[2])) < 0.006, h
+assert abs(float(m.group(2)) - h["error_pct"]) < 5e-4 * h["error_pct"], h
+EOF
   # the claim of the note: --scale linear without --noise lowers E itself
   run fit "$W2/model.ini" "$W2/measured.uff" --params $P --log --scale linear --json
   expect_rc 0

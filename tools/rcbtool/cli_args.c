@@ -164,16 +164,16 @@ int cli_noise_opt(const cli_args *a, const char *opt, double *x, double *y, doub
   const char *s = cli_opt_value(a, opt), *t = s ? strchr(s, ',') : NULL, *u;
   char *e1, *e2, *e3 = NULL;
   if (!s) return 0;
-  if (!t) return cli_usage(a->cmd, "option %s expects A,S or A,S,P (numbers separated by "
-                           "',')", opt);
+  if (!t) return cli_usage(a->cmd, "option %s expects BETA_A,BETA_S[,PHASE_DEG]: two or three "
+                           "numbers separated by ',' (e.g. 10,1 or 10,1,2)", opt);
   u = strchr(t + 1, ',');
   *x = strtod(s, &e1);
   *y = strtod(t + 1, &e2);
   *ph = u ? strtod(u + 1, &e3) : 0.0;
   if (e1 != t || (u ? e2 != u || *e3 : *e2 != 0) || !(*x >= 0) || !(*y >= 0) ||
       !isfinite(*x) || !isfinite(*y) || !(*ph >= 0 && *ph < 90))
-    return cli_usage(a->cmd, "option %s expects A,S[,P]: A, S >= 0 (%%), P phase noise "
-                     "0 <= P < 90 (degrees), got '%s'", opt, s);
+    return cli_usage(a->cmd, "option %s expects BETA_A,BETA_S[,PHASE_DEG]: BETA_A, BETA_S >= 0 "
+                     "(%%), PHASE_DEG a phase noise 0 <= P < 90 (degrees), got '%s'", opt, s);
   return 0;
 }
 
