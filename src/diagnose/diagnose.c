@@ -988,12 +988,7 @@ static void judge(const rcb_diag *d, diag_cand *c, double k) {
 }
 
 /* The whiteness of the residual of fit f's last evaluation (on all points). */
-static void whiteness(rcb_diag *d, diag_cand *c, rcb_fit *f) {
-  double *r = rcb_alloc(&d->alloc, (d->nres ? d->nres : 1) * sizeof *r);
-  c->white_z = HUGE_VAL; /* unknown: not white */
-  if (r && !rcb_fit_last_residuals(f, r)) c->white_z = rcb_fit_white_z(f, r);
-  rcb_free(&d->alloc, r);
-}
+static void whiteness(diag_cand *c, rcb_fit *f) { c->white_z = rcb_fit_last_white_z(f); }
 
 /* A refit with nothing to fit (kramer_1, rigid): the model evaluated. */
 static rcb_status evaluate_only(rcb_diag *d, diag_cand *c, rcb_model **m, rcb_fit *f) {
@@ -1003,7 +998,7 @@ static rcb_status evaluate_only(rcb_diag *d, diag_cand *c, rcb_model **m, rcb_fi
   if (st) return st;
   c->refitted = 1;
   c->polished = 1;
-  whiteness(d, c, f);
+  whiteness(c, f);
   judge(d, c, 0.0);
   snprintf(c->fitted, sizeof c->fitted, "no parameter");
   c->model = *m, *m = NULL; /* kept: --apply writes it */
@@ -1026,7 +1021,7 @@ static void refit_result(rcb_diag *d, diag_cand *c, rcb_model **m, rcb_fit *f, d
   c->refitted = 1;
   c->polished = polished;
   c->F = F, c->err = err;
-  whiteness(d, c, f);
+  whiteness(c, f);
   judge(d, c, (double)c->np);
   record_fit(c, f);
   keep_chain(c, f);

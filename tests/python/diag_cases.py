@@ -197,6 +197,48 @@ def add_phase_noise(data, deg, seed):
     return data * np.exp(1j * math.radians(deg) * u)
 
 
+# --------------------------------------------------------------------------
+# Issue #33: noise librcb did not make, for the calibration of the claims
+# (tools/bench/diag_calibration.py, test_diag_calibration.py)
+# --------------------------------------------------------------------------
+
+
+def calibration_noise(form, H, seed):
+    """One noisy measurement of H (channels x lines) drawn by numpy (PCG64):
+    "eq19" f (1 + a r1) + L r2 e^{i phi} as declared (10 %, 1 %: a = 0.1,
+    L = ||f||_2 / n 0.01; r1, r2 uniform in [-1, 1], phi uniform); "literal"
+    eq. 19 read on magnitudes, the systematic term real and in phase with f,
+    (|f| (1 + a r1) + L r2) e^{i arg f}, with a phase noise uniform in
+    +-PHASE_DEG; "high" eq19 with both factors 20 % above (12 %, 1.2 %);
+    "phase" eq19 then turned by a phase uniform in +-PHASE_DEG."""
+    rng = np.random.default_rng(seed)
+    level = np.sqrt(np.sum(np.abs(H) ** 2, axis=1, keepdims=True)) / H.shape[1]
+    ba, bs = NOISE[0] / 100.0, NOISE[1] / 100.0
+    if form == "high":
+        ba, bs = 1.2 * ba, 1.2 * bs
+    r1 = rng.uniform(-1, 1, H.shape)
+    r2 = rng.uniform(-1, 1, H.shape)
+    if form == "literal":
+        mag = np.abs(H) * (1 + ba * r1) + level * bs * r2
+        ph = np.angle(H) + math.radians(PHASE_DEG) * rng.uniform(-1, 1, H.shape)
+        return mag * np.exp(1j * ph)
+    out = H * (1 + ba * r1) + level * bs * r2 * np.exp(2j * math.pi * rng.uniform(0, 1, H.shape))
+    if form == "phase":
+        out = out * np.exp(1j * math.radians(PHASE_DEG) * rng.uniform(-1, 1, H.shape))
+    return out
+
+
+def binom_upper(n, p=0.01, conf=0.99):
+    """The smallest k with P(X > k) <= 1 - conf for X ~ Bin(n, p): more than k
+    false alarms in n replicas reject a rate p at that confidence."""
+    cdf, k = 0.0, 0
+    while True:
+        cdf += math.comb(n, k) * p**k * (1 - p) ** (n - k)
+        if cdf >= conf:
+            return k
+        k += 1
+
+
 def noisy(case, H, seed):
     """The measurement of a case's truth H for a noise seed: eq. 19, and on the
     large grid the phase noise too."""

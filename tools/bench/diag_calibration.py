@@ -37,7 +37,6 @@ expectation (mean over the replicas), and what the words said.
 
 import argparse
 import json
-import math
 import os
 import subprocess
 import sys
@@ -66,7 +65,6 @@ CASES = {
     "phase-complex": ("phase", "complex", "10,1,2"),
     "phase-log": ("phase", "log", "10,1"),
 }
-BETA_A, BETA_S, PHASE_DEG = 10.0, 1.0, 2.0  # %, %, degrees
 # hidden effects of the detection cases: diag_cases.LARGE_CASES by name
 EFFECTS = {"cross": "large_cross_B3", "cr": "large_cr_C", "aniso": "large_aniso_B4"}
 
@@ -89,43 +87,14 @@ def want(effect):
                                         if c.name == EFFECTS[effect]).expect[0]
 
 
-def binom_upper(n, p=0.01, conf=0.99):
-    """The smallest k with P(X > k) <= 1 - conf for X ~ Bin(n, p): more than
-    k false alarms in n rejects a rate p at that confidence."""
-    cdf, k = 0.0, 0
-    while True:
-        cdf += math.comb(n, k) * p**k * (1 - p) ** (n - k)
-        if cdf >= conf:
-            return k
-        k += 1
-
-
-def draw(form, H, seed):
-    """One noisy measurement of H (channels x lines), numpy's own generator."""
-    rng = np.random.default_rng(seed)
-    level = np.sqrt(np.sum(np.abs(H) ** 2, axis=1, keepdims=True)) / H.shape[1]
-    ba, bs = BETA_A / 100.0, BETA_S / 100.0
-    if form == "high":
-        ba, bs = 1.2 * ba, 1.2 * bs
-    r1 = rng.uniform(-1, 1, H.shape)
-    r2 = rng.uniform(-1, 1, H.shape)
-    if form == "literal":
-        mag = np.abs(H) * (1 + ba * r1) + level * bs * r2
-        ph = np.angle(H) + math.radians(PHASE_DEG) * rng.uniform(-1, 1, H.shape)
-        return mag * np.exp(1j * ph)
-    out = H * (1 + ba * r1) + level * bs * r2 * np.exp(2j * math.pi * rng.uniform(0, 1, H.shape))
-    if form == "phase":
-        out = out * np.exp(1j * math.radians(PHASE_DEG) * rng.uniform(-1, 1, H.shape))
-    return out
-
-
+binom_upper = dc.binom_upper
 def one(tool, case, H, rep, workdir, params):
     form, scale, noise = CASES[case.split("@")[0]]
     d = Path(workdir) / f"{case.replace('@', '_')}_{rep}"
     d.mkdir(parents=True, exist_ok=True)
     meas, model = d / "meas.uff", d / "model.ini"
     model.write_text(dc.model_ini())
-    dc.write_uff(meas, draw(form, H, 1000 * rep + 7), dc.LARGE_FREQ_HZ, dc.LARGE_INS)
+    dc.write_uff(meas, dc.calibration_noise(form, H, 1000 * rep + 7), dc.LARGE_FREQ_HZ, dc.LARGE_INS)
     sc = ["--log"] if scale == "log" else ["--scale", "complex"]
     t0 = time.time()
     res = subprocess.run([tool, "diagnose", str(model), str(meas), "--params", params, *sc,
