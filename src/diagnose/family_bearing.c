@@ -1,7 +1,10 @@
 /*
  * The bearing family (issue #4): at every bearing with constant coefficients,
- * a stiffness in one direction (anisotropy), a cross-coupled stiffness
- * kxy = -kyx and the damping. Coefficients of the model: no structural edit.
+ * a stiffness in one direction (anisotropy), in both directions together (a
+ * bearing softened or stiffened as a whole: worn, loose, another clearance;
+ * issue #33, where no one-direction candidate reached the floor and B3's kxx
+ * and kyy fitted together did), a cross-coupled stiffness kxy = -kyx and the
+ * damping. Coefficients of the model: no structural edit.
  */
 #include <math.h>
 #include <stdio.h>
@@ -28,6 +31,13 @@ static rcb_status enumerate(rcb_diag *d, const rcb_model *m) {
       snprintf(c->desc, sizeof c->desc, "stiffness in %s at bearing %s (anisotropy)",
                a ? "y" : "x", b->name);
       rcb_diag_bounds(v, 10 * kb, &lo, &hi, &logp);
+      rcb_diag_add_par(c, a ? "bearing.%s.kyy" : "bearing.%s.kxx", b->name, lo, hi, logp);
+    }
+    if (!(c = rcb_diag_new_cand(d, &rcb_diag_family_bearing, RCB_EFFECT_BEARING_STIFFNESS, place))) return RCB_ERR_NOMEM;
+    snprintf(c->desc, sizeof c->desc, "stiffness in x and y at bearing %s (the bearing as a "
+             "whole softer or stiffer)", b->name);
+    for (a = 0; a < 2; a++) {
+      rcb_diag_bounds(a ? k->kyy : k->kxx, 10 * kb, &lo, &hi, &logp);
       rcb_diag_add_par(c, a ? "bearing.%s.kyy" : "bearing.%s.kxx", b->name, lo, hi, logp);
     }
     if (!(c = rcb_diag_new_cand(d, &rcb_diag_family_bearing, RCB_EFFECT_BEARING_CROSS_COUPLING, place))) return RCB_ERR_NOMEM;

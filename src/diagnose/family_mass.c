@@ -1,9 +1,11 @@
 /*
  * The added-mass family (issue #4): a mass and a diametral inertia at every
  * node, on its disk where it has one (the disk's own values), else on a new
- * massless disk there (neutral value 0). Its candidates sit at the nodes of a
- * shaft (node, shaft, variant 0: mass, 1: inertia), where the run-off path
- * walks along the shaft (DIAG_FAM_PLACE_WALK).
+ * massless disk there (neutral value 0); at a disk also both together (a
+ * ring or a balancing collar added to it, with its polar inertia, issue
+ * #33: named as mass alone before). Its candidates sit at the nodes of a shaft (node, shaft, variant
+ * 0: mass, 1: inertia, 2: both), where the run-off path walks along the
+ * shaft (DIAG_FAM_PLACE_WALK).
  */
 #include <math.h>
 #include <stdio.h>
@@ -29,9 +31,11 @@ static rcb_status enumerate(rcb_diag *d, const rcb_model *m) {
     else
       snprintf(place, sizeof place, "node #%zu (shaft %s, z = %g m)", i,
                m->shafts[nd->shaft].name, nd->z);
-    for (k = 0; k < 2; k++) { /* a mass, or a diametral inertia */
+    for (k = 0; k < (disk ? 3u : 2u); k++) { /* a mass, a diametral inertia, both */
       if (!(c = rcb_diag_new_cand(d, &rcb_diag_family_mass, RCB_EFFECT_ADDED_MASS, place))) return RCB_ERR_NOMEM;
-      snprintf(c->desc, sizeof c->desc, "an added %s at %s", k ? "diametral inertia" : "mass",
+      snprintf(c->desc, sizeof c->desc, "an added %s at %s",
+               k == 2 ? "mass with its diametral and polar inertia (a ring)"
+                      : k ? "diametral inertia" : "mass",
                place);
       c->node = i + 1;
       c->variant = (int)k;
@@ -39,9 +43,18 @@ static rcb_status enumerate(rcb_diag *d, const rcb_model *m) {
       if (disk) {
         double lo, hi;
         int logp;
-        if (k == 0) rcb_diag_bounds(disk->m, 10 * mtot, &lo, &hi, &logp);
-        else rcb_diag_bounds(disk->Id, 0.01 * mtot, &lo, &hi, &logp);
-        rcb_diag_add_par(c, k ? "disk.%s.Id" : "disk.%s.mass", disk->name, lo, hi, logp);
+        if (k != 1) {
+          rcb_diag_bounds(disk->m, 10 * mtot, &lo, &hi, &logp);
+          rcb_diag_add_par(c, "disk.%s.mass", disk->name, lo, hi, logp);
+        }
+        if (k != 0) {
+          rcb_diag_bounds(disk->Id, 0.01 * mtot, &lo, &hi, &logp);
+          rcb_diag_add_par(c, "disk.%s.Id", disk->name, lo, hi, logp);
+        }
+        if (k == 2) { /* a ring turns with the disk: its polar inertia too */
+          rcb_diag_bounds(disk->Ip, 0.02 * mtot, &lo, &hi, &logp);
+          rcb_diag_add_par(c, "disk.%s.Ip", disk->name, lo, hi, logp);
+        }
         continue;
       }
       c->new_disk = 1;
