@@ -12,8 +12,8 @@
 #include <string.h>
 
 #include "diagnose/diag_internal.h"
+#include "diagnose/tuning.h"
 #include "identify/identify.h"
-
 
 rcb_status rcb_diag_create(rcb_diag **out, const rcb_model *m, const rcb_meas *meas,
                            const rcb_allocator *alloc) {
@@ -242,15 +242,6 @@ static rcb_status objective(rcb_diag *d, rcb_fit *f, double *r, double *F, doubl
   return RCB_OK;
 }
 
-/* A baseline fit that a missing effect has pulled far from the nominal model
- * is itself a finding: a parameter moved by more than this factor from its
- * nominal value (or onto a bound that far away). With 0.07 kg per hub hidden
- * at coupling C (32 x 1101, and 8 x 151 too) kr falls 1000 x onto its bound
- * and kt halves; so it does with 1.3 kg at DB and with the two-effect case
- * (tests/python/diag_cases.py); in every other case of the success table no
- * parameter moves by 2 x or more. */
-#define RCB_DIAG_FAR 10.0
-
 /* Note the base parameters the fit f moved by more than RCB_DIAG_FAR. */
 static void note_drift(rcb_diag *d, const rcb_fit *f) {
   size_t k, n = 0;
@@ -269,19 +260,12 @@ static void note_drift(rcb_diag *d, const rcb_fit *f) {
   }
 }
 
-#define RCB_DIAG_SCREEN_ITER 25 /* see screen() */
-
 /* The fit of the model as it is on the subset w: at most
- * RCB_DIAG_SCREEN_ITER iterations first; a fit that has run off by then
- * (d->far) stops there, as a finding, with no polish on all points (capped
- * at 12 iterations it crawled on for 4-5 s; the 0.15 kg hub case converges
- * on the subset in 15 and its polish took one iteration of 15 sweeps on all
- * points, 0.3 s); one that has not goes on to its end as before. With
- * 0.07 kg per hub hidden at C (32 x 1101) the fit crawled 94 iterations and
- * 1228 subset sweeps (about 4 s of the 5.3 s before the refits) to kr's
- * bound, 1000 x below nominal; it is 10 x below within the first 25. The
- * cases whose fit does not run off converge in a few iterations (kcross at
- * B2: 3) and take the same path as before. */
+ * RCB_DIAG_SCREEN_ITER iterations first (tuning.h says why); a fit that has
+ * run off by then (d->far) stops there, as a finding, with no polish on all
+ * points; one that has not goes on to its end as before (the cases whose
+ * fit does not run off converge in a few iterations and take the same path
+ * as before). */
 static rcb_status baseline_screen(rcb_diag *d, rcb_fit *f, const double *w) {
   size_t it = 0;
   double ftol = 0.0, xtol = 0.0;
@@ -327,15 +311,12 @@ static double z_upper(double p) {
 
 /* Which sensors concentrate the misfit (rcb_diag_misfit_get states the
  * rule): the per-channel parts of the adequacy test summed per response. */
-#define RCB_DIAG_MISFIT_SHARE 80.0 /* % of the excess on one sensor or a pair */
-
 /* Whether responses a and b ("C.A.x", "C.A.y") are two directions of one
  * station (a probe pair that may be swapped). */
 static int same_station(const char *a, const char *b) {
   const char *da = strrchr(a, '.'), *db = strrchr(b, '.');
   return da && db && da - a == db - b && strncmp(a, b, (size_t)(da - a)) == 0;
 }
-#define RCB_DIAG_MISFIT_RATIO 3.0
 static rcb_status misfit_sensors(rcb_diag *d, const double *chi2, const double *mean,
                                  const double *var) {
   size_t nch = rcb_meas_channel_count(d->meas), c, k, i, m;
@@ -519,14 +500,6 @@ static rcb_status candidate_dz(rcb_diag *d, const diag_cand *c, size_t ndof, rcb
   rcb_model_destroy(m);
   return st;
 }
-
-/* Candidates are scored in batches of parameters whose columns share one
- * sweep of the base model (fit_score.c): as many as a J of 2^22 values
- * (32 MB) holds, at least 32 and at most 128 (the paper system's 70 batched
- * parameters on 32 x 1101: one sweep instead of three). */
-#define RCB_DIAG_BATCH 128
-#define RCB_DIAG_BATCH_MIN 32
-#define RCB_DIAG_BATCH_VALUES ((size_t)1 << 22)
 
 typedef struct score_ws {
   rcb_fit *f;           /* the base model, fitted */
@@ -731,34 +704,14 @@ static size_t refit_starts(const rcb_diag *d, const diag_cand *c) {
   return c->refit_only || (c->fam->flags & DIAG_FAM_ADDS_DOFS) || d->far ? 1 : 3;
 }
 
-/* Another coupling model (no neutral value, no score) is fitted to the
- * resolution the ranking prints, 0.1 of BIC per step: the fit stops when a
- * step gains or promises less than that, instead of 1e-10 of the objective.
- * With noise-aware weights BIC changes as F itself (ftol_rel F = 0.1 at
- * F = F0), else as N ln F (ftol_rel N = 0.1). A slow descent can stop a few
- * units of BIC early, so the scored candidates, whose BICs are compared
- * with each other, keep the default on 8 x 151; a wrong coupling model ends
- * far above F0 (32 x 1101: BIC +5.9e5 and more), and stops two or three
- * iterations earlier. On the subset (screened, 32 x 1101) every refit gets
- * it: there a screen stops after 25 iterations and a polish after 12
- * anyway, and candidates that explain nothing crawl to those caps gaining
- * about 0.1 of BIC an iteration at 11 sweeps each (large_null, seed 4: five
- * added masses and inertias, 289 subset sweeps each and 123-140 sweeps on
- * all points, to lower F by 1.5 in all; 2254 sweeps, 18 s). */
-#define RCB_DIAG_BIC_RESOLUTION 0.1
-/* A screen on the subset (32 x 1101) stops at an iteration that gains, or a
- * step that promises, less than 1 of BIC (its F on the subset scaled to all
- * points): it only ranks the refits and brings them near their end, and the
- * polish of those that can lead goes on to RCB_DIAG_BIC_RESOLUTION. On
- * large_null (seed 4) three added masses and inertias, at their bound of 0,
- * took 20-22 iterations of 11-12 subset sweeps each to gain 0.5 of F on the
- * subset (about 0.18 of BIC an iteration). */
-#define RCB_DIAG_SCREEN_RESOLUTION 1.0
 typedef enum refit_stage {
   REFIT_ALL_POINTS, /* the refit on all points (8 x 151) */
   REFIT_SCREEN,     /* a screen on the frequency subset */
   REFIT_POLISH      /* a polish on all points after a screen */
 } refit_stage;
+/* How far each stage of a refit goes: RCB_DIAG_BIC_RESOLUTION of BIC (all
+ * points; not for a scored candidate on 8 x 151) or RCB_DIAG_SCREEN_RESOLUTION
+ * (a screen on the subset) as the fit's relative tolerance on F (tuning.h). */
 static rcb_status refit_tolerance(const rcb_diag *d, const diag_cand *c, rcb_fit *f,
                                   refit_stage stage) {
   double scale = chi2(d) ? d->F0 : (double)d->nres;
@@ -801,18 +754,6 @@ static rcb_status refit_setup(rcb_diag *d, const diag_cand *c, const rcb_model *
   return st;
 }
 
-/* On the subset (32 x 1101) a refit's random starts come after every
- * candidate's first start has been screened, and only when none of those
- * screens reached the noise floor (refit_restart): once one did, a
- * candidate explains the data, and random starts would only look for a
- * rival, as the pedestals' grids did in the run-off screen (prefit_selected).
- * Measured on the ROSS large_* sets, seed 1 (rcbtool diagnose, 8 refits):
- * the random starts never gave the best point of a refit there and took
- * 2/3 of the screen's sweeps of the candidates that ended far from the data
- * (the added mass at DB on large_pedestal_B4: 625 of 640; the dampings at
- * B1 and B4 on large_cr_C: 436 of 598). */
-#define RCB_DIAG_STARTS_SUBSET 1
-
 /* The screening fit on the frequency subset w (NULL: the fit on all points)
  * stops after cap iterations (RCB_DIAG_SCREEN_ITER): it ranks the starts and
  * brings the polish near its end, and a fit crawling along a bound (a
@@ -829,12 +770,8 @@ static rcb_status screen(rcb_fit *f, const double *w, size_t cap) {
 }
 
 /* The polish of a screened fit on all points, from where the subset left it,
- * with no further starts, and at most RCB_DIAG_POLISH_ITER iterations: a
- * candidate that fits converges in a few (the hub mass of the 0.15 kg hub
- * case: 14 sweeps), while a wrong one can crawl along a valley to the fit's
- * own limit (the hub's diametral inertia there: 1001 sweeps, 15.6 s, for an
- * error of 39 %, far from any significant rival). */
-#define RCB_DIAG_POLISH_ITER 12
+ * with no further starts, and at most RCB_DIAG_POLISH_ITER iterations
+ * (tuning.h: a wrong candidate can crawl along a valley). */
 static rcb_status polish(rcb_fit *f) {
   size_t it = 0;
   double ftol = 0.0, xtol = 0.0;
@@ -863,22 +800,8 @@ static rcb_status polish(rcb_fit *f) {
  * joint fit from that start stays there. The nominal refits
  * (RCB_DIAG_NOM_REFITS) are the pre-fits with the lowest objective, and
  * start where their pre-fit ended. */
-#define RCB_DIAG_PREFIT_ITER 8
-/* On the subset (32 x 1101), a pre-fit is refitted only when its objective
- * is within this factor of the best pre-fit's: on the 0.15 kg hub case the
- * hub mass ends its pre-fit at F = 4528, the hub's inertia at 4.7e5 and the
- * rest at 2e6-3e6; the inertia's joint refit took 3.1 s (352 sweeps) to end
- * at 38 %, far behind. 8 x 151 refits the 3 best as before. */
-#define RCB_DIAG_PRE_RATIO 10.0
-/* On the subset (32 x 1101) 4: a candidate that explains the data gets
- * there in a few (the 0.15 kg hub mass: the same joint refit after 4 as
- * after 8), the rest crawl (dampings: 52-83 sweeps in 8); 8 x 151 keeps 8. */
-#define RCB_DIAG_PREFIT_ITER_SUBSET 4 /* not for an added mass or inertia (place_search) */
-/* A pre-fit whose error ends below this factor of the noise floor (the
- * fit's own "unsure" limit) explains the data: nothing is left for a place
- * search to find (place_search). */
-#define RCB_DIAG_FLOOR_FACTOR 1.5
-
+/* Whether error err is at the noise floor (the fit's own "unsure" limit,
+ * RCB_DIAG_FLOOR_FACTOR: tuning.h). */
 static int at_floor(double err, double floor) {
   return isfinite(floor) && err < RCB_DIAG_FLOOR_FACTOR * floor;
 }
@@ -914,15 +837,6 @@ static rcb_status prefit_grid(rcb_diag *d, diag_cand *c, const rcb_model *m, rcb
   rcb_free(&d->alloc, r);
   return st;
 }
-
-/* On the subset a pre-fit (but for an added mass or inertia) also stops at
- * an iteration that gains, or a step that promises, less than this fraction
- * of its objective: pre-fits are compared within a factor
- * RCB_DIAG_PRE_RATIO, which RCB_DIAG_PREFIT_ITER_SUBSET such steps cannot
- * bridge. On the 0.15 kg hub case the bearing and shaft dampings gained
- * 0.003-0.3 % of F in their second iteration and under 0.001 % in the next
- * two, at 4-12 sweeps each (damping at B1: 39 sweeps in all). */
-#define RCB_DIAG_PREFIT_FTOL 1e-2
 
 /* Any other pre-fit: at most RCB_DIAG_PREFIT_ITER iterations
  * (RCB_DIAG_PREFIT_ITER_SUBSET and RCB_DIAG_PREFIT_FTOL on the subset w,
@@ -1005,16 +919,6 @@ static rcb_status evaluate_only(rcb_diag *d, diag_cand *c, rcb_model **m, rcb_fi
   return RCB_OK;
 }
 
-/* On the subset (32 x 1101) a refit is polished on all points only when,
- * evaluated there where its screen ended, its objective is within this
- * fraction of the lowest refit's; the others keep that evaluation, their
- * BIC an upper bound (rcb_diag_candidate.screened_only). A polish lowers
- * a screened objective by little: on bench_diagnose --large (kcross at B2)
- * by 0.001-1.7 % (34738.5 -> 34738.1 for the cross-coupling, the rest
- * 5.8-390 x above it), while the six polishes behind it took 71 of the 78
- * sweeps on all points, 2 s of the 3.6 s. */
-#define RCB_DIAG_POLISH_WITHIN 0.1
-
 /* A refit fitted or evaluated on all points: its figures. */
 static void refit_result(rcb_diag *d, diag_cand *c, rcb_model **m, rcb_fit *f, double F,
                          double err, int polished) {
@@ -1045,10 +949,9 @@ static rcb_status refit_screen(rcb_diag *d, diag_cand *c, const double *w) {
   char why[320] = "";
   size_t s, b = 0;
   int from_pre;
-  /* from a run-off fit on the subset, 4 iterations first, and on only when
-   * within RCB_DIAG_PRE_RATIO of the best pre-fit: there the other coupling
-   * models of the 0.15 kg hub case took 54 and 86 subset sweeps to end
-   * 650-810 x above the hub mass's pre-fit, far behind */
+  /* from a run-off fit on the subset, RCB_DIAG_PREFIT_ITER_SUBSET iterations
+   * first, and on only when within RCB_DIAG_PRE_RATIO of the best pre-fit
+   * (tuning.h) */
   int far_start = w && d->far;
   rcb_fit_report rep;
   rcb_status st = RCB_OK;
@@ -1188,18 +1091,6 @@ static int at_neutral(const diag_cand *c) {
   return c->np > 0;
 }
 
-/* A polish gains about what the Gauss-Newton step at its start promises:
- * the linearised objective's minimum, || P_J r ||^2 with J the Jacobian of
- * all its parameters (the base's and its own, bounds ignored: an upper
- * bound of the clipped step). On the 0.15 kg hub case (bench_diagnose
- * --large --hub-mass 0.15) the hub's mass and inertia were promised 44.24
- * and gained 44.12 in 10 iterations and 40 sweeps on all points (1.4 s),
- * the hub mass alone 17.30 and 17.27. A polish is left out (the candidate
- * keeps its evaluation, its BIC an upper bound) when even this factor
- * times the promise cannot bring its BIC below that of the first
- * candidate, once that one has been polished and explains the data. */
-#define RCB_DIAG_GN_SLACK 1.25
-
 /* Whether the polish of c (its fit f, at its evaluation c->F) cannot make
  * it lead d->cand[d->lead]: one Jacobian on all points. *out stays 0 when
  * that cannot be told (a failed Jacobian: the polish runs). */
@@ -1297,14 +1188,6 @@ static void sort_order(rcb_diag *d) {
       d->order[j - 1] = t;
     }
 }
-
-/* With the baseline run off, the RCB_DIAG_NOM_PREFITS candidates the score
- * test ranks first at the nominal model are pre-fitted alone there
- * (prefit), and the RCB_DIAG_NOM_REFITS best pre-fits are refitted jointly
- * from where they ended (from both starts when they are also among the best
- * at the fitted model). Sixteen: the hub of the 0.15 kg case scores 14th. */
-#define RCB_DIAG_NOM_PREFITS 16
-#define RCB_DIAG_NOM_REFITS 3
 
 /* The candidates a step fits, in order, for rcb_diag_for_each. */
 typedef struct cand_jobs {
@@ -1641,11 +1524,6 @@ static int node_placed(const rcb_diag *d, long node, int element) {
   return 0;
 }
 
-/* Grid points of a candidate's one parameter across its bounds: the score
- * at the neutral value cannot see an effect tens of times larger (B2 kyy
- * 9e7 -> 2e6 N/m scored 5 %, rank 35, on 8 x 151). */
-#define RCB_DIAG_PLACED_GRID 13
-
 /* Candidate c, one parameter, acting where the misfit is placed: its
  * objective on a grid across its bounds (one sweep each, the base
  * parameters where the base fit left them), then a fit from the best grid
@@ -1700,10 +1578,8 @@ done:
  * misfit at a node (locate.c; a span of at most RCB_DIAG_PLACED_SPAN
  * nodes), every one-parameter model candidate acting there is fitted from a
  * grid across its bounds (placed_refit), and the candidates ranked again:
- * place first, then name. A wider span places nothing one can name (two
- * effects at once: round 1 of the crack and B2 cross-coupling on 32 x 1101
- * spans nodes #0-#10, whose 40 candidates took 33 s of CPU to name none). */
-#define RCB_DIAG_PLACED_SPAN 3
+ * place first, then name. A wider span places nothing one can name
+ * (tuning.h). */
 static rcb_status placed_refits(rcb_diag *d) {
   size_t k;
   rcb_status st = RCB_OK;
@@ -1890,7 +1766,6 @@ static size_t say_where(const rcb_diag *d, char *text, size_t size, size_t n) {
  * the significant candidates that sit at nodes (DIAG_FAM_PLACE_WALK) among
  * the first RCB_DIAG_SPAN_RANKS ranks, on the shaft of the best of them, as
  * a span of z. Nothing when none is significant. */
-#define RCB_DIAG_SPAN_RANKS 6
 static size_t say_span(const rcb_diag *d, char *text, size_t size, size_t n) {
   const rcb_model *m = d->base_model;
   size_t k, shaft = 0, lo = 0, hi = 0, found = 0;
