@@ -2,9 +2,10 @@
  * The first stage of the diagnosis: the fit of the model as it is (its own
  * parameters, the --params), screened on the frequency subset and polished
  * on all points unless it ran off from the nominal model (itself a finding,
- * d->far); its objective, error and noise floor; the adequacy test and the
- * null distribution every refit's limit comes from; and the sensors the
- * misfit concentrates on.
+ * d->far); the noise model's reference (its predictions, d->nref), where
+ * every later fit evaluates the noise model; its objective, error and noise
+ * floor; the adequacy test and the null distribution every refit's limit
+ * comes from; and the sensors the misfit concentrates on.
  */
 #include <math.h>
 #include <stdio.h>

@@ -2,7 +2,9 @@
  * The words of a diagnosis (rcb_diag_explain): what the best candidate
  * claims, or that nothing is needed or found; the rival the data cannot
  * separate; where the misfit concentrates (a sensor) or is placed (a node, a
- * span); and a baseline that ran off from the nominal model.
+ * span); and a baseline that ran off from the nominal model. Also the one
+ * rule on the model as it is (rcb_diag_base_adequate), which locate.c asks
+ * too.
  */
 #include <math.h>
 #include <stdio.h>
