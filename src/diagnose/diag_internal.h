@@ -1,7 +1,13 @@
 /*
  * The diagnosis object, shared by catalogue.c and the family files (the
- * candidate effects of a model, family.h) and diagnose.c (scoring,
- * refitting, ranking, explaining). A candidate is its family's edit of the
+ * candidate effects of a model, family.h) and the stages of the flow that
+ * diagnose.c runs in order (rcb_diag_run): baseline.c (the fit of the
+ * model as it is), score.c (the score test), rank.c (which candidates are
+ * refitted, and their order), prefit.c (pre-fits at the nominal model and
+ * the place walk), refit.c (one candidate's refit, stage by stage),
+ * locate.c and placed.c (where the misfit sits, and the candidates there),
+ * words.c (the explanation); fits.c makes the fits they all run, and
+ * tuning.h holds their tuning constants. A candidate is its family's edit of the
  * model (none, a coupling model change, an added disk, an added pedestal) or
  * of the measurement chain, plus the parameters the effect adds, so every
  * candidate model is made through the public edit API: clone the fitted
@@ -155,6 +161,7 @@ rcb_status rcb_diag_refit_start(rcb_diag *d, const diag_cand *c, rcb_model *m, r
  * c's parameters (c may be NULL); no intervals. rcb_diag_drop_fit destroys
  * it, counting its model sweeps in the diagnosis' figures. */
 #define RCB_DIAG_FIT_BASE 1u
+#define RCB_DIAG_FIT_LEAD 2u /* the candidate's first nlead parameters only (pre-fit) */
 rcb_status rcb_diag_make_fit(rcb_diag *d, rcb_model *m, unsigned with_base, const diag_cand *c,
                              rcb_fit **out);
 void rcb_diag_drop_fit(rcb_diag *d, rcb_fit *f);
@@ -165,7 +172,7 @@ rcb_status rcb_diag_locate(rcb_diag *d);
 
 /* Whether the model as it is fits the data to their noise, by the one rule
  * (rcb_evidence_adequate on its adequacy test: within the limit, or beyond
- * it with a white residual): 1 yes, 0 no, -1 unknown (diagnose.c). */
+ * it with a white residual): 1 yes, 0 no, -1 unknown (words.c). */
 int rcb_diag_base_adequate(const rcb_diag *d);
 
 /* A finalized copy of model src with the diagnosis' allocator (caller destroys). */
@@ -181,5 +188,82 @@ rcb_status rcb_diag_subset_weights(rcb_diag *d, double **out);
  * (caller destroys). */
 rcb_status rcb_diag_candidate_model(rcb_diag *d, const diag_cand *c, const rcb_model *from,
                                     rcb_model **out);
+
+/* ---- the stages of rcb_diag_run (diagnose.c), in the order it calls them ---- */
+
+/* fits.c. Where the chain parameters of c (the last c->np of fit f) ended,
+ * kept with the model of that fit (rcb_diag_make_fit restores them). */
+void rcb_diag_keep_chain(diag_cand *c, const rcb_fit *f);
+/* fits.c. F = r^T r with fit f's weights (r: d->nres values, filled), and
+ * the error % of the same sweep. */
+rcb_status rcb_diag_objective(rcb_diag *d, rcb_fit *f, double *r, double *F, double *err);
+
+/* baseline.c. Fit the model as it is, on a copy: d->base_model, F0, error,
+ * floor, residual count, the adequacy test and the sensors the misfit
+ * concentrates on; whether the fit ran off from the nominal model (d->far,
+ * then d->nom_model too). */
+rcb_status rcb_diag_fit_baseline(rcb_diag *d);
+
+/* score.c. Score every candidate at the fitted base model (nominal = 0:
+ * c->predicted) or at the nominal one (c->predicted_nom; the caller swaps
+ * d->base_model for d->nom_model). */
+rcb_status rcb_diag_score_all(rcb_diag *d, int nominal);
+/* score.c. Whether c is a fixed edit of the measurement chain (a sign, a
+ * swap: no parameter), scored by what it does at the fitted base. */
+int rcb_diag_fixed_chain(const diag_cand *c);
+
+/* The candidates a step fits, in order, for rcb_diag_for_each (rank.c,
+ * prefit.c). */
+typedef struct diag_jobs {
+  size_t *k;      /* candidate indices */
+  size_t n, todo; /* jobs; refits reported to the progress callback */
+  double *w;      /* the frequency subset, or NULL */
+} diag_jobs;
+
+/* rank.c. Choose the candidates to refit (and with a run-off baseline,
+ * pre-fit them at the nominal model first), refit them stage by stage
+ * (refit.c) on d->nthreads threads, and rank them (d->order). */
+rcb_status rcb_diag_refit_best(rcb_diag *d);
+/* rank.c. d->order: refitted candidates by claim then BIC change, then the
+ * rest by predicted reduction. */
+void rcb_diag_sort_order(rcb_diag *d);
+
+/* prefit.c. Pre-fit the candidates j->k[0 .. j->n) alone at the nominal
+ * model (the others, then added masses and inertias at nodes, then the
+ * pedestals, left out on the subset once a pre-fit is at the noise floor). */
+rcb_status rcb_diag_prefit_selected(rcb_diag *d, diag_jobs *j);
+/* prefit.c. From the best pre-fitted added mass and inertia, pre-fit the
+ * neighbouring nodes of the same shaft while their objective falls
+ * (serial), unless a pre-fit already ended at the noise floor. */
+rcb_status rcb_diag_place_search(rcb_diag *d, const double *w);
+/* prefit.c. Whether an error err (%) is at the noise floor (%): below
+ * RCB_DIAG_FLOOR_FACTOR times it. */
+int rcb_diag_at_floor(double err, double floor);
+
+/* refit.c: the steps of one candidate's refit, each a job across the
+ * candidates (rank.c). 1: its first start(s), screened on the subset w (or
+ * fitted on all points without w); 2: its random starts on the subset,
+ * when no screen reached the noise floor; 3: evaluated on all points where
+ * its screen ended; 4: polished on all points when near the best. */
+rcb_status rcb_diag_refit_screen(rcb_diag *d, diag_cand *c, const double *w);
+rcb_status rcb_diag_refit_restart(rcb_diag *d, diag_cand *c, const double *w);
+rcb_status rcb_diag_refit_evaluate(rcb_diag *d, diag_cand *c);
+rcb_status rcb_diag_refit_polish(rcb_diag *d, diag_cand *c);
+/* refit.c. The screening fit on the frequency subset w (NULL: the fit on
+ * all points), at most cap iterations on the subset. */
+rcb_status rcb_diag_screen(rcb_fit *f, const double *w, size_t cap);
+/* refit.c. The polish of a screened fit on all points from where it is,
+ * one start, at most RCB_DIAG_POLISH_ITER iterations. */
+rcb_status rcb_diag_polish(rcb_fit *f);
+/* refit.c. A refit fitted (polished) or evaluated on all points, F and err:
+ * its figures, its claim, and its model *m kept in c (*m set to NULL). */
+void rcb_diag_refit_result(rcb_diag *d, diag_cand *c, rcb_model **m, rcb_fit *f, double F,
+                           double err, int polished);
+
+/* placed.c. When no candidate explains the data and the equivalent loads
+ * (rcb_diag_locate) place the misfit at a few nodes, refit every
+ * one-parameter model candidate acting there from a grid across its
+ * bounds, and rank again. */
+rcb_status rcb_diag_placed_refits(rcb_diag *d);
 
 #endif

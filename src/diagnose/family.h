@@ -2,7 +2,7 @@
  * The families of candidate effects (issue #23): each family lives in its own
  * file, src/diagnose/family_<name>.c, and fills one small table of functions,
  * as every N_Vector kind fills N_Vector_Ops in SUNDIALS. The diagnosis
- * (diagnose.c) iterates over the list in catalogue.c and never looks inside a
+ * (diagnose.c and its stages) iterates over the list in catalogue.c and never looks inside a
  * family: adding a family is one new file, one line in that list and one in
  * src/CMakeLists.txt.
  *

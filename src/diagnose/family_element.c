@@ -8,7 +8,7 @@
  * + 1, variant 0: stiffness, 1: mass: DIAG_FAM_PLACE_WALK), as added masses
  * do. Neighbouring elements score alike: of each variant only the best
  * scored is refitted, and none is pre-fitted on the run-off path
- * (DIAG_FAM_ONE_REFIT, diagnose.c one_taken), or they would take most of
+ * (DIAG_FAM_ONE_REFIT, rank.c one_taken), or they would take most of
  * the refits from the other effects.
  */
 #include <math.h>
