@@ -84,8 +84,16 @@ static void claims_consistent(const rcb_diag *d, const char *text) {
       assert_int_equal(c.claim, RCB_CLAIM_NONE);
       continue;
     }
-    e.delta_bic = c.delta_bic, e.error_before_pct = err0, e.error_after_pct = c.error_pct;
-    e.chi2 = c.chi2, e.chi2_limit = c.chi2_limit;
+    /* the evidence it was judged on holds its own figures (issue #33: the
+     * dispersion, the candidates tried, the whiteness and plausibility are
+     * in it too) */
+    assert_int_equal(rcb_diag_candidate_evidence(d, k, &e), RCB_OK);
+    assert_true(e.error_before_pct == err0 && e.error_after_pct == c.error_pct);
+    assert_true(e.chi2 == c.chi2 && (e.chi2_limit == c.chi2_limit || isnan(c.chi2_limit)));
+    assert_true(fabs(rcb_evidence_dbic(&e) - c.delta_bic) <= 1e-9 * fabs(c.delta_bic));
+    assert_true(e.tried == (double)n);
+    assert_int_equal(e.white, c.white == 1);
+    assert_int_equal(e.beyond, c.beyond);
     assert_int_equal(c.claim, rcb_evidence_claim(&e));
     assert_int_equal(c.significant, rcb_evidence_significant(&e));
     assert_int_equal(c.significant, c.claim != RCB_CLAIM_NONE);

@@ -82,10 +82,11 @@ RCB_API const char *rcb_effect_name(rcb_effect e);
  *   frequency, rcb_fit_adequacy.white), which is noise larger than
  *   declared (dispersion phi), not a missing effect; unknown when the noise
  *   is unknown (chi2_limit NaN);
- * - the claim: RCB_CLAIM_EXPLAINS when significant and adequate,
+ * - the claim: RCB_CLAIM_EXPLAINS when significant and adequate and no
+ *   fitted size is beyond what its part can be (beyond = 0),
  *   RCB_CLAIM_IMPROVES when significant only (it lowers the misfit, and
- *   something is still missing, or the noise is unknown), else
- *   RCB_CLAIM_NONE.
+ *   something is still missing, the noise is unknown, or its size is not
+ *   physical), else RCB_CLAIM_NONE.
  * The fields after chi2_limit were added by issue #33; all 0 gives the rule
  * of issue #23 (phi 1, one candidate tried, no whiteness test).
  */
@@ -106,6 +107,9 @@ typedef struct rcb_evidence {
   double dispersion;       /**< chi2 / expected of the model with the edit (-); <= 1: 1 */
   double tried;            /**< candidates tried for this claim (-); <= 1: one */
   int white;               /**< 1: the residual with the edit is white (rcb_fit_adequacy) */
+  int beyond;              /**< 1: a fitted size lies beyond what the part can be (an
+                                added inertia several times the disk's own): a stand-in
+                                for another effect, never "explains" */
 } rcb_evidence;
 #define RCB_BIC_SIGNIFICANT (-10.0) /**< dBIC below this is significant */
 #define RCB_ERROR_FALL 0.98         /**< and, noise unknown, the error below this fraction */
@@ -225,9 +229,18 @@ typedef struct rcb_diag_candidate {
   double white_z;           /**< the whiteness statistic of its residual (rcb_fit_adequacy) */
   int white;                /**< 1: its residual is white (no structure along frequency),
                                  0: not, -1: unknown */
+  int beyond;               /**< 1: a fitted size is beyond what the part can be
+                                 (rcb_evidence.beyond; the explanation names it) */
 } rcb_diag_candidate;
 
 RCB_API size_t rcb_diag_candidate_count(const rcb_diag *d);
+/**
+ * @brief The evidence candidate @p rank was judged on (rcb_evidence_claim of
+ * it is its claim): a caller may re-derive or re-state every word.
+ * @return RCB_ERR_ARG for a rank out of range or a candidate not refitted
+ */
+RCB_API rcb_status rcb_diag_candidate_evidence(const rcb_diag *d, size_t rank,
+                                               rcb_evidence *out);
 RCB_API rcb_status rcb_diag_candidate_get(const rcb_diag *d, size_t rank,
                                           rcb_diag_candidate *out);
 /** @brief Error % and objective of the model as it is, after fitting its own parameters. */

@@ -53,8 +53,8 @@ void rcb_diag_add_par(diag_cand *c, const char *fmt, const char *item, double lo
                       int logp) {
   size_t k = c->np++;
   snprintf(c->pname[k], sizeof c->pname[k], fmt, item);
-  c->lo[k] = lo;
-  c->hi[k] = hi;
+  c->lo[k] = c->plo[k] = lo;
+  c->hi[k] = c->phi[k] = hi;
   c->logp[k] = logp;
   snprintf(c->params + strlen(c->params), sizeof c->params - strlen(c->params), "%s%s",
            k ? ", " : "", c->pname[k]);

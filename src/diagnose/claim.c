@@ -65,7 +65,7 @@ int rcb_evidence_adequate(const rcb_evidence *e) {
 
 rcb_claim rcb_evidence_claim(const rcb_evidence *e) {
   if (!rcb_evidence_significant(e)) return RCB_CLAIM_NONE;
-  return rcb_evidence_adequate(e) == 1 ? RCB_CLAIM_EXPLAINS : RCB_CLAIM_IMPROVES;
+  return rcb_evidence_adequate(e) == 1 && !e->beyond ? RCB_CLAIM_EXPLAINS : RCB_CLAIM_IMPROVES;
 }
 
 const char *rcb_claim_str(rcb_claim c) {

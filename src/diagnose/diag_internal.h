@@ -53,6 +53,8 @@ typedef struct diag_cand {
                                        in the effect's size */
   char pname[RCB_DIAG_MAXP][RCB_DIAG_NAME];
   double lo[RCB_DIAG_MAXP], hi[RCB_DIAG_MAXP];
+  double plo[RCB_DIAG_MAXP], phi[RCB_DIAG_MAXP]; /* what the part can be (the bounds
+                                       unless the family says tighter, issue #33) */
   int logp[RCB_DIAG_MAXP];
   char params[RCB_DIAG_MAXP * RCB_DIAG_NAME];
   /* results */
@@ -77,6 +79,10 @@ typedef struct diag_cand {
   double F, err, dbic;              /* dbic: calibrated (rcb_evidence_dbic) */
   double dispersion;                /* F / its expectation with the candidate (NaN: unknown) */
   double white_z;                   /* whiteness of its residual (rcb_fit_white_z) */
+  int beyond;                       /* a fitted value outside [plo, phi] (beyond_k) */
+  size_t beyond_k;
+  double beyond_v;
+  rcb_evidence ev;                  /* what judge() decided its claim on */
   char fitted[RCB_DIAG_MAXP * (RCB_DIAG_NAME + 32)];
   rcb_model *model;                 /* refitted model (owned, finalized) */
 } diag_cand;

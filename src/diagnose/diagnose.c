@@ -219,6 +219,15 @@ rcb_status rcb_diag_set_progress(rcb_diag *d, int (*cb)(void *user, size_t done,
 
 size_t rcb_diag_candidate_count(const rcb_diag *d) { return d && d->ran ? d->ncand : 0; }
 
+rcb_status rcb_diag_candidate_evidence(const rcb_diag *d, size_t rank, rcb_evidence *out) {
+  const diag_cand *c;
+  if (!d || !out || !d->ran || rank >= d->ncand) return RCB_ERR_ARG;
+  c = &d->cand[d->order[rank]];
+  if (!c->refitted) return RCB_ERR_ARG;
+  *out = c->ev;
+  return RCB_OK;
+}
+
 rcb_status rcb_diag_candidate_get(const rcb_diag *d, size_t rank, rcb_diag_candidate *out) {
   const diag_cand *c;
   if (!d || !out || !d->ran || rank >= d->ncand) return RCB_ERR_ARG;
@@ -243,6 +252,7 @@ rcb_status rcb_diag_candidate_get(const rcb_diag *d, size_t rank, rcb_diag_candi
   out->dispersion = c->refitted ? c->dispersion : (double)NAN;
   out->white_z = c->refitted ? c->white_z : (double)NAN;
   out->white = c->refitted && d->adeq0.known ? c->white_z <= RCB_ADEQUACY_Z : -1;
+  out->beyond = c->refitted && c->beyond;
   return RCB_OK;
 }
 

@@ -134,6 +134,8 @@ static void judge(const rcb_diag *d, diag_cand *c, double k) {
   e.params = k, e.residuals = N, e.dispersion = c->dispersion;
   e.tried = (double)d->ncand;
   e.white = d->adeq0.known && c->white_z <= RCB_ADEQUACY_Z;
+  e.beyond = c->beyond;
+  c->ev = e;
   c->dbic = rcb_evidence_dbic(&e);
   c->significant = rcb_evidence_significant(&e);
   c->adequate = rcb_evidence_adequate(&e);
@@ -142,6 +144,24 @@ static void judge(const rcb_diag *d, diag_cand *c, double k) {
 
 /* The whiteness of the residual of fit f's last evaluation (on all points). */
 static void whiteness(diag_cand *c, rcb_fit *f) { c->white_z = rcb_fit_last_white_z(f); }
+
+/* Whether a fitted value of the candidate (the last c->np parameters of f)
+ * lies outside what its part can be, [plo, phi] (issue #33: a section error
+ * along a whole shaft was named "an added diametral inertia" 5 x the disk's
+ * own). */
+static void beyond(diag_cand *c, const rcb_fit *f) {
+  size_t k, np = rcb_fit_param_count(f);
+  c->beyond = 0;
+  for (k = 0; k < c->np && np >= c->np; k++) {
+    rcb_fit_param p;
+    if (rcb_fit_get_param(f, np - c->np + k, &p)) continue;
+    if (p.value < c->plo[k] - 1e-3 * fabs(c->plo[k]) ||
+        p.value > c->phi[k] + 1e-3 * fabs(c->phi[k])) {
+      c->beyond = 1, c->beyond_k = k, c->beyond_v = p.value;
+      return;
+    }
+  }
+}
 
 /* A refit with nothing to fit (kramer_1, rigid): the model evaluated. */
 static rcb_status evaluate_only(rcb_diag *d, diag_cand *c, rcb_model **m, rcb_fit *f) {
@@ -165,6 +185,7 @@ void rcb_diag_refit_result(rcb_diag *d, diag_cand *c, rcb_model **m, rcb_fit *f,
   c->polished = polished;
   c->F = F, c->err = err;
   whiteness(c, f);
+  beyond(c, f);
   judge(d, c, (double)c->np);
   record_fit(c, f);
   rcb_diag_keep_chain(c, f);

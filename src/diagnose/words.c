@@ -229,7 +229,18 @@ rcb_status rcb_diag_explain(const rcb_diag *d, char *buf, size_t size, size_t *n
                c->desc, c->fitted, trend(d->err0, c->err), d->err0, c->err, floor_txt, c->dbic,
                test);
   } else if (c && c->refitted && c->claim == RCB_CLAIM_IMPROVES) {
-    if (isfinite(c->chi2_limit)) {
+    if (c->beyond) {
+      say_test(test, sizeof test, c->F, c->chi2_limit, c->white_z <= RCB_ADEQUACY_Z,
+               c->dispersion);
+      snprintf(text, sizeof text,
+               "The best candidate, %s (%s), lowers the misfit by %.1f %% (the error %s from "
+               "%.3g %% to %.3g %%%s; %s), but its fitted %s = %.4g is beyond what the part can "
+               "be (%.4g at most): it stands in for an effect of another kind, or one outside "
+               "the catalogue, and does not explain the data.",
+               c->desc, c->fitted, 100.0 * (d->F0 - c->F) / d->F0, trend(d->err0, c->err),
+               d->err0, c->err, floor_txt, isfinite(c->chi2_limit) ? test : "noise unknown",
+               c->pname[c->beyond_k], c->beyond_v, c->phi[c->beyond_k]);
+    } else if (isfinite(c->chi2_limit)) {
       say_test(test, sizeof test, c->F, c->chi2_limit, 0, 1.0);
       snprintf(text, sizeof text,
                "The best candidate, %s (%s), accounts for %.1f %% of the misfit but leaves "

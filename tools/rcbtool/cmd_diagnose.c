@@ -348,7 +348,8 @@ static void print_json(FILE *fp, const diag_job *j, const rcb_diag *d, const cha
     cli_json_num(fp, c.dispersion);
     fputs(", \"white_z\": ", fp);
     cli_json_num(fp, c.white_z);
-    fprintf(fp, ", \"white\": %s", c.white < 0 ? "null" : c.white ? "true" : "false");
+    fprintf(fp, ", \"white\": %s, \"beyond\": %s", c.white < 0 ? "null" : c.white ? "true" : "false",
+            c.beyond ? "true" : "false");
     fprintf(fp, ", \"chain\": %s, \"screened_only\": %s, \"fitted\": ",
             c.chain ? "true" : "false", c.screened_only ? "true" : "false");
     cli_json_str(fp, c.fitted);

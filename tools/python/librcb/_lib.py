@@ -98,13 +98,16 @@ class DiagCandidate(ctypes.Structure):
                 ("error_pct", c_double), ("objective_drop_pct", c_double),
                 ("delta_bic", c_double), ("significant", c_int), ("fitted", c_char_p),
                 ("claim", c_int), ("adequate", c_int), ("chi2", c_double),
-                ("chi2_limit", c_double), ("chain", c_int), ("screened_only", c_int)]
+                ("chi2_limit", c_double), ("chain", c_int), ("screened_only", c_int),
+                ("dispersion", c_double), ("white_z", c_double), ("white", c_int),
+                ("beyond", c_int)]
 
 
 class FitAdequacy(ctypes.Structure):
     _fields_ = [("known", c_int), ("chi2", c_double), ("dof", c_double),
                 ("expected", c_double), ("sd", c_double), ("limit", c_double),
-                ("adequate", c_int)]
+                ("adequate", c_int), ("white_z", c_double), ("white", c_int),
+                ("dispersion", c_double)]
 
 
 class DiagMisfit(ctypes.Structure):
@@ -135,7 +138,9 @@ class PlanCandidate(ctypes.Structure):
 
 class Evidence(ctypes.Structure):
     _fields_ = [("delta_bic", c_double), ("error_before_pct", c_double),
-                ("error_after_pct", c_double), ("chi2", c_double), ("chi2_limit", c_double)]
+                ("error_after_pct", c_double), ("chi2", c_double), ("chi2_limit", c_double),
+                ("params", c_double), ("residuals", c_double), ("dispersion", c_double),
+                ("tried", c_double), ("white", c_int), ("beyond", c_int)]
 
 
 class CompareChannel(ctypes.Structure):

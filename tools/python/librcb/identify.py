@@ -160,13 +160,18 @@ class Diagnosis(Handle):
                 "claim": _lib.text(L.rcb_claim_str(c.claim)),
                 "adequate": None if c.adequate < 0 else bool(c.adequate),
                 "chi2": c.chi2, "chi2_limit": c.chi2_limit, "chain": bool(c.chain),
-                "screened_only": bool(c.screened_only)})
+                "screened_only": bool(c.screened_only), "dispersion": c.dispersion,
+                "white_z": c.white_z, "white": None if c.white < 0 else bool(c.white),
+                "beyond": bool(c.beyond)})
         a = _lib.FitAdequacy()
         self.check(L.rcb_diag_adequacy(self.handle, ctypes.byref(a)), "rcb_diag_adequacy")
         self.adequacy = {"known": bool(a.known), "chi2": a.chi2, "dof": a.dof,
                          "expected": a.expected if a.known else float("nan"),
                          "sd": a.sd if a.known else float("nan"), "limit": a.limit,
-                         "adequate": bool(a.adequate) if a.known else None}
+                         "adequate": bool(a.adequate) if a.known else None,
+                         "white_z": a.white_z if a.known else float("nan"),
+                         "white": bool(a.white) if a.known else None,
+                         "dispersion": a.dispersion}
         m = _lib.DiagMisfit()
         self.misfit = []
         for k in range(L.rcb_diag_misfit_count(self.handle)):
@@ -272,14 +277,19 @@ def compare(model, meas):
 
 
 def claim(delta_bic, error_before_pct, error_after_pct, chi2=float("nan"),
-          chi2_limit=float("nan")):
+          chi2_limit=float("nan"), params=0, residuals=0, dispersion=0, tried=0, white=0,
+          beyond=0):
     """What the evidence lets one say of an edit of a model: "explains",
     "improves" or "none". The library's one rule (rcb_evidence_claim), called,
-    not restated: significant when BIC falls by more than 10 and the error by
-    2 % of itself; "explains" only when also adequate (chi2 <= chi2_limit)."""
+    not restated: significant when the calibrated BIC falls by more than 10
+    (and, noise unknown, the error by 2 % of itself; noise known, the drop
+    over the dispersion passes the 1 % test over the candidates tried);
+    "explains" only when also adequate (chi2 <= chi2_limit, or a white
+    residual) and no fitted size is beyond its part (rcb_diagnose.h)."""
     L = _lib.lib()
     e = _lib.Evidence(float(delta_bic), float(error_before_pct), float(error_after_pct),
-                      float(chi2), float(chi2_limit))
+                      float(chi2), float(chi2_limit), float(params), float(residuals),
+                      float(dispersion), float(tried), int(white), int(beyond))
     return _lib.text(L.rcb_claim_str(L.rcb_evidence_claim(ctypes.byref(e))))
 
 
