@@ -413,13 +413,19 @@ static double polished_F(const rcb_diag *d, const rcb_meas *ms, size_t rank) {
   rcb_fit *f = NULL;
   rcb_fit_report rep;
   char names[512], *name;
-  size_t k;
+  size_t k, nall = rcb_meas_channel_count(ms) * rcb_meas_point_count(ms);
+  rcb_complex *ref;
   assert_int_equal(rcb_diag_candidate_get(d, rank, &c), RCB_OK);
   assert_int_equal(rcb_diag_apply_model(d, rank, NULL, &m), RCB_OK);
   assert_int_equal(rcb_fit_create(&f, m, ms, NULL), RCB_OK);
   assert_int_equal(rcb_fit_set_scale(f, RCB_SCALE_LOG10), RCB_OK);
   assert_int_equal(rcb_fit_set_noise_model(f, 10.0, 1.0), RCB_OK);
   assert_int_equal(rcb_fit_set_uncertainty(f, 0), RCB_OK);
+  /* weighed as the diagnosis weighs (its noise reference): the same F */
+  ref = calloc(nall, sizeof *ref);
+  assert_int_equal(rcb_diag_get_noise_reference(d, ref, nall), 1);
+  assert_int_equal(rcb_fit_set_noise_reference(f, ref), RCB_OK);
+  free(ref);
   for (k = 0; k < 3; k++) assert_int_equal(rcb_fit_add_param(f, base[k], lo[k], hi[k], 1), 0);
   snprintf(names, sizeof names, "%s", c.params);
   for (name = strtok(names, ", "); name; name = strtok(NULL, ", ")) {

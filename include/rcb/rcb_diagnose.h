@@ -156,6 +156,16 @@ RCB_API rcb_status rcb_diag_set_scale(rcb_diag *d, rcb_fit_scale scale);
 RCB_API rcb_status rcb_diag_set_noise_model(rcb_diag *d, double beta_a, double beta_s);
 /** @brief The noise model's phase term, rad (rcb_fit_set_noise_phase; 0: none). */
 RCB_API rcb_status rcb_diag_set_noise_phase(rcb_diag *d, double phase_rad);
+/**
+ * @brief The noise model's reference of the last run (issue #33): the fitted
+ * model's predictions as it is, where every fit of the diagnosis after the
+ * baseline's first evaluates the noise model (rcb_fit_set_noise_reference),
+ * so that a caller's own fit weighs as the diagnosis' fits did.
+ * @param h n = channels x points values, channel-major
+ * @return 1 when there is one (h filled), 0 when not (no run, no noise model:
+ * h untouched), negative on bad arguments (another n)
+ */
+RCB_API int rcb_diag_get_noise_reference(const rcb_diag *d, rcb_complex *h, size_t n);
 RCB_API rcb_status rcb_diag_set_band(rcb_diag *d, double lo, double hi);
 /**
  * @brief Known standard deviations of the measured values (as

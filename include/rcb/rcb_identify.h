@@ -142,7 +142,10 @@ RCB_API double rcb_fit_get_noise_phase(const rcb_fit *f);
  * floor is kept), which biases F by far more than chance at 32 x 1101; a
  * reference free of the measurement's noise (the fitted model's
  * predictions, rcb_fit_predictions) removes it, and fits that share one
- * reference share their weights, so their F compare as chi-squares.
+ * reference share their weights, so their F compare as chi-squares. Where
+ * a reference value lies more than 4 declared standard deviations from the
+ * measured value (a misfit, not noise: the model far off there), the
+ * measured value is used instead.
  * @param h nch * npts values in channel-major order (h[c * npoints + i]),
  * the measurement's units; a non-finite value drops its point; NULL: the
  * measured values again

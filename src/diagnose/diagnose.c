@@ -219,6 +219,14 @@ rcb_status rcb_diag_set_progress(rcb_diag *d, int (*cb)(void *user, size_t done,
 
 size_t rcb_diag_candidate_count(const rcb_diag *d) { return d && d->ran ? d->ncand : 0; }
 
+int rcb_diag_get_noise_reference(const rcb_diag *d, rcb_complex *h, size_t n) {
+  if (!d || !h) return RCB_ERR_ARG;
+  if (n != rcb_meas_channel_count(d->meas) * rcb_meas_point_count(d->meas)) return RCB_ERR_ARG;
+  if (!d->ran || !d->nref) return 0;
+  memcpy(h, d->nref, n * sizeof *h);
+  return 1;
+}
+
 rcb_status rcb_diag_candidate_evidence(const rcb_diag *d, size_t rank, rcb_evidence *out) {
   const diag_cand *c;
   if (!d || !out || !d->ran || rank >= d->ncand) return RCB_ERR_ARG;

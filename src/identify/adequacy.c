@@ -34,7 +34,7 @@ static size_t draw_point(const rcb_fit *f, size_t j, double a, rcb_rng *rng, dou
                      ? 2
                      : 1;
   double complex h = f->Hmod[f->res_ch[j] * f->npts + f->res_pt[j]];
-  double complex ref = f->nref ? f->nref[f->res_ch[j] * f->npts + f->res_pt[j]] : h;
+  double complex ref = f->nref ? rcb_fit_noise_value(f, f->res_ch[j], f->res_pt[j], a) : h;
   double bias = rcb_fit_log_bias(f);
   double wu = f->wuser ? f->wuser[f->res_ch[j] * f->npts + f->res_pt[j]] : 1.0;
   double s1[2] = {0, 0}, t1 = 0.0, t2 = 0.0;

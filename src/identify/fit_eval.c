@@ -119,6 +119,28 @@ static double base_weight(const rcb_fit *f, size_t c, size_t i, double complex e
   return w;
 }
 
+/* A reference farther from the measured value than this many of the
+ * declared noise's standard deviations (of the modulus of the difference)
+ * is a misfit, not noise: the measured value is then the better estimate of
+ * the true one, and the noise model is evaluated there (issue #33). Eq. 19
+ * moves a value by at most 1.7 of them (r1, r2 bounded), so the choice never
+ * follows the noise; with a model far off (a seal at 88 % error) the
+ * reference alone gave weights for values the data do not have. */
+#define RCB_NOISE_REF_SD 4.0
+
+double complex rcb_fit_noise_value(const rcb_fit *f, size_t c, size_t i, double a) {
+  rcb_meas_channel_info ci;
+  double complex e, h;
+  double ba = f->beta_a / 100.0, v;
+  rcb_meas_channel(f->meas, c, &ci);
+  e = ci.data[i];
+  if (!f->nref || !(f->beta_a > 0 || f->beta_s > 0)) return e;
+  h = f->nref[c * f->npts + i];
+  if (!isfinite(creal(h)) || !isfinite(cimag(h))) return h;
+  v = (ba * ba + f->phase * f->phase) * creal(h * conj(h)) / 3.0 + a * a / 3.0;
+  return creal((e - h) * conj(e - h)) > RCB_NOISE_REF_SD * RCB_NOISE_REF_SD * v ? e : h;
+}
+
 /* Walk every residual; fill the layout when fill != 0. Returns the count.
  * The noise model's variances, the channel's additive level a and the floor
  * gate are evaluated at the reference (rcb_fit_set_noise_reference) when one
@@ -135,10 +157,9 @@ static size_t layout(rcb_fit *f, int fill) {
   for (c = 0; c < f->nch; c++) {
     rcb_meas_channel_info ci;
     double a = rcb_fit_noise_level(f, c); /* eq. 19 additive amplitude */
-    const rcb_complex *ref = f->nref ? f->nref + c * f->npts : NULL;
     rcb_meas_channel(f->meas, c, &ci);
     for (i = 0; i < f->npts; i++) {
-      double complex e = ci.data[i], v = ref && noisy ? ref[i] : e;
+      double complex e = ci.data[i], v = rcb_fit_noise_value(f, c, i, a);
       double w = base_weight(f, c, i, e);
       if (w == 0.0) continue;
       if (!isfinite(creal(v)) || !isfinite(cimag(v))) continue; /* no reference there */

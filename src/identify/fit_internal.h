@@ -185,6 +185,11 @@ double rcb_fit_noise_level(const rcb_fit *f, size_t c);
  * where it is below the value (E ln|1 + u| = 0 for |u| < 1 and a uniform
  * phase), which the floor gate (2 a) keeps. */
 double rcb_fit_log_bias(const rcb_fit *f);
+/* Where the noise model is evaluated for point i of channel c (additive
+ * amplitude a): the measured value; with a noise reference, the reference,
+ * unless it lies farther than RCB_NOISE_REF_SD declared standard deviations
+ * from the measured value (a misfit: then the measured value; fit_eval.c). */
+double complex rcb_fit_noise_value(const rcb_fit *f, size_t c, size_t i, double a);
 
 
 /* Pieces of the analytic Jacobian (fit_eval.c) for fit_score.c: the model
