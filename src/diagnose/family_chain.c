@@ -335,8 +335,10 @@ void rcb_diag_carry_text(const rcb_diag *d, rcb_effect kind, const char *r, cons
     const diag_carry *e = &d->carry[k];
     int flip = kind == RCB_EFFECT_SENSOR_SIGN && strcmp(e->a, r) == 0;
     if (e->b[0]) continue;
+    double g = flip ? -e->gain : e->gain;
     cut |= put(buf, size, &n, n == first ? " --sensor %s%s" : ",%s%s", e->a, "");
-    snprintf(num, sizeof num, ":gain=%.6g", flip ? -e->gain : e->gain);
+    if (g == -1.0 && e->phase == 0.0) snprintf(num, sizeof num, ":sign=-1");
+    else snprintf(num, sizeof num, ":gain=%.6g", g);
     cut |= put(buf, size, &n, "%s%s", num, "");
     if (e->phase != 0.0) {
       snprintf(num, sizeof num, ",phase=%.6g", e->phase);
