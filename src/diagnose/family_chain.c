@@ -254,19 +254,11 @@ rcb_status rcb_diag_swap_sensors(rcb_diag *d, const char *a, const char *b) {
   return RCB_OK;
 }
 
-/* "sensor.<r>.gain" -> r (the name is a chain parameter's). */
-static void chain_response(const char *name, int which, char *r, size_t size) {
-  size_t p = sizeof "sensor." - 1, len = strlen(name) - p - (which == RCB_CHAIN_GAIN ? 5 : 6);
-  if (len >= size) len = size - 1;
-  memcpy(r, name + p, len);
-  r[len] = '\0';
-}
-
 rcb_status rcb_diag_carry_check(rcb_diag *d, const char *name) {
   int which = rcb_fit_param_is_chain(name);
   char r[RCB_DIAG_NAME], what[RCB_DIAG_NAME + 16];
   if (!which) return RCB_OK;
-  chain_response(name, which, r, sizeof r);
+  rcb_fit_chain_response(name, r, sizeof r);
   snprintf(what, sizeof what, "parameter %s: sensor", name);
   return need_measured(d, what, r);
 }
@@ -288,7 +280,7 @@ rcb_status rcb_diag_carry_apply(rcb_diag *d, rcb_fit *f, int with_base) {
       st = rcb_fit_set_chain_value(f, p->name, p->chain_v);
       continue;
     }
-    chain_response(p->name, which, r, sizeof r);
+    rcb_fit_chain_response(p->name, r, sizeof r);
     if (!(st = rcb_fit_get_sensor(f, r, &g, &ph, NULL)))
       st = which == RCB_CHAIN_GAIN ? rcb_fit_set_sensor(f, r, g * p->chain_v, ph)
                                    : rcb_fit_set_sensor(f, r, g, ph + p->chain_v);

@@ -48,6 +48,18 @@ int rcb_fit_param_is_chain(const char *name) {
   return 0;
 }
 
+void rcb_fit_chain_response(const char *name, char *r, size_t size) {
+  int which = rcb_fit_param_is_chain(name);
+  size_t p = sizeof SENSOR_PREFIX - 1, len;
+  if (!size) return;
+  r[0] = '\0';
+  if (!which) return;
+  len = strlen(name) - p - (which == RCB_CHAIN_GAIN ? 5 : 6);
+  if (len >= size) len = size - 1;
+  memcpy(r, name + p, len);
+  r[len] = '\0';
+}
+
 int rcb_fit_sensor_param_defaults(const char *name, double *start, double *lo, double *hi,
                                   int *log_param) {
   int which = rcb_fit_param_is_chain(name);
@@ -116,17 +128,13 @@ void rcb_fit_chain_reroute(rcb_fit *f) {
  * the measured responses when it is none of them. */
 static rcb_status chain_lookup(rcb_fit *f, const char *name, int *which, size_t *sensor) {
   char resp[RCB_PARAM_NAME_MAX];
-  size_t p = sizeof SENSOR_PREFIX - 1, n = strlen(name), len;
   *which = rcb_fit_param_is_chain(name);
   if (!*which)
     return rcb_fit_fail(f, RCB_ERR_ARG,
                         "parameter '%s': a sensor parameter is sensor.<response>.gain or "
                         "sensor.<response>.phase",
                         name);
-  len = n - p - (*which == RCB_CHAIN_GAIN ? 5 : 6);
-  if (len >= sizeof resp) len = sizeof resp - 1;
-  memcpy(resp, name + p, len);
-  resp[len] = '\0';
+  rcb_fit_chain_response(name, resp, sizeof resp);
   if ((*sensor = find_sensor(f, resp)) != (size_t)-1) return RCB_OK;
   {
     char list[RCB_ERRMSG_MAX / 2];
