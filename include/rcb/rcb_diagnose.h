@@ -249,12 +249,6 @@ typedef struct rcb_diag_candidate {
   double chi2, chi2_limit;  /**< its F and the adequacy limit (NaN: unknown) */
   int chain;                /**< 1: a fault of the measurement chain (a sensor), not of
                                  the model: --apply refuses, the model is not changed */
-  const char *carry;        /**< a chain candidate: the rcbtool options (fit and
-                                 diagnose) that read the data through its correction in
-                                 the next round, on top of the corrections carried into
-                                 this one, e.g. "--params coupling.C.kt,sensor.DB.y.gain"
-                                 or "--sensor DB.y:sign=-1" or "--swap DB.x,DB.y"; ""
-                                 for a model candidate */
   int screened_only;        /**< 1 when the refit was fitted on a frequency subset only
                                  and evaluated on all points where it ended there, as its
                                  objective was over 10 % above the best refit's (large sets,
@@ -267,6 +261,12 @@ typedef struct rcb_diag_candidate {
                                  0: not, -1: unknown */
   int beyond;               /**< 1: a fitted size is beyond what the part can be
                                  (rcb_evidence.beyond; the explanation names it) */
+  const char *carry;        /**< a chain candidate: the rcbtool options (fit and
+                                 diagnose) that read the data through its correction in
+                                 the next round, on top of the corrections carried into
+                                 this one, e.g. "--params coupling.C.kt,sensor.DB.y.gain"
+                                 or "--sensor DB.y:sign=-1" or "--swap DB.x,DB.y"; ""
+                                 for a model candidate */
 } rcb_diag_candidate;
 
 RCB_API size_t rcb_diag_candidate_count(const rcb_diag *d);
