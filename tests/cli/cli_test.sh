@@ -896,6 +896,9 @@ bad_sensor)
     err_has "DB.y given twice"
     usage $v "$MODEL" "$W/m.csv" --params coupling.C.kt --swap DB.x; err_has "pairs"
     usage $v "$MODEL" "$W/m.csv" --params coupling.C.kt --swap DB.x,DB.x; err_has "itself"
+    # well formed: keys continue the sensor before them, a RESP: starts the next one
+    run $v "$MODEL" "$W/m.csv" --params coupling.C.kt --sensor DB.y:gain=1,sign=-1,DB.x:gain=1
+    expect_rc 0
   done ;;
 # ---- rcbtool monitor (issue #16): the series and its refusals ----
 bad_monitor_series)

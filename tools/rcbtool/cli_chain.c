@@ -70,16 +70,16 @@ static int parse_sensors(const cli_args *a, cli_chain *ch, char *list) {
   for (p = list; *p; p++) n += (*p == ',');
   if (!(ch->sens = calloc(n, sizeof *ch->sens))) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   for (p = list; p; p = next) {
-    char *colon = strchr(p, ':');
+    char *colon;
     if ((next = strchr(p, ','))) *next++ = '\0';
-    if (colon) { /* a new sensor: RESP:KEY=V */
+    if ((colon = strchr(p, ':'))) { /* a new sensor: RESP:KEY=V */
       cli_sensor_edit *e = &ch->sens[ch->nsens];
       *colon = '\0';
       if (!*p)
         return cli_usage(a->cmd, "option --sensor: empty sensor name; expected "
                          "RESP:KEY=V[,KEY=V] (e.g. DB.y:gain=0.8 or DB.y:sign=-1)");
       for (i = 0; i < ch->nsens; i++)
-        if (strcmp(ch->sens[i].response, p) == 0)
+        if (ch->sens[i].response && strcmp(ch->sens[i].response, p) == 0)
           return cli_usage(a->cmd, "option --sensor: sensor %s given twice", p);
       e->response = p, e->gain = 1.0, e->phase = 0.0;
       ch->nsens++, seen = 0;
@@ -105,11 +105,10 @@ static int parse_swaps(const cli_args *a, cli_chain *ch, char *list) {
     if ((next = strchr(p, ','))) *next++ = '\0';
     if (!*p) return cli_usage(a->cmd, "option --swap has an empty sensor name");
     ch->swap[i] = p;
-  }
-  for (i = 0; i < n; i += 2)
-    if (strcmp(ch->swap[i], ch->swap[i + 1]) == 0)
+    if (i % 2 && strcmp(ch->swap[i - 1], p) == 0)
       return cli_usage(a->cmd, "option --swap: %s with itself; expected two different sensors",
-                       ch->swap[i]);
+                       p);
+  }
   ch->nswap = n / 2;
   return 0;
 }
