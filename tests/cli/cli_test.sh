@@ -899,7 +899,11 @@ bad_sensor)
     # well formed: keys continue the sensor before them, a RESP: starts the next one
     run $v "$MODEL" "$W/m.csv" --params coupling.C.kt --sensor DB.y:gain=1,sign=-1,DB.x:gain=1
     expect_rc 0
-  done ;;
+  done
+  # a sensor's gain says nothing about where to measure
+  usage sensitivity "$MODEL" --params coupling.C.kt,sensor.DB.y.gain --frf --in DA.x \
+    --fmax 400 --rpm 10000
+  err_has "sensor.DB.y.gain belongs to the measurement chain" ;;
 # ---- rcbtool monitor (issue #16): the series and its refusals ----
 bad_monitor_series)
   M="--params coupling.C.kt --noise 10,1"; O=C.A.x,C.A.y,C.B.x,C.B.y
