@@ -44,9 +44,11 @@ typedef struct diag_cand {
   double chain_v[RCB_DIAG_MAXP];
   int chain_kept;
   int refit_only;                   /* no neutral value: refitted, not scored */
-  char carry[RCB_DIAG_CARRY];       /* a chain candidate: the rcbtool options that read the
+  char *carry;                      /* a chain candidate: the rcbtool options that read the
                                        data through its correction in the next round
-                                       (rcb_diag_carry_text); "" otherwise */
+                                       (rcb_diag_carry_text; owned, allocated only for
+                                       chain candidates, so the catalogue of a monitor's
+                                       fixed arena does not grow); NULL otherwise */
   /* a candidate at a node of a shaft (DIAG_FAM_PLACE_WALK) */
   size_t node;                      /* its node + 1 (0: other effects) */
   int variant;                      /* which parameter of the family (mass 0, inertia 1) */

@@ -41,7 +41,10 @@ rcb_status rcb_diag_create(rcb_diag **out, const rcb_model *m, const rcb_meas *m
 
 static void free_results(rcb_diag *d) {
   size_t i;
-  for (i = 0; i < d->ncand; i++) rcb_model_destroy(d->cand[i].model);
+  for (i = 0; i < d->ncand; i++) {
+    rcb_model_destroy(d->cand[i].model);
+    rcb_free(&d->alloc, d->cand[i].carry);
+  }
   rcb_free(&d->alloc, d->cand);
   rcb_free(&d->alloc, d->order);
   rcb_model_destroy(d->base_model);
@@ -250,7 +253,7 @@ rcb_status rcb_diag_candidate_get(const rcb_diag *d, size_t rank, rcb_diag_candi
   out->chi2 = c->refitted ? c->F : (double)NAN;
   out->chi2_limit = c->refitted ? c->chi2_limit : (double)NAN;
   out->chain = (c->fam->flags & DIAG_FAM_CHAIN) != 0;
-  out->carry = c->carry;
+  out->carry = c->carry ? c->carry : "";
   out->fitted = c->fitted;
   out->screened_only = c->refitted && !c->polished;
   out->dispersion = c->refitted ? c->dispersion : (double)NAN;
@@ -304,7 +307,7 @@ rcb_status rcb_diag_apply_model(const rcb_diag *d, size_t rank, const rcb_alloca
                          "candidate %zu (%s) is a fault of the measurement chain, not of the "
                          "model: nothing to apply; check or recalibrate the sensor, or read the "
                          "data through the correction in the next round (rcbtool fit or "
-                         "diagnose with %s)", rank + 1, c->desc, c->carry);
+                         "diagnose with %s)", rank + 1, c->desc, c->carry ? c->carry : "");
   if (!c->model)
     return rcb_diag_fail((rcb_diag *)d, RCB_ERR_STATE,
                          "candidate %zu (%s) was not refitted: nothing to apply", rank + 1,

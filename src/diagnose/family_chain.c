@@ -85,6 +85,18 @@ static void add_chain_par(diag_cand *c, const char *fmt, const char *r) {
 
 static const diag_carry *carried_swap(const rcb_diag *d, const char *r);
 
+/* c->carry: the options that carry c's correction (rcb_diag_carry_text), in
+ * an allocation of its own. */
+static rcb_status set_carry(rcb_diag *d, diag_cand *c, const char *r, const char *r2) {
+  char buf[RCB_DIAG_CARRY];
+  size_t n;
+  rcb_diag_carry_text(d, c->effect, r, r2, buf, sizeof buf);
+  n = strlen(buf) + 1;
+  if (!(c->carry = rcb_alloc(&d->alloc, n))) return RCB_ERR_NOMEM;
+  memcpy(c->carry, buf, n);
+  return RCB_OK;
+}
+
 static rcb_status gain_and_sign(rcb_diag *d, const char *r) {
   char place[RCB_DIAG_NAME], nm[RCB_DIAG_NAME];
   int cplx = d->scale == RCB_SCALE_COMPLEX;
@@ -99,7 +111,7 @@ static rcb_status gain_and_sign(rcb_diag *d, const char *r) {
     snprintf(c->target, sizeof c->target, "%s", r);
     add_chain_par(c, "sensor.%s.gain", r);
     if (cplx) add_chain_par(c, "sensor.%s.phase", r);
-    rcb_diag_carry_text(d, RCB_EFFECT_SENSOR_GAIN, r, NULL, c->carry, sizeof c->carry);
+    if (set_carry(d, c, r, NULL)) return RCB_ERR_NOMEM;
   }
   if (!cplx) return RCB_OK;
   if (!(c = rcb_diag_new_cand(d, &rcb_diag_family_chain, RCB_EFFECT_SENSOR_SIGN, place)))
@@ -108,8 +120,7 @@ static rcb_status gain_and_sign(rcb_diag *d, const char *r) {
            "way)", r);
   snprintf(c->target, sizeof c->target, "%s", r);
   c->refit_only = 1;
-  rcb_diag_carry_text(d, RCB_EFFECT_SENSOR_SIGN, r, NULL, c->carry, sizeof c->carry);
-  return RCB_OK;
+  return set_carry(d, c, r, NULL);
 }
 
 /* r = "<station>.x" with "<station>.y" measured with the same references:
@@ -131,8 +142,7 @@ static rcb_status swap(rcb_diag *d, const char *r) {
   snprintf(c->target, sizeof c->target, "%s", r);
   snprintf(c->target2, sizeof c->target2, "%s", y);
   c->refit_only = 1;
-  rcb_diag_carry_text(d, RCB_EFFECT_SENSOR_SWAP, r, y, c->carry, sizeof c->carry);
-  return RCB_OK;
+  return set_carry(d, c, r, y);
 }
 
 static rcb_status enumerate(rcb_diag *d, const rcb_model *m) {

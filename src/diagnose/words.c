@@ -227,7 +227,7 @@ rcb_status rcb_diag_explain(const rcb_diag *d, char *buf, size_t size, size_t *n
                "Check or recalibrate this sensor, or read the data through the correction in "
                "the next round (rcbtool fit or diagnose with %s); the model is not changed.",
                c->desc, c->fitted, trend(d->err0, c->err), d->err0, c->err, floor_txt, c->dbic,
-               test, c->carry);
+               test, c->carry ? c->carry : "");
     else
       snprintf(text, sizeof text,
                "Missing: %s. Adding it (%s) explains the misfit: the error %s from %.3g %% "
@@ -265,7 +265,7 @@ rcb_status rcb_diag_explain(const rcb_diag *d, char *buf, size_t size, size_t *n
                c->desc, c->fitted, 100.0 * (d->F0 - c->F) / d->F0, trend(d->err0, c->err),
                d->err0, c->err, c->dbic);
     }
-    if ((c->fam->flags & DIAG_FAM_CHAIN) && c->carry[0]) /* a sensor: how to carry it */
+    if ((c->fam->flags & DIAG_FAM_CHAIN) && c->carry && c->carry[0]) /* a sensor: how */
       snprintf(text + strlen(text), sizeof text - strlen(text),
                " Read the data through this correction in the next round: rcbtool fit or "
                "diagnose with %s.", c->carry);
