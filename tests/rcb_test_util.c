@@ -1,6 +1,7 @@
 #define _POSIX_C_SOURCE 200809L /* mkdtemp, fork, setenv */
 #include "rcb_test_util.h"
 
+#include <complex.h>
 #include <errno.h>
 #include <math.h>
 #include <setjmp.h>
@@ -253,4 +254,28 @@ const char *rcb_test_tmp_path(const char *name) {
   k = (k + 1) % 4;
   snprintf(buf[k], sizeof buf[k], "%s/%s", tmpdir_, name);
   return buf[k];
+}
+
+/* (rcb_test_util.h) */
+rcb_meas *rcb_test_meas_copy(const rcb_meas *ms, const double complex *fac,
+                             const char *const *rename) {
+  rcb_meas *out = NULL;
+  size_t n = rcb_meas_point_count(ms), c, i;
+  rcb_complex *col = calloc(n, sizeof *col);
+  assert_non_null(col);
+  assert_int_equal(rcb_meas_create(&out, NULL), RCB_OK);
+  assert_int_equal(rcb_meas_set_grid(out, rcb_meas_get_type(ms), n, rcb_meas_grid(ms),
+                                     rcb_meas_speed(ms)),
+                   RCB_OK);
+  for (c = 0; c < rcb_meas_channel_count(ms); c++) {
+    rcb_meas_channel_info ci;
+    assert_int_equal(rcb_meas_channel(ms, c, &ci), RCB_OK);
+    if (fac[c] == 0.0) continue;
+    for (i = 0; i < n; i++) col[i] = fac[c] * ci.data[i];
+    assert_int_equal(rcb_meas_add_channel(out, rename ? rename[c] : ci.response, ci.reference,
+                                          ci.kind, col),
+                     RCB_OK);
+  }
+  free(col);
+  return out;
 }

@@ -64,6 +64,12 @@ void rcb_test_walk_child_end(const rcb_test_failing *f, const char *name, rcb_st
 rcb_meas *rcb_test_frf_meas(const rcb_model *m, const char *const *outs, size_t no,
                             const char *const *ins, size_t ni, double f0, double f1, size_t n,
                             double rpm, rcb_frf_kind kind);
+/* A copy of ms, channel c's data multiplied by fac[c] (0: channel left
+ * out), and its response renamed to rename[c] when rename is not NULL: a
+ * probe's gain, a sign flipped, two probes swapped (aborts the test on
+ * failure). */
+rcb_meas *rcb_test_meas_copy(const rcb_meas *ms, const _Complex double *fac,
+                             const char *const *rename);
 /* Noise-free unbalance responses of m at channels outs (no of them), n speeds
  * evenly from r0 to r1 rpm, as a measurement (aborts the test on failure). */
 rcb_meas *rcb_test_unbalance_meas(const rcb_model *m, const char *const *outs, size_t no,

@@ -33,31 +33,6 @@
 
 #define DEG (RCB_PI / 180.0)
 
-/* A copy of ms, channel c's data multiplied by fac(c) (0: channel left
- * out), and its response renamed to rename[c] when rename is not NULL. */
-static rcb_meas *meas_copy(const rcb_meas *ms, const double complex *fac,
-                           const char *const *rename) {
-  rcb_meas *out = NULL;
-  size_t n = rcb_meas_point_count(ms), c, i;
-  rcb_complex *col = calloc(n, sizeof *col);
-  assert_non_null(col);
-  assert_int_equal(rcb_meas_create(&out, NULL), RCB_OK);
-  assert_int_equal(rcb_meas_set_grid(out, rcb_meas_get_type(ms), n, rcb_meas_grid(ms),
-                                     rcb_meas_speed(ms)),
-                   RCB_OK);
-  for (c = 0; c < rcb_meas_channel_count(ms); c++) {
-    rcb_meas_channel_info ci;
-    assert_int_equal(rcb_meas_channel(ms, c, &ci), RCB_OK);
-    if (fac[c] == 0.0) continue;
-    for (i = 0; i < n; i++) col[i] = fac[c] * ci.data[i];
-    assert_int_equal(rcb_meas_add_channel(out, rename ? rename[c] : ci.response, ci.reference,
-                                          ci.kind, col),
-                     RCB_OK);
-  }
-  free(col);
-  return out;
-}
-
 static double objective(rcb_fit *f) {
   size_t n = rcb_fit_residual_count(f), j;
   double *r = calloc(n, sizeof *r), F = 0.0;
@@ -136,7 +111,7 @@ static void check_case(const jac_case *jc, rcb_fit_scale sc) {
   size_t n, k, c, nc = rcb_meas_channel_count(ms0);
   double *Ja, *Jf, *d;
   for (c = 0; c < nc; c++) fac[c] = 0.9 * cexp(CMPLX(0.0, 0.1));
-  ms = meas_copy(ms0, fac, NULL);
+  ms = rcb_test_meas_copy(ms0, fac, NULL);
   assert_int_equal(rcb_fit_create(&f, m, ms, NULL), RCB_OK);
   for (k = 0; k < jc->np; k++) {
     const char *nm = jc->names[k];
@@ -244,7 +219,7 @@ static rcb_meas *paper_meas(const rcb_model *m, double complex fy, unsigned seed
   const char *outs[] = {"C.A.x", "C.A.y", "C.B.x", "C.B.y", "DB.y"}, *ins[] = {"DA.x"};
   rcb_meas *ms0 = rcb_test_frf_meas(m, outs, 5, ins, 1, 200, 400, NPTS, 10000, RCB_INERTANCE);
   double complex fac[5] = {1, 1, 1, 1, fy};
-  rcb_meas *ms = meas_copy(ms0, fac, NULL); /* the sensor's factor before the noise */
+  rcb_meas *ms = rcb_test_meas_copy(ms0, fac, NULL); /* the sensor's factor before the noise */
   size_t c, i;
   for (c = 0; c < 5; c++) {
     rcb_meas_channel_info ci;
@@ -361,8 +336,8 @@ static void test_chain_sign_swap_identity(void **state) {
   size_t s;
   (void)state;
   assert_int_equal(rcb_meas_add_noise(ms0, 10.0, 1.0, 3u), RCB_OK);
-  ms_neg = meas_copy(ms0, neg, NULL);       /* the DB.y probe wired the wrong way */
-  ms_swap = meas_copy(ms0, one, swapped);   /* the DB.x and DB.y probes exchanged */
+  ms_neg = rcb_test_meas_copy(ms0, neg, NULL);      /* the DB.y probe wired the wrong way */
+  ms_swap = rcb_test_meas_copy(ms0, one, swapped); /* the DB.x and DB.y probes exchanged */
   assert_int_equal(rcb_model_get_param(m, "coupling.C.kt", &kt), RCB_OK);
   assert_int_equal(rcb_model_set_param(m, "coupling.C.kt", 1.3 * kt), RCB_OK);
   for (s = 0; s < 3; s++) {
@@ -394,7 +369,7 @@ static void test_chain_errors(void **state) {
   /* DB.y's channel for the reference C.B.x left out */
   double complex part[6] = {1, 1, 1, 1, 1, 0};
   rcb_meas *ms = rcb_test_frf_meas(m, outs, 3, ins, 2, 200, 400, 11, 10000, RCB_INERTANCE);
-  rcb_meas *ms_part = meas_copy(ms, part, NULL);
+  rcb_meas *ms_part = rcb_test_meas_copy(ms, part, NULL);
   rcb_fit *f = NULL;
   rcb_fit_dz dz[2];
   double g, ph;

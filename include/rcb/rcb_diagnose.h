@@ -147,10 +147,40 @@ RCB_API const char *rcb_diag_errmsg(const rcb_diag *d);
 
 /**
  * @brief A parameter of the model as it is, fitted before the candidates are
- * scored and refitted with each of them (e.g. the coupling's kt, kr).
+ * scored and refitted with each of them (e.g. the coupling's kt, kr), or of
+ * the measurement chain ("sensor.DB.y.gain", "sensor.DB.y.phase": a sensor
+ * found at fault in an earlier round, read through its fitted gain; bounds
+ * as rcb_fit_sensor_param_defaults gives them). A sensor's gain fitted so is
+ * no longer a candidate, and every score reads the data through the gain
+ * where the baseline fit left it.
  */
 RCB_API rcb_status rcb_diag_add_fitted_param(rcb_diag *d, const char *name, double lo,
                                              double hi, int log_param);
+/**
+ * @brief A known correction of the measurement chain, carried into every fit
+ * of the diagnosis (the baseline, the score test, the refits), as
+ * rcb_fit_set_sensor: the channels of measured response @p response ("DB.y")
+ * are predicted as gain e^{i phase_rad} times the model's value. A sensor
+ * finding of an earlier round (a sign flipped: gain -1; a gain measured on
+ * a calibrator) is carried this way; a sign candidate is then tried on top
+ * of it. Setting a response again replaces its correction; (1, 0) removes it.
+ * @param gain dimensionless, finite and nonzero @param phase_rad rad,
+ * positive when the sensor leads
+ * @return RCB_ERR_ARG when no measured channel has that response (the
+ * message lists those measured) or a value is not finite
+ */
+RCB_API rcb_status rcb_diag_set_sensor(rcb_diag *d, const char *response, double gain,
+                                       double phase_rad);
+/**
+ * @brief Two probes known to be swapped, carried into every fit of the
+ * diagnosis, as rcb_fit_swap_sensors: channels whose response is @p a are
+ * predicted from the model's response at @p b and vice versa. A swap
+ * candidate is not tried on either of them.
+ * @return RCB_ERR_ARG when a or b is not a measured response, a equals b,
+ * the two are not measured with the same references, or either is carried
+ * swapped with another already
+ */
+RCB_API rcb_status rcb_diag_swap_sensors(rcb_diag *d, const char *a, const char *b);
 /** @brief Objective settings, as rcb_fit_set_scale / _set_noise_model / _set_band. */
 RCB_API rcb_status rcb_diag_set_scale(rcb_diag *d, rcb_fit_scale scale);
 RCB_API rcb_status rcb_diag_set_noise_model(rcb_diag *d, double beta_a, double beta_s);
@@ -241,6 +271,12 @@ typedef struct rcb_diag_candidate {
                                  0: not, -1: unknown */
   int beyond;               /**< 1: a fitted size is beyond what the part can be
                                  (rcb_evidence.beyond; the explanation names it) */
+  const char *carry;        /**< a chain candidate: the rcbtool options (fit and
+                                 diagnose) that read the data through its correction in
+                                 the next round, on top of the corrections carried into
+                                 this one, e.g. "--params coupling.C.kt,sensor.DB.y.gain"
+                                 or "--sensor DB.y:sign=-1" or "--swap DB.x,DB.y"; ""
+                                 for a model candidate */
 } rcb_diag_candidate;
 
 RCB_API size_t rcb_diag_candidate_count(const rcb_diag *d);

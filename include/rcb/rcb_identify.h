@@ -69,6 +69,21 @@ RCB_API const char *rcb_fit_errmsg(const rcb_fit *f);
 RCB_API rcb_status rcb_fit_add_param(rcb_fit *f, const char *name, double lo, double hi,
                                      int log_param);
 
+/**
+ * @brief The neutral start and default bounds of a measurement-chain
+ * parameter, as rcb_fit_add_param would take them when the caller has none:
+ * "sensor.R.gain" starts at 1 (dimensionless) in [0.1, 10], fitted on log(g);
+ * "sensor.R.phase" starts at 0 rad in [-pi/2, pi/2] rad, fitted on phi. The
+ * diagnosis's sensor candidates use the same. Syntactic only: whether R is
+ * measured is checked by rcb_fit_add_param. Any output may be NULL.
+ * @param start neutral value (1, or 0 rad) @param lo lower bound @param hi
+ * upper bound @param log_param 1 for a gain, 0 for a phase
+ * @return 1 for a gain, 2 for a phase, 0 when @p name is not a chain parameter
+ * (outputs untouched)
+ */
+RCB_API int rcb_fit_sensor_param_defaults(const char *name, double *start, double *lo,
+                                          double *hi, int *log_param);
+
 /* ---- the measurement chain: fixed edits (not fitted) ---- */
 
 /**

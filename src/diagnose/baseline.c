@@ -223,6 +223,7 @@ rcb_status rcb_diag_fit_baseline(rcb_diag *d) {
     rcb_free(&d->alloc, r);
   }
   if (!st) st = baseline_adequacy(d, f);
+  if (!st) rcb_diag_carry_keep(d, f); /* the base sensor parameters, for every later fit */
   rcb_diag_drop_fit(d, f);
   if (!st) d->base_model = m; /* the fitted values stay in it */
   else rcb_model_destroy(m);

@@ -21,6 +21,7 @@
 #include "diagnose/family.h"
 
 #define RCB_DIAG_NAME 128
+#define RCB_DIAG_CARRY 1024
 
 typedef struct diag_cand {
   const diag_family *fam;           /* its family: the edit, the start, the flags */
@@ -43,6 +44,11 @@ typedef struct diag_cand {
   double chain_v[RCB_DIAG_MAXP];
   int chain_kept;
   int refit_only;                   /* no neutral value: refitted, not scored */
+  char *carry;                      /* a chain candidate: the rcbtool options that read the
+                                       data through its correction in the next round
+                                       (rcb_diag_carry_text; owned, allocated only for
+                                       chain candidates, so the catalogue of a monitor's
+                                       fixed arena does not grow); NULL otherwise */
   /* a candidate at a node of a shaft (DIAG_FAM_PLACE_WALK) */
   size_t node;                      /* its node + 1 (0: other effects) */
   int variant;                      /* which parameter of the family (mass 0, inertia 1) */
@@ -91,7 +97,17 @@ typedef struct diag_base_par {
   char name[RCB_DIAG_NAME];
   double lo, hi;
   int logp;
+  double chain_v; /* a sensor parameter: where the baseline fit left it (chain_kept) */
+  int chain_kept;
 } diag_base_par;
+
+/* A correction of the measurement chain carried into every fit of the
+ * diagnosis (rcb_diag_set_sensor, rcb_diag_swap_sensors; family_chain.c). */
+typedef struct diag_carry {
+  char a[RCB_NAME_MAX];  /* the response ("DB.y") */
+  char b[RCB_NAME_MAX];  /* a swap: the other response; "" for a gain edit */
+  double gain, phase;    /* a gain edit: dimensionless, rad */
+} diag_carry;
 
 struct rcb_diag {
   rcb_allocator alloc;
@@ -114,6 +130,8 @@ struct rcb_diag {
   size_t progress_done;             /* steps reported: a count that only rises */
   diag_base_par *base;
   size_t nbase, cap_base;
+  diag_carry *carry;                /* chain corrections carried into every fit */
+  size_t ncarry, cap_carry;
   /* results */
   rcb_model *base_model;            /* the model with its own parameters fitted
                                        (owned, finalized) */
@@ -171,6 +189,24 @@ rcb_status rcb_diag_refit_start(rcb_diag *d, const diag_cand *c, rcb_model *m, r
 rcb_status rcb_diag_make_fit(rcb_diag *d, rcb_model *m, unsigned with_base, const diag_cand *c,
                              rcb_fit **out);
 void rcb_diag_drop_fit(rcb_diag *d, rcb_fit *f);
+/* The carried chain (family_chain.c): onto fit f, the corrections of
+ * rcb_diag_set_sensor / rcb_diag_swap_sensors, then the base sensor
+ * parameters where the baseline left them: as their start when f fits them
+ * (with_base), folded into the fixed edit when it does not (the score test
+ * reads the data as the baseline did). */
+rcb_status rcb_diag_carry_apply(rcb_diag *d, rcb_fit *f, int with_base);
+/* RCB_ERR_ARG, naming the measured responses, when name is a sensor
+ * parameter whose response no channel measures; RCB_OK otherwise. */
+rcb_status rcb_diag_carry_check(rcb_diag *d, const char *name);
+/* Keep where the baseline fit f left the base sensor parameters. */
+void rcb_diag_carry_keep(rcb_diag *d, const rcb_fit *f);
+/* The rcbtool options that read the data through a chain correction of
+ * kind (RCB_EFFECT_SENSOR_GAIN: fit the gain, and the phase on the complex
+ * scale; _SIGN; _SWAP with r2) at response r on top of those carried, e.g.
+ * "--params coupling.C.kt,sensor.DB.y.gain --sensor DA.x:sign=-1"; "" when
+ * they do not fit in size. */
+void rcb_diag_carry_text(const rcb_diag *d, rcb_effect kind, const char *r, const char *r2,
+                         char *buf, size_t size);
 /* Where the misfit of the model as it is sits, the effect class left open
  * (locate.c): fills d->place / d->nplace when the noise is known and the
  * model as it is fails the adequacy test; nothing otherwise. */

@@ -41,7 +41,10 @@ rcb_status rcb_diag_create(rcb_diag **out, const rcb_model *m, const rcb_meas *m
 
 static void free_results(rcb_diag *d) {
   size_t i;
-  for (i = 0; i < d->ncand; i++) rcb_model_destroy(d->cand[i].model);
+  for (i = 0; i < d->ncand; i++) {
+    rcb_model_destroy(d->cand[i].model);
+    rcb_free(&d->alloc, d->cand[i].carry);
+  }
   rcb_free(&d->alloc, d->cand);
   rcb_free(&d->alloc, d->order);
   rcb_model_destroy(d->base_model);
@@ -67,6 +70,7 @@ void rcb_diag_destroy(rcb_diag *d) {
   a = d->alloc;
   free_results(d);
   rcb_free(&a, d->base);
+  rcb_free(&a, d->carry);
   rcb_free(&a, d->sd);
   rcb_free(&a, d);
 }
@@ -124,7 +128,9 @@ const char *rcb_diag_errmsg(const rcb_diag *d) { return d ? d->errmsg : "no diag
 rcb_status rcb_diag_add_fitted_param(rcb_diag *d, const char *name, double lo, double hi,
                                      int log_param) {
   diag_base_par *p;
+  rcb_status st;
   if (!d || !name || strlen(name) >= RCB_DIAG_NAME) return RCB_ERR_ARG;
+  if ((st = rcb_diag_carry_check(d, name))) return st; /* a sensor's: measured? */
   if (rcb_grow(&d->alloc, (void **)&d->base, &d->cap_base, d->nbase + 1, sizeof *d->base))
     return rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
   p = &d->base[d->nbase++];
@@ -255,6 +261,7 @@ rcb_status rcb_diag_candidate_get(const rcb_diag *d, size_t rank, rcb_diag_candi
   out->chi2 = c->refitted ? c->F : (double)NAN;
   out->chi2_limit = c->refitted ? c->chi2_limit : (double)NAN;
   out->chain = (c->fam->flags & DIAG_FAM_CHAIN) != 0;
+  out->carry = c->carry ? c->carry : "";
   out->fitted = c->fitted;
   out->screened_only = c->refitted && !c->polished;
   out->dispersion = c->refitted ? c->dispersion : (double)NAN;
@@ -306,8 +313,9 @@ rcb_status rcb_diag_apply_model(const rcb_diag *d, size_t rank, const rcb_alloca
   if (c->fam->flags & DIAG_FAM_CHAIN)
     return rcb_diag_fail((rcb_diag *)d, RCB_ERR_STATE,
                          "candidate %zu (%s) is a fault of the measurement chain, not of the "
-                         "model: nothing to apply; check or recalibrate the sensor, or fit with "
-                         "its gain (%s)", rank + 1, c->desc, c->params);
+                         "model: nothing to apply; check or recalibrate the sensor, or read the "
+                         "data through the correction in the next round (rcbtool fit or "
+                         "diagnose with %s)", rank + 1, c->desc, c->carry ? c->carry : "");
   if (!c->model)
     return rcb_diag_fail((rcb_diag *)d, RCB_ERR_STATE,
                          "candidate %zu (%s) was not refitted: nothing to apply", rank + 1,

@@ -30,12 +30,16 @@ rcb_status rcb_diag_make_fit(rcb_diag *d, rcb_model *m, unsigned with_base, cons
     size_t j;
     int dup = 0;
     for (j = 0; c && j < c->np; j++) dup |= strcmp(c->pname[j], d->base[k].name) == 0;
-    /* another coupling model may not have the parameter (kramer_1: no kt) */
-    if (dup || rcb_model_get_param(m, d->base[k].name, &v)) continue;
+    /* another coupling model may not have the parameter (kramer_1: no kt);
+     * a sensor's is in no model */
+    if (dup || (!rcb_fit_param_is_chain(d->base[k].name) &&
+                rcb_model_get_param(m, d->base[k].name, &v)))
+      continue;
     st = rcb_fit_add_param(f, d->base[k].name, d->base[k].lo, d->base[k].hi, d->base[k].logp);
   }
   for (k = 0; !st && k < npc; k++)
     st = rcb_fit_add_param(f, c->pname[k], c->lo[k], c->hi[k], c->logp[k]);
+  if (!st) st = rcb_diag_carry_apply(d, f, (with_base & RCB_DIAG_FIT_BASE) != 0);
   for (k = 0; !st && c && c->chain_kept && k < c->np; k++)
     if (rcb_fit_param_is_chain(c->pname[k]))
       st = rcb_fit_set_chain_value(f, c->pname[k], c->chain_v[k]);

@@ -31,11 +31,16 @@ static size_t say_where(const rcb_diag *d, char *text, size_t size, size_t n) {
   if (!d->nmis || n >= size) return n;
   if (d->mis[0].concentrated) {
     const rcb_diag_misfit *s = &d->mis[0];
+    char nm[RCB_DIAG_NAME + 16], carry[RCB_DIAG_CARRY] = "";
+    snprintf(nm, sizeof nm, "sensor.%s.gain", s->sensor);
+    if (!rcb_diag_is_base(d, nm)) /* its gain not fitted already: say how */
+      rcb_diag_carry_text(d, RCB_EFFECT_SENSOR_GAIN, s->sensor, NULL, carry, sizeof carry);
     n += (size_t)snprintf(text + n, size - n,
                           " The misfit concentrates on sensor %s (chi-square %.3g x what the "
                           "noise leaves there, %.0f %% of the excess): check this sensor (gain, "
-                          "phase, sign, direction, mounting) before the model.",
-                          s->sensor, s->chi2 / s->expected, s->excess_pct);
+                          "phase, sign, direction, mounting) before the model%s%s.",
+                          s->sensor, s->chi2 / s->expected, s->excess_pct,
+                          carry[0] ? ", or fit its gain with " : "", carry);
     return n < size ? n : size - 1;
   }
   n += (size_t)snprintf(text + n, size - n, " The misfit is spread over the sensors; the "
@@ -219,9 +224,10 @@ rcb_status rcb_diag_explain(const rcb_diag *d, char *buf, size_t size, size_t *n
       snprintf(text, sizeof text,
                "The measurement chain, not the model: %s (%s). Read through it, the data fit "
                "the model as it is: the error %s from %.3g %% to %.3g %%%s, BIC %+.1f, %s. "
-               "Check or recalibrate this sensor; the model is not changed.",
+               "Check or recalibrate this sensor, or read the data through the correction in "
+               "the next round (rcbtool fit or diagnose with %s); the model is not changed.",
                c->desc, c->fitted, trend(d->err0, c->err), d->err0, c->err, floor_txt, c->dbic,
-               test);
+               test, c->carry ? c->carry : "");
     else
       snprintf(text, sizeof text,
                "Missing: %s. Adding it (%s) explains the misfit: the error %s from %.3g %% "
@@ -259,6 +265,10 @@ rcb_status rcb_diag_explain(const rcb_diag *d, char *buf, size_t size, size_t *n
                c->desc, c->fitted, 100.0 * (d->F0 - c->F) / d->F0, trend(d->err0, c->err),
                d->err0, c->err, c->dbic);
     }
+    if ((c->fam->flags & DIAG_FAM_CHAIN) && c->carry && c->carry[0]) /* a sensor: how */
+      snprintf(text + strlen(text), sizeof text - strlen(text),
+               " Read the data through this correction in the next round: rcbtool fit or "
+               "diagnose with %s.", c->carry);
   } else if (base_ok == 1 && d->adeq0.chi2 <= d->adeq0.limit) {
     say_test(test, sizeof test, d->adeq0.chi2, d->adeq0.limit, 0, 1.0);
     snprintf(text, sizeof text,

@@ -48,6 +48,43 @@ int rcb_fit_param_is_chain(const char *name) {
   return 0;
 }
 
+void rcb_fit_chain_response(const char *name, char *r, size_t size) {
+  int which = rcb_fit_param_is_chain(name);
+  size_t p = sizeof SENSOR_PREFIX - 1, len;
+  if (!size) return;
+  r[0] = '\0';
+  if (!which) return;
+  len = strlen(name) - p - (which == RCB_CHAIN_GAIN ? 5 : 6);
+  if (len >= size) len = size - 1;
+  memcpy(r, name + p, len);
+  r[len] = '\0';
+}
+
+int rcb_fit_sensor_param_defaults(const char *name, double *start, double *lo, double *hi,
+                                  int *log_param) {
+  int which = rcb_fit_param_is_chain(name);
+  if (!which) return 0;
+  /* a probe off by a factor 10 is a wrong unit or range, not a calibration:
+   * the gain's bounds stop there; a phase beyond a quarter period is a
+   * sign or a swap (fixed edits), not a lag */
+  if (start) *start = which == RCB_CHAIN_GAIN ? 1.0 : 0.0;
+  if (lo) *lo = which == RCB_CHAIN_GAIN ? 0.1 : -RCB_PI / 2;
+  if (hi) *hi = which == RCB_CHAIN_GAIN ? 10.0 : RCB_PI / 2;
+  if (log_param) *log_param = which == RCB_CHAIN_GAIN;
+  return which;
+}
+
+/* The measured responses, "DA.x, DA.y, ...", into list (cut to size). */
+static void list_responses(const rcb_fit *f, char *list, size_t size) {
+  size_t s, used = 0;
+  list[0] = '\0';
+  for (s = 0; s < f->nsens && used + 1 < size; s++) {
+    int w = snprintf(list + used, size - used, "%s%s", s ? ", " : "", f->sens[s].response);
+    if (w < 0) break;
+    used += (size_t)w;
+  }
+}
+
 /* Every channel's model output (its sensor's, or the swapped partner's) and
  * its factor g0 e^{i phi0} g e^{i phi}. */
 static void chain_route(rcb_fit *f) {
@@ -91,27 +128,17 @@ void rcb_fit_chain_reroute(rcb_fit *f) {
  * the measured responses when it is none of them. */
 static rcb_status chain_lookup(rcb_fit *f, const char *name, int *which, size_t *sensor) {
   char resp[RCB_PARAM_NAME_MAX];
-  size_t p = sizeof SENSOR_PREFIX - 1, n = strlen(name), s, len, used;
   *which = rcb_fit_param_is_chain(name);
   if (!*which)
     return rcb_fit_fail(f, RCB_ERR_ARG,
                         "parameter '%s': a sensor parameter is sensor.<response>.gain or "
                         "sensor.<response>.phase",
                         name);
-  len = n - p - (*which == RCB_CHAIN_GAIN ? 5 : 6);
-  if (len >= sizeof resp) len = sizeof resp - 1;
-  memcpy(resp, name + p, len);
-  resp[len] = '\0';
+  rcb_fit_chain_response(name, resp, sizeof resp);
   if ((*sensor = find_sensor(f, resp)) != (size_t)-1) return RCB_OK;
   {
     char list[RCB_ERRMSG_MAX / 2];
-    list[0] = '\0';
-    for (s = 0, used = 0; s < f->nsens && used + 1 < sizeof list; s++) {
-      int w = snprintf(list + used, sizeof list - used, "%s%s", s ? ", " : "",
-                       f->sens[s].response);
-      if (w < 0) break;
-      used += (size_t)w;
-    }
+    list_responses(f, list, sizeof list);
     return rcb_fit_fail(f, RCB_ERR_ARG,
                         "parameter '%s': no measured channel has the response '%s' (measured "
                         "responses: %s)",
@@ -217,9 +244,14 @@ rcb_status rcb_fit_chain_jacobian(rcb_fit *f, const char *const *names, size_t n
 rcb_status rcb_fit_set_sensor(rcb_fit *f, const char *response, double gain, double phase_rad) {
   size_t s;
   if (!f || !response) return RCB_ERR_ARG;
-  if ((s = find_sensor(f, response)) == (size_t)-1)
-    return rcb_fit_fail(f, RCB_ERR_ARG, "sensor '%s': no measured channel has that response",
-                        response);
+  if ((s = find_sensor(f, response)) == (size_t)-1) {
+    char list[RCB_ERRMSG_MAX / 2];
+    list_responses(f, list, sizeof list);
+    return rcb_fit_fail(f, RCB_ERR_ARG,
+                        "sensor '%s': no measured channel has that response (measured "
+                        "responses: %s)",
+                        response, list);
+  }
   if (!isfinite(gain) || gain == 0.0 || !isfinite(phase_rad))
     return rcb_fit_fail(f, RCB_ERR_ARG,
                         "sensor '%s': gain %g, phase %g rad: expected a finite, nonzero gain "
@@ -248,17 +280,21 @@ static int refs_within(const rcb_fit *f, size_t a, size_t b) {
 rcb_status rcb_fit_swap_sensors(rcb_fit *f, const char *a, const char *b) {
   size_t sa, sb;
   if (!f || !a) return RCB_ERR_ARG;
-  if ((sa = find_sensor(f, a)) == (size_t)-1)
-    return rcb_fit_fail(f, RCB_ERR_ARG, "swap: no measured channel has the response '%s'", a);
+  if ((sa = find_sensor(f, a)) == (size_t)-1 || (b && find_sensor(f, b) == (size_t)-1)) {
+    char list[RCB_ERRMSG_MAX / 2];
+    list_responses(f, list, sizeof list);
+    return rcb_fit_fail(f, RCB_ERR_ARG,
+                        "swap %s with %s: no measured channel has the response '%s' (measured "
+                        "responses: %s)",
+                        a, b ? b : "itself", sa == (size_t)-1 ? a : b, list);
+  }
   if (!b || strcmp(a, b) == 0) { /* undo a's swap */
     f->sens[f->sens[sa].swap].swap = f->sens[sa].swap;
     f->sens[sa].swap = sa;
     chain_route(f);
     return RCB_OK;
   }
-  if ((sb = find_sensor(f, b)) == (size_t)-1)
-    return rcb_fit_fail(f, RCB_ERR_ARG, "swap %s with %s: no measured channel has the "
-                        "response '%s'", a, b, b);
+  sb = find_sensor(f, b); /* found above */
   if (f->sens[sa].swap == sb) return RCB_OK; /* already */
   if (f->sens[sa].swap != sa || f->sens[sb].swap != sb) {
     size_t x = f->sens[sa].swap != sa ? sa : sb;

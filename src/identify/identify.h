@@ -110,6 +110,9 @@ rcb_status rcb_fit_residuals_from(rcb_fit *f, const rcb_fit *src, double *r);
 #define RCB_CHAIN_GAIN 1
 #define RCB_CHAIN_PHASE 2
 int rcb_fit_param_is_chain(const char *name);
+/* The response of chain parameter name ("sensor.DB.y.gain" -> "DB.y") into
+ * r (cut to size); "" when name is not a chain parameter. */
+void rcb_fit_chain_response(const char *name, char *r, size_t size);
 
 /* Columns d r / d p (parameter units, nres x n column-major) of the chain
  * parameters names[0 .. n) (sensor.<response>.gain or .phase of a measured

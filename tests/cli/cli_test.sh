@@ -819,6 +819,91 @@ bad_fit_params)
   err_has "coupling.C.nope"
   [ "$(cat "$W/f.ini")" = old ] || fail "a refused fit overwrote the output"
   cmp -s "$MODEL" "$W/model.ini" || fail "the model was modified" ;;
+# ---- a sensor correction carried into the next round (issue #33, item 5) ----
+sensor_carry)
+  # the paper system as modelled, eq. 19 noise, every DB.y channel read 0.8 x (a probe 20 % low)
+  run simulate "$MODEL" --frf --out DA.x,DA.y,DB.x,DB.y --in DA.x,DB.y --fmin 100 --fmax 400 \
+    --points 61 --rpm 10000 --kind inertance --noise 10,1 --seed 1 -o "$W/ok.csv"; expect_rc 0
+  python3 - "$W/ok.csv" "$W/bad.csv" <<'EOF' || fail "could not scale DB.y"
+import sys
+lines = open(sys.argv[1]).read().splitlines()
+head = next(l for l in lines if l.startswith("freq")).split(",")
+cols = [i for i, h in enumerate(head) if h.startswith("DB.y/")]
+with open(sys.argv[2], "w") as out:
+    for l in lines:
+        if l[0].isdigit():
+            v = l.split(",")
+            for i in cols:
+                v[i] = repr(0.8 * float(v[i]))
+            l = ",".join(v)
+        out.write(l + "\n")
+EOF
+  # the gain the diagnosis advises, fitted: 0.8 within its 95 % interval; the null data: 1
+  for d in bad:0.8 ok:1; do
+    run fit "$MODEL" "$W/${d%:*}.csv" --params coupling.C.kt,sensor.DB.y.gain --noise 10,1 \
+      --starts 1 --json; expect_rc 0
+    python3 - "$W/out" "${d#*:}" <<'EOF' || fail "sensor.DB.y.gain not within its interval of ${d#*:}"
+import json, sys
+p = {q["name"]: q for q in json.load(open(sys.argv[1]))["params"]}["sensor.DB.y.gain"]
+lo, hi = p["ci95"]
+assert lo <= float(sys.argv[2]) <= hi and hi - lo < 0.05, p
+EOF
+  done
+  run fit "$MODEL" "$W/bad.csv" --params coupling.C.kt,sensor.DB.y.gain --noise 10,1 --starts 1
+  expect_rc 0; out_has "carry it into the next run with --sensor DB.y:gain=0.8"
+  # round 1 names the sensor and the options that carry it; --apply refuses it with them
+  run diagnose "$MODEL" "$W/bad.csv" --params coupling.C.kt --noise 10,1 --top 3 --json
+  expect_rc 0; json_ok
+  carry=$(python3 -c 'import json,sys; c=json.load(open(sys.argv[1]))["candidates"][0]
+assert c["effect"] == "sensor gain and phase" and c["place"] == "sensor DB.y", c
+assert c["claim"] == "explains" and c["chain"], c
+print(c["carry"])' "$W/out") || fail "round 1 does not name the gain at DB.y first"
+  [ "$carry" = "--params coupling.C.kt,sensor.DB.y.gain" ] || fail "carry: '$carry'"
+  out_has "rcbtool fit or diagnose with --params coupling.C.kt,sensor.DB.y.gain)"
+  run diagnose "$MODEL" "$W/bad.csv" --params coupling.C.kt --noise 10,1 --apply 1 -o "$W/m2.ini"
+  expect_rc 3; err_has "with --params coupling.C.kt,sensor.DB.y.gain)"
+  [ ! -e "$W/m2.ini" ] || fail "--apply of a sensor wrote a model"
+  # round 2 with the options as printed, and with the gain fixed: adequate, the sensor not named
+  for opts in "$carry" "--params coupling.C.kt --sensor DB.y:gain=0.8"; do
+    # shellcheck disable=SC2086 # the options are split into words as a user pastes them
+    run diagnose "$MODEL" "$W/bad.csv" $opts --noise 10,1 --top 3 --json; expect_rc 0
+    python3 - "$W/out" <<'EOF' || fail "round 2 ($opts) still names the sensor or is not adequate"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["adequacy"]["adequate"], d["adequacy"]
+assert "DB.y" not in d["explanation"] and "none is needed" in d["explanation"], d["explanation"]
+for c in d["candidates"]:
+    assert c["claim"] == "none" or not c["chain"], c
+EOF
+  done ;;
+bad_sensor)
+  run simulate "$MODEL" --frf --out DA.x,DB.x,DB.y --in DA.x --fmin 100 --fmax 400 --points 11 \
+    --rpm 10000 -o "$W/m.csv"; expect_rc 0
+  # a sensor no channel measures: exit 3, named, with the measured ones
+  for v in fit diagnose; do
+    run $v "$MODEL" "$W/m.csv" --params coupling.C.kt,sensor.DB.z.gain; expect_rc 3
+    err_has "DB.z"; err_has "measured responses: DA.x, DB.x, DB.y"
+    run $v "$MODEL" "$W/m.csv" --params coupling.C.kt --sensor DB.z:sign=-1; expect_rc 3
+    err_has "sensor 'DB.z'"; err_has "measured responses: DA.x, DB.x, DB.y"
+    run $v "$MODEL" "$W/m.csv" --params coupling.C.kt --swap DB.x,Q.y; expect_rc 3
+    err_has "'Q.y'"
+    # malformed: exit 2, saying what is expected
+    usage $v "$MODEL" "$W/m.csv" --params coupling.C.kt --sensor DB.y; err_has "RESP:KEY=V"
+    usage $v "$MODEL" "$W/m.csv" --params coupling.C.kt --sensor DB.y:gian=2; err_has "'gian'"
+    usage $v "$MODEL" "$W/m.csv" --params coupling.C.kt --sensor DB.y:gain=0; err_has "nonzero"
+    usage $v "$MODEL" "$W/m.csv" --params coupling.C.kt --sensor DB.y:sign=2; err_has "-1 or 1"
+    usage $v "$MODEL" "$W/m.csv" --params coupling.C.kt --sensor DB.y:gain=1,DB.y:sign=-1
+    err_has "DB.y given twice"
+    usage $v "$MODEL" "$W/m.csv" --params coupling.C.kt --swap DB.x; err_has "pairs"
+    usage $v "$MODEL" "$W/m.csv" --params coupling.C.kt --swap DB.x,DB.x; err_has "itself"
+    # well formed: keys continue the sensor before them, a RESP: starts the next one
+    run $v "$MODEL" "$W/m.csv" --params coupling.C.kt --sensor DB.y:gain=1,sign=-1,DB.x:gain=1
+    expect_rc 0
+  done
+  # a sensor's gain says nothing about where to measure
+  usage sensitivity "$MODEL" --params coupling.C.kt,sensor.DB.y.gain --frf --in DA.x \
+    --fmax 400 --rpm 10000
+  err_has "sensor.DB.y.gain belongs to the measurement chain" ;;
 # ---- rcbtool monitor (issue #16): the series and its refusals ----
 bad_monitor_series)
   M="--params coupling.C.kt --noise 10,1"; O=C.A.x,C.A.y,C.B.x,C.B.y

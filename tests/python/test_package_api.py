@@ -218,6 +218,8 @@ def test_diagnose_finds_the_walkthrough_effect(rcb):
         assert float(best["fitted"].split("=")[1]) == pytest.approx(2e7, rel=0.05)
         # 8 x 151 is fitted on all points: no refit is left screened only
         assert not any(c["screened_only"] for c in d.candidates)
+        # a sensor finding names the options of its next round; a model candidate none
+        assert all(bool(c["carry"]) == c["chain"] for c in d.candidates), d.candidates
         assert "B2" in d.explanation
         m2 = d.apply(best["rank"])
     assert m2.get("bearing.B2.kxy") == pytest.approx(2e7, rel=0.05)

@@ -393,6 +393,37 @@ int cli_history_append(const char *path, const char *command, const char *model,
 int cli_params_add(const cli_args *a, rcb_fit *f, const rcb_model *m, const cli_params *ps,
                    int log_all, int any_bounds);
 
+/* ---- the measurement chain: --sensor, --swap (cli_chain.c) ---- */
+
+/** One --sensor item: the response read as gain e^{i phase} times the model. */
+typedef struct cli_sensor_edit {
+  const char *response;
+  double gain, phase; /**< dimensionless (sign included), rad */
+} cli_sensor_edit;
+typedef struct cli_chain {
+  char *buf; /**< the options' text, split in place */
+  cli_sensor_edit *sens;
+  size_t nsens;
+  const char **swap; /**< pairs: swap[2k] with swap[2k + 1] */
+  size_t nswap;
+} cli_chain;
+/** Parse --sensor RESP:KEY=V[,KEY=V][,RESP2:...] and --swap A,B[,C,D...] (both
+ * optional); usage error 2 when malformed. */
+int cli_chain_parse(const cli_args *a, cli_chain *ch);
+void cli_chain_free(cli_chain *ch);
+/** Carry the corrections into a fit / a diagnosis: a sensor no channel
+ * measures, or probes that cannot be swapped, exit 3 with the library's
+ * message (which lists the measured responses). */
+int cli_chain_fit(const cli_args *a, const cli_chain *ch, rcb_fit *f);
+int cli_chain_diag(const cli_args *a, const cli_chain *ch, rcb_diag *d);
+/** Start, bounds and log flag of one --params item: a model parameter from
+ * the model (bounds as cli_param_bounds, log as @p log_all); a sensor's
+ * (sensor.RESP.gain | .phase) from rcb_fit_sensor_param_defaults (bounds
+ * given or its defaults; log for a gain with LO > 0, whatever @p log_all).
+ * Unknown model parameter exit 3, bad bounds exit 2. */
+int cli_param_setup(const cli_args *a, const rcb_model *m, const cli_param_spec *p, int log_all,
+                    int any_bounds, double *lo, double *hi, int *logp);
+
 /* ---- plots (cli_plot.c) ---- */
 
 /** Make the directories of a --plot path (mkdir -p of its dirname); 0 or exit 5. */

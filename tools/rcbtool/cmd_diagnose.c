@@ -13,7 +13,7 @@ const char cli_help_diagnose[] =
     "                        [--log] [--scale linear|log10|db|complex] [--noise A,S|--sd FILE]\n"
     "                        [--band LO:HI] [--map NODE=STATION,...] [--rpm R] [--refits N]\n"
     "                        [--top N] [--apply K [--force] -o MODEL2.ini]\n"
-    "                        [--history FILE]\n"
+    "                        [--sensor RESP:KEY=V,...] [--swap A,B,...] [--history FILE]\n"
     "                        [--threads N] [--json] [--progress]\n"
     "\n"
     "Fits the model as it is (the --params, e.g. the coupling's kt and kr), then\n"
@@ -40,7 +40,12 @@ const char cli_help_diagnose[] =
     "the misfit concentrates (per response sensor), and a sensor whose misfit\n"
     "stands out is named to be checked first. The catalogue also holds faults of\n"
     "the measurement chain (a sensor's gain, sign, two swapped probes): they\n"
-    "never change the model, and --apply refuses them.\n"    "On large sets (where a subset of the frequencies keeps at most half of\n"
+    "never change the model, and --apply refuses them. A sensor finding names the\n"
+    "options that read the data through its correction in the next round (round\n"
+    "2 then neither needs nor names it again): its gain fitted with the model's\n"
+    "parameters (--params ...,sensor.DB.y.gain), a sign (--sensor DB.y:sign=-1)\n"
+    "or a swap (--swap DB.x,DB.y); the same options work for rcbtool fit.\n"
+    "On large sets (where a subset of the frequencies keeps at most half of\n"
     "them) the refits are screened on that subset and evaluated on all points\n"
     "where their screen ended; only those within 10 % of the best objective are\n"
     "polished on all points. The others are marked \"screened\" (\"screened_only\"\n"
@@ -53,6 +58,13 @@ const char cli_help_diagnose[] =
     "                 or order written with the measurement; the objective is\n"
     "                 then a chi-square, and dBIC = F - F0 + k ln N\n"
     "  --band LO:HI   use only this band: Hz for FRF data, rpm for unbalance data\n"
+    "  --params LIST  the model's parameters to fit first, as for rcbtool fit, and\n"
+    "                 sensor gains and phases (sensor.DB.y.gain: dimensionless,\n"
+    "                 [0.1, 10]; sensor.DB.y.phase: rad, [-pi/2, pi/2])\n"
+    "  --sensor LIST  known sensor corrections, RESP:KEY=V[,KEY=V][,RESP2:...] with\n"
+    "                 KEY gain (dimensionless), phase (rad) or sign (-1 or 1),\n"
+    "                 carried into every fit (as for rcbtool fit)\n"
+    "  --swap LIST    probes known to be swapped, in pairs A,B[,C,D...]\n"
     "  --refits N     candidates refitted (default 8)\n"
     "  --top N        candidates to print (default 10)\n"
     "  --threads N    fit the candidates on N threads (default 1); the same\n"
@@ -65,7 +77,8 @@ const char cli_help_diagnose[] =
     "  --history FILE record this step (rcbtool history FILE shows the steps)\n"
     "  --json         the ranking as JSON: per candidate \"claim\" (explains,\n"
     "                 improves, none), \"significant\", \"adequate\" (null when\n"
-    "                 unknown), \"chi2\", \"chi2_limit\", \"chain\"; \"adequacy\" of\n"
+    "                 unknown), \"chi2\", \"chi2_limit\", \"chain\", \"carry\" (a sensor\n"
+    "                 finding's options for the next round); \"adequacy\" of\n"
     "                 the model as it is (chi2, dof, expected, sd, limit,\n"
     "                 adequate); \"misfit\": per sensor chi2, expected, excess_pct,\n"
     "                 concentrated; and \"evaluations\" (model sweeps, a\n"
@@ -92,6 +105,7 @@ typedef struct diag_job {
   size_t refits, top, apply, threads;
   int force;
   const char *history;
+  cli_chain chain; /* --sensor, --swap: the measurement chain's known corrections */
 } diag_job;
 
 static int pair(const cli_args *a, const char *opt, char sep, double *x, double *y) {
@@ -126,6 +140,7 @@ static int parse_job(const cli_args *a, diag_job *j) {
   if (j->apply && !a->output)
     return cli_usage(a->cmd, "--apply K writes a model: give -o MODEL2.ini");
   if (j->force && !j->apply) return cli_usage(a->cmd, "--force goes with --apply K");
+  if ((rc = cli_chain_parse(a, &j->chain))) return rc;
   if ((j->have_params = cli_opt_value(a, "--params") != NULL) &&
       (rc = cli_params_parse(a, "--params", &j->params)))
     return rc;
@@ -155,15 +170,14 @@ static int setup(const cli_args *a, const diag_job *j, const rcb_model *m, const
     return cli_usage(a->cmd, "--threads %zu: from 1 to %d", j->threads, RCB_DIAG_MAX_THREADS);
   for (k = 0; j->have_params && k < j->params.n; k++) {
     const cli_param_spec *p = &j->params.items[k];
-    double v, lo = 0, hi = 0;
-    int rc;
-    if (rcb_model_get_param(m, p->name, &v))
-      return cli_fail(CLI_EXIT_INPUT, "%s: %s", a->cmd, rcb_model_errmsg(m));
-    if ((rc = cli_param_bounds(a, p, v, 0, &lo, &hi))) return rc;
-    if (rcb_diag_add_fitted_param(d, p->name, lo, hi, j->log_all))
-      return cli_fail(CLI_EXIT_NUMERIC, "%s: %s", a->cmd, rcb_diag_errmsg(d));
+    double lo = 0, hi = 0;
+    int rc, logp = 0;
+    if ((rc = cli_param_setup(a, m, p, j->log_all, 0, &lo, &hi, &logp))) return rc;
+    if ((st = rcb_diag_add_fitted_param(d, p->name, lo, hi, logp)))
+      return cli_fail(st == RCB_ERR_ARG ? CLI_EXIT_INPUT : CLI_EXIT_NUMERIC, "%s: %s", a->cmd,
+                      rcb_diag_errmsg(d));
   }
-  return 0;
+  return cli_chain_diag(a, &j->chain, d);
 }
 
 typedef struct prog_ctx {
@@ -353,6 +367,8 @@ static void print_json(FILE *fp, const diag_job *j, const rcb_diag *d, const cha
     fprintf(fp, ", \"chain\": %s, \"screened_only\": %s, \"fitted\": ",
             c.chain ? "true" : "false", c.screened_only ? "true" : "false");
     cli_json_str(fp, c.fitted);
+    fputs(", \"carry\": ", fp);
+    cli_json_str(fp, c.carry);
     fputs("}", fp);
   }
   fputs("]}\n", fp);
@@ -375,8 +391,9 @@ static int apply(const cli_args *a, const diag_job *j, const rcb_diag *d) {
       return cli_fail(CLI_EXIT_INPUT,
                       "%s: --apply %zu: candidate %zu (%s) is a fault of the measurement "
                       "chain, not of the model: nothing written; check or recalibrate the "
-                      "sensor, or apply a model candidate",
-                      a->cmd, j->apply, j->apply, c.description);
+                      "sensor, or read the data through the correction in the next round "
+                      "(rcbtool fit or diagnose with %s)",
+                      a->cmd, j->apply, j->apply, c.description, c.carry);
     if (rcb_diag_candidate_get(d, j->apply - 1, &c) == RCB_OK && c.claim == RCB_CLAIM_NONE) {
       if (!j->force)
         return cli_fail(CLI_EXIT_INPUT,
@@ -488,7 +505,9 @@ int cmd_diagnose(int argc, char **argv) {
                     {"--threads", "N", NULL},
                     {"--apply", "K", NULL},
                     {"--force", NULL, NULL},
-                    {"--history", "FILE", NULL}};
+                    {"--history", "FILE", NULL},
+                    {"--sensor", "RESP:KEY=V,...", NULL},
+                    {"--swap", "A,B,...", NULL}};
   size_t nopts = sizeof opts / sizeof opts[0];
   diag_job j;
   cli_args a;
@@ -503,6 +522,7 @@ int cmd_diagnose(int argc, char **argv) {
       !(rc = parse_job(&a, &j)))
     rc = run(&a, &j);
   if (j.have_params) cli_params_free(&j.params);
+  cli_chain_free(&j.chain);
   free(args);
   return rc < 0 ? CLI_EXIT_OK : rc;
 }

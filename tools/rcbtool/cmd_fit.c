@@ -16,6 +16,7 @@ const char cli_help_fit[] =
     "                   [--log] [--method paper|nlopt:ALG]\n"
     "                   [--scale linear|log10|db|complex] [--band LO:HI]\n"
     "                   [--noise BETA_A,BETA_S] [--fd] [--max-iter N] [--starts N]\n"
+    "                   [--sensor RESP:KEY=V,...] [--swap A,B,...]\n"
     "                   [--map NODE=STATION,...] [--rpm R] [-o FITTED.ini] [--json] [--progress]\n"
     "\n"
     "Fits model parameters so that the model reproduces the measurement (paper\n"
@@ -25,7 +26,22 @@ const char cli_help_fit[] =
     "                 disk.DA.mass, shaft.A.damping_stiffness, unbalance.UA.phase,\n"
     "                 ...; SI units of the INI keys), each with optional bounds\n"
     "                 NAME:LO:HI; without bounds [start/1000, start*1000] (a start\n"
-    "                 <= 0 needs explicit bounds)\n"
+    "                 <= 0 needs explicit bounds). Also the measurement chain's:\n"
+    "                 sensor.RESP.gain (dimensionless, start 1, default bounds\n"
+    "                 [0.1, 10], fitted on log g) and sensor.RESP.phase (rad,\n"
+    "                 start 0, default [-pi/2, pi/2]; seen on --scale complex\n"
+    "                 only) of a measured response RESP (DB.y): every channel\n"
+    "                 measured at RESP is predicted as g e^(i phase) x the model.\n"
+    "                 They are not written to -o (not part of the model)\n"
+    "  --sensor LIST  known corrections of the measurement chain, not fitted:\n"
+    "                 RESP:KEY=V[,KEY=V][,RESP2:KEY=V...] with KEY gain\n"
+    "                 (dimensionless, nonzero), phase (rad, positive when the\n"
+    "                 sensor leads) or sign (-1: wired the wrong way), e.g.\n"
+    "                 DB.y:gain=0.8,phase=0 or DB.y:sign=-1; a fitted\n"
+    "                 sensor.RESP.gain multiplies them\n"
+    "  --swap LIST    probes known to be swapped, in pairs: A,B[,C,D...] (e.g.\n"
+    "                 DB.x,DB.y: the channels of DB.x read the model at DB.y and\n"
+    "                 vice versa; the two measured with the same references)\n"
     "  --log          optimise log(p) for every parameter (needs LO > 0)\n"
     "  --method M     paper (default: Gauss-Newton by pseudo-inverse, Coggins line\n"
     "                 search, lambda-Q damping, exterior penalty; eqs. 14-18) or\n"
@@ -171,19 +187,36 @@ int cli_param_bounds(const cli_args *a, const cli_param_spec *p, double start, i
   return 0;
 }
 
+int cli_param_setup(const cli_args *a, const rcb_model *m, const cli_param_spec *p, int log_all,
+                    int any_bounds, double *lo, double *hi, int *logp) {
+  double start;
+  rcb_status st;
+  if (rcb_fit_sensor_param_defaults(p->name, &start, lo, hi, logp)) {
+    /* a sensor's (the measurement chain, in no model): its own bounds and scale */
+    if (p->has_bounds) *lo = p->lo, *hi = p->hi;
+    *logp = *logp && *lo > 0;
+    return 0;
+  }
+  if ((st = rcb_model_get_param(m, p->name, &start)))
+    return cli_fail(st == RCB_ERR_NOT_FOUND ? CLI_EXIT_INPUT : CLI_EXIT_NUMERIC, "%s: %s",
+                    a->cmd, cli_msg(rcb_model_errmsg(m), st));
+  *logp = log_all;
+  return cli_param_bounds(a, p, start, any_bounds, lo, hi);
+}
+
 int cli_params_add(const cli_args *a, rcb_fit *f, const rcb_model *m, const cli_params *ps,
                    int log_all, int any_bounds) {
   size_t k;
   for (k = 0; k < ps->n; k++) {
     const cli_param_spec *p = &ps->items[k];
-    double start, lo = 0.0, hi = 0.0;
-    rcb_status st = rcb_model_get_param(m, p->name, &start);
-    int rc;
-    if (st)
-      return cli_fail(st == RCB_ERR_NOT_FOUND ? CLI_EXIT_INPUT : CLI_EXIT_NUMERIC, "%s: %s",
-                      a->cmd, cli_msg(rcb_model_errmsg(m), st));
-    if ((rc = cli_param_bounds(a, p, start, any_bounds, &lo, &hi))) return rc;
-    st = rcb_fit_add_param(f, p->name, lo, hi, log_all);
+    double lo = 0.0, hi = 0.0;
+    int rc, logp = 0;
+    rcb_status st;
+    if ((rc = cli_param_setup(a, m, p, log_all, any_bounds, &lo, &hi, &logp))) return rc;
+    st = rcb_fit_add_param(f, p->name, lo, hi, logp);
+    /* a sensor no channel measures is a bad name, as a model parameter's */
+    if (st == RCB_ERR_ARG && rcb_fit_sensor_param_defaults(p->name, NULL, NULL, NULL, NULL))
+      return cli_fail(CLI_EXIT_INPUT, "%s: %s", a->cmd, cli_msg(rcb_fit_errmsg(f), st));
     if (st)
       return st == RCB_ERR_ARG ? cli_usage(a->cmd, "%s", cli_msg(rcb_fit_errmsg(f), st))
                                : cli_fail(cli_status_exit(st), "%s: %s", a->cmd,
@@ -206,6 +239,7 @@ typedef struct fit_job {
   size_t max_iter, starts;
   int is_uff; /* the measurement is a UFF file (set by read_meas) */
   int have_sd;          /* --sd: weights and the noise floor from the standard deviations */
+  cli_chain chain;      /* --sensor, --swap: the measurement chain's known corrections */
 } fit_job;
 
 /* "A<sep>B": two finite numbers. */
@@ -256,6 +290,7 @@ static int parse_job(const cli_args *a, fit_job *j) {
   if (a->output && strcmp(a->output, "-") == 0)
     return cli_usage(a->cmd, "-o - is not supported: the report goes to standard output; give "
                      "a file for the fitted model");
+  if ((rc = cli_chain_parse(a, &j->chain))) return rc;
   return cli_params_parse(a, "--params", &j->params);
 }
 
@@ -324,7 +359,9 @@ static int make_fit(const cli_args *a, const fit_job *j, rcb_model *m, const rcb
             stderr);
     return code;
   }
-  if ((rc = cli_params_add(a, *out, m, &j->params, j->log_all, 0))) return rc;
+  if ((rc = cli_chain_fit(a, &j->chain, *out)) ||
+      (rc = cli_params_add(a, *out, m, &j->params, j->log_all, 0)))
+    return rc;
   return settings(a, j, *out, ms);
 }
 
@@ -400,6 +437,17 @@ static void write_text_params(FILE *fp, const fit_result *r) {
   for (k = 0; k < r->np; k++)
     if (!r->par[k].identifiable)
       fprintf(fp, "note: %s is " NOT_IDENTIFIABLE "\n", r->par[k].name);
+  for (k = 0; k < r->np; k++) {
+    const char *nm = r->par[k].name;
+    int which = rcb_fit_sensor_param_defaults(nm, NULL, NULL, NULL, NULL);
+    size_t len = strlen(nm) - (sizeof "sensor." - 1) - (which == 1 ? 5 : 6);
+    if (which)
+      fprintf(fp, "note: %s belongs to the measurement chain, not to the model: a model "
+              "written with -o does not hold it; carry it into the next run with --sensor "
+              "%.*s:%s=%.6g (on top of any --sensor correction of this run), or fit it again\n",
+              nm, (int)len, nm + sizeof "sensor." - 1, which == 1 ? "gain" : "phase",
+              r->par[k].value);
+  }
 }
 
 /* E0/E1 are the paper's error (linear magnitudes, every point alike: the figure
@@ -694,7 +742,9 @@ int cmd_fit(int argc, char **argv) {
                     {"--starts", "N", NULL},
                     {"--history", "FILE", NULL},
                     {"--map", "NODE=STATION,...", NULL},
-                    {"--rpm", "R", NULL}};
+                    {"--rpm", "R", NULL},
+                    {"--sensor", "RESP:KEY=V,...", NULL},
+                    {"--swap", "A,B,...", NULL}};
   size_t nopts = sizeof opts / sizeof opts[0];
   fit_job j;
   cli_args a;
@@ -709,6 +759,7 @@ int cmd_fit(int argc, char **argv) {
       !(rc = parse_job(&a, &j)))
     rc = run(&a, &j);
   cli_params_free(&j.params);
+  cli_chain_free(&j.chain);
   free(args);
   return rc < 0 ? CLI_EXIT_OK : rc;
 }

@@ -363,7 +363,16 @@ static int sensitivities(const cli_args *a, const sens_job *j, rcb_model *m,
   /* calloc of at least one: the analyzer cannot see rcb_fit fill S */
   double *S = calloc(cl->n && j->params.n ? cl->n * j->params.n : 1, sizeof *S);
   int rc = 0;
-  rcb_status st = S ? rcb_fit_create(&f, m, ms, NULL) : RCB_ERR_NOMEM;
+  rcb_status st;
+  size_t k;
+  for (k = 0; k < j->params.n; k++) /* fit and diagnose take them; a placement does not */
+    if (rcb_fit_sensor_param_defaults(j->params.items[k].name, NULL, NULL, NULL, NULL)) {
+      free(S);
+      return cli_usage(a->cmd, "parameter %s belongs to the measurement chain, not to the "
+                       "model: it says nothing about where to measure; give model parameters",
+                       j->params.items[k].name);
+    }
+  st = S ? rcb_fit_create(&f, m, ms, NULL) : RCB_ERR_NOMEM;
   if (st) {
     rc = cli_fail(cli_status_exit(st), "sensitivity: %s", cli_msg(f ? rcb_fit_errmsg(f) : NULL,
                                                                   st));

@@ -100,7 +100,7 @@ class DiagCandidate(ctypes.Structure):
                 ("claim", c_int), ("adequate", c_int), ("chi2", c_double),
                 ("chi2_limit", c_double), ("chain", c_int), ("screened_only", c_int),
                 ("dispersion", c_double), ("white_z", c_double), ("white", c_int),
-                ("beyond", c_int)]
+                ("beyond", c_int), ("carry", c_char_p)]
 
 
 class FitAdequacy(ctypes.Structure):

@@ -162,7 +162,7 @@ class Diagnosis(Handle):
                 "chi2": c.chi2, "chi2_limit": c.chi2_limit, "chain": bool(c.chain),
                 "screened_only": bool(c.screened_only), "dispersion": c.dispersion,
                 "white_z": c.white_z, "white": None if c.white < 0 else bool(c.white),
-                "beyond": bool(c.beyond)})
+                "beyond": bool(c.beyond), "carry": _lib.text(c.carry)})
         a = _lib.FitAdequacy()
         self.check(L.rcb_diag_adequacy(self.handle, ctypes.byref(a)), "rcb_diag_adequacy")
         self.adequacy = {"known": bool(a.known), "chi2": a.chi2, "dof": a.dof,
