@@ -306,6 +306,10 @@ typedef struct rcb_diag_misfit {
   double excess_pct;    /**< its share of F's excess over the expectation, % */
   int concentrated;     /**< 1: its excess is above the others' by the rule of
                              rcb_diag_misfit_get (a sensor to check first) */
+  double z_even;        /**< (chi2 - phi expected) / (phi sd), phi = the other sensors'
+                             chi2 / expected: how far it stands out of an even residual (-) */
+  int uneven;           /**< 1: z_even beyond the normal quantile of 1 % / sensors (issue
+                             #33: with a white residual, a sensor noisier than the rest) */
 } rcb_diag_misfit;
 /** @brief Sensors of the measurement (0 before a run or without a known noise). */
 RCB_API size_t rcb_diag_misfit_count(const rcb_diag *d);

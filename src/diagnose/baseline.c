@@ -125,6 +125,17 @@ static rcb_status misfit_sensors(rcb_diag *d, const double *chi2, const double *
    * the excess, each failing its own test beyond the Bonferroni limit and
    * RCB_DIAG_MISFIT_RATIO x the median chi2 / expected of the rest */
   zlim = z_upper(0.01 / (double)(d->nmis ? d->nmis : 1));
+  for (k = 0; k < d->nmis; k++) { /* evenness: each sensor against the others' dispersion */
+    double c2 = 0.0, ex = 0.0, phi;
+    for (i = 0; i < d->nmis; i++)
+      if (i != k) c2 += d->mis[i].chi2, ex += d->mis[i].expected;
+    phi = ex > 0 ? fmax(c2 / ex, 1e-300) : 1.0;
+    d->mis[k].z_even = d->mis[k].sd > 0 ? (d->mis[k].chi2 - phi * d->mis[k].expected) /
+                                              (phi * d->mis[k].sd)
+                                        : 0.0;
+    d->mis[k].uneven = d->nmis > 1 && d->mis[k].z_even > zlim && d->mis[k].expected > 0 &&
+                       d->mis[k].chi2 / d->mis[k].expected >= RCB_DIAG_UNEVEN_RATIO * phi;
+  }
   for (m = 1; m <= 2 && m < d->nmis; m++) {
     double share = 0.0, med;
     size_t n = 0;

@@ -25,6 +25,7 @@
 #define RCB_DIAG_SCREEN_ITER        25                 /* iterations (refit.c, placed.c too) */
 #define RCB_DIAG_MISFIT_SHARE       80.0               /* % of F's excess over the noise */
 #define RCB_DIAG_MISFIT_RATIO       3.0                /* ratio of chi2 / expected ratios */
+#define RCB_DIAG_UNEVEN_RATIO       1.25               /* ratio of chi2 / expected ratios */
 /* the score test: score.c */
 #define RCB_DIAG_BATCH              128                /* parameters a sweep, at most */
 #define RCB_DIAG_BATCH_MIN          32                 /* parameters a sweep, at least */
@@ -81,6 +82,15 @@
  * expected of the rest (rcb_diag_misfit_get states the rule: a fault of a
  * sensor, not an effect every sensor sees). No measurement behind the two
  * values is recorded.
+ *
+ * RCB_DIAG_UNEVEN_RATIO (issue #33). A white residual is not even over the
+ * sensors when one sensor's chi2 / expected stands out of the others' by
+ * more than the Bonferroni limit (z over the sensors at 1 %) and by this
+ * ratio: with 4400 residuals a sensor, z alone flagged the paper's literal
+ * eq. 19 (its excess gathers at weak points: DA.x at 1.12 against 1.07 for
+ * the rest, a ratio of 1.05), which is noise of another form everywhere,
+ * not one noisy sensor; a probe with 10 % more random noise (DB.y, 91 % of
+ * the excess) stands at about 1.4.
  *
  * RCB_DIAG_BATCH, RCB_DIAG_BATCH_MIN, RCB_DIAG_BATCH_VALUES. Candidates are
  * scored in batches of parameters whose columns share one sweep of the base

@@ -276,14 +276,36 @@ rcb_status rcb_diag_explain(const rcb_diag *d, char *buf, size_t size, size_t *n
              "adequacy test (%s; error %.3g %%%s).",
              test, d->err0, floor_txt);
   } else if (base_ok == 1) {
+    size_t k, nu = 0, w = 0;
+    char even[512];
+    for (k = 0; k < d->nmis; k++) nu += d->mis[k].uneven != 0;
+    if (nu) { /* white, but not even: the sensors that stand out */
+      w = (size_t)snprintf(even, sizeof even, "white along frequency (lag-1 statistic %.3g, "
+                           "1 %% limit %.3g) but not even over the sensors: ",
+                           d->adeq0.white_z, RCB_ADEQUACY_Z);
+      for (k = 0; k < d->nmis && w < sizeof even; k++)
+        if (d->mis[k].uneven)
+          w += (size_t)snprintf(even + w, sizeof even - w,
+                                "%s%s (%.0f %% of the excess, its noise about %.3g x the "
+                                "declared)",
+                                even[w - 1] == ')' ? ", " : "", d->mis[k].sensor,
+                                d->mis[k].excess_pct,
+                                sqrt(d->mis[k].chi2 / fmax(d->mis[k].expected, 1e-300)));
+      if (w < sizeof even)
+        snprintf(even + w, sizeof even - w, " %s noisier than the rest",
+                 nu > 1 ? "are" : "is");
+    } else
+      snprintf(even, sizeof even, "white along frequency and even over the sensors (lag-1 "
+               "statistic %.3g, 1 %% limit %.3g; no sensor stands out)",
+               d->adeq0.white_z, RCB_ADEQUACY_Z);
     snprintf(text, sizeof text,
              "No candidate is significant, and none is needed: the model as it is leaves a "
              "chi-square of %.6g, above the adequacy limit %.6g of the declared noise, but what "
-             "it leaves is white along frequency (lag-1 statistic %.3g, 1 %% limit %.3g): the "
-             "noise is about %.3g x the declared level, and nothing is shown missing (error "
-             "%.3g %%%s). Declare the noise as measured to test to its level.",
-             d->adeq0.chi2, d->adeq0.limit, d->adeq0.white_z, RCB_ADEQUACY_Z,
-             sqrt(d->adeq0.dispersion), d->err0, floor_txt);
+             "it leaves is %s: the noise is about %.3g x the declared level, and nothing is "
+             "shown missing (error %.3g %%%s). Declare the noise as measured to test to its "
+             "level.",
+             d->adeq0.chi2, d->adeq0.limit, even, sqrt(d->adeq0.dispersion), d->err0,
+             floor_txt);
   } else if (base_ok == 0) {
     say_test(test, sizeof test, d->adeq0.chi2, d->adeq0.limit, 0, 1.0);
     snprintf(text, sizeof text,

@@ -294,7 +294,9 @@ static void json_adequacy(FILE *fp, const rcb_diag *d) {
     cli_json_num(fp, s.expected > 0 ? s.chi2 / s.expected : (double)NAN);
     fputs(", \"excess_pct\": ", fp);
     cli_json_num(fp, s.excess_pct);
-    fprintf(fp, ", \"concentrated\": %s}", s.concentrated ? "true" : "false");
+    fprintf(fp, ", \"concentrated\": %s, \"z_even\": ", s.concentrated ? "true" : "false");
+    cli_json_num(fp, s.z_even);
+    fprintf(fp, ", \"uneven\": %s}", s.uneven ? "true" : "false");
   }
   fputs("]}", fp);
   /* where equivalent loads place it (rcb_diag_place_get), the largest share first */

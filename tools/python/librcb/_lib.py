@@ -112,7 +112,8 @@ class FitAdequacy(ctypes.Structure):
 
 class DiagMisfit(ctypes.Structure):
     _fields_ = [("sensor", c_char_p), ("chi2", c_double), ("expected", c_double),
-                ("sd", c_double), ("excess_pct", c_double), ("concentrated", c_int)]
+                ("sd", c_double), ("excess_pct", c_double), ("concentrated", c_int),
+                ("z_even", c_double), ("uneven", c_int)]
 
 
 class DiagPlace(ctypes.Structure):

@@ -178,7 +178,8 @@ class Diagnosis(Handle):
             self.check(L.rcb_diag_misfit_get(self.handle, k, ctypes.byref(m)))
             self.misfit.append({"response": _lib.text(m.sensor), "chi2": m.chi2,
                                 "expected": m.expected, "excess_pct": m.excess_pct,
-                                "concentrated": bool(m.concentrated)})
+                                "concentrated": bool(m.concentrated),
+                                "z_even": m.z_even, "uneven": bool(m.uneven)})
         pl = _lib.DiagPlace()
         self.places = []  # where equivalent loads place the misfit, the largest share first
         for k in range(L.rcb_diag_place_count(self.handle)):
