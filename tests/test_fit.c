@@ -135,11 +135,9 @@ static void test_sensitivities_unbalance(void **state) {
  * direct re-solve with one) and the batched columns of the diagnosis'
  * score test (rcb_fit_dz_get, rcb_fit_jacobian_dz), each against
  * extrapolated central differences of the residuals to 1e-6. */
-static void test_sensitivities_element(void **state) {
+static void factor_sensitivities(const char *const names[4], int one_element) {
   rcb_model *m = rcb_test_model_from_example("paper_system.ini");
   const char *outs[] = {"C.A.x", "C.B.y", "DB.x"}, *ins[] = {"DA.x", "C.B.x"};
-  const char *names[] = {"shaft.B.e3.stiffness", "shaft.B.e3.mass", "shaft.A.e7.stiffness",
-                         "coupling.C.kt"};
   rcb_meas *ms = rcb_test_frf_meas(m, outs, 3, ins, 2, 120, 400, 15, 10000, RCB_INERTANCE);
   rcb_fit *f = NULL, *fc = NULL;
   rcb_fit_dz dz[2];
@@ -147,7 +145,6 @@ static void test_sensitivities_element(void **state) {
   size_t n, k, j;
   double *J, *rp, *rm, *d1, *d2;
   int sc;
-  (void)state;
   for (sc = 0; sc < 4; sc++) { /* all four: the adjoint; one: the direct re-solve */
     size_t np = sc == 3 ? 1 : 4;
     assert_int_equal(rcb_fit_create(&f, m, ms, NULL), RCB_OK);
@@ -158,7 +155,7 @@ static void test_sensitivities_element(void **state) {
     rcb_fit_destroy(f);
   }
   /* batched: the base fit has coupling.C.kt, the candidate's columns come
-   * from the dZ of a fit of the element's two factors */
+   * from the dZ of a fit of the element's (the shaft's) two factors */
   rcb_allocator_init(&a, NULL);
   assert_int_equal(rcb_fit_create(&f, m, ms, NULL), RCB_OK);
   assert_int_equal(rcb_fit_add_param(f, names[3], 0.0, 1e9, 0), RCB_OK);
@@ -172,7 +169,8 @@ static void test_sensitivities_element(void **state) {
   rp = calloc(n, sizeof *rp), rm = calloc(n, sizeof *rm);
   d1 = calloc(n, sizeof *d1), d2 = calloc(n, sizeof *d2);
   assert_true(J && rp && rm && d1 && d2 && n > 0);
-  assert_true(dz[0].ne > 0 && dz[0].ne <= 64 && !dz[0].dF); /* one element's 8 x 8 block */
+  /* one element's 8 x 8 block, or every element of the shaft */
+  assert_true(dz[0].ne > 0 && (dz[0].ne <= 64) == one_element && !dz[0].dF);
   assert_int_equal(rcb_fit_jacobian_dz(f, dz, 2, J), RCB_OK);
   for (k = 0; k < 2; k++) {
     double na = 0, dc = 0;
@@ -193,6 +191,21 @@ static void test_sensitivities_element(void **state) {
   rcb_fit_destroy(f);
   rcb_meas_destroy(ms);
   rcb_model_destroy(m);
+}
+
+static void test_sensitivities_element(void **state) {
+  static const char *const names[4] = {"shaft.B.e3.stiffness", "shaft.B.e3.mass",
+                                       "shaft.A.e7.stiffness", "coupling.C.kt"};
+  (void)state;
+  factor_sensitivities(names, 1);
+}
+
+/* The shaft-wide factors (issue #33): the same paths. */
+static void test_sensitivities_shaft_factors(void **state) {
+  static const char *const names[4] = {"shaft.B.stiffness", "shaft.B.mass", "shaft.A.stiffness",
+                                       "coupling.C.kt"};
+  (void)state;
+  factor_sensitivities(names, 0);
 }
 
 /* Noise-free FRF data of the paper system (inertances at the coupling, force
@@ -677,6 +690,7 @@ int main(void) {
       cmocka_unit_test(test_sensitivities_frf),
       cmocka_unit_test(test_sensitivities_unbalance),
       cmocka_unit_test(test_sensitivities_element),
+      cmocka_unit_test(test_sensitivities_shaft_factors),
       cmocka_unit_test(test_paper_fit_noise_free),
       cmocka_unit_test(test_paper_fit_noisy_seeds),
       cmocka_unit_test(test_unsure_missing_effect),

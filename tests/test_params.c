@@ -377,28 +377,32 @@ static void test_enumerate(void **state) {
   rcb_model *m = rcb_test_model_from_example("paper_system.ini");
   char small[8];
   (void)state;
-  /* 1 material x 2 + 2 shafts x 2 + 2 disks x 3 + 4 bearings x 8
-   * + nelson_crandall_2 (kt kr ct cr + 3 hub) + 2 unbalances x 2 = 55 */
-  check_enumeration(m, 55, "material.steel.density", "unbalance.UB.phase");
+  /* 1 material x 2 + 2 shafts x 4 (2 damping, 2 factors) + 2 disks x 3 + 4 bearings x 8
+   * + nelson_crandall_2 (kt kr ct cr + 3 hub) + 2 unbalances x 2 = 59 */
+  check_enumeration(m, 59, "material.steel.density", "unbalance.UB.phase");
   {
     char b[64];
     assert_int_equal(rcb_model_param_name(m, 2, b, sizeof b), RCB_OK);
     assert_string_equal(b, "shaft.A.damping_mass");
-    assert_int_equal(rcb_model_param_name(m, 44, b, sizeof b), RCB_OK);
+    assert_int_equal(rcb_model_param_name(m, 4, b, sizeof b), RCB_OK);
+    assert_string_equal(b, "shaft.A.stiffness");
+    assert_int_equal(rcb_model_param_name(m, 5, b, sizeof b), RCB_OK);
+    assert_string_equal(b, "shaft.A.mass");
+    assert_int_equal(rcb_model_param_name(m, 48, b, sizeof b), RCB_OK);
     assert_string_equal(b, "coupling.C.kt");
   }
-  assert_int_equal(rcb_model_param_name(m, 55, small, sizeof small), RCB_ERR_NOT_FOUND);
+  assert_int_equal(rcb_model_param_name(m, 59, small, sizeof small), RCB_ERR_NOT_FOUND);
   assert_int_equal(rcb_model_param_name(m, 0, small, sizeof small), RCB_ERR_WORKSPACE);
   assert_int_equal(small[0], '\0');
   rcb_model_destroy(m);
   /* tabulated BR and the unused kt, ct of kramer_2 are left out:
-   * 2 + 2 shafts x 2 + BA 8 + kramer_2 (kr cr + 3 hub) + disk 3 + unbalance 2 = 24 */
+   * 2 + 2 shafts x 4 + BA 8 + kramer_2 (kr cr + 3 hub) + disk 3 + unbalance 2 = 28 */
   m = rcb_test_model_from_string(KRAMER_TABLE);
-  check_enumeration(m, 24, "material.steel.density", "unbalance.U.phase");
+  check_enumeration(m, 28, "material.steel.density", "unbalance.U.phase");
   rcb_model_destroy(m);
-  /* cross_coupled: 2 + 2 + disk 3 + BL 8 (BR tabulated) + 2 = 17 */
+  /* cross_coupled: 2 + 4 + disk 3 + BL 8 (BR tabulated) + 2 = 19 */
   m = rcb_test_model_from_example("cross_coupled.ini");
-  check_enumeration(m, 17, "material.steel.density", "unbalance.U.phase");
+  check_enumeration(m, 19, "material.steel.density", "unbalance.U.phase");
   rcb_model_destroy(m);
 }
 
@@ -775,6 +779,148 @@ static void test_element_factor_identity(void **state) {
   rcb_model_destroy(m);
 }
 
+/* Every element of shaft `shaft` (only) with factor `key` = f. */
+static void set_shaft_elements(rcb_model *m, const char *shaft, const char *key, double f) {
+  char name[64];
+  size_t e, ne = rcb_model_element_count(m);
+  for (e = 0; e < ne; e++) {
+    rcb_element_info ei;
+    assert_int_equal(rcb_model_element_info(m, e, &ei), RCB_OK);
+    if (strcmp(ei.shaft, shaft) != 0) continue;
+    snprintf(name, sizeof name, "shaft.%s.e%zu.%s", shaft, ei.index, key);
+    set(m, name, f);
+  }
+}
+
+/* The shaft-wide factors (issue #33), three ways to the same matrices, bit
+ * for bit: shaft.S.stiffness = f is the material's young x f when S is the
+ * only shaft of that material, and every element factor of S at f; the same
+ * for mass and density. M and G stay under a stiffness factor (to rounding:
+ * phi holds E/G), K under a mass factor (bit for bit). On the paper system (A and B share steel) only shaft A's rows
+ * change: the same as A's element factors. */
+static void test_shaft_factors(void **state) {
+  static const char *const key[2] = {"stiffness", "mass"};
+  static const char *const mat[2] = {"material.steel.young", "material.steel.density"};
+  const double f[2] = {0.85, 1.1};
+  rcb_model *m0 = rcb_test_model_from_example("cross_coupled.ini"), *m1, *m2, *m3;
+  size_t n = rcb_model_dof_count(m0), nn = n * n;
+  double *A0, *A1, *A2, *A3;
+  char name[64];
+  int v;
+  (void)state;
+  set(m0, "shaft.S.damping_stiffness", 2e-5); /* C = qz_m M + qz_k K follows both */
+  set(m0, "shaft.S.damping_mass", 3.0);
+  A0 = matrices(m0, 500.0);
+  for (v = 0; v < 2; v++) {
+    assert_int_equal(rcb_model_clone(&m1, m0, NULL), RCB_OK);
+    assert_int_equal(rcb_model_clone(&m2, m0, NULL), RCB_OK);
+    assert_int_equal(rcb_model_clone(&m3, m0, NULL), RCB_OK);
+    assert_int_equal(rcb_model_finalize(m1), RCB_OK);
+    assert_int_equal(rcb_model_finalize(m2), RCB_OK);
+    assert_int_equal(rcb_model_finalize(m3), RCB_OK);
+    assert_true(get(m1, v ? "shaft.S.mass" : "shaft.S.stiffness") == 1.0);
+    snprintf(name, sizeof name, "shaft.S.%s", key[v]);
+    set(m1, name, f[v]);
+    assert_true(get(m1, name) == f[v]);
+    set(m2, mat[v], get(m2, mat[v]) * f[v]);
+    set_shaft_elements(m3, "S", key[v], f[v]);
+    A1 = matrices(m1, 500.0);
+    A2 = matrices(m2, 500.0);
+    A3 = matrices(m3, 500.0);
+    expect_same(A2, A1, 4 * nn, v ? "M C G K: shaft.S.mass vs density" : "M C G K: shaft.S.stiffness vs young");
+    expect_same(A3, A1, 4 * nn, v ? "M C G K: shaft.S.mass vs elements" : "M C G K: shaft.S.stiffness vs elements");
+    if (v == 0) {
+      /* phi holds E/G: the same, to the rounding of E x f and G x f */
+      expect_scaled(A0, A1, nn, 1.0, 1e-15, "M under a stiffness factor");
+      expect_scaled(A0 + 2 * nn, A1 + 2 * nn, nn, 1.0, 1e-15, "G under a stiffness factor");
+    } else {
+      expect_same(A0 + 3 * nn, A1 + 3 * nn, nn, "K under a mass factor");
+    }
+    assert_true(memcmp(A0, A1, 4 * nn * sizeof *A0) != 0); /* it did change */
+    free(A1);
+    free(A2);
+    free(A3);
+    /* a clone keeps the factor through its own finalize */
+    rcb_model_destroy(m2);
+    assert_int_equal(rcb_model_clone(&m2, m1, NULL), RCB_OK);
+    assert_int_equal(rcb_model_finalize(m2), RCB_OK);
+    assert_true(get(m2, name) == f[v]);
+    rcb_model_destroy(m1);
+    rcb_model_destroy(m2);
+    rcb_model_destroy(m3);
+  }
+  expect_set_error(m0, "shaft.S.stiffness", 0.0, RCB_ERR_ARG, "shaft 'S'", "stiffness factor");
+  expect_set_error(m0, "shaft.S.mass", -1.0, RCB_ERR_ARG, "shaft 'S'", "mass factor");
+  free(A0);
+  rcb_model_destroy(m0);
+  /* two shafts of one material: shaft A's factor is A's element factors */
+  m0 = rcb_test_model_from_example("paper_system.ini");
+  nn = rcb_model_dof_count(m0) * rcb_model_dof_count(m0);
+  for (v = 0; v < 2; v++) {
+    assert_int_equal(rcb_model_clone(&m1, m0, NULL), RCB_OK);
+    assert_int_equal(rcb_model_clone(&m3, m0, NULL), RCB_OK);
+    assert_int_equal(rcb_model_finalize(m1), RCB_OK);
+    assert_int_equal(rcb_model_finalize(m3), RCB_OK);
+    snprintf(name, sizeof name, "shaft.A.%s", key[v]);
+    set(m1, name, f[v]);
+    assert_true(get(m1, v ? "shaft.B.mass" : "shaft.B.stiffness") == 1.0);
+    set_shaft_elements(m3, "A", key[v], f[v]);
+    A1 = matrices(m1, 500.0);
+    A3 = matrices(m3, 500.0);
+    expect_same(A3, A1, 4 * nn, "paper system: shaft A's factor vs its elements'");
+    free(A1);
+    free(A3);
+    rcb_model_destroy(m1);
+    rcb_model_destroy(m3);
+  }
+  rcb_model_destroy(m0);
+}
+
+/* INI: [shaft] stiffness_factor, mass_factor read and written (only when not
+ * 1), the same values and matrices after the round trip; 0 refused at its
+ * line. */
+static void test_shaft_factors_ini(void **state) {
+  rcb_model *m = rcb_test_model_from_example("paper_system.ini"), *r = NULL;
+  char *text;
+  (void)state;
+  text = write_text(m);
+  assert_null(strstr(text, "stiffness_factor"));
+  assert_null(strstr(text, "mass_factor"));
+  free(text);
+  set(m, "shaft.B.stiffness", 0.9);
+  set(m, "shaft.A.mass", 1.1);
+  text = write_text(m);
+  assert_non_null(strstr(text, "stiffness_factor = 0.9"));
+  assert_non_null(strstr(text, "mass_factor = 1.1"));
+  assert_int_equal(rcb_model_create(&r, NULL), RCB_OK);
+  if (rcb_model_load_string(r, text, "<written>") != RCB_OK)
+    fail_msg("written INI does not load: %s\n%s", rcb_model_errmsg(r), text);
+  assert_true(get(r, "shaft.B.stiffness") == 0.9);
+  assert_true(get(r, "shaft.A.mass") == 1.1);
+  assert_true(get(r, "shaft.A.stiffness") == 1.0);
+  assert_true(get(r, "shaft.B.mass") == 1.0);
+  expect_round_trip(m, "shaft factors");
+  rcb_model_destroy(r);
+  r = NULL;
+  {
+    const char *at = strstr(text, "stiffness_factor = 0.9");
+    char *bad = malloc(strlen(text) + 1);
+    assert_non_null(bad);
+    strcpy(bad, text);
+    bad[at - text + strlen("stiffness_factor = ")] = '0';
+    bad[at - text + strlen("stiffness_factor = ") + 1] = ' ';
+    bad[at - text + strlen("stiffness_factor = ") + 2] = ' ';
+    assert_int_equal(rcb_model_create(&r, NULL), RCB_OK);
+    assert_int_not_equal(rcb_model_load_string(r, bad, "<bad>"), RCB_OK);
+    if (!strstr(rcb_model_errmsg(r), "stiffness factor"))
+      fail_msg("message: %s", rcb_model_errmsg(r));
+    free(bad);
+    rcb_model_destroy(r);
+  }
+  free(text);
+  rcb_model_destroy(m);
+}
+
 /* One element of the paper system: only the rows of its two end nodes
  * change, linearly in the factor (K(f) = K_rest + f Ke), and the factors
  * are read back, kept by a clone and set before finalize. */
@@ -829,8 +975,8 @@ static void test_element_factor_local(void **state) {
   assert_int_equal(memcmp(A1, A2, 4 * nn * sizeof *A1), 0);
   assert_int_equal(rcb_model_element_info(c, e, &ei), RCB_OK);
   assert_true(ei.stiffness == 0.25 && ei.mass == 0.25);
-  /* not enumerated: the list of 55 stays */
-  assert_int_equal(rcb_model_param_count(m), 55);
+  /* not enumerated: the list of 59 stays */
+  assert_int_equal(rcb_model_param_count(m), 59);
   free(A0);
   free(A1);
   free(A2);
@@ -966,6 +1112,8 @@ int main(void) {
       cmocka_unit_test(test_element_factor_local),
       cmocka_unit_test(test_element_factor_errors),
       cmocka_unit_test(test_element_factor_frequencies),
+      cmocka_unit_test(test_shaft_factors),
+      cmocka_unit_test(test_shaft_factors_ini),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -49,7 +49,10 @@ typedef enum rcb_effect {
   RCB_EFFECT_SENSOR_GAIN = 14,                   /**< a response sensor's gain (and phase) */
   RCB_EFFECT_SENSOR_SIGN = 15,                   /**< a response sensor's sign flipped */
   RCB_EFFECT_SENSOR_SWAP = 16,                   /**< two probes (x, y) swapped */
-  RCB_EFFECT_COUNT = 17
+  RCB_EFFECT_SHAFT_STIFFNESS = 17,               /**< a whole shaft's bending stiffness
+                                                      (its section or material) */
+  RCB_EFFECT_SHAFT_MASS = 18,                    /**< a whole shaft's mass and inertia */
+  RCB_EFFECT_COUNT = 19
 } rcb_effect;
 
 /** @brief Short English name of an effect. */

@@ -376,6 +376,10 @@ RCB_API rcb_status rcb_model_unbalance_force(const rcb_model *m, double speed,
  *    once-per-revolution frequency. INI: [model] speed_factor.
  *  - disk.DA.mass | Id | Ip
  *  - shaft.A.damping_mass | damping_stiffness
+ *  - shaft.A.stiffness | mass: factors (neutral 1, > 0) on the E and G, and
+ *    on the density, of every element of shaft A, on top of the element
+ *    factors below: a section or material along the whole shaft other than
+ *    stated. INI: [shaft] stiffness_factor | mass_factor (written when not 1).
  *  - shaft.A.e<k>.stiffness | mass: factors (neutral 1, > 0) on element k's
  *    E and G (its whole stiffness matrix, bending and shear) and on its
  *    density (translational and rotary inertia, gyroscopic matrix): a local

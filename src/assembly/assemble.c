@@ -54,10 +54,10 @@ static void add_shafts(const rcb_model *m, const rcb_layout *L, double *M, doubl
     p.L = el->L;
     p.od = el->od;
     p.id = el->id;
-    /* the element's factors (issue #23): E and G together, so phi and the
-     * shape of Ke stay; rho scales M and G alike */
-    p.rho = mat->rho * (el->k < sh->nef ? sh->ef[2 * el->k + 1] : 1.0);
-    p.E = mat->E * (el->k < sh->nef ? sh->ef[2 * el->k] : 1.0);
+    /* the element's factors (issue #23) and the shaft's (issue #33): E and G
+     * together, so phi and the shape of Ke stay; rho scales M and G alike */
+    p.rho = mat->rho * sh->sf[1] * (el->k < sh->nef ? sh->ef[2 * el->k + 1] : 1.0);
+    p.E = mat->E * sh->sf[0] * (el->k < sh->nef ? sh->ef[2 * el->k] : 1.0);
     p.nu = mat->nu;
     p.kappa = sh->kappa;
     rcb_shaft_element(&p, Me, Ge, Ke);

@@ -95,6 +95,10 @@ typedef struct rcb_shaft_s {
    * Parameters shaft.NAME.e<k+1>.stiffness | mass (element_params.c). */
   double *ef;
   size_t nef, capef; /* nef: elements of the shaft so far; capef: doubles allocated */
+  /* Shaft-wide factors (issue #33): sf[0] multiplies E and G of every element
+   * of the shaft, sf[1] its density, on top of ef; neutral 1. Parameters
+   * shaft.NAME.stiffness | mass (params.c); INI stiffness_factor | mass_factor. */
+  double sf[2];
   size_t first_node, nnodes; /* after finalize */
 } rcb_shaft_t;
 

@@ -99,7 +99,10 @@ static rcb_status element_factors(ini_ctx *c, ini_section *s, const ini_entry *e
 
 static rcb_status build_shaft(ini_ctx *c, ini_section *s) {
   char mat[RCB_NAME_MAX], hint[200];
-  double z0, kappa, qm, qk;
+  double z0, kappa, qm, qk, sf[2];
+  static const char *const sf_keys[2] = {"stiffness_factor", "mass_factor"};
+  static const char *const sf_params[2] = {"stiffness", "mass"};
+  char pname[256];
   size_t i, nseg = 0;
   rcb_status st;
   TRY(rcb_ini_get_word(c, s, "material", "the name of a [material NAME] section", mat, sizeof mat));
@@ -118,6 +121,12 @@ static rcb_status build_shaft(ini_ctx *c, ini_section *s) {
   TRY(rcb_ini_get_num(c, s, "damping_mass", "mass-proportional damping qz_m in 1/s", 0, 0.0, &qm));
   TRY(rcb_ini_get_num(c, s, "damping_stiffness", "stiffness-proportional damping qz_k in s", 0, 0.0,
               &qk));
+  TRY(rcb_ini_get_num(c, s, "stiffness_factor",
+              "a factor > 0 on E and G of the whole shaft (1: as the material states)", 0, 1.0,
+              &sf[0]));
+  TRY(rcb_ini_get_num(c, s, "mass_factor",
+              "a factor > 0 on the density of the whole shaft (1: as the material states)", 0,
+              1.0, &sf[1]));
   for (i = 0; i < s->n_ent; i++) nseg += strcmp(s->ent[i].key, "segment") == 0;
   if (nseg == 0)
     return rcb_ini_missing(c, s, "segment",
@@ -126,6 +135,12 @@ static rcb_status build_shaft(ini_ctx *c, ini_section *s) {
   if ((st = rcb_model_add_shaft(c->m, s->name, mat, z0, kappa)) ||
       (st = rcb_model_set_shaft_damping(c->m, s->name, qm, qk)))
     return builder_fail(c, s, s->line, st);
+  for (i = 0; i < 2; i++) { /* shaft.S.stiffness | mass: checked > 0 by the parameter table */
+    const ini_entry *e = rcb_ini_get(s, sf_keys[i]);
+    snprintf(pname, sizeof pname, "shaft.%s.%s", s->name, sf_params[i]);
+    if ((st = rcb_model_set_param(c->m, pname, sf[i])))
+      return builder_fail(c, s, e ? e->line : s->line, st);
+  }
   s->z0 = s->z1 = z0;
   for (i = 0; i < s->n_ent; i++)
     if (strcmp(s->ent[i].key, "segment") == 0) TRY(segment(c, s, &s->ent[i]));

@@ -34,7 +34,8 @@ static const char *const keys_model[] = {"name", "description", "speed_factor"};
 static const char *const keys_material[] = {"density", "young", "poisson"};
 static const char *const keys_shaft[] = {"material",          "start",
                                          "shear_factor",      "damping_mass",
-                                         "damping_stiffness", "segment",
+                                         "damping_stiffness", "stiffness_factor",
+                                         "mass_factor",       "segment",
                                          "element_stiffness", "element_mass"};
 static const char *const keys_disk[] = {"at",      "mass",           "Id",
                                         "Ip",      "density",        "outer_diameter",

@@ -188,6 +188,8 @@ static void write_shafts(wbuf *w, const rcb_model *m) {
     kv_num(w, "shear_factor", s->kappa, "- (Timoshenko kappa)");
     kv_num(w, "damping_mass", s->qz_m, "qz_m, 1/s (C = qz_m M + qz_k K)");
     kv_num(w, "damping_stiffness", s->qz_k, "qz_k, s");
+    if (s->sf[0] != 1.0) kv_num(w, "stiffness_factor", s->sf[0], "- on E and G of the shaft");
+    if (s->sf[1] != 1.0) kv_num(w, "mass_factor", s->sf[1], "- on the density of the shaft");
     for (g = 0; g < s->nseg; g++) {
       const rcb_segment_t *sg = &s->seg[g];
       snprintf(line, sizeof line, "%s %s %s %d", num(a, sg->L), num(b, sg->od), num(c, sg->id),

@@ -203,6 +203,7 @@ rcb_status rcb_model_add_shaft(rcb_model *m, const char *name, const char *mater
   s->material = (size_t)mat;
   s->z0 = z_start;
   s->kappa = shear_factor;
+  s->sf[0] = s->sf[1] = 1.0; /* the shaft-wide factors' neutral value */
   return RCB_OK;
 }
 

@@ -39,8 +39,12 @@ typedef struct pkey {
 
 static const pkey material_keys[] = {{"density", "density (kg/m^3)", 1},
                                      {"young", "young (Pa)", 1}};
+/* stiffness, mass: factors on the whole shaft's E and G, and its density
+ * (rcb_shaft_t.sf), on top of the element factors */
 static const pkey shaft_keys[] = {{"damping_mass", "damping_mass qz_m (1/s)", 0},
-                                  {"damping_stiffness", "damping_stiffness qz_k (s)", 0}};
+                                  {"damping_stiffness", "damping_stiffness qz_k (s)", 0},
+                                  {"stiffness", "stiffness factor (-)", 1},
+                                  {"mass", "mass factor (-)", 1}};
 static const pkey disk_keys[] = {
     {"mass", "mass (kg)", 0}, {"Id", "Id (kg m^2)", 0}, {"Ip", "Ip (kg m^2)", 0}};
 /* Bearing coefficients may be negative (cross-coupled bearings): finite only,
@@ -135,7 +139,11 @@ static int slots(rcb_model *m, pkind k, size_t i, size_t j, double *v[2]) {
   v[1] = NULL;
   switch (k) {
     case PK_MATERIAL: v[0] = j == 0 ? &m->materials[i].rho : &m->materials[i].E; return 1;
-    case PK_SHAFT: v[0] = j == 0 ? &m->shafts[i].qz_m : &m->shafts[i].qz_k; return 1;
+    case PK_SHAFT: {
+      rcb_shaft_t *sh = &m->shafts[i];
+      v[0] = j == 0 ? &sh->qz_m : j == 1 ? &sh->qz_k : &sh->sf[j - 2];
+      return 1;
+    }
     case PK_DISK: {
       rcb_disk_t *d = &m->disks[i];
       v[0] = j == 0 ? &d->m : j == 1 ? &d->Id : &d->Ip;

@@ -189,6 +189,13 @@ class Shaft:
             n = int(n)
             for _ in range(n):
                 self.elements.append((length / n, od, idd))
+        # shaft-wide factors (librcb's shaft.NAME.stiffness | mass), on top of
+        # the element factors: every element then gets its own Material
+        sk, sm = _f(d, "stiffness_factor", 1.0), _f(d, "mass_factor", 1.0)
+        if sk != 1.0 or sm != 1.0:
+            for k in range(len(self.elements)):
+                fk, fm = self.factors.get(k, (1.0, 1.0))
+                self.factors[k] = (fk * sk, fm * sm)
         z = [self.start]
         for el in self.elements:
             z.append(z[-1] + el[0])
