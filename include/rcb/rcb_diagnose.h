@@ -259,7 +259,9 @@ typedef struct rcb_diag_candidate {
   rcb_claim claim;          /**< what may be said of it (rcb_evidence_claim) */
   int adequate;             /**< 1: the model with it passes the adequacy test, 0: not,
                                  -1: unknown (no noise known, or not refitted) */
-  double chi2, chi2_limit;  /**< its F and the adequacy limit (NaN: unknown) */
+  double chi2, chi2_limit;  /**< the chi-square of its adequacy test (with the noise model
+                                 evaluated at its own predictions: F when the noise is
+                                 given as --sd) and the test's limit (NaN: unknown) */
   int chain;                /**< 1: a fault of the measurement chain (a sensor), not of
                                  the model: --apply refuses, the model is not changed */
   int screened_only;        /**< 1 when the refit was fitted on a frequency subset only

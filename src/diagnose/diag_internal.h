@@ -85,6 +85,7 @@ typedef struct diag_cand {
   double F, err, dbic;              /* dbic: calibrated (rcb_evidence_dbic) */
   double dispersion;                /* F / its expectation with the candidate (NaN: unknown) */
   double white_z;                   /* whiteness of its residual (rcb_fit_white_z) */
+  double adeq_chi2;                 /* F of its own adequacy test (at its own reference) */
   int beyond;                       /* a fitted value outside [plo, phi] (beyond_k) */
   size_t beyond_k;
   double beyond_v;
@@ -299,8 +300,8 @@ rcb_status rcb_diag_screen(rcb_fit *f, const double *w, size_t cap);
 rcb_status rcb_diag_polish(rcb_fit *f);
 /* refit.c. A refit fitted (polished) or evaluated on all points, F and err:
  * its figures, its claim, and its model *m kept in c (*m set to NULL). */
-void rcb_diag_refit_result(rcb_diag *d, diag_cand *c, rcb_model **m, rcb_fit *f, double F,
-                           double err, int polished);
+rcb_status rcb_diag_refit_result(rcb_diag *d, diag_cand *c, rcb_model **m, rcb_fit *f,
+                                 double F, double err, int polished);
 
 /* placed.c. When no candidate explains the data and the equivalent loads
  * (rcb_diag_locate) place the misfit at a few nodes, refit every

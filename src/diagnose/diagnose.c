@@ -258,7 +258,7 @@ rcb_status rcb_diag_candidate_get(const rcb_diag *d, size_t rank, rcb_diag_candi
   out->significant = c->significant;
   out->claim = c->refitted ? c->claim : RCB_CLAIM_NONE;
   out->adequate = c->refitted ? c->adequate : -1;
-  out->chi2 = c->refitted ? c->F : (double)NAN;
+  out->chi2 = c->refitted ? c->adeq_chi2 : (double)NAN; /* its adequacy test's */
   out->chi2_limit = c->refitted ? c->chi2_limit : (double)NAN;
   out->chain = (c->fam->flags & DIAG_FAM_CHAIN) != 0;
   out->carry = c->carry ? c->carry : "";

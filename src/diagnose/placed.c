@@ -93,7 +93,8 @@ static rcb_status placed_refit(rcb_diag *d, diag_cand *c, const double *w) {
   }
   if (isfinite(F) && (!c->refitted || F < c->F)) {
     c->from_fit = 1;
-    rcb_diag_refit_result(d, c, &m, f, F, err, polished);
+    if ((st = rcb_diag_refit_result(d, c, &m, f, F, err, polished)) == RCB_ERR_NOMEM) goto done;
+    st = RCB_OK; /* a failed test leaves the candidate as it was */
     if (F < d->best_F) d->best_F = F;
   }
 done:

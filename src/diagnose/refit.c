@@ -120,17 +120,15 @@ rcb_status rcb_diag_polish(rcb_fit *f) {
 /* BIC change, adequacy limit and claim of a refitted candidate (F, err set;
  * k: its own parameters, refitted with the base's). */
 static void judge(const rcb_diag *d, diag_cand *c, double k) {
-  double N = (double)d->nres, expected = d->adeq_mean - ((double)d->nbase_fit + k);
+  double N = (double)d->nres;
   rcb_evidence e;
   memset(&e, 0, sizeof e);
   /* with noise-aware weights or known standard deviations F is a
    * chi-square: BIC = F + k ln N; else the Gaussian likelihood with the
    * variance estimated */
   e.delta_bic = chi2(d) ? (c->F - d->F0) + k * log(N) : N * log(c->F / d->F0) + k * log(N);
-  c->chi2_limit = d->adeq0.known ? expected + RCB_ADEQUACY_Z * d->adeq_sd : (double)NAN;
-  c->dispersion = d->adeq0.known && expected > 0 ? c->F / expected : (double)NAN;
   e.error_before_pct = d->err0, e.error_after_pct = c->err;
-  e.chi2 = c->F, e.chi2_limit = c->chi2_limit;
+  e.chi2 = c->adeq_chi2, e.chi2_limit = c->chi2_limit;
   e.params = k, e.residuals = N, e.dispersion = c->dispersion;
   e.tried = (double)d->ncand;
   e.white = d->adeq0.known && c->white_z <= RCB_ADEQUACY_Z;
@@ -142,8 +140,31 @@ static void judge(const rcb_diag *d, diag_cand *c, double k) {
   c->claim = rcb_evidence_claim(&e);
 }
 
-/* The whiteness of the residual of fit f's last evaluation (on all points). */
-static void whiteness(diag_cand *c, rcb_fit *f) { c->white_z = rcb_fit_last_white_z(f); }
+/* The adequacy test of the model with candidate c (its fit f, on all
+ * points, at its refitted values): its chi-square, limit, dispersion and
+ * whiteness (issue #33). Its own test, with the noise model evaluated at
+ * its own predictions: the weights every fit shares come from the model as
+ * it is, and a large effect (a hub 120 % off) leaves them at values the
+ * model with the effect does not have, which no test of it may use. F for
+ * the BIC stays on the shared weights (c->F). f is left on the new weights. */
+static rcb_status cand_adequacy(rcb_diag *d, diag_cand *c, rcb_fit *f) {
+  size_t n = rcb_meas_channel_count(d->meas) * rcb_meas_point_count(d->meas);
+  rcb_complex *h;
+  rcb_fit_adequacy a;
+  rcb_status st;
+  c->adeq_chi2 = c->chi2_limit = c->dispersion = (double)NAN, c->white_z = HUGE_VAL;
+  if (!d->adeq0.known) return RCB_OK;
+  if (!(h = rcb_alloc(&d->alloc, (n ? n : 1) * sizeof *h)))
+    return rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
+  st = d->nref ? rcb_fit_predictions(f, h) : RCB_OK;
+  if (!st && d->nref) st = rcb_fit_set_noise_reference(f, h);
+  if (!st) st = rcb_fit_get_adequacy(f, &a, NULL, NULL, NULL);
+  rcb_free(&d->alloc, h);
+  if (st) return rcb_diag_fail(d, st, "the adequacy test of %s: %s", c->desc, rcb_fit_errmsg(f));
+  c->adeq_chi2 = a.chi2, c->chi2_limit = a.limit, c->dispersion = a.dispersion;
+  c->white_z = a.white_z;
+  return RCB_OK;
+}
 
 /* Whether a fitted value of the candidate (the last c->np parameters of f)
  * lies outside what its part can be, [plo, phi] (issue #33: a section error
@@ -168,10 +189,10 @@ static rcb_status evaluate_only(rcb_diag *d, diag_cand *c, rcb_model **m, rcb_fi
   double *r = rcb_alloc(&d->alloc, d->nres * sizeof *r);
   rcb_status st = r ? rcb_diag_objective(d, f, r, &c->F, &c->err) : RCB_ERR_NOMEM;
   rcb_free(&d->alloc, r);
+  if (!st) st = cand_adequacy(d, c, f);
   if (st) return st;
   c->refitted = 1;
   c->polished = 1;
-  whiteness(c, f);
   judge(d, c, 0.0);
   snprintf(c->fitted, sizeof c->fitted, "no parameter");
   c->model = *m, *m = NULL; /* kept: --apply writes it */
@@ -179,18 +200,20 @@ static rcb_status evaluate_only(rcb_diag *d, diag_cand *c, rcb_model **m, rcb_fi
 }
 
 /* A refit fitted or evaluated on all points: its figures. */
-void rcb_diag_refit_result(rcb_diag *d, diag_cand *c, rcb_model **m, rcb_fit *f, double F,
-                         double err, int polished) {
+rcb_status rcb_diag_refit_result(rcb_diag *d, diag_cand *c, rcb_model **m, rcb_fit *f,
+                                 double F, double err, int polished) {
+  rcb_status st = cand_adequacy(d, c, f);
+  if (st) return st;
   c->refitted = 1;
   c->polished = polished;
   c->F = F, c->err = err;
-  whiteness(c, f);
   beyond(c, f);
   judge(d, c, (double)c->np);
   record_fit(c, f);
   rcb_diag_keep_chain(c, f);
   rcb_model_destroy(c->model);
   c->model = *m, *m = NULL;
+  return RCB_OK;
 }
 
 /* The first step of the refit of candidate c with the base parameters, from
@@ -269,7 +292,7 @@ rcb_status rcb_diag_refit_screen(rcb_diag *d, diag_cand *c, const double *w) {
       c->model = m[b], m[b] = NULL;
     } else {
       rcb_fit_get_report(f[b], &rep);
-      rcb_diag_refit_result(d, c, &m[b], f[b], rep.objective, rep.error_pct, 1);
+      st = rcb_diag_refit_result(d, c, &m[b], f[b], rep.objective, rep.error_pct, 1);
     }
   }
   for (s = 0; s < 2; s++) {
@@ -326,8 +349,8 @@ rcb_status rcb_diag_refit_evaluate(rcb_diag *d, diag_cand *c) {
   st = rcb_diag_make_fit(d, m, 1, c, &f);
   if (!st) st = (r = rcb_alloc(&d->alloc, d->nres * sizeof *r)) ? RCB_OK : RCB_ERR_NOMEM;
   if (!st) st = rcb_diag_objective(d, f, r, &F, &err);
-  if (!st) rcb_diag_refit_result(d, c, &m, f, F, err, 0);
-  else if (st != RCB_ERR_NOMEM)
+  if (!st) st = rcb_diag_refit_result(d, c, &m, f, F, err, 0);
+  if (st && st != RCB_ERR_NOMEM)
     snprintf(c->fitted, sizeof c->fitted, "refit failed: %.300s", d->errmsg);
   rcb_free(&d->alloc, r);
   rcb_diag_drop_fit(d, f);
@@ -421,8 +444,8 @@ rcb_status rcb_diag_refit_polish(rcb_diag *d, diag_cand *c) {
   if (!st) st = refit_tolerance(d, c, f, REFIT_POLISH);
   if (!st) st = rcb_diag_polish(f);
   if (!st) st = rcb_fit_get_report(f, &rep);
-  if (!st) rcb_diag_refit_result(d, c, &m, f, rep.objective, rep.error_pct, 1);
-  else if (st == RCB_ERR_NOMEM)
+  if (!st) st = rcb_diag_refit_result(d, c, &m, f, rep.objective, rep.error_pct, 1);
+  if (st == RCB_ERR_NOMEM)
     rcb_diag_fail(d, st, "refitting %s: %s", c->desc, f ? rcb_fit_errmsg(f) : "out of memory");
   rcb_diag_drop_fit(d, f);
   rcb_model_destroy(m);

@@ -219,7 +219,8 @@ rcb_status rcb_diag_explain(const rcb_diag *d, char *buf, size_t size, size_t *n
   if (isfinite(d->floor0))
     snprintf(floor_txt, sizeof floor_txt, " (noise floor %.3g %%)", d->floor0);
   if (c && c->refitted && c->claim == RCB_CLAIM_EXPLAINS) {
-    say_test(test, sizeof test, c->F, c->chi2_limit, c->white_z <= RCB_ADEQUACY_Z, c->dispersion);
+    say_test(test, sizeof test, c->adeq_chi2, c->chi2_limit, c->white_z <= RCB_ADEQUACY_Z,
+             c->dispersion);
     if (c->fam->flags & DIAG_FAM_CHAIN)
       snprintf(text, sizeof text,
                "The measurement chain, not the model: %s (%s). Read through it, the data fit "
@@ -236,7 +237,7 @@ rcb_status rcb_diag_explain(const rcb_diag *d, char *buf, size_t size, size_t *n
                test);
   } else if (c && c->refitted && c->claim == RCB_CLAIM_IMPROVES) {
     if (c->beyond) {
-      say_test(test, sizeof test, c->F, c->chi2_limit, c->white_z <= RCB_ADEQUACY_Z,
+      say_test(test, sizeof test, c->adeq_chi2, c->chi2_limit, c->white_z <= RCB_ADEQUACY_Z,
                c->dispersion);
       snprintf(text, sizeof text,
                "The best candidate, %s (%s), lowers the misfit by %.1f %% (the error %s from "
@@ -247,7 +248,7 @@ rcb_status rcb_diag_explain(const rcb_diag *d, char *buf, size_t size, size_t *n
                d->err0, c->err, floor_txt, isfinite(c->chi2_limit) ? test : "noise unknown",
                c->pname[c->beyond_k], c->beyond_v, c->phi[c->beyond_k]);
     } else if (isfinite(c->chi2_limit)) {
-      say_test(test, sizeof test, c->F, c->chi2_limit, 0, 1.0);
+      say_test(test, sizeof test, c->adeq_chi2, c->chi2_limit, 0, 1.0);
       snprintf(text, sizeof text,
                "The best candidate, %s (%s), accounts for %.1f %% of the misfit but leaves "
                "%.1f %%: the error %s from %.3g %% to %.3g %%, %.2g x the noise floor of "

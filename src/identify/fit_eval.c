@@ -326,12 +326,6 @@ static size_t same_channel(const rcb_fit *src, size_t o, size_t q, rcb_frf_kind 
   return src->nch;
 }
 
-double rcb_fit_last_white_z(rcb_fit *f) {
-  if (!f || !f->prepared || !f->sweeps) return HUGE_VAL;
-  residuals_from_model(f, f->r); /* the optimisers' workspace: no allocation */
-  return rcb_fit_white_z(f, f->r);
-}
-
 rcb_status rcb_fit_residuals_from(rcb_fit *f, const rcb_fit *src, double *r) {
   size_t c, i, *from;
   rcb_status st;

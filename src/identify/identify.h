@@ -85,9 +85,6 @@ rcb_status rcb_fit_last_residuals(rcb_fit *f, double *r);
  * residuals r of fit f (rcb_fit_residual_count values, as rcb_fit_residuals
  * orders them; identify/adequacy.c). */
 double rcb_fit_white_z(const rcb_fit *f, const double *r);
-/* rcb_fit_white_z of the residuals of the last evaluation, in the fit's own
- * workspace (no allocation, no sweep); HUGE_VAL before any evaluation. */
-double rcb_fit_last_white_z(rcb_fit *f);
 
 /* The residuals r (nres) of f from the model values of src's last sweep,
  * without a sweep of f's own: f and src fit the same model (at the same
