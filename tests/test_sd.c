@@ -211,7 +211,7 @@ static void diagnose(rcb_model *truth, uint64_t seed, rcb_diag_candidate *best, 
     fail_msg("F0 = %g, expected %g +- %g", F0, N - 3.0, 5.0 * sqrt(2.0 * N));
   for (k = 0; k < rcb_diag_candidate_count(d); k++) {
     rcb_diag_candidate c;
-    double np, Fc, phi;
+    double np, nfit, Fc, phi;
     const char *p;
     assert_int_equal(rcb_diag_candidate_get(d, k, &c), RCB_OK);
     if (!c.refitted || strcmp(c.fitted, "no parameter") == 0) continue;
@@ -219,10 +219,25 @@ static void diagnose(rcb_model *truth, uint64_t seed, rcb_diag_candidate *best, 
      * probes swapped: a fixed edit of the chain, the base refitted) */
     np = c.params[0] ? 1.0 : 0.0;
     for (p = c.params; (p = strchr(p, ',')) != NULL; p++) np += 1.0;
+    /* the parameters its fit holds: the coupling's three and those of its
+     * own that are not among them (another coupling model refits kt, kr) */
+    nfit = 3.0 + np - (strstr(c.params, "coupling.C.kt") != NULL) -
+           (strstr(c.params, "coupling.C.kr") != NULL) -
+           (strstr(c.params, "coupling.C.ct") != NULL);
+    if (c.effect == RCB_EFFECT_COUPLING_MODEL) { /* less those its model lacks */
+      static const char *const cp[3] = {"coupling.C.kt", "coupling.C.kr", "coupling.C.ct"};
+      rcb_model *cm = NULL;
+      double v;
+      size_t j;
+      assert_int_equal(rcb_diag_apply_model(d, k, NULL, &cm), RCB_OK);
+      for (j = 0; j < 3; j++)
+        if (!strstr(c.params, cp[j]) && rcb_model_get_param(cm, cp[j], &v) != RCB_OK) nfit -= 1.0;
+      rcb_model_destroy(cm);
+    }
     Fc = F0 * (1.0 - c.objective_drop_pct / 100.0);
     /* calibrated (issue #33): the drop over the dispersion phi = max(1, F /
-     * its expectation with the candidate), the expectation N - 3 - k */
-    phi = fmax(1.0, Fc / (N - 3.0 - np));
+     * its expectation with the candidate, N less the parameters it fits) */
+    phi = fmax(1.0, Fc / (N - nfit));
     if (!(fabs(c.delta_bic - ((Fc - F0) / phi + np * log(N))) < 1e-6 * (fabs(c.delta_bic) + F0)))
       fail_msg("%s: dBIC %.10g, expected (F - F0) / phi + k ln N = %.10g", c.description,
                c.delta_bic, (Fc - F0) / phi + np * log(N));
