@@ -23,6 +23,12 @@
  * said so, and the candidate never "explains" (rcb_evidence.beyond). */
 #define RCB_MASS_AT_DISK 4.0
 #define RCB_MASS_AT_NODE 2.0
+/* A ring's refit bounds below and what it can be (issue #33): with the
+ * three free from 1e-4 of the disk's own, a ring at DB took the place of a
+ * cross-coupled B2 beside 0.35 kg there (Id 1e-4 x the disk's, Ip 1.8 x: the
+ * gyroscopic split standing in for kxy), and ended near the floor. */
+#define RCB_RING_LO 0.5
+#define RCB_RING_PLAUSIBLE 0.9
 
 /* A mass at every disk, and a new (massless) disk at every other node. */
 static rcb_status enumerate(rcb_diag *d, const rcb_model *m) {
@@ -68,9 +74,15 @@ static rcb_status enumerate(rcb_diag *d, const rcb_model *m) {
           if (disk->Id > 0) c->phi[c->np - 1] = fmin(hi, RCB_MASS_AT_DISK * disk->Id);
         }
         if (k == 2) { /* a ring turns with the disk: its polar inertia too */
+          size_t j;
+          const double own[3] = {disk->m, disk->Id, disk->Ip};
           rcb_diag_bounds(disk->Ip, 0.02 * mtot, &lo, &hi, &logp);
           rcb_diag_add_par(c, "disk.%s.Ip", disk->name, lo, hi, logp);
           if (disk->Ip > 0) c->phi[c->np - 1] = fmin(hi, RCB_MASS_AT_DISK * disk->Ip);
+          /* a ring adds to the disk: none of the three below the disk's own
+           * (RCB_RING_LO of it to fit, RCB_RING_PLAUSIBLE of it to explain) */
+          for (j = 0; j < 3; j++)
+            if (own[j] > 0) c->lo[j] = RCB_RING_LO * own[j], c->plo[j] = RCB_RING_PLAUSIBLE * own[j];
         }
         continue;
       }
