@@ -52,7 +52,11 @@ typedef enum rcb_effect {
   RCB_EFFECT_SHAFT_STIFFNESS = 17,               /**< a whole shaft's bending stiffness
                                                       (its section or material) */
   RCB_EFFECT_SHAFT_MASS = 18,                    /**< a whole shaft's mass and inertia */
-  RCB_EFFECT_COUNT = 19
+  RCB_EFFECT_BEARING_STIFFNESS_XY = 19,          /**< kxx and kyy together: a bearing softer
+                                                      or stiffer as a whole (nested with the
+                                                      one-direction effect: the monitor leaves
+                                                      it out by default) */
+  RCB_EFFECT_COUNT = 20
 } rcb_effect;
 
 /** @brief Short English name of an effect. */

@@ -23,7 +23,7 @@ static const char *const effect_names[RCB_EFFECT_COUNT] = {
     "shaft element stiffness",        "shaft element mass",
     "sensor gain and phase",          "sensor sign",
     "swapped sensors",                "shaft section or material (stiffness)",
-    "shaft section or material (mass)"};
+    "shaft section or material (mass)", "bearing stiffness (both directions)"};
 
 const char *rcb_effect_name(rcb_effect e) {
   return (int)e >= 0 && e < RCB_EFFECT_COUNT ? effect_names[e] : "?";

@@ -33,7 +33,7 @@ static rcb_status enumerate(rcb_diag *d, const rcb_model *m) {
       rcb_diag_bounds(v, 10 * kb, &lo, &hi, &logp);
       rcb_diag_add_par(c, a ? "bearing.%s.kyy" : "bearing.%s.kxx", b->name, lo, hi, logp);
     }
-    if (!(c = rcb_diag_new_cand(d, &rcb_diag_family_bearing, RCB_EFFECT_BEARING_STIFFNESS, place))) return RCB_ERR_NOMEM;
+    if (!(c = rcb_diag_new_cand(d, &rcb_diag_family_bearing, RCB_EFFECT_BEARING_STIFFNESS_XY, place))) return RCB_ERR_NOMEM;
     snprintf(c->desc, sizeof c->desc, "stiffness in x and y at bearing %s (the bearing as a "
              "whole softer or stiffer)", b->name);
     for (a = 0; a < 2; a++) {

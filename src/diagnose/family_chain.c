@@ -324,6 +324,7 @@ void rcb_diag_carry_text(const rcb_diag *d, rcb_effect kind, const char *r, cons
   int cut = 0, cplx = d->scale == RCB_SCALE_COMPLEX, gain = kind == RCB_EFFECT_SENSOR_GAIN;
   char num[64];
   if (!size) return;
+  buf[0] = '\0'; /* nothing to carry: the empty text */
   /* the base parameters, and the sensor's gain to fit (its phase on the complex scale) */
   for (k = 0; k < d->nbase; k++)
     cut |= put(buf, size, &n, k ? ",%s%s" : "--params %s%s", d->base[k].name, "");

@@ -85,9 +85,18 @@ static double noise_var(const rcb_fit *f, double complex e, double a, int part) 
 
 double rcb_fit_noise_level(const rcb_fit *f, size_t c) {
   rcb_meas_channel_info ci;
-  if (f->nref) return rcb_noise_level(f->nref + c * f->npts, f->npts, f->beta_s);
+  double s2 = 0.0;
+  size_t i;
   rcb_meas_channel(f->meas, c, &ci);
-  return rcb_noise_level(ci.data, f->npts, f->beta_s);
+  if (!f->nref) return rcb_noise_level(ci.data, f->npts, f->beta_s);
+  /* eq. 19's ||f||_2 / n over the channel: the reference where it has a
+   * value, the measured value where it has none (out of the band) */
+  for (i = 0; i < f->npts; i++) {
+    double complex h = f->nref[c * f->npts + i];
+    if (!isfinite(creal(h)) || !isfinite(cimag(h))) h = ci.data[i];
+    s2 += creal(h * conj(h));
+  }
+  return f->npts ? sqrt(s2) / (double)f->npts * (f->beta_s / 100.0) : 0.0;
 }
 
 double rcb_fit_log_bias(const rcb_fit *f) {

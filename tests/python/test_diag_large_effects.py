@@ -35,7 +35,8 @@ def _ring_edit(name, dm, did):
 
 
 CASES = [
-    ("soft_B3", dc.bearing_keys("B3", kxx=2.5e7, kyy=3.5e7), dc.STIFF, "bearing B3",
+    ("soft_B3", dc.bearing_keys("B3", kxx=2.5e7, kyy=3.5e7), "bearing stiffness (both directions)",
+     "bearing B3",
      ("bearing.B3.kxx", "bearing.B3.kyy")),
     ("ring_DB", _ring_edit("DB", 0.5, 6e-4), dc.MASS, "disk DB",
      ("disk.DB.mass", "disk.DB.Id", "disk.DB.Ip")),

@@ -12,13 +12,11 @@ kt,kr,ct --noise 10,1` on --scale log10 (rcbtool fit's default) and on
 Asserted, on the NFILES (24) fits: the complex fits' mean error is within 4
 standard errors of the mean of zero for every parameter and their 95 %
 intervals cover the truth at least as often as the lower end of the binomial
-99 % interval of 95 % allows; the log10 fits' mean error of kt is more than 3
-of its standard errors from zero, and every parameter's rms error is more than
-3 times the complex fits'. Why: eq. 19's noise has mean 0 on Re and Im, so
-complex residuals are unbiased to first order, while E[log10 |1 + e|] < 0 for
-the proportional noise e: the log-magnitude objective is pulled by the noise
-itself, and without the phase it determines the coupling's parameters far
-less well. The figures are printed (pytest -s) and in docs/monitoring.md.
+99 % interval of 95 % allows; the log10 fits' mean error is within 4 standard
+errors of the mean too (E[log10 |1 + e|] < 0 for the proportional noise e is
+taken off the data since issue #33), and every parameter's rms error is more
+than 3 times the complex fits': without the phase the magnitudes determine
+the coupling's parameters far less well. The figures are printed (pytest -s) and in docs/monitoring.md.
 """
 
 import json
@@ -88,15 +86,18 @@ def test_complex_unbiased_and_covering(fits):
         assert cover >= lo, FIGURES[f"complex {name}"]
 
 
-def test_log10_biased_and_scattered(fits):
-    """The log10 fits: kt's mean error beyond 3 standard errors of the mean, and every
-    parameter's rms error more than 3 times the complex fits' (a variance ratio of 9:
-    F(n-1, n-1) exceeds it with probability 8e-7 for n = 24)."""
+def test_log10_unbiased_but_scattered(fits):
+    """The log10 fits: every parameter's mean error within 4 standard errors of the mean
+    of zero (issue #33: the declared noise's mean on the log scale, E log10(1 + A/100 r1),
+    is taken off the data, rcb_fit_log_bias; before, kt's mean error was -0.088 %, -5.0
+    standard errors of the mean), and every parameter's rms error more than 3 times the
+    complex fits' (a variance ratio of 9: F(n-1, n-1) exceeds it with probability 8e-7 for
+    n = 24): without the phase the magnitudes determine the coupling far less well."""
     figures(fits)
-    mean, sem, rms, cover = summary(fits["log10"], "coupling.C.kt")
-    assert abs(mean) > 3 * sem, FIGURES["log10 coupling.C.kt"]
     for name in PARAMS:
-        assert summary(fits["log10"], name)[2] > 3 * summary(fits["complex"], name)[2], FIGURES
+        mean, sem, rms, cover = summary(fits["log10"], name)
+        assert abs(mean) < 4 * sem, FIGURES[f"log10 {name}"]
+        assert rms > 3 * summary(fits["complex"], name)[2], FIGURES
 
 
 def wear_run(tool, scale, tmp, series="kt_wear"):
