@@ -76,3 +76,33 @@ def test_named_at_the_floor(exe, tmp_path, name, edit, effect, place, params):
 def test_null_beside_them(exe, tmp_path):
     d = _diagnose(exe, tmp_path, None, 11)
     assert not d["candidates"][0]["significant"], d["candidates"][0]
+
+
+def test_bad_probe_carried_into_round_2(exe, tmp_path):
+    """Issue #33 item 5 at the users' size: ROSS's rotor exactly as modelled,
+    probe DB.y reading 0.8 and 4 deg late (every reference), numpy noise. Round
+    1 names the sensor's gain first with the options that carry it ("carry");
+    round 2, run with exactly those options, names no sensor and finds the
+    model adequate: nothing else is missing."""
+    H = dc.ross_inertance(dc.BASE_INI, None, freq=dc.LARGE_FREQ_HZ, ins=dc.LARGE_INS)
+    data = dc.probe_edit("DB.y", dc.PROBE_GAIN)(dc.calibration_noise("eq19", H, 12))
+    meas, model = tmp_path / "probe.uff", tmp_path / "model.ini"
+    model.write_text(dc.model_ini())
+    dc.write_uff(meas, data, dc.LARGE_FREQ_HZ, dc.LARGE_INS)
+
+    def diagnose(*opts):
+        res = subprocess.run([exe, "diagnose", str(model), str(meas), *opts, "--scale",
+                              "complex", "--noise", "10,1", "--top", "3", "--json"],
+                             capture_output=True, text=True, timeout=600)
+        assert res.returncode == 0, res.stderr
+        return json.loads(res.stdout)
+
+    d1 = diagnose("--params", dc.FIT_PARAMS)
+    c0 = d1["candidates"][0]
+    assert c0["chain"] and "DB.y" in c0["place"] and c0["claim"] == "explains", c0
+    assert "sensor.DB.y.gain" in c0["carry"], c0
+    d2 = diagnose(*c0["carry"].split())
+    first = d2["candidates"][0]
+    assert not first["significant"], first
+    assert d2["explanation"].startswith("No candidate is significant, and none is needed"), \
+        d2["explanation"]
