@@ -4,8 +4,8 @@
  * on all points unless it ran off from the nominal model (itself a finding,
  * d->far); the noise model's reference (its predictions, d->nref), where
  * every later fit evaluates the noise model; its objective, error and noise
- * floor; the adequacy test and the null distribution every refit's limit
- * comes from; and the sensors the misfit concentrates on.
+ * floor; its adequacy test (each refit takes its own, refit.c); and the
+ * sensors the misfit concentrates on.
  */
 #include <math.h>
 #include <stdio.h>
@@ -157,9 +157,8 @@ static rcb_status misfit_sensors(rcb_diag *d, const double *chi2, const double *
   return RCB_OK;
 }
 
-/* The adequacy test of the fitted model as it is (fit f), the null
- * distribution every refit's limit comes from, and where the misfit
- * concentrates. */
+/* The adequacy test of the fitted model as it is (fit f) and where the
+ * misfit concentrates (each refit takes its own test: refit.c). */
 static rcb_status baseline_adequacy(rcb_diag *d, rcb_fit *f) {
   size_t nch = rcb_meas_channel_count(d->meas);
   double *w = rcb_alloc(&d->alloc, 3 * (nch ? nch : 1) * sizeof *w);
@@ -172,9 +171,6 @@ static rcb_status baseline_adequacy(rcb_diag *d, rcb_fit *f) {
     return rcb_diag_fail(d, st, "the adequacy test of the model as it is: %s",
                          rcb_fit_errmsg(f));
   }
-  d->nbase_fit = rcb_fit_param_count(f);
-  d->adeq_mean = d->adeq0.expected + (double)d->nbase_fit;
-  d->adeq_sd = d->adeq0.sd;
   for (c = 0; c < nch; c++) w[2 * nch + c] *= w[2 * nch + c]; /* variances */
   if (d->adeq0.known) st = misfit_sensors(d, w, w + nch, w + 2 * nch);
   rcb_free(&d->alloc, w);

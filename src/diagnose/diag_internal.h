@@ -147,9 +147,6 @@ struct rcb_diag {
   char drift[256];                  /* which parameter ran off, in words */
   double F0, err0, floor0;
   rcb_fit_adequacy adeq0;           /* the adequacy test of the model as it is */
-  double adeq_mean, adeq_sd;        /* F's mean (no parameter fitted) and sd under the
-                                       noise alone: every refit's limit comes from them */
-  size_t nbase_fit;                 /* parameters the baseline fitted */
   rcb_diag_misfit *mis;             /* per response sensor, the largest excess first */
   size_t nmis;
   size_t nres;

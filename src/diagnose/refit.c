@@ -5,8 +5,8 @@
  * subset (or fitted on all points on a small set); random starts while no
  * screen reached the noise floor; the evaluation on all points where the
  * screen ended; the polish of those that can lead. judge() gives each its
- * BIC change, adequacy limit, dispersion and claim, with the whiteness of
- * its residual (whiteness()).
+ * BIC change and claim, from its own adequacy test at its own predictions
+ * (cand_adequacy(): limit, dispersion, whiteness).
  */
 #include <math.h>
 #include <stdio.h>
