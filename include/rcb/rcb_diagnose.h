@@ -364,6 +364,11 @@ typedef struct rcb_diag_place {
                           (rcb_evidence_separable of the two chi2); else its chi2 - dof
                           within RCB_DIAG_PLACE_SPAN_FACTOR x the best's (what the best
                           leaves is then model error, which tells no neighbour apart) */
+  int at_drive;      /**< 1: every measured force acts at this node (the data hold one
+                          excitation point): a force here takes any misfit shaped like the
+                          response to the drive, as a mode moved by an effect anywhere
+                          gives it near its resonance, so a placement here is not evidence
+                          of place (issue #33); a second excitation point tells it */
 } rcb_diag_place;
 #define RCB_DIAG_PLACE_SPAN_FACTOR 2.0
 #define RCB_DIAG_PLACE_LOCAL 50.0 /**< the misfit is local when the best node takes this % */

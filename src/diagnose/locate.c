@@ -46,6 +46,7 @@ typedef struct locate_ws {
   int *kpow;                            /* per channel: (i w)^kpow from receptance */
   double *sqrtw, *R, *dof;              /* R, dof per node */
   double R0, dof0;                      /* the weighted residual without any force */
+  size_t drive;                         /* 1 + the node every reference acts at, 0: several */
   size_t nb;                            /* the fitted (base) parameters */
   double *r, *J;                        /* per residual (point-major): the fit's weighted
                                            residual, its row of d r / d p (nb values) */
@@ -130,6 +131,16 @@ static rcb_status locate_channels(rcb_diag *d, locate_ws *w) {
     w->ins[2 * k + 1].node = k, w->ins[2 * k + 1].dir = RCB_DIR_Y;
   }
   w->nin = 2 * w->nn;
+  /* the excitation point, when every reference acts at one node */
+  w->drive = 0;
+  for (k = 0; k < w->nref; k++) {
+    rcb_dof q;
+    if (rcb_model_find_dof(w->m, w->rname[k], &q) || (k && w->drive != q.node + 1)) {
+      w->drive = 0;
+      break;
+    }
+    w->drive = q.node + 1;
+  }
   return RCB_OK;
 }
 
@@ -311,6 +322,7 @@ static rcb_status locate_result(rcb_diag *d, locate_ws *w, double R0, double dof
     p->share_pct = excess > 0 ? 100.0 * (R0 - w->R[k] - (dof0 - w->dof[k])) / excess : 0.0;
     p->share_pct = fmin(100.0, fmax(0.0, p->share_pct));
     p->adequate = w->R[k] <= w->dof[k] + RCB_PLACE_Z * sqrt(2.0 * w->dof[k]);
+    p->at_drive = w->drive == k + 1;
   }
   d->nplace = w->nn;
   sort_places(d->place, d->nplace);

@@ -111,6 +111,17 @@ static size_t say_place(const rcb_diag *d, char *text, size_t size, size_t n) {
                           b->share_pct, b->shaft, b->z, b->node);
     return n < size ? n : size - 1;
   }
+  if (b->at_drive) { /* one excitation point, and the misfit placed at it: no evidence */
+    n += (size_t)snprintf(text + n, size - n,
+                          " The equivalent loads cannot place it: the data hold one excitation "
+                          "point (shaft %s, z = %.3g m, node #%zu), and a force there, where it "
+                          "takes %.0f %% of the misfit's excess over the noise, takes any misfit "
+                          "shaped like the response to the drive, as a mode moved by an effect "
+                          "anywhere gives it. A second excitation point (another node) would "
+                          "place it.",
+                          b->shaft, b->z, b->node, b->share_pct);
+    return n < size ? n : size - 1;
+  }
   if (b->adequate)
     n += (size_t)snprintf(text + n, size - n,
                           " Placed by equivalent loads, whatever the effect: a force at shaft %s, "
@@ -145,6 +156,14 @@ static size_t say_place(const rcb_diag *d, char *text, size_t size, size_t n) {
                             pl->shaft, pl->z, ph->z, lo, hi);
     runs++, lo = hi;
   }
+  for (lo = 0; lo < d->nplace && n < size; lo++)
+    if (d->place[lo].in_span && d->place[lo].at_drive) {
+      n += (size_t)snprintf(text + n, size - n,
+                            "; the span holds the only excitation point (node #%zu), where a "
+                            "force takes any misfit shaped like the response to the drive",
+                            d->place[lo].node);
+      break;
+    }
   if (n < size)
     n += (size_t)snprintf(text + n, size - n, ". The kind of effect there is left open.");
   return n < size ? n : size - 1;

@@ -71,6 +71,8 @@ def test_named_at_the_floor(exe, tmp_path, name, edit, effect, place, params):
     assert all(p in c0["params"] for p in params), c0
     assert c0["error_pct"] < dc.AT_FLOOR * d["floor_pct"], (c0, d["floor_pct"])
     assert not c0["beyond"] and c0["adequate"], c0
+    # forces at DA and DB: two excitation points, so no place is the drive's
+    assert not any(p["at_drive"] for p in d["places"]), d["places"][:3]
 
 
 def test_null_beside_them(exe, tmp_path):

@@ -41,6 +41,7 @@ pytest.importorskip("pyuff")
 
 SEED = 1
 SEAL_NODE = 6  # A 0.30 in the paper system (nodes every 0.05 m from A 0.0)
+DRIVE_NODE = 4  # DA (A 0.20), where the one measured force (dc.IN, DA.x) acts
 
 
 def _seal_ini(k, kc, c=200.0):
@@ -90,6 +91,14 @@ def test_moderate_seal_span_holds_its_node(tool, tmp_path):
     assert all(d["places"][k]["node"] in span for k in range(1))  # the best is in it
     assert "along a span" in d["explanation"]
     assert not [c for c in d["candidates"] if c["claim"] == "explains"], d["candidates"][:2]
+    # one excitation point (DA.x, node #4): that node alone is flagged, and
+    # the words say the span holds it (issue #33: a force at the drive takes
+    # any misfit shaped like the response to the drive)
+    assert [p["node"] for p in d["places"] if p["at_drive"]] == [DRIVE_NODE], d["places"]
+    if any(p["in_span"] and p["at_drive"] for p in d["places"]):
+        assert f"the only excitation point (node #{DRIVE_NODE})" in d["explanation"]
+    if d["places"][0]["at_drive"]:
+        assert "cannot place it" in d["explanation"] and "Placed by" not in d["explanation"]
 
 
 def test_null_places_nothing(tool, tmp_path):

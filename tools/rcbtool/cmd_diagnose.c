@@ -315,8 +315,9 @@ static void json_adequacy(FILE *fp, const rcb_diag *d) {
     cli_json_num(fp, p.chi2);
     fputs(", \"dof\": ", fp);
     cli_json_num(fp, p.dof);
-    fprintf(fp, ", \"adequate\": %s, \"in_span\": %s}", p.adequate ? "true" : "false",
-            p.in_span ? "true" : "false");
+    fprintf(fp, ", \"adequate\": %s, \"in_span\": %s, \"at_drive\": %s}",
+            p.adequate ? "true" : "false", p.in_span ? "true" : "false",
+            p.at_drive ? "true" : "false");
   }
   fputs("]", fp);
 }

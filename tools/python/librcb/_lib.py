@@ -119,7 +119,7 @@ class DiagMisfit(ctypes.Structure):
 class DiagPlace(ctypes.Structure):
     _fields_ = [("node", c_size_t), ("shaft", c_char_p), ("z", c_double),
                 ("share_pct", c_double), ("chi2", c_double), ("dof", c_double),
-                ("adequate", c_int), ("in_span", c_int)]
+                ("adequate", c_int), ("in_span", c_int), ("at_drive", c_int)]
 
 
 class PlanResult(ctypes.Structure):

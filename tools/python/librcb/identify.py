@@ -186,7 +186,8 @@ class Diagnosis(Handle):
             self.check(L.rcb_diag_place_get(self.handle, k, ctypes.byref(pl)))
             self.places.append({"node": pl.node, "shaft": _lib.text(pl.shaft), "z": pl.z,
                                 "share_pct": pl.share_pct, "chi2": pl.chi2, "dof": pl.dof,
-                                "adequate": bool(pl.adequate), "in_span": bool(pl.in_span)})
+                                "adequate": bool(pl.adequate), "in_span": bool(pl.in_span),
+                                "at_drive": bool(pl.at_drive)})
         st, self.explanation = _lib.two_call_string(L.rcb_diag_explain, self.handle)
         self.check(st, "rcb_diag_explain")
 
