@@ -901,6 +901,52 @@ static size_t find_cand(const rcb_monitor *mon, rcb_effect e, const char *params
   return 0;
 }
 
+/* Issue #34 item 1: a probe's gain among the candidates (opts.effects with
+ * RCB_EFFECT_SENSOR_GAIN). Without noise the update is the set-up with
+ * channel C.A.y read at 0.9 x: the gain's column is the model's values on
+ * that channel, exact for any gain (the reading is linear in it), so the
+ * first candidate is C.A.y's gain with a change of -0.1 to rounding, the
+ * tracked kt unmoved; a gain of -1 (a probe wired the wrong way) is the
+ * change -2, as exactly. By default (effects 0) no sensor is a candidate. */
+static void test_sensor_gain(void **state) {
+  fixture *f = *state;
+  rcb_monitor_param tp;
+  rcb_monitor_opts o = opts_kt(&tp, f->kt);
+  rcb_monitor *mon = NULL;
+  rcb_monitor_result r;
+  rcb_complex *v = malloc(NPT * sizeof *v);
+  const double gains[2] = {0.9, -1.0};
+  size_t j, i, g;
+  assert_non_null(v);
+  o.setup_averages = HUGE_VAL;
+  assert_int_equal(rcb_monitor_create(&mon, f->truth, f->setup, &o, NULL), RCB_OK);
+  for (j = 0; j < rcb_monitor_candidate_count(mon); j++) {
+    rcb_monitor_candidate_info ci;
+    assert_int_equal(rcb_monitor_candidate_info_get(mon, j, &ci), RCB_OK);
+    assert_int_not_equal(ci.effect, RCB_EFFECT_SENSOR_GAIN);
+  }
+  rcb_monitor_destroy(mon);
+  o.effects = ((1u << RCB_EFFECT_ELEMENT_STIFFNESS) - 1u) | (1u << RCB_EFFECT_SENSOR_GAIN);
+  assert_int_equal(rcb_monitor_create(&mon, f->truth, f->setup, &o, NULL), RCB_OK);
+  (void)find_cand(mon, RCB_EFFECT_SENSOR_GAIN, "sensor.C.A.y.gain");
+  for (g = 0; g < 2; g++) {
+    rcb_monitor_candidate_info ci;
+    memcpy(v, f->fs, NPT * sizeof *v);
+    for (i = 0; i < NPTS; i++) v[3 * NPTS + i] *= gains[g]; /* OUTS[3] = C.A.y */
+    assert_int_equal(rcb_monitor_update(mon, v, NULL, &r), RCB_OK);
+    assert_true(r.alarm);
+    assert_int_equal(rcb_monitor_candidate_info_get(mon, r.top[0].index, &ci), RCB_OK);
+    assert_int_equal(ci.effect, RCB_EFFECT_SENSOR_GAIN);
+    assert_string_equal(ci.params, "sensor.C.A.y.gain");
+    print_message("C.A.y read at %g x: gain change %.9f (truth %g); kt change %.3g N/m\n",
+                  gains[g], r.top[0].size[0], gains[g] - 1.0, r.tracked[0].change);
+    assert_true(rcb_test_close(r.top[0].size[0], gains[g] - 1.0, 1e-6, 0));
+    assert_true(fabs(r.tracked[0].change) < 1e-6 * f->kt);
+  }
+  rcb_monitor_destroy(mon);
+  free(v);
+}
+
 /* The smallest angle (deg) between candidate parameter cname's column and
  * the span of the tracked kt and kr, by forward differences (1e-4 relative)
  * of model m's FRFs on channels outs per excitation ins (one each, or the
@@ -1335,6 +1381,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_chi2),
       cmocka_unit_test(test_drift_glr),
+      cmocka_unit_test_setup_teardown(test_sensor_gain, fixture_setup, fixture_teardown),
       cmocka_unit_test(test_null),
       cmocka_unit_test(test_null_reweighted),
       cmocka_unit_test(test_null_phase),

@@ -181,14 +181,30 @@ static rcb_status baseline(rcb_monitor *mon, const rcb_model *base, const rcb_mo
 /* ---- columns ---- */
 
 
-/* The candidates the monitor tracks: effects of the model (not of the
- * measurement chain) with parameters; by default the catalogue of issue #4,
- * not the shaft elements of issue #23 (a crack is a diagnosis' finding, and
- * one candidate per element would double the columns of every update). */
+/* The candidates the monitor tracks: effects with parameters; by default
+ * the catalogue of issue #4, not the shaft elements of issue #23 (a crack is
+ * a diagnosis' finding, and one candidate per element would double the
+ * columns of every update). Every measured sensor's gain
+ * (RCB_EFFECT_SENSOR_GAIN in opts.effects; issue #34: a drifting probe named
+ * as the sensor, not read as the machine) is asked for: by default its
+ * columns, added to the rank space, moved the reweighted path on the ROSS
+ * kt_wear series (the drift test alarmed on 6 of 101 updates at kt -8.5 to
+ * -10 %, bound 4; with the phase too, ct's CUSUM alarmed from kt -4.4 %). A
+ * sensor's sign is its gain at -1 and the gain's column is exact (the
+ * model's values scale linearly with it), so the gain covers it; a swap has
+ * no parameter and is left to the diagnosis. The catalogue is on its
+ * default scale, so a sensor's phase is not among its parameters. */
 static int wanted(const rcb_diag_cand_desc *c, unsigned mask) {
-  if (c->refit_only || !c->np || c->chain) return 0;
-  return mask ? (mask >> (unsigned)c->effect) & 1u : c->effect < RCB_EFFECT_ELEMENT_STIFFNESS;
+  if (c->refit_only || !c->np) return 0;
+  if (mask) return (mask >> (unsigned)c->effect) & 1u;
+  return !c->chain && c->effect < RCB_EFFECT_ELEMENT_STIFFNESS;
 }
+
+/* A candidate whose columns are not a batched adjoint sweep of the base
+ * model: one with DOFs of its own (a pedestal: a sweep of its model) or of
+ * the measurement chain (a sensor: the base model's own values scaled,
+ * rcb_fit_chain_jacobian, no sweep). */
+static int own_columns(const rcb_diag_cand_desc *c) { return c->adds_dofs || c->chain; }
 
 /* A fit of candidate model cm with its parameters (complex scale, as the base). */
 static rcb_status cand_fit(rcb_monitor *mon, rcb_model *cm, const rcb_diag_cand_desc *c,
@@ -217,6 +233,13 @@ static rcb_status cand_columns(rcb_monitor *mon, rcb_diag *d, const col_plan *pl
     rcb_model *cm = NULL;
     rcb_fit *cf = NULL;
     rcb_diag_catalogue_get(d, pl->cand[j], &c);
+    if (c.chain) { /* a sensor's gain and phase at neutral (1, 0 rad): the model's values */
+      for (k = 0; k < c.np; k++)
+        pl->neutral[pl->col[j] + k] = rcb_fit_param_is_chain(c.pname[k]) == RCB_CHAIN_GAIN;
+      if ((st = rcb_fit_chain_jacobian(mon->fit, c.pname, c.np, J + mon->n * pl->col[j])))
+        rcb_mon_fail(mon, st, "%s: %s", c.desc, rcb_fit_errmsg(mon->fit));
+      continue;
+    }
     if ((st = rcb_diag_catalogue_model(d, pl->cand[j], mon->model, &cm))) {
       rcb_mon_fail(mon, st, "%s", rcb_diag_errmsg(d));
       break;
@@ -270,8 +293,8 @@ static rcb_status plan(rcb_monitor *mon, rcb_diag *d, unsigned mask, col_plan *p
     for (i = 0; i < nc; i++) {
       rcb_diag_cand_desc c;
       rcb_diag_catalogue_get(d, i, &c);
-      if (!wanted(&c, mask) || c.adds_dofs != (int)pass) continue;
-      pl->own[pl->ncand] = c.adds_dofs;
+      if (!wanted(&c, mask) || own_columns(&c) != (int)pass) continue;
+      pl->own[pl->ncand] = own_columns(&c);
       pl->cand[pl->ncand] = i;
       pl->col[pl->ncand++] = pl->ncol;
       pl->ncol += c.np;

@@ -105,6 +105,9 @@ static rcb_status cand_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
     mc->col = pl->col[j];
     for (a = 0; a < c.np; a++)
       mc->neutral[a] = pl->neutral[pl->col[j] + a], mc->lo[a] = c.lo[a], mc->hi[a] = c.hi[a];
+    /* a sensor's gain: a sign flipped (a probe wired the wrong way) is its
+     * gain at -1, as plausible as the gain's own range mirrored */
+    if (c.chain && c.effect == RCB_EFFECT_SENSOR_GAIN) mc->lo[0] = -mc->hi[0];
     if (!pl->own[j]) { /* the batched candidates' derivative matrices, in plan order */
       if (mon->cdz && idz + c.np <= mon->ncdz) mc->dz = mon->cdz + idz;
       idz += c.np;

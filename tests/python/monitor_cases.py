@@ -21,7 +21,10 @@ The series (SERIES):
             COMMISSION files (the commissioning period), then falls linearly by
             0.1 % per update to -10 % at file COMMISSION + 100 (111 files);
 * cross_B3: a cross-coupled stiffness kxy = -kyx = 1.5e7 N/m appears at
-            bearing B3 at update 37 of 60 and stays.
+            bearing B3 at update 37 of 60 and stays;
+* probe_DA_x: the machine as it is, read by a DA.x probe whose gain stays 1
+            for the COMMISSION files, then falls linearly to 0.85 over 70
+            updates (issue #34: a drifting probe, not a drifting machine).
 
 Truth: ROSS 2.3 (an implementation that is not ours). Its rotor is built from
 the INI by the independent parser of the ROSS bridge (ross_models.py), the
@@ -82,8 +85,12 @@ class Series:
     """A series: n updates; kt(u) the coupling's kt (N/m) at update u;
     cross_from the first update with the cross-coupling at B3 (None: never)."""
 
-    def __init__(self, name, n, seed0, what, kt=None, cross_from=None, phase_deg=0.0):
+    def __init__(self, name, n, seed0, what, kt=None, cross_from=None, phase_deg=0.0,
+                 probe=None):
         self.name = name
+        # (response, gain(u)): a probe's gain, applied last (the sensor reads
+        # the machine's motion and the noise alike)
+        self.probe = probe
         self.phase_deg = phase_deg  # uniform phase noise, +- degrees
         self.n = n
         self.seed0 = seed0  # update u has noise seed seed0 + u
@@ -109,6 +116,9 @@ class Series:
             "freq_hz": [float(f) for f in FREQ_HZ], "rpm": dc.RPM,
             "noise": list(NOISE), "phase_deg": self.phase_deg,
             "files": [file_name(u) for u in range(self.n)],
+            "probe": self.probe[0] if self.probe else None,
+            "probe_gain": [float(self.probe[1](u)) for u in range(self.n)] if self.probe
+            else None,
         }
 
 
@@ -121,6 +131,15 @@ def _wear(u):
     return KT0 * (1.0 - 0.10 * k / WEAR_UPDATES)
 
 
+PROBE_UPDATES = 70  # probe_DA_x: DA.x's gain falls to PROBE_GAIN over these updates
+PROBE_GAIN = 0.85
+
+
+def _probe(u):
+    k = min(max(u - COMMISSION, 0), PROBE_UPDATES)
+    return 1.0 - (1.0 - PROBE_GAIN) * k / PROBE_UPDATES
+
+
 SERIES = {
     "null": Series("null", 200, 160000, "nothing changes"),
     "null_phase": Series("null_phase", 200, 163000, "nothing changes; 2 degrees of phase noise",
@@ -131,6 +150,10 @@ SERIES = {
     "cross_B3": Series("cross_B3", 60, 162000,
                        "kxy = -kyx = 1.5e7 N/m appears at bearing B3 at update 37",
                        cross_from=37),
+    "probe_DA_x": Series("probe_DA_x", COMMISSION + PROBE_UPDATES + 1, 164000,
+                         f"the machine unchanged; the DA.x probe's gain steady for "
+                         f"{COMMISSION} files, then falling linearly to {PROBE_GAIN} at file "
+                         f"{COMMISSION + PROBE_UPDATES}", probe=("DA.x", _probe)),
 }
 
 
@@ -244,8 +267,10 @@ def write_series(outdir, names=None, truth=None):
             key = (round(s.kt(u), 9), s.cross(u))
             if key not in clean:
                 clean[key] = truth.inertance(s.kt(u), s.cross(u))
-            dc.write_uff(d / file_name(u), measurement(clean[key], s.seed0 + u, s.phase_deg),
-                         FREQ_HZ)
+            m = measurement(clean[key], s.seed0 + u, s.phase_deg)
+            if s.probe:
+                m[OUTS.index(s.probe[0])] *= s.probe[1](u)
+            dc.write_uff(d / file_name(u), m, FREQ_HZ)
         (d / "truth.json").write_text(json.dumps(s.truth(), indent=1) + "\n")
     return outdir
 

@@ -27,6 +27,11 @@ up to 8 re-linearisations of the tracked parameters, until converged).
   not change) are covered by theirs over the series, each at least the
   lower end of the binomial 99 % interval of 95 % coverage, and their
   CUSUMs stay silent;
+* probe_DA_x (issue #34: the machine unchanged, DA.x's gain falling to 0.85
+  over 70 updates), monitored with --sensors (every probe's gain among the
+  candidates), and the null series beside it with the same option: the first alarm names the sensor DA.x before its gain
+  has lost 10 %, every TEST alarm names it, its gain's interval covers the
+  truth, and the tracked parameters are left alone (no CUSUM alarm);
 * null_phase (the null series with 2 degrees of phase noise per point, issue
   #14's), monitored with --noise 10,1,2 (the phase term of rcb_monitor_opts):
   false alarms as for null.
@@ -231,6 +236,58 @@ def test_cross_coupling_B3_intervals(tool):
     assert sum(size) >= lo_s, FIGURES["cross_B3 intervals"]
     assert all(v >= lo_t for v in tracked.values()), FIGURES["cross_B3 intervals"]
     assert not cusum, FIGURES["cross_B3 intervals"]
+
+
+def test_drifting_probe_named_as_the_sensor(tool):
+    """Issue #34 item 1: DA.x's gain falls linearly to 0.85 over 70 updates
+    (the machine unchanged). The first alarm, of the instant or the drift
+    test, names the sensor DA.x before its gain has lost 10 %; every alarmed
+    update names it first; the gain's 95 % interval covers the truth at the
+    binomial 99 % lower end of 95 %; the tracked parameters' CUSUMs stay
+    silent and their intervals cover their unchanged values as often."""
+    log, truth = monitor(tool, "probe_DA_x", "--alpha", 0.01, "--sensors")
+    ups = log["updates"]
+    sensor = "sensor " + truth["probe"]
+    gain = truth["probe_gain"]
+    first = next((u for u in ups if u["alarm"] or (u["drift"] and u["drift"]["alarm"])), None)
+    assert first is not None, "no alarm on the drifting probe"
+    named_first = (first["top"][0]["place"] if first["alarm"] else first["drift"]["place"])
+    tests = _alarms(log)
+    named = sum(u["top"][0]["place"] == sensor for u in tests)
+    size = [u["top"][0]["ci_lo"][0] <= gain[u["index"]] - 1 <= u["top"][0]["ci_hi"][0]
+            for u in tests if u["top"][0]["place"] == sensor]
+    lo_s, _ = stats.binom.interval(0.99, len(size), 0.95)
+    lo_t, _ = stats.binom.interval(0.99, len(ups), 0.95)
+    tracked = {b["name"]: sum(u["tracked"][k]["ci_lo"] <= b["baseline"] <= u["tracked"][k]["ci_hi"]
+                              for u in ups) for k, b in enumerate(log["tracked"])}
+    cusum = [u["update"] for u in _alarms(log, "cusum_alarm")]
+    FIGURES["probe_DA_x"] = (
+        f"first alarm at file {first['index']} (gain {gain[first['index']]:.4f}) names "
+        f"{named_first}; {named} of {len(tests)} TEST alarms name {sensor}; its gain's 95 % "
+        f"interval covers the truth on {sum(size)} of {len(size)} (99 % lower end {lo_s:.0f}); "
+        f"tracked intervals cover their values on {tracked} of {len(ups)} (lower end "
+        f"{lo_t:.0f}); CUSUM alarms at {cusum}")
+    assert named_first == sensor, FIGURES["probe_DA_x"]
+    assert gain[first["index"]] > 0.90, FIGURES["probe_DA_x"]
+    assert named == len(tests), FIGURES["probe_DA_x"]
+    assert sum(size) >= lo_s, FIGURES["probe_DA_x"]
+    assert all(v >= lo_t for v in tracked.values()), FIGURES["probe_DA_x"]
+    assert not cusum, FIGURES["probe_DA_x"]
+
+
+def test_sensors_null(tool):
+    """The null case beside the drifting probe: with the probes' gains among
+    the candidates (--sensors) the null series' instant and drift alarms stay
+    within the binomial 99 % bound of alpha 0.01, and no CUSUM alarms."""
+    log, truth = monitor(tool, "null", "--alpha", 0.01, "--sensors")
+    ups = log["updates"]
+    hi = stats.binom.ppf(0.99, len(ups), 0.01)
+    tests = [u["update"] for u in _alarms(log)]
+    drift = [u["update"] for u in ups if u["drift"] and u["drift"]["alarm"]]
+    cusum = [u["update"] for u in _alarms(log, "cusum_alarm")]
+    FIGURES["null --sensors"] = (f"TEST alarms at {tests}, drift alarms at {drift} of "
+                                 f"{len(ups)} (at most {hi:.0f} each); CUSUM at {cusum}")
+    assert len(tests) <= hi and len(drift) <= hi and not cusum, FIGURES["null --sensors"]
 
 
 SLOW = pytest.mark.skipif(not os.environ.get("RCB_MONITOR_ALL"),
