@@ -415,7 +415,7 @@ static void long_run(const fixture *f, double navg, const double *bvar) {
       assert_int_equal(rcb_monitor_save(c, back, sizeof back, &m), RCB_OK);
       assert_int_equal(m, n);
       assert_memory_equal(back, buf, n);
-      infw += isinf(get_f64(buf + OFF_REF_W));
+      infw += isinf(get_f64(buf + OFF_REF_W)) != 0;
       loads++;
     }
   }

@@ -255,7 +255,7 @@ static void io_setup(st_buf *b, rcb_meas **ms) {
     if (!b->bad && !(v = malloc(n * sizeof *v))) b->bad = 1;
     if (!b->bad) io_f64s(b, (double *)(void *)v, 2 * n);
     if (!b->bad && !resp) st_bad(b, "the set-up's channel %zu: no response name", c + 1);
-    if (!b->bad && rcb_meas_add_channel(*ms, resp, ref, kind, v))
+    if (!b->bad && rcb_meas_add_channel(*ms, resp, ref, (rcb_frf_kind)kind, v))
       st_bad(b, "the set-up's channel %zu: %s", c + 1, rcb_meas_errmsg(*ms));
     free(resp);
     free(ref);
