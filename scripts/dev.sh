@@ -593,18 +593,20 @@ cmd_fuzz() {
     > "$dir/configure.log" 2>&1 || { cat "$dir/configure.log"; die "cmake configure failed in $dir"; }
   cmake --build "$dir" -j "$JOBS"
   mkdir -p "$dir/crashes"
-  # the four harnesses at once (each one process on one core, for a fixed
-  # time: together they take the time of one); each writes its own log
+  # the harnesses at once (each one process on one core, for a fixed
+  # time: together they take the time of one); each writes its own log. The
+  # state harnesses' seeds are whole states (7 kB, 50-58 kB): their own max_len
   local pids=() t_of=()
-  say "fuzz_ini, fuzz_csv, fuzz_uff, fuzz_strtod at once: replay fuzz/corpus/NAME, then ${secs} s each"
-  for t in ini csv uff strtod; do
+  say "fuzz_ini, fuzz_csv, fuzz_uff, fuzz_strtod, fuzz_monitor_state, fuzz_rcbtool_state at once: replay fuzz/corpus/NAME, then ${secs} s each"
+  for t in ini csv uff strtod monitor_state rcbtool_state; do
     rm -rf "$dir/work_$t"
     cp -r "fuzz/corpus/$t" "$dir/work_$t"
     (
       UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 "$dir/fuzz/fuzz_$t" -runs=0 \
         "fuzz/corpus/$t" > "$dir/replay_$t.log" 2>&1 &&
         UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 "$dir/fuzz/fuzz_$t" "$dir/work_$t" \
-          -max_total_time="$secs" -max_len=8192 -timeout=10 -rss_limit_mb=2048 \
+          -max_total_time="$secs" -max_len="$([[ $t == *state ]] && echo 65536 || echo 8192)" \
+          -timeout=10 -rss_limit_mb=2048 \
           -artifact_prefix="$dir/crashes/fuzz_${t}-" -print_final_stats=1 > "$dir/fuzz_$t.log" 2>&1
     ) &
     pids+=($!)
@@ -621,7 +623,7 @@ cmd_fuzz() {
 }
 
 # The fuzz stage of `test`: shorter runs (FUZZ_SECONDS, default 5 s each: the
-# four harnesses at once on 2 cores; `fuzz` gives each 30 s).
+# harnesses at once on 2 cores; `fuzz` gives each 30 s).
 cmd_fuzz_smoke() { FUZZ_SECONDS=${FUZZ_SECONDS:-5} cmd_fuzz; }
 
 # valgrind memcheck on small CLI runs of the examples, in the Release build.

@@ -402,10 +402,23 @@ RCB_API const char *rcb_monitor_errmsg(const rcb_monitor *mon);
  * O(n k)
  * @param res output
  * @return RCB_ERR_ARG for a NaN/infinite value or a negative/NaN sd, naming
- * the channel and point (the monitor's state is left unchanged)
+ * the channel and point (the monitor's state is left unchanged);
+ * RCB_ERR_STATE after RCB_MONITOR_MAX_UPDATES updates
  */
 RCB_API rcb_status rcb_monitor_update(rcb_monitor *mon, const rcb_complex *values,
                                       const double *sd, rcb_monitor_result *res);
+
+/** @brief The most updates one monitor takes: 2^32 - 1 (136 years at one a
+ * second). Every counter of the monitor and of its saved state then fits a
+ * 32-bit size_t and a double exactly, and none can wrap: rcb_monitor_update
+ * refuses the next one (RCB_ERR_STATE) and rcb_monitor_load refuses a state
+ * that claims more. */
+#define RCB_MONITOR_MAX_UPDATES 4294967295u
+
+/** @brief Updates taken so far (result.update of the last one; loaded with
+ * a state; rcb_monitor_reset_cusum keeps it); 0 for a monitor not created
+ * successfully. */
+RCB_API size_t rcb_monitor_update_count(const rcb_monitor *mon);
 
 /** @brief Forget the CUSUM sums and the drift test's window (after
  * maintenance, or once an alarm is acknowledged; the drift test's common
@@ -557,9 +570,17 @@ RCB_API rcb_status rcb_monitor_save(const rcb_monitor *mon, void *buf, size_t si
 /**
  * @brief Load a state saved by rcb_monitor_save into @p mon, created from
  * the same baseline model, set-up and settings. All checks come before
- * anything is changed: on any error the monitor is left as it was.
- * @return RCB_ERR_CORRUPT (not a monitor state, truncated, or a CRC that
- * does not match), RCB_ERR_VERSION (another format version),
+ * anything is changed: on any error the monitor is left as it was. Besides
+ * its CRC every field is checked against what a monitor writes, so that a
+ * state with a CRC made again cannot load values no update gives: CUSUMs
+ * and the reference's weights finite and >= 0 (the weight +inf only for a
+ * noise-free reference), every sum finite (0 while nothing is in it), the
+ * update count at most RCB_MONITOR_MAX_UPDATES, the drift window's updates
+ * at most the update count, its ring count and newest slot those that
+ * follow from them, flags 0 or 1 and padding 0.
+ * @return RCB_ERR_CORRUPT (not a monitor state, truncated, a CRC that
+ * does not match, a length other than this monitor's state, or a field no
+ * monitor writes: the message names it), RCB_ERR_VERSION (another format version),
  * RCB_ERR_OTHER_MODEL (another baseline model or tracked parameters),
  * RCB_ERR_OTHER_SETUP (another set-up or other settings); the message
  * (rcb_monitor_errmsg) says which field differs

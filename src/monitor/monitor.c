@@ -504,6 +504,10 @@ rcb_status rcb_monitor_update(rcb_monitor *mon, const rcb_complex *values, const
   if (!ready(mon))
     return rcb_mon_fail(mon, RCB_ERR_STATE, "rcb_monitor_update: the monitor was not created "
                         "successfully");
+  if (mon->updates >= RCB_MONITOR_MAX_UPDATES)
+    return rcb_mon_fail(mon, RCB_ERR_STATE, "rcb_monitor_update: %zu updates taken, the most "
+                        "a monitor takes (RCB_MONITOR_MAX_UPDATES); start a new series",
+                        mon->updates);
   if ((st = check_input(mon, values, sd))) return st;
   gls = mon->reweight || sd;
   for (p = 0; p < mon->npt; p++) {
@@ -568,6 +572,7 @@ void rcb_monitor_reset_cusum(rcb_monitor *mon) {
 }
 
 size_t rcb_monitor_point_count(const rcb_monitor *mon) { return ready(mon) ? mon->npt : 0; }
+size_t rcb_monitor_update_count(const rcb_monitor *mon) { return ready(mon) ? mon->updates : 0; }
 int rcb_monitor_fast_relinearise(const rcb_monitor *mon) { return ready(mon) && mon->lr; }
 size_t rcb_monitor_memory(const rcb_monitor *mon) { return mon ? mon->held : 0; }
 

@@ -18,6 +18,12 @@
 /* The model's response sums agree to this relative difference (another
  * BLAS may change their last bits, never their 9th digit). */
 #define ST_SIG_TOL 1e-9
+/* The end of every message about a field no monitor writes. */
+#define ST_NOT_WRITTEN "not a state the monitor writes (damaged, or made by something else)"
+
+/* The update count is read into a size_t (rcb_monitor_load): bounded by
+ * RCB_MONITOR_MAX_UPDATES first, so no target's size_t may be narrower. */
+_Static_assert(SIZE_MAX >= RCB_MONITOR_MAX_UPDATES, "size_t holds every update count");
 
 /* ---- little-endian fields ---- */
 
@@ -205,17 +211,45 @@ static void save_drift(const rcb_monitor *mon, unsigned char *q) {
   }
 }
 
-/* Checked before anything is changed: 0 or the first bad field. */
-static const char *check_drift(const rcb_monitor *mon, const unsigned char *q) {
-  size_t i, n = (MON_DRIFT_WINDOW + 1u) * (mon->k + mon->nt + cand_dofs(mon));
-  if (get_u32(q) != mon->k || get_u32(q + 4) != mon->nt || get_u32(q + 8) != MON_DRIFT_WINDOW)
-    return "drift window's dimensions";
-  if (get_u32(q + 12) > MON_DRIFT_WINDOW || get_u32(q + 16) >= MON_DRIFT_WINDOW ||
-      get_u32(q + 28) > 1 || get_u64(q + 20) < get_u32(q + 12))
-    return "drift window's count";
-  for (i = 0, q += ST_DRIFT_HEAD; i < n; i++, q += 8)
-    if (!isfinite(get_f64(q))) return "drift window's values";
-  return NULL;
+/* The drift window, checked before anything is changed against what the
+ * update writes (monitor_drift.c, push and reset): its dimensions, at most
+ * the monitor's updates in its sums (none before the first update), the
+ * ring's count min(updates in the sums, window) and its newest slot the last
+ * of them, finite values, and sums of zero while no update is in them. */
+static rcb_status check_drift(rcb_monitor *mon, const unsigned char *q, uint64_t updates,
+                              int started) {
+  const size_t W = MON_DRIFT_WINDOW, nsum = mon->k + mon->nt + cand_dofs(mon);
+  const uint64_t dall = get_u64(q + 20);
+  const uint32_t cnt = get_u32(q + 12), head = get_u32(q + 16);
+  size_t i, n = (W + 1u) * nsum;
+  if (get_u32(q) != mon->k || get_u32(q + 4) != mon->nt || get_u32(q + 8) != W)
+    return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: the drift window's dimensions (rank %lu, "
+                        "%lu tracked, window %lu) are not this monitor's (%zu, %zu, %zu): "
+                        ST_NOT_WRITTEN, (unsigned long)get_u32(q), (unsigned long)get_u32(q + 4),
+                        (unsigned long)get_u32(q + 8), mon->k, mon->nt, W);
+  if (dall > updates || (!started && dall))
+    return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: the drift window holds %llu updates in "
+                        "its sums, the monitor %llu%s: " ST_NOT_WRITTEN,
+                        (unsigned long long)dall, (unsigned long long)updates,
+                        started ? "" : " before its first update");
+  if (cnt != (dall < W ? dall : W) || head != (dall ? (dall - 1u) % W : 0u))
+    return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: the drift window's ring count %lu and "
+                        "newest slot %lu, with %llu updates in its sums (expected %llu and "
+                        "%llu): " ST_NOT_WRITTEN, (unsigned long)cnt, (unsigned long)head,
+                        (unsigned long long)dall, (unsigned long long)(dall < W ? dall : W),
+                        (unsigned long long)(dall ? (dall - 1u) % W : 0u));
+  if (get_u32(q + 28) > 1)
+    return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: the drift window's free-offset flag %lu, "
+                        "expected 0 or 1: " ST_NOT_WRITTEN, (unsigned long)get_u32(q + 28));
+  for (i = 0, q += ST_DRIFT_HEAD; i < n; i++, q += 8) {
+    double v = get_f64(q);
+    if (!isfinite(v) || (i < nsum && !dall && v != 0))
+      return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: the drift window's %s %zu = %g, "
+                          "expected %s: " ST_NOT_WRITTEN, i < nsum ? "sum" : "value",
+                          i < nsum ? i + 1 : (i - nsum) % nsum + 1, v,
+                          isfinite(v) ? "0 with no update in the sums" : "finite");
+  }
+  return RCB_OK;
 }
 
 static void load_drift(rcb_monitor *mon, const unsigned char *q) {
@@ -273,8 +307,9 @@ static int sig_differs(double x, double y) {
 }
 
 /* The header's checks, in the order a reader needs them: what it is, its
- * version (a newer layout may move everything after it), its integrity, and
- * then whose it is. */
+ * version (a newer layout may move everything after it), its integrity,
+ * whose it is, and then its length (of a state of this monitor: a shorter
+ * one with a CRC of its own was cut short, not saved by another model). */
 static rcb_status check(rcb_monitor *mon, const unsigned char *b, size_t size) {
   size_t need = rcb_monitor_state_size(mon), len;
   uint32_t ver;
@@ -293,7 +328,7 @@ static rcb_status check(rcb_monitor *mon, const unsigned char *b, size_t size) {
   if (get_u32(b + len - ST_CRC) != (uint32_t)rcb_monitor_crc32(0, b, len - ST_CRC))
     return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: CRC-32 does not match (the %zu bytes "
                         "were changed or damaged)", len);
-  if (get_u32(b + 12) != mon->nt || len != need)
+  if (get_u32(b + 12) != mon->nt)
     return rcb_mon_fail(mon, RCB_ERR_OTHER_MODEL, "state: %lu tracked parameters, this "
                         "monitor tracks %zu", (unsigned long)get_u32(b + 12), mon->nt);
   if (get_u64(b + 16) != model_hash(mon, sig) || sig_differs(get_f64(b + 24), sig[0]) ||
@@ -309,7 +344,92 @@ static rcb_status check(rcb_monitor *mon, const unsigned char *b, size_t size) {
     return rcb_mon_fail(mon, RCB_ERR_OTHER_SETUP, "state: saved with other settings (alpha, "
                         "CUSUM k or h, noise, averages, re-linearisation, reweighting or "
                         "tracked ranges differ)");
+  if (len != need)
+    return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: %zu bytes, a state of this monitor has "
+                        "%zu (truncated or damaged, its CRC-32 made again)", len, need);
   return RCB_OK;
+}
+
+/* The update count and the reference-started flag (then the padding after
+ * it, written 0). */
+static rcb_status check_counts(rcb_monitor *mon, const unsigned char *b) {
+  uint64_t updates = get_u64(b + 56);
+  if (updates > RCB_MONITOR_MAX_UPDATES)
+    return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: update count %llu, more than a monitor "
+                        "takes (%llu, RCB_MONITOR_MAX_UPDATES): " ST_NOT_WRITTEN,
+                        (unsigned long long)updates,
+                        (unsigned long long)RCB_MONITOR_MAX_UPDATES);
+  if (get_u32(b + 64) > 1 || get_u32(b + 68) != 0)
+    return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: reference-started flag %lu (and padding "
+                        "%lu), expected 0 or 1 (and 0): " ST_NOT_WRITTEN,
+                        (unsigned long)get_u32(b + 64), (unsigned long)get_u32(b + 68));
+  return RCB_OK;
+}
+
+/* Tracked parameter a's fields against what the update writes
+ * (monitor.c, tracked_result and innovation): CUSUMs finite and >= 0, the
+ * reference's sum finite and its weight finite and >= 0 (+inf only for a
+ * noise-free reference, setup_averages HUGE_VAL), sums of 0 while the
+ * weight is 0 (no update in the reference) and everything 0 before the
+ * first update; the frozen flag 0 or 1 and the padding after it 0; its row
+ * of the reference's sums of every step (bref) finite, and 0 without
+ * opts.baseline_cov (then never accumulated). */
+static const char *tracked_want(const rcb_monitor *mon, const double *v, int started,
+                                size_t *bad) {
+  size_t i;
+  for (i = 0; i < 4; i++) {
+    *bad = i;
+    if (i == 2 ? !isfinite(v[i]) : !(v[i] >= 0)) return i == 2 ? "finite" : "finite >= 0";
+    if (isinf(v[i]) && !(i == 3 && mon->navg_inv == 0))
+      return i == 3 ? "finite >= 0 (+inf only for a noise-free reference)" : "finite >= 0";
+    if (v[i] != 0 && !started) return "0 before the first update";
+  }
+  *bad = 2;
+  return v[3] == 0 && v[2] != 0 ? "0 while the reference's weight is 0" : NULL;
+}
+
+static rcb_status check_tracked(rcb_monitor *mon, const unsigned char *b, size_t a,
+                                int started) {
+  static const char *const field[4] = {"CUSUM S+", "CUSUM S-", "reference sum",
+                                       "reference weight"};
+  const unsigned char *q = b + ST_HEAD + ST_PER * a;
+  const unsigned char *r = b + ST_HEAD + ST_PER * mon->nt + 8 * mon->nt * a;
+  const char *want;
+  double v[4];
+  size_t i, j;
+  for (i = 0; i < 4; i++) v[i] = get_f64(q + 8 * i);
+  if ((want = tracked_want(mon, v, started, &i)))
+    return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: tracked parameter %zu (%s): %s = %g, "
+                        "expected %s: " ST_NOT_WRITTEN, a + 1, mon->tname[a], field[i], v[i],
+                        want);
+  if (get_u32(q + 32) > (uint32_t)started || get_u32(q + 36) != 0)
+    return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: tracked parameter %zu (%s): frozen flag "
+                        "%lu (and padding %lu), expected %s (and 0): " ST_NOT_WRITTEN, a + 1,
+                        mon->tname[a], (unsigned long)get_u32(q + 32),
+                        (unsigned long)get_u32(q + 36), started ? "0 or 1" : "0");
+  for (j = 0; j < mon->nt; j++, r += 8) {
+    double x = get_f64(r);
+    if (!isfinite(x) || (x != 0 && (!mon->bcurv || v[3] == 0)))
+      return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: tracked parameter %zu (%s): the "
+                          "reference's sum of step %zu = %g, expected %s: " ST_NOT_WRITTEN,
+                          a + 1, mon->tname[a], j + 1, x,
+                          !isfinite(x) ? "finite"
+                          : mon->bcurv ? "0 while the reference's weight is 0"
+                                       : "0 without opts.baseline_cov");
+  }
+  return RCB_OK;
+}
+
+/* Every field against what a monitor writes, before anything is changed. */
+static rcb_status check_fields(rcb_monitor *mon, const unsigned char *b) {
+  int started = get_u32(b + 64) != 0;
+  size_t a;
+  rcb_status st;
+  if ((st = check_counts(mon, b))) return st;
+  for (a = 0; a < mon->nt; a++)
+    if ((st = check_tracked(mon, b, a, started))) return st;
+  return check_drift(mon, b + ST_HEAD + ST_PER * mon->nt + bref_bytes(mon), get_u64(b + 56),
+                     started);
 }
 
 rcb_status rcb_monitor_load(rcb_monitor *mon, const void *buf, size_t size) {
@@ -321,31 +441,12 @@ rcb_status rcb_monitor_load(rcb_monitor *mon, const void *buf, size_t size) {
     return rcb_mon_fail(mon, RCB_ERR_STATE, "rcb_monitor_load: the monitor was not created "
                         "successfully");
   if (!buf) return rcb_mon_fail(mon, RCB_ERR_ARG, "rcb_monitor_load: no buffer");
-  if ((st = check(mon, b, size))) return st;
-  for (a = 0, q = b + ST_HEAD; a < mon->nt; a++, q += ST_PER) {
-    double v[4];
-    size_t i;
-    for (i = 0; i < 4; i++) v[i] = get_f64(q + 8 * i);
-    if (!(v[0] >= 0) || !(v[1] >= 0) || isnan(v[2]) || !(v[3] >= 0) || get_u32(q + 32) > 1)
-      return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: tracked parameter %zu: CUSUM %g, %g, "
-                          "reference %g / %g: not a state the monitor writes", a + 1, v[0],
-                          v[1], v[2], v[3]);
-  }
-  for (a = 0, q = b + ST_HEAD + ST_PER * mon->nt; a < mon->nt * mon->nt; a++, q += 8)
-    if (!isfinite(get_f64(q)))
-      return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: the reference's sums are not a state "
-                          "the monitor writes");
-  {
-    const char *bad = check_drift(mon, b + ST_HEAD + ST_PER * mon->nt + bref_bytes(mon));
-    if (bad)
-      return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: the %s are not a state the monitor "
-                          "writes", bad);
-  }
+  if ((st = check(mon, b, size)) || (st = check_fields(mon, b))) return st;
   load_drift(mon, b + ST_HEAD + ST_PER * mon->nt + bref_bytes(mon));
   memset(mon->bref, 0, sizeof mon->bref);
   for (a = 0, q = b + ST_HEAD + ST_PER * mon->nt; a < mon->nt * mon->nt; a++, q += 8)
     mon->bref[(a / mon->nt) * RCB_MONITOR_MAX_TRACKED + a % mon->nt] = get_f64(q);
-  mon->updates = (size_t)get_u64(b + 56);
+  mon->updates = (size_t)get_u64(b + 56); /* <= RCB_MONITOR_MAX_UPDATES: check_counts */
   mon->ref_started = get_u32(b + 64) != 0;
   for (a = 0, q = b + ST_HEAD; a < mon->nt; a++, q += ST_PER) {
     mon->cus_up[a] = get_f64(q);

@@ -96,9 +96,19 @@ int mon_log_is_csv(const char *path);
 /** matplotlib's format for --plot FILE ("png", "pdf", "svg"), NULL otherwise. */
 const char *mon_plot_format(const char *path);
 
-/** Read a --state file (all of it checked: magic, version, CRC, layout); 0 or
- * exit 3 naming the file and what is wrong. */
+/** Read a --state file (all of it checked: magic, version, CRC, layout, and
+ * every record against what rcbtool writes); 0 or exit 3 naming the file and
+ * what is wrong. */
 int mon_saved_read(const char *cmd, const char *path, mon_saved *sv);
+/** The same on the @p n bytes of a state file at @p p (@p path names it in
+ * messages): mon_saved_read's parser, which the fuzz harness calls. */
+int mon_saved_parse(const char *cmd, const char *path, const unsigned char *p, size_t n,
+                    mon_saved *sv);
+/** After rcb_monitor_load: the records against the monitor (one per update
+ * of its state, its tracked count, its candidates' indices, effects and
+ * parameter counts); 0 or exit 3 naming the file and the update. */
+int mon_saved_check(const char *cmd, const char *path, const mon_saved *sv,
+                    const rcb_monitor *mon);
 void mon_saved_free(mon_saved *sv);
 /** Write @p sv to a temporary for @p path (written and fsync'ed; the caller
  * renames it with cli_tmpfile_close); 0 or an exit code. */

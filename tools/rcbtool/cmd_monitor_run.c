@@ -538,6 +538,7 @@ static int resume(const mon_ctx *x, mon_state *s, rcb_monitor *mon) {
                     cli_msg(rcb_monitor_errmsg(mon), st),
                     st == RCB_ERR_OTHER_MODEL ? " (give the baseline model the series was "
                                                 "started with)" : "");
+  if ((rc = mon_saved_check(x->a->cmd, x->j->state, sv, mon))) return rc;
   for (k = 0; k < sv->nrec; k++) {
     if ((rc = keep(s, mon, sv->ncomm + k, &sv->rec[k].r))) return rc;
     s->rec[s->nrec - 1].hash = sv->rec[k].hash;

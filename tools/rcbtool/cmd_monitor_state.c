@@ -9,6 +9,8 @@
  * the series are rebuilt from it; it is replaced by write, fsync, rename. */
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
+#include <stdarg.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -20,12 +22,28 @@
 #define ST_MAGIC "RCBTOOL-MONSTATE"
 #define ST_VERSION 4u
 
-/* A growing or consumed byte buffer: one codec writes and reads. */
+/* A growing or consumed byte buffer: one codec writes and reads. bad: 1
+ * truncated or damaged, 2 not a state, 3 another version, 4 CRC, 5 a field
+ * no rcbtool writes (named in what). */
 typedef struct st_buf {
   unsigned char *p;
   size_t n, cap, pos;
   int reading, bad;
+  char what[160];
 } st_buf;
+
+/* A field read that no rcbtool writes: the first one named. */
+#if defined(__GNUC__)
+__attribute__((format(printf, 2, 3)))
+#endif
+static void st_bad(st_buf *b, const char *fmt, ...) {
+  va_list ap;
+  if (b->bad) return;
+  b->bad = 5;
+  va_start(ap, fmt);
+  vsnprintf(b->what, sizeof b->what, fmt, ap);
+  va_end(ap);
+}
 
 static void io_bytes(st_buf *b, void *x, size_t n) {
   if (b->bad || !n) return;
@@ -64,15 +82,22 @@ static void io_u64(st_buf *b, uint64_t *v) {
   if (b->reading && !b->bad)
     for (*v = 0, i = 7; i >= 0; i--) *v = (*v << 8) | c[i];
 }
+/* Read: range-checked before the cast (a 32-bit size_t, an int). */
 static void io_size(st_buf *b, size_t *v) {
   uint64_t u = *v;
   io_u64(b, &u);
-  if (b->reading) *v = (size_t)u;
+  if (!b->reading || b->bad) return;
+  if (u > SIZE_MAX) st_bad(b, "a count of %llu (more than this host's size_t)",
+                           (unsigned long long)u);
+  else *v = (size_t)u;
 }
 static void io_int(st_buf *b, int *v) {
   uint64_t u = (uint64_t)(int64_t)*v;
   io_u64(b, &u);
-  if (b->reading) *v = (int)(int64_t)u;
+  if (!b->reading || b->bad) return;
+  if ((int64_t)u < INT_MIN || (int64_t)u > INT_MAX)
+    st_bad(b, "an integer of %lld (more than an int)", (long long)(int64_t)u);
+  else *v = (int)(int64_t)u;
 }
 static void io_f64(st_buf *b, double *x) {
   uint64_t u;
@@ -99,6 +124,8 @@ static void get_str(st_buf *b, char **s) {
   *s = NULL;
   io_int(b, &has);
   io_size(b, &n);
+  if (!b->bad && (has < 0 || has > 1 || (!has && n)))
+    st_bad(b, "a name's flag %d and length %zu", has, n);
   if (b->bad || !has) return;
   if (n > b->n - b->pos || !(*s = malloc(n + 1))) {
     b->bad = 1;
@@ -114,6 +141,38 @@ static void io_str(st_buf *b, char **s) {
     put_str(b, *s);
 }
 
+/* An update's record read: what rcbtool writes (the library's result): update
+ * k + 1 of the series, flags 0 or 1 (a CUSUM's and the attribution's -1, 0
+ * or 1), counts of parameters within RCB_MONITOR_MAXP, effects in the
+ * catalogue. The indices into the monitor's candidates are checked against
+ * the monitor (mon_saved_check). */
+static int flag(int v, int lo) { return v >= lo && v <= 1; }
+static void check_result(st_buf *b, const rcb_monitor_result *r, size_t k) {
+  size_t i;
+  if (r->update != k + 1)
+    st_bad(b, "update %zu: numbered %zu", k + 1, r->update);
+  else if (!flag(r->alarm, 0) || !flag(r->cusum_alarm, 0) || !flag(r->drift_alarm, 0))
+    st_bad(b, "update %zu: alarm flags %d, %d, %d", k + 1, r->alarm, r->cusum_alarm,
+           r->drift_alarm);
+  else if (r->drift_dof > RCB_MONITOR_MAXP)
+    st_bad(b, "update %zu: the drift's degrees of freedom %zu", k + 1, r->drift_dof);
+  for (i = 0; !b->bad && i < r->ntop; i++) {
+    const rcb_monitor_candidate *c = &r->top[i];
+    if (c->np < 1 || c->np > RCB_MONITOR_MAXP || c->dof > RCB_MONITOR_MAXP ||
+        (int)c->effect < 0 || (int)c->effect >= RCB_EFFECT_COUNT || !flag(c->implausible, 0))
+      st_bad(b, "update %zu: candidate %zu: effect %d with %zu parameters (%zu degrees of "
+             "freedom)", k + 1, i + 1, (int)c->effect, c->np, c->dof);
+  }
+  for (i = 0; !b->bad && i < r->ntracked; i++) {
+    const rcb_monitor_tracked *t = &r->tracked[i];
+    if (!flag(t->cusum_alarm, -1) || !flag(t->out_of_range, 0) || !flag(t->named, -1) ||
+        t->rival_dof > RCB_MONITOR_MAXP || t->rival2_dof > RCB_MONITOR_MAXP)
+      st_bad(b, "update %zu: tracked parameter %zu's flags (CUSUM %d, range %d, named %d) or "
+             "rivals' parameters (%zu, %zu)", k + 1, i + 1, t->cusum_alarm, t->out_of_range,
+             t->named, t->rival_dof, t->rival2_dof);
+  }
+}
+
 static void io_result(st_buf *b, rcb_monitor_result *r) {
   size_t k;
   int eff;
@@ -122,7 +181,7 @@ static void io_result(st_buf *b, rcb_monitor_result *r) {
   io_f64(b, &r->T), io_size(b, &r->dof), io_f64(b, &r->threshold), io_f64(b, &r->p_value);
   io_int(b, &r->alarm), io_int(b, &r->cusum_alarm);
   io_size(b, &r->ntop);
-  if (r->ntop > RCB_MONITOR_TOP) b->bad = 1;
+  if (r->ntop > RCB_MONITOR_TOP) st_bad(b, "update %zu: %zu candidates ranked", r->update, r->ntop);
   for (k = 0; !b->bad && k < r->ntop; k++) {
     rcb_monitor_candidate *c = &r->top[k];
     eff = (int)c->effect;
@@ -134,7 +193,8 @@ static void io_result(st_buf *b, rcb_monitor_result *r) {
     io_int(b, &c->implausible);
   }
   io_size(b, &r->ntracked);
-  if (r->ntracked > RCB_MONITOR_MAX_TRACKED) b->bad = 1;
+  if (r->ntracked < 1 || r->ntracked > RCB_MONITOR_MAX_TRACKED)
+    st_bad(b, "update %zu: %zu tracked parameters", r->update, r->ntracked);
   for (k = 0; !b->bad && k < r->ntracked; k++) {
     rcb_monitor_tracked *t = &r->tracked[k];
     io_f64(b, &t->value), io_f64(b, &t->ci_lo), io_f64(b, &t->ci_hi), io_f64(b, &t->stderr_);
@@ -172,7 +232,8 @@ static void io_setup(st_buf *b, rcb_meas **ms) {
       return;
     }
     io_f64s(b, grid, n);
-    if (b->bad || rcb_meas_set_grid(*ms, (rcb_meas_type)type, n, grid, speed)) b->bad = 1;
+    if (!b->bad && rcb_meas_set_grid(*ms, (rcb_meas_type)type, n, grid, speed))
+      st_bad(b, "the set-up's grid: %s", rcb_meas_errmsg(*ms));
     free(grid);
   } else {
     io_f64s(b, grid, n);
@@ -193,7 +254,9 @@ static void io_setup(st_buf *b, rcb_meas **ms) {
     get_str(b, &resp), get_str(b, &ref), io_int(b, &kind);
     if (!b->bad && !(v = malloc(n * sizeof *v))) b->bad = 1;
     if (!b->bad) io_f64s(b, (double *)(void *)v, 2 * n);
-    if (!b->bad && (!resp || rcb_meas_add_channel(*ms, resp, ref, kind, v))) b->bad = 1;
+    if (!b->bad && !resp) st_bad(b, "the set-up's channel %zu: no response name", c + 1);
+    if (!b->bad && rcb_meas_add_channel(*ms, resp, ref, (rcb_frf_kind)kind, v))
+      st_bad(b, "the set-up's channel %zu: %s", c + 1, rcb_meas_errmsg(*ms));
     free(resp);
     free(ref);
     free(v);
@@ -234,6 +297,7 @@ static void io_state(st_buf *b, mon_saved *sv) {
     io_str(b, &sv->recfile[k]);
     io_u64(b, &sv->rec[k].hash);
     io_result(b, &sv->rec[k].r);
+    if (b->reading && !b->bad) check_result(b, &sv->rec[k].r, k);
   }
 }
 
@@ -247,36 +311,29 @@ void mon_saved_free(mon_saved *sv) {
   memset(sv, 0, sizeof *sv);
 }
 
-int mon_saved_read(const char *cmd, const char *path, mon_saved *sv) {
+int mon_saved_parse(const char *cmd, const char *path, const unsigned char *p, size_t n,
+                    mon_saved *sv) {
   st_buf b;
-  FILE *fp = fopen(path, "rb");
-  long len;
   memset(sv, 0, sizeof *sv);
   memset(&b, 0, sizeof b);
-  if (!fp) return cli_fail(CLI_EXIT_INPUT, "%s: --state '%s': cannot read it: %s", cmd, path,
-                           strerror(errno));
-  if (fseek(fp, 0, SEEK_END) != 0 || (len = ftell(fp)) < 0 || fseek(fp, 0, SEEK_SET) != 0 ||
-      !(b.p = malloc((size_t)len + 1)) || fread(b.p, 1, (size_t)len, fp) != (size_t)len) {
-    fclose(fp);
-    free(b.p);
-    return cli_fail(CLI_EXIT_INPUT, "%s: --state '%s': cannot read it", cmd, path);
-  }
-  fclose(fp);
-  b.n = (size_t)len, b.reading = 1;
+  b.p = (unsigned char *)(uintptr_t)p, b.n = n, b.reading = 1; /* only read */
   if (b.n < 20 || memcmp(b.p, ST_MAGIC, 16) != 0) {
     b.bad = 2;
   } else {
-    unsigned char *e = b.p + b.n - 4;
+    const unsigned char *e = b.p + b.n - 4;
     unsigned long crc = (unsigned long)e[0] | (unsigned long)e[1] << 8 |
                         (unsigned long)e[2] << 16 | (unsigned long)e[3] << 24;
     if (crc != rcb_monitor_crc32(0, b.p, b.n - 4)) b.bad = 4;
     b.n -= 4;
   }
   if (!b.bad) io_state(&b, sv);
-  if (!b.bad && b.pos != b.n) b.bad = 1;
-  free(b.p);
+  if (!b.bad && b.pos != b.n) st_bad(&b, "%zu bytes after the last update", b.n - b.pos);
   if (!b.bad) return 0;
   mon_saved_free(sv);
+  if (b.bad == 5)
+    return cli_fail(CLI_EXIT_INPUT, "%s: --state '%s': %s: not a state rcbtool writes "
+                    "(damaged, or made by something else); replay the series to rebuild it",
+                    cmd, path, b.what);
   return cli_fail(CLI_EXIT_INPUT, "%s: --state '%s': %s", cmd, path,
                   b.bad == 2 ? "not a monitor state (written by rcbtool monitor --state); give "
                                "the state file of the series or a new file name"
@@ -285,6 +342,55 @@ int mon_saved_read(const char *cmd, const char *path, mon_saved *sv) {
                   : b.bad == 4 ? "its CRC-32 does not match: the file was changed or damaged; "
                                  "replay the series to rebuild it"
                                : "truncated or damaged: replay the series to rebuild it");
+}
+
+int mon_saved_read(const char *cmd, const char *path, mon_saved *sv) {
+  FILE *fp = fopen(path, "rb");
+  unsigned char *p = NULL;
+  long len;
+  int rc;
+  memset(sv, 0, sizeof *sv);
+  if (!fp) return cli_fail(CLI_EXIT_INPUT, "%s: --state '%s': cannot read it: %s", cmd, path,
+                           strerror(errno));
+  if (fseek(fp, 0, SEEK_END) != 0 || (len = ftell(fp)) < 0 || fseek(fp, 0, SEEK_SET) != 0 ||
+      !(p = malloc((size_t)len + 1)) || fread(p, 1, (size_t)len, fp) != (size_t)len) {
+    fclose(fp);
+    free(p);
+    return cli_fail(CLI_EXIT_INPUT, "%s: --state '%s': cannot read it", cmd, path);
+  }
+  fclose(fp);
+  rc = mon_saved_parse(cmd, path, p, (size_t)len, sv);
+  free(p);
+  return rc;
+}
+
+int mon_saved_check(const char *cmd, const char *path, const mon_saved *sv,
+                    const rcb_monitor *mon) {
+  size_t k, i, nt = 0, nc = rcb_monitor_candidate_count(mon);
+  rcb_monitor_rank(mon, NULL, &nt);
+  if (sv->nrec != rcb_monitor_update_count(mon))
+    return cli_fail(CLI_EXIT_INPUT, "%s: --state '%s': %zu updates' records, the monitor's "
+                    "state %zu updates: not a state rcbtool writes (damaged, or made by "
+                    "something else); replay the series to rebuild it", cmd, path, sv->nrec,
+                    rcb_monitor_update_count(mon));
+  for (k = 0; k < sv->nrec; k++) {
+    const rcb_monitor_result *r = &sv->rec[k].r;
+    int bad = r->ntracked != nt || (r->drift_dof && r->drift_index >= nc);
+    for (i = 0; !bad && i < r->ntop; i++) {
+      rcb_monitor_candidate_info ci;
+      bad = rcb_monitor_candidate_info_get(mon, r->top[i].index, &ci) != RCB_OK ||
+            ci.effect != r->top[i].effect || ci.np != r->top[i].np;
+    }
+    for (i = 0; !bad && i < r->ntracked; i++)
+      bad = (r->tracked[i].rival_dof && r->tracked[i].rival >= nc) ||
+            (r->tracked[i].rival2_dof && r->tracked[i].rival2 >= nc);
+    if (bad)
+      return cli_fail(CLI_EXIT_INPUT, "%s: --state '%s': update %zu: its tracked parameters "
+                      "or candidates are not the monitor's (%zu tracked, %zu candidates): not "
+                      "a state rcbtool writes (damaged, or made by something else); replay "
+                      "the series to rebuild it", cmd, path, k + 1, nt, nc);
+  }
+  return 0;
 }
 
 /* The mode a plain fopen would have given (0666 & ~umask). */
