@@ -89,12 +89,14 @@ const char cli_help_monitor[] =
     "                  refused), and FILE is replaced atomically (write, fsync,\n"
     "                  rename; a crash leaves the previous state). --log and --plot\n"
     "                  then cover the whole series, so with no NEW file they rebuild\n"
-    "                  them from the state\n"
+    "                  them from the state. One run at a time: another run on FILE\n"
+    "                  waits up to RCB_LOCK_WAIT s (default 10), then exits 6\n"
     "Units: error, floor %; T and its threshold have no unit; parameters in SI\n"
     "(N/m, N s/m, N m/rad, N m s/rad, kg). Exit codes: 0 ok (alarms or not), 2\n"
     "usage, 3 bad input (a missing or empty DIR, a file whose channels, points or\n"
     "speed differ from the commissioning file's), 4 numerical failure, 5 output\n"
-    "not written (no partial log or plot is ever left).\n";
+    "not written (no partial log or plot is ever left), 6 the --state FILE is\n"
+    "being updated by another run (nothing read or written).\n";
 
 /* --noise A,S[,P]: eq. 19's two numbers, then the phase noise in degrees. */
 /* --baseline-sd SD,...: one standard error >= 0 per tracked parameter. */
