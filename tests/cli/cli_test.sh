@@ -1770,6 +1770,23 @@ history_validate)
   run history "$W/h.jsonl" --json; expect_rc 0
   python3 -c 'import json,sys; assert len(json.load(open(sys.argv[1]))) == 2' "$W/out" ||
     fail "appended to a last line without newline: $(cat "$W/h.jsonl")" ;;
+lock_stale_and_wait_env)
+  # issue #34 item 6: a lock file a killed run left (no process holds it) does not block,
+  # and is removed; RCB_LOCK_WAIT must be seconds from 0 to 86400 (exit 2 before any work)
+  run simulate "$MODEL" --frf --out C.A.x --in DA.x --fmin 200 --fmax 400 --points 21 \
+    --rpm 10000 -o "$W/meas.csv"; expect_rc 0
+  echo "left by a killed run" >"$W/h.jsonl.lock"
+  RCB_LOCK_WAIT=0 run fit "$MODEL" "$W/meas.csv" --params coupling.C.kt --history "$W/h.jsonl"
+  expect_rc 0; [ "$(wc -l <"$W/h.jsonl")" -eq 1 ] || fail "the step was not recorded"
+  [ ! -e "$W/h.jsonl.lock" ] || fail "the lock file was left"
+  for v in abc -1 1e9 nan ''; do
+    RCB_LOCK_WAIT=$v run fit "$MODEL" "$W/meas.csv" --params coupling.C.kt --history "$W/h.jsonl"
+    if [ -z "$v" ]; then expect_rc 0; continue; fi # empty: the default
+    expect_rc 2; err_has "RCB_LOCK_WAIT='$v'"; out_empty
+  done
+  [ "$(wc -l <"$W/h.jsonl")" -eq 2 ] || fail "a refused run recorded a step"
+  stray=$(ls -A "$W" | grep -v -x -e err -e out -e meas.csv -e h.jsonl)
+  [ -z "$stray" ] || fail "left behind: $stray" ;;
 *) echo "unknown test case '$CASE'"; exit 1 ;;
 esac
 exit 0
