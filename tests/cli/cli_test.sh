@@ -1714,6 +1714,79 @@ history_nonfinite)
     err_has "'$W/h.jsonl':2: not a history record"
     cmp -s "$W/h.jsonl" "$W/h.orig" || fail "the history was appended to"
   done ;;
+history_validate)
+  # issue #34 item 6: a history is validated like any input (file:line and what is
+  # wrong), numbers read whole, every bar at most 50 characters, CRLF blank lines skipped
+  L='{"command": "fit", "model": "m.ini", "error_pct": 2, "floor_pct": null, "params": 1, "note": "a"}'
+  bad() { # VALUE-LINE MESSAGE: line 2 refused by history (exit 3) and fit --history (exit 5)
+    printf '%s\n%s\n' "$L" "$1" >"$W/h.jsonl"; cp "$W/h.jsonl" "$W/h.orig"
+    run history "$W/h.jsonl"; expect_rc 3; out_empty
+    err_has "'$W/h.jsonl':2: not a history record: $2"
+    run fit "$MODEL" "$W/meas.csv" --params coupling.C.kt --history "$W/h.jsonl"; expect_rc 5
+    err_has "'$W/h.jsonl':2: not a history record: $2"
+    cmp -s "$W/h.jsonl" "$W/h.orig" || fail "a refused history was appended to"
+  }
+  run simulate "$MODEL" --frf --out C.A.x --in DA.x --fmin 200 --fmax 400 --points 21 \
+    --rpm 10000 -o "$W/meas.csv"; expect_rc 0
+  # the fuzzer's 583-byte history printed a bar of 1.67 GB in 6 s
+  bad '{"command": "fit", "model": "m.ini", "error_pct": -1.4e17, "floor_pct": null, "params": 1}' \
+    "error_pct -1.4e+17 % is negative"
+  bad '{"command": "fit", "model": "m.ini", "error_pct": -42949672.98}' "error_pct -4.29497e+07 % is negative"
+  bad '{"command": "fit", "model": "m.ini", "error_pct": 1, "floor_pct": -0.5}' "floor_pct -0.5 % is negative"
+  big=1.$(printf '%070d' 0)e999 # 75 characters: it was cut to 63 and read as 1
+  bad "{\"command\": \"fit\", \"model\": \"m.ini\", \"error_pct\": $big}" "error_pct inf % is not finite"
+  bad '{"command": "rm", "model": "m.ini", "error_pct": 1}' 'command "rm" is none of fit, diagnose, apply'
+  bad '{"command": "fit", "model": "m.ini"}' 'no "error_pct"'
+  bad '{"command": "fit", "model": "m.ini", "error_pct": 1, "params": 2.5}' "params: expected a count"
+  bad '{"command": "fit", "model": "m.ini", "error_pct": NaN}' "error_pct: expected a string, a number or null"
+  bad '{"command": "fit", "model": "m.ini", "error_pct": 0x10}' "expected ',' or '}' after a value"
+  bad '{"command": "fit", "model": "m.ini", "error_pct": 1, "error_pct": 2}' "error_pct given twice"
+  bad '{"command": "fit", "model": "m.ini", "error_pct": 1} {' "text after the object"
+  # a 71-digit number: the same value in the table and in --json (the table showed 2e+62)
+  d71=2$(printf '%070d' 0)
+  printf '%s\n{"command": "fit", "model": "m.ini", "error_pct": %s, "params": 1}\n' "$L" "$d71" >"$W/h.jsonl"
+  run history "$W/h.jsonl"; expect_rc 0; out_has " 2e+70 "
+  grep -q 'e+62' "$W/out" && fail "the 71-digit number was cut"
+  run history "$W/h.jsonl" --json; expect_rc 0; json_ok
+  python3 -c 'import json,sys; r=json.load(open(sys.argv[1])); assert [s["error_pct"] for s in r] == [2, 2e70], r' \
+    "$W/out" || fail "--json: $(cat "$W/out")"
+  # bars of 50 x e / emax '#' whatever the errors' range (50 x 1.8e308 is no number)
+  for e in 0.9e308 1e-300 0 1.7976931348623157e308; do
+    printf '{"command": "fit", "model": "m.ini", "error_pct": %s}\n' "$e"
+  done >"$W/h.jsonl"
+  run history "$W/h.jsonl"; expect_rc 0
+  [ "$(grep '|' "$W/out" | tr -cd '#\n' | awk '{printf "%d ", length}')" = "25 0 0 50 " ] ||
+    fail "bars: $(grep '|' "$W/out")"
+  # CRLF lines and a blank CRLF line: 2 steps, not 3 (a blank line was an empty step)
+  printf '%s\r\n\r\n \r\n%s\r\n' "$L" "$L" >"$W/h.jsonl"
+  run history "$W/h.jsonl" --json; expect_rc 0
+  python3 -c 'import json,sys; r=json.load(open(sys.argv[1])); assert len(r) == 2 and r[1]["command"] == "fit", r' \
+    "$W/out" || fail "CRLF: $(cat "$W/out")"
+  run history "$W/h.jsonl"; expect_rc 0
+  grep -q '^3 ' "$W/out" && fail "a blank CRLF line became a step"
+  # a history whose last line has no newline: the next step goes on a line of its own
+  printf '%s' "$L" >"$W/h.jsonl"
+  run fit "$MODEL" "$W/meas.csv" --params coupling.C.kt --history "$W/h.jsonl"; expect_rc 0
+  run history "$W/h.jsonl" --json; expect_rc 0
+  python3 -c 'import json,sys; assert len(json.load(open(sys.argv[1]))) == 2' "$W/out" ||
+    fail "appended to a last line without newline: $(cat "$W/h.jsonl")" ;;
+lock_stale_and_wait_env)
+  # issue #34 item 6: a lock file a killed run left (no process holds it) does not block,
+  # and is removed; RCB_LOCK_WAIT must be seconds from 0 to 86400 (exit 2 before any work)
+  run simulate "$MODEL" --frf --out C.A.x --in DA.x --fmin 200 --fmax 400 --points 21 \
+    --rpm 10000 -o "$W/meas.csv"; expect_rc 0
+  echo "left by a killed run" >"$W/h.jsonl.lock"
+  RCB_LOCK_WAIT=0 run fit "$MODEL" "$W/meas.csv" --params coupling.C.kt --history "$W/h.jsonl"
+  expect_rc 0; [ "$(wc -l <"$W/h.jsonl")" -eq 1 ] || fail "the step was not recorded"
+  [ ! -e "$W/h.jsonl.lock" ] || fail "the lock file was left"
+  for v in abc -1 1e9 nan ''; do
+    RCB_LOCK_WAIT=$v run fit "$MODEL" "$W/meas.csv" --params coupling.C.kt --history "$W/h.jsonl"
+    if [ -z "$v" ]; then expect_rc 0; continue; fi # empty: the default
+    expect_rc 2; err_has "RCB_LOCK_WAIT='$v'"; out_empty
+  done
+  [ "$(wc -l <"$W/h.jsonl")" -eq 2 ] || fail "a refused run recorded a step"
+  stray=$(ls -A "$W" | grep -v -x -e err -e out -e meas.csv -e h.jsonl)
+  [ -z "$stray" ] || fail "left behind: $stray" ;;
 *) echo "unknown test case '$CASE'"; exit 1 ;;
 esac
 exit 0

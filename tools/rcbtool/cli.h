@@ -19,7 +19,8 @@ enum {
   CLI_EXIT_USAGE = 2,   /**< bad command line */
   CLI_EXIT_INPUT = 3,   /**< bad input: model file or data */
   CLI_EXIT_NUMERIC = 4, /**< numerical failure in an analysis */
-  CLI_EXIT_IO = 5       /**< output could not be written */
+  CLI_EXIT_IO = 5,      /**< output could not be written */
+  CLI_EXIT_LOCKED = 6   /**< a file of the run is being updated by another run */
 };
 
 #define CLI_PI 3.14159265358979323846

@@ -10,7 +10,9 @@
  * not writable. Outputs are opened only through the plan (cli_plan_open.c:
  * cli_out_open, cli_tmpfile_open refuse a path the plan does not hold), each
  * written to a temporary in its own directory; cli_plan_finish renames them all after the verb succeeded and
- * removes them all otherwise; a signal removes them all too. */
+ * removes them all otherwise; a signal removes them all too. A file both read
+ * and rewritten (CLI_IO_INOUT) is locked by the check, before the verb reads
+ * it, until after the renames (cli_plan_lock.c): one writer at a time. */
 #define _XOPEN_SOURCE 700 /* realpath */
 #include <errno.h>
 #include <fcntl.h>
@@ -30,6 +32,8 @@ typedef struct plan_file {
   char *what;    /* "model", "signals", "-o", "--stats", ... */
   unsigned io;   /* CLI_IO_IN | CLI_IO_OUT | CLI_IO_MKDIR */
   int checked;   /* an output that passed cli_plan_check */
+  char *lock;    /* CLI_IO_INOUT: the lock file held (cli_plan_lock.c), NULL when none */
+  int lockfd, lockslot;
 } plan_file;
 
 /* A temporary written and closed, renamed onto its output when the run succeeded. */
@@ -170,6 +174,7 @@ static void declare(const char *path, const char *what, unsigned io) {
   f->path = dup_str(path);
   f->what = dup_str(what);
   f->io = io;
+  f->lockfd = f->lockslot = -1;
   if (!f->path || !f->what) {
     free(f->path);
     free(f->what);
@@ -311,9 +316,6 @@ int cli_plan_check(void) {
     co = canonical(o->path);
     for (k = 0; k < plan.n; k++) {
       if (k == i || (!(plan.f[k].io & CLI_IO_IN) && k < i)) continue;
-      if (strcmp(plan.f[k].path, o->path) == 0 && (plan.f[k].io & CLI_IO_IN) &&
-          (o->io & CLI_IO_IN))
-        continue; /* a file both read and rewritten (--history) */
       if ((rc = check_pair(o, exists ? &so : NULL, co, &plan.f[k]))) {
         free(co);
         return rc;
@@ -321,6 +323,13 @@ int cli_plan_check(void) {
     }
     free(co);
     o->checked = 1;
+  }
+  /* every check passed: a file read and rewritten is locked before it is read */
+  for (i = 0; i < plan.n; i++) {
+    plan_file *f = &plan.f[i];
+    if ((f->io & CLI_IO_INOUT) == CLI_IO_INOUT && f->lockfd < 0 &&
+        (rc = cli_plan_lock(f->path, f->what, &f->lock, &f->lockfd, &f->lockslot)))
+      return rc;
   }
   return 0;
 }
@@ -412,6 +421,12 @@ int cli_plan_finish(int rc) {
     free(plan.p[i].path);
   }
   plan.np = 0;
+  /* the locks last: another run reads a file only once this run's rename is done */
+  for (i = 0; i < plan.n; i++) {
+    cli_plan_unlock(plan.f[i].lock, plan.f[i].lockfd, plan.f[i].lockslot);
+    plan.f[i].lock = NULL;
+    plan.f[i].lockfd = plan.f[i].lockslot = -1;
+  }
   /* a temporary a command made and neither committed nor removed (a path that
    * forgot its abort) is removed here, as a signal would */
   for (i = 0; i < CLI_TMP_SLOTS; i++)

@@ -74,7 +74,8 @@ const char cli_help_diagnose[] =
     "                 A candidate that is not significant is refused (exit 3)\n"
     "  --force        with --apply: write a candidate that is not significant\n"
     "                 all the same (a warning says so)\n"
-    "  --history FILE record this step (rcbtool history FILE shows the steps)\n"
+    "  --history FILE record this step (rcbtool history FILE shows the steps); one\n"
+    "                 run at a time, as for fit\n"
     "  --json         the ranking as JSON: per candidate \"claim\" (explains,\n"
     "                 improves, none), \"significant\", \"adequate\" (null when\n"
     "                 unknown), \"chi2\", \"chi2_limit\", \"chain\", \"carry\" (a sensor\n"
@@ -92,7 +93,8 @@ const char cli_help_diagnose[] =
     "objective (no unit); fitted: values in SI units\n"
     "(N/m, N s/m, N m/rad, N m s/rad, kg, kg m^2).\n"
     "Other options as for rcbtool fit. Exit codes: 0 ok, 2 usage, 3 bad input,\n"
-    "4 numerical failure, 5 output error.\n";
+    "4 numerical failure, 5 output error, 6 the --history FILE is being updated\n"
+    "by another run.\n";
 
 static const char *const scale_names[] = {"linear", "log10", "db", "complex"};
 

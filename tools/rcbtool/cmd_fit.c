@@ -62,7 +62,9 @@ const char cli_help_fit[] =
     "  --fd           sensitivities by finite differences (eq. 11) instead of the\n"
     "                 analytic ones (eq. 9)\n"
     "  --max-iter N   iteration limit (default 100)\n"
-    "  --history FILE record this fit as a step (rcbtool history FILE shows them)\n"
+    "  --history FILE record this fit as a step (rcbtool history FILE shows them);\n"
+    "                 one run at a time: another run on FILE waits up to\n"
+    "                 RCB_LOCK_WAIT s (default 10), then exits 6\n"
     "  --starts N     when the fit ends unsure (above 1.5 x the noise floor that\n"
     "                 --noise or --sd predicts, or not converged: a local minimum or a\n"
     "                 missing effect), retry from up to N - 1 random starts within\n"
@@ -91,7 +93,8 @@ const char cli_help_fit[] =
     "\"objective0\", "
     "\"objective\", \"sigma\", \"correlation\": [[...]], \"notes\": [...], \"output\"}\n"
     "Exit codes: 2 usage, 3 bad model, measurement or parameter name, 4 numerical\n"
-    "failure, 5 output not written.\n";
+    "failure, 5 output not written, 6 the --history FILE is being updated by\n"
+    "another run.\n";
 
 static const char *const scale_names[] = {"linear", "log10", "db", "complex"};
 

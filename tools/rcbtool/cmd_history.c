@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 
 #include "cli.h"
+#include "cli_history.h"
 
 const char cli_help_history[] =
     "usage: rcbtool history FILE [--json]\n"
@@ -17,77 +18,68 @@ const char cli_help_history[] =
     "parameters, note; then draws the error falling, one bar per step.\n"
     "FILE holds one JSON object per line; --json prints them as one JSON array.\n"
     "A file with a line that is not such a record is refused (exit 3), naming the\n"
-    "line.\n";
+    "line and what is wrong: a command other than fit, diagnose or apply, an error\n"
+    "or floor that is negative or not finite (numbers are read whole, however\n"
+    "long), a missing field. Blank lines are skipped. The longest bar is 50 #.\n";
 
+/* The whole file, NUL-terminated, or NULL (cannot open, read error, out of
+ * memory): never a part of it, which --history would write back as the whole. */
 static char *slurp(const char *path, size_t *len) {
   FILE *fp = fopen(path, "rb");
   char *buf = NULL;
   size_t cap = 0, n = 0, r;
+  int bad = 0;
   *len = 0;
   if (!fp) return NULL;
   do {
     if (n + 4096 + 1 > cap) {
       char *nb = realloc(buf, cap = 2 * cap + 8192);
-      if (!nb) break;
+      if (!nb) {
+        bad = 1;
+        break;
+      }
       buf = nb;
     }
     r = fread(buf + n, 1, cap - n - 1, fp);
     n += r;
   } while (r > 0);
+  if (ferror(fp)) bad = 1;
   fclose(fp);
-  if (buf) buf[n] = '\0';
+  if (bad) {
+    free(buf);
+    return NULL;
+  }
+  buf[n] = '\0';
   *len = n;
   return buf;
 }
 
-/* A line (@p n bytes, no newline) is a history record: one JSON object with the
- * fields cli_history_append writes. */
-static int field(const char *line, const char *key, char *out, size_t size);
-
-/* A number field as --history writes it: absent, null, or a finite number
- * (a nan or 1e999 typed into the file is no record: cli_json_num writes null). */
-static int number_ok(const char *line, const char *key) {
-  char v[64], *end;
-  double x;
-  if (!field(line, key, v, sizeof v) || strcmp(v, "null") == 0) return 1;
-  x = strtod(v, &end);
-  return end != v && *end == '\0' && isfinite(x);
-}
-
-static int is_record(const char *line, size_t n) {
-  static const char *const keys[] = {"\"command\": ", "\"model\": ", "\"error_pct\": "};
-  static const char *const nums[] = {"error_pct", "floor_pct", "params"};
-  char buf[4096];
-  size_t i;
-  if (n < 2 || n >= sizeof buf || line[0] != '{' || line[n - 1] != '}') return 0;
-  memcpy(buf, line, n);
-  buf[n] = '\0';
-  for (i = 0; i < sizeof keys / sizeof keys[0]; i++)
-    if (!strstr(buf, keys[i])) return 0;
-  for (i = 0; i < sizeof nums / sizeof nums[0]; i++)
-    if (!number_ok(buf, nums[i])) return 0;
-  return strlen(buf) == n; /* no NUL byte inside */
-}
-
-/* 0 if @p text (@p len bytes) is empty or history lines only; else the
- * number of the first line that is not. */
-static size_t first_bad_line(const char *text, size_t len) {
-  size_t pos = 0, k = 0;
-  while (pos < len) {
-    const char *nl = memchr(text + pos, '\n', len - pos);
-    size_t end = nl ? (size_t)(nl - text) : len, n = end - pos;
-    k++;
-    if (n > 0 && text[end - 1] == '\r') n--;
-    if (n > 0 && !is_record(text + pos, n)) return k;
-    pos = end + 1;
-  }
-  return 0;
+/* @p text (@p len bytes) read as a history into @p h: 0, or the message and
+ * @p code naming @p path and the line that is no record (cli_history_read.c
+ * says what is wrong with it): exit 5 for a --history to append to, 3 for
+ * rcbtool history. */
+static int read_history(const char *text, size_t len, const char *path, int code,
+                        cli_history *h) {
+  int r = cli_history_parse(text, len, h);
+  if (r < 0) return cli_fail(CLI_EXIT_NUMERIC, "out of memory reading the history '%s'", path);
+  if (r == 0) return 0;
+  if (code == CLI_EXIT_IO)
+    return cli_fail(code, "--history '%s':%zu: not a history record: %s; refusing to append "
+                    "to a file that is not a history (expected one JSON line per step, as "
+                    "--history writes them): give a new file name", path, h->bad_line, h->why);
+  return cli_fail(code, "history '%s':%zu: not a history record: %s (expected one JSON line "
+                  "per step with \"command\" (fit, diagnose or apply), \"model\" and "
+                  "\"error_pct\", numbers finite and >= 0 or null, as 'rcbtool fit --history' "
+                  "and 'rcbtool diagnose --history' write them); give a history file", path,
+                  h->bad_line, h->why);
 }
 
 int cli_history_check(const char *path) {
-  size_t len = 0, bad;
+  size_t len = 0;
   struct stat st;
+  cli_history h;
   char *text;
+  int rc;
   if (cli_plan_check()) return CLI_EXIT_IO;
   if (stat(path, &st) != 0) return 0; /* a new history */
   if (!S_ISREG(st.st_mode))
@@ -95,24 +87,24 @@ int cli_history_check(const char *path) {
                     "file (JSON lines written by --history) or a new file name", path);
   if (!(text = slurp(path, &len)))
     return cli_fail(CLI_EXIT_IO, "--history '%s': cannot read it", path);
-  bad = first_bad_line(text, len);
+  rc = read_history(text, len, path, CLI_EXIT_IO, &h);
+  cli_history_free(&h);
   free(text);
-  if (bad)
-    return cli_fail(CLI_EXIT_IO, "--history '%s':%zu: not a history record; refusing to "
-                    "append to a file that is not a history (expected one JSON line per "
-                    "step, as --history writes them): give a new file name", path, bad);
-  return 0;
+  return rc;
 }
 
 int cli_history_append(const char *path, const char *command, const char *model,
                        double error_pct, double floor_pct, size_t nparams, const char *note) {
   size_t len = 0;
-  char *old;
+  char *old = NULL;
   cli_tmpfile t;
+  struct stat st;
   FILE *fp;
   int ok, rc, e;
   if ((rc = cli_history_check(path))) return rc;
-  old = slurp(path, &len);
+  /* the steps so far, all of them or the run fails: never a history of one step */
+  if (stat(path, &st) == 0 && !(old = slurp(path, &len)))
+    return cli_fail(CLI_EXIT_IO, "--history '%s': cannot read it", path);
   /* the whole history, old steps and the new one, in a temporary of the plan:
    * renamed onto the history when the run succeeded */
   if ((rc = cli_tmpfile_open(&t, path))) {
@@ -127,6 +119,7 @@ int cli_history_append(const char *path, const char *command, const char *model,
   }
   errno = 0; /* the first failing write sets it: its reason is the message's */
   if (old) fwrite(old, 1, len, fp);
+  if (old && len && old[len - 1] != '\n') fputc('\n', fp); /* not glued to its last line */
   fputs("{\"command\": ", fp);
   cli_json_str(fp, command);
   fputs(", \"model\": ", fp);
@@ -150,56 +143,6 @@ int cli_history_append(const char *path, const char *command, const char *model,
   return rc;
 }
 
-/* The value of "key": in a JSON line (a string or a number), copied to out. */
-static int field(const char *line, const char *key, char *out, size_t size) {
-  char pat[64];
-  const char *p;
-  size_t n = 0;
-  snprintf(pat, sizeof pat, "\"%s\": ", key);
-  if (!(p = strstr(line, pat))) return 0;
-  p += strlen(pat);
-  if (*p == '"') {
-    for (p++; *p && *p != '"' && n + 5 < size; p++) {
-      if (*p != '\\' || !p[1]) {
-        out[n++] = *p;
-        continue;
-      }
-      p++; /* a JSON escape: \uXXXX back to UTF-8 (cli_json_str writes them) */
-      if (*p == 'u' && strspn(p + 1, "0123456789abcdefABCDEF") >= 4) {
-        char hex[5] = {p[1], p[2], p[3], p[4], 0};
-        unsigned long cp = strtoul(hex, NULL, 16);
-        p += 4;
-        if (cp == 0) cp = 0xfffd; /* a NUL would end the text: U+FFFD, shown as such */
-        if (cp < 0x80) {
-          out[n++] = (char)cp;
-        } else if (cp < 0x800) {
-          out[n++] = (char)(0xc0 | (cp >> 6));
-          out[n++] = (char)(0x80 | (cp & 0x3f));
-        } else {
-          out[n++] = (char)(0xe0 | (cp >> 12));
-          out[n++] = (char)(0x80 | ((cp >> 6) & 0x3f));
-          out[n++] = (char)(0x80 | (cp & 0x3f));
-        }
-      } else {
-        out[n++] = *p == 'n' ? '\n' : *p == 't' ? '\t' : *p == 'r' ? '\r' : *p == 'b' ? '\b'
-                 : *p == 'f' ? '\f' : *p;
-      }
-    }
-  } else {
-    while (*p && *p != ',' && *p != '}' && n + 1 < size) out[n++] = *p++;
-  }
-  out[n] = '\0';
-  return 1;
-}
-
-/* A number field of a record (0 when it holds none, e.g. null), with the
- * conversion checked (cert-err34-c) instead of atof's silent 0. */
-static double num_field(const char *s) {
-  char *end;
-  double v = strtod(s, &end);
-  return end == s ? 0.0 : v;
-}
-
 /* The model column: the file name whole (a long directory is cut to ".../"),
  * so two models never look alike. */
 static const char *short_name(const char *path, char *buf, size_t size) {
@@ -209,98 +152,73 @@ static const char *short_name(const char *path, char *buf, size_t size) {
   return buf;
 }
 
-static void print_steps(char *text) {
-  char *line, *save = NULL;
+#define BAR_WIDTH 50 /* characters: the largest error's bar */
+
+static void print_steps(const cli_history *h) {
   double emax = 0;
-  int step = 0, pass;
-  for (pass = 0; pass < 2; pass++) {
-    char *copy = strdup(text);
-    if (!copy) return;
-    step = 0;
-    if (pass == 1) {
-      printf("%-4s %-10s %-28s %10s %10s %6s  %s\n", "step", "command", "model", "error %",
-             "floor % *", "params", "note");
-    }
-    for (line = strtok_r(copy, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
-      char cmd[32] = "", model[256] = "", err[64] = "", flo[64] = "", np[16] = "",
-           note[512] = "", shown[300], tcmd[128], tmodel[1024], tnote[2048], tnp[64];
-      double e;
-      field(line, "command", cmd, sizeof cmd);
-      field(line, "model", model, sizeof model);
-      field(line, "error_pct", err, sizeof err);
-      field(line, "floor_pct", flo, sizeof flo);
-      field(line, "params", np, sizeof np);
-      field(line, "note", note, sizeof note);
-      e = num_field(err);
-      step++;
-      if (pass == 0) {
-        if (e > emax) emax = e;
-        continue;
-      }
-      /* the one escaping rule (cli_text.c): a file's bytes never reach the terminal raw */
-      cli_text(cmd, tcmd, sizeof tcmd);
-      cli_text(short_name(model, shown, sizeof shown), tmodel, sizeof tmodel);
-      cli_text(note, tnote, sizeof tnote);
-      cli_text(np, tnp, sizeof tnp);
-      if (strcmp(flo, "null") != 0 && flo[0])
-        printf("%-4d %-10s %-28s %10.4g %10.4g %6s  %s\n", step, tcmd, tmodel, e,
-               num_field(flo), tnp, tnote);
-      else
-        printf("%-4d %-10s %-28s %10.4g %10s %6s  %s\n", step, tcmd, tmodel, e, "-", tnp,
-               tnote);
-    }
-    free(copy);
+  size_t i;
+  int b;
+  printf("%-4s %-10s %-28s %10s %10s %6s  %s\n", "step", "command", "model", "error %",
+         "floor % *", "params", "note");
+  for (i = 0; i < h->n; i++) {
+    const cli_hist_step *st = &h->step[i];
+    char shown[300], tcmd[128], tmodel[1024], tnote[2048], e[32] = "-", f[32] = "-",
+         np[32] = "-";
+    if (st->error_pct > emax) emax = st->error_pct;
+    /* the one escaping rule (cli_text.c): a file's bytes never reach the terminal raw */
+    cli_text(st->command, tcmd, sizeof tcmd);
+    cli_text(short_name(st->model, shown, sizeof shown), tmodel, sizeof tmodel);
+    cli_text(st->note, tnote, sizeof tnote);
+    if (!isnan(st->error_pct)) snprintf(e, sizeof e, "%.4g", st->error_pct);
+    if (!isnan(st->floor_pct)) snprintf(f, sizeof f, "%.4g", st->floor_pct);
+    if (st->params >= 0) snprintf(np, sizeof np, "%ld", st->params);
+    printf("%-4zu %-10s %-28s %10s %10s %6s  %s\n", i + 1, tcmd, tmodel, e, f, np, tnote);
   }
-  if (step == 0) return;
+  if (h->n == 0) return;
   puts("* predicted by the --noise model (eq. 19), not measured: the error reached can be "
        "lower");
-  printf("\nerror %% by step (each # is %.3g %%):\n", emax / 50);
-  {
-    char *copy = strdup(text);
-    int k = 0;
-    if (!copy) return;
-    for (line = strtok_r(copy, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
-      char err[64] = "";
-      int bars, b;
-      field(line, "error_pct", err, sizeof err);
-      bars = emax > 0 ? (int)lround(50.0 * num_field(err) / emax) : 0;
-      printf("%4d |", ++k);
-      for (b = 0; b < bars; b++) putchar('#');
-      printf(" %.4g %%\n", num_field(err));
-    }
-    free(copy);
+  printf("\nerror %% by step (each # is %.3g %%):\n", emax / BAR_WIDTH);
+  for (i = 0; i < h->n; i++) {
+    /* 0 to BAR_WIDTH characters, whatever the file holds */
+    int bars = cli_history_bar(h->step[i].error_pct, emax, BAR_WIDTH);
+    printf("%4zu |", i + 1);
+    for (b = 0; b < bars; b++) putchar('#');
+    if (isnan(h->step[i].error_pct))
+      puts(" - %");
+    else
+      printf(" %.4g %%\n", h->step[i].error_pct);
   }
 }
 
-/* One record written again field by field (strings through cli_json_str,
- * numbers through cli_json_num): valid JSON whatever the line held. */
-static void print_json_record(const char *line, int first) {
-  static const char *const strs[] = {"command", "model", "note"};
-  static const char *const nums[] = {"error_pct", "floor_pct", "params"};
-  char buf[4096];
+/* The steps as one JSON array, every field written again (strings through
+ * cli_json_str, numbers through cli_json_num): valid JSON whatever the file held,
+ * the same numbers as the table. */
+static void print_json(const cli_history *h) {
   size_t i;
-  printf("%s\n{", first ? "" : ",");
-  for (i = 0; i < 3; i++) {
-    printf("%s\"%s\": ", i ? ", " : "", strs[i]);
-    buf[0] = '\0';
-    field(line, strs[i], buf, sizeof buf);
-    cli_json_str(stdout, buf);
+  fputs("[", stdout);
+  for (i = 0; i < h->n; i++) {
+    const cli_hist_step *st = &h->step[i];
+    printf("%s\n{\"command\": ", i ? "," : "");
+    cli_json_str(stdout, st->command);
+    fputs(", \"model\": ", stdout);
+    cli_json_str(stdout, st->model);
+    fputs(", \"note\": ", stdout);
+    cli_json_str(stdout, st->note);
+    fputs(", \"error_pct\": ", stdout);
+    cli_json_num(stdout, st->error_pct);
+    fputs(", \"floor_pct\": ", stdout);
+    cli_json_num(stdout, st->floor_pct);
+    fputs(", \"params\": ", stdout);
+    cli_json_num(stdout, st->params < 0 ? (double)NAN : (double)st->params);
+    putchar('}');
   }
-  for (i = 0; i < 3; i++) {
-    char *end;
-    double v;
-    buf[0] = '\0';
-    field(line, nums[i], buf, sizeof buf);
-    v = strtod(buf, &end);
-    printf(", \"%s\": ", nums[i]);
-    cli_json_num(stdout, end == buf ? (double)NAN : v);
-  }
-  putchar('}');
+  fputs("]\n", stdout);
 }
 
 int cmd_history(int argc, char **argv) {
   cli_args a;
-  size_t len, bad;
+  size_t len;
+  cli_history h;
   char *text;
   int rc = cli_parse(argc, argv, NULL, 0, &a);
   if (rc) return rc;
@@ -309,25 +227,12 @@ int cmd_history(int argc, char **argv) {
     return cli_usage(a.cmd, "missing the history file; expected rcbtool history FILE");
   if (!(text = slurp(a.model, &len)))
     return cli_fail(CLI_EXIT_INPUT, "history '%s': cannot read it", a.model);
-  if ((bad = first_bad_line(text, len)) != 0) {
-    free(text);
-    return cli_fail(CLI_EXIT_INPUT, "history '%s':%zu: not a history record (expected one JSON "
-                    "line per step with \"command\", \"model\" and \"error_pct\", numbers "
-                    "finite or null, as 'rcbtool fit --history' and 'rcbtool diagnose --history' "
-                    "write them); give a history file", a.model, bad);
-  }
-  if (a.json) {
-    char *line, *save = NULL;
-    int first = 1;
-    fputs("[", stdout);
-    for (line = strtok_r(text, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
-      print_json_record(line, first);
-      first = 0;
-    }
-    fputs("]\n", stdout);
-  } else {
-    print_steps(text);
-  }
+  rc = read_history(text, len, a.model, CLI_EXIT_INPUT, &h);
   free(text);
-  return 0;
+  if (!rc && a.json)
+    print_json(&h);
+  else if (!rc)
+    print_steps(&h);
+  cli_history_free(&h);
+  return rc;
 }

@@ -89,12 +89,14 @@ const char cli_help_monitor[] =
     "                  refused), and FILE is replaced atomically (write, fsync,\n"
     "                  rename; a crash leaves the previous state). --log and --plot\n"
     "                  then cover the whole series, so with no NEW file they rebuild\n"
-    "                  them from the state\n"
+    "                  them from the state. One run at a time: another run on FILE\n"
+    "                  waits up to RCB_LOCK_WAIT s (default 10), then exits 6\n"
     "Units: error, floor %; T and its threshold have no unit; parameters in SI\n"
     "(N/m, N s/m, N m/rad, N m s/rad, kg). Exit codes: 0 ok (alarms or not), 2\n"
     "usage, 3 bad input (a missing or empty DIR, a file whose channels, points or\n"
     "speed differ from the commissioning file's), 4 numerical failure, 5 output\n"
-    "not written (no partial log or plot is ever left).\n";
+    "not written (no partial log or plot is ever left), 6 the --state FILE is\n"
+    "being updated by another run (nothing read or written).\n";
 
 /* --noise A,S[,P]: eq. 19's two numbers, then the phase noise in degrees. */
 /* --baseline-sd SD,...: one standard error >= 0 per tracked parameter. */
@@ -284,7 +286,9 @@ static int guard_outputs(const mon_job *j) {
 /* An existing --state is read before the command line is parsed (its
  * settings join it): the run's plan is checked on what the line names
  * first, so a --state onto an input is refused as every output onto an
- * input is (exit 5), before it is read as a state. */
+ * input is (exit 5), before it is read as a state. The check locks the
+ * state (CLI_IO_INOUT, cli_plan_lock.c) before the caller looks whether it
+ * exists: two runs on one new state cannot both start a series. */
 static int state_plan(int argc, char **argv, const cli_opt *opts, size_t nopts,
                       const char *state) {
   char **args = malloc(((size_t)argc + 1) * sizeof *args);
@@ -305,7 +309,7 @@ static int state_plan(int argc, char **argv, const cli_opt *opts, size_t nopts,
       cli_plan_input(args[i], "model");
     }
   }
-  cli_plan_output(state, "--state", 0);
+  cli_plan_output(state, "--state", CLI_IO_IN);
   free(args), free((void *)series);
   return cli_plan_check();
 }
@@ -409,7 +413,7 @@ int cmd_monitor(int argc, char **argv) {
   static const cli_file_opt files[] = {{"--sd", CLI_IO_IN},
                                        {"--log", CLI_IO_OUT},
                                        {"--plot", CLI_IO_OUT | CLI_IO_MKDIR},
-                                       {"--state", CLI_IO_OUT}};
+                                       {"--state", CLI_IO_INOUT}};
   int nargs = 0, rc = 0;
   mon_job j;
   mon_saved saved;
@@ -419,10 +423,9 @@ int cmd_monitor(int argc, char **argv) {
   memset(&j, 0, sizeof j);
   memset(&saved, 0, sizeof saved);
   cli_plan_options(files, sizeof files / sizeof files[0]);
+  if (state && (rc = state_plan(argc, argv, opts, nopts, state))) goto done;
   if (state && stat(state, &sst) == 0) {
-    if ((rc = state_plan(argc, argv, opts, nopts, state)) ||
-        (rc = with_saved(argc, argv, state, &saved, &sargv, &argc)))
-      goto done;
+    if ((rc = with_saved(argc, argv, state, &saved, &sargv, &argc))) goto done;
     argv = sargv;
     j.saved = &saved;
   }

@@ -65,7 +65,9 @@ static void print_usage(FILE *fp) {
         "--progress (progress line on stderr), --help.\n"
         "Speeds are in rpm and frequencies in Hz on the command line.\n"
         "Exit codes: 0 ok, 2 usage error, 3 bad input (model or data),\n"
-        "4 numerical failure, 5 output I/O error.\n",
+        "4 numerical failure, 5 output I/O error, 6 a file the run reads and rewrites\n"
+        "(--history, --state) is being updated by another run (RCB_LOCK_WAIT=SECONDS,\n"
+        "default 10, is how long a run waits for it).\n",
         fp);
 }
 
