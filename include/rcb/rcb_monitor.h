@@ -279,8 +279,10 @@ typedef struct rcb_monitor_candidate {
  * the estimate is fitted jointly with the best-ranked candidate (a new
  * effect left out of the fit would bias the trend). Two intervals: of the
  * absolute value (the change's noise and the baseline's own uncertainty,
- * opts.baseline_cov) and of the change since the baseline (its noise only:
- * what the CUSUM and z watch). */
+ * opts.baseline_cov) and of the change since the baseline (its noise, and
+ * with opts.baseline_cov the error a baseline off the truth makes in a
+ * change linearised there: the curvature of the sequential detector; z
+ * watches the noise alone). */
 typedef struct rcb_monitor_tracked {
   double value;        /**< estimate, parameter units */
   double ci_lo, ci_hi; /**< 95 % interval of the value, parameter units:
@@ -296,9 +298,13 @@ typedef struct rcb_monitor_tracked {
   int cusum_alarm;     /**< +1: S+ > h (rising), -1: S- > h (falling), 0 */
   int out_of_range;    /**< 1 when value lies outside [lo, hi] */
   double abs_stderr;   /**< standard error of the value, parameter units:
-                            sqrt(stderr_^2 + the baseline's variance) */
+                            sqrt(stderr_^2 + the baseline's share: its variance,
+                            and with opts.baseline_cov (e_a - g)^T S (e_a - g),
+                            g the curvature's effect of the change) */
   double change;       /**< value - baseline, parameter units */
-  double change_lo, change_hi; /**< its 95 % interval: change -+ 1.96 stderr_ */
+  double change_lo, change_hi; /**< its 95 % interval: change -+ 1.96
+                            sqrt(stderr_^2 + g^T S g) (S = opts.baseline_cov, g
+                            the curvature's effect of the change; 0 without S) */
   int named;           /**< while cusum_alarm: whether the accumulated change is
                             this parameter's (the attribution in the method
                             above, by the one rule of rcb_monitor_named): 1 this

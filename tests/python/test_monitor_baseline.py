@@ -173,6 +173,30 @@ def test_null_from_fitted_baseline(tmp_path):
     assert out["value"] >= lo and out["change"] >= lo, msg
 
 
+@pytest.mark.parametrize("series", ["kt_wear", "null", "cross_B3"])
+def test_log10_baseline_holds(tmp_path, series):
+    """Issue #34 item 4: the baseline fitted as the README does it (rcbtool fit's
+    default log10 scale, --noise 10,1), its standard errors carried: on the
+    wear, the null and the step (cross_B3, the step's own alarms aside) series
+    the TEST alarms stay within the binomial 99 % bound at alpha 0.01 where
+    nothing new appears, and kt's change interval covers the true change at
+    least as often as the binomial 99 % lower end of 90 % allows (the aim:
+    90 % over null, wear and step series; the baseline's error enters the
+    change through the curvature, rcb_monitor_tracked.change_lo). Before
+    (issue #34): 15 TEST alarms in 100 updates and 38 % coverage on the wear."""
+    tool = _rcbtool_path()
+    out = wear_run(tool, "log10", tmp_path, series)
+    d, truth, _ = mc.series(series)
+    n_quiet = out["n"] if series != "cross_B3" else truth["change_update"] - mc.COMMISSION
+    _, hi = stats.binom.interval(0.99, max(n_quiet, 1), 0.01)
+    lo, _ = stats.binom.interval(0.99, out["n"], 0.90)
+    msg = FIGURES[f"{series} from a log10 baseline"]
+    if series != "cross_B3":
+        assert out["tests"] <= hi, msg
+    assert out["change"] >= lo, msg
+    assert not any(out["cusum_others"].values()), msg
+
+
 def teardown_module(module):
     if FIGURES:
         print(f"\ncommissioning fits on {NFILES} files of the ROSS null series:")
