@@ -171,6 +171,11 @@
  *    alone only when the runner-up candidate is told apart from it too; else
  *    both are given (rival2: on one channel a B4 kyy drift and B1 kxx fit
  *    the change within 1.5 of BIC, so "not kr" holds but not which bearing).
+ *    Untracked before tracked (issue #34): while the same update's instant
+ *    test (its first candidate) or drift test (its candidate) points at an
+ *    untracked candidate, that candidate is the rival whenever the best one
+ *    is not told apart from it, and a CUSUM alarm is never a's alone: "a, or
+ *    that candidate: not separable" (named 0) at least.
  */
 #ifndef RCB_MONITOR_H
 #define RCB_MONITOR_H

@@ -181,7 +181,7 @@ static double explained(rcb_monitor *mon, size_t a, size_t col, size_t q, double
 /* A CUSUM alarm of tracked parameter a: is the accumulated change (the
  * drift-weighted sum of the whole window, GLS in the shared noise) better
  * explained by a candidate than by a, the other tracked parameters free? */
-static void attribute(rcb_monitor *mon, size_t a, rcb_monitor_tracked *t) {
+static void attribute(rcb_monitor *mon, size_t a, size_t pointed, rcb_monitor_tracked *t) {
   size_t k = mon->k, nt = mon->nt, i, b, j, m = mon->dcount;
   double den, x[RCB_MONITOR_MAXP] = {0}, ga, ba, bbest = 0, b2 = 0, scale;
   size_t r2 = 0;
@@ -222,8 +222,33 @@ static void attribute(rcb_monitor *mon, size_t a, rcb_monitor_tracked *t) {
     }
   }
   if (!have) return;
+  /* a candidate the instant or drift test points at this update (a step
+   * named, a drift under way) is the rival whenever the accumulated change
+   * does not tell the best candidate from it (issue #34 item 2: after a
+   * step, the tracked CUSUMs alarm on its leakage, which the step's own
+   * columns explain about as well as any other's) */
+  if (pointed < mon->ncand && pointed != t->rival && mon->cand[pointed].dof) {
+    const mon_cand *c = &mon->cand[pointed];
+    double g = explained(mon, a, c->col, c->np, x), bp;
+    if (g >= 0 && (!rcb_evidence_separable(bp = rcb_mon_bic(mon, g, c->dof), bbest) ||
+                   bp < bbest)) {
+      have2 = 1, b2 = bbest, r2 = t->rival;
+      bbest = bp, t->rival = pointed, t->rival_dof = c->np;
+      for (b = 0; b < c->np; b++) t->rival_rate[b] = x[b] / (den * scale);
+    }
+  }
   if (rcb_evidence_separable(ba, bbest)) t->named = ba <= bbest ? 1 : -1;
   else t->named = 0;
+  /* untracked before tracked (issue #34 item 3): while this update's instant
+   * or drift test points at an untracked candidate, the CUSUM alarm is not
+   * the tracked parameter alone: "a, or that candidate: not separable" */
+  if (t->named == 1 && pointed < mon->ncand && mon->cand[pointed].dof &&
+      explained(mon, a, mon->cand[pointed].col, mon->cand[pointed].np, x) >= 0) {
+    const mon_cand *c = &mon->cand[pointed];
+    t->named = 0, t->rival = pointed, t->rival_dof = c->np;
+    for (b = 0; b < c->np; b++) t->rival_rate[b] = x[b] / (den * scale);
+    return;
+  }
   /* the rival named alone only when the runner-up is told apart from it too:
    * on few channels two candidates can fit the change equally well */
   if (t->named == -1 && have2 && !rcb_evidence_separable(bbest, b2))
@@ -233,10 +258,15 @@ static void attribute(rcb_monitor *mon, size_t a, rcb_monitor_tracked *t) {
 void rcb_mon_drift_update(rcb_monitor *mon, const double *theta, int gls,
                           rcb_monitor_result *res) {
   size_t a;
+  size_t pointed;
   push(mon, theta, gls);
   drift_test(mon, res);
+  /* the untracked candidate this update's tests point at, if any */
+  pointed = res->alarm && res->ntop ? res->top[0].index
+            : res->drift_alarm         ? res->drift_index
+                                       : (size_t)-1;
   for (a = 0; a < mon->nt; a++) {
     res->tracked[a].named = 1;
-    if (res->tracked[a].cusum_alarm) attribute(mon, a, &res->tracked[a]);
+    if (res->tracked[a].cusum_alarm) attribute(mon, a, pointed, &res->tracked[a]);
   }
 }

@@ -24,7 +24,9 @@ The series (SERIES):
             bearing B3 at update 37 of 60 and stays;
 * probe_DA_x: the machine as it is, read by a DA.x probe whose gain stays 1
             for the COMMISSION files, then falls linearly to 0.85 over 70
-            updates (issue #34: a drifting probe, not a drifting machine).
+            updates (issue #34: a drifting probe, not a drifting machine);
+* mass_DB:  a point mass of 0.05 kg appears at disk DB at update 37 of 60 and
+            stays (issue #34: a step named, then quiet).
 
 Truth: ROSS 2.3 (an implementation that is not ours). Its rotor is built from
 the INI by the independent parser of the ROSS bridge (ross_models.py), the
@@ -86,8 +88,11 @@ class Series:
     cross_from the first update with the cross-coupling at B3 (None: never)."""
 
     def __init__(self, name, n, seed0, what, kt=None, cross_from=None, phase_deg=0.0,
-                 probe=None):
+                 probe=None, step=None):
         self.name = name
+        # (edit key of STEPS, first update): an untracked step; cross_from is
+        # the cross-coupling's
+        self.step = step or (("cross_B3", cross_from) if cross_from is not None else None)
         # (response, gain(u)): a probe's gain, applied last (the sensor reads
         # the machine's motion and the noise alike)
         self.probe = probe
@@ -104,13 +109,18 @@ class Series:
     def cross(self, u):
         return self.cross_from is not None and u >= self.cross_from
 
+    def edit(self, u):
+        """The STEPS key of the untracked step in force at update u (None: none)."""
+        return self.step[0] if self.step and u >= self.step[1] else None
+
     def truth(self):
         return {
             "name": self.name, "what": self.what, "updates": self.n,
             "kt": [self.kt(u) for u in range(self.n)], "kt0": KT0,
-            "change_update": self.cross_from,
-            "effect": dc.CROSS if self.cross_from is not None else None,
-            "place": "bearing B3" if self.cross_from is not None else None,
+            "change_update": self.step[1] if self.step else None,
+            "effect": STEPS[self.step[0]][1] if self.step else None,
+            "place": STEPS[self.step[0]][2] if self.step else None,
+            "step_size": STEPS[self.step[0]][3] if self.step else None,
             "cross_kxy": CROSS_B3 if self.cross_from is not None else 0.0,
             "seeds": [self.seed0 + u for u in range(self.n)],
             "freq_hz": [float(f) for f in FREQ_HZ], "rpm": dc.RPM,
@@ -131,6 +141,13 @@ def _wear(u):
     return KT0 * (1.0 - 0.10 * k / WEAR_UPDATES)
 
 
+MASS_DB = 0.05  # kg, a point mass added at disk DB (mass_DB's step)
+# untracked steps: key -> (ROSS model edit, effect, place, size in the candidate's units)
+STEPS = {
+    "cross_B3": (dc.bearing_keys("B3", kxy=CROSS_B3, kyx=-CROSS_B3), dc.CROSS, "bearing B3",
+                 CROSS_B3),
+    "mass_DB": (dc.point_mass_edit("B 0.82", MASS_DB), dc.MASS, "disk DB", MASS_DB),
+}
 PROBE_UPDATES = 70  # probe_DA_x: DA.x's gain falls to PROBE_GAIN over these updates
 PROBE_GAIN = 0.85
 
@@ -150,6 +167,9 @@ SERIES = {
     "cross_B3": Series("cross_B3", 60, 162000,
                        "kxy = -kyx = 1.5e7 N/m appears at bearing B3 at update 37",
                        cross_from=37),
+    "mass_DB": Series("mass_DB", 60, 165000,
+                      f"a point mass of {MASS_DB} kg appears at disk DB at update 37 (issue #34: "
+                      f"a step, then quiet)", step=("mass_DB", 37)),
     "probe_DA_x": Series("probe_DA_x", COMMISSION + PROBE_UPDATES + 1, 164000,
                          f"the machine unchanged; the DA.x probe's gain steady for "
                          f"{COMMISSION} files, then falling linearly to {PROBE_GAIN} at file "
@@ -206,33 +226,33 @@ def inertance(M, C, K, G, speed, freq, rows, jin):
 
 
 class Truth:
-    """Clean inertances for any (kt, cross-coupling at B3 or not)."""
+    """Clean inertances for any (kt, untracked step of STEPS or none)."""
 
     def __init__(self):
         self.sys = {}
         kt1 = 0.5 * KT0
-        for cross in (False, True):
-            edits = [dc.bearing_keys("B3", kxy=CROSS_B3, kyx=-CROSS_B3)] if cross else []
+        for key in (None, *STEPS):
+            edits = [STEPS[key][0]] if key else []
             a = RossSystem(dc.both(*edits) if edits else None)
             b = RossSystem(dc.both(*edits, dc.coupling_keys(kt=kt1)))
-            self.sys[cross] = (a, b, kt1)
+            self.sys[key] = (a, b, kt1)
         # affine in kt: a third build at another kt is the interpolation
         kt2 = 0.83 * KT0
         c = RossSystem(dc.coupling_keys(kt=kt2))
         for name in ("M", "C", "K", "G"):
             want = getattr(c, name)
-            got = self._matrix(False, name, kt2)
+            got = self._matrix(None, name, kt2)
             err = np.max(np.abs(got - want)) / max(np.max(np.abs(want)), 1e-300)
             assert err < 1e-12, f"ROSS {name} is not affine in kt ({err:.3e})"
 
-    def _matrix(self, cross, name, kt):
-        a, b, kt1 = self.sys[cross]
+    def _matrix(self, key, name, kt):
+        a, b, kt1 = self.sys[key]
         ma, mb = getattr(a, name), getattr(b, name)
         return ma + (kt - KT0) / (kt1 - KT0) * (mb - ma)
 
-    def inertance(self, kt, cross):
-        a = self.sys[cross][0]
-        M, C, K, G = (self._matrix(cross, n, kt) for n in ("M", "C", "K", "G"))
+    def inertance(self, kt, key):
+        a = self.sys[key][0]
+        M, C, K, G = (self._matrix(key, n, kt) for n in ("M", "C", "K", "G"))
         return inertance(M, C, K, G, a.speed, FREQ_HZ, a.rows, a.jin)
 
 
@@ -264,9 +284,9 @@ def write_series(outdir, names=None, truth=None):
         d.mkdir(exist_ok=True)
         clean = {}
         for u in range(s.n):
-            key = (round(s.kt(u), 9), s.cross(u))
+            key = (round(s.kt(u), 9), s.edit(u))
             if key not in clean:
-                clean[key] = truth.inertance(s.kt(u), s.cross(u))
+                clean[key] = truth.inertance(s.kt(u), s.edit(u))
             m = measurement(clean[key], s.seed0 + u, s.phase_deg)
             if s.probe:
                 m[OUTS.index(s.probe[0])] *= s.probe[1](u)

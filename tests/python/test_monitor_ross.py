@@ -32,6 +32,8 @@ up to 8 re-linearisations of the tracked parameters, until converged).
   candidates), and the null series beside it with the same option: the first alarm names the sensor DA.x before its gain
   has lost 10 %, every TEST alarm names it, its gain's interval covers the
   truth, and the tracked parameters are left alone (no CUSUM alarm);
+* mass_DB (0.05 kg appears at disk DB at update 37 and stays): named at once
+  with its size, then no CUSUM alarm of the tracked parameters;
 * null_phase (the null series with 2 degrees of phase noise per point, issue
   #14's), monitored with --noise 10,1,2 (the phase term of rcb_monitor_opts):
   false alarms as for null.
@@ -144,8 +146,17 @@ def test_drift_test_quiet(tool, name):
     assert len(drift) <= hi, FIGURES[f"{name} drift"]
     if name == "kt_wear":
         k = PARAMS.split(",").index("coupling.C.kt")
-        named = [u["tracked"][k]["named"] for u in ups if u["tracked"][k]["cusum_alarm"]]
+        # kt alone, except where the instant or drift test points at an untracked
+        # candidate in the same update (issue #34 item 3: then "kt, or it: not
+        # separable", that candidate the rival)
+        named = [u["tracked"][k]["named"] for u in ups if u["tracked"][k]["cusum_alarm"]
+                 and not u["alarm"] and not u["drift"]["alarm"]]
+        pointed = [(u["tracked"][k]["named"], u["tracked"][k]["rival"]["place"],
+                    (u["drift"] if u["drift"]["alarm"] else u["top"][0])["place"])
+                   for u in ups if u["tracked"][k]["cusum_alarm"]
+                   and (u["alarm"] or u["drift"]["alarm"])]
         assert named and all(v == 1 for v in named), named
+        assert all(n == 0 and r == p for n, r, p in pointed), pointed
 
 
 def test_kt_wear(tool):
@@ -273,6 +284,37 @@ def test_drifting_probe_named_as_the_sensor(tool):
     assert sum(size) >= lo_s, FIGURES["probe_DA_x"]
     assert all(v >= lo_t for v in tracked.values()), FIGURES["probe_DA_x"]
     assert not cusum, FIGURES["probe_DA_x"]
+
+
+def test_step_then_quiet(tool):
+    """Issue #34 item 2: a point mass of 0.05 kg appears at disk DB at update 37
+    (mass_DB, about 125 of its standard errors) and stays. The instant test
+    alarms on the first changed update and names the added mass at disk DB, its
+    95 % interval holding 0.05 kg on at least the binomial 99 % lower end of 95 %
+    of the alarmed updates; no alarm before the change beyond the bound; and no
+    CUSUM alarm of the tracked kt, kr, ct after it (the step's leakage into the
+    tracked parameters is not a new finding: with --relinearise the tracked step
+    is refined jointly with the named effect while the test fires)."""
+    log, truth = monitor(tool, "mass_DB", "--alpha", 0.01)
+    change = truth["change_update"]
+    before = _alarms(log, hi=change)
+    n_before = sum(1 for u in log["updates"] if u["index"] < change)
+    _, hi = stats.binom.interval(0.99, n_before, 0.01)
+    after = _alarms(log, lo=change)
+    named = [u for u in after if u["top"][0]["place"] == truth["place"] and
+             u["top"][0]["effect"] == truth["effect"]]
+    size = sum(u["top"][0]["ci_lo"][0] <= truth["step_size"] <= u["top"][0]["ci_hi"][0]
+               for u in named)
+    lo_s, _ = stats.binom.interval(0.99, max(len(named), 1), 0.95)
+    cusum = [u["update"] for u in _alarms(log, "cusum_alarm")]
+    FIGURES["mass_DB"] = (
+        f"first TEST alarm at file {after[0]['index'] if after else None} (change at {change}); "
+        f"{len(named)} of {len(after)} alarms name {truth['effect']} at {truth['place']}; its "
+        f"mass interval holds {truth['step_size']} kg on {size} (lower end {lo_s:.0f}); "
+        f"{len(before)} alarms before (bound {hi:.0f}); CUSUM alarms at {cusum}")
+    assert after and after[0]["index"] == change, FIGURES["mass_DB"]
+    assert len(named) == len(after) == truth["updates"] - change, FIGURES["mass_DB"]
+    assert size >= lo_s and len(before) <= hi and not cusum, FIGURES["mass_DB"]
 
 
 def test_sensors_null(tool):
