@@ -887,6 +887,30 @@ static void test_csv_limits(void **state) {
   bad_csv(text, "bad.csv:1: column 3", "without the unit degrees");
   snprintf(text, sizeof text, "freq_hz,DA.x/DB.y mag,DA.x/DB.y phase_%s\n1,1,2\n", name);
   bad_csv(text, "bad.csv:1: column 3", "unknown part");
+  /* a node map's station: 100 characters read whole ("S...S.rx" fills a
+   * channel), 101 refused with the limit, by the CSV and the UFF reader */
+  {
+    char st[102];
+    rcb_uff_node map[1] = {{1, st}};
+    rcb_meas_channel_info c;
+    memset(st, 's', 101);
+    st[100] = '\0';
+    write_text(p, "freq_hz,1.rx/1.x_re,1.rx/1.x_im\n1,1,2\n");
+    assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+    if (rcb_meas_read_csv_map(ms, p, 1, map)) fail_msg("%s", rcb_meas_errmsg(ms));
+    assert_int_equal(rcb_meas_channel(ms, 0, &c), RCB_OK);
+    assert_int_equal(strlen(c.response), 103);
+    assert_int_equal(strncmp(c.response, st, 100), 0);
+    assert_string_equal(c.response + 100, ".rx");
+    st[100] = 's';
+    st[101] = '\0';
+    assert_int_equal(rcb_meas_read_csv_map(ms, p, 1, map), RCB_ERR_ARG);
+    assert_non_null(strstr(rcb_meas_errmsg(ms), "read_csv: node 1 of the map: station 'ssss"));
+    assert_non_null(strstr(rcb_meas_errmsg(ms), "101 characters; at most 100"));
+    assert_int_equal(rcb_meas_read_uff(ms, p, 1, map), RCB_ERR_ARG);
+    assert_non_null(strstr(rcb_meas_errmsg(ms), "read_uff: node 1 of the map: station"));
+    rcb_meas_destroy(ms);
+  }
 }
 
 static void test_bad_api(void **state) {

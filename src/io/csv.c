@@ -554,14 +554,10 @@ rcb_status rcb_meas_read_csv_map(rcb_meas *ms, const char *path, size_t nmap,
                                  const rcb_uff_node *map) {
   csv_state S;
   char *buf = NULL;
-  size_t len, i;
+  size_t len;
   rcb_status st;
   if (!ms) return RCB_ERR_ARG;
-  if (nmap && !map) return rcb_meas_fail(ms, RCB_ERR_ARG, "read_csv: node map is NULL");
-  for (i = 0; i < nmap; i++)
-    if (!map[i].station || !map[i].station[0])
-      return rcb_meas_fail(ms, RCB_ERR_ARG, "read_csv: node %ld of the map has no station",
-                           map[i].node);
+  if ((st = rcb_meas_check_map(ms, "read_csv", nmap, map))) return st;
   memset(&S, 0, sizeof S);
   S.ms = ms;
   S.path = path;
