@@ -597,8 +597,8 @@ cmd_fuzz() {
   # time: together they take the time of one); each writes its own log. The
   # state harnesses' seeds are whole states (7 kB, 50-58 kB): their own max_len
   local pids=() t_of=()
-  say "fuzz_ini, fuzz_csv, fuzz_uff, fuzz_strtod, fuzz_monitor_state, fuzz_rcbtool_state, fuzz_history at once: replay fuzz/corpus/NAME, then ${secs} s each"
-  for t in ini csv uff strtod monitor_state rcbtool_state history; do
+  say "fuzz_ini, fuzz_csv, fuzz_signals_csv, fuzz_uff, fuzz_strtod, fuzz_monitor_state, fuzz_rcbtool_state, fuzz_history at once: replay fuzz/corpus/NAME, then ${secs} s each"
+  for t in ini csv signals_csv uff strtod monitor_state rcbtool_state history; do
     rm -rf "$dir/work_$t"
     cp -r "fuzz/corpus/$t" "$dir/work_$t"
     (

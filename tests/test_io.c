@@ -379,6 +379,67 @@ static void test_csv_header_variants(void **state) {
   rcb_meas_destroy(ms);
 }
 
+/* Lab scripts' column conventions (issue #35 item 3): the part after '_',
+ * numeric stations through the node map, the two columns of a channel apart.
+ * Each file holds the values of the canonical header's file and must read
+ * to the very same doubles. */
+static void test_csv_lab_conventions(void **state) {
+  static const char rows[] = "10,1e-6,-2e-6,3e-6,90\n20,4e-6,5e-6,6e-6,180\n";
+  static const char *const heads[] = {
+      "freq_hz,DA.x/DB.y_re,DA.x/DB.y_im,DA.y/DB.y_mag,DA.y/DB.y_phase_deg\n",
+      "freq_hz,2.x/11.y_re,2.x/11.y_im,2.y/11.y_mag,2.y/11.y_phase_deg\n",
+      "freq_hz,2.x/11.y_Real,2.x/11.y_Imag,2.y/11.y_amp,2.y/11.y_phase [deg]\n",
+      "freq_hz,DA.x/11.y re,DA.x/11.y im,2.y/DB.y mag,2.y/DB.y phase_deg\n",
+      "freq_hz,002.x/011.y_re,002.x/011.y_im,2.y/11.y_abs,2.y/11.y_Phase (deg)\n"};
+  static const rcb_uff_node map[] = {{11, "DB"}, {2, "DA"}, {7, "C.A"}};
+  const char *p = rcb_test_tmp_path("lab.csv");
+  rcb_meas *ref = NULL, *ms = NULL;
+  rcb_meas_channel_info a, b;
+  char text[512];
+  size_t k, c, i;
+  (void)state;
+  assert_int_equal(rcb_meas_create(&ref, NULL), RCB_OK);
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  snprintf(text, sizeof text, "freq_hz,DA.x/DB.y re,DA.x/DB.y im,DA.y/DB.y mag,DA.y/DB.y "
+           "phase_deg\n%s", rows);
+  write_text(p, text);
+  if (rcb_meas_read_csv(ref, p)) fail_msg("%s", rcb_meas_errmsg(ref));
+  for (k = 0; k < sizeof heads / sizeof heads[0]; k++) {
+    snprintf(text, sizeof text, "%s%s", heads[k], rows);
+    write_text(p, text);
+    if (rcb_meas_read_csv_map(ms, p, 3, map)) fail_msg("%s: %s", heads[k], rcb_meas_errmsg(ms));
+    assert_int_equal(rcb_meas_channel_count(ms), 2);
+    for (c = 0; c < 2; c++) {
+      assert_int_equal(rcb_meas_channel(ref, c, &a), RCB_OK);
+      assert_int_equal(rcb_meas_channel(ms, c, &b), RCB_OK);
+      assert_string_equal(a.response, b.response);
+      assert_string_equal(a.reference, b.reference);
+      for (i = 0; i < 2; i++)
+        if (a.data[i] != b.data[i]) fail_msg("%s: channel %zu point %zu differs", heads[k], c, i);
+    }
+  }
+  /* all re columns first, then all im (a DataFrame built so): paired by
+   * name, channels in the order of their re columns */
+  write_text(p, "freq_hz,2.x/7.x_re,2.y/7.x_re,2.x/7.x_im,2.y/7.x_im\n5,1,2,3,4\n");
+  if (rcb_meas_read_csv_map(ms, p, 3, map)) fail_msg("%s", rcb_meas_errmsg(ms));
+  assert_int_equal(rcb_meas_channel(ms, 0, &b), RCB_OK);
+  assert_string_equal(b.response, "DA.x");
+  assert_string_equal(b.reference, "C.A.x");
+  assert_true(b.data[0] == CMPLX(1.0, 3.0));
+  assert_int_equal(rcb_meas_channel(ms, 1, &b), RCB_OK);
+  assert_string_equal(b.response, "DA.y");
+  assert_true(b.data[0] == CMPLX(2.0, 4.0));
+  /* unbalance responses too */
+  write_text(p, "rpm,2.x_amp,2.x_phase_deg\n600,2,90\n");
+  if (rcb_meas_read_csv_map(ms, p, 3, map)) fail_msg("%s", rcb_meas_errmsg(ms));
+  assert_int_equal(rcb_meas_channel(ms, 0, &b), RCB_OK);
+  assert_string_equal(b.response, "DA.x");
+  assert_true(cclose(b.data[0], CMPLX(0.0, 2.0), 1e-15));
+  assert_int_equal(rcb_meas_read_csv_map(ms, p, 1, NULL), RCB_ERR_ARG);
+  rcb_meas_destroy(ms);
+  rcb_meas_destroy(ref);
+}
+
 /* "# kind" and "# rpm" comment lines. */
 static void test_csv_comments(void **state) {
   const char *p = rcb_test_tmp_path("kind.csv");
@@ -764,7 +825,7 @@ static void test_bad_csv(void **state) {
   snprintf(t, sizeof t, "%s10,1,2\n20,1\n", h);
   bad_csv(t, "bad.csv:3:", "2 fields, the header has 3");
   bad_csv("freq_hz,DA.x/DA.x re,DA.x/DA.x im,DA.x/DA.x re,DA.x/DA.x im\n1,1,2,3,4\n",
-          "duplicate channel DA.x/DA.x", "columns 4-5");
+          "duplicate channel DA.x/DA.x", "column 4 repeats its re (column 2)");
   bad_csv("freq_hz,DA.z/DA.x re,DA.z/DA.x im\n1,1,2\n", "unknown direction", "DA.z");
   /* "imag" is read since issue #17; an unknown part word still is not */
   bad_csv("freq_hz,DA.x/DA.x re,DA.x/DA.x quad\n1,1,2\n", "bad.csv:1: column 3",
@@ -775,6 +836,81 @@ static void test_bad_csv(void **state) {
           "receptance, mobility or inertance");
   bad_csv("time_s,DA.x/DA.x re,DA.x/DA.x im\n1,1,2\n", "first column 'time_s'", NULL);
   bad_csv("freq_hz,DA.x/DA.x re,DA.x/DA.x im\n", "no data rows", NULL);
+  /* issue #35 item 3: what stays refused among the lab conventions */
+  bad_csv("freq_hz,DA.x/DB.y_re,DA.x/DB.y_im,DA.x/DB.y_mag,DA.x/DB.y_phase_deg\n1,1,2,3,4\n",
+          "bad.csv:1: channel DA.x/DB.y is given both as re/im and as mag/phase (columns 2 "
+          "and 4): ambiguous", NULL);
+  bad_csv("freq_hz,DA.x/DB.y re,DA.x/DB.y mag,DA.x/DB.y im,DA.x/DB.y phase_deg\n1,1,2,3,4\n",
+          "both as re/im and as mag/phase", NULL);
+  bad_csv("freq_hz,DA.x/DB.y_mag,DA.x/DB.y_phase\n1,1,2\n", "bad.csv:1: column 3",
+          "without the unit degrees");
+  bad_csv("freq_hz,DA.x/DB.y_re,DA.y/DB.y_im\n1,1,2\n", "column 2 ('DA.x/DB.y'): its re has "
+          "no pair", "\"DA.x/DB.y im\"");
+  bad_csv("freq_hz,DA.x/DB.y_re,DA.x/DB.y_im,DA.x/DB.y_im\n1,1,2,3\n",
+          "duplicate channel DA.x/DB.y: column 4 repeats its im (column 3)", NULL);
+  bad_csv("freq_hz,DA.x/DB.y_quad,DA.x/DB.y_im\n1,1,2\n", "bad.csv:1: column 2",
+          "or CHANNEL_re");
+  bad_csv("freq_hz,2.x/11.y_re,2.x/11.y_im\n1,1,2\n", "station '2' is a number",
+          "--map 2=STATION");
+  bad_csv(",freq_hz,DA.x/DB.y_re,DA.x/DB.y_im\n0,1,1,2\n", "bad.csv:1: the first column has "
+          "no name", "index=False");
+  bad_csv("# freq_hz,DA.x/DB.y_re,DA.x/DB.y_im\n1,1,2\n", "bad.csv:2: the line starts with "
+          "a number", "comments=''");
+}
+
+/* No fixed-size buffer cuts a header or a comment (issue #35 item 6): at the
+ * limit read, past it refused with the limit. */
+static void test_csv_limits(void **state) {
+  char text[2048], ref[100], name[260];
+  const char *p = rcb_test_tmp_path("lim.csv");
+  rcb_meas *ms = NULL;
+  (void)state;
+  memset(ref, 'r', 80);
+  ref[80] = '\0';
+  snprintf(text, sizeof text, "# phase = lag (%s)\nfreq_hz,DA.x/DB.y re,DA.x/DB.y im\n1,1,2\n",
+           ref);
+  write_text(p, text);
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  if (rcb_meas_read_csv(ms, p)) fail_msg("%s", rcb_meas_errmsg(ms));
+  rcb_meas_destroy(ms);
+  snprintf(text, sizeof text, "# phase = lag (%sr)\nfreq_hz,DA.x/DB.y re,DA.x/DB.y im\n1,1,2\n",
+           ref);
+  bad_csv(text, "bad.csv:1: phase reference 'rrrr", "81 characters; at most 80");
+  memset(name, 'n', 250);
+  name[250] = '\0';
+  snprintf(text, sizeof text, "freq_hz,%s/DB.y re,%s/DB.y im\n1,1,2\n", name, name);
+  bad_csv(text, "bad.csv:1: column 2: channel name 'nnnn", "255 characters; at most 209");
+  /* a unit or a part word of 250 characters: not degrees, not a part (no cut
+   * prefix matched) */
+  memset(name, 'x', 250);
+  snprintf(text, sizeof text, "freq_hz,DA.x/DB.y mag,DA.x/DB.y phase (deg%s)\n1,1,2\n", name);
+  bad_csv(text, "bad.csv:1: column 3", "without the unit degrees");
+  snprintf(text, sizeof text, "freq_hz,DA.x/DB.y mag,DA.x/DB.y phase_%s\n1,1,2\n", name);
+  bad_csv(text, "bad.csv:1: column 3", "unknown part");
+  /* a node map's station: 100 characters read whole ("S...S.rx" fills a
+   * channel), 101 refused with the limit, by the CSV and the UFF reader */
+  {
+    char st[102];
+    rcb_uff_node map[1] = {{1, st}};
+    rcb_meas_channel_info c;
+    memset(st, 's', 101);
+    st[100] = '\0';
+    write_text(p, "freq_hz,1.rx/1.x_re,1.rx/1.x_im\n1,1,2\n");
+    assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+    if (rcb_meas_read_csv_map(ms, p, 1, map)) fail_msg("%s", rcb_meas_errmsg(ms));
+    assert_int_equal(rcb_meas_channel(ms, 0, &c), RCB_OK);
+    assert_int_equal(strlen(c.response), 103);
+    assert_int_equal(strncmp(c.response, st, 100), 0);
+    assert_string_equal(c.response + 100, ".rx");
+    st[100] = 's';
+    st[101] = '\0';
+    assert_int_equal(rcb_meas_read_csv_map(ms, p, 1, map), RCB_ERR_ARG);
+    assert_non_null(strstr(rcb_meas_errmsg(ms), "read_csv: node 1 of the map: station 'ssss"));
+    assert_non_null(strstr(rcb_meas_errmsg(ms), "101 characters; at most 100"));
+    assert_int_equal(rcb_meas_read_uff(ms, p, 1, map), RCB_ERR_ARG);
+    assert_non_null(strstr(rcb_meas_errmsg(ms), "read_uff: node 1 of the map: station"));
+    rcb_meas_destroy(ms);
+  }
 }
 
 static void test_bad_api(void **state) {
@@ -856,6 +992,8 @@ int main(void) {
       cmocka_unit_test(test_noise_seeds),           cmocka_unit_test(test_noise_stream),
       cmocka_unit_test(test_bad_uff), cmocka_unit_test(test_uff_axial_skipped),               cmocka_unit_test(test_bad_uff_binary),
       cmocka_unit_test(test_csv_header_variants),
+      cmocka_unit_test(test_csv_lab_conventions),
+      cmocka_unit_test(test_csv_limits),
       cmocka_unit_test(test_uff_speed_not_stated),
       cmocka_unit_test(test_bad_csv),               cmocka_unit_test(test_bad_api),
       cmocka_unit_test(test_write_atomic),          cmocka_unit_test(test_allocator),

@@ -161,10 +161,24 @@ RCB_API rcb_status rcb_meas_write_uff(const rcb_meas *ms, const char *path, int 
  * header: kind = receptance|mobility|inertance, rpm = rotor speed of an FRF test.
  * Other spellings are read too (case, spaces, '_' and a unit in brackets do not
  * matter: "Frequency (Hz)", "speed_rpm", "DA.x/C.y Real", "... Phase (deg)");
- * a header that leaves the unit open or a numeric station ("3.x") is refused
- * with the name to use.
+ * a header that leaves the unit open is refused with the name to use. The
+ * part may follow '_' instead of a space, as lab scripts write it
+ * ("DA.x/C.y_re", "DA.x/C.y_im", "_mag"/"_amp", "_phase_deg"); the two columns
+ * of a channel are paired by name, adjacent or not, and a channel given both
+ * as re/im and as mag/phase is refused as ambiguous. A station written as a
+ * number ("3.x", a node number) is refused with the name to use; see
+ * rcb_meas_read_csv_map.
  */
 RCB_API rcb_status rcb_meas_read_csv(rcb_meas *ms, const char *path);
+/**
+ * @brief rcb_meas_read_csv with stations written as node numbers ("2.x/11.x_re")
+ * read through @p map (@p nmap entries, as rcb_meas_read_uff takes it): node 2
+ * mapped to "DA" reads "DA.x". A numeric station without an entry is refused
+ * with file:line and the entry to give (unlike a UFF read, which takes it as
+ * model node "#N": a CSV names stations, so a number is a lab's node).
+ */
+RCB_API rcb_status rcb_meas_read_csv_map(rcb_meas *ms, const char *path, size_t nmap,
+                                         const rcb_uff_node *map);
 /** @brief Write CSV (re/im columns) that rcb_meas_read_csv reads back, atomically. */
 RCB_API rcb_status rcb_meas_write_csv(const rcb_meas *ms, const char *path);
 

@@ -114,7 +114,11 @@ RCB_API const char *rcb_signals_warning(const rcb_signals *s, size_t i);
  * @brief Read CSV: optional "# units = U1,U2,..." line (one unit per channel
  * column, e.g. "N,g,mm"), then a header "time_s,NAME1,NAME2,..." (a name may
  * carry its unit in brackets: "DA.x [mm]"), then rows of numbers. The time
- * column must be evenly spaced (1e-6 relative); the rate is taken from it.
+ * column must be evenly spaced (each time within 0.1 % of a step of
+ * t0 + i dt), with a finite spacing and rate; the rate is taken from it.
+ * Limits, each refused with file:line and the limit named, never cut: at
+ * most 256 channel columns, names of at most 63 characters. Lines, units
+ * lines and units have no length limit.
  */
 RCB_API rcb_status rcb_signals_read_csv(rcb_signals *s, const char *path);
 /**

@@ -6,13 +6,23 @@
  *                                 conjugates of the model's, read back to them)
  *   freq_hz,D1.x/C.x re,D1.x/C.x im,...     (FRF, abscissa Hz)
  *   rpm,DA.x amp,DA.x phase_deg,...         (unbalance, abscissa rpm)
- * Per channel two adjacent columns: "re","im", or "mag"/"amp","phase_deg"
- * (degrees). Other "#" lines are comments. Errors name the file, line and
- * column. Other tools' spellings are read too (case, spaces, '_' and a unit
- * in brackets do not matter: "Frequency (Hz)", "frequency_hz", "Speed [rpm]",
- * "DA.x/C.y Real", "DA.x/C.y Phase (deg)", "DA.x/C.y re (m/N)"); a spelling
- * that leaves the unit open (frequency, phase) or a station given as a
- * number is refused with the name to use.
+ * Per channel two columns: "re","im", or "mag"/"amp","phase_deg" (degrees),
+ * the part after a space or, as lab scripts write them, after '_'
+ * ("2.x/11.x_re", "DA.x_phase_deg"; issue #35 item 3). The two columns of a
+ * channel are paired by name, adjacent or not; a channel given both ways
+ * (re/im and mag/phase) is refused as ambiguous. Other "#" lines are
+ * comments. Errors name the file, line and column. Other tools' spellings are
+ * read too (case, spaces, '_' and a unit in brackets do not matter:
+ * "Frequency (Hz)", "frequency_hz", "Speed [rpm]", "DA.x/C.y Real",
+ * "DA.x/C.y Phase (deg)", "DA.x/C.y re (m/N)"); a spelling that leaves the
+ * unit open (frequency, phase) is refused with the name to use. A station
+ * given as a number ("3.x", a test system's node) is read through the node
+ * map of rcb_meas_read_csv_map (rcbtool --map, the model's [uff] map), and
+ * refused with what to write when the map has no entry for it.
+ *
+ * No fixed-size buffer cuts a header (issue #35 item 6): a name, part word or
+ * unit too long for its buffer is refused, or is not a word the reader knows,
+ * which is refused with the text as written.
  */
 #include <ctype.h>
 #include <errno.h>
@@ -29,7 +39,10 @@ typedef enum col_part { COL_RE, COL_IM, COL_MAG, COL_PHASE } col_part;
 typedef struct csv_col {
   char name[RCB_MEAS_CH_MAX * 2 + 2]; /* "RESP/REF" or "RESP" */
   col_part part;
+  size_t mate; /* RE/MAG: the column of its IM/PHASE (check_pairs) */
 } csv_col;
+
+#define CSV_REF_MAX 80 /* characters of a "# phase = lag (reference)" */
 
 typedef struct csv_state {
   rcb_meas *ms;
@@ -40,7 +53,9 @@ typedef struct csv_state {
   rcb_frf_kind kind;
   double speed; /* rad/s, < 0 synchronous */
   rcb_phase_convention phase; /* "# phase = lead|lag (reference)" */
-  char phase_ref[84];
+  char phase_ref[CSV_REF_MAX + 4];
+  size_t nmap; /* node map for stations written as numbers */
+  const rcb_uff_node *map;
   csv_col *cols; /* ncols value columns (after the abscissa) */
   size_t ncols, capcols;
   double *x, *v; /* rows: x[r], v[r * ncols + c] */
@@ -116,20 +131,35 @@ static rcb_status comment(csv_state *S, char *text) {
       ref[strlen(ref) - 1] = '\0';
       ref++;
     }
-    snprintf(S->phase_ref, sizeof S->phase_ref, "%.80s", ref);
+    if (strlen(ref) > CSV_REF_MAX)
+      return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: phase reference '%.40s...' has %zu "
+                           "characters; at most %d are kept", S->path, S->line, ref, strlen(ref),
+                           CSV_REF_MAX);
+    snprintf(S->phase_ref, sizeof S->phase_ref, "%s", ref);
   }
   return RCB_OK;
 }
 
-/* Header token folded for comparison: lower case, without ' ', '_', '-' and
- * brackets, so "Frequency (Hz)", "frequency_hz" and "FREQ-HZ" all read
- * "frequencyhz". */
-static void fold(const char *s, char *out, size_t size) {
-  size_t k = 0;
-  for (; *s && k + 1 < size; s++)
-    if (!strchr(" _-()[]\t", *s)) out[k++] = (char)tolower((unsigned char)*s);
+/* Header token (n bytes of s) folded for comparison: lower case, without
+ * ' ', '_', '-' and brackets, so "Frequency (Hz)", "frequency_hz" and
+ * "FREQ-HZ" all read "frequencyhz". A token too long for out folds to ""
+ * (-1): no word the reader knows is that long, so it is refused as written,
+ * never matched by a cut prefix. */
+static int fold_n(const char *s, size_t n, char *out, size_t size) {
+  size_t k = 0, i;
+  for (i = 0; i < n && s[i]; i++)
+    if (!strchr(" _-()[]\t", s[i])) {
+      if (k + 1 >= size) {
+        out[0] = '\0';
+        return -1;
+      }
+      out[k++] = (char)tolower((unsigned char)s[i]);
+    }
   out[k] = '\0';
+  return 0;
 }
+
+static int fold(const char *s, char *out, size_t size) { return fold_n(s, strlen(s), out, size); }
 
 static int in_list(const char *s, const char *const *list) {
   for (; *list; list++)
@@ -144,6 +174,17 @@ static rcb_status abscissa(csv_state *S, const char *f) {
   static const char *const rpm[] = {"rpm", "speedrpm", "rotorspeedrpm", "nrpm",
                                     "rotationalspeedrpm", "speedinrpm", NULL};
   char g[64];
+  double num;
+  if (!f[0])
+    return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: the first column has no name; expected "
+                         "freq_hz (FRF) or rpm (unbalance response) (pandas writes its row "
+                         "index so: DataFrame.to_csv(..., index=False) leaves it out)", S->path,
+                         S->line);
+  if (!parse_num(f, &num))
+    return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: the line starts with a number: no header "
+                         "line (freq_hz,... or rpm,...) before the data (numpy.savetxt writes "
+                         "its header as a '# ' comment unless given comments='')", S->path,
+                         S->line);
   fold(f, g, sizeof g);
   if (in_list(g, hz)) {
     S->type = RCB_MEAS_FRF;
@@ -172,7 +213,8 @@ static rcb_status abscissa(csv_state *S, const char *f) {
 }
 
 /* A trailing unit in brackets, "(m/N)" or "[deg]": cut off *end, the unit
- * (folded) into unit ("" without one). */
+ * (folded) into unit ("" without one; a unit too long for it folds to "",
+ * which is not degrees). */
 static void cut_unit(const char *f, size_t *end, char *unit, size_t size) {
   size_t n = *end;
   char close;
@@ -182,14 +224,7 @@ static void cut_unit(const char *f, size_t *end, char *unit, size_t size) {
   close = f[n - 1];
   while (n > 0 && f[n - 1] != (close == ')' ? '(' : '[')) n--;
   if (n == 0) return;
-  {
-    char u[64];
-    size_t len = *end - n;
-    if (len >= sizeof u) len = sizeof u - 1;
-    memcpy(u, f + n, len);
-    u[len] = '\0';
-    fold(u, unit, size);
-  }
+  fold_n(f + n, *end - n, unit, size);
   n--;
   while (n > 0 && f[n - 1] == ' ') n--;
   *end = n;
@@ -201,11 +236,8 @@ static int part_of(const char *word, size_t n, const char *unit) {
   static const char *const re[] = {"re", "real", NULL};
   static const char *const im[] = {"im", "imag", "imaginary", NULL};
   static const char *const mag[] = {"mag", "amp", "abs", "magnitude", "amplitude", NULL};
-  char w[32], g[32];
-  if (n >= sizeof w) return -1;
-  memcpy(w, word, n);
-  w[n] = '\0';
-  fold(w, g, sizeof g);
+  char g[32];
+  if (fold_n(word, n, g, sizeof g)) return -1;
   if (in_list(g, re)) return COL_RE;
   if (in_list(g, im)) return COL_IM;
   if (in_list(g, mag)) return COL_MAG;
@@ -217,90 +249,192 @@ static int part_of(const char *word, size_t n, const char *unit) {
   return -1;
 }
 
-/* A station written as a number ("3.x/10.y"): a test system's node number,
- * which is not a model station; say what to write instead. */
-static rcb_status numeric_station(csv_state *S, const char *name, size_t k) {
-  const char *p = name;
-  while (p) {
+/* Stations written as numbers ("3.x/10.y", a test system's node numbers)
+ * through the node map (issue #35 item 3: lab scripts write them); one the
+ * map does not name is refused with what to give or write instead. */
+static rcb_status map_stations(csv_state *S, csv_col *c, size_t k) {
+  char out[sizeof c->name];
+  const char *p = c->name;
+  size_t at = 0;
+  for (;;) {
     const char *slash = strchr(p, '/'), *end = slash ? slash : p + strlen(p), *dot = end, *q;
+    const char *st = "", *tail = p; /* written: st, then [tail, end) */
+    size_t stlen = 0, rest, i;
     while (dot > p && dot[-1] != '.') dot--;
     if (dot > p + 1) {
       for (q = p; q < dot - 1 && isdigit((unsigned char)*q); q++) continue;
-      if (q == dot - 1)
-        return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: column %zu ('%s'): station '%.*s' "
-                             "is a number, not a model station; rename it to the station it "
-                             "stands for (e.g. DA; 'rcbtool check' lists them) or to '#%.*s' "
-                             "for model node %.*s", S->path, S->line, k + 1, name,
-                             (int)(dot - 1 - p), p, (int)(dot - 1 - p), p, (int)(dot - 1 - p),
-                             p);
+      if (q == dot - 1) {
+        long node = 0;
+        int n = (int)(dot - 1 - p);
+        for (q = p; q < dot - 1 && node < 100000000L; q++) node = node * 10 + (*q - '0');
+        for (i = 0; i < S->nmap && S->map[i].node != node; i++) continue;
+        if (i == S->nmap || q < dot - 1)
+          return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: column %zu ('%s'): station '%.*s' "
+                               "is a number, not a model station, and the node map has no entry "
+                               "for it: give it (rcbtool --map %.*s=STATION, the model's [uff] "
+                               "map; rcb_meas_read_csv_map), or rename it to the station it "
+                               "stands for (e.g. DA; 'rcbtool check' lists them) or to '#%.*s' "
+                               "for model node %.*s", S->path, S->line, k + 1, c->name, n, p, n,
+                               p, n, p, n, p);
+        st = S->map[i].station;
+        stlen = strlen(st);
+        tail = dot - 1; /* ".DIR" */
+      }
     }
-    p = slash ? slash + 1 : NULL;
+    rest = (size_t)(end - tail);
+    if (at + stlen + rest + 1 >= sizeof out)
+      return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: column %zu ('%s'): the channel, its "
+                           "stations mapped, has more than %zu characters", S->path, S->line,
+                           k + 1, c->name, sizeof out - 1);
+    memcpy(out + at, st, stlen);
+    memcpy(out + at + stlen, tail, rest);
+    at += stlen + rest;
+    if (!slash) break;
+    out[at++] = '/';
+    p = slash + 1;
   }
+  out[at] = '\0';
+  memcpy(c->name, out, at + 1);
   return RCB_OK;
 }
 
-/* One header field "NAME part" -> column. */
+/* Where the part word of header field f (its first end bytes) starts: after
+ * the last space ("DA.x/C.y re"), else after the last '_' or the one before
+ * it whose remainder is a part word ("2.x/11.x_re", "DA.x_phase_deg");
+ * *part as part_of, *name_len the channel's length. 0: no part word found. */
+static int find_part(const char *f, size_t end, const char *unit, size_t *name_len, int *part) {
+  const char *sp = f + end, *u;
+  int tries;
+  while (sp > f && sp[-1] != ' ') sp--;
+  if (sp > f + 1) {
+    *name_len = (size_t)(sp - 1 - f);
+    *part = part_of(sp, (size_t)(f + end - sp), unit);
+    return 1;
+  }
+  for (u = f + end, tries = 0; tries < 2; tries++) {
+    while (u > f && u[-1] != '_') u--;
+    if (u <= f + 1) return 0;
+    *part = part_of(u, (size_t)(f + end - u), unit);
+    *name_len = (size_t)(u - 1 - f);
+    if (*part != -1) return 1;
+    u--;
+  }
+  return 0;
+}
+
+/* One header field "NAME part" or "NAME_part" -> column. */
 static rcb_status header_col(csv_state *S, const char *f, size_t k) {
   csv_col *c;
-  const char *sp;
   char unit[32];
-  size_t len, end = strlen(f);
-  int part;
+  size_t len = 0, end = strlen(f);
+  int part = -1;
   cut_unit(f, &end, unit, sizeof unit);
-  for (sp = f + end; sp > f && sp[-1] != ' '; sp--) continue;
-  sp = sp > f ? sp - 1 : NULL;
-  if (!sp || sp == f)
+  if (!find_part(f, end, unit, &len, &part))
     return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: column %zu '%s': expected \"CHANNEL "
                          "re\", \"CHANNEL im\", \"CHANNEL mag\"/\"amp\" or \"CHANNEL "
-                         "phase_deg\"", S->path, S->line, k + 1, f);
+                         "phase_deg\" (or CHANNEL_re, CHANNEL_im, CHANNEL_mag, "
+                         "CHANNEL_phase_deg)", S->path, S->line, k + 1, f);
   if (rcb_grow(&S->ms->alloc, (void **)&S->cols, &S->capcols, S->ncols + 1, sizeof *S->cols))
     return rcb_meas_fail(S->ms, RCB_ERR_NOMEM, "%s: out of memory", S->path);
   c = &S->cols[S->ncols];
-  len = (size_t)(sp - f);
   while (len > 0 && f[len - 1] == ' ') len--;
   if (len >= sizeof c->name)
-    return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: column %zu: channel name too long",
-                         S->path, S->line, k + 1);
+    return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: column %zu: channel name '%.40s...' has "
+                         "%zu characters; at most %zu are read", S->path, S->line, k + 1, f, len,
+                         sizeof c->name - 1);
   memcpy(c->name, f, len);
   c->name[len] = '\0';
-  part = part_of(sp + 1, (size_t)(f + end - sp - 1), unit);
   if (part == -2)
     return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: column %zu '%s': a phase without "
                          "the unit degrees; give it in degrees and name the column \"%s "
-                         "phase_deg\"", S->path, S->line, k + 1, f, c->name);
+                         "phase_deg\" (or %s_phase_deg)", S->path, S->line, k + 1, f, c->name,
+                         c->name);
   if (part < 0)
     return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: column %zu '%s': unknown part '%.*s'; "
                          "expected re, im, mag, amp or phase_deg", S->path, S->line, k + 1, f,
-                         (int)(f + end - sp - 1), sp + 1);
+                         (int)(end - len - 1), f + len + 1);
   c->part = (col_part)part;
   S->ncols++;
-  return numeric_station(S, c->name, k);
+  return map_stations(S, c, k);
 }
 
-/* Columns come in pairs re+im or mag+phase_deg of one channel. */
+static const char *const part_word[] = {"re", "im", "mag", "phase_deg"};
+
+typedef struct name_col {
+  const char *name;
+  size_t col;
+} name_col;
+
+static int by_name(const void *a, const void *b) {
+  const name_col *x = a, *y = b;
+  int d = strcmp(x->name, y->name);
+  return d ? d : (x->col > y->col) - (x->col < y->col);
+}
+
+/* The columns of one channel (sorted[g0..g1), one name): re+im or
+ * mag+phase_deg, each once; cols[RE or MAG].mate set. */
+static rcb_status pair_channel(csv_state *S, const name_col *sorted, size_t g0, size_t g1) {
+  size_t at[4] = {0, 0, 0, 0}, g; /* 1 + column of each part, 0: none */
+  const char *name = sorted[g0].name;
+  for (g = g0; g < g1; g++) {
+    size_t c = sorted[g].col;
+    col_part p = S->cols[c].part;
+    if (at[p])
+      return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: duplicate channel %s: column %zu "
+                           "repeats its %s (column %zu); give each channel once", S->path,
+                           S->line, name, c + 2, part_word[p], at[p] + 1);
+    at[p] = c + 1;
+  }
+  if ((at[COL_RE] || at[COL_IM]) && (at[COL_MAG] || at[COL_PHASE]))
+    return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: channel %s is given both as re/im and "
+                         "as mag/phase (columns %zu and %zu): ambiguous; keep one pair",
+                         S->path, S->line, name, (at[COL_RE] ? at[COL_RE] : at[COL_IM]) + 1,
+                         (at[COL_MAG] ? at[COL_MAG] : at[COL_PHASE]) + 1);
+  for (g = 0; g < 4; g += 2)
+    if (at[g] || at[g + 1]) {
+      size_t have = at[g] ? g : g + 1, miss = at[g] ? g + 1 : g;
+      if (!at[miss])
+        return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: column %zu ('%s'): its %s has no "
+                             "pair; expected the two columns \"%s %s\",\"%s %s\"", S->path,
+                             S->line, at[have] + 1, name, part_word[have], name, part_word[g],
+                             name, part_word[g + 1]);
+      S->cols[at[g] - 1].mate = at[g + 1] - 1;
+    }
+  return RCB_OK;
+}
+
+/* Columns come in pairs re+im or mag+phase_deg of one channel, found by
+ * name (sorted, so a header of many columns costs n log n). */
 static rcb_status check_pairs(csv_state *S) {
-  size_t c;
+  name_col *sorted;
+  size_t c, g0;
+  rcb_status st = RCB_OK;
   if (S->ncols == 0)
     return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: no channel columns after the "
                          "abscissa", S->path, S->line);
-  for (c = 0; c < S->ncols; c += 2) {
-    csv_col *a = &S->cols[c], *b = c + 1 < S->ncols ? &S->cols[c + 1] : NULL;
-    int ok = b && strcmp(a->name, b->name) == 0 &&
-             ((a->part == COL_RE && b->part == COL_IM) ||
-              (a->part == COL_MAG && b->part == COL_PHASE));
-    if (!ok)
-      return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: column %zu ('%s'): expected a pair "
-                           "of adjacent columns \"%s re\",\"%s im\" or \"%s mag\",\"%s "
-                           "phase_deg\"", S->path, S->line, c + 2, a->name, a->name, a->name,
-                           a->name, a->name);
-    if ((S->type == RCB_MEAS_FRF) != (strchr(a->name, '/') != NULL))
+  for (c = 0; c < S->ncols; c++) {
+    const char *name = S->cols[c].name;
+    if ((S->type == RCB_MEAS_FRF) != (strchr(name, '/') != NULL))
       return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: column %zu ('%s'): %s", S->path,
-                           S->line, c + 2, a->name,
+                           S->line, c + 2, name,
                            S->type == RCB_MEAS_FRF
                                ? "an FRF channel is RESPONSE/REFERENCE, e.g. DA.x/C.y"
                                : "an unbalance response channel has no /REFERENCE");
   }
-  return RCB_OK;
+  sorted = rcb_alloc(&S->ms->alloc, S->ncols * sizeof *sorted);
+  if (!sorted) return rcb_meas_fail(S->ms, RCB_ERR_NOMEM, "%s: out of memory", S->path);
+  for (c = 0; c < S->ncols; c++) {
+    sorted[c].name = S->cols[c].name;
+    sorted[c].col = c;
+  }
+  qsort(sorted, S->ncols, sizeof *sorted, by_name);
+  for (g0 = 0, c = 1; c <= S->ncols && !st; c++)
+    if (c == S->ncols || strcmp(sorted[c].name, sorted[g0].name) != 0) {
+      st = pair_channel(S, sorted, g0, c);
+      g0 = c;
+    }
+  rcb_free(&S->ms->alloc, sorted);
+  return st;
 }
 
 static rcb_status header(csv_state *S, char *text) {
@@ -391,15 +525,18 @@ static rcb_status build(csv_state *S) {
   }
   snprintf(where, sizeof where, "%s", S->path);
   st = rcb_meas_set_grid_at(ms, S->type, S->nrows, S->x, S->speed, where, RCB_ERR_PARSE);
-  for (c = 0; c < S->ncols && !st; c += 2) {
+  for (c = 0; c < S->ncols && !st; c++) {
     char *slash = strchr(S->cols[c].name, '/');
+    size_t m = S->cols[c].mate;
+    if (S->cols[c].part != COL_RE && S->cols[c].part != COL_MAG) continue;
     for (r = 0; r < S->nrows; r++) {
-      double a = S->v[r * S->ncols + c], b = S->v[r * S->ncols + c + 1];
+      double a = S->v[r * S->ncols + c], b = S->v[r * S->ncols + m];
       d[r] = S->cols[c].part == COL_RE ? CMPLX(a, b)
                                        : a * CMPLX(cos(b * RCB_PI / 180.0), sin(b * RCB_PI / 180.0));
       if (S->phase == RCB_PHASE_LAG) d[r] = conj(d[r]); /* to the model's lead */
     }
-    snprintf(where, sizeof where, "%s: columns %zu-%zu", S->path, c + 2, c + 3);
+    snprintf(where, sizeof where, m == c + 1 ? "%s: columns %zu-%zu" : "%s: columns %zu and %zu",
+             S->path, c + 2, m + 2);
     if (slash) *slash = '\0';
     st = rcb_meas_add_channel_at(ms, S->cols[c].name, slash ? slash + 1 : NULL,
                                  S->type == RCB_MEAS_FRF ? S->kind : RCB_RECEPTANCE, d, where,
@@ -410,14 +547,22 @@ static rcb_status build(csv_state *S) {
 }
 
 rcb_status rcb_meas_read_csv(rcb_meas *ms, const char *path) {
+  return rcb_meas_read_csv_map(ms, path, 0, NULL);
+}
+
+rcb_status rcb_meas_read_csv_map(rcb_meas *ms, const char *path, size_t nmap,
+                                 const rcb_uff_node *map) {
   csv_state S;
   char *buf = NULL;
   size_t len;
   rcb_status st;
   if (!ms) return RCB_ERR_ARG;
+  if ((st = rcb_meas_check_map(ms, "read_csv", nmap, map))) return st;
   memset(&S, 0, sizeof S);
   S.ms = ms;
   S.path = path;
+  S.nmap = nmap;
+  S.map = map;
   S.kind = RCB_RECEPTANCE;
   rcb_meas_clear(ms);
   rcb_meas_clear_warnings(ms);

@@ -410,3 +410,20 @@ rcb_status rcb_atomic_commit(rcb_meas *ms, rcb_atomic_file *af, const char *path
   af->tmp[0] = '\0';
   return RCB_OK;
 }
+
+rcb_status rcb_meas_check_map(rcb_meas *ms, const char *who, size_t nmap,
+                              const rcb_uff_node *map) {
+  size_t i;
+  if (nmap && !map) return rcb_meas_fail(ms, RCB_ERR_ARG, "%s: node map is NULL", who);
+  for (i = 0; i < nmap; i++) {
+    const char *st = map[i].station;
+    if (!st || !st[0])
+      return rcb_meas_fail(ms, RCB_ERR_ARG, "%s: node %ld of the map has no station", who,
+                           map[i].node);
+    if (strlen(st) > RCB_MEAS_STATION_MAX)
+      return rcb_meas_fail(ms, RCB_ERR_ARG, "%s: node %ld of the map: station '%.40s...' has "
+                           "%zu characters; at most %d", who, map[i].node, st, strlen(st),
+                           RCB_MEAS_STATION_MAX);
+  }
+  return RCB_OK;
+}

@@ -118,6 +118,15 @@ rcb_status rcb_uff58_read_time(rcb_meas *ms, const char *path, size_t nmap,
  * (uff58_warn.c); @p abscissa: record 8's data type (17 time). */
 void rcb_uff_function_text(long func_type, long abscissa, char *buf, size_t size);
 
+/* Longest station a node map may give: "STATION.rx" must fit a channel
+ * (RCB_MEAS_CH_MAX with its NUL), so a name is refused, never cut. */
+#define RCB_MEAS_STATION_MAX (RCB_MEAS_CH_MAX - 4)
+/* A reader's node map (@p who names the call in the message): NULL with
+ * entries, an entry without a station or with one longer than
+ * RCB_MEAS_STATION_MAX is RCB_ERR_ARG with the entry and the limit named. */
+rcb_status rcb_meas_check_map(rcb_meas *ms, const char *who, size_t nmap,
+                              const rcb_uff_node *map);
+
 /* Whole file into memory (NUL-terminated), through the object's allocator. */
 rcb_status rcb_meas_slurp(rcb_meas *ms, const char *path, char **buf, size_t *len);
 

@@ -815,7 +815,7 @@ rcb_status rcb_uff58_read_time(rcb_meas *ms, const char *path, size_t nmap,
   size_t len;
   rcb_status st;
   if (!ms || !fn) return RCB_ERR_ARG;
-  if (nmap && !map) return rcb_meas_fail(ms, RCB_ERR_ARG, "read_uff: node map is NULL");
+  if ((st = rcb_meas_check_map(ms, "read_uff", nmap, map))) return st;
   if ((st = rcb_meas_slurp(ms, path, &buf, &len))) return st;
   reader_init(&R, &S, ms, path, buf, len, nmap, map);
   R.on_time = fn;
@@ -919,7 +919,7 @@ rcb_status rcb_meas_read_uff(rcb_meas *ms, const char *path, size_t nmap,
   size_t len, i;
   rcb_status st;
   if (!ms) return RCB_ERR_ARG;
-  if (nmap && !map) return rcb_meas_fail(ms, RCB_ERR_ARG, "read_uff: node map is NULL");
+  if ((st = rcb_meas_check_map(ms, "read_uff", nmap, map))) return st;
   rcb_meas_clear(ms);
   rcb_meas_clear_warnings(ms);
   if ((st = rcb_meas_slurp(ms, path, &buf, &len))) return st;

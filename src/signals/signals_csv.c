@@ -19,12 +19,18 @@
 
 #include "signals/signals_internal.h"
 
-#define CSV_MAXCH 256
+#define CSV_MAXCH 256 /* channel columns; one more is refused with the limit named */
 #define CSV_CHUNK (1u << 20) /* bytes per read */
+#define CSV_SHOW 60          /* characters of a long name or unit shown in a message */
 
+/* Names and units point into copies of the header and units lines, so a
+ * line of any length is read whole (issue #35 item 6: a units line cut at
+ * 1024 bytes read "mm/s^2" as "m" without a word). The only limit left is
+ * the name the container keeps (RCB_SIGNAL_NAME_MAX - 1 characters), and a
+ * longer name is refused with file:line, never cut. */
 typedef struct csv_col {
-  char name[RCB_SIGNAL_NAME_MAX];
-  char unit[32];
+  const char *name;
+  const char *unit; /* "" without one */
   size_t unit_line; /* line the unit came from */
 } csv_col;
 
@@ -39,8 +45,10 @@ typedef struct csv_state {
   size_t line;
   csv_col col[CSV_MAXCH];
   size_t ncol; /* channel columns (time excluded) */
-  char units_line[1024];
+  char *head;  /* the header line (allocated copy) */
+  char *units; /* the text after "# units =" (allocated copy), NULL: none */
   size_t units_at;
+  size_t row_line[2]; /* lines of the first and the last sample row */
 } csv_state;
 
 /* Keep the unread bytes, then read up to the buffer's end; a buffer that
@@ -91,55 +99,78 @@ static rcb_status next_line(csv_state *C, char **line) {
   return RCB_OK;
 }
 
-static void trim(char *a, char *out, size_t size) {
+/* A copy of line @p l in *out (the previous one freed). */
+static rcb_status keep_line(csv_state *C, const char *l, char **out) {
+  size_t n = strlen(l);
+  char *c = rcb_alloc(&C->s->alloc, n + 1);
+  if (!c) return rcb_signals_fail(C->s, RCB_ERR_NOMEM, "%s:%zu: out of memory", C->path, C->line);
+  memcpy(c, l, n + 1);
+  rcb_free(&C->s->alloc, *out);
+  *out = c;
+  return RCB_OK;
+}
+
+/* Blanks cut off both ends, in place. */
+static char *trim(char *a) {
   size_t n;
   while (*a == ' ' || *a == '\t') a++;
   n = strlen(a);
   while (n > 0 && (a[n - 1] == ' ' || a[n - 1] == '\t')) n--;
-  if (n >= size) n = size - 1;
-  memcpy(out, a, n);
-  out[n] = '\0';
+  a[n] = '\0';
+  return a;
 }
 
-/* "NAME [unit]" -> name, unit. */
-static void split_name(const char *f, csv_col *c) {
-  const char *lb = strchr(f, '['), *rb = lb ? strchr(lb, ']') : NULL;
-  char tmp[RCB_SIGNAL_NAME_MAX + 40];
-  size_t n = lb && rb ? (size_t)(lb - f) : strlen(f);
-  if (n >= sizeof tmp) n = sizeof tmp - 1;
-  memcpy(tmp, f, n);
-  tmp[n] = '\0';
-  trim(tmp, c->name, sizeof c->name);
-  if (lb && rb && (size_t)(rb - lb - 1) < sizeof tmp) {
-    memcpy(tmp, lb + 1, (size_t)(rb - lb - 1));
-    tmp[rb - lb - 1] = '\0';
-    trim(tmp, c->unit, sizeof c->unit);
+/* "NAME [unit]" (in place) -> column k. */
+static rcb_status split_name(csv_state *C, char *f, size_t k) {
+  csv_col *c = &C->col[k];
+  char *lb = strchr(f, '['), *rb = lb ? strchr(lb, ']') : NULL;
+  c->unit = "";
+  if (lb && !rb)
+    return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s:%zu: column %zu ('%.*s'): '[' without "
+                            "']'; write the unit as NAME [unit]", C->path, C->line, k + 2,
+                            CSV_SHOW, f);
+  if (rb) {
+    const char *after = trim(rb + 1);
+    if (*after)
+      return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s:%zu: column %zu: '%.*s' after the "
+                              "unit's ']'; write NAME [unit]", C->path, C->line, k + 2,
+                              CSV_SHOW, after);
+    *lb = *rb = '\0';
+    c->unit = trim(lb + 1);
   }
+  c->name = trim(f);
+  c->unit_line = C->line;
+  if (!c->name[0])
+    return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s:%zu: column %zu has no name", C->path,
+                            C->line, k + 2);
+  if (strlen(c->name) >= RCB_SIGNAL_NAME_MAX)
+    return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s:%zu: column %zu: name '%.*s...' has %zu "
+                            "characters; at most %d are kept (a shorter name, please)",
+                            C->path, C->line, k + 2, CSV_SHOW, c->name, strlen(c->name),
+                            RCB_SIGNAL_NAME_MAX - 1);
+  return RCB_OK;
 }
 
 static rcb_status parse_header(csv_state *C, char *l) {
-  char *f = l, *comma;
-  char first[64];
+  char *f = l, *comma, *first;
   size_t k = 0;
+  rcb_status st;
   comma = strchr(f, ',');
   if (comma) *comma = '\0';
-  trim(f, first, sizeof first);
+  first = trim(f);
   if (strncmp(first, "time", 4) != 0 && strcmp(first, "t") != 0)
-    return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s:%zu: first column '%s': expected the time "
-                            "column 'time_s' (seconds), then one column per channel", C->path,
-                            C->line, first);
+    return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s:%zu: first column '%.*s': expected the "
+                            "time column 'time_s' (seconds), then one column per channel",
+                            C->path, C->line, CSV_SHOW, first);
   while (comma) {
     f = comma + 1;
     comma = strchr(f, ',');
     if (comma) *comma = '\0';
     if (k == CSV_MAXCH)
-      return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s:%zu: more than %d channels", C->path,
-                              C->line, CSV_MAXCH);
-    split_name(f, &C->col[k]);
-    C->col[k].unit_line = C->line;
-    if (!C->col[k].name[0])
-      return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s:%zu: column %zu has no name", C->path,
-                              C->line, k + 2);
+      return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s:%zu: more than %d channel columns, "
+                              "the most librcb reads from one file; split the file",
+                              C->path, C->line, CSV_MAXCH);
+    if ((st = split_name(C, f, k))) return st;
     k++;
   }
   if (k == 0)
@@ -151,9 +182,9 @@ static rcb_status parse_header(csv_state *C, char *l) {
 
 /* "# units = N,mm": fills columns without a bracketed unit. */
 static rcb_status apply_units(csv_state *C) {
-  char *f = C->units_line, *comma;
+  char *f = C->units, *comma;
   size_t k = 0;
-  if (!C->units_at) return RCB_OK;
+  if (!C->units) return RCB_OK;
   do {
     comma = strchr(f, ',');
     if (comma) *comma = '\0';
@@ -161,7 +192,7 @@ static rcb_status apply_units(csv_state *C) {
       return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s:%zu: more units than the %zu channel "
                               "columns of the header", C->path, C->units_at, C->ncol);
     if (!C->col[k].unit[0]) {
-      trim(f, C->col[k].unit, sizeof C->col[k].unit);
+      C->col[k].unit = trim(f);
       C->col[k].unit_line = C->units_at;
     }
     k++;
@@ -228,12 +259,19 @@ static rcb_status parse_rows(csv_state *C, double **t, double **v, size_t *nrows
       cap = c;
     }
     if ((st = parse_row(C, nc, l, r, *t, v))) return st;
+    C->row_line[r == 0 ? 0 : 1] = C->line;
     r++;
   }
   *nrows = r;
   return RCB_OK;
 }
 
+/* The rate from the time column. Times of -1e308 and 1e308 made the
+ * spacing overflow to infinity, which passed the spacing test below (every
+ * difference compared with inf) and surfaced as "sample rate 0" with no
+ * file nor line (issue #35 item 6): a spacing or a rate that is not a
+ * finite positive number is refused here, with the lines of the first and
+ * the last row. */
 static rcb_status check_time(csv_state *C, const double *t, size_t n, size_t first_line,
                              double *rate) {
   double dt;
@@ -242,10 +280,22 @@ static rcb_status check_time(csv_state *C, const double *t, size_t n, size_t fir
     return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s: %zu sample rows; expected at least 2",
                             C->path, n);
   dt = (t[n - 1] - t[0]) / (double)(n - 1);
+  if (!isfinite(dt))
+    return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s:%zu: time %g s, and %g s at line %zu: the "
+                            "spacing of the time column, (last - first) / %zu, is not a finite "
+                            "number; expected times in seconds", C->path, C->row_line[0], t[0],
+                            t[n - 1], C->row_line[1], n - 1);
   if (!(dt > 0.0))
-    return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s: time column not increasing", C->path);
+    return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s:%zu: time %.9g s, and %.9g s at line %zu: "
+                            "the time column is not increasing", C->path, C->row_line[0], t[0],
+                            t[n - 1], C->row_line[1]);
+  if (!isfinite(1.0 / dt))
+    return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s:%zu: time %g s, and %g s at line %zu: a "
+                            "spacing of %g s, whose sample rate is not a finite number; "
+                            "expected times in seconds", C->path, C->row_line[0], t[0],
+                            t[n - 1], C->row_line[1], dt);
   for (i = 0; i < n; i++)
-    if (fabs(t[i] - (t[0] + (double)i * dt)) > 1e-3 * dt)
+    if (!(fabs(t[i] - (t[0] + (double)i * dt)) <= 1e-3 * dt))
       return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s: sample row %zu (near line %zu): time "
                               "%.9g s, expected %.9g s: the time column must be evenly spaced "
                               "(a dropped or repeated sample?)", C->path, i + 1,
@@ -260,16 +310,17 @@ static rcb_status take_columns(csv_state *C, double **v) {
   for (k = 0; k < C->ncol; k++) {
     rcb_quantity q = RCB_QTY_UNKNOWN;
     double f = 1.0;
-    const char *given = rcb_signals_unit_override(C->s, C->col[k].name);
+    const char *given = rcb_signals_unit_override(C->s, C->col[k].name), *u = C->col[k].unit;
     if (given && (!C->col[k].unit[0] || rcb_unit_parse(C->col[k].unit, &q, &f))) {
       rcb_unit_parse(given, &q, &f); /* checked by rcb_signals_set_unit */
     } else if (C->col[k].unit[0] && rcb_unit_parse(C->col[k].unit, &q, &f)) {
       char known[300];
       rcb_unit_list(RCB_QTY_UNKNOWN, known, sizeof known);
-      return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s:%zu: channel '%s': unit '%s' is not "
+      return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s:%zu: channel '%s': unit '%.*s%s' is not "
                               "one librcb knows (%s); give it: --units '%s=UNIT' "
                               "(rcb_signals_set_unit)", C->path, C->col[k].unit_line,
-                              C->col[k].name, C->col[k].unit, known, C->col[k].name);
+                              C->col[k].name, CSV_SHOW, u, strlen(u) > CSV_SHOW ? "..." : "",
+                              known, C->col[k].name);
     }
     for (i = 0; i < C->s->n; i++) v[k][i] *= f;
     st = rcb_signals_take(C->s, C->col[k].name, q, v[k]);
@@ -289,12 +340,14 @@ static rcb_status read_body(csv_state *C) {
     if ((st = next_line(C, &l))) return st;
     if (!l || l[0] != '#') break;
     if (strncmp(l, "# units", 7) == 0 && strchr(l, '=')) {
-      snprintf(C->units_line, sizeof C->units_line, "%s", strchr(l, '=') + 1);
+      if ((st = keep_line(C, strchr(l, '=') + 1, &C->units))) return st;
       C->units_at = C->line;
     }
   }
   if (!l) return rcb_signals_fail(C->s, RCB_ERR_PARSE, "%s: no header line", C->path);
-  if ((st = parse_header(C, l)) || (st = apply_units(C))) return st;
+  if ((st = keep_line(C, l, &C->head)) || (st = parse_header(C, C->head)) ||
+      (st = apply_units(C)))
+    return st;
   first_line = C->line + 1;
   st = parse_rows(C, &t, v, &nrows);
   if (!st) st = check_time(C, t, nrows, first_line, &rate);
@@ -312,6 +365,7 @@ rcb_status rcb_signals_read_csv(rcb_signals *s, const char *path) {
   rcb_signals_begin_read(s);
   if (!path || !path[0]) return rcb_signals_fail(s, RCB_ERR_ARG, "no file name given");
   C = rcb_alloc(&s->alloc, sizeof *C);
+  if (C) memset(C, 0, sizeof *C);
   if (C) C->buf = rcb_alloc(&s->alloc, CSV_CHUNK + 1);
   if (!C || !C->buf) {
     if (C) rcb_free(&s->alloc, C);
@@ -330,6 +384,8 @@ rcb_status rcb_signals_read_csv(rcb_signals *s, const char *path) {
     fclose(C->fp);
   }
   if (st) rcb_signals_empty(s);
+  rcb_free(&s->alloc, C->head);
+  rcb_free(&s->alloc, C->units);
   rcb_free(&s->alloc, C->buf);
   rcb_free(&s->alloc, C);
   return st;

@@ -1362,7 +1362,12 @@ compare_usage)
   usage compare "$MODEL" "$W/m.csv" --bands 0; err_has "--bands"
   usage compare "$MODEL" "$W/m.csv" --tol 0; err_has "percentage"
   usage compare "$MODEL" "$W/m.csv" --prominence -1; err_has "--prominence"
-  usage compare "$MODEL" "$W/m.csv" --map 10=DA; err_has "UFF measurements only"
+  # --map applies to CSV too since issue #35 (stations written as node numbers); a
+  # malformed one is still a usage error, and one the file does not use changes nothing
+  usage compare "$MODEL" "$W/m.csv" --map 10; err_has "expected NODE=STATION"
+  run compare "$MODEL" "$W/m.csv" --map 10=DA; expect_rc 0; mv "$W/out" "$W/with_map"
+  run compare "$MODEL" "$W/m.csv"; expect_rc 0
+  cmp -s "$W/out" "$W/with_map" || fail "an unused --map changed the comparison"
   run compare "$MODEL" "$W/none.csv"; expect_rc 3; err_has "none.csv"
   # --plot under a path that cannot be a directory (a file): exit 5, named
   run compare "$MODEL" "$W/m.csv" --plot "$W/m.csv/p"; expect_rc 5; err_has "m.csv' is not a directory"
@@ -1787,6 +1792,38 @@ lock_stale_and_wait_env)
   [ "$(wc -l <"$W/h.jsonl")" -eq 2 ] || fail "a refused run recorded a step"
   stray=$(ls -A "$W" | grep -v -x -e err -e out -e meas.csv -e h.jsonl)
   [ -z "$stray" ] || fail "left behind: $stray" ;;
+csv_lab_conventions)
+  # issue #35 item 3: a lab's FRF CSV ("1.x/3.x_re", node numbers) is read by fit through
+  # --map to the canonical file's result; without the map, refused naming file:line and
+  # the entry to give; a channel given both as re/im and mag/phase is ambiguous
+  run simulate "$MODEL" --frf --out C.A.x --in DA.x --fmin 200 --fmax 400 --points 21 \
+    --rpm 10000 --noise 5,1 -o "$W/meas.csv"; expect_rc 0
+  sed -e '/^freq_hz/s| re|_re|g' -e '/^freq_hz/s| im|_im|g' -e '/^freq_hz/s|C\.A\.x/DA\.x|3.x/1.x|g' \
+    "$W/meas.csv" >"$W/lab.csv"
+  grep -q '^freq_hz,3.x/1.x_re,3.x/1.x_im$' "$W/lab.csv" || fail "lab header: $(cat "$W/lab.csv")"
+  run fit "$MODEL" "$W/meas.csv" --params coupling.C.kt --json; expect_rc 0; mv "$W/out" "$W/a.json"
+  run fit "$MODEL" "$W/lab.csv" --params coupling.C.kt --json --map 1=DA,3=C.A; expect_rc 0
+  python3 -c 'import json,sys
+a, b = (json.load(open(p)) for p in sys.argv[1:])
+assert a["params"] == b["params"] and a["objective"] == b["objective"], (a, b)' "$W/a.json" "$W/out" ||
+    fail "the lab file fits otherwise: $(cat "$W/out")"
+  run fit "$MODEL" "$W/lab.csv" --params coupling.C.kt; expect_rc 3
+  err_has "lab.csv:3: column 2 ('3.x/1.x'): station '3' is a number"; err_has "--map 3=STATION"
+  printf 'freq_hz,DA.x/DA.x_re,DA.x/DA.x_im,DA.x/DA.x_amp,DA.x/DA.x_phase_deg\n10,1,2,3,4\n' >"$W/amb.csv"
+  run compare "$MODEL" "$W/amb.csv"; expect_rc 3
+  err_has "amb.csv:1: channel DA.x/DA.x is given both as re/im and as mag/phase" ;;
+signals_csv_no_silent_cuts)
+  # issue #35 item 6: times whose spacing overflows are refused with file:line before any
+  # work (they read as "sample rate 0" with no file nor line); a name over 63 characters
+  # is refused naming the limit, not cut
+  printf 'time_s,force [N],DA.x [m]\n-1e308,1,1\n0,1,1\n1e308,2,2\n' >"$W/sig.csv"
+  run estimate "$W/sig.csv" --input force=DA.x --outputs DA.x -o "$W/o.csv"; expect_rc 3
+  err_has "sig.csv:2: time -1e+308 s, and 1e+308 s at line 4"; err_has "not a finite number"
+  n=$(printf '%070d' 0 | tr 0 n)
+  printf 'time_s,force [N],%s [m]\n0,1,1\n1,1,1\n' "$n" >"$W/sig.csv"
+  run estimate "$W/sig.csv" --input force=DA.x --outputs DA.x -o "$W/o.csv"; expect_rc 3
+  err_has "sig.csv:1: column 3: name 'nnnn"; err_has "70 characters; at most 63"
+  [ ! -e "$W/o.csv" ] || fail "an output was written" ;;
 *) echo "unknown test case '$CASE'"; exit 1 ;;
 esac
 exit 0

@@ -164,6 +164,20 @@ def test_meas_errors_name_the_file(rcb, tmp_path):
         rcb.Meas.read(p)
 
 
+def test_meas_read_csv_node_numbers(rcb, tmp_path):
+    """Issue #35: a lab's CSV ("1.x/2.y_re", node numbers) read through uff_map
+    to the values of the canonical header; without the map, refused."""
+    canon, lab = tmp_path / "c.csv", tmp_path / "lab.csv"
+    canon.write_text("freq_hz,DA.x/DB.y re,DA.x/DB.y im\n10,1e-6,-2e-6\n20,3e-6,4e-6\n")
+    lab.write_text("freq_hz,1.x/2.y_re,1.x/2.y_im\n10,1e-6,-2e-6\n20,3e-6,4e-6\n")
+    a = rcb.Meas.read(canon)
+    b = rcb.Meas.read(lab, uff_map={1: "DA", 2: "DB"})
+    assert b.channels == a.channels
+    assert np.array_equal(b.data, a.data)
+    with pytest.raises(rcb.RcbError, match="lab.csv:1: column 2.*station '1' is a number"):
+        rcb.Meas.read(lab)
+
+
 def test_fit_recovers_hidden_coupling(rcb, paper):
     """Noise-free data from hidden kt, kr (x2.5, x0.4): the fit finds them."""
     truth = paper.copy()

@@ -155,15 +155,13 @@ static int meas_read(const cli_args *a, const char *path, const rcb_model *m, in
     cli_uff_map_free(&mp);
     return rc;
   }
-  if (!is_uff && cli_opt_value(a, "--map")) {
-    cli_uff_map_free(&mp);
-    return cli_usage(a->cmd, "--map applies to UFF measurements only ('%s' is CSV)", path);
-  }
   if (rcb_meas_create(&ms, NULL)) {
     cli_uff_map_free(&mp);
     return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   }
-  st = is_uff ? rcb_meas_read_uff(ms, path, mp.n, mp.nodes) : rcb_meas_read_csv(ms, path);
+  /* CSV too: stations written as node numbers ("2.x/11.x_re", issue #35) */
+  st = is_uff ? rcb_meas_read_uff(ms, path, mp.n, mp.nodes)
+              : rcb_meas_read_csv_map(ms, path, mp.n, mp.nodes);
   cli_uff_map_free(&mp);
   if (st) {
     const char *msg = cli_msg(rcb_meas_errmsg(ms), st);

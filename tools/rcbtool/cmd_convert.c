@@ -16,7 +16,8 @@ const char cli_help_convert[] =
     "  --map LIST   UFF node number <-> model station, e.g. 10=DA,20=C.A; a UFF node\n"
     "               without an entry reads as model node \"#N\" (0-based node N);\n"
     "               writing UFF, a station without an entry gets the next free\n"
-    "               number (the numbers used are printed on stderr)\n"
+    "               number (the numbers used are printed on stderr); reading CSV,\n"
+    "               stations written as node numbers (2.x/11.x_re) map through it\n"
     "  --kind K     convert FRFs to receptance (m/N), mobility (m/(N s)) or\n"
     "               inertance (m/(N s^2)) before writing\n"
     "  --binary     write binary 58b instead of ASCII 58\n"
@@ -28,7 +29,8 @@ const char cli_help_convert[] =
     "synchronous); directions 1, 2, 4, 5 = x, y, rx, ry (negative flips the sign).\n"
     "CSV: '# kind = K' and '# rpm = R' comment lines, then freq_hz (FRF) or rpm\n"
     "(unbalance) and per channel 'RESP/REF re','RESP/REF im' (or mag/amp and\n"
-    "phase_deg columns), as rcbtool frf and rcbtool unbalance write.\n"
+    "phase_deg columns), as rcbtool frf and rcbtool unbalance write; the part may\n"
+    "follow '_' (RESP/REF_re, _im, _mag, _phase_deg), as lab scripts write it.\n"
     "Exit codes: 2 usage, 3 unreadable or bad input data, 5 output not written.\n";
 
 static const char *const kind_names[] = {"receptance", "mobility", "inertance"};
@@ -269,7 +271,7 @@ static int read_input(const cli_args *a, rcb_meas *ms, const cli_uff_map *mp) {
   rcb_status st;
   if ((rc = cli_meas_format(a->cmd, a->model, &is_uff))) return rc;
   st = is_uff ? rcb_meas_read_uff(ms, a->model, mp->n, mp->nodes)
-              : rcb_meas_read_csv(ms, a->model);
+              : rcb_meas_read_csv_map(ms, a->model, mp->n, mp->nodes);
   if (st)
     return cli_fail(st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC : CLI_EXIT_INPUT, "%s",
                     cli_msg(rcb_meas_errmsg(ms), st));

@@ -294,6 +294,7 @@ _PROTOTYPES = {
     "rcb_meas_read_uff": (c_int, [c_void_p, c_char_p, c_size_t, c_void_p]),
     "rcb_meas_write_uff": (c_int, [c_void_p, c_char_p, c_int, c_size_t, c_void_p]),
     "rcb_meas_read_csv": (c_int, [c_void_p, c_char_p]),
+    "rcb_meas_read_csv_map": (c_int, [c_void_p, c_char_p, c_size_t, c_void_p]),
     "rcb_meas_write_csv": (c_int, [c_void_p, c_char_p]),
     # identification
     "rcb_fit_create": (c_int, [PP, c_void_p, c_void_p, c_void_p]),

@@ -83,16 +83,18 @@ class Meas(Handle):
     @classmethod
     def read(cls, path, uff_map=None, model=None):
         """Read UFF58 (.uff/.unv/.uf, ASCII or binary) or CSV (.csv).
-        uff_map {node: station}; default: the model's [uff] map when a model is given."""
+        uff_map {node: station}; default: the model's [uff] map when a model is given.
+        It also names a CSV's stations written as node numbers ("2.x/11.x_re")."""
         path = Path(path)
         ms = cls()
         L = _lib.lib()
+        if uff_map is None and model is not None:
+            uff_map = model.uff_map
+        n, arr, _keep = _uff_array(uff_map)
         if path.suffix.lower() == ".csv":
-            ms.check(L.rcb_meas_read_csv(ms.handle, str(path).encode()), "rcb_meas_read_csv")
+            ms.check(L.rcb_meas_read_csv_map(ms.handle, str(path).encode(), n, arr),
+                     "rcb_meas_read_csv_map")
         else:
-            if uff_map is None and model is not None:
-                uff_map = model.uff_map
-            n, arr, _keep = _uff_array(uff_map)
             ms.check(L.rcb_meas_read_uff(ms.handle, str(path).encode(), n, arr),
                      "rcb_meas_read_uff")
         return ms
