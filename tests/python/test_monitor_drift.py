@@ -243,23 +243,46 @@ def _first_message(r):
     return "alone" if "alone" in msgs else "b4" if all(m == "b4" for m in msgs) else "other"
 
 
+def _wrong_told_apart(r):
+    """The "told apart" statements of update r that are wrong when the truth is the
+    case's drift (issue #34 item 2): the instant test's first candidate named
+    alone (the one rule: told apart from the second) when it is not the drift,
+    a tracked CUSUM alarm named alone (told apart from every candidate), or its
+    rival told apart from the tracked parameter (no not-separable runner-up)
+    when that rival is not the drift. (statements, wrong) counts."""
+    n = bad = 0
+    if r["alarm"] and r.get("separable"):
+        n += 1
+        bad += not _b4(r["top"][0])
+    for t in r["tracked"]:
+        if t["cusum_alarm"] and (t["named"] == 1 or (t["named"] == -1 and not t.get("rival2"))):
+            n += 1
+            bad += t["named"] == 1 or not _b4(t["rival"])
+    return n, bad
+
+
 def test_drift_detected_and_attributed(groups):
     H, gs = groups
     need = int(math.floor(3 / DRIFT_SD))  # updates of drift before its size reaches 3 sd
     detected, delays, R = 0, [], 0
     firsts = {"alone": 0, "b4": 0, "other": 0, None: 0}
+    told, told_bad, reps_bad = 0, 0, 0
     for gi, (mon, fresh) in enumerate(gs):
         for rep in range(REPLICAS):
             mon.load_state(fresh)
             R += 1
             first = None
             delay = None
+            rep_bad = False
             for u in range(ONSET + DRIFT_UPDATES):
                 j = max(0, u - ONSET + 1)  # updates of drift so far
                 with _meas(_eq19(H[j], 2000000 * (gi + 1) + 1000 * rep + u)) as ms:
                     r = mon.update(ms)
                 if first is None:
                     first = _first_message(r)
+                n, bad = _wrong_told_apart(r)
+                told, told_bad = told + n, told_bad + bad
+                rep_bad = rep_bad or bad > 0
                 # detected and named: the drift test, or the instant test's first
                 # candidate (the drift test is silent while the instant test fires)
                 if delay is None and ((r["drift"]["alarm"] and _b4(r["drift"])) or
@@ -268,6 +291,7 @@ def test_drift_detected_and_attributed(groups):
             delays.append(delay)
             detected += delay is not None and 0 < delay <= need
             firsts[first] += 1
+            reps_bad += rep_bad
     FIGURES["drift"] = (detected, firsts, R, delays)
     print(f"{_CASE} falling {DRIFT_SD} sd per update: detected within {need} updates (3 sd) in "
           f"{detected} of {R}; first message: {firsts['b4']} B4 kyy (alone or not separable "
@@ -277,6 +301,9 @@ def test_drift_detected_and_attributed(groups):
     # named alone, in at most 20 %; B4 kyy in the first message in at least 30 %;
     # and (issue #34) named before 5 sd (all DRIFT_UPDATES: 4.3 sd) in at least 80 %
     late = sum(d is not None and 0 < d <= DRIFT_UPDATES for d in delays)
+    print(f"{_CASE}: {told} 'told apart' statements, {told_bad} wrong; replicas with a wrong "
+          f"one {reps_bad} of {R} (99 % bound at 5 %: {stats.binom.ppf(0.99, R, 0.05):.0f})")
+    assert reps_bad <= stats.binom.ppf(0.99, R, 0.05)
     print(f"{_CASE}: named within {DRIFT_UPDATES} updates ({DRIFT_UPDATES * DRIFT_SD:.1f} sd) "
           f"in {late} of {R}")
     assert late >= stats.binom.ppf(0.01, R, 0.8)

@@ -51,7 +51,7 @@ def clean():
         return np.load(path)["H0"]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return mc.Truth().inertance(mc.KT0, False)
+        return mc.Truth().inertance(mc.KT0, None)
 
 
 def report(label, Z):
