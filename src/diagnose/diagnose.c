@@ -86,7 +86,10 @@ void rcb_diag_destroy(rcb_diag *d) {
  * rcb_diag_refit_best (rank.c, prefit.c, refit.c): the refits, ranked;
  * rcb_diag_locate (locate.c): where the misfit of the model as it is sits;
  * rcb_diag_placed_refits (placed.c): the candidates acting there, refitted
- *   from a grid, ranked again.
+ *   from a grid, ranked again;
+ * rcb_diag_neighbour_refits (neighbours.c): a leading local candidate's
+ *   neighbours of its kind, refitted where the placement points, ranked
+ *   again.
  * rcb_diag_explain (words.c) puts the result in words. */
 static rcb_status run_steps(rcb_diag *d) {
   rcb_status st;
@@ -105,6 +108,7 @@ static rcb_status run_steps(rcb_diag *d) {
   if (!st) st = rcb_diag_refit_best(d);
   if (!st) st = rcb_diag_locate(d);
   if (!st) st = rcb_diag_placed_refits(d);
+  if (!st) st = rcb_diag_neighbour_refits(d);
   return st;
 }
 
