@@ -45,8 +45,8 @@ typedef struct diag_cand {
   int chain_kept;
   int refit_only;                   /* no neutral value: refitted, not scored */
   int late;                         /* refitted after the ranking: a leading local
-                                       candidate's neighbour (neighbours.c): one start,
-                                       RCB_DIAG_SCREEN_ITER at most */
+                                       candidate's neighbour (neighbours.c), a span
+                                       (span.c): one start, RCB_DIAG_SCREEN_ITER at most */
   char *carry;                      /* a chain candidate: the rcbtool options that read the
                                        data through its correction in the next round
                                        (rcb_diag_carry_text; owned, allocated only for
@@ -158,6 +158,9 @@ struct rcb_diag {
   diag_cand *cand;
   size_t ncand, cap_cand;
   size_t *order;                    /* rank -> candidate */
+  size_t cap_order;
+  size_t span_tried;                /* spans fitted by the search of span.c, not kept as
+                                       candidates: counted among those tried */
   rcb_diag_stats stats;             /* work done by the last run */
   int ran;
 };
@@ -330,5 +333,11 @@ rcb_status rcb_diag_placed_refits(rcb_diag *d);
  * and in the placement's span, walking on while the lead moves, and rank
  * again: the data choose among neighbours by the one rule. */
 rcb_status rcb_diag_neighbour_refits(rcb_diag *d);
+
+/* span.c. When a shaft's stiffness or mass leads (an element, the whole
+ * shaft) and nothing explains the data, search the span of its elements
+ * (shaft.S.e<a>-<b>.stiffness | mass) the data point to, refit the best and
+ * the spans one element from it as candidates, and rank again. */
+rcb_status rcb_diag_span_refits(rcb_diag *d);
 
 #endif

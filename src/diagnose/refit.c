@@ -33,9 +33,10 @@ static int chi2(const rcb_diag *d) { return d->beta_a > 0 || d->beta_s > 0 || d-
  * the nominal model: when it ran off (d->far) each candidate is fitted from
  * the fitted and from the nominal base, two informed starts in place of the
  * random ones (see refit). A candidate refitted after the ranking (c->late:
- * a leading local candidate's neighbour) starts where the leader did, at
- * its neutral value, and gets none: on ROSS's element 8 at 0.6 (8 x 151) the four neighbours' random
- * starts took 2743 sweeps, 4.7 s, against 412 for the whole diagnosis. */
+ * a leading local candidate's neighbour, a span) starts at its neutral value
+ * and gets none: on ROSS's element 8 at 0.6 (8 x 151) the four neighbours'
+ * random starts took 2743 sweeps, 4.7 s, against 412 for the whole
+ * diagnosis. */
 static size_t refit_starts(const rcb_diag *d, const diag_cand *c) {
   return c->refit_only || c->late || (c->fam->flags & DIAG_FAM_ADDS_DOFS) || d->far ? 1
                                                                                       : 3;
@@ -135,7 +136,7 @@ static void judge(const rcb_diag *d, diag_cand *c, double k) {
   e.error_before_pct = d->err0, e.error_after_pct = c->err;
   e.chi2 = c->adeq_chi2, e.chi2_limit = c->chi2_limit;
   e.params = k, e.residuals = N, e.dispersion = c->dispersion;
-  e.tried = (double)d->ncand;
+  e.tried = (double)(d->ncand + d->span_tried);
   e.white = d->adeq0.known && c->white_z <= RCB_ADEQUACY_Z;
   e.beyond = c->beyond;
   c->ev = e;

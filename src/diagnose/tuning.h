@@ -52,6 +52,9 @@
 /* the neighbours of a local candidate: neighbours.c */
 #define RCB_DIAG_NEIGHBOURS         6                  /* candidates a round */
 #define RCB_DIAG_NEIGHBOUR_WALK     3                  /* rounds */
+/* a span of a shaft: span.c */
+#define RCB_DIAG_SPAN_ITER          8                  /* iterations */
+#define RCB_DIAG_SPAN_STEPS         12                 /* moves of an end */
 /* the words: words.c */
 #define RCB_DIAG_SPAN_RANKS         6                  /* ranks */
 
@@ -231,6 +234,16 @@
  * places nothing one can name (RCB_DIAG_PLACED_SPAN). Three rounds bound a
  * walk along a shaft whose objective keeps falling; none was measured to
  * need a second.
+ *
+ * RCB_DIAG_SPAN_ITER, RCB_DIAG_SPAN_STEPS. The span search (span.c) fits
+ * each span alone (its factor; the base parameters where they are) for at
+ * most 8 iterations, from the factor of the span it moved from, and moves
+ * an end at most 12 times. On ROSS's E and G x 0.85 on elements 3-7 of
+ * shaft B (32 x 1101, a run-off baseline) it walked from the placement's
+ * run (elements 1-7) to 3-7 in 11-15 spans, 95-127 subset sweeps, 0.3-0.4 s;
+ * the refit of the best span 25 sweeps, 0.35 s. Twelve moves cover a shaft
+ * of 13 elements from one end to the other; none was measured to need more
+ * than 5.
  *
  * RCB_DIAG_SPAN_RANKS. The words name the span of the significant
  * candidates that sit at nodes among the first this many ranks. No
