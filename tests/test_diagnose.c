@@ -277,8 +277,11 @@ static void test_hidden_element_stiffness(void **state) {
                   name, best.place, best.predicted_pct, err0, best.error_pct, floor0,
                   best.delta_bic, best.fitted);
     assert_int_equal(best.effect, RCB_EFFECT_ELEMENT_STIFFNESS);
-    assert_true(strstr(best.place, near[0]) || strstr(best.place, near[1]) ||
-                strstr(best.place, near[2]));
+    /* at its own element since its neighbours are refitted where the
+     * placement points (neighbours.c): before, element 8 was found as
+     * element 7 at 0.78 (5.84 %, floor 5.77 %) */
+    assert_non_null(strstr(best.place, near[1]));
+    assert_null(strstr(best.place, near[0]));
     assert_true(best.significant);
     apply_reaches_floor(d, floor0);
     rcb_diag_destroy(d);

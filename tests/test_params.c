@@ -1019,6 +1019,43 @@ static void test_element_factor_errors(void **state) {
   rcb_model_destroy(u);
 }
 
+/* A span of elements (issue #33), shaft.S.e<a>-<b>.stiffness | mass: a
+ * view that sets the factor of elements a to b and no other, reads element
+ * a's, and refuses what is not a span of the shaft. */
+static void test_element_span_param(void **state) {
+  rcb_model *m = rcb_test_model_from_example("paper_system.ini");
+  rcb_element_info ei;
+  size_t e;
+  double v;
+  (void)state;
+  set(m, "shaft.B.e3-7.stiffness", 0.85);
+  set(m, "shaft.B.e5-5.mass", 1.5); /* a span of one: element 5 */
+  for (e = 0; e < rcb_model_element_count(m); e++) {
+    int onB, in;
+    assert_int_equal(rcb_model_element_info(m, e, &ei), RCB_OK);
+    onB = strcmp(ei.shaft, "B") == 0;
+    in = onB && ei.index >= 3 && ei.index <= 7;
+    assert_true(ei.stiffness == (in ? 0.85 : 1.0));
+    assert_true(ei.mass == (onB && ei.index == 5 ? 1.5 : 1.0));
+  }
+  assert_int_equal(rcb_model_get_param(m, "shaft.B.e3-7.stiffness", &v), RCB_OK);
+  assert_true(v == 0.85);
+  set(m, "shaft.B.e7.stiffness", 0.5); /* the elements stay separate parameters */
+  assert_int_equal(rcb_model_get_param(m, "shaft.B.e6-7.stiffness", &v), RCB_OK);
+  assert_true(v == 0.85); /* element a's */
+  assert_int_equal(rcb_model_get_param(m, "shaft.B.e1-10.mass", &v), RCB_OK);
+  expect_set_error(m, "shaft.B.e7-3.stiffness", 0.5, RCB_ERR_NOT_FOUND, "a <= b", NULL);
+  expect_set_error(m, "shaft.B.e3-11.stiffness", 0.5, RCB_ERR_NOT_FOUND, "e1 to e10", NULL);
+  expect_set_error(m, "shaft.B.e3-.stiffness", 0.5, RCB_ERR_NOT_FOUND, "e1 to e10", NULL);
+  expect_set_error(m, "shaft.B.e3-07.mass", 0.5, RCB_ERR_NOT_FOUND, "e1 to e10", NULL);
+  expect_set_error(m, "shaft.B.e3-7x.mass", 0.5, RCB_ERR_NOT_FOUND, "e1 to e10", NULL);
+  expect_set_error(m, "shaft.B.e3-7.stiffness", 0.0, RCB_ERR_ARG, "expected a positive value",
+                   NULL);
+  assert_int_equal(rcb_model_get_param(m, "shaft.B.e7.stiffness", &v), RCB_OK);
+  assert_true(v == 0.5); /* a refused span leaves every element as it was */
+  rcb_model_destroy(m);
+}
+
 #define NMODE 8
 
 /* The lowest NMODE damped frequencies of m at standstill, rad/s. */
@@ -1111,6 +1148,7 @@ int main(void) {
       cmocka_unit_test(test_element_factor_identity),
       cmocka_unit_test(test_element_factor_local),
       cmocka_unit_test(test_element_factor_errors),
+      cmocka_unit_test(test_element_span_param),
       cmocka_unit_test(test_element_factor_frequencies),
       cmocka_unit_test(test_shaft_factors),
       cmocka_unit_test(test_shaft_factors_ini),

@@ -388,6 +388,11 @@ RCB_API rcb_status rcb_model_unbalance_force(const rcb_model *m, double speed,
  *    element's z range; `rcbtool check` lists them). Not enumerated by
  *    rcb_model_param_count; INI: [shaft] element_stiffness | element_mass =
  *    k factor [k factor ...] (the writer lists those that are not 1).
+ *  - shaft.A.e<a>-<b>.stiffness | mass (a <= b): the same factor on elements
+ *    a to b together, a section or material change along a span of the
+ *    shaft; setting it sets each element's factor, getting it gives element
+ *    a's. A view (the model stores the elements' factors; the INI lists
+ *    them), as pedestal_k is of a pedestal's x and y.
  *  - material.steel.density | young
  *  - unbalance.UA.amount (kg m) | phase (rad)
  * All of them enter M, C, G, K (and the unbalance force) affinely, which the

@@ -44,6 +44,9 @@ typedef struct diag_cand {
   double chain_v[RCB_DIAG_MAXP];
   int chain_kept;
   int refit_only;                   /* no neutral value: refitted, not scored */
+  int late;                         /* refitted after the ranking: a leading local
+                                       candidate's neighbour (neighbours.c), a span
+                                       (span.c): one start, RCB_DIAG_SCREEN_ITER at most */
   char *carry;                      /* a chain candidate: the rcbtool options that read the
                                        data through its correction in the next round
                                        (rcb_diag_carry_text; owned, allocated only for
@@ -155,6 +158,9 @@ struct rcb_diag {
   diag_cand *cand;
   size_t ncand, cap_cand;
   size_t *order;                    /* rank -> candidate */
+  size_t cap_order;
+  size_t span_tried;                /* spans fitted by the search of span.c, not kept as
+                                       candidates: counted among those tried */
   rcb_diag_stats stats;             /* work done by the last run */
   int ran;
 };
@@ -300,10 +306,38 @@ rcb_status rcb_diag_polish(rcb_fit *f);
 rcb_status rcb_diag_refit_result(rcb_diag *d, diag_cand *c, rcb_model **m, rcb_fit *f,
                                  double F, double err, int polished);
 
+/* placed.c. The model node a candidate acts at, from its node (a place
+ * walk) or the station its first parameter names ("bearing.B2.kyy": B2,
+ * "disk.DA.mass": DA), or an element's first node ("shaft.A.e5.stiffness",
+ * a span's first element "shaft.A.e3-7.stiffness"); -1: none (a whole-shaft
+ * effect, the speed, a sensor). */
+long rcb_diag_cand_node(const rcb_diag *d, const diag_cand *c);
+/* placed.c. Whether node (for an element, node or node + 1) is in the
+ * placement's span (d->place, in_span). */
+int rcb_diag_node_placed(const rcb_diag *d, long node, int element);
+
+/* rank.c. Refit the candidates k[0 .. n) after the ranking (their from_fit,
+ * from_nom marked), stage by stage as rcb_diag_refit_best does, and rank
+ * again. */
+rcb_status rcb_diag_refit_more(rcb_diag *d, size_t *k, size_t n);
+
 /* placed.c. When no candidate explains the data and the equivalent loads
  * (rcb_diag_locate) place the misfit at a few nodes, refit every
  * one-parameter model candidate acting there from a grid across its
  * bounds, and rank again. */
 rcb_status rcb_diag_placed_refits(rcb_diag *d);
+
+/* neighbours.c. When the leading candidate is significant and sits at a
+ * node or an element (DIAG_FAM_PLACE_WALK) where the placement points, or
+ * next to it, refit the candidates of its kind at the neighbouring places
+ * and in the placement's span, walking on while the lead moves, and rank
+ * again: the data choose among neighbours by the one rule. */
+rcb_status rcb_diag_neighbour_refits(rcb_diag *d);
+
+/* span.c. When a shaft's stiffness or mass leads (an element, the whole
+ * shaft) and nothing explains the data, search the span of its elements
+ * (shaft.S.e<a>-<b>.stiffness | mass) the data point to, refit the best and
+ * the spans one element from it as candidates, and rank again. */
+rcb_status rcb_diag_span_refits(rcb_diag *d);
 
 #endif

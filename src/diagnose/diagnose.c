@@ -59,6 +59,7 @@ static void free_results(rcb_diag *d) {
   d->cand = NULL, d->order = NULL, d->base_model = NULL, d->nom_model = NULL;
   d->far = 0, d->drift[0] = '\0', d->pre_best = HUGE_VAL;
   d->ncand = d->cap_cand = 0;
+  d->cap_order = 0, d->span_tried = 0;
   d->ran = 0;
   memset(&d->stats, 0, sizeof d->stats);
   d->progress_done = 0;
@@ -86,7 +87,12 @@ void rcb_diag_destroy(rcb_diag *d) {
  * rcb_diag_refit_best (rank.c, prefit.c, refit.c): the refits, ranked;
  * rcb_diag_locate (locate.c): where the misfit of the model as it is sits;
  * rcb_diag_placed_refits (placed.c): the candidates acting there, refitted
- *   from a grid, ranked again.
+ *   from a grid, ranked again;
+ * rcb_diag_neighbour_refits (neighbours.c): a leading local candidate's
+ *   neighbours of its kind, refitted where the placement points, ranked
+ *   again;
+ * rcb_diag_span_refits (span.c): a shaft's stiffness or mass leading, the
+ *   span of its elements searched for, refitted, ranked again.
  * rcb_diag_explain (words.c) puts the result in words. */
 static rcb_status run_steps(rcb_diag *d) {
   rcb_status st;
@@ -95,6 +101,7 @@ static rcb_status run_steps(rcb_diag *d) {
     rcb_diag_fail(d, st, "laying out the catalogue of effects: %s", rcb_status_str(st));
   if (!st && !(d->order = rcb_alloc(&d->alloc, (d->ncand ? d->ncand : 1) * sizeof *d->order)))
     st = rcb_diag_fail(d, RCB_ERR_NOMEM, "out of memory");
+  if (!st) d->cap_order = d->ncand ? d->ncand : 1;
   if (!st) st = rcb_diag_score_all(d, 0);
   if (!st && d->far) { /* the candidates scored at the nominal model too */
     rcb_model *fitted = d->base_model;
@@ -105,6 +112,8 @@ static rcb_status run_steps(rcb_diag *d) {
   if (!st) st = rcb_diag_refit_best(d);
   if (!st) st = rcb_diag_locate(d);
   if (!st) st = rcb_diag_placed_refits(d);
+  if (!st) st = rcb_diag_neighbour_refits(d);
+  if (!st) st = rcb_diag_span_refits(d);
   return st;
 }
 

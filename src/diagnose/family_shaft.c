@@ -17,7 +17,8 @@
 
 /* The shaft-wide factor `variant` (0: stiffness, 1: mass) of shaft s, unless
  * the base fit already holds it. */
-static rcb_status add_factor(rcb_diag *d, const rcb_shaft_t *s, int variant) {
+static rcb_status add_factor(rcb_diag *d, const rcb_model *m, size_t i, int variant) {
+  const rcb_shaft_t *s = &m->shafts[i];
   static const char *const key[2] = {"stiffness", "mass"};
   char name[RCB_DIAG_NAME], place[RCB_DIAG_NAME];
   double v = s->sf[variant];
@@ -33,6 +34,7 @@ static rcb_status add_factor(rcb_diag *d, const rcb_shaft_t *s, int variant) {
                    : "a change of section or material along shaft %s (its bending stiffness)",
            s->name);
   c->variant = variant;
+  c->shaft = i;
   /* a model that already holds a factor (an applied candidate): its value inside */
   rcb_diag_add_par(c, variant ? "shaft.%s.mass" : "shaft.%s.stiffness", s->name,
                    fmin(SHAFT_FACTOR_LO, 0.5 * v), fmax(SHAFT_FACTOR_HI, 2.0 * v), 1);
@@ -56,7 +58,7 @@ static rcb_status enumerate(rcb_diag *d, const rcb_model *m) {
   }
   for (i = 0; i < m->n_shafts; i++) {
     rcb_status st;
-    if ((st = add_factor(d, &m->shafts[i], 0)) || (st = add_factor(d, &m->shafts[i], 1)))
+    if ((st = add_factor(d, m, i, 0)) || (st = add_factor(d, m, i, 1)))
       return st;
   }
   return RCB_OK;

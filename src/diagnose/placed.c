@@ -13,11 +13,8 @@
 #include "diagnose/tuning.h"
 #include "identify/identify.h"
 
-/* The model node a candidate acts at, from its node (a place walk) or the
- * station its first parameter names ("bearing.B2.kyy": B2, "disk.DA.mass":
- * DA), or an element's first node ("shaft.A.e5.stiffness"); -1: none (a
- * whole-shaft effect, the speed, a sensor). */
-static long cand_node(const rcb_diag *d, const diag_cand *c) {
+/* The model node a candidate acts at (diag_internal.h). */
+long rcb_diag_cand_node(const rcb_diag *d, const diag_cand *c) {
   const rcb_model *m = d->base_model;
   char name[RCB_DIAG_NAME];
   const char *a = strchr(c->pname[0], '.'), *b = a ? strchr(a + 1, '.') : NULL;
@@ -43,8 +40,8 @@ static long cand_node(const rcb_diag *d, const diag_cand *c) {
   return -1;
 }
 
-/* Whether node (or, for an element, node + 1) is in the placement's span. */
-static int node_placed(const rcb_diag *d, long node, int element) {
+/* Whether node (element: node + 1 too) is in the placement's span. */
+int rcb_diag_node_placed(const rcb_diag *d, long node, int element) {
   size_t k;
   for (k = 0; node >= 0 && k < d->nplace; k++)
     if (d->place[k].in_span && (d->place[k].node == (size_t)node ||
@@ -124,7 +121,7 @@ rcb_status rcb_diag_placed_refits(rcb_diag *d) {
   for (k = 0; !st && k < d->ncand; k++) {
     diag_cand *c = &d->cand[k];
     if (c->np != 1 || c->refit_only || (c->fam->flags & (DIAG_FAM_CHAIN | DIAG_FAM_ADDS_DOFS)) ||
-        !node_placed(d, cand_node(d, c), strncmp(c->pname[0], "shaft.", 6) == 0))
+        !rcb_diag_node_placed(d, rcb_diag_cand_node(d, c), strncmp(c->pname[0], "shaft.", 6) == 0))
       continue;
     st = placed_refit(d, c, w);
   }

@@ -196,3 +196,30 @@ rcb_status rcb_diag_refit_best(rcb_diag *d) {
   rcb_free(&d->alloc, j.k);
   return st;
 }
+
+/* Refit the candidates k[0 .. n) (not refitted yet) after the ranking, stage
+ * by stage as refit_best does (screen on the frequency subset when there is
+ * one, random starts when no screen reached the floor, evaluation on all
+ * points, polish when near the best: refit.c), each from the fitted base
+ * (c->from_fit) and the nominal model (c->from_nom) as the caller marked
+ * it; then rank again. The polished leader (d->lead) stays what a polish
+ * must beat (cannot_lead). */
+rcb_status rcb_diag_refit_more(rcb_diag *d, size_t *k, size_t n) {
+  diag_jobs j;
+  rcb_status st;
+  if (!n) return RCB_OK;
+  memset(&j, 0, sizeof j);
+  j.k = k, j.n = n;
+  if (d->ncand && d->cand[d->order[0]].refitted && d->cand[d->order[0]].polished)
+    d->lead = d->order[0]; /* the placed refits may have made another */
+  if ((st = rcb_diag_subset_weights(d, &j.w))) return st;
+  st = rcb_diag_for_each(d, j.n, refit_job, &j, NULL);
+  if (!st) any_screen_at_floor(d);
+  if (!st) st = rcb_diag_for_each(d, j.n, restart_job, &j, NULL);
+  if (!st) st = rcb_diag_for_each(d, j.n, evaluate_job, &j, NULL);
+  if (!st) lowest_refit(d);
+  if (!st) st = rcb_diag_for_each(d, j.n, polish_job, &j, NULL);
+  if (!st) rcb_diag_sort_order(d);
+  rcb_free(&d->alloc, j.w);
+  return st;
+}

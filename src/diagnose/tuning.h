@@ -49,6 +49,12 @@
 /* large effects named where the misfit is placed: placed.c */
 #define RCB_DIAG_PLACED_GRID        13                 /* grid points */
 #define RCB_DIAG_PLACED_SPAN        3                  /* nodes */
+/* the neighbours of a local candidate: neighbours.c */
+#define RCB_DIAG_NEIGHBOURS         6                  /* candidates a round */
+#define RCB_DIAG_NEIGHBOUR_WALK     3                  /* rounds */
+/* a span of a shaft: span.c */
+#define RCB_DIAG_SPAN_ITER          8                  /* iterations */
+#define RCB_DIAG_SPAN_STEPS         12                 /* moves of an end */
 /* the words: words.c */
 #define RCB_DIAG_SPAN_RANKS         6                  /* ranks */
 
@@ -214,6 +220,30 @@
  * (two effects at once: round 1 of the crack and B2 cross-coupling on
  * 32 x 1101 spans nodes #0-#10, whose 40 candidates took 33 s of CPU to name
  * none).
+ *
+ * RCB_DIAG_NEIGHBOURS, RCB_DIAG_NEIGHBOUR_WALK. A leading local candidate's
+ * neighbours (neighbours.c): its kind at one place either way and in the
+ * placement's span, at most 6 a round, the nearest first; a round more from
+ * a neighbour that took the lead, at most 3 rounds. On ROSS's shaft B
+ * element 8 at 0.6 (8 x 151) the span was nodes #17-#21 (elements 6-10
+ * around the lead, element 7): four refits, 257 sweeps (412 for the rest of
+ * the diagnosis), element 8 took the lead at 0.5999 and its own
+ * neighbours were refitted already, so one round; on 32 x 1101 (element 8
+ * leading already) elements 7, 9, 10 took 330 sweeps, 0.95 s of CPU. Six
+ * covers a span of five nodes either side of an element; a wider span
+ * places nothing one can name (RCB_DIAG_PLACED_SPAN). Three rounds bound a
+ * walk along a shaft whose objective keeps falling; none was measured to
+ * need a second.
+ *
+ * RCB_DIAG_SPAN_ITER, RCB_DIAG_SPAN_STEPS. The span search (span.c) fits
+ * each span alone (its factor; the base parameters where they are) for at
+ * most 8 iterations, from the factor of the span it moved from, and moves
+ * an end at most 12 times. On ROSS's E and G x 0.85 on elements 3-7 of
+ * shaft B (32 x 1101, a run-off baseline) it walked from the placement's
+ * run (elements 1-7) to 3-7 in 11-15 spans, 95-127 subset sweeps, 0.3-0.4 s;
+ * the refit of the best span 25 sweeps, 0.35 s. Twelve moves cover a shaft
+ * of 13 elements from one end to the other; none was measured to need more
+ * than 5.
  *
  * RCB_DIAG_SPAN_RANKS. The words name the span of the significant
  * candidates that sit at nodes among the first this many ranks. No

@@ -18,6 +18,16 @@
  * INI: [shaft] element_stiffness | element_mass = k factor [k factor ...]
  * (ini_build.c reads them through rcb_model_set_param, ini_write.c writes
  * those that are not 1).
+ *
+ * A span of elements (issue #33: a change of section or material along part
+ * of a shaft) is a view, as pedestal_k is of a pedestal's x and y:
+ *
+ *   shaft.S.e<a>-<b>.stiffness | mass  the factor of elements a to b
+ *                           (a <= b) together: setting it sets each of
+ *                           them, getting it gives element a's
+ *
+ * so the fit's sensitivity (set, assemble, difference) is that of the whole
+ * span; the INI and the writer know elements only.
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -44,19 +54,20 @@ static long shaft_named(const rcb_model *m, const char *s, size_t n) {
   return -1;
 }
 
-rcb_status rcb_element_param_slot(rcb_model *m, const char *name, double **slot) {
+rcb_status rcb_element_param_slot(rcb_model *m, const char *name, double **slot, size_t *n) {
   const char *item = name + 6, *d2 = strchr(item, '.'), *d3 = d2 ? strchr(d2 + 1, '.') : NULL;
   const rcb_shaft_t *sh;
   char *end = NULL;
   long s;
-  unsigned long k;
+  unsigned long k, k2;
   int key;
-  *slot = NULL;
+  *slot = NULL, *n = 0;
   if (!d2 || !d3) return rcb_model_fail(m, RCB_ERR_NOT_FOUND, "parameter '%s' unknown", name);
   if ((s = shaft_named(m, item, (size_t)(d2 - item))) < 0)
     return rcb_model_fail(m, RCB_ERR_NOT_FOUND,
                           "parameter '%s': the model has no shaft '%.*s' (element parameters "
-                          "are shaft.SHAFT.e<k>.stiffness | mass)",
+                          "are shaft.SHAFT.e<k>.stiffness | mass, a span of elements "
+                          "shaft.SHAFT.e<a>-<b>.stiffness | mass)",
                           name, (int)(d2 - item < 64 ? d2 - item : 64), item);
   sh = &m->shafts[s];
   for (key = 0; key < 2 && strcmp(d3 + 1, element_keys[key]) != 0; key++) continue;
@@ -65,18 +76,22 @@ rcb_status rcb_element_param_slot(rcb_model *m, const char *name, double **slot)
                           "parameter '%s': an element of shaft '%s' has the parameters "
                           "stiffness and mass (factors, neutral 1)",
                           name, sh->name);
-  k = 0;
-  if (d2[1] == 'e' && d2[2] >= '1' && d2[2] <= '9') k = strtoul(d2 + 2, &end, 10);
-  if (k == 0 || end != d3 || k > sh->nef) {
+  k = k2 = 0;
+  if (d2[1] == 'e' && d2[2] >= '1' && d2[2] <= '9') k = k2 = strtoul(d2 + 2, &end, 10);
+  if (k && end && *end == '-' && end[1] >= '1' && end[1] <= '9') /* a span e<a>-<b> */
+    k2 = strtoul(end + 1, &end, 10);
+  if (k == 0 || end != d3 || k2 < k || k2 > sh->nef) {
     if (sh->nef == 0)
       return rcb_model_fail(m, RCB_ERR_NOT_FOUND, "parameter '%s': shaft '%s' has no element",
                             name, sh->name);
     return rcb_model_fail(m, RCB_ERR_NOT_FOUND,
-                          "parameter '%s': expected an element e1 to e%zu of shaft '%s' "
-                          "(counted from 1 in z order; 'rcbtool check' lists them)",
+                          "parameter '%s': expected an element e1 to e%zu of shaft '%s', or a "
+                          "span e<a>-<b> of them with a <= b (counted from 1 in z order; "
+                          "'rcbtool check' lists them)",
                           name, sh->nef, sh->name);
   }
   *slot = &m->shafts[s].ef[2 * (k - 1) + (size_t)key];
+  *n = k2 - k + 1; /* every second double from *slot (stiffness, mass interleaved) */
   return RCB_OK;
 }
 

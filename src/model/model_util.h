@@ -32,9 +32,11 @@ static inline double rcb_segment_node_z(double zs, double L, size_t e, int nel) 
 }
 
 /* element_params.c: whether name has the shape of an element parameter,
- * "shaft.S.e<k>.KEY" (three dots; names have none), and the storage of one
- * (RCB_ERR_NOT_FOUND with a message when S, k or KEY does not exist). */
+ * "shaft.S.e<k>.KEY" or "shaft.S.e<a>-<b>.KEY" (three dots; names have
+ * none), and its storage: *n slots (one, or one per element of the span)
+ * at *slot, *slot + 2, ... (RCB_ERR_NOT_FOUND with a message when S, k or
+ * KEY does not exist). */
 int rcb_element_param_shape(const char *name);
-rcb_status rcb_element_param_slot(rcb_model *m, const char *name, double **slot);
+rcb_status rcb_element_param_slot(rcb_model *m, const char *name, double **slot, size_t *n);
 
 #endif

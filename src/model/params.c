@@ -396,8 +396,9 @@ rcb_status rcb_model_get_param(const rcb_model *m, const char *name, double *val
     *value = m->speed_factor;
     return RCB_OK;
   }
-  if (rcb_element_param_shape(name)) {
-    if ((st = rcb_element_param_slot(mm, name, v))) return st;
+  if (rcb_element_param_shape(name)) { /* a span: its first element's */
+    size_t ne;
+    if ((st = rcb_element_param_slot(mm, name, v, &ne))) return st;
     *value = *v[0];
     return RCB_OK;
   }
@@ -424,11 +425,12 @@ rcb_status rcb_model_set_param(rcb_model *m, const char *name, double value) {
     m->speed_factor = value;
     return RCB_OK;
   }
-  if (rcb_element_param_shape(name)) { /* shaft.S.e<k>.stiffness | mass */
-    if ((st = rcb_element_param_slot(m, name, v)) ||
+  if (rcb_element_param_shape(name)) { /* shaft.S.e<k> | e<a>-<b> .stiffness | mass */
+    size_t ne, e;
+    if ((st = rcb_element_param_slot(m, name, v, &ne)) ||
         (st = rcb_model_check_value(m, "shaft element", name, "factor (-)", value, 1)))
       return st;
-    *v[0] = value;
+    for (e = 0; e < ne; e++) v[0][2 * e] = value;
     return RCB_OK;
   }
   if ((st = lookup(m, name, &r))) return st;

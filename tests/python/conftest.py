@@ -206,6 +206,7 @@ SLOW_FILES = {
     "test_package_dask.py", "test_plots.py", "test_ross_bridge.py",
     "test_diag_place.py", "test_monitor_state.py", "test_monitor_baseline.py",
     "test_monitor_replicas.py", "test_diag_calibration.py", "test_diag_large_effects.py", "test_diag_shaft.py",
+    "test_diag_neighbours.py",
 }
 # single tests of the other files that took 74-123 s each under a load of ~9
 # on 2 cores (about a tenth of that quiet): ROSS rotors rebuilt per speed
