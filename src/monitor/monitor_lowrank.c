@@ -27,6 +27,17 @@
 #define LR_TOL 1e-7
 /* The check's step: this fraction of each tracked parameter's baseline. */
 #define LR_STEP 0.05
+/* A candidate's check step, in its standard errors at create. The sweep's
+ * change (rm - rbase, a difference of two sweeps) carries a rounding floor
+ * of about 3e-17 on the paper system (receptances up to 1e-6 m/N): at 10
+ * standard errors B1's and B2's cross-coupling changed the model by 2-3e-10,
+ * so the check read 1.0e-7 and 1.6e-7 (rounding, not a non-affine
+ * parameter), failed against LR_TOL, and their joint step ran by sweeps
+ * (the alarmed update 39 ms against 4.7 ms, bench_monitor 'changed'). At
+ * 100 the smallest change of any candidate is 2e-9 and the worst check
+ * 2.6e-8, 4 times under LR_TOL; a parameter that does not enter Z affinely
+ * shows more clearly at the larger step, not less. */
+#define LR_CAND_STEP 100.0
 
 
 /* Index of matrix row r in P (appending it if new; np capped by cap). */
@@ -311,8 +322,8 @@ static double mismatch(rcb_monitor *mon, const double *theta, const mon_cand *c,
 }
 
 /* Does the low-rank change equal the sweep's, at theta = LR_STEP t0 for the
- * tracked parameters (*ok), and at ten standard errors of each candidate
- * taken (c->ep, reset for one that does not)? */
+ * tracked parameters (*ok), and at LR_CAND_STEP standard errors of each
+ * candidate taken (c->ep, reset for one that does not)? */
 static rcb_status check(rcb_monitor *mon, int *ok) {
   double theta[RCB_MONITOR_MAX_TRACKED], zero[RCB_MONITOR_MAX_TRACKED] = {0}, s[RCB_MONITOR_MAXP];
   rcb_complex *dm = rcb_mon_alloc(mon, mon->npt, sizeof *dm);
@@ -331,7 +342,7 @@ static rcb_status check(rcb_monitor *mon, int *ok) {
     int good;
     if (!c->ep) continue;
     for (a = 0; !sc && a < c->np; a++) {
-      s[a] = 10.0 * c->se[a];
+      s[a] = LR_CAND_STEP * c->se[a];
       sc = rcb_model_set_param(mon->model, c->pname[a], c->neutral[a] + s[a]);
     }
     good = !sc && mismatch(mon, zero, c, s, dm, &sc) <= LR_TOL;
