@@ -374,7 +374,8 @@ void rcb_mon_lowrank_free(rcb_monitor *mon, mon_lowrank *lr) {
 
 /* The low-rank path when it applies (mon->lr), else none (mon->lr NULL):
  * an error only for memory. */
-static rcb_status lowrank_try(rcb_monitor *mon, mon_lowrank *lr, rcb_meas_dofs *md) {
+static rcb_status lowrank_try(rcb_monitor *mon, mon_lowrank *lr, rcb_meas_dofs *md,
+                              const mon_image *im) {
   size_t c;
   rcb_status st;
   int ok;
@@ -385,19 +386,26 @@ static rcb_status lowrank_try(rcb_monitor *mon, mon_lowrank *lr, rcb_meas_dofs *
   lr->speed = rcb_meas_speed(mon->setup);
   if ((st = layout(mon, lr, md->nin))) return st == RCB_ERR_NOMEM ? st : RCB_OK;
   for (c = 0; c < mon->nch; c++) lr->ch_in[c] = md->ch_in[c];
+  if (im) { /* the blocks and the check's outcome as a full create made them */
+    if (!im->lr) return RCB_OK;
+    if ((st = rcb_mon_image_lowrank(mon, im, lr))) return st;
+    mon->lr = lr;
+    return RCB_OK;
+  }
   if ((st = blocks(mon, lr, md))) return st == RCB_ERR_NOMEM ? st : RCB_OK;
   mon->lr = lr;
   if ((st = check(mon, &ok)) || !ok) mon->lr = NULL;
   return st;
 }
 
-rcb_status rcb_mon_lowrank_init(rcb_monitor *mon) {
+rcb_status rcb_mon_lowrank_init(rcb_monitor *mon, const mon_image *im) {
   mon_lowrank *lr;
   rcb_meas_dofs md;
   size_t nch = mon->nch;
   rcb_status st;
   if (!mon->nt || !mon->relin || rcb_meas_get_type(mon->setup) != RCB_MEAS_FRF)
-    return RCB_OK; /* the sweep re-evaluates */
+    return im && im->lr ? rcb_mon_fail(mon, RCB_ERR_OTHER_SETUP, "commissioning image: a "
+                                       "low-rank path this monitor has not") : RCB_OK;
   memset(&md, 0, sizeof md);
   lr = rcb_mon_alloc(mon, 1, sizeof *lr);
   md.ch_out = rcb_mon_alloc(mon, 2 * nch, sizeof *md.ch_out);
@@ -405,10 +413,14 @@ rcb_status rcb_mon_lowrank_init(rcb_monitor *mon) {
   st = lr && md.ch_out && md.outs ? RCB_OK : RCB_ERR_NOMEM;
   if (!st) {
     md.ch_in = md.ch_out + nch, md.ins = md.outs + nch;
-    st = lowrank_try(mon, lr, &md);
+    st = lowrank_try(mon, lr, &md, im);
   }
   rcb_free(&mon->alloc, md.outs);
   rcb_free(&mon->alloc, md.ch_out);
   if (!mon->lr) rcb_mon_lowrank_free(mon, lr); /* not applicable: the sweep re-evaluates */
-  return st ? rcb_mon_fail(mon, st, "out of memory (re-linearisation blocks)") : RCB_OK;
+  if (st == RCB_ERR_NOMEM) return rcb_mon_fail(mon, st, "out of memory (re-linearisation blocks)");
+  if (!st && im && im->lr && !mon->lr)
+    st = rcb_mon_fail(mon, RCB_ERR_OTHER_SETUP, "commissioning image: a low-rank path this "
+                      "monitor has not");
+  return st; /* an image's refusal keeps its message */
 }

@@ -24,7 +24,9 @@
  *   bench_monitor examples/paper_system.ini sensors [N] (changed, --sensors)
  *   bench_monitor examples/paper_system.ini probe [N]   (probe DA.x 0.85, series)
  * (and linear, reweighted, relin). BENCH_MONITOR_DUMP=FILE writes every
- * update's rcb_monitor_result to FILE as bytes, to compare two builds.
+ * update's rcb_monitor_result to FILE as bytes, to compare two builds;
+ * BENCH_MONITOR_IMAGE=1 runs the updates on the monitor created again from
+ * the first one's commissioning image (rcb_monitor_opts.image).
  */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
@@ -186,10 +188,12 @@ static int run(const rcb_model *m, const rcb_meas *setup, rcb_complex *const *no
   rcb_monitor_param tp[3] = {{"coupling.C.kt", 0, 0}, {"coupling.C.kr", 0, 0},
                              {"coupling.C.ct", 0, 0}};
   rcb_monitor_opts o;
-  rcb_monitor *mon = NULL;
+  rcb_monitor *mon = NULL, *mi = NULL;
   rcb_monitor_result r;
+  void *im = NULL;
+  size_t nim;
   size_t u, k = 0, kt = 0, alarms = 0, nst = 0, named[NAMED], ncount[NAMED] = {0}, nnamed = 0, i;
-  double t0, c0, tc, tu, cu, ts = 0, tl = 0;
+  double t0, c0, tc, ti, tu, cu, ts = 0, tl = 0;
   memset(&o, 0, sizeof o);
   for (i = 0; i < 3; i++) { /* rcbtool's default range: [v / 1000, 1000 v] */
     double v = 0;
@@ -214,6 +218,23 @@ static int run(const rcb_model *m, const rcb_meas *setup, rcb_complex *const *no
     return 1;
   }
   tc = now() - t0;
+  /* create again from the commissioning image (a process per measurement) */
+  nim = rcb_monitor_image_size(mon);
+  if (!(im = malloc(nim)) || rcb_monitor_image_save(mon, im, nim, NULL)) {
+    fprintf(stderr, "image: %zu bytes\n", nim);
+    return 1;
+  }
+  o.image = im, o.image_size = nim;
+  t0 = now();
+  if (rcb_monitor_create(&mi, m, setup, &o, NULL)) {
+    fprintf(stderr, "create from the image: %s\n", rcb_monitor_errmsg(mi));
+    return 1;
+  }
+  ti = now() - t0;
+  if (getenv("BENCH_MONITOR_IMAGE")) { /* the updates on the monitor made from it */
+    rcb_monitor *t = mon;
+    mon = mi, mi = t;
+  }
   rcb_monitor_rank(mon, &k, &kt);
   t0 = now();
   c0 = cpu_now();
@@ -243,8 +264,11 @@ static int run(const rcb_model *m, const rcb_meas *setup, rcb_complex *const *no
          rcb_monitor_fast_relinearise(mon) ? "; re-linearised without a sweep" : "");
   printf("%-24s state %zu bytes: save %.1f us, load %.1f us (issue #24)\n", "", nst, 1e6 * ts,
          1e6 * tl);
+  printf("%-24s commissioning image %.1f MB: create from it %.3f s\n", "", (double)nim / 1e6, ti);
   print_named(mon, named, ncount, nnamed);
   rcb_monitor_destroy(mon);
+  rcb_monitor_destroy(mi);
+  free(im);
   return 0;
 }
 
