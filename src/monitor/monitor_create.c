@@ -389,10 +389,11 @@ static rcb_status settings(rcb_monitor *mon, const rcb_monitor_opts *o) {
 }
 
 /* A commissioning image's rank and basis Q (row-major, as the update reads
- * it) in place of the QR of the columns. */
-static rcb_status image_q(rcb_monitor *mon, const mon_image *im) {
+ * it) in place of the QR of the columns: in a block of the columns' size,
+ * as a full create leaves it (rcb_monitor_memory the same). */
+static rcb_status image_q(rcb_monitor *mon, const mon_image *im, size_t ncol) {
   mon->k = im->k;
-  if (!(mon->Q = rcb_mon_alloc(mon, mon->n * mon->k, sizeof *mon->Q)))
+  if (!(mon->Q = rcb_mon_alloc(mon, mon->n * (ncol ? ncol : 1), sizeof *mon->Q)))
     return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (rank space)");
   rcb_mon_image_doubles(im, im->g - 8 * mon->n * mon->k, mon->Q, mon->n * mon->k);
   return RCB_OK;
@@ -432,7 +433,7 @@ static rcb_status commission(rcb_monitor *mon, const rcb_model *base, const rcb_
   if (!st) mon->img_fp = rcb_mon_image_fingerprint(mon, d, &pl, o->effects);
   if (!st && o->image) {
     st = rcb_mon_image_open(mon, o->image, o->image_size, mon->img_fp, pl.ncol, pl.ncand, &im);
-    if (!st) st = image_q(mon, &im);
+    if (!st) st = image_q(mon, &im, pl.ncol);
   } else if (!st) {
     whiten_columns(mon, J, pl.ncol);
     memset(mon->r, 0, mon->n * sizeof *mon->r);
