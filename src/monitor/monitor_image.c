@@ -14,7 +14,11 @@
  * column-major), the low-rank blocks (H0_oP, H0_PP, H0_Pi as Re, Im), one
  * byte per candidate (1: its joint step without a sweep), zero padding to 8
  * bytes, then a u64 checksum of everything before it. Every dimension must
- * be the one this create computes, every value finite, every flag 0 or 1.
+ * be the one this create computes, every value finite, Q's columns of unit
+ * length, every flag 0 or 1. Beyond that the values are not checked against
+ * what a create computes (that would be the create): an image whose
+ * checksum was made again over other finite values gives wrong statistics,
+ * never a read outside the monitor's blocks (fuzz/fuzz_monitor_image.c).
  */
 #include <math.h>
 #include <stdint.h>
@@ -228,6 +232,20 @@ rcb_status rcb_mon_image_open(rcb_monitor *mon, const void *buf, size_t size, ui
     if (!isfinite(get_f64(p + IM_HEAD + 8 * i)))
       return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "commissioning image: value %zu is not "
                           "finite: damaged", i + 1);
+  { /* Q's columns are orthonormal: each of unit length (a cheap check that
+     * catches a basis a create never makes, its checksum made again) */
+    size_t a, kk = dims[2];
+    for (a = 0; a < kk; a++) {
+      double s = 0;
+      for (i = 0; i < mon->n; i++) {
+        double q = get_f64(p + IM_HEAD + 8 * (kk * i + a));
+        s += q * q;
+      }
+      if (!(fabs(s - 1.0) <= 1e-6))
+        return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "commissioning image: column %zu of Q has "
+                            "length %g, not 1: damaged", a + 1, sqrt(s));
+    }
+  }
   for (i = 0; i < ((ncand + 7) & ~(size_t)7); i++)
     if (p[IM_HEAD + 8 * nd + i] > (i < ncand))
       return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "commissioning image: candidate %zu's flag "
