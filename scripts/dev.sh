@@ -597,15 +597,15 @@ cmd_fuzz() {
   # time: together they take the time of one); each writes its own log. The
   # state harnesses' seeds are whole states (7 kB, 50-58 kB): their own max_len
   local pids=() t_of=()
-  say "fuzz_ini, fuzz_csv, fuzz_signals_csv, fuzz_uff, fuzz_strtod, fuzz_monitor_state, fuzz_rcbtool_state, fuzz_history at once: replay fuzz/corpus/NAME, then ${secs} s each"
-  for t in ini csv signals_csv uff strtod monitor_state rcbtool_state history; do
+  say "fuzz_ini, fuzz_csv, fuzz_signals_csv, fuzz_uff, fuzz_strtod, fuzz_monitor_state, fuzz_monitor_image, fuzz_rcbtool_state, fuzz_history at once: replay fuzz/corpus/NAME, then ${secs} s each"
+  for t in ini csv signals_csv uff strtod monitor_state monitor_image rcbtool_state history; do
     rm -rf "$dir/work_$t"
     cp -r "fuzz/corpus/$t" "$dir/work_$t"
     (
       UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 "$dir/fuzz/fuzz_$t" -runs=0 \
         "fuzz/corpus/$t" > "$dir/replay_$t.log" 2>&1 &&
         UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 "$dir/fuzz/fuzz_$t" "$dir/work_$t" \
-          -max_total_time="$secs" -max_len="$([[ $t == *state ]] && echo 65536 || echo 8192)" \
+          -max_total_time="$secs" -max_len="$([[ $t == monitor_image ]] && echo 131072 || { [[ $t == *state ]] && echo 65536 || echo 8192; })" \
           -timeout=10 -rss_limit_mb=2048 \
           -artifact_prefix="$dir/crashes/fuzz_${t}-" -print_final_stats=1 > "$dir/fuzz_$t.log" 2>&1
     ) &

@@ -21,7 +21,10 @@
  *    reference weight, which the monitor writes there), with and without
  *    opts.baseline_cov;
  *  - the update count at RCB_MONITOR_MAX_UPDATES: that state loads, the
- *    next update is refused (RCB_ERR_STATE), one more in the state is refused.
+ *    next update is refused (RCB_ERR_STATE), one more in the state is refused;
+ *  - the commissioning image (rcb_monitor_opts.image): the monitor made from
+ *    it updates as the full create's, bit for bit; damaged, cut short, of
+ *    another version or of other options, it is refused.
  */
 #include <complex.h>
 #include <math.h>
@@ -467,8 +470,81 @@ static void test_update_count_max(void **state) {
   rcb_monitor_destroy(c);
 }
 
+/* The commissioning image (rcb_monitor_opts.image, issue #34 item 5): a
+ * monitor created from it gives the full create's results bit for bit (the
+ * re-linearised, reweighted path, whose low-rank blocks it carries too); a
+ * damaged image (a value changed, a byte cut) is refused with
+ * RCB_ERR_CORRUPT, one of other options (another tracked range, the
+ * fingerprint) with RCB_ERR_OTHER_SETUP, another version with
+ * RCB_ERR_VERSION; a buffer too small with RCB_ERR_WORKSPACE. */
+static void test_image(void **state) {
+  fixture *f = *state;
+  rcb_monitor_param tp;
+  rcb_monitor_opts o;
+  rcb_monitor *a = NULL, *b = NULL;
+  rcb_monitor_result ra, rb;
+  unsigned char *im, *bad;
+  uint64_t seed = 21;
+  size_t n, w = 0, u;
+  memset(&o, 0, sizeof o);
+  tp.name = KT_NAME, tp.lo = 0.5 * f->kt, tp.hi = 1.5 * f->kt;
+  o.ntracked = 1, o.tracked = &tp, o.beta_a = 2.0, o.beta_s = 0.5, o.setup_averages = 4.0;
+  o.relinearise = 8, o.reweight = 1;
+  o.effects = (1u << RCB_EFFECT_BEARING_CROSS_COUPLING) | (1u << RCB_EFFECT_BEARING_STIFFNESS);
+  assert_int_equal(rcb_monitor_create(&a, f->base, f->setup, &o, NULL), RCB_OK);
+  assert_true(rcb_monitor_fast_relinearise(a));
+  n = rcb_monitor_image_size(a);
+  assert_true(n > 0);
+  im = malloc(n), bad = malloc(n);
+  assert_non_null(im), assert_non_null(bad);
+  assert_int_equal(rcb_monitor_image_save(a, im, n - 1, &w), RCB_ERR_WORKSPACE);
+  assert_int_equal(rcb_monitor_image_save(a, im, n, &w), RCB_OK);
+  assert_true(w == n);
+  o.image = im, o.image_size = n;
+  assert_int_equal(rcb_monitor_create(&b, f->base, f->setup, &o, NULL), RCB_OK);
+  for (u = 0; u < 12; u++) { /* kt falling 1 % an update: alarms, re-linearised */
+    noisy(f, -0.01 * (double)u * f->kt, &seed, f->v);
+    assert_int_equal(rcb_monitor_update(a, f->v, NULL, &ra), RCB_OK);
+    assert_int_equal(rcb_monitor_update(b, f->v, NULL, &rb), RCB_OK);
+    assert_true(memcmp(&ra, &rb, sizeof ra) == 0);
+  }
+  rcb_monitor_destroy(b);
+  b = NULL;
+  /* damaged: a value of Q changed, the checksum kept; a byte short */
+  memcpy(bad, im, n);
+  bad[200] ^= 1;
+  o.image = bad;
+  assert_int_equal(rcb_monitor_create(&b, f->base, f->setup, &o, NULL), RCB_ERR_CORRUPT);
+  assert_non_null(strstr(rcb_monitor_errmsg(b), "checksum"));
+  rcb_monitor_destroy(b);
+  b = NULL;
+  o.image = im, o.image_size = n - 1;
+  assert_int_equal(rcb_monitor_create(&b, f->base, f->setup, &o, NULL), RCB_ERR_CORRUPT);
+  rcb_monitor_destroy(b);
+  b = NULL;
+  /* another version; other options */
+  memcpy(bad, im, n);
+  bad[4] = 2;
+  o.image = bad, o.image_size = n;
+  assert_int_equal(rcb_monitor_create(&b, f->base, f->setup, &o, NULL), RCB_ERR_VERSION);
+  rcb_monitor_destroy(b);
+  b = NULL;
+  o.image = im;
+  tp.hi = 1.6 * f->kt;
+  assert_int_equal(rcb_monitor_create(&b, f->base, f->setup, &o, NULL), RCB_ERR_OTHER_SETUP);
+  rcb_monitor_destroy(b);
+  b = NULL;
+  tp.hi = 1.5 * f->kt;
+  o.beta_a = 2.5; /* the noise: other weights */
+  assert_int_equal(rcb_monitor_create(&b, f->base, f->setup, &o, NULL), RCB_ERR_OTHER_SETUP);
+  rcb_monitor_destroy(b);
+  rcb_monitor_destroy(a);
+  free(im), free(bad);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_image),
       cmocka_unit_test(test_crafted),
       cmocka_unit_test(test_written_states_load),
       cmocka_unit_test(test_update_count_max),

@@ -257,6 +257,20 @@ typedef struct rcb_monitor_opts {
                           values' intervals (rcb_monitor_tracked.ci_lo, ci_hi),
                           taken independent of the change's noise. NULL: the
                           baseline is exact (the intervals are the change's) */
+  const void *image; /**< a commissioning image (rcb_monitor_image_save) of a
+                          monitor created from the same baseline model, set-up
+                          and options: create takes the sensitivity columns'
+                          QR, the rank-space projection and the low-rank
+                          blocks from it instead of computing them (sweeps and
+                          QRs: most of create's time), with results identical
+                          to a create without it. Checked before use (its
+                          checksum, a fingerprint of the inputs, every
+                          dimension and value): create fails with
+                          RCB_ERR_OTHER_SETUP for an image of other inputs,
+                          RCB_ERR_CORRUPT or RCB_ERR_VERSION for a damaged or
+                          other-version one; the caller then creates without
+                          it. NULL (default): none */
+  size_t image_size; /**< bytes at image */
 } rcb_monitor_opts;
 
 /** @brief One ranked candidate effect in a result. */
@@ -597,6 +611,28 @@ RCB_API rcb_status rcb_monitor_save(const rcb_monitor *mon, void *buf, size_t si
  * (rcb_monitor_errmsg) says which field differs
  */
 RCB_API rcb_status rcb_monitor_load(rcb_monitor *mon, const void *buf, size_t size);
+/** @brief Format version of the commissioning image. */
+#define RCB_MONITOR_IMAGE_VERSION 1u
+/** @brief Bytes rcb_monitor_image_save writes: 8 per value of the rank-space
+ * basis Q (2 x channels x points x k) and projection (k x the columns), 16
+ * per value of the low-rank blocks (rcb_monitor_fast_relinearise), one per
+ * candidate, and 112 more (megabytes: 9.8 MB for the paper system's 8 x 400
+ * set-up with every probe's gain a candidate); 0 for a monitor not created
+ * successfully. */
+RCB_API size_t rcb_monitor_image_size(const rcb_monitor *mon);
+/**
+ * @brief Save what commissioning computed by sweeps and QRs (the
+ * commissioning image), for rcb_monitor_opts.image: a process that creates
+ * the monitor again for every measurement (a gateway) then skips them. It
+ * does not change with the updates; little-endian, versioned
+ * (RCB_MONITOR_IMAGE_VERSION), with a checksum.
+ * @param size bytes available at @p buf (rcb_monitor_image_size)
+ * @param written bytes written, may be NULL
+ * @return RCB_ERR_WORKSPACE when @p size is too small (nothing written),
+ * RCB_ERR_STATE for a monitor not created successfully
+ */
+RCB_API rcb_status rcb_monitor_image_save(const rcb_monitor *mon, void *buf, size_t size,
+                                          size_t *written);
 /** @brief CRC-32 (IEEE 802.3, zlib's crc32) of @p n bytes continuing from
  * @p crc (0 to start): the state's checksum, for hosts that store the state
  * inside records of their own. */

@@ -222,7 +222,8 @@ static rcb_status cand_fit(rcb_monitor *mon, rcb_model *cm, const rcb_diag_cand_
 
 /* The candidates' columns into J (n x ncol, after the tracked ones): one
  * batched adjoint sweep of the base model for those with its DOFs, a sweep
- * of their own model for the others (a pedestal). */
+ * of their own model for the others (a pedestal). J NULL (a commissioning
+ * image): their neutral values and derivative matrices only. */
 static rcb_status cand_columns(rcb_monitor *mon, rcb_diag *d, const col_plan *pl, double *J) {
   size_t ndz = 0, j, k, ndof = rcb_model_dof_count(mon->model), batch = 0;
   rcb_fit_dz *dz = rcb_mon_alloc(mon, pl->ncol ? pl->ncol : 1, sizeof *dz);
@@ -236,7 +237,7 @@ static rcb_status cand_columns(rcb_monitor *mon, rcb_diag *d, const col_plan *pl
     if (c.chain) { /* a sensor's gain and phase at neutral (1, 0 rad): the model's values */
       for (k = 0; k < c.np; k++)
         pl->neutral[pl->col[j] + k] = rcb_fit_param_is_chain(c.pname[k]) == RCB_CHAIN_GAIN;
-      if ((st = rcb_fit_chain_jacobian(mon->fit, c.pname, c.np, J + mon->n * pl->col[j])))
+      if (J && (st = rcb_fit_chain_jacobian(mon->fit, c.pname, c.np, J + mon->n * pl->col[j])))
         rcb_mon_fail(mon, st, "%s: %s", c.desc, rcb_fit_errmsg(mon->fit));
       continue;
     }
@@ -256,7 +257,7 @@ static rcb_status cand_columns(rcb_monitor *mon, rcb_diag *d, const col_plan *pl
         rcb_mon_fail(mon, st, "%s: %s", c.desc, rcb_fit_errmsg(cf));
       else
         ndz += c.np, batch++;
-    } else if (!st) {
+    } else if (!st && J) {
       if ((st = rcb_fit_jacobian(cf, 1, J + mon->n * pl->col[j])))
         rcb_mon_fail(mon, st, "%s: %s", c.desc, rcb_fit_errmsg(cf));
       else if (rcb_fit_residual_count(cf) != mon->n)
@@ -265,7 +266,7 @@ static rcb_status cand_columns(rcb_monitor *mon, rcb_diag *d, const col_plan *pl
     rcb_fit_destroy(cf);
     rcb_model_destroy(cm);
   }
-  if (!st && ndz) {
+  if (!st && ndz && J) {
     /* the batch's columns are contiguous after the tracked ones (plan order) */
     if ((st = rcb_fit_jacobian_dz(mon->fit, dz, ndz, J + mon->n * mon->nt)))
       rcb_mon_fail(mon, st, "candidate columns: %s", rcb_fit_errmsg(mon->fit));
@@ -387,9 +388,21 @@ static rcb_status settings(rcb_monitor *mon, const rcb_monitor_opts *o) {
   return RCB_OK;
 }
 
+/* A commissioning image's rank and basis Q (row-major, as the update reads
+ * it) in place of the QR of the columns: in a block of the columns' size,
+ * as a full create leaves it (rcb_monitor_memory the same). */
+static rcb_status image_q(rcb_monitor *mon, const mon_image *im, size_t ncol) {
+  mon->k = im->k;
+  if (!(mon->Q = rcb_mon_alloc(mon, mon->n * (ncol ? ncol : 1), sizeof *mon->Q)))
+    return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (rank space)");
+  rcb_mon_image_doubles(im, im->g - 8 * mon->n * mon->k, mon->Q, mon->n * mon->k);
+  return RCB_OK;
+}
+
 static rcb_status commission(rcb_monitor *mon, const rcb_model *base, const rcb_meas *setup,
                              const rcb_monitor_opts *o) {
   rcb_diag *d = NULL;
+  mon_image im;
   col_plan pl;
   double *J = NULL;
   size_t c, k;
@@ -411,18 +424,23 @@ static rcb_status commission(rcb_monitor *mon, const rcb_model *base, const rcb_
   if (!st && (st = rcb_diag_catalogue(d, mon->model)))
     rcb_mon_fail(mon, st, "catalogue: %s", rcb_diag_errmsg(d));
   if (!st) st = plan(mon, d, o->effects, &pl);
-  if (!st && !(J = rcb_mon_alloc(mon, mon->n * (pl.ncol ? pl.ncol : 1), sizeof *J)))
+  if (!st && !o->image && !(J = rcb_mon_alloc(mon, mon->n * (pl.ncol ? pl.ncol : 1), sizeof *J)))
     st = rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (%zu x %zu sensitivity columns)",
                       mon->n, pl.ncol);
-  if (!st && mon->nt && (st = rcb_fit_jacobian(mon->fit, 1, J)))
+  if (!st && mon->nt && J && (st = rcb_fit_jacobian(mon->fit, 1, J)))
     rcb_mon_fail(mon, st, "tracked parameters' sensitivities: %s", rcb_fit_errmsg(mon->fit));
   if (!st) st = cand_columns(mon, d, &pl, J);
-  if (!st) {
+  if (!st) mon->img_fp = rcb_mon_image_fingerprint(mon, d, &pl, o->effects);
+  if (!st && o->image) {
+    st = rcb_mon_image_open(mon, o->image, o->image_size, mon->img_fp, pl.ncol, pl.ncand, &im);
+    if (!st) st = image_q(mon, &im, pl.ncol);
+  } else if (!st) {
     whiten_columns(mon, J, pl.ncol);
     memset(mon->r, 0, mon->n * sizeof *mon->r);
     st = rcb_mon_factor(mon, d, J, pl.ncol);
   }
-  if (!st && !(st = rcb_mon_rank_space(mon, d, &pl, J))) J = NULL; /* now mon->Q */
+  if (!st && !(st = rcb_mon_rank_space(mon, d, &pl, J, o->image ? &im : NULL)))
+    J = NULL; /* now mon->Q */
   if (!st) {
     mon->y = rcb_mon_alloc(mon, 3 * mon->k + 2 * (mon->ncand ? mon->ncand : 1), sizeof *mon->y);
     if (!mon->y) st = rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (update workspace)");
@@ -451,7 +469,7 @@ static rcb_status commission(rcb_monitor *mon, const rcb_model *base, const rcb_
     }
   }
   if (!st) st = rcb_mon_pass_init(mon);
-  if (!st) st = rcb_mon_lowrank_init(mon);
+  if (!st) st = rcb_mon_lowrank_init(mon, o->image ? &im : NULL);
   if (!st && mon->bcurv) st = rcb_mon_curvature(mon);
   if (!st) {
     size_t dof = mon->k > mon->nt ? mon->k - mon->nt : 0;

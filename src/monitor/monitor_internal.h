@@ -12,6 +12,8 @@
 #ifndef RCB_MONITOR_INTERNAL_H
 #define RCB_MONITOR_INTERNAL_H
 
+#include <stdint.h>
+
 #include "core/rcb_internal.h"
 #include "rcb/rcb_monitor.h"
 
@@ -20,6 +22,8 @@
 /* Points per block of the reweighted covariance (monitor_gls.c: C += B B^T
  * by BLAS dsyrk on 2 MON_SYRK_POINTS rows at a time) */
 #define MON_SYRK_POINTS 128
+
+struct mon_image; /* a commissioning image (monitor_image.c), below */
 
 /* A candidate in the rank space (dimension k): its estimate rows and the
  * orthonormal directions it adds beyond the tracked parameters. */
@@ -220,6 +224,9 @@ struct rcb_monitor {
   double *dssum;       /* ncand x RCB_MONITOR_MAXP: sum of each candidate's s */
   double dthsum[RCB_MONITOR_MAX_TRACKED]; /* sum of the steps */
   double *dY;          /* k: work, the accumulated change */
+
+  uint64_t img_fp;     /* the commissioning image's fingerprint of the inputs
+                          (monitor_image.c) */
 };
 
 /* Updates the drift test looks back over, and the onsets it tries within
@@ -253,7 +260,7 @@ void rcb_mon_model_restore(rcb_monitor *mon, const mon_cand *c);
  * (it marks the candidates it takes: c->ep); the change of every point's
  * model value (SI, channel-major) for tracked steps theta and, with c
  * (c->ep set), candidate c's parameters at neutral + s; free. */
-rcb_status rcb_mon_lowrank_init(rcb_monitor *mon);
+rcb_status rcb_mon_lowrank_init(rcb_monitor *mon, const struct mon_image *im);
 rcb_status rcb_mon_lowrank_change(rcb_monitor *mon, const double *theta, const mon_cand *c,
                                   const double *s, rcb_complex *dm);
 void rcb_mon_lowrank_free(rcb_monitor *mon, mon_lowrank *lr);
@@ -266,7 +273,9 @@ rcb_status rcb_mon_curvature(rcb_monitor *mon);
 /* monitor_rank.c: the QR of the whitened columns J (n x ncol; the basis
  * made explicit in mon->Q), then the rank space; J's block becomes mon->Q. */
 rcb_status rcb_mon_factor(rcb_monitor *mon, rcb_diag *d, const double *J, size_t ncol);
-rcb_status rcb_mon_rank_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl, double *J);
+/* With im (a commissioning image, J NULL): G from it, Q already in place. */
+rcb_status rcb_mon_rank_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl, double *J,
+                              const struct mon_image *im);
 
 /* monitor_create.c's pieces used by the update */
 void rcb_mon_whiten(const rcb_monitor *mon, const rcb_complex *d, double *r);
@@ -312,5 +321,25 @@ void rcb_mon_drift_update(rcb_monitor *mon, const double *theta, int gls,
 void rcb_mon_drift_reset(rcb_monitor *mon);
 /* The one naming rule's BIC change of a score with dof degrees of freedom. */
 double rcb_mon_bic(const rcb_monitor *mon, double score, size_t dof);
+
+/* monitor_image.c: the commissioning image (rcb_monitor_image_save). Byte
+ * offsets of its sections once checked (rcb_mon_image_open: every
+ * dimension, the fingerprint, the checksum, every value finite). */
+typedef struct mon_image {
+  const unsigned char *p;
+  size_t k;          /* rank */
+  int lr;            /* the low-rank path was taken */
+  size_t lnp, lnin;  /* its |P| and inputs */
+  size_t g, a, ep;   /* offsets of G, the low-rank blocks, the candidates' flags
+                        (Q at the head's end) */
+} mon_image;
+uint64_t rcb_mon_image_fingerprint(const rcb_monitor *mon, const rcb_diag *d,
+                                   const struct col_plan *pl, unsigned effects);
+rcb_status rcb_mon_image_open(rcb_monitor *mon, const void *buf, size_t size, uint64_t fp,
+                              size_t ncol, size_t ncand, mon_image *im);
+/* n doubles of the image from byte offset at into x. */
+void rcb_mon_image_doubles(const mon_image *im, size_t at, double *x, size_t n);
+/* The low-rank blocks and the check's outcome into lr (after its layout). */
+rcb_status rcb_mon_image_lowrank(rcb_monitor *mon, const mon_image *im, mon_lowrank *lr);
 
 #endif

@@ -27,6 +27,17 @@
 #define LR_TOL 1e-7
 /* The check's step: this fraction of each tracked parameter's baseline. */
 #define LR_STEP 0.05
+/* A candidate's check step, in its standard errors at create. The sweep's
+ * change (rm - rbase, a difference of two sweeps) carries a rounding floor
+ * of about 3e-17 on the paper system (receptances up to 1e-6 m/N): at 10
+ * standard errors B1's and B2's cross-coupling changed the model by 2-3e-10,
+ * so the check read 1.0e-7 and 1.6e-7 (rounding, not a non-affine
+ * parameter), failed against LR_TOL, and their joint step ran by sweeps
+ * (the alarmed update 39 ms against 4.7 ms, bench_monitor 'changed'). At
+ * 100 the smallest change of any candidate is 2e-9 and the worst check
+ * 2.6e-8, 4 times under LR_TOL; a parameter that does not enter Z affinely
+ * shows more clearly at the larger step, not less. */
+#define LR_CAND_STEP 100.0
 
 
 /* Index of matrix row r in P (appending it if new; np capped by cap). */
@@ -311,8 +322,8 @@ static double mismatch(rcb_monitor *mon, const double *theta, const mon_cand *c,
 }
 
 /* Does the low-rank change equal the sweep's, at theta = LR_STEP t0 for the
- * tracked parameters (*ok), and at ten standard errors of each candidate
- * taken (c->ep, reset for one that does not)? */
+ * tracked parameters (*ok), and at LR_CAND_STEP standard errors of each
+ * candidate taken (c->ep, reset for one that does not)? */
 static rcb_status check(rcb_monitor *mon, int *ok) {
   double theta[RCB_MONITOR_MAX_TRACKED], zero[RCB_MONITOR_MAX_TRACKED] = {0}, s[RCB_MONITOR_MAXP];
   rcb_complex *dm = rcb_mon_alloc(mon, mon->npt, sizeof *dm);
@@ -331,7 +342,7 @@ static rcb_status check(rcb_monitor *mon, int *ok) {
     int good;
     if (!c->ep) continue;
     for (a = 0; !sc && a < c->np; a++) {
-      s[a] = 10.0 * c->se[a];
+      s[a] = LR_CAND_STEP * c->se[a];
       sc = rcb_model_set_param(mon->model, c->pname[a], c->neutral[a] + s[a]);
     }
     good = !sc && mismatch(mon, zero, c, s, dm, &sc) <= LR_TOL;
@@ -363,7 +374,8 @@ void rcb_mon_lowrank_free(rcb_monitor *mon, mon_lowrank *lr) {
 
 /* The low-rank path when it applies (mon->lr), else none (mon->lr NULL):
  * an error only for memory. */
-static rcb_status lowrank_try(rcb_monitor *mon, mon_lowrank *lr, rcb_meas_dofs *md) {
+static rcb_status lowrank_try(rcb_monitor *mon, mon_lowrank *lr, rcb_meas_dofs *md,
+                              const mon_image *im) {
   size_t c;
   rcb_status st;
   int ok;
@@ -374,19 +386,26 @@ static rcb_status lowrank_try(rcb_monitor *mon, mon_lowrank *lr, rcb_meas_dofs *
   lr->speed = rcb_meas_speed(mon->setup);
   if ((st = layout(mon, lr, md->nin))) return st == RCB_ERR_NOMEM ? st : RCB_OK;
   for (c = 0; c < mon->nch; c++) lr->ch_in[c] = md->ch_in[c];
+  if (im) { /* the blocks and the check's outcome as a full create made them */
+    if (!im->lr) return RCB_OK;
+    if ((st = rcb_mon_image_lowrank(mon, im, lr))) return st;
+    mon->lr = lr;
+    return RCB_OK;
+  }
   if ((st = blocks(mon, lr, md))) return st == RCB_ERR_NOMEM ? st : RCB_OK;
   mon->lr = lr;
   if ((st = check(mon, &ok)) || !ok) mon->lr = NULL;
   return st;
 }
 
-rcb_status rcb_mon_lowrank_init(rcb_monitor *mon) {
+rcb_status rcb_mon_lowrank_init(rcb_monitor *mon, const mon_image *im) {
   mon_lowrank *lr;
   rcb_meas_dofs md;
   size_t nch = mon->nch;
   rcb_status st;
   if (!mon->nt || !mon->relin || rcb_meas_get_type(mon->setup) != RCB_MEAS_FRF)
-    return RCB_OK; /* the sweep re-evaluates */
+    return im && im->lr ? rcb_mon_fail(mon, RCB_ERR_OTHER_SETUP, "commissioning image: a "
+                                       "low-rank path this monitor has not") : RCB_OK;
   memset(&md, 0, sizeof md);
   lr = rcb_mon_alloc(mon, 1, sizeof *lr);
   md.ch_out = rcb_mon_alloc(mon, 2 * nch, sizeof *md.ch_out);
@@ -394,10 +413,14 @@ rcb_status rcb_mon_lowrank_init(rcb_monitor *mon) {
   st = lr && md.ch_out && md.outs ? RCB_OK : RCB_ERR_NOMEM;
   if (!st) {
     md.ch_in = md.ch_out + nch, md.ins = md.outs + nch;
-    st = lowrank_try(mon, lr, &md);
+    st = lowrank_try(mon, lr, &md, im);
   }
   rcb_free(&mon->alloc, md.outs);
   rcb_free(&mon->alloc, md.ch_out);
   if (!mon->lr) rcb_mon_lowrank_free(mon, lr); /* not applicable: the sweep re-evaluates */
-  return st ? rcb_mon_fail(mon, st, "out of memory (re-linearisation blocks)") : RCB_OK;
+  if (st == RCB_ERR_NOMEM) return rcb_mon_fail(mon, st, "out of memory (re-linearisation blocks)");
+  if (!st && im && im->lr && !mon->lr)
+    st = rcb_mon_fail(mon, RCB_ERR_OTHER_SETUP, "commissioning image: a low-rank path this "
+                      "monitor has not");
+  return st; /* an image's refusal keeps its message */
 }

@@ -205,8 +205,10 @@ static void transpose_q(rcb_monitor *mon, double *Qr) {
   mon->Q = Qr;
 }
 
-/* J (n x ncol >= n x k) is used up: Q moves into its block. */
-rcb_status rcb_mon_rank_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl, double *J) {
+/* J (n x ncol >= n x k) is used up: Q moves into its block. With a
+ * commissioning image G is its, and Q (row-major) was taken from it. */
+rcb_status rcb_mon_rank_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl, double *J,
+                              const mon_image *im) {
   size_t k = mon->k, nt = mon->nt, pmax = nt + RCB_MONITOR_MAXP, lw, pq;
   double q1 = 0, q2 = 0;
   mon_small *w = &mon->sw;
@@ -238,10 +240,13 @@ rcb_status rcb_mon_rank_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
   if (!(w->work = rcb_mon_alloc(mon, lw, sizeof *w->work)))
     return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (rank space)");
   w->lwork = lw;
-  project(mon, J, pl->ncol, mon->G);
+  if (im)
+    rcb_mon_image_doubles(im, im->g, mon->G, k * pl->ncol);
+  else
+    project(mon, J, pl->ncol, mon->G);
   if ((st = tracked_space(mon, mon->G, w)) || (st = cand_space(mon, d, pl, mon->G, w)))
     return st;
-  transpose_q(mon, J);
+  if (!im) transpose_q(mon, J);
   return RCB_OK;
 }
 

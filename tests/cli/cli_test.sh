@@ -990,9 +990,15 @@ monitor_state)
   run monitor "$MODEL" --state "$W/s.rcbmon" "$W/again.csv"; expect_rc 3; err_has "taken once"
   cmp -s "$W/s.rcbmon" "$W/s.orig" || fail "a refused update changed the state"
   usage monitor "$MODEL" --state "$W/s.rcbmon" --noise 5,1 "$W/m4.csv"; err_has "--noise"
+  # the commissioning image beside the state (issue #34 item 5): a damaged one
+  # is not used (the run commissions in full, same results) and is written again
+  [ -s "$W/s.rcbmon.image" ] || fail "no commissioning image beside the state"
+  cp "$W/s.rcbmon.image" "$W/image.orig"
+  printf 'x' | dd of="$W/s.rcbmon.image" bs=1 seek=4000 conv=notrunc 2>/dev/null
   run monitor "$MODEL" --state "$W/s.rcbmon" "$W/m4.csv" --log "$W/st.json"; expect_rc 0
   cmp -s "$W/all.json" "$W/st.json" || fail "the state's log differs from the one-shot run's"
-  ls "$W" | grep -q 's.rcbmon.' && fail "temporary state left behind"
+  cmp -s "$W/s.rcbmon.image" "$W/image.orig" || fail "a damaged image was not written again"
+  ls "$W" | grep 's.rcbmon.' | grep -qv '^s.rcbmon.image$' && fail "temporary state left behind"
   : ;;
 monitor_sd)
   # per-point sds: one --sd file for every update, or a directory of STEM_stats.csv

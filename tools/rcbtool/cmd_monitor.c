@@ -90,7 +90,11 @@ const char cli_help_monitor[] =
     "                  rename; a crash leaves the previous state). --log and --plot\n"
     "                  then cover the whole series, so with no NEW file they rebuild\n"
     "                  them from the state. One run at a time: another run on FILE\n"
-    "                  waits up to RCB_LOCK_WAIT s (default 10), then exits 6\n"
+    "                  waits up to RCB_LOCK_WAIT s (default 10), then exits 6.\n"
+    "                  FILE.image beside it keeps what commissioning computed\n"
+    "                  (megabytes), so a run per file skips it (the same\n"
+    "                  results); missing or not this series' (a changed model),\n"
+    "                  the run commissions in full and writes it again\n"
     "Units: error, floor %; T and its threshold have no unit; parameters in SI\n"
     "(N/m, N s/m, N m/rad, N m s/rad, kg). Exit codes: 0 ok (alarms or not), 2\n"
     "usage, 3 bad input (a missing or empty DIR, a file whose channels, points or\n"
@@ -470,6 +474,13 @@ int cmd_monitor(int argc, char **argv) {
                    j.commission == 1 ? "s" : "");
     goto done;
   }
+  if (state) { /* the commissioning image beside it, read and rewritten */
+    if (!(j.image = mon_image_path(state))) {
+      rc = cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+      goto done;
+    }
+    cli_plan_output(j.image, "--state image", CLI_IO_INOUT);
+  }
   if ((rc = guard_outputs(&j))) goto done;
   rc = mon_run(&a, &j);
 done:
@@ -477,6 +488,7 @@ done:
   mon_series_free(&j.series);
   mon_saved_free(&saved);
   free(sargv);
+  free(j.image);
   free(j.setopts);
   free(args);
   free((void *)series);

@@ -58,6 +58,7 @@ typedef struct mon_job {
   char **setopts;      /**< the settings' options of this command line (to store) */
   size_t nsetopts;
   size_t resume;       /**< first file of the series to update (0: after commissioning) */
+  char *image;         /**< --state: FILE.image, the commissioning image (owned) */
 } mon_job;
 
 /** The measurement that would separate tracked parameter @c tracked from
@@ -113,6 +114,14 @@ void mon_saved_free(mon_saved *sv);
 /** Write @p sv to a temporary for @p path (written and fsync'ed; the caller
  * renames it with cli_tmpfile_close); 0 or an exit code. */
 int mon_saved_write(const char *cmd, const char *path, mon_saved *sv, cli_tmpfile *t);
+/** --state FILE: the commissioning image's path, FILE.image (malloc'ed;
+ * NULL when out of memory) (cmd_monitor_image.c). */
+char *mon_image_path(const char *state);
+/** Its bytes into *buf (malloc'ed), 1; 0 when there is none to read. */
+int mon_image_read(const char *path, void **buf, size_t *n);
+/** Write @p mon's commissioning image to a temporary for @p path (renamed by
+ * the caller with the other outputs); 0 or an exit code. */
+int mon_image_write(const char *cmd, const char *path, const rcb_monitor *mon, cli_tmpfile *t);
 /** FNV-1a 64 of the bytes of @p path; *ok 0 when it cannot be read. */
 uint64_t mon_file_hash(const char *path, int *ok);
 

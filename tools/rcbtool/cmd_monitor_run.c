@@ -96,6 +96,8 @@ typedef struct mon_ctx {
   rcb_meas *setup; /* the first commissioning file, its values the average */
   rcb_meas *avg;   /* with --commission N > 1: the set-up holding the average */
   uint64_t *hash;  /* --state: the new files' content hashes */
+  void *image;     /* --state: the commissioning image read */
+  int new_image;   /* --state: write the image (none, or not this monitor's) */
   size_t n, nc, *perm;
   rcb_complex *values;
   double *sd;
@@ -213,7 +215,7 @@ static int create_monitor(mon_ctx *x, rcb_monitor **mon) {
   double cov[RCB_MONITOR_MAX_TRACKED * RCB_MONITOR_MAX_TRACKED];
   rcb_monitor_opts o;
   rcb_meas *avg = NULL;
-  rcb_status st;
+  rcb_status st = RCB_OK;
   size_t k;
   int rc;
   memset(&o, 0, sizeof o);
@@ -248,7 +250,18 @@ static int create_monitor(mon_ctx *x, rcb_monitor **mon) {
     o.baseline_cov = cov;
   }
   if (x->j->commission > 1 && (rc = averaged_setup(x, &avg))) return rc;
-  st = rcb_monitor_create(mon, x->m, avg ? avg : x->setup, &o, NULL);
+  /* --state: from the commissioning image when there is a good one (then
+   * not rewritten), else in full (rcb_monitor_opts.image) */
+  x->new_image = x->j->image != NULL;
+  if (x->j->image && x->j->saved && mon_image_read(x->j->image, &x->image, &o.image_size)) {
+    o.image = x->image;
+    st = rcb_monitor_create(mon, x->m, avg ? avg : x->setup, &o, NULL);
+    if (st == RCB_ERR_OTHER_SETUP || st == RCB_ERR_CORRUPT || st == RCB_ERR_VERSION)
+      rcb_monitor_destroy(*mon), *mon = NULL, o.image = NULL, o.image_size = 0;
+    else
+      x->new_image = 0;
+  }
+  if (!o.image) st = rcb_monitor_create(mon, x->m, avg ? avg : x->setup, &o, NULL);
   x->avg = avg; /* kept for --state */
   if (st)
     return cli_fail(st == RCB_ERR_ARG || st == RCB_ERR_NOT_FOUND ? CLI_EXIT_INPUT
@@ -586,9 +599,10 @@ int mon_run(const cli_args *a, const mon_job *j) {
   mon_state s;
   rcb_monitor *mon = NULL;
   cli_out o;
-  cli_tmpfile st;
+  cli_tmpfile st, it;
   int rc;
   memset(&st, 0, sizeof st);
+  memset(&it, 0, sizeof it);
   memset(&x, 0, sizeof x);
   memset(&s, 0, sizeof s);
   memset(&o, 0, sizeof o);
@@ -612,12 +626,23 @@ int mon_run(const cli_args *a, const mon_job *j) {
     cli_out_abort(&o);
     goto done;
   }
+  if (x.new_image && (rc = mon_image_write(a->cmd, j->image, mon, &it))) {
+    cli_tmpfile_close(&st, 0);
+    cli_out_abort(&o);
+    goto done;
+  }
   if ((rc = cli_out_flush(&o)) || (rc = mon_write_outputs(&s))) {
     if (j->state) cli_tmpfile_close(&st, 0);
+    if (x.new_image) cli_tmpfile_close(&it, 0);
     cli_out_abort(&o);
     goto done;
   }
   if (j->state && (rc = cli_tmpfile_close(&st, 1))) {
+    if (x.new_image) cli_tmpfile_close(&it, 0);
+    cli_out_abort(&o);
+    goto done;
+  }
+  if (x.new_image && (rc = cli_tmpfile_close(&it, 1))) {
     cli_out_abort(&o);
     goto done;
   }
@@ -626,6 +651,7 @@ done:
   rcb_monitor_destroy(mon);
   rcb_meas_destroy(x.avg);
   free(x.hash);
+  free(x.image);
   rcb_meas_destroy(x.setup);
   rcb_model_destroy(x.m);
   free(x.perm);

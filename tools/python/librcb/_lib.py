@@ -179,7 +179,7 @@ class MonitorOpts(ctypes.Structure):
                 ("beta_a", c_double), ("beta_s", c_double), ("sd", c_void_p),
                 ("setup_averages", c_double), ("effects", ctypes.c_uint), ("top", c_size_t),
                 ("relinearise", c_size_t), ("reweight", c_int), ("phase_deg", c_double),
-                ("baseline_cov", c_void_p)]
+                ("baseline_cov", c_void_p), ("image", c_void_p), ("image_size", c_size_t)]
 
 
 class MonitorCandidate(ctypes.Structure):
