@@ -946,6 +946,123 @@ static void test_uff_time_records(void **state) {
   rcb_signals_destroy(s);
 }
 
+/* Impact hits (issue #35): the pulse of a half-sine of T samples has the width
+ * T (1 - 2 asin(0.05) / pi) above 5 % of its peak (closed form); a second
+ * pulse of 30 % is a double hit, of 8 % not (default fraction 0.1). */
+static void test_hit_pulse(void **state) {
+  enum { N = 2000 };
+  static double f[N];
+  const double rate = 10000.0, T = 0.002, pi = 3.14159265358979323846;
+  rcb_hit_pulse h;
+  size_t i;
+  (void)state;
+  for (i = 0; i < N; i++) {
+    double t = (double)i / rate - 0.01;
+    f[i] = t >= 0.0 && t <= T ? -400.0 * sin(pi * t / T) : 0.0; /* a negative pulse */
+  }
+  assert_int_equal(rcb_hit_pulse_find(f, N, rate, 0.0, &h), RCB_OK);
+  assert_true(fabs(h.peak + 400.0) < 1e-9 && !h.double_hit && h.second < 1e-12);
+  assert_true(fabs(h.width / (T * (1.0 - 2.0 * asin(0.05) / pi)) - 1.0) < 2e-3);
+  assert_true(fabs(h.start - 0.01 - T * asin(0.05) / pi) < 2e-6);
+  for (i = 0; i < N; i++) {
+    double t = (double)i / rate - 0.04;
+    f[i] += t >= 0.0 && t <= T ? -120.0 * sin(pi * t / T) : 0.0;
+  }
+  assert_int_equal(rcb_hit_pulse_find(f, N, rate, 0.0, &h), RCB_OK);
+  assert_true(h.double_hit && fabs(h.second - 0.3) < 1e-9 && fabs(h.second_time - 0.041) < 1e-9);
+  assert_int_equal(rcb_hit_pulse_find(f, N, rate, 0.5, &h), RCB_OK); /* 30 % < 50 % */
+  assert_false(h.double_hit);
+  for (i = 0; i < N; i++) f[i] = 0.0;
+  assert_int_equal(rcb_hit_pulse_find(f, N, rate, 0.0, &h), RCB_OK);
+  assert_true(h.peak == 0.0 && !h.double_hit);
+  assert_int_equal(rcb_hit_pulse_find(f, N, rate, 1.0, &h), RCB_ERR_ARG);
+}
+
+/* A decaying 60 Hz response clipped at 60 % of its peak: the run at the clip
+ * level is counted; the unclipped one has none; a declared range is met. */
+static void test_hit_overload(void **state) {
+  enum { N = 8192 };
+  static double y[N];
+  const double rate = 8192.0, pi = 3.14159265358979323846;
+  rcb_hit_overload o;
+  size_t i, top = 0;
+  (void)state;
+  for (i = 0; i < N; i++) y[i] = exp(-7.5 * (double)i / rate) * sin(2 * pi * 60.0 * (double)i / rate);
+  assert_int_equal(rcb_hit_overload_find(y, N, 0, 0.0, &o), RCB_OK);
+  assert_false(o.overload);
+  assert_true(o.run == 1);
+  for (i = 0; i < N; i++) {
+    if (y[i] > 0.6) y[i] = 0.6, top++;
+    if (y[i] < -0.6) y[i] = -0.6;
+  }
+  assert_int_equal(rcb_hit_overload_find(y, N, 0, 0.0, &o), RCB_OK);
+  assert_true(o.overload && !o.at_range && o.level == 0.6 && o.run >= 5 && o.run < top);
+  for (i = 0; i < N; i++) y[i] = exp(-7.5 * (double)i / rate) * sin(2 * pi * 60.0 * (double)i / rate);
+  assert_int_equal(rcb_hit_overload_find(y, N, 0, 0.9, &o), RCB_OK);
+  assert_true(o.overload && o.at_range && o.level >= 0.9 && o.at > 0);
+  assert_int_equal(rcb_hit_overload_find(y, N, 1, 0.0, &o), RCB_ERR_ARG);
+}
+
+/* Five pulses in a stream, each with a bounce inside its hold-off: five hits
+ * starting pre samples before their crossings; one too near the start. */
+static void test_hit_triggers(void **state) {
+  enum { N = 10000, LEN = 1500, PRE = 50 };
+  static double f[N];
+  static const size_t at[6] = {20, 1000, 3000, 4600, 6100, 8400};
+  size_t starts[8], count = 0, partial = 0, i, k;
+  (void)state;
+  for (k = 0; k < 6; k++)
+    for (i = 0; i < 10; i++) {
+      f[at[k] + i] = 100.0 * sin(3.14159265358979323846 * (double)i / 10.0);
+      f[at[k] + 300 + i] = 40.0 * sin(3.14159265358979323846 * (double)i / 10.0); /* bounce */
+    }
+  assert_int_equal(rcb_hit_triggers(f, N, 20.0, PRE, LEN, NULL, 0, &count, &partial), RCB_OK);
+  assert_int_equal(count, 4); /* 20: before the start; 1000 within its hold-off (to 1470) */
+  assert_int_equal(partial, 1);
+  assert_int_equal(rcb_hit_triggers(f, N, 20.0, PRE, LEN, starts, 8, &count, &partial), RCB_OK);
+  assert_int_equal(starts[0], 3001 - PRE);
+  assert_int_equal(starts[1], 4601 - PRE);
+  assert_int_equal(starts[2], 6101 - PRE);
+  assert_int_equal(starts[3], 8401 - PRE);
+  assert_int_equal(rcb_hit_triggers(f, N, -20.0, PRE, LEN, NULL, 0, &count, &partial), RCB_OK);
+  assert_int_equal(count + partial, 0); /* a falling level: the pulses never go below -20 */
+  assert_int_equal(rcb_hit_triggers(f, N, 20.0, LEN, LEN, NULL, 0, &count, &partial), RCB_ERR_ARG);
+}
+
+/* A UFF file with two records of each channel (two hits): joined end to end
+ * when asked, refused otherwise; a channel short of a record is refused. */
+static void test_uff_hit_records(void **state) {
+  const char *p = rcb_test_tmp_path("hits.uff");
+  const double v1[4] = {1.0, -2.0, 0.5, 4.0}, v2[4] = {3.0, 5.0, -1.0, 2.0};
+  rcb_uff_node map[] = {{1, "DA"}, {2, "H"}};
+  rcb_signals *s;
+  const double *x;
+  FILE *fp = fopen(p, "w");
+  (void)state;
+  assert_non_null(fp);
+  time_rec(fp, 1, 1, 8, "mm", v1);
+  time_rec(fp, 2, 1, 13, "N", v1);
+  time_rec(fp, 1, 1, 8, "mm", v2);
+  time_rec(fp, 2, 1, 13, "N", v2);
+  fclose(fp);
+  assert_int_equal(rcb_signals_create(&s, NULL), RCB_OK);
+  assert_int_equal(rcb_signals_read_uff(s, p, 2, map), RCB_ERR_PARSE);
+  assert_non_null(strstr(rcb_signals_errmsg(s), "channel 'DA.x' again (first in record 1)"));
+  rcb_signals_set_join_records(s, 1);
+  if (rcb_signals_read_uff(s, p, 2, map)) fail_msg("%s", rcb_signals_errmsg(s));
+  assert_int_equal(rcb_signals_record_count(s), 2);
+  assert_int_equal(rcb_signals_length(s), 8);
+  rcb_signals_channel(s, 1, NULL, NULL, &x);
+  assert_true(x[1] == -2.0 && x[4] == 3.0 && x[7] == 2.0);
+  fp = fopen(p, "a");
+  time_rec(fp, 1, 1, 8, "mm", v2);
+  fclose(fp);
+  assert_int_equal(rcb_signals_read_uff(s, p, 2, map), RCB_ERR_PARSE);
+  assert_non_null(strstr(rcb_signals_errmsg(s), "channel 'DA.x' has 3 records, 'H.x' has 2"));
+  assert_int_equal(rcb_signals_channel_count(s), 0);
+  rcb_signals_destroy(s);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_white_noise_level),
@@ -964,6 +1081,10 @@ int main(void) {
       cmocka_unit_test(test_order_fit_nyquist),
       cmocka_unit_test(test_order_sd_near_resonance),
       cmocka_unit_test(test_uff_time_records),
+      cmocka_unit_test(test_hit_pulse),
+      cmocka_unit_test(test_hit_overload),
+      cmocka_unit_test(test_hit_triggers),
+      cmocka_unit_test(test_uff_hit_records),
   };
   return cmocka_run_group_tests(tests, rcb_test_setup_tmpdir, rcb_test_teardown_tmpdir);
 }

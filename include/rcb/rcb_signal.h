@@ -147,6 +147,95 @@ RCB_API rcb_status rcb_signals_read_wav(rcb_signals *s, const char *path, size_t
 RCB_API rcb_status rcb_signals_read_uff(rcb_signals *s, const char *path, size_t nmap,
                                         const rcb_uff_node *map);
 
+/**
+ * @brief Join the records of a channel that a UFF file holds several times
+ * (default 0: refused as a channel given twice). With @p join nonzero,
+ * rcb_signals_read_uff appends the k-th record of each channel after its
+ * (k-1)-th: an impact test written as one record per channel per hit becomes
+ * channels of rcb_signals_record_count() records of equal length, end to end.
+ * Every channel must then have the same number of records (refused otherwise,
+ * naming the file and the channels).
+ */
+RCB_API rcb_status rcb_signals_set_join_records(rcb_signals *s, int join);
+/** @brief Records per channel joined by the last read (1 for CSV, WAV and a UFF
+ * file with one record per channel; 0 before a read). Each is
+ * rcb_signals_length() / count samples long. */
+RCB_API size_t rcb_signals_record_count(const rcb_signals *s);
+
+/* ----------------------------------------------------- impact tests -- */
+
+/**
+ * @brief The force pulse of one hit of an impact test.
+ * The peak is the sample of largest magnitude (its sign is the pulse's); the
+ * pulse extends on both sides to where the force, taken with that sign, first
+ * falls to the "decayed" level min(0.05, double_frac / 2) x |peak|; the width
+ * is the time between those two crossings (interpolated between samples).
+ * Any other sample beyond the pulse (before or after it) whose signed force
+ * exceeds double_frac x |peak| is a second pulse: a double hit (the hammer
+ * bounced, or the structure struck back). Two pulses that overlap above the
+ * decayed level are one pulse to this test (its width shows them).
+ */
+typedef struct rcb_hit_pulse {
+  double peak;          /**< force at the peak, signed (unit of the samples, N) */
+  double peak_time;     /**< s from the hit's first sample */
+  double width;         /**< s, between the crossings of the decayed level */
+  double start, end;    /**< s from the first sample: where the pulse begins and ends */
+  double second;        /**< largest other pulse / |peak| (0 if none, 0 <= second) */
+  double second_time;   /**< s from the first sample (0 if none) */
+  int double_hit;       /**< 1 if second > double_frac */
+} rcb_hit_pulse;
+
+/**
+ * @brief Find a hit's force pulse and whether it is a double hit.
+ * @param force @p n samples at @p rate samples/s
+ * @param double_frac fraction of the peak above which a second pulse is a
+ * double hit, 0 < double_frac < 1 (0: 0.1)
+ * @return RCB_ERR_ARG for bad arguments; a force that is 0 throughout gives
+ * peak 0, width 0 and no double hit (the caller decides what a hit without a
+ * pulse is).
+ */
+RCB_API rcb_status rcb_hit_pulse_find(const double *force, size_t n, double rate,
+                                      double double_frac, rcb_hit_pulse *out);
+
+/** @brief Overload of one channel in one hit (rcb_hit_overload_find). */
+typedef struct rcb_hit_overload {
+  int overload;   /**< 1 if clipped or at the declared range */
+  int at_range;   /**< 1 if a sample reached the declared range */
+  size_t run;     /**< longest run of equal samples at an extreme (see below) */
+  double level;   /**< the clipped value (the run's, or the first sample at range) */
+  size_t at;      /**< index of the run's (or that sample's) first sample */
+} rcb_hit_overload;
+
+/**
+ * @brief Whether a channel was clipped (its recorder overloaded) in a hit.
+ * Clipping shows as a run of @p min_run or more consecutive samples exactly
+ * equal to the channel's largest or smallest value in the hit; an extreme
+ * counts if it is not 0 and its magnitude is at least half the channel's
+ * largest (a flat top, not a quiet stretch). With @p range > 0 (the recorder's
+ * declared full scale, unit of the samples), any |sample| >= range (1 - 1e-9)
+ * is an overload as well. A channel recorded at a few per cent of a
+ * quantizing recorder's scale can show equal samples at a slow peak: raise
+ * @p min_run or declare the range.
+ * @param min_run 2 or more (0: 5)
+ */
+RCB_API rcb_status rcb_hit_overload_find(const double *x, size_t n, size_t min_run,
+                                         double range, rcb_hit_overload *out);
+
+/**
+ * @brief Cut a long recording into hits at the crossings of a trigger level.
+ * A crossing is the first sample at or beyond @p level after a sample short of
+ * it (rising for level > 0, falling for level < 0); its hit starts @p pre
+ * samples before it and is @p length samples long; the next crossing is looked
+ * for from the hit's end on (the hold-off: a hit's own pulse, ringing or
+ * bounce does not start another). Two-call: the first @p cap starts go to
+ * @p starts (may be NULL with cap 0), *count is the number of whole hits;
+ * crossings whose hit would begin before the first sample or end after the
+ * last are counted in *partial (not in starts).
+ */
+RCB_API rcb_status rcb_hit_triggers(const double *force, size_t n, double level, size_t pre,
+                                    size_t length, size_t *starts, size_t cap, size_t *count,
+                                    size_t *partial);
+
 /* ------------------------------------------------------- estimation -- */
 
 /** @brief Segment window. */

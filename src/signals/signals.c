@@ -27,6 +27,7 @@ void rcb_signals_empty(rcb_signals *s) {
   for (i = 0; i < s->nch; i++) rcb_free(&s->alloc, s->ch[i].v);
   s->nch = 0;
   s->n = 0;
+  s->nrec = 0;
   s->rate = 0.0;
 }
 
@@ -56,6 +57,16 @@ rcb_status rcb_signals_set_allow_truncated(rcb_signals *s, int allow) {
   if (!s) return RCB_ERR_ARG;
   s->allow_truncated = allow != 0;
   return RCB_OK;
+}
+
+rcb_status rcb_signals_set_join_records(rcb_signals *s, int join) {
+  if (!s) return RCB_ERR_ARG;
+  s->join_records = join != 0;
+  return RCB_OK;
+}
+
+size_t rcb_signals_record_count(const rcb_signals *s) {
+  return s && s->nch ? (s->nrec ? s->nrec : 1) : 0;
 }
 
 rcb_status rcb_signals_set_unit(rcb_signals *s, const char *name, const char *unit) {

@@ -60,7 +60,9 @@ struct rcb_signals {
   size_t n;    /* samples per channel */
   rcb_signal_ch *ch;
   size_t nch, capch;
+  size_t nrec;             /* records per channel joined end to end (0: one) */
   int allow_truncated;     /* rcb_signals_set_allow_truncated */
+  int join_records;        /* rcb_signals_set_join_records */
   rcb_warning_t *warnings; /* of the last read */
   size_t nwarn, capwarn;
   rcb_signal_unit *units;  /* rcb_signals_set_unit */

@@ -1,7 +1,9 @@
 /*
  * Time signals from UFF dataset 58 time records (function type 1, abscissa
  * type 17), read by io's uff58 reader in time mode (io/meas_internal.h): one
- * channel per record, all with one sample interval and length.
+ * channel per record, all with one sample interval and length; with
+ * rcb_signals_set_join_records, a channel's further records (one per hit of
+ * an impact test) appended end to end.
  */
 #include <math.h>
 #include <string.h>
@@ -15,6 +17,8 @@ typedef struct uff_ctx {
   double dt;
   size_t n, first, nskip;
   int failed; /* the message is in s, not in the scratch measurement */
+  size_t *rec, *idx; /* per channel: records joined, dataset ordinal of its first */
+  size_t caprec, capidx;
 } uff_ctx;
 
 /* What the model cannot use is skipped with a warning, not fatal (issue
@@ -67,6 +71,63 @@ static rcb_status unknown_label(uff_ctx *c, const rcb_uff_time_rec *r, rcb_quant
                           r->name);
 }
 
+/* The record's samples in SI, in a new buffer through the set's allocator. */
+static rcb_status values(uff_ctx *c, const rcb_uff_time_rec *r, double f, double **out) {
+  rcb_signals *s = c->s;
+  double *v = rcb_alloc(&s->alloc, r->n * sizeof *v);
+  size_t i;
+  *out = NULL;
+  if (!v) return rcb_signals_fail(s, RCB_ERR_NOMEM, "%s: out of memory", c->path);
+  for (i = 0; i < r->n; i++) {
+    v[i] = creal(r->y[i]) * f;
+    if (fabs(v[i]) > RCB_SIGNAL_MAX) {
+      double x = v[i];
+      rcb_free(&s->alloc, v);
+      return rcb_signals_fail(s, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu, value %zu is "
+                              "%g (SI): beyond %g, the largest sample librcb takes (its power "
+                              "would overflow); a corrupt value?", c->path, r->line + 12,
+                              r->index, i + 1, x, RCB_SIGNAL_MAX);
+    }
+  }
+  *out = v;
+  return RCB_OK;
+}
+
+/* A channel seen before (channel @p i): its next record appended when the
+ * caller joins records (an impact test's hits), refused otherwise. */
+static rcb_status join(uff_ctx *c, const rcb_uff_time_rec *r, rcb_quantity q, size_t i,
+                       double *v) {
+  rcb_signals *s = c->s;
+  rcb_signal_ch *ch = &s->ch[i];
+  size_t k = c->rec[i];
+  double *all;
+  if (!s->join_records || q != ch->q) {
+    rcb_free(&s->alloc, v);
+    if (!s->join_records)
+      return rcb_signals_fail(s, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu: channel '%s' "
+                              "again (first in record %zu); several records of a channel are "
+                              "read as the hits of an impact test (rcbtool estimate; "
+                              "rcb_signals_set_join_records)", c->path, r->line, r->index,
+                              r->name, c->idx[i]);
+    return rcb_signals_fail(s, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu: channel '%s' is "
+                            "%s here, %s in record %zu", c->path, r->line, r->index, r->name,
+                            rcb_quantity_name(q), rcb_quantity_name(ch->q), c->idx[i]);
+  }
+  all = rcb_alloc(&s->alloc, (k + 1) * c->n * sizeof *all);
+  if (!all) {
+    rcb_free(&s->alloc, v);
+    return rcb_signals_fail(s, RCB_ERR_NOMEM, "%s: out of memory", c->path);
+  }
+  memcpy(all, ch->v, k * c->n * sizeof *all);
+  memcpy(all + k * c->n, v, c->n * sizeof *all);
+  rcb_free(&s->alloc, ch->v);
+  rcb_free(&s->alloc, v);
+  ch->v = all;
+  c->rec[i] = k + 1;
+  c->failed = 0;
+  return RCB_OK;
+}
+
 static rcb_status take_record(void *user, const rcb_uff_time_rec *r) {
   uff_ctx *c = user;
   rcb_signals *s = c->s;
@@ -96,21 +157,33 @@ static rcb_status take_record(void *user, const rcb_uff_time_rec *r) {
                             "be sampled together", c->path, r->line + 7, r->index, r->n, r->dt,
                             c->first, c->n, c->dt);
   }
-  v = rcb_alloc(&s->alloc, r->n * sizeof *v);
-  if (!v) return rcb_signals_fail(s, RCB_ERR_NOMEM, "%s: out of memory", c->path);
-  for (i = 0; i < r->n; i++) {
-    v[i] = creal(r->y[i]) * f;
-    if (fabs(v[i]) > RCB_SIGNAL_MAX) {
-      double x = v[i];
-      rcb_free(&s->alloc, v);
-      return rcb_signals_fail(s, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu, value %zu is "
-                              "%g (SI): beyond %g, the largest sample librcb takes (its power "
-                              "would overflow); a corrupt value?", c->path, r->line + 12,
-                              r->index, i + 1, x, RCB_SIGNAL_MAX);
-    }
+  if ((st = values(c, r, f, &v))) return st;
+  if (rcb_signals_find(s, r->name, &i) == RCB_OK) return join(c, r, q, i, v);
+  if (rcb_grow(&s->alloc, (void **)&c->rec, &c->caprec, s->nch + 1, sizeof *c->rec) ||
+      rcb_grow(&s->alloc, (void **)&c->idx, &c->capidx, s->nch + 1, sizeof *c->idx)) {
+    rcb_free(&s->alloc, v);
+    return rcb_signals_fail(s, RCB_ERR_NOMEM, "%s: out of memory", c->path);
   }
+  c->rec[s->nch] = 1;
+  c->idx[s->nch] = r->index;
   if ((st = rcb_signals_take(s, r->name, q, v))) return st;
   c->failed = 0;
+  return RCB_OK;
+}
+
+/* With joined records: every channel has as many (one per hit); the set is
+ * that many records end to end. */
+static rcb_status joined(uff_ctx *c) {
+  rcb_signals *s = c->s;
+  size_t i;
+  for (i = 1; i < s->nch; i++)
+    if (c->rec[i] != c->rec[0])
+      return rcb_signals_fail(s, RCB_ERR_PARSE, "%s: channel '%s' has %zu records, '%s' has "
+                              "%zu: with several records of a channel (one per hit) every "
+                              "channel needs one for each hit", c->path, s->ch[0].name,
+                              c->rec[0], s->ch[i].name, c->rec[i]);
+  s->nrec = s->nch ? c->rec[0] : 0;
+  s->n = s->nrec * c->n;
   return RCB_OK;
 }
 
@@ -128,10 +201,13 @@ rcb_status rcb_signals_read_uff(rcb_signals *s, const char *path, size_t nmap,
   c.path = path;
   st = rcb_uff58_read_time(ms, path, nmap, map, take_record, &c);
   if (st && !c.failed) rcb_signals_fail(s, st, "%s", rcb_meas_errmsg(ms));
+  if (!st) st = joined(&c);
   if (!st && s->nch == 0)
     st = rcb_signals_fail(s, RCB_ERR_PARSE, "%s: no usable time record: all %zu were skipped "
                           "(the warnings say why)", path, c.nskip);
   if (st) rcb_signals_empty(s);
+  rcb_free(&s->alloc, c.rec);
+  rcb_free(&s->alloc, c.idx);
   rcb_meas_destroy(ms);
   return st;
 }

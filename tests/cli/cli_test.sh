@@ -676,6 +676,62 @@ for a, b in (("h1.csv", "h2.csv"), ("st1.csv", "st2.csv")):
 EOF
   run estimate "$W/s.csv" --input f=DA.x --outputs DA.x --nseg 256 --every 0 -o "$W/h3.csv"
   expect_rc 2; err_has "--every"; [ ! -e "$W/h3.csv" ] || fail "output written" ;;
+estimate_hits_bad)
+  # issue #35 item 1: hits as files. A hit file that differs from the first (length,
+  # rate, channels) is refused naming it; the hits' options with one stream, and the
+  # stream's with hits, are usage errors; nothing is written in any case.
+  hit() { # hit FILE ROWS RATE AMP2: a 60 N half-sine at sample 10 (+ one of AMP2 at 60)
+    awk -v n="$2" -v r="$3" -v a2="$4" 'BEGIN { print "# units = N,m"; print "time_s,f,DA.x";
+      for (i = 0; i < n; i++) { f = (i >= 10 && i <= 15) ? 60 * sin(3.14159265 * (i - 10) / 5) : 0;
+        if (i >= 60 && i <= 65) f += a2 * sin(3.14159265 * (i - 60) / 5);
+        y = i >= 10 ? 1e-5 * exp(-(i - 10) / 40) * sin((i - 10) / 3) : 0;
+        printf "%.17g,%.9g,%.9g\n", i / r, f + 0.01 * sin(i), y } }' >"$1"; }
+  hit "$W/h1.csv" 256 1024 0; hit "$W/h2.csv" 256 1024 0; hit "$W/h3.csv" 200 1024 0
+  hit "$W/h4.csv" 256 2048 0; hit "$W/d1.csv" 256 1024 30; hit "$W/d2.csv" 256 1024 30
+  sed 's/time_s,f,DA.x/time_s,f,DB.x/' "$W/h2.csv" >"$W/h5.csv"
+  E="--input f=DA.x --outputs DA.x"
+  run estimate "$W/h1.csv" "$W/h2.csv" $E --report "$W/r.csv" -o "$W/o.csv"
+  no_fft && exit 77; expect_rc 0; [ -s "$W/r.csv" ] || fail "no report"
+  rm -f "$W/o.csv" "$W/r.csv"
+  run estimate "$W/h1.csv" "$W/h3.csv" $E --stats "$W/s.csv" -o "$W/o.csv"
+  expect_rc 3; err_has "h3.csv: 200 samples per hit, $W/h1.csv has 256"
+  run estimate "$W/h1.csv" "$W/h4.csv" $E -o "$W/o.csv"
+  expect_rc 3; err_has "h4.csv: 2048 samples/s, $W/h1.csv has 1024"; err_has "same sample rate"
+  run estimate "$W/h1.csv" "$W/h5.csv" $E -o "$W/o.csv"
+  expect_rc 3; err_has "h5.csv: no channel 'DA.x'"
+  # every hit a double hit: none left (exit 3, the table says why)
+  run estimate "$W/d1.csv" "$W/d2.csv" $E --report "$W/r.csv" -o "$W/o.csv"
+  expect_rc 3; err_has "no hit left"; err_has "a double hit (a second pulse of 50 %"
+  run estimate "$W/d1.csv" "$W/d2.csv" $E --keep-flagged -o "$W/o.csv"
+  expect_rc 0; err_has "kept (--keep-flagged)"; rm -f "$W/o.csv"
+  usage estimate "$W/h1.csv" "$W/h2.csv" $E --nseg 128 -o "$W/o.csv"; err_has "--nseg does not apply to hits"
+  usage estimate "$W/h1.csv" "$W/h2.csv" $E --reject 3 -o "$W/o.csv"; err_has "hit numbers 1 to 2"
+  usage estimate "$W/h1.csv" "$W/h2.csv" $E --hit-length 0.1 -o "$W/o.csv"; err_has "goes with --trigger"
+  usage estimate "$W/h1.csv" "$W/h2.csv" $E --range DA.x:5kN -o "$W/o.csv"; err_has "'kN' is force, the channel is displacement"
+  usage estimate "$W/h1.csv" $E --report "$W/r.csv" -o "$W/o.csv"; err_has "--report applies to an impact test's hits"
+  usage estimate "$W/h1.csv" $E --trigger f -o "$W/o.csv"; err_has "expected CH:LEVEL[:PRE]"
+  usage estimate "$W/h1.csv" $E --trigger DA.x:1 --hit-length 0.1 -o "$W/o.csv"; err_has "the trigger is the force"
+  usage estimate "$W/h1.csv" $E --trigger f:20 -o "$W/o.csv"; err_has "--hit-length is required"
+  run estimate "$W/h1.csv" $E --trigger f:500 --hit-length 0.1 -o "$W/o.csv"
+  expect_rc 3; err_has "no hit: the force never crosses the trigger level 500 N"
+  # order takes one signals file: the extra one is not called a model
+  usage order "$W/h1.csv" "$W/h2.csv" --kp KP --outputs DA.x -o "$W/o.csv"
+  err_has "unexpected argument '$W/h2.csv' (the signals file is already '$W/h1.csv')"
+  [ ! -e "$W/o.csv" ] && [ ! -e "$W/s.csv" ] && [ ! -e "$W/r.csv" ] || fail "an output was written" ;;
+estimate_hits_trigger)
+  # --trigger on three hits end to end (pre-trigger 5 samples) gives the hits of the
+  # three files, byte for byte; a report names each hit's start
+  hit() { awk -v n=256 -v a="$2" -v t0="$3" 'BEGIN { if (t0 == 0) { print "# units = N,m"; print "time_s,f,DA.x" }
+      for (i = 0; i < n; i++) { f = (i >= 10 && i <= 15) ? a * sin(3.14159265 * (i - 10) / 5) : 0;
+        y = i >= 10 ? 1e-5 * a / 60 * exp(-(i - 10) / 40) * sin((i - 10) / 3 + a) : 0;
+        printf "%.17g,%.9g,%.9g\n", (t0 + i) / 1024, f + 0.01 * sin(i * a), y } }'; }
+  hit x 60 0 >"$W/h1.csv"; hit x 70 0 >"$W/h2.csv"; hit x 50 0 >"$W/h3.csv"
+  { hit x 60 0; hit x 70 256 | cat; hit x 50 512; } >"$W/all.csv"
+  E="--input f=DA.x --outputs DA.x"
+  run estimate "$W/h1.csv" "$W/h2.csv" "$W/h3.csv" $E -o "$W/a.csv"; no_fft && exit 77; expect_rc 0
+  run estimate "$W/all.csv" $E --trigger f:20N:0.0107421875 --hit-length 0.25 --report "$W/r.csv" -o "$W/b.csv"
+  expect_rc 0; cmp -s "$W/a.csv" "$W/b.csv" || fail "trigger and files differ"
+  grep -q "^3,$W/all.csv,1,0.5," "$W/r.csv" || fail "report: hit 3 at 0.5 s" ;;
 order_conventions)
   # issue #25: --phase lag|lead and --kp-edge rising|falling, stated in the CSV
   # and --help. A notch keyphasor (falling through 2.5 V at the shaft's angle

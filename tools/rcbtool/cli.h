@@ -51,10 +51,15 @@ typedef struct cli_file_opt {
   unsigned io;
 } cli_file_opt;
 
+/** Most positional files a command takes (estimate: one signals file per hit). */
+#define CLI_FILES_MAX 256
+
 /** A parsed command line. */
 typedef struct cli_args {
   const char *cmd;    /**< subcommand name */
-  const char *model;  /**< MODEL.ini path */
+  const char *model;  /**< MODEL.ini path (the first positional argument) */
+  const char *files[CLI_FILES_MAX]; /**< every positional argument (files[0] == model) */
+  size_t nfiles;      /**< how many (1 unless the command takes several) */
   const char *output; /**< -o FILE, NULL = stdout */
   int json;           /**< --json */
   int progress;       /**< --progress */
@@ -126,6 +131,11 @@ void cli_warn_condition(const char *cmd, const rcb_frf_condition *c, int by_spee
  * @return 0, or CLI_EXIT_USAGE after printing what is wrong.
  */
 int cli_parse(int argc, char **argv, cli_opt *opts, size_t nopts, cli_args *a);
+/** cli_parse for a command taking up to @p max_files positional files (at
+ * most CLI_FILES_MAX; estimate: one signals file per hit), each declared an
+ * input of the run. */
+int cli_parse_files(int argc, char **argv, cli_opt *opts, size_t nopts, size_t max_files,
+                    cli_args *a);
 /** The option's value, NULL if not given. */
 const char *cli_opt_value(const cli_args *a, const char *name);
 /** A finite number from option @p name (default @p def when absent). */
@@ -187,6 +197,8 @@ void cli_channels_free(cli_channels *ch);
 /** Name the run's first positional argument from the command's help text
  * ("usage: rcbtool estimate SIGNALS ..." -> "signals"); called once, from main. */
 void cli_plan_begin(const char *help);
+/** What the command's first positional argument is ("model", "signals", "input"). */
+const char *cli_plan_positional(void);
 /** Declare @p path an input ("model", "measurement", "--sd", ...); "-" is ignored. */
 void cli_plan_input(const char *path, const char *what);
 /** Declare @p path an output (@p what: "-o", "--stats", ...; @p io: CLI_IO_MKDIR or 0). */
@@ -455,6 +467,8 @@ int cli_sd_read(const char *path, const rcb_meas *ms, double **sd);
  * --allow-truncated (the command declares them); the reader's warnings
  * printed; exit code 0, 2, 3, 4. */
 int cli_signals_read(const cli_args *a, rcb_signals *s);
+/** cli_signals_read of the file @p path (estimate's further hit files). */
+int cli_signals_read_path(const cli_args *a, const char *path, rcb_signals *s);
 
 /* ---- subcommands (one file each) ---- */
 

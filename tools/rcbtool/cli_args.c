@@ -100,15 +100,27 @@ static int parse_own(cli_args *a, int argc, char **argv, int *k, int *rc) {
   return 0;
 }
 
-static int positional(cli_args *a, const char *arg) {
-  if (a->model)
-    return cli_usage(a->cmd, "unexpected argument '%s' (the model is already '%s')", arg,
-                     a->model);
-  a->model = arg;
+/* The first positional argument is the model (or the signals file, ...: what
+ * the usage line names); a command may take several files (@p max). */
+static int positional(cli_args *a, const char *arg, size_t max) {
+  if (a->nfiles >= max) {
+    if (max > 1)
+      return cli_usage(a->cmd, "unexpected argument '%s': at most %zu %s files", arg, max,
+                       cli_plan_positional());
+    return cli_usage(a->cmd, "unexpected argument '%s' (the %s file is already '%s')", arg,
+                     cli_plan_positional(), a->model);
+  }
+  a->files[a->nfiles++] = arg;
+  if (!a->model) a->model = arg;
   return 0;
 }
 
 int cli_parse(int argc, char **argv, cli_opt *opts, size_t nopts, cli_args *a) {
+  return cli_parse_files(argc, argv, opts, nopts, 1, a);
+}
+
+int cli_parse_files(int argc, char **argv, cli_opt *opts, size_t nopts, size_t max_files,
+                    cli_args *a) {
   int k, rc = 0, only_positional = 0;
   size_t i;
   memset(a, 0, sizeof *a);
@@ -119,7 +131,7 @@ int cli_parse(int argc, char **argv, cli_opt *opts, size_t nopts, cli_args *a) {
   for (k = 1; k < argc && !rc; k++) {
     const char *arg = argv[k];
     if (only_positional || arg[0] != '-' || arg[1] == '\0') {
-      rc = positional(a, arg);
+      rc = positional(a, arg, max_files < CLI_FILES_MAX ? max_files : CLI_FILES_MAX);
     } else if (strcmp(arg, "--") == 0) {
       only_positional = 1;
     } else if (!parse_common(a, argc, argv, &k, &rc) && !parse_own(a, argc, argv, &k, &rc)) {

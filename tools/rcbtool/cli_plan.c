@@ -195,9 +195,12 @@ void cli_plan_options(const cli_file_opt *files, size_t n) {
   plan.nopts = n;
 }
 
+const char *cli_plan_positional(void) { return plan.positional[0] ? plan.positional : "input"; }
+
 int cli_plan_args(const cli_args *a) {
   size_t i;
   cli_plan_input(a->model, plan.positional);
+  for (i = 1; i < a->nfiles; i++) cli_plan_input(a->files[i], plan.positional);
   cli_plan_output(a->output, "-o", 0);
   for (i = 0; i < plan.nopts; i++)
     declare(cli_opt_value(a, plan.opts[i].name), plan.opts[i].name, plan.opts[i].io);

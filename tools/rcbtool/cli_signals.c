@@ -38,7 +38,7 @@ static int list(const cli_args *a, const char *opt, char **buf, char ***items, s
   return 0;
 }
 
-static int read_wav(const cli_args *a, rcb_signals *s) {
+static int read_wav(const cli_args *a, const char *path, rcb_signals *s) {
   char *b[3] = {NULL, NULL, NULL}, **it[3] = {NULL, NULL, NULL};
   static const char *const opt[3] = {"--wav-names", "--wav-units", "--wav-scale"};
   size_t n[3] = {0, 0, 0}, k;
@@ -57,7 +57,7 @@ static int read_wav(const cli_args *a, rcb_signals *s) {
       rc = cli_usage(a->cmd, "--wav-scale item '%s' is not a number", it[2][k]);
   }
   if (!rc) {
-    st = rcb_signals_read_wav(s, a->model, n[0], (const char *const *)it[0],
+    st = rcb_signals_read_wav(s, path, n[0], (const char *const *)it[0],
                               (const char *const *)it[1], scale);
     if (st) rc = cli_fail(st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC : CLI_EXIT_INPUT, "%s",
                           cli_msg(rcb_signals_errmsg(s), st));
@@ -97,35 +97,39 @@ static void warnings(const rcb_signals *s) {
   for (w = 0; w < rcb_signals_warning_count(s); w++) cli_warn("%s", rcb_signals_warning(s, w));
 }
 
-static int read_file(const cli_args *a, rcb_signals *s);
+static int read_file(const cli_args *a, const char *path, rcb_signals *s);
 
-int cli_signals_read(const cli_args *a, rcb_signals *s) {
+int cli_signals_read_path(const cli_args *a, const char *path, rcb_signals *s) {
   int rc;
   rcb_signals_set_allow_truncated(s, cli_opt_value(a, "--allow-truncated") != NULL);
   if ((rc = unit_overrides(a, s))) return rc;
-  if (!(rc = read_file(a, s)) || rc == CLI_EXIT_INPUT) warnings(s); /* also why nothing was read */
+  if (!(rc = read_file(a, path, s)) || rc == CLI_EXIT_INPUT) warnings(s); /* also why nothing was read */
   return rc;
 }
 
-static int read_file(const cli_args *a, rcb_signals *s) {
+int cli_signals_read(const cli_args *a, rcb_signals *s) {
+  return cli_signals_read_path(a, a->model, s);
+}
+
+static int read_file(const cli_args *a, const char *path, rcb_signals *s) {
   static const char *const csv[] = {".csv", ".CSV"}, *const uff[] = {".uff", ".unv", ".uf", ".UFF", ".UNV"};
   static const char *const wav[] = {".wav", ".WAV"};
   rcb_status st;
   cli_uff_map mp;
   int rc;
-  if (ext_is(a->model, wav, 2)) return read_wav(a, s);
-  if (ext_is(a->model, csv, 2)) {
-    st = rcb_signals_read_csv(s, a->model);
-  } else if (ext_is(a->model, uff, 5)) {
+  if (ext_is(path, wav, 2)) return read_wav(a, path, s);
+  if (ext_is(path, csv, 2)) {
+    st = rcb_signals_read_csv(s, path);
+  } else if (ext_is(path, uff, 5)) {
     if ((rc = cli_uff_map_parse(a, "--map", NULL, &mp))) {
       cli_uff_map_free(&mp);
       return rc;
     }
-    st = rcb_signals_read_uff(s, a->model, mp.n, mp.nodes);
+    st = rcb_signals_read_uff(s, path, mp.n, mp.nodes);
     cli_uff_map_free(&mp);
   } else {
     return cli_usage(a->cmd, "'%s': unknown signal file type; expected .csv, .uff/.unv (UFF58 "
-                     "time records) or .wav", a->model);
+                     "time records) or .wav", path);
   }
   if (st)
     return cli_fail(st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC : CLI_EXIT_INPUT, "%s",

@@ -5,16 +5,22 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "cli.h"
+#include "cmd_estimate.h"
 
 const char cli_help_estimate[] =
-    "usage: rcbtool estimate SIGNALS --input CH --outputs CH,... -o OUT [options]\n"
+    "usage: rcbtool estimate SIGNALS [SIGNALS...] --input CH --outputs CH,... -o OUT [options]\n"
     "\n"
     "Estimates FRFs from sampled signals by Welch averaging: segments of --nseg\n"
     "samples, windowed, overlapping, averaged; H1 (default), H2 or Hv; coherence\n"
     "and the standard deviation of each line from the coherence and the number of\n"
     "averages (Bendat & Piersol). OUT (.uff/.unv: UFF dataset 58; .csv) holds the\n"
     "FRFs as a measurement that compare, fit and diagnose read.\n"
+    "Impact tests: the hits are the averages, one segment each (no overlap, the\n"
+    "mean kept, --window force-exp unless given) when SIGNALS are several files\n"
+    "(one hit each: same channels, rate and length), a UFF file holding several\n"
+    "records of each channel (one per hit), or with --trigger on a long recording.\n"
+    "Each hit is checked for a double hit and an overload; a per-hit table goes to\n"
+    "stderr (or --report FILE); a flagged hit is dropped with a warning.\n"
     "  SIGNALS        .csv: optional '# units = U1,U2,...', header 'time_s,CH1,CH2\n"
     "                 [unit],...', rows of numbers (evenly spaced time, s);\n"
     "                 .uff/.unv: UFF58 time records (function type 1, abscissa 17;\n"
@@ -33,7 +39,7 @@ const char cli_help_estimate[] =
     "                 point has force 'f=DA.x' and response 'DA.x')\n"
     "  --kind K       write receptance, mobility or inertance (default: what the\n"
     "                 first output measures; the others are converted to it)\n"
-    "  --nseg N       samples per segment (default 4096)\n"
+    "  --nseg N       samples per segment (default 4096; not with hits)\n"
     "  --overlap F    overlap fraction of a segment, 0 <= F < 1 (default 0.5)\n"
     "  --window W     hann (default), flattop, rect, force-exp (impact tests)\n"
     "  --force-frac F force window length / segment (force-exp; default 0.1)\n"
@@ -52,6 +58,26 @@ const char cli_help_estimate[] =
     "  --spectra FILE CSV: freq_hz and the averaged density spectra G (unit^2/Hz,\n"
     "                 SciPy's csd/welch scaling): 'G IN' per input, 'G IN/OUT re',\n"
     "                 'G IN/OUT im' per pair, 'G OUT' per output\n"
+    "  --trigger CH:LEVEL[:PRE]  cut each recording into hits: a hit starts PRE s\n"
+    "                 (default 2 % of --hit-length) before each crossing of LEVEL\n"
+    "                 by force channel CH (rising for LEVEL > 0, falling below 0;\n"
+    "                 N, or with a unit: 20N, 0.1kN, 5lbf); the next crossing is\n"
+    "                 looked for after the hit's end (hold-off)\n"
+    "  --hit-length S length of a hit, s (with --trigger)\n"
+    "  --double-frac F  a second force pulse above F x the peak, after the pulse\n"
+    "                 has decayed below min(5 %, F/2) of it, is a double hit\n"
+    "                 (default 0.1)\n"
+    "  --clip-run N   N or more equal samples at a channel's extreme in a hit are\n"
+    "                 clipping: an overload (default 5)\n"
+    "  --range CH:MAX,...  a channel's recorder range (SI, or with a unit: 5g,\n"
+    "                 2000N): a sample reaching it is an overload\n"
+    "  --reject N,... drop these hits (numbered as listed: files in order, their\n"
+    "                 records, their triggers)\n"
+    "  --keep-flagged keep double hits and overloads (with a warning; default:\n"
+    "                 dropped with a warning)\n"
+    "  --report FILE  CSV of the per-hit table (hit, file, record, start_s, peak_N,\n"
+    "                 width_s, second_frac, second_s, double_hit, overload,\n"
+    "                 overload_channel, kept, reason) instead of stderr\n"
     "  --map LIST     UFF node map for SIGNALS and OUT, NODE=STATION,... (as convert)\n"
     "  --binary       write binary 58b\n"
     "  --plot FILE    also draw FILE (PNG): magnitude and phase of each FRF with the\n"
@@ -63,22 +89,6 @@ const char cli_help_estimate[] =
 static const char *const window_names[] = {"hann", "flattop", "rect", "force-exp"};
 static const char *const est_names[] = {"h1", "h2", "hv"};
 static const char *const kind_names[] = {"receptance", "mobility", "inertance"};
-
-typedef struct est_job {
-  const cli_args *a;
-  rcb_signals *sig;
-  size_t p, q;
-  size_t *idx;  /* p + q channel indices into sig */
-  char *buf;    /* --input and --outputs text, split */
-  char **names; /* p + q: channel names in the file */
-  char **model; /* p + q: model channels "STATION.DIR" (NAME=STATION.DIR, else NAME) */
-  rcb_spectral_opts o;
-  rcb_spectral *e;
-  void *work;
-  rcb_estimator est;
-  int kind;
-  rcb_frf_kind meas_kind[64 + 256];
-} est_job;
 
 /* Split "A,B,C" into names (appended to j->names). */
 static int split_list(est_job *j, char *list, size_t *count) {
@@ -94,7 +104,7 @@ static int split_list(est_job *j, char *list, size_t *count) {
     j->model[j->p + j->q + *count] = eq ? eq + 1 : p;
     j->names[j->p + j->q + (*count)++] = p;
     p = comma ? comma + 1 : NULL;
-    if (j->p + j->q + *count >= 64 + 256 && p)
+    if (j->p + j->q + *count >= EST_MAX_IN + EST_MAX_OUT && p)
       return cli_usage(j->a->cmd, "too many channels (at most 64 inputs, 256 outputs)");
   }
   return 0;
@@ -105,9 +115,9 @@ static int channels(est_job *j) {
   size_t n, i, total;
   int rc;
   j->buf = malloc(strlen(in) + strlen(out) + 2);
-  j->names = calloc(64 + 256, sizeof *j->names);
-  j->model = calloc(64 + 256, sizeof *j->model);
-  j->idx = calloc(64 + 256, sizeof *j->idx);
+  j->names = calloc(EST_MAX_IN + EST_MAX_OUT, sizeof *j->names);
+  j->model = calloc(EST_MAX_IN + EST_MAX_OUT, sizeof *j->model);
+  j->idx = calloc(EST_MAX_IN + EST_MAX_OUT, sizeof *j->idx);
   if (!j->buf || !j->names || !j->model || !j->idx) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   strcpy(j->buf, in);
   strcpy(j->buf + strlen(in) + 1, out);
@@ -163,39 +173,43 @@ static int options(est_job *j) {
   j->o.force_frac = ff;
   j->o.exp_end = ee;
   j->o.no_detrend = cli_opt_value(a, "--no-detrend") != NULL;
+  j->window_given = cli_opt_value(a, "--window") != NULL;
   j->est = (rcb_estimator)e;
   return 0;
 }
 
-/* Feed the segments (progress on long files). */
-static int average(est_job *j) {
-  size_t n = rcb_signals_length(j->sig), step = j->o.nseg - j->o.noverlap, start, c, nseg;
-  const double **seg = calloc(j->p + j->q, sizeof *seg);
-  cli_progress pr;
-  size_t bytes = 0, done = 0;
+int est_setup(est_job *j) {
+  size_t bytes = 0;
   rcb_status st;
-  if (!seg) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   j->o.ninputs = j->p;
   j->o.noutputs = j->q;
   j->o.rate = rcb_signals_rate(j->sig);
-  if (n < j->o.nseg) {
-    free(seg);
-    return cli_fail(CLI_EXIT_INPUT, "%s: %zu samples, fewer than one segment (--nseg %zu)",
-                    j->a->model, n, j->o.nseg);
-  }
   st = rcb_spectral_workspace_size(&j->o, &bytes);
   if (st) {
-    free(seg);
     if (st == RCB_ERR_UNSUPPORTED)
       return cli_fail(CLI_EXIT_NUMERIC, "estimate: librcb was built without an FFT backend "
                       "(RCB_WITH_FFTW or RCB_WITH_KISSFFT)");
     return cli_fail(cli_status_exit(st), "estimate: %s", rcb_status_str(st));
   }
   j->work = malloc(bytes);
-  if (!j->work || rcb_spectral_init(&j->e, &j->o, j->work, bytes)) {
-    free(seg);
+  if (!j->work || rcb_spectral_init(&j->e, &j->o, j->work, bytes))
     return cli_fail(CLI_EXIT_NUMERIC, "estimate: cannot set up the estimator (%zu bytes)", bytes);
-  }
+  return 0;
+}
+
+/* Feed the segments (progress on long files). */
+static int average(est_job *j) {
+  size_t n = rcb_signals_length(j->sig), step = j->o.nseg - j->o.noverlap, start, c, nseg;
+  const double **seg;
+  cli_progress pr;
+  size_t done = 0;
+  rcb_status st = RCB_OK;
+  int rc;
+  if (n < j->o.nseg)
+    return cli_fail(CLI_EXIT_INPUT, "%s: %zu samples, fewer than one segment (--nseg %zu)",
+                    j->a->model, n, j->o.nseg);
+  if ((rc = est_setup(j))) return rc;
+  if (!(seg = calloc(j->p + j->q, sizeof *seg))) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   nseg = (n - j->o.noverlap) / step;
   cli_progress_start(&pr, j->a, "estimate", "segments", nseg);
   for (start = 0; start + j->o.nseg <= n; start += step) {
@@ -316,8 +330,8 @@ static int write_meas(est_job *j, const est_out *r) {
   return rc;
 }
 
-/* Open a side file (--stats, --spectra) atomically through cli_out. */
-static int side_open(const est_job *j, const char *path, cli_out *out) {
+/* Open a side file (--stats, --spectra, --report) atomically through cli_out. */
+int est_side_open(const est_job *j, const char *path, cli_out *out) {
   cli_args b = *j->a;
   b.output = path;
   return cli_out_open(out, &b);
@@ -327,10 +341,12 @@ static int write_stats(est_job *j, const est_out *r, const char *path) {
   size_t nb = rcb_spectral_bin_count(j->e), k, c, np = j->p * j->q;
   cli_out out;
   int rc;
-  if ((rc = side_open(j, path, &out))) return rc;
+  if ((rc = est_side_open(j, path, &out))) return rc;
   fprintf(out.fp, "# estimator = %s, averages = %zu, nseg = %zu, overlap = %zu, window = %s, "
-          "kind = %s\nfreq_hz", est_names[j->est], rcb_spectral_averages(j->e), j->o.nseg,
+          "kind = %s\n", est_names[j->est], rcb_spectral_averages(j->e), j->o.nseg,
           j->o.noverlap, window_names[j->o.window], kind_names[j->kind]);
+  if (j->hits_note[0]) fprintf(out.fp, "# %s\n", j->hits_note);
+  fputs("freq_hz", out.fp);
   for (c = 0; c < np; c++)
     fprintf(out.fp, ",%s/%s coh,%s/%s sd", j->model[j->p + c / j->p], j->model[c % j->p],
             j->model[j->p + c / j->p], j->model[c % j->p]);
@@ -363,7 +379,7 @@ static int write_spectra(est_job *j, const char *path) {
   for (a = 0; a < nc; a++)
     for (b = 0; b < nc; b++)
       if (a < j->p || a == b) rcb_spectral_cross(j->e, a, b, g + (a * nc + b) * nb);
-  if ((rc = side_open(j, path, &out))) {
+  if ((rc = est_side_open(j, path, &out))) {
     free(g);
     free(w);
     return rc;
@@ -456,12 +472,14 @@ static int estimate(const cli_args *a) {
     return cli_usage(a->cmd, "missing -o OUT (.uff, .unv or .csv) for the estimated FRFs");
   if ((rc = options(&j)) || (rc = cli_meas_format(a->cmd, a->output, &is_uff))) return rc;
   if (rcb_signals_create(&j.sig, NULL)) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+  rcb_signals_set_join_records(j.sig, 1); /* a UFF file's records of a channel: its hits */
   rc = cli_signals_read(a, j.sig);
   if (!rc) rc = channels(&j);
   if (!rc && j.est != RCB_EST_H1 && j.p != 1)
     rc = cli_usage(a->cmd, "--estimator %s takes one input (%zu given); use h1",
                    est_names[j.est], j.p);
-  if (!rc) rc = average(&j);
+  if (!rc) rc = est_hits_options(&j, est_hits_mode(&j));
+  if (!rc) rc = est_hits_mode(&j) ? est_hits_average(&j) : average(&j);
   if (!rc) rc = line_range(&j, &k1, &every);
   if (!rc) rc = compute(&j, &r, k1);
   if (!rc) thin_lines(&r, rcb_spectral_bin_count(j.e), j.p * j.q, every);
@@ -499,13 +517,19 @@ int cmd_estimate(int argc, char **argv) {
                     {"--map", "NODE=STATION,...", NULL}, {"--binary", NULL, NULL},
                     {"--wav-names", "LIST", NULL}, {"--wav-units", "LIST", NULL},
                     {"--wav-scale", "LIST", NULL}, {"--plot", "FILE.png", NULL},
-                    {"--units", "CH=UNIT,...", NULL}, {"--allow-truncated", NULL, NULL}};
-  static const cli_file_opt files[] = {
-      {"--stats", CLI_IO_OUT}, {"--spectra", CLI_IO_OUT}, {"--plot", CLI_IO_OUT | CLI_IO_MKDIR}};
+                    {"--units", "CH=UNIT,...", NULL}, {"--allow-truncated", NULL, NULL},
+                    {"--trigger", "CH:LEVEL[:PRE]", NULL}, {"--hit-length", "S", NULL},
+                    {"--double-frac", "F", NULL}, {"--clip-run", "N", NULL},
+                    {"--range", "CH:MAX,...", NULL}, {"--reject", "N,...", NULL},
+                    {"--keep-flagged", NULL, NULL}, {"--report", "FILE", NULL}};
+  static const cli_file_opt files[] = {{"--stats", CLI_IO_OUT},
+                                       {"--spectra", CLI_IO_OUT},
+                                       {"--plot", CLI_IO_OUT | CLI_IO_MKDIR},
+                                       {"--report", CLI_IO_OUT}};
   cli_args a;
   int rc;
   cli_plan_options(files, sizeof files / sizeof files[0]);
-  rc = cli_parse(argc, argv, opts, sizeof opts / sizeof opts[0], &a);
+  rc = cli_parse_files(argc, argv, opts, sizeof opts / sizeof opts[0], CLI_FILES_MAX, &a);
   if (rc || a.help) return rc ? rc : cli_print_help(cli_help_estimate);
   if (a.json) return cli_usage(a.cmd, "--json does not apply: the format follows OUT's extension");
   return estimate(&a);
