@@ -118,7 +118,13 @@ def test_state_restart(rcb, tmp_path):
                 ra, rb = a.update(ms), b.update(ms)
             assert ra == rb and rb["update"] == 3
             t = rb["tracked"][0]
-            assert t["abs_stderr"] == pytest.approx((t["stderr"] ** 2 + 25.0) ** 0.5, rel=1e-12)
+            # the value's variance: the change's and the baseline's share (e_a - g)^T S
+            # (e_a - g), S = diag(25, 1e-4), g the curvature's effect of the change
+            # (issue #34 item 4): near S's own 25 for changes this small
+            share = t["abs_stderr"] ** 2 - t["stderr"] ** 2
+            assert 0.5 * 25.0 < share < 2.0 * 25.0, (share, t)
+            assert t["ci_hi"] - t["value"] == pytest.approx(1.959963984540054 * t["abs_stderr"],
+                                                            rel=1e-9)
             bad = bytearray(state)
             bad[40] ^= 1
             with pytest.raises(rcb.RcbError):
