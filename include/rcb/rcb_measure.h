@@ -131,10 +131,26 @@ RCB_API rcb_status rcb_meas_add_noise(rcb_meas *ms, double beta_a, double beta_s
 RCB_API rcb_status rcb_meas_add_noise_phase(rcb_meas *ms, double beta_a, double beta_s,
                                             double phase_rad, uint64_t seed);
 
-/** @brief UFF node number <-> model station, for dataset 58 files. */
+/**
+ * @brief UFF node number <-> model station, for dataset 58 files (and CSV
+ * channels written as node numbers). An entry with @p dir NULL maps a whole
+ * node: its x, y, rx, ry channels read as the station's ("10=DA": 10.x is
+ * DA.x). An entry with @p dir maps one channel of the node, in any direction,
+ * to a model channel ("1.z=DA.x", "3.s=DB.y" for a scalar channel): an
+ * accelerometer's own axis (z, direction 3) or a scalar record (direction 0),
+ * as acquisition systems export them, read as the model channel it stands
+ * for. A direction entry wins over its node's entry; a negative file
+ * direction still flips the sign. Zero-initialised @p dir and @p model_dir
+ * (as in {10, "DA"}) make a node entry.
+ */
 typedef struct rcb_uff_node {
-  long node;           /**< UFF node number */
-  const char *station; /**< model station name, e.g. "DA" */
+  long node;             /**< UFF node number */
+  const char *station;   /**< model station name, e.g. "DA" */
+  const char *dir;       /**< NULL: the whole node; else the file direction this entry
+                              maps: "x", "y", "z", "rx", "ry", "rz" (UFF 1 to 6) or "s"
+                              (scalar, UFF 0) */
+  const char *model_dir; /**< with @p dir: the model direction it reads as, "x", "y",
+                              "rx" or "ry"; NULL with a node entry */
 } rcb_uff_node;
 
 /**

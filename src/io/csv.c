@@ -249,39 +249,65 @@ static int part_of(const char *word, size_t n, const char *unit) {
   return -1;
 }
 
+/* The map entry of node @p node for direction [dir, dir + dlen): its direction
+ * entry ("2.z=DA.x") first, else its node entry ("2=DA"); NULL when neither. */
+static const rcb_uff_node *csv_map_find(const csv_state *S, long node, const char *dir,
+                                        size_t dlen) {
+  const rcb_uff_node *whole = NULL;
+  size_t i;
+  for (i = 0; i < S->nmap; i++) {
+    const rcb_uff_node *e = &S->map[i];
+    if (e->node != node) continue;
+    if (!e->dir)
+      whole = whole ? whole : e;
+    else if (strlen(e->dir) == dlen && strncmp(e->dir, dir, dlen) == 0)
+      return e;
+  }
+  return whole;
+}
+
 /* Stations written as numbers ("3.x/10.y", a test system's node numbers)
- * through the node map (issue #35 item 3: lab scripts write them); one the
- * map does not name is refused with what to give or write instead. */
+ * through the node map (issue #35 item 3: lab scripts write them); a
+ * direction entry maps a channel of any direction ("3.z=DA.x"); one the map
+ * does not name is refused with what to give or write instead. */
 static rcb_status map_stations(csv_state *S, csv_col *c, size_t k) {
   char out[sizeof c->name];
   const char *p = c->name;
   size_t at = 0;
   for (;;) {
     const char *slash = strchr(p, '/'), *end = slash ? slash : p + strlen(p), *dot = end, *q;
-    const char *st = "", *tail = p; /* written: st, then [tail, end) */
-    size_t stlen = 0, rest, i;
+    const char *st = "", *tail = p, *tail_end = end; /* written: st, then [tail, tail_end) */
+    char dirbuf[8];
+    size_t stlen = 0, rest;
     while (dot > p && dot[-1] != '.') dot--;
     if (dot > p + 1) {
       for (q = p; q < dot - 1 && isdigit((unsigned char)*q); q++) continue;
       if (q == dot - 1) {
         long node = 0;
         int n = (int)(dot - 1 - p);
+        const rcb_uff_node *e;
         for (q = p; q < dot - 1 && node < 100000000L; q++) node = node * 10 + (*q - '0');
-        for (i = 0; i < S->nmap && S->map[i].node != node; i++) continue;
-        if (i == S->nmap || q < dot - 1)
+        e = q < dot - 1 ? NULL : csv_map_find(S, node, dot, (size_t)(end - dot));
+        if (!e)
           return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: column %zu ('%s'): station '%.*s' "
                                "is a number, not a model station, and the node map has no entry "
-                               "for it: give it (rcbtool --map %.*s=STATION, the model's [uff] "
-                               "map; rcb_meas_read_csv_map), or rename it to the station it "
-                               "stands for (e.g. DA; 'rcbtool check' lists them) or to '#%.*s' "
-                               "for model node %.*s", S->path, S->line, k + 1, c->name, n, p, n,
-                               p, n, p, n, p);
-        st = S->map[i].station;
+                               "for it: give it (rcbtool --map %.*s=STATION, or %.*s.%.*s="
+                               "STATION.DIR for this channel alone; the model's [uff] map; "
+                               "rcb_meas_read_csv_map), or rename it to the station it stands "
+                               "for (e.g. DA; 'rcbtool check' lists them) or to '#%.*s' for "
+                               "model node %.*s", S->path, S->line, k + 1, c->name, n, p, n, p,
+                               n, p, (int)(end - dot), dot, n, p, n, p);
+        st = e->station;
         stlen = strlen(st);
         tail = dot - 1; /* ".DIR" */
+        if (e->dir) { /* ".MODEL_DIR" */
+          snprintf(dirbuf, sizeof dirbuf, ".%s", e->model_dir);
+          tail = dirbuf;
+          tail_end = dirbuf + strlen(dirbuf);
+        }
       }
     }
-    rest = (size_t)(end - tail);
+    rest = (size_t)(tail_end - tail);
     if (at + stlen + rest + 1 >= sizeof out)
       return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: column %zu ('%s'): the channel, its "
                            "stations mapped, has more than %zu characters", S->path, S->line,

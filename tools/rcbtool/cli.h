@@ -455,6 +455,14 @@ int cli_sd_read(const char *path, const rcb_meas *ms, double **sd);
  * --allow-truncated (the command declares them); the reader's warnings
  * printed; exit code 0, 2, 3, 4. */
 int cli_signals_read(const cli_args *a, rcb_signals *s);
+/** The index of channel @p name of the signals, else exit 3 with the channels
+ * the file holds listed. */
+int cli_signals_find(const cli_args *a, const rcb_signals *s, const char *name, size_t *idx);
+/** 0 when @p model (the model channel that file channel @p name stands for:
+ * NAME=STATION.DIR, else the name itself) is STATION.DIR with DIR x, y, rx or
+ * ry; else a usage error naming the --outputs item or the --map entry that
+ * names it ("#1.z": --map 1.z=STATION.DIR; issue #35). */
+int cli_signals_model_channel(const cli_args *a, const char *name, const char *model);
 
 /* ---- subcommands (one file each) ---- */
 

@@ -164,6 +164,11 @@ static int meas_read(const cli_args *a, const char *path, const rcb_model *m, in
               : rcb_meas_read_csv_map(ms, path, mp.n, mp.nodes);
   cli_uff_map_free(&mp);
   if (st) {
+    size_t w; /* what was skipped, and the map entry that would read it */
+    for (w = 0; w < rcb_meas_warning_count(ms); w++)
+      fprintf(stderr, "rcbtool: warning: %s\n", rcb_meas_warning(ms, w));
+  }
+  if (st) {
     const char *msg = cli_msg(rcb_meas_errmsg(ms), st);
     rc = cli_fail(st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC : CLI_EXIT_INPUT, "%s", msg);
     if (!strstr(msg, path)) (void)cli_fail(rc, "(while reading measurement '%s')", path);

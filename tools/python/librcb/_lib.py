@@ -75,7 +75,8 @@ class MeasChannelInfo(ctypes.Structure):
 
 
 class UffNode(ctypes.Structure):
-    _fields_ = [("node", c_long), ("station", c_char_p)]
+    _fields_ = [("node", c_long), ("station", c_char_p), ("dir", c_char_p),
+                ("model_dir", c_char_p)]
 
 
 class FitReport(ctypes.Structure):
