@@ -222,6 +222,56 @@ static const char V3[] =
  * without them, with a warning naming the entry that would read it; with
  * "3.z=DB.y" and "10.s=DA.x" it is DB.y/DA.x, and 3.x still reads through the
  * node entry 3=DB. A direction -3 flips the sign as any negative direction. */
+/* Magnitude-only CSV (issue #35 item 4): a 'mag' or 'dB' column without
+ * phase is a channel of magnitudes (|H| + 0i, flagged); a phase without its
+ * magnitude, a negative magnitude, and UFF output are refused; conversion
+ * multiplies by w^k (real), and the CSV writer gives one 'mag' column back. */
+static void test_csv_magnitude_only(void **state) {
+  const char *p = rcb_test_tmp_path("mag.csv"), *q = rcb_test_tmp_path("mag2.csv");
+  FILE *fp = fopen(p, "w");
+  rcb_meas *ms = NULL;
+  rcb_meas_channel_info c;
+  (void)state;
+  assert_non_null(fp);
+  fputs("# kind = receptance\nfreq_hz,DA.x/DA.x mag,DB.x/DA.x dB,DA.y/DA.x re,DA.y/DA.x im\n"
+        "10,2,-20,1,2\n20,4,0,3,4\n", fp);
+  fclose(fp);
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  if (rcb_meas_read_csv(ms, p) != RCB_OK) fail_msg("%s", rcb_meas_errmsg(ms));
+  assert_int_equal(rcb_meas_magnitude_only_count(ms), 2);
+  assert_int_equal(rcb_meas_channel(ms, 0, &c), RCB_OK);
+  assert_true(c.magnitude_only && creal(c.data[1]) == 4.0 && cimag(c.data[1]) == 0.0);
+  assert_int_equal(rcb_meas_channel(ms, 1, &c), RCB_OK);
+  assert_true(c.magnitude_only && fabs(creal(c.data[0]) - 0.1) < 1e-15);
+  assert_int_equal(rcb_meas_channel(ms, 2, &c), RCB_OK);
+  assert_false(c.magnitude_only);
+  /* receptance -> inertance: |(i w)^2| = w^2 on the magnitudes, (i w)^2 on H */
+  assert_int_equal(rcb_meas_convert(ms, RCB_INERTANCE), RCB_OK);
+  assert_int_equal(rcb_meas_channel(ms, 0, &c), RCB_OK);
+  assert_true(fabs(creal(c.data[0]) - 2.0 * pow(2 * 3.14159265358979323846 * 10, 2)) < 1e-9 && cimag(c.data[0]) == 0);
+  assert_int_equal(rcb_meas_channel(ms, 2, &c), RCB_OK);
+  assert_true(creal(c.data[0]) < 0);
+  assert_int_equal(rcb_meas_write_uff(ms, rcb_test_tmp_path("mag.uff"), 0, 0, NULL),
+                   RCB_ERR_ARG);
+  assert_non_null(strstr(rcb_meas_errmsg(ms), "DA.x/DA.x holds magnitudes only"));
+  assert_int_equal(rcb_meas_write_csv(ms, q), RCB_OK);
+  assert_int_equal(rcb_meas_read_csv(ms, q), RCB_OK);
+  assert_int_equal(rcb_meas_magnitude_only_count(ms), 2);
+  fp = fopen(p, "w");
+  fputs("freq_hz,DA.x/DA.x phase_deg\n10,2\n", fp);
+  fclose(fp);
+  assert_int_equal(rcb_meas_read_csv(ms, p), RCB_ERR_PARSE);
+  assert_non_null(strstr(rcb_meas_errmsg(ms), "its phase_deg has no pair"));
+  fp = fopen(p, "w");
+  fputs("freq_hz,DA.x/DA.x mag\n10,2\n20,-1\n", fp);
+  fclose(fp);
+  assert_int_equal(rcb_meas_read_csv(ms, p), RCB_ERR_PARSE);
+  assert_non_null(strstr(rcb_meas_errmsg(ms), "point 2 (20 Hz): magnitude -1"));
+  rcb_meas_destroy(ms);
+  remove(p);
+  remove(q);
+}
+
 static void test_uff_map_directions(void **state) {
   const char *p = rcb_test_tmp_path("dirs.uff");
   FILE *fp = fopen(p, "w");
@@ -1052,6 +1102,7 @@ int main(void) {
       cmocka_unit_test(test_bad_csv),               cmocka_unit_test(test_bad_api),
       cmocka_unit_test(test_write_atomic),          cmocka_unit_test(test_allocator),
       cmocka_unit_test(test_uff_binary_big_endian), cmocka_unit_test(test_uff_map_directions),
+      cmocka_unit_test(test_csv_magnitude_only),
   };
   return cmocka_run_group_tests(tests, rcb_test_setup_tmpdir, rcb_test_teardown_tmpdir);
 }

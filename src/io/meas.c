@@ -271,6 +271,47 @@ rcb_status rcb_meas_add_channel(rcb_meas *ms, const char *response, const char *
   return rcb_meas_add_channel_at(ms, response, reference, kind, data, NULL, RCB_ERR_ARG);
 }
 
+rcb_status rcb_meas_add_mag_at(rcb_meas *ms, const char *response, const char *reference,
+                               rcb_frf_kind kind, const rcb_complex *data, const char *where,
+                               rcb_status bad) {
+  size_t i;
+  rcb_status st;
+  if (!ms) return RCB_ERR_ARG;
+  for (i = 0; data && i < ms->n; i++)
+    if (!(creal(data[i]) >= 0.0) || cimag(data[i]) != 0.0)
+      return rcb_meas_fail(ms, bad, "%s%schannel %s%s%s, point %zu (%.9g Hz): magnitude %g: "
+                           "expected a finite value >= 0", pre(where), sep(where), response,
+                           reference ? "/" : "", reference ? reference : "", i + 1,
+                           ms->x[i] / TWO_PI, creal(data[i]));
+  if ((st = rcb_meas_add_channel_at(ms, response, reference, kind, data, where, bad))) return st;
+  ms->ch[ms->nch - 1].mag_only = 1;
+  return RCB_OK;
+}
+
+rcb_status rcb_meas_add_channel_mag(rcb_meas *ms, const char *response, const char *reference,
+                                    rcb_frf_kind kind, const double *mag) {
+  rcb_complex *d;
+  size_t i;
+  rcb_status st;
+  if (!ms) return RCB_ERR_ARG;
+  if (!mag) return rcb_meas_fail(ms, RCB_ERR_ARG, "add channel: data is NULL");
+  if (ms->n == 0)
+    return rcb_meas_fail(ms, RCB_ERR_STATE, "add channel: set the abscissa first "
+                         "(rcb_meas_set_grid)");
+  if (!(d = rcb_alloc(&ms->alloc, ms->n * sizeof *d)))
+    return rcb_meas_fail(ms, RCB_ERR_NOMEM, "out of memory (channel %s)", response);
+  for (i = 0; i < ms->n; i++) d[i] = CMPLX(mag[i], 0.0);
+  st = rcb_meas_add_mag_at(ms, response, reference, kind, d, NULL, RCB_ERR_ARG);
+  rcb_free(&ms->alloc, d);
+  return st;
+}
+
+size_t rcb_meas_magnitude_only_count(const rcb_meas *ms) {
+  size_t c, n = 0;
+  for (c = 0; ms && c < ms->nch; c++) n += ms->ch[c].mag_only != 0;
+  return n;
+}
+
 rcb_meas_type rcb_meas_get_type(const rcb_meas *ms) { return ms ? ms->type : RCB_MEAS_FRF; }
 size_t rcb_meas_point_count(const rcb_meas *ms) { return ms ? ms->n : 0; }
 size_t rcb_meas_channel_count(const rcb_meas *ms) { return ms ? ms->nch : 0; }
@@ -284,6 +325,7 @@ rcb_status rcb_meas_channel(const rcb_meas *ms, size_t i, rcb_meas_channel_info 
   out->reference = ms->type == RCB_MEAS_FRF ? ms->ch[i].ref : NULL;
   out->kind = ms->ch[i].kind;
   out->data = ms->ch[i].data;
+  out->magnitude_only = ms->ch[i].mag_only;
   return RCB_OK;
 }
 
@@ -310,6 +352,7 @@ rcb_status rcb_meas_convert(rcb_meas *ms, rcb_frf_kind kind) {
     for (i = 0; i < ms->n && k != 0; i++) {
       rcb_complex iw = CMPLX(0.0, ms->x[i]);
       rcb_complex f = k == 1 ? iw : k == 2 ? iw * iw : k == -1 ? 1.0 / iw : 1.0 / (iw * iw);
+      if (ms->ch[c].mag_only) f = cabs(f); /* |(i w)^k| = w^k: magnitudes stay magnitudes */
       ms->ch[c].data[i] *= f;
     }
     ms->ch[c].kind = kind;

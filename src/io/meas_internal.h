@@ -18,7 +18,8 @@ typedef struct rcb_meas_ch {
   char resp[RCB_MEAS_CH_MAX];
   char ref[RCB_MEAS_CH_MAX]; /* "" for unbalance responses */
   rcb_frf_kind kind;
-  rcb_complex *data; /* n values */
+  rcb_complex *data; /* n values (magnitude only: |H| + 0i) */
+  int mag_only;      /* magnitudes without phase (rcb_meas_add_channel_mag) */
 } rcb_meas_ch;
 
 struct rcb_meas {
@@ -70,6 +71,10 @@ rcb_status rcb_meas_set_grid_at(rcb_meas *ms, rcb_meas_type type, size_t n, cons
 rcb_status rcb_meas_add_channel_at(rcb_meas *ms, const char *response, const char *reference,
                                    rcb_frf_kind kind, const rcb_complex *data,
                                    const char *where, rcb_status bad);
+/* The same for magnitudes only (values |H| + 0i, each >= 0; issue #35 item 4). */
+rcb_status rcb_meas_add_mag_at(rcb_meas *ms, const char *response, const char *reference,
+                               rcb_frf_kind kind, const rcb_complex *data, const char *where,
+                               rcb_status bad);
 
 /* Split "STATION.DIR": dir index 0..3 (x, y, rx, ry) or -1 if the suffix is
  * not one of them; *stlen = length of the station part. */

@@ -183,6 +183,12 @@ rcb_status rcb_meas_write_uff(const rcb_meas *cms, const char *path, int binary,
   rcb_status st = RCB_OK;
   if (!ms) return RCB_ERR_ARG;
   if ((st = rcb_meas_check_map(ms, "write_uff", nmap, map))) return st;
+  for (c = 0; c < ms->nch; c++)
+    if (ms->ch[c].mag_only)
+      return rcb_meas_fail(ms, RCB_ERR_ARG, "%s: channel %s%s%s holds magnitudes only: a "
+                           "dataset 58 FRF record is complex, and no phase is known; write CSV "
+                           "(a 'mag' column)", path ? path : "", ms->ch[c].resp,
+                           ms->ch[c].ref[0] ? "/" : "", ms->ch[c].ref);
   if (ms->n == 0 || ms->nch == 0)
     return rcb_meas_fail(ms, RCB_ERR_STATE, "%s: nothing to write (no abscissa or no "
                          "channels)", path ? path : "");

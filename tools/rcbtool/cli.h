@@ -360,6 +360,11 @@ int cli_guard_outputs(const cli_args *a, const char *meas);
 /** Read a measurement by extension ("-": standard input, CSV or UFF by content) (UFF with --map or the model's [uff] map,
  * or CSV); exit code 0, 2, 3 or 4 with the message printed. */
 int cli_meas_read(const cli_args *a, const char *path, const rcb_model *m, rcb_meas **out);
+/** 0 when every channel of @p ms has its phase; else a usage error (2) naming
+ * the file @p path, a magnitude-only channel and @p what needs the phase
+ * ("--scale complex", "the monitor"; issue #35 item 4). */
+int cli_meas_need_phase(const cli_args *a, const rcb_meas *ms, const char *path,
+                        const char *what);
 
 /* ---- fitted parameters (cmd_fit.c; used by sensitivity) ---- */
 

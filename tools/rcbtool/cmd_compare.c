@@ -283,6 +283,10 @@ static void print_text(FILE *fp, const cli_args *a, const cmp_job *j, const rcb_
   fprintf(fp, "%zu channels x %zu points, %.6g to %.6g %s\n", rcb_compare_channel_count(c),
           rcb_compare_point_count(c), rcb_compare_grid(c)[0] * j->xscale,
           rcb_compare_grid(c)[rcb_compare_point_count(c) - 1] * j->xscale, j->xunit);
+  if (rcb_meas_magnitude_only_count(ms)) /* issue #35 item 4 */
+    fprintf(fp, "# %zu of %zu channels hold magnitudes only (no phase): their FRAC and phase "
+            "error are nan, and they are left out of the mean FRAC, CSAC and CSF\n",
+            rcb_meas_magnitude_only_count(ms), rcb_meas_channel_count(ms));
   print_channels(fp, c);
   print_outliers(fp, c);
   print_bands(fp, c, j, ord);

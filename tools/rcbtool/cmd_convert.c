@@ -38,6 +38,8 @@ const char cli_help_convert[] =
     "(unbalance) and per channel 'RESP/REF re','RESP/REF im' (or mag/amp and\n"
     "phase_deg columns), as rcbtool frf and rcbtool unbalance write; the part may\n"
     "follow '_' (RESP/REF_re, _im, _mag, _phase_deg), as lab scripts write it.\n"
+    "A 'mag' or 'dB' column without phase is read as magnitudes only (written back\n"
+    "as a 'mag' column; UFF output refused: a dataset 58 FRF is complex).\n"
     "Exit codes: 2 usage, 3 unreadable or bad input data, 5 output not written.\n";
 
 static const char *const kind_names[] = {"receptance", "mobility", "inertance"};

@@ -48,7 +48,9 @@ const char cli_help_fit[] =
     "                 nlopt:ALG with an NLopt algorithm name (LN_BOBYQA, LN_SBPLX,\n"
     "                 LD_LBFGS, LD_MMA, GN_DIRECT_L, GN_CRS2_LM, G_MLSL_LDS, ...)\n"
     "  --scale S      residuals on |H| (linear), log10 |H| (log10, default: FRF\n"
-    "                 magnitudes span decades), 20 log10 |H| (db) or Re/Im (complex)\n"
+    "                 magnitudes span decades), 20 log10 |H| (db) or Re/Im (complex);\n"
+    "                 a CSV of magnitudes only ('mag' or 'dB' columns, no phase) fits\n"
+    "                 on the first three, and complex is refused\n"
     "  --band LO:HI   fit only points with LO <= abscissa <= HI: Hz for FRFs, rpm\n"
     "                 for unbalance responses\n"
     "  --noise A,S    noise-aware weights from the paper's eq. 19 noise model (random\n"
@@ -302,7 +304,13 @@ static int parse_job(const cli_args *a, fit_job *j) {
 
 static int read_meas(const cli_args *a, fit_job *j, const rcb_model *m, rcb_meas **out) {
   int rc = strcmp(j->meas_path, "-") == 0 ? 0 : cli_meas_format(a->cmd, j->meas_path, &j->is_uff);
-  return rc ? rc : cli_meas_read(a, j->meas_path, m, out);
+  if (!rc) rc = cli_meas_read(a, j->meas_path, m, out);
+  if (!rc && j->scale == RCB_SCALE_COMPLEX &&
+      (rc = cli_meas_need_phase(a, *out, j->meas_path, "--scale complex (Re and Im)"))) {
+    rcb_meas_destroy(*out);
+    *out = NULL;
+  }
+  return rc;
 }
 
 /* Progress per iteration on stderr. */
