@@ -10,7 +10,12 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
-static const rcb_uff_node MAP[] = {{1, "DA"}, {2, "DB"}, {10, "C.A"}, {11, "C.B"}};
+static const rcb_uff_node MAP[] = {
+    {1, "DA", NULL, NULL},
+    {2, "DB", NULL, NULL},
+    {10, "C.A", NULL, NULL},
+    {11, "C.B", NULL, NULL}
+};
 
 static void read_once(const char *path, size_t nmap) {
   rcb_meas *ms = NULL;

@@ -184,7 +184,7 @@ static const char *uff_path(void) {
   return rcb_test_tmp_path("meas.uff");
 }
 
-static const rcb_uff_node uff_map[2] = {{1, "D"}, {2, "P"}};
+static const rcb_uff_node uff_map[2] = {{1, "D", NULL, NULL}, {2, "P", NULL, NULL}};
 
 static rcb_status sc_uff(const rcb_allocator *a, int check) {
   rcb_meas *ms = NULL;

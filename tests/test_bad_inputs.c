@@ -509,7 +509,7 @@ static char *read_all(const char *path, size_t *n) {
   return buf;
 }
 
-static const rcb_uff_node MAP[] = {{1, "D"}, {2, "P"}};
+static const rcb_uff_node MAP[] = {{1, "D", NULL, NULL}, {2, "P", NULL, NULL}};
 
 /* A 5-point FRF D.x/D.x, P.y/D.x of the base model, written as UFF58. */
 static void write_sample_uff(const char *path, int binary) {

@@ -65,7 +65,12 @@ static rcb_meas *sample_frf(double speed, int uneven) {
   return ms;
 }
 
-static const rcb_uff_node MAP[] = {{10, "DA"}, {20, "C.A"}, {21, "C.B"}, {30, "DB"}};
+static const rcb_uff_node MAP[] = {
+    {10, "DA", NULL, NULL},
+    {20, "C.A", NULL, NULL},
+    {21, "C.B", NULL, NULL},
+    {30, "DB", NULL, NULL}
+};
 
 static void assert_same(const rcb_meas *a, const rcb_meas *b, double xtol, double vtol) {
   size_t i, c, n = rcb_meas_point_count(a);
@@ -212,12 +217,107 @@ static const char V3[] =
     "   1.00000000000e+00   2.00000000000e+00   3.00000000000e+00   4.00000000000e+00\n"
     "   5.00000000000e+00   6.00000000000e+00\n";
 
+/* Direction entries of the node map (issue #35 item 2): an FRF from node 3's
+ * own z (direction 3) over node 10's scalar force (direction 0) is skipped
+ * without them, with a warning naming the entry that would read it; with
+ * "3.z=DB.y" and "10.s=DA.x" it is DB.y/DA.x, and 3.x still reads through the
+ * node entry 3=DB. A direction -3 flips the sign as any negative direction. */
+/* Magnitude-only CSV (issue #35 item 4): a 'mag' or 'dB' column without
+ * phase is a channel of magnitudes (|H| + 0i, flagged); a phase without its
+ * magnitude, a negative magnitude, and UFF output are refused; conversion
+ * multiplies by w^k (real), and the CSV writer gives one 'mag' column back. */
+static void test_csv_magnitude_only(void **state) {
+  const char *p = rcb_test_tmp_path("mag.csv"), *q = rcb_test_tmp_path("mag2.csv");
+  FILE *fp = fopen(p, "w");
+  rcb_meas *ms = NULL;
+  rcb_meas_channel_info c;
+  (void)state;
+  assert_non_null(fp);
+  fputs("# kind = receptance\nfreq_hz,DA.x/DA.x mag,DB.x/DA.x dB,DA.y/DA.x re,DA.y/DA.x im\n"
+        "10,2,-20,1,2\n20,4,0,3,4\n", fp);
+  fclose(fp);
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  if (rcb_meas_read_csv(ms, p) != RCB_OK) fail_msg("%s", rcb_meas_errmsg(ms));
+  assert_int_equal(rcb_meas_magnitude_only_count(ms), 2);
+  assert_int_equal(rcb_meas_channel(ms, 0, &c), RCB_OK);
+  assert_true(c.magnitude_only && creal(c.data[1]) == 4.0 && cimag(c.data[1]) == 0.0);
+  assert_int_equal(rcb_meas_channel(ms, 1, &c), RCB_OK);
+  assert_true(c.magnitude_only && fabs(creal(c.data[0]) - 0.1) < 1e-15);
+  assert_int_equal(rcb_meas_channel(ms, 2, &c), RCB_OK);
+  assert_false(c.magnitude_only);
+  /* receptance -> inertance: |(i w)^2| = w^2 on the magnitudes, (i w)^2 on H */
+  assert_int_equal(rcb_meas_convert(ms, RCB_INERTANCE), RCB_OK);
+  assert_int_equal(rcb_meas_channel(ms, 0, &c), RCB_OK);
+  assert_true(fabs(creal(c.data[0]) - 2.0 * pow(2 * 3.14159265358979323846 * 10, 2)) < 1e-9 && cimag(c.data[0]) == 0);
+  assert_int_equal(rcb_meas_channel(ms, 2, &c), RCB_OK);
+  assert_true(creal(c.data[0]) < 0);
+  assert_int_equal(rcb_meas_write_uff(ms, rcb_test_tmp_path("mag.uff"), 0, 0, NULL),
+                   RCB_ERR_ARG);
+  assert_non_null(strstr(rcb_meas_errmsg(ms), "DA.x/DA.x holds magnitudes only"));
+  assert_int_equal(rcb_meas_write_csv(ms, q), RCB_OK);
+  assert_int_equal(rcb_meas_read_csv(ms, q), RCB_OK);
+  assert_int_equal(rcb_meas_magnitude_only_count(ms), 2);
+  fp = fopen(p, "w");
+  fputs("freq_hz,DA.x/DA.x phase_deg\n10,2\n", fp);
+  fclose(fp);
+  assert_int_equal(rcb_meas_read_csv(ms, p), RCB_ERR_PARSE);
+  assert_non_null(strstr(rcb_meas_errmsg(ms), "its phase_deg has no pair"));
+  fp = fopen(p, "w");
+  fputs("freq_hz,DA.x/DA.x mag\n10,2\n20,-1\n", fp);
+  fclose(fp);
+  assert_int_equal(rcb_meas_read_csv(ms, p), RCB_ERR_PARSE);
+  assert_non_null(strstr(rcb_meas_errmsg(ms), "point 2 (20 Hz): magnitude -1"));
+  rcb_meas_destroy(ms);
+  remove(p);
+  remove(q);
+}
+
+static void test_uff_map_directions(void **state) {
+  const char *p = rcb_test_tmp_path("dirs.uff");
+  FILE *fp = fopen(p, "w");
+  rcb_meas *ms = NULL;
+  rcb_meas_channel_info c;
+  rcb_uff_node map[] = {{3, "DB", NULL, NULL}, {3, "DB", "z", "y"}, {10, "DA", "s", "x"}};
+  rcb_uff_node bad[] = {{3, "DB", "q", "y"}, {3, "DB", "z", "z"}, {3, "DB", NULL, "x"}};
+  (void)state;
+  assert_non_null(fp);
+  rec58(fp, 4, 3, -3, 10, 0, 6, 3, 1, 10.0, 10.0, 1200.0, 18, 8, 13, 19, V3);
+  rec58(fp, 4, 3, 1, 10, 0, 6, 3, 1, 10.0, 10.0, 1200.0, 18, 8, 13, 19, V3);
+  fclose(fp);
+  assert_int_equal(rcb_meas_create(&ms, NULL), RCB_OK);
+  assert_int_equal(rcb_meas_read_uff(ms, p, 1, map), RCB_ERR_PARSE);
+  assert_int_equal(rcb_meas_warning_count(ms), 2);
+  assert_non_null(strstr(rcb_meas_warning(ms, 0), "its response (node 3) is axial (direction "
+                                                   "3, z); the model's channels are x, y, rx, "
+                                                   "ry: the map entry 3.z=DB.DIR"));
+  assert_non_null(strstr(rcb_meas_warning(ms, 1), "its reference (node 10) is scalar "
+                                                   "(direction 0)"));
+  assert_non_null(strstr(rcb_meas_warning(ms, 1), "the map entry 10.s=STATION.DIR"));
+  if (rcb_meas_read_uff(ms, p, 3, map) != RCB_OK) fail_msg("%s", rcb_meas_errmsg(ms));
+  assert_int_equal(rcb_meas_channel_count(ms), 2);
+  assert_int_equal(rcb_meas_channel(ms, 0, &c), RCB_OK);
+  assert_string_equal(c.response, "DB.y");
+  assert_string_equal(c.reference, "DA.x");
+  assert_true(creal(c.data[1]) == -3.0 && cimag(c.data[1]) == -4.0);
+  assert_int_equal(rcb_meas_channel(ms, 1, &c), RCB_OK);
+  assert_string_equal(c.response, "DB.x");
+  assert_true(creal(c.data[1]) == 3.0 && cimag(c.data[1]) == 4.0);
+  for (size_t k = 0; k < 3; k++) {
+    rcb_uff_node one[1];
+    one[0] = bad[k];
+    assert_int_equal(rcb_meas_read_uff(ms, p, 1, one), RCB_ERR_ARG);
+  }
+  assert_non_null(strstr(rcb_meas_errmsg(ms), "model direction 'x' but no file direction"));
+  rcb_meas_destroy(ms);
+  remove(p);
+}
+
 static void test_uff_read_hand_written(void **state) {
   const char *p = rcb_test_tmp_path("hand.uff");
   FILE *fp = fopen(p, "w");
   rcb_meas *ms = NULL;
   rcb_meas_channel_info c;
-  rcb_uff_node map[] = {{10, "DA"}};
+  rcb_uff_node map[] = {{10, "DA", NULL, NULL}};
   (void)state;
   assert_non_null(fp);
   /* a dataset we skip (164, units), an FRF with a negative response
@@ -264,7 +364,7 @@ static void test_uff_read_hand_written(void **state) {
   assert_int_equal(rcb_meas_speed_given(ms), 1); /* z axis type 19 */
   /* with node 3 mapped: no warning */
   {
-    rcb_uff_node map2[] = {{10, "DA"}, {3, "DB"}};
+    rcb_uff_node map2[] = {{10, "DA", NULL, NULL}, {3, "DB", NULL, NULL}};
     assert_int_equal(rcb_meas_read_uff(ms, p, 2, map2), RCB_OK);
     assert_int_equal(rcb_meas_warning_count(ms), 0);
   }
@@ -278,7 +378,7 @@ static void test_uff_speed_not_stated(void **state) {
   const char *p = rcb_test_tmp_path("zaxis0.uff");
   FILE *fp = fopen(p, "w");
   rcb_meas *ms = NULL;
-  rcb_uff_node map[] = {{10, "DA"}, {3, "DB"}};
+  rcb_uff_node map[] = {{10, "DA", NULL, NULL}, {3, "DB", NULL, NULL}};
   (void)state;
   assert_non_null(fp);
   rec58(fp, 4, 10, 1, 3, 1, 6, 3, 1, 10.0, 10.0, 0.0, 18, 8, 13, 0, V3);
@@ -391,7 +491,11 @@ static void test_csv_lab_conventions(void **state) {
       "freq_hz,2.x/11.y_Real,2.x/11.y_Imag,2.y/11.y_amp,2.y/11.y_phase [deg]\n",
       "freq_hz,DA.x/11.y re,DA.x/11.y im,2.y/DB.y mag,2.y/DB.y phase_deg\n",
       "freq_hz,002.x/011.y_re,002.x/011.y_im,2.y/11.y_abs,2.y/11.y_Phase (deg)\n"};
-  static const rcb_uff_node map[] = {{11, "DB"}, {2, "DA"}, {7, "C.A"}};
+  static const rcb_uff_node map[] = {
+      {11, "DB", NULL, NULL},
+      {2, "DA", NULL, NULL},
+      {7, "C.A", NULL, NULL}
+  };
   const char *p = rcb_test_tmp_path("lab.csv");
   rcb_meas *ref = NULL, *ms = NULL;
   rcb_meas_channel_info a, b;
@@ -891,7 +995,7 @@ static void test_csv_limits(void **state) {
    * channel), 101 refused with the limit, by the CSV and the UFF reader */
   {
     char st[102];
-    rcb_uff_node map[1] = {{1, st}};
+    rcb_uff_node map[1] = {{1, st, NULL, NULL}};
     rcb_meas_channel_info c;
     memset(st, 's', 101);
     st[100] = '\0';
@@ -997,7 +1101,8 @@ int main(void) {
       cmocka_unit_test(test_uff_speed_not_stated),
       cmocka_unit_test(test_bad_csv),               cmocka_unit_test(test_bad_api),
       cmocka_unit_test(test_write_atomic),          cmocka_unit_test(test_allocator),
-      cmocka_unit_test(test_uff_binary_big_endian),
+      cmocka_unit_test(test_uff_binary_big_endian), cmocka_unit_test(test_uff_map_directions),
+      cmocka_unit_test(test_csv_magnitude_only),
   };
   return cmocka_run_group_tests(tests, rcb_test_setup_tmpdir, rcb_test_teardown_tmpdir);
 }

@@ -909,7 +909,7 @@ static void time_rec(FILE *fp, long node, int dir, int s9, const char *lab, cons
 static void test_uff_time_records(void **state) {
   const char *p = rcb_test_tmp_path("time.uff");
   const double v[4] = {1.0, -2.0, 0.5, 4.0};
-  rcb_uff_node map[] = {{1, "DA"}, {99, "KP"}};
+  rcb_uff_node map[] = {{1, "DA", NULL, NULL}, {99, "KP", NULL, NULL}};
   rcb_signals *s;
   const char *name;
   const double *x;
@@ -1034,7 +1034,7 @@ static void test_hit_triggers(void **state) {
 static void test_uff_hit_records(void **state) {
   const char *p = rcb_test_tmp_path("hits.uff");
   const double v1[4] = {1.0, -2.0, 0.5, 4.0}, v2[4] = {3.0, 5.0, -1.0, 2.0};
-  rcb_uff_node map[] = {{1, "DA"}, {2, "H"}};
+  rcb_uff_node map[] = {{1, "DA", NULL, NULL}, {2, "H", NULL, NULL}};
   rcb_signals *s;
   const double *x;
   FILE *fp = fopen(p, "w");

@@ -89,7 +89,10 @@ typedef struct rcb_compare_channel {
                                rcb_compare_set_sd) */
   double chi2_dof;        /**< sum |m - e|^2 / (2 sd^2) over the points with sd > 0, divided
                                by 2 x their count (Re and Im): ~1 at the noise (NaN without
-                               sds) */
+                               sds); magnitudes only: (|m| - |e|)^2 / sd^2 per point */
+  int magnitude_only;     /**< the measured channel has no phase (rcb_meas_add_channel_mag):
+                               frac and phase_rms_deg are NaN, and it is left out of CSAC, CSF
+                               and the mean FRAC */
 } rcb_compare_channel;
 
 /** @brief Totals over every channel and point. */

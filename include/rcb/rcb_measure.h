@@ -53,6 +53,26 @@ RCB_API rcb_status rcb_meas_add_channel(rcb_meas *ms, const char *response,
                                         const char *reference, rcb_frf_kind kind,
                                         const rcb_complex *data);
 
+/**
+ * @brief Add a channel of magnitudes only, the phase unknown (issue #35 item
+ * 4: many exports and published data sets give |H| alone): n =
+ * rcb_meas_point_count values |H| >= 0 (SI, of @p kind), held as |H| + 0i with
+ * the channel marked (rcb_meas_channel_info.magnitude_only). What uses only
+ * magnitudes takes it: fits on RCB_SCALE_LINEAR, LOG10 and DB, the
+ * comparison's error, log error, residual map and peaks, rcb_meas_convert
+ * (times w^k). What needs the phase refuses it with a message (the fit's
+ * RCB_SCALE_COMPLEX, sensor phases, the monitor, UFF output) or leaves it out
+ * and says so (the comparison's FRAC, phase error, CSAC/CSF are NaN; the
+ * diagnosis skips its placement).
+ * @return RCB_ERR_ARG for a negative or non-finite magnitude (the message
+ * names the point)
+ */
+RCB_API rcb_status rcb_meas_add_channel_mag(rcb_meas *ms, const char *response,
+                                            const char *reference, rcb_frf_kind kind,
+                                            const double *mag);
+/** @brief Number of channels given as magnitudes only (0: every channel has its phase). */
+RCB_API size_t rcb_meas_magnitude_only_count(const rcb_meas *ms);
+
 RCB_API rcb_meas_type rcb_meas_get_type(const rcb_meas *ms);
 RCB_API size_t rcb_meas_point_count(const rcb_meas *ms);
 RCB_API size_t rcb_meas_channel_count(const rcb_meas *ms);
@@ -106,7 +126,9 @@ typedef struct rcb_meas_channel_info {
   const char *response;     /**< "DA.x" */
   const char *reference;    /**< "C.B.y", NULL for unbalance responses */
   rcb_frf_kind kind;        /**< what the values are */
-  const rcb_complex *data;  /**< rcb_meas_point_count values, owned by ms */
+  const rcb_complex *data;  /**< rcb_meas_point_count values, owned by ms (magnitude
+                                 only: |H| + 0i) */
+  int magnitude_only;       /**< 1: magnitudes without phase (rcb_meas_add_channel_mag) */
 } rcb_meas_channel_info;
 RCB_API rcb_status rcb_meas_channel(const rcb_meas *ms, size_t i, rcb_meas_channel_info *out);
 
@@ -131,10 +153,26 @@ RCB_API rcb_status rcb_meas_add_noise(rcb_meas *ms, double beta_a, double beta_s
 RCB_API rcb_status rcb_meas_add_noise_phase(rcb_meas *ms, double beta_a, double beta_s,
                                             double phase_rad, uint64_t seed);
 
-/** @brief UFF node number <-> model station, for dataset 58 files. */
+/**
+ * @brief UFF node number <-> model station, for dataset 58 files (and CSV
+ * channels written as node numbers). An entry with @p dir NULL maps a whole
+ * node: its x, y, rx, ry channels read as the station's ("10=DA": 10.x is
+ * DA.x). An entry with @p dir maps one channel of the node, in any direction,
+ * to a model channel ("1.z=DA.x", "3.s=DB.y" for a scalar channel): an
+ * accelerometer's own axis (z, direction 3) or a scalar record (direction 0),
+ * as acquisition systems export them, read as the model channel it stands
+ * for. A direction entry wins over its node's entry; a negative file
+ * direction still flips the sign. Zero-initialised @p dir and @p model_dir
+ * (as in {10, "DA"}) make a node entry.
+ */
 typedef struct rcb_uff_node {
-  long node;           /**< UFF node number */
-  const char *station; /**< model station name, e.g. "DA" */
+  long node;             /**< UFF node number */
+  const char *station;   /**< model station name, e.g. "DA" */
+  const char *dir;       /**< NULL: the whole node; else the file direction this entry
+                              maps: "x", "y", "z", "rx", "ry", "rz" (UFF 1 to 6) or "s"
+                              (scalar, UFF 0) */
+  const char *model_dir; /**< with @p dir: the model direction it reads as, "x", "y",
+                              "rx" or "ry"; NULL with a node entry */
 } rcb_uff_node;
 
 /**
@@ -165,7 +203,9 @@ RCB_API rcb_status rcb_meas_write_uff(const rcb_meas *ms, const char *path, int 
  * part may follow '_' instead of a space, as lab scripts write it
  * ("DA.x/C.y_re", "DA.x/C.y_im", "_mag"/"_amp", "_phase_deg"); the two columns
  * of a channel are paired by name, adjacent or not, and a channel given both
- * as re/im and as mag/phase is refused as ambiguous. A station written as a
+ * as re/im and as mag/phase is refused as ambiguous. A "mag" or "dB" (20
+ * log10 |H|) column without a phase column is read as a channel of magnitudes
+ * only (rcb_meas_add_channel_mag). A station written as a
  * number ("3.x", a node number) is refused with the name to use; see
  * rcb_meas_read_csv_map.
  */

@@ -138,8 +138,13 @@ RCB_API rcb_status rcb_signals_read_wav(rcb_signals *s, const char *path, size_t
  * listed (as pyuff writes) within 0.1 sample of an even grid; ASCII or
  * binary 58b), one
  * channel per record, all with one sample interval and length. Channel names
- * "STATION.DIR" through @p map (as rcb_meas_read_uff), or the station alone
- * for direction 0 (a keyphasor). Quantity from the ordinate data type (8
+ * "STATION.DIR" through @p map (as rcb_meas_read_uff; a direction entry
+ * "1.z=DA.x" names the model channel of any direction), or the station alone
+ * for direction 0 (a keyphasor, a scalar record); every direction is read, a
+ * channel no entry names keeping its file name ("#1.z", "DA.z", "#5"). A
+ * record repeating an earlier record's channel is skipped with a warning; an
+ * ASCII record holding fewer samples than record 7 claims before its "-1" is
+ * refused, or read with rcb_signals_set_allow_truncated (a warning). Quantity from the ordinate data type (8
  * displacement, 11 velocity, 12 acceleration, 9/13 force) or else from the
  * record-9 units label (V, ...); units from that label or a dataset 164
  * (a disagreement of the two is refused).

@@ -31,7 +31,7 @@ static void free_results(rcb_compare *c) {
   void *ptrs[] = {c->grid, c->meas,  c->model, c->names, (void *)c->resp, (void *)c->ref,
                   c->kind, c->err,   c->frac,  c->lrms,  c->prms,         c->csac,
                   c->csf,  c->map,   c->peaks, c->band_first, c->band_count,
-                  c->floor, c->chi2, c->outl};
+                  c->floor, c->chi2, c->outl, c->magonly};
   size_t k;
   for (k = 0; k < sizeof ptrs / sizeof ptrs[0]; k++) rcb_free(a, ptrs[k]);
   c->grid = NULL;
@@ -39,6 +39,7 @@ static void free_results(rcb_compare *c) {
   c->names = NULL;
   c->resp = c->ref = NULL;
   c->kind = NULL;
+  c->magonly = NULL;
   c->err = c->frac = c->lrms = c->prms = c->csac = c->csf = c->map = NULL;
   c->floor = c->chi2 = NULL;
   c->peaks = NULL;
@@ -178,6 +179,7 @@ static rcb_status alloc_results(rcb_compare *c) {
   c->resp = rcb_alloc(a, nc * sizeof *c->resp);
   c->ref = rcb_alloc(a, nc * sizeof *c->ref);
   c->kind = rcb_alloc(a, nc * sizeof *c->kind);
+  c->magonly = rcb_alloc(a, nc * sizeof *c->magonly);
   c->err = rcb_alloc(a, nc * sizeof *c->err);
   c->frac = rcb_alloc(a, nc * sizeof *c->frac);
   c->lrms = rcb_alloc(a, nc * sizeof *c->lrms);
@@ -191,7 +193,7 @@ static rcb_status alloc_results(rcb_compare *c) {
   c->band_count = rcb_alloc(a, nb * sizeof *c->band_count);
   if (!c->grid || !c->meas || !c->model || !c->resp || !c->ref || !c->kind || !c->err ||
       !c->frac || !c->lrms || !c->prms || !c->csac || !c->csf || !c->map || !c->band_first ||
-      !c->band_count || !c->floor || !c->chi2)
+      !c->band_count || !c->floor || !c->chi2 || !c->magonly)
     return rcb_cmp_fail(c, RCB_ERR_NOMEM, "out of memory for the comparison results");
   return RCB_OK;
 }
@@ -211,6 +213,7 @@ static rcb_status copy_meas(rcb_compare *c, const rcb_meas *ms) {
   for (k = 0; k < c->nch; k++) {
     rcb_meas_channel(ms, k, &ci);
     c->kind[k] = ci.kind;
+    c->magonly[k] = ci.magnitude_only;
     memcpy(c->meas + k * c->npts, ci.data, c->npts * sizeof *c->meas);
     strcpy(c->names + pos, ci.response);
     c->resp[k] = c->names + pos;
@@ -252,18 +255,21 @@ typedef struct sums {
   size_t nl, np;
 } sums;
 
-static void add_point(sums *s, double complex e, double complex m) {
+/* A point of a channel; @p phase 0 for magnitudes only: the measures that
+ * need the phase (FRAC, the phase error) leave it out. */
+static void add_point(sums *s, double complex e, double complex m, int phase) {
   double ae = cabs(e), am = cabs(m), l;
   s->num += (am - ae) * (am - ae);
   s->den += ae * ae;
-  s->ee += ae * ae;
-  s->mm += am * am;
-  s->em += conj(e) * m;
   l = log_err(e, m);
   if (isfinite(l)) {
     s->l2 += l * l;
     s->nl++;
   }
+  if (!phase) return;
+  s->ee += ae * ae;
+  s->mm += am * am;
+  s->em += conj(e) * m;
   if (ae > 0 && am > 0) {
     double p = phase_err_deg(e, m);
     s->p2 += p * p;
@@ -285,7 +291,12 @@ static void sd_metrics(const rcb_compare *c, size_t k, double *floor_pct, double
       if (!usable(e, m) || !(sd > 0)) continue;
       s2 += sd * sd;
       e2 += creal(e * conj(e));
-      x2 += creal(d * conj(d)) / (sd * sd);
+      /* magnitudes only: one degree of freedom, (|m| - |e|) of variance sd^2,
+       * counted twice against the 2 n of the complex points */
+      if (c->magonly[k])
+        x2 += 2.0 * (cabs(m) - cabs(e)) * (cabs(m) - cabs(e)) / (sd * sd);
+      else
+        x2 += creal(d * conj(d)) / (sd * sd);
       n++;
     }
   if (e2 > 0) *floor_pct = 100.0 * sqrt(s2 / e2);
@@ -294,7 +305,7 @@ static void sd_metrics(const rcb_compare *c, size_t k, double *floor_pct, double
 
 static void channel_metrics(rcb_compare *c) {
   sums all;
-  size_t k, i;
+  size_t k, i, nfrac = 0;
   double fsum = 0.0;
   memset(&all, 0, sizeof all);
   for (k = 0; k < c->nch; k++) {
@@ -304,20 +315,20 @@ static void channel_metrics(rcb_compare *c) {
     memset(&s, 0, sizeof s);
     for (i = 0; i < c->npts; i++) {
       if (!usable(e[i], m[i])) continue;
-      add_point(&s, e[i], m[i]);
-      add_point(&all, e[i], m[i]);
+      add_point(&s, e[i], m[i], !c->magonly[k]);
+      add_point(&all, e[i], m[i], !c->magonly[k]);
     }
     cem = cabs(s.em);
     c->err[k] = s.den > 0 ? 100.0 * sqrt(s.num / s.den) : (double)NAN;
     c->frac[k] = s.ee > 0 && s.mm > 0 ? cem * cem / (s.ee * s.mm) : (double)NAN;
     c->lrms[k] = s.nl ? sqrt(s.l2 / (double)s.nl) : (double)NAN;
     c->prms[k] = s.np ? sqrt(s.p2 / (double)s.np) : (double)NAN;
-    fsum += c->frac[k];
+    if (!c->magonly[k]) fsum += c->frac[k], nfrac++;
     sd_metrics(c, k, &c->floor[k], &c->chi2[k]);
   }
   sd_metrics(c, c->nch, &c->sum.floor_pct, &c->sum.chi2_dof);
   c->sum.error_pct = all.den > 0 ? 100.0 * sqrt(all.num / all.den) : (double)NAN;
-  c->sum.frac_mean = fsum / (double)c->nch;
+  c->sum.frac_mean = nfrac ? fsum / (double)nfrac : (double)NAN; /* channels with phase */
   c->sum.log_rms = all.nl ? sqrt(all.l2 / (double)all.nl) : (double)NAN;
   c->sum.phase_rms_deg = all.np ? sqrt(all.p2 / (double)all.np) : (double)NAN;
 }
@@ -332,7 +343,7 @@ static void point_metrics(rcb_compare *c) {
     size_t used = 0;
     for (k = 0; k < c->nch; k++) {
       double complex e = c->meas[k * c->npts + i], m = c->model[k * c->npts + i];
-      if (!usable(e, m)) continue;
+      if (!usable(e, m) || c->magonly[k]) continue; /* CSAC, CSF need the phase */
       ee += creal(conj(e) * e);
       mm += creal(conj(m) * m);
       em += conj(e) * m;
@@ -465,6 +476,7 @@ rcb_status rcb_compare_get_channel(const rcb_compare *c, size_t i, rcb_compare_c
   out->phase_rms_deg = c->prms[i];
   out->floor_pct = c->floor[i];
   out->chi2_dof = c->chi2[i];
+  out->magnitude_only = c->magonly[i];
   out->meas = c->meas + i * c->npts;
   out->model = c->model + i * c->npts;
   return RCB_OK;

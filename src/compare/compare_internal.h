@@ -24,6 +24,7 @@ struct rcb_compare {
   char *names;                 /* response and reference strings */
   const char **resp, **ref;    /* nch each, into names (ref NULL for unbalance) */
   rcb_frf_kind *kind;          /* nch */
+  int *magonly;                /* nch: magnitudes only (no phase; issue #35 item 4) */
   double *err, *frac, *lrms, *prms; /* nch */
   double *floor, *chi2;        /* nch, NaN without sds */
   double *csac, *csf;          /* npts */

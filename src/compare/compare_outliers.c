@@ -70,7 +70,9 @@ static void channel_sums(const rcb_compare *c, size_t k, unit_sums *u) {
     if (!c->sd) continue;
     sd = c->sd[k * c->npts + i];
     if (!(sd > 0)) continue;
-    u->x2 += creal(d * conj(d)) / (sd * sd);
+    /* magnitudes only: |m| - |e|, one degree of freedom counted as two */
+    u->x2 += c->magonly[k] ? 2.0 * (am - ae) * (am - ae) / (sd * sd)
+                           : creal(d * conj(d)) / (sd * sd);
     u->nx++;
   }
 }

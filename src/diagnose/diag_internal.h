@@ -154,6 +154,7 @@ struct rcb_diag {
   size_t nmis;
   size_t nres;
   rcb_diag_place *place;            /* per shaft node, the largest share first (locate.c) */
+  int place_no_phase;               /* placement skipped: magnitudes only (locate.c) */
   size_t nplace;
   diag_cand *cand;
   size_t ncand, cap_cand;

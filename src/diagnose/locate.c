@@ -348,7 +348,11 @@ rcb_status rcb_diag_locate(rcb_diag *d) {
   const double *grid = rcb_meas_grid(d->meas);
   double *gw = NULL; /* the frequency subset (large sets), NULL: every point */
   rcb_status st;
-  if (rcb_diag_base_adequate(d) != 0 || rcb_meas_get_type(d->meas) != RCB_MEAS_FRF)
+  /* the equivalent loads are fitted on the complex scale: magnitudes alone
+   * (issue #35 item 4) cannot place the misfit; skipped, and said (words.c) */
+  d->place_no_phase = rcb_meas_magnitude_only_count(d->meas) > 0;
+  if (d->place_no_phase || rcb_diag_base_adequate(d) != 0 ||
+      rcb_meas_get_type(d->meas) != RCB_MEAS_FRF)
     return RCB_OK;
   memset(&w, 0, sizeof w);
   w.nch = rcb_meas_channel_count(d->meas);

@@ -349,6 +349,14 @@ rcb_status rcb_diag_explain(const rcb_diag *d, char *buf, size_t size, size_t *n
     if (d->nplace && !(d->nmis && d->mis[0].concentrated)) n = say_place(d, text, sizeof text, n);
     else if (!d->nplace) n = say_span(d, text, sizeof text, n);
   }
+  if (d->place_no_phase && n < sizeof text)
+    n += (size_t)snprintf(text + n, sizeof text - n,
+                          " The misfit was not placed along the shaft: placement fits "
+                          "equivalent loads on the complex scale and so needs the phase, and "
+                          "%zu of the %zu measured channels hold magnitudes only.",
+                          rcb_meas_magnitude_only_count(d->meas),
+                          rcb_meas_channel_count(d->meas));
+  if (n > sizeof text) n = sizeof text;
   if (d->far) /* the run-off baseline is a finding of its own */
     snprintf(text + n, sizeof text - n,
              " The fit of the model as it is ran far from the nominal model (%s): a missing "

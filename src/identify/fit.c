@@ -213,8 +213,25 @@ rcb_status rcb_fit_add_param(rcb_fit *f, const char *name, double lo, double hi,
   return RCB_OK;
 }
 
+/* The complex scale needs the phase: a measurement channel of magnitudes
+ * only (rcb_meas_add_channel_mag) is refused on it, naming the channel and
+ * the scales that take it (issue #35 item 4). */
+static rcb_status phase_check(rcb_fit *f, rcb_fit_scale scale) {
+  size_t c;
+  rcb_meas_channel_info ci;
+  if (scale != RCB_SCALE_COMPLEX || rcb_meas_magnitude_only_count(f->meas) == 0) return RCB_OK;
+  for (c = 0; rcb_meas_channel(f->meas, c, &ci) == RCB_OK && !ci.magnitude_only; c++) continue;
+  return rcb_fit_fail(f, RCB_ERR_ARG, "the complex scale fits Re and Im and so needs the "
+                      "phase, but measurement channel %zu (%s%s%s) holds magnitudes only (%zu "
+                      "of %zu channels); fit on the log10, linear or dB scale", c + 1,
+                      ci.response, ci.reference ? "/" : "", ci.reference ? ci.reference : "",
+                      rcb_meas_magnitude_only_count(f->meas), rcb_meas_channel_count(f->meas));
+}
+
 rcb_status rcb_fit_set_scale(rcb_fit *f, rcb_fit_scale scale) {
+  rcb_status st;
   if (!f || (int)scale < 0 || (int)scale > 3) return RCB_ERR_ARG;
+  if ((st = phase_check(f, scale))) return st;
   f->scale = scale;
   f->prepared = 0;
   return RCB_OK;
@@ -652,6 +669,7 @@ rcb_status rcb_fit_run(rcb_fit *f) {
   if (f->first_start >= (f->nstarts ? f->nstarts : 1))
     return rcb_fit_fail(f, RCB_ERR_ARG, "first start %zu of %zu starting points: nothing to try",
                         f->first_start, f->nstarts ? f->nstarts : 1);
+  if ((st = phase_check(f, f->scale))) return st;
   for (k = 0; k < f->np; k++) f->par[k].value = f->par[k].start = rcb_fit_par_get(f, k);
   if (f->wmodel) f->prepared = 0; /* a run starts from the measured weights */
   if ((st = rcb_fit_prepare(f))) return st;

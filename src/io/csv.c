@@ -10,7 +10,9 @@
  * the part after a space or, as lab scripts write them, after '_'
  * ("2.x/11.x_re", "DA.x_phase_deg"; issue #35 item 3). The two columns of a
  * channel are paired by name, adjacent or not; a channel given both ways
- * (re/im and mag/phase) is refused as ambiguous. Other "#" lines are
+ * (re/im and mag/phase) is refused as ambiguous. A "mag" (or "dB", 20 log10)
+ * column without phase is a channel of magnitudes only (issue #35 item 4:
+ * rcb_meas_add_channel_mag), written back as one "mag" column. Other "#" lines are
  * comments. Errors name the file, line and column. Other tools' spellings are
  * read too (case, spaces, '_' and a unit in brackets do not matter:
  * "Frequency (Hz)", "frequency_hz", "Speed [rpm]", "DA.x/C.y Real",
@@ -34,12 +36,13 @@
 
 #define CSV_WHERE 512
 
-typedef enum col_part { COL_RE, COL_IM, COL_MAG, COL_PHASE } col_part;
+typedef enum col_part { COL_RE, COL_IM, COL_MAG, COL_PHASE, COL_DB } col_part;
 
 typedef struct csv_col {
   char name[RCB_MEAS_CH_MAX * 2 + 2]; /* "RESP/REF" or "RESP" */
   col_part part;
-  size_t mate; /* RE/MAG: the column of its IM/PHASE (check_pairs) */
+  size_t mate; /* RE/MAG/DB: the column of its IM/PHASE (check_pairs); MAG or DB
+                  alone: itself (a magnitude-only channel, issue #35 item 4) */
 } csv_col;
 
 #define CSV_REF_MAX 80 /* characters of a "# phase = lag (reference)" */
@@ -241,6 +244,7 @@ static int part_of(const char *word, size_t n, const char *unit) {
   if (in_list(g, re)) return COL_RE;
   if (in_list(g, im)) return COL_IM;
   if (in_list(g, mag)) return COL_MAG;
+  if (strcmp(g, "db") == 0) return COL_DB;
   if (strcmp(g, "phasedeg") == 0) return COL_PHASE;
   if (strcmp(g, "phase") == 0 || strcmp(g, "ph") == 0)
     return strcmp(unit, "deg") == 0 || strcmp(unit, "degrees") == 0 || strcmp(unit, "\u00b0") == 0
@@ -249,39 +253,65 @@ static int part_of(const char *word, size_t n, const char *unit) {
   return -1;
 }
 
+/* The map entry of node @p node for direction [dir, dir + dlen): its direction
+ * entry ("2.z=DA.x") first, else its node entry ("2=DA"); NULL when neither. */
+static const rcb_uff_node *csv_map_find(const csv_state *S, long node, const char *dir,
+                                        size_t dlen) {
+  const rcb_uff_node *whole = NULL;
+  size_t i;
+  for (i = 0; i < S->nmap; i++) {
+    const rcb_uff_node *e = &S->map[i];
+    if (e->node != node) continue;
+    if (!e->dir)
+      whole = whole ? whole : e;
+    else if (strlen(e->dir) == dlen && strncmp(e->dir, dir, dlen) == 0)
+      return e;
+  }
+  return whole;
+}
+
 /* Stations written as numbers ("3.x/10.y", a test system's node numbers)
- * through the node map (issue #35 item 3: lab scripts write them); one the
- * map does not name is refused with what to give or write instead. */
+ * through the node map (issue #35 item 3: lab scripts write them); a
+ * direction entry maps a channel of any direction ("3.z=DA.x"); one the map
+ * does not name is refused with what to give or write instead. */
 static rcb_status map_stations(csv_state *S, csv_col *c, size_t k) {
   char out[sizeof c->name];
   const char *p = c->name;
   size_t at = 0;
   for (;;) {
     const char *slash = strchr(p, '/'), *end = slash ? slash : p + strlen(p), *dot = end, *q;
-    const char *st = "", *tail = p; /* written: st, then [tail, end) */
-    size_t stlen = 0, rest, i;
+    const char *st = "", *tail = p, *tail_end = end; /* written: st, then [tail, tail_end) */
+    char dirbuf[8];
+    size_t stlen = 0, rest;
     while (dot > p && dot[-1] != '.') dot--;
     if (dot > p + 1) {
       for (q = p; q < dot - 1 && isdigit((unsigned char)*q); q++) continue;
       if (q == dot - 1) {
         long node = 0;
         int n = (int)(dot - 1 - p);
+        const rcb_uff_node *e;
         for (q = p; q < dot - 1 && node < 100000000L; q++) node = node * 10 + (*q - '0');
-        for (i = 0; i < S->nmap && S->map[i].node != node; i++) continue;
-        if (i == S->nmap || q < dot - 1)
+        e = q < dot - 1 ? NULL : csv_map_find(S, node, dot, (size_t)(end - dot));
+        if (!e)
           return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: column %zu ('%s'): station '%.*s' "
                                "is a number, not a model station, and the node map has no entry "
-                               "for it: give it (rcbtool --map %.*s=STATION, the model's [uff] "
-                               "map; rcb_meas_read_csv_map), or rename it to the station it "
-                               "stands for (e.g. DA; 'rcbtool check' lists them) or to '#%.*s' "
-                               "for model node %.*s", S->path, S->line, k + 1, c->name, n, p, n,
-                               p, n, p, n, p);
-        st = S->map[i].station;
+                               "for it: give it (rcbtool --map %.*s=STATION, or %.*s.%.*s="
+                               "STATION.DIR for this channel alone; the model's [uff] map; "
+                               "rcb_meas_read_csv_map), or rename it to the station it stands "
+                               "for (e.g. DA; 'rcbtool check' lists them) or to '#%.*s' for "
+                               "model node %.*s", S->path, S->line, k + 1, c->name, n, p, n, p,
+                               n, p, (int)(end - dot), dot, n, p, n, p);
+        st = e->station;
         stlen = strlen(st);
         tail = dot - 1; /* ".DIR" */
+        if (e->dir) { /* ".MODEL_DIR" */
+          snprintf(dirbuf, sizeof dirbuf, ".%s", e->model_dir);
+          tail = dirbuf;
+          tail_end = dirbuf + strlen(dirbuf);
+        }
       }
     }
-    rest = (size_t)(end - tail);
+    rest = (size_t)(tail_end - tail);
     if (at + stlen + rest + 1 >= sizeof out)
       return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: column %zu ('%s'): the channel, its "
                            "stations mapped, has more than %zu characters", S->path, S->line,
@@ -333,7 +363,8 @@ static rcb_status header_col(csv_state *S, const char *f, size_t k) {
     return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: column %zu '%s': expected \"CHANNEL "
                          "re\", \"CHANNEL im\", \"CHANNEL mag\"/\"amp\" or \"CHANNEL "
                          "phase_deg\" (or CHANNEL_re, CHANNEL_im, CHANNEL_mag, "
-                         "CHANNEL_phase_deg)", S->path, S->line, k + 1, f);
+                         "CHANNEL_phase_deg); a magnitude alone, \"CHANNEL mag\" or \"CHANNEL "
+                         "dB\", is read without phase", S->path, S->line, k + 1, f);
   if (rcb_grow(&S->ms->alloc, (void **)&S->cols, &S->capcols, S->ncols + 1, sizeof *S->cols))
     return rcb_meas_fail(S->ms, RCB_ERR_NOMEM, "%s: out of memory", S->path);
   c = &S->cols[S->ncols];
@@ -351,14 +382,14 @@ static rcb_status header_col(csv_state *S, const char *f, size_t k) {
                          c->name);
   if (part < 0)
     return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: column %zu '%s': unknown part '%.*s'; "
-                         "expected re, im, mag, amp or phase_deg", S->path, S->line, k + 1, f,
+                         "expected re, im, mag, amp, dB or phase_deg", S->path, S->line, k + 1, f,
                          (int)(end - len - 1), f + len + 1);
   c->part = (col_part)part;
   S->ncols++;
   return map_stations(S, c, k);
 }
 
-static const char *const part_word[] = {"re", "im", "mag", "phase_deg"};
+static const char *const part_word[] = {"re", "im", "mag", "phase_deg", "dB"};
 
 typedef struct name_col {
   const char *name;
@@ -374,7 +405,7 @@ static int by_name(const void *a, const void *b) {
 /* The columns of one channel (sorted[g0..g1), one name): re+im or
  * mag+phase_deg, each once; cols[RE or MAG].mate set. */
 static rcb_status pair_channel(csv_state *S, const name_col *sorted, size_t g0, size_t g1) {
-  size_t at[4] = {0, 0, 0, 0}, g; /* 1 + column of each part, 0: none */
+  size_t at[5] = {0, 0, 0, 0, 0}, g; /* 1 + column of each part, 0: none */
   const char *name = sorted[g0].name;
   for (g = g0; g < g1; g++) {
     size_t c = sorted[g].col;
@@ -385,11 +416,23 @@ static rcb_status pair_channel(csv_state *S, const name_col *sorted, size_t g0, 
                            S->line, name, c + 2, part_word[p], at[p] + 1);
     at[p] = c + 1;
   }
-  if ((at[COL_RE] || at[COL_IM]) && (at[COL_MAG] || at[COL_PHASE]))
+  if ((at[COL_RE] || at[COL_IM]) && (at[COL_MAG] || at[COL_PHASE] || at[COL_DB]))
     return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: channel %s is given both as re/im and "
                          "as mag/phase (columns %zu and %zu): ambiguous; keep one pair",
                          S->path, S->line, name, (at[COL_RE] ? at[COL_RE] : at[COL_IM]) + 1,
-                         (at[COL_MAG] ? at[COL_MAG] : at[COL_PHASE]) + 1);
+                         (at[COL_MAG] ? at[COL_MAG] : at[COL_PHASE] ? at[COL_PHASE] : at[COL_DB]) + 1);
+  if (at[COL_MAG] && at[COL_DB])
+    return rcb_meas_fail(S->ms, RCB_ERR_PARSE, "%s:%zu: channel %s is given both as mag and as "
+                         "dB (columns %zu and %zu): ambiguous; keep one", S->path, S->line, name,
+                         at[COL_MAG] + 1, at[COL_DB] + 1);
+  if (at[COL_DB]) { /* dB stands for the magnitude: paired with a phase as mag is */
+    at[COL_MAG] = at[COL_DB];
+    at[COL_DB] = 0;
+  }
+  if (at[COL_MAG] && !at[COL_PHASE]) { /* magnitudes only (issue #35 item 4) */
+    S->cols[at[COL_MAG] - 1].mate = at[COL_MAG] - 1;
+    return RCB_OK;
+  }
   for (g = 0; g < 4; g += 2)
     if (at[g] || at[g + 1]) {
       size_t have = at[g] ? g : g + 1, miss = at[g] ? g + 1 : g;
@@ -528,19 +571,26 @@ static rcb_status build(csv_state *S) {
   for (c = 0; c < S->ncols && !st; c++) {
     char *slash = strchr(S->cols[c].name, '/');
     size_t m = S->cols[c].mate;
-    if (S->cols[c].part != COL_RE && S->cols[c].part != COL_MAG) continue;
+    col_part part = S->cols[c].part;
+    int mag_only = m == c; /* a mag or dB column without phase (issue #35 item 4) */
+    if (part != COL_RE && part != COL_MAG && part != COL_DB) continue;
     for (r = 0; r < S->nrows; r++) {
       double a = S->v[r * S->ncols + c], b = S->v[r * S->ncols + m];
-      d[r] = S->cols[c].part == COL_RE ? CMPLX(a, b)
-                                       : a * CMPLX(cos(b * RCB_PI / 180.0), sin(b * RCB_PI / 180.0));
+      if (part == COL_DB) a = pow(10.0, a / 20.0); /* 20 log10 |H| */
+      d[r] = part == COL_RE ? CMPLX(a, b)
+             : mag_only     ? CMPLX(a, 0.0)
+                            : a * CMPLX(cos(b * RCB_PI / 180.0), sin(b * RCB_PI / 180.0));
       if (S->phase == RCB_PHASE_LAG) d[r] = conj(d[r]); /* to the model's lead */
     }
-    snprintf(where, sizeof where, m == c + 1 ? "%s: columns %zu-%zu" : "%s: columns %zu and %zu",
-             S->path, c + 2, m + 2);
+    if (mag_only)
+      snprintf(where, sizeof where, "%s: column %zu", S->path, c + 2);
+    else
+      snprintf(where, sizeof where, m == c + 1 ? "%s: columns %zu-%zu" : "%s: columns %zu and %zu",
+               S->path, c + 2, m + 2);
     if (slash) *slash = '\0';
-    st = rcb_meas_add_channel_at(ms, S->cols[c].name, slash ? slash + 1 : NULL,
-                                 S->type == RCB_MEAS_FRF ? S->kind : RCB_RECEPTANCE, d, where,
-                                 RCB_ERR_PARSE);
+    st = (mag_only ? rcb_meas_add_mag_at : rcb_meas_add_channel_at)(
+        ms, S->cols[c].name, slash ? slash + 1 : NULL,
+        S->type == RCB_MEAS_FRF ? S->kind : RCB_RECEPTANCE, d, where, RCB_ERR_PARSE);
   }
   rcb_free(&ms->alloc, d);
   return st;
@@ -618,7 +668,9 @@ static void write_body(const rcb_meas *ms, FILE *fp, rcb_frf_kind kind) {
   fputs(frf ? "freq_hz" : "rpm", fp);
   for (c = 0; c < ms->nch; c++) {
     const rcb_meas_ch *h = &ms->ch[c];
-    if (frf)
+    if (h->mag_only) /* magnitudes only: one column (issue #35 item 4) */
+      fprintf(fp, frf ? ",%s/%s mag" : ",%s mag", h->resp, h->ref);
+    else if (frf)
       fprintf(fp, ",%s/%s re,%s/%s im", h->resp, h->ref, h->resp, h->ref);
     else
       fprintf(fp, ",%s re,%s im", h->resp, h->resp);
@@ -627,8 +679,11 @@ static void write_body(const rcb_meas *ms, FILE *fp, rcb_frf_kind kind) {
   for (i = 0; i < ms->n; i++) {
     fprintf(fp, "%.17g", ms->x[i] * (frf ? 1.0 / (2.0 * RCB_PI) : 30.0 / RCB_PI));
     for (c = 0; c < ms->nch; c++) /* LAG: the conjugate, so arg is the lag */
-      fprintf(fp, ",%.17g,%.17g", creal(ms->ch[c].data[i]),
-              ms->phase == RCB_PHASE_LAG ? -cimag(ms->ch[c].data[i]) : cimag(ms->ch[c].data[i]));
+      if (ms->ch[c].mag_only)
+        fprintf(fp, ",%.17g", creal(ms->ch[c].data[i]));
+      else
+        fprintf(fp, ",%.17g,%.17g", creal(ms->ch[c].data[i]),
+                ms->phase == RCB_PHASE_LAG ? -cimag(ms->ch[c].data[i]) : cimag(ms->ch[c].data[i]));
     fputc('\n', fp);
   }
 }

@@ -271,6 +271,47 @@ rcb_status rcb_meas_add_channel(rcb_meas *ms, const char *response, const char *
   return rcb_meas_add_channel_at(ms, response, reference, kind, data, NULL, RCB_ERR_ARG);
 }
 
+rcb_status rcb_meas_add_mag_at(rcb_meas *ms, const char *response, const char *reference,
+                               rcb_frf_kind kind, const rcb_complex *data, const char *where,
+                               rcb_status bad) {
+  size_t i;
+  rcb_status st;
+  if (!ms) return RCB_ERR_ARG;
+  for (i = 0; data && i < ms->n; i++)
+    if (!(creal(data[i]) >= 0.0) || cimag(data[i]) != 0.0)
+      return rcb_meas_fail(ms, bad, "%s%schannel %s%s%s, point %zu (%.9g Hz): magnitude %g: "
+                           "expected a finite value >= 0", pre(where), sep(where), response,
+                           reference ? "/" : "", reference ? reference : "", i + 1,
+                           ms->x[i] / TWO_PI, creal(data[i]));
+  if ((st = rcb_meas_add_channel_at(ms, response, reference, kind, data, where, bad))) return st;
+  ms->ch[ms->nch - 1].mag_only = 1;
+  return RCB_OK;
+}
+
+rcb_status rcb_meas_add_channel_mag(rcb_meas *ms, const char *response, const char *reference,
+                                    rcb_frf_kind kind, const double *mag) {
+  rcb_complex *d;
+  size_t i;
+  rcb_status st;
+  if (!ms) return RCB_ERR_ARG;
+  if (!mag) return rcb_meas_fail(ms, RCB_ERR_ARG, "add channel: data is NULL");
+  if (ms->n == 0)
+    return rcb_meas_fail(ms, RCB_ERR_STATE, "add channel: set the abscissa first "
+                         "(rcb_meas_set_grid)");
+  if (!(d = rcb_alloc(&ms->alloc, ms->n * sizeof *d)))
+    return rcb_meas_fail(ms, RCB_ERR_NOMEM, "out of memory (channel %s)", response);
+  for (i = 0; i < ms->n; i++) d[i] = CMPLX(mag[i], 0.0);
+  st = rcb_meas_add_mag_at(ms, response, reference, kind, d, NULL, RCB_ERR_ARG);
+  rcb_free(&ms->alloc, d);
+  return st;
+}
+
+size_t rcb_meas_magnitude_only_count(const rcb_meas *ms) {
+  size_t c, n = 0;
+  for (c = 0; ms && c < ms->nch; c++) n += ms->ch[c].mag_only != 0;
+  return n;
+}
+
 rcb_meas_type rcb_meas_get_type(const rcb_meas *ms) { return ms ? ms->type : RCB_MEAS_FRF; }
 size_t rcb_meas_point_count(const rcb_meas *ms) { return ms ? ms->n : 0; }
 size_t rcb_meas_channel_count(const rcb_meas *ms) { return ms ? ms->nch : 0; }
@@ -284,6 +325,7 @@ rcb_status rcb_meas_channel(const rcb_meas *ms, size_t i, rcb_meas_channel_info 
   out->reference = ms->type == RCB_MEAS_FRF ? ms->ch[i].ref : NULL;
   out->kind = ms->ch[i].kind;
   out->data = ms->ch[i].data;
+  out->magnitude_only = ms->ch[i].mag_only;
   return RCB_OK;
 }
 
@@ -310,6 +352,7 @@ rcb_status rcb_meas_convert(rcb_meas *ms, rcb_frf_kind kind) {
     for (i = 0; i < ms->n && k != 0; i++) {
       rcb_complex iw = CMPLX(0.0, ms->x[i]);
       rcb_complex f = k == 1 ? iw : k == 2 ? iw * iw : k == -1 ? 1.0 / iw : 1.0 / (iw * iw);
+      if (ms->ch[c].mag_only) f = cabs(f); /* |(i w)^k| = w^k: magnitudes stay magnitudes */
       ms->ch[c].data[i] *= f;
     }
     ms->ch[c].kind = kind;
@@ -411,19 +454,75 @@ rcb_status rcb_atomic_commit(rcb_meas *ms, rcb_atomic_file *af, const char *path
   return RCB_OK;
 }
 
+const char *rcb_uff_dir_name(long code) {
+  static const char *const names[] = {"s", "x", "y", "z", "rx", "ry", "rz"};
+  long a = code < 0 ? -code : code;
+  return a <= 6 ? names[a] : NULL;
+}
+
+/* The UFF direction code of a map entry's dir name, -1 if it is none. */
+static long dir_code(const char *name) {
+  long k;
+  for (k = 0; k <= 6; k++)
+    if (strcmp(name, rcb_uff_dir_name(k)) == 0) return k;
+  return -1;
+}
+
+const rcb_uff_node *rcb_uff_map_find(size_t nmap, const rcb_uff_node *map, long node,
+                                     long code) {
+  const char *name = rcb_uff_dir_name(code);
+  const rcb_uff_node *whole = NULL;
+  size_t i;
+  for (i = 0; i < nmap; i++) {
+    if (map[i].node != node || !map[i].station) continue;
+    if (!map[i].dir)
+      whole = whole ? whole : &map[i];
+    else if (name && strcmp(map[i].dir, name) == 0)
+      return &map[i];
+  }
+  return whole;
+}
+
+/* One entry's direction fields (node entry: both NULL). */
+static rcb_status check_entry_dirs(rcb_meas *ms, const char *who, const rcb_uff_node *e) {
+  if (!e->dir && !e->model_dir) return RCB_OK;
+  if (!e->dir)
+    return rcb_meas_fail(ms, RCB_ERR_ARG, "%s: node %ld of the map has a model direction "
+                         "'%s' but no file direction; expected both (e.g. %ld.z=%s.x) or "
+                         "neither", who, e->node, e->model_dir, e->node, e->station);
+  if (dir_code(e->dir) < 0)
+    return rcb_meas_fail(ms, RCB_ERR_ARG, "%s: map entry %ld.%.8s: file direction '%.8s' is "
+                         "not a UFF direction; expected x, y, z, rx, ry, rz (1 to 6) or s "
+                         "(scalar, 0)", who, e->node, e->dir, e->dir);
+  if (!e->model_dir || !(strcmp(e->model_dir, "x") == 0 || strcmp(e->model_dir, "y") == 0 ||
+                         strcmp(e->model_dir, "rx") == 0 || strcmp(e->model_dir, "ry") == 0))
+    return rcb_meas_fail(ms, RCB_ERR_ARG, "%s: map entry %ld.%s=%s.%.8s: the model direction "
+                         "must be x, y, rx or ry (the model's channels)", who, e->node, e->dir,
+                         e->station, e->model_dir ? e->model_dir : "(none)");
+  return RCB_OK;
+}
+
 rcb_status rcb_meas_check_map(rcb_meas *ms, const char *who, size_t nmap,
                               const rcb_uff_node *map) {
-  size_t i;
+  size_t i, j;
+  rcb_status st;
   if (nmap && !map) return rcb_meas_fail(ms, RCB_ERR_ARG, "%s: node map is NULL", who);
   for (i = 0; i < nmap; i++) {
-    const char *st = map[i].station;
-    if (!st || !st[0])
+    const char *st_name = map[i].station;
+    if (!st_name || !st_name[0])
       return rcb_meas_fail(ms, RCB_ERR_ARG, "%s: node %ld of the map has no station", who,
                            map[i].node);
-    if (strlen(st) > RCB_MEAS_STATION_MAX)
+    if (strlen(st_name) > RCB_MEAS_STATION_MAX)
       return rcb_meas_fail(ms, RCB_ERR_ARG, "%s: node %ld of the map: station '%.40s...' has "
-                           "%zu characters; at most %d", who, map[i].node, st, strlen(st),
-                           RCB_MEAS_STATION_MAX);
+                           "%zu characters; at most %d", who, map[i].node, st_name,
+                           strlen(st_name), RCB_MEAS_STATION_MAX);
+    if ((st = check_entry_dirs(ms, who, &map[i]))) return st;
+    for (j = 0; j < i; j++)
+      if (map[j].node == map[i].node && (map[j].dir == NULL) == (map[i].dir == NULL) &&
+          (!map[i].dir || strcmp(map[j].dir, map[i].dir) == 0))
+        return rcb_meas_fail(ms, RCB_ERR_ARG, "%s: entries %zu and %zu of the map both give "
+                             "node %ld%s%s; give each once", who, j + 1, i + 1, map[i].node,
+                             map[i].dir ? "." : "", map[i].dir ? map[i].dir : "");
   }
   return RCB_OK;
 }

@@ -18,7 +18,8 @@ typedef struct rcb_meas_ch {
   char resp[RCB_MEAS_CH_MAX];
   char ref[RCB_MEAS_CH_MAX]; /* "" for unbalance responses */
   rcb_frf_kind kind;
-  rcb_complex *data; /* n values */
+  rcb_complex *data; /* n values (magnitude only: |H| + 0i) */
+  int mag_only;      /* magnitudes without phase (rcb_meas_add_channel_mag) */
 } rcb_meas_ch;
 
 struct rcb_meas {
@@ -70,6 +71,10 @@ rcb_status rcb_meas_set_grid_at(rcb_meas *ms, rcb_meas_type type, size_t n, cons
 rcb_status rcb_meas_add_channel_at(rcb_meas *ms, const char *response, const char *reference,
                                    rcb_frf_kind kind, const rcb_complex *data,
                                    const char *where, rcb_status bad);
+/* The same for magnitudes only (values |H| + 0i, each >= 0; issue #35 item 4). */
+rcb_status rcb_meas_add_mag_at(rcb_meas *ms, const char *response, const char *reference,
+                               rcb_frf_kind kind, const rcb_complex *data, const char *where,
+                               rcb_status bad);
 
 /* Split "STATION.DIR": dir index 0..3 (x, y, rx, ry) or -1 if the suffix is
  * not one of them; *stlen = length of the station part. */
@@ -96,10 +101,14 @@ void rcb_atomic_abort(rcb_atomic_file *af);
  * ms's message; a nonzero return of fn stops the read with that status. */
 typedef struct rcb_uff_time_rec {
   char name[RCB_MEAS_CH_MAX]; /* "STATION.DIR" (DIR x, y, z, rx, ry, rz), or the
-                                 station for direction 0 (scalar) */
+                                 station for direction 0 (scalar); a direction entry
+                                 of the map ("1.z=DA.x") gives its model channel */
+  long node;                  /* the record's response node */
   long dir;                   /* the record's direction code (0 scalar, 3 z, 6 rz, ...) */
   double t0, dt;              /* s */
   size_t n;
+  size_t claimed;             /* ASCII record cut short: the points record 7 claims
+                                 (n were read, up to its '-1'); 0 when whole */
   const rcb_complex *y;       /* n values, SI, imaginary parts 0 (file units when
                                  label_unknown) */
   rcb_quantity q;             /* from the data type or the label; unknown if neither */
@@ -123,9 +132,21 @@ void rcb_uff_function_text(long func_type, long abscissa, char *buf, size_t size
 #define RCB_MEAS_STATION_MAX (RCB_MEAS_CH_MAX - 4)
 /* A reader's node map (@p who names the call in the message): NULL with
  * entries, an entry without a station or with one longer than
- * RCB_MEAS_STATION_MAX is RCB_ERR_ARG with the entry and the limit named. */
+ * RCB_MEAS_STATION_MAX, a direction entry whose dir is not a UFF direction
+ * name or whose model_dir is not x, y, rx, ry (or a model_dir without dir),
+ * and two entries for one node (or one node and direction) are RCB_ERR_ARG
+ * with the entry named. */
 rcb_status rcb_meas_check_map(rcb_meas *ms, const char *who, size_t nmap,
                               const rcb_uff_node *map);
+
+/* A UFF direction code's name in a map entry ("1.z=DA.x"): 0 "s" (scalar),
+ * 1 to 6 "x", "y", "z", "rx", "ry", "rz", the sign dropped; NULL beyond. */
+const char *rcb_uff_dir_name(long code);
+/* The map entry a channel at @p node in file direction @p code reads
+ * through: the node's direction entry for that direction, else the node's
+ * entry (dir NULL), else NULL. */
+const rcb_uff_node *rcb_uff_map_find(size_t nmap, const rcb_uff_node *map, long node,
+                                     long code);
 
 /* Whole file into memory (NUL-terminated), through the object's allocator. */
 rcb_status rcb_meas_slurp(rcb_meas *ms, const char *path, char **buf, size_t *len);

@@ -93,7 +93,10 @@ rcb_status rcb_meas_add_noise_phase(rcb_meas *ms, double beta_a, double beta_s, 
   for (c = 0; c < ms->nch; c++) {
     rcb_complex *f = ms->ch[c].data;
     double level = rcb_noise_level(f, ms->n, beta_s);
-    for (i = 0; i < ms->n; i++) f[i] = rcb_noise_draw(&r, f[i], beta_a, level, phase_rad);
+    for (i = 0; i < ms->n; i++) {
+      f[i] = rcb_noise_draw(&r, f[i], beta_a, level, phase_rad);
+      if (ms->ch[c].mag_only) f[i] = cabs(f[i]); /* the magnitude of the noisy value */
+    }
   }
   return RCB_OK;
 }

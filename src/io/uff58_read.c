@@ -103,6 +103,8 @@ typedef struct uff_rec {
   long n_bytes;
   long func_type, rsp_node, rsp_dir, ref_node, ref_dir;
   long ord_type, npts, spacing;
+  long claimed;            /* time mode: record 7's count when the record holds fewer
+                              values (read up to its '-1'), else 0 */
   double xmin, dx, zval;   /* Hz, Hz, z value */
   long spec[4];            /* records 8..11 specific data types */
   int real;                /* real ordinates (types 2, 4): time records only */
@@ -197,7 +199,11 @@ static rcb_status check_form(uff_reader *R, uff_rec *r) {
      * takes at least 2 bytes in ASCII, 4 in binary) */
     size_t per = r->real ? (r->spacing ? 1u : 2u) : (r->spacing ? 2u : 3u);
     size_t least = r->binary ? 4u : 2u, left = R->c.len - R->c.pos;
-    if (r->npts > 100000000L || (size_t)r->npts > left / (per * least))
+    size_t cap = left / (per * least);
+    r->claimed = r->npts;
+    if (R->on_time && !r->binary && cap > 0 && (r->npts > 100000000L || (size_t)r->npts > cap))
+      r->npts = (long)(cap < 100000000u ? cap : 100000000u); /* read to its '-1' (read_ascii) */
+    else if (r->npts > 100000000L || (size_t)r->npts > cap)
       return rfail(R, r, line, "record 7 claims %ld points (%zu values), but the %zu bytes "
                    "left in the file hold at most %zu: truncated, or a wrong count", r->npts,
                    (size_t)r->npts * per, left, left / least);
@@ -253,9 +259,18 @@ static rcb_status read_ascii(uff_reader *R, uff_rec *r) {
   size_t n;
   while (k < need) {
     size_t j, at = 0;
-    if (!get_line(&R->c, &s, &n) || is_delim(s, n))
+    if (!get_line(&R->c, &s, &n) || is_delim(s, n)) {
+      size_t per = need / (size_t)r->npts;
+      /* a time record cut short (an excerpt of a long recording, as pyuff's
+       * dataset_milestone_in_header.uff): its whole samples, the count that
+       * record 7 claims kept for the caller to refuse or allow (issue #35) */
+      if (R->on_time && k > 0 && k % per == 0) {
+        r->npts = (long)(k / per);
+        return RCB_OK;
+      }
       return rfail(R, r, R->c.line, "truncated: %zu of %zu values (%ld points) before %s",
-                   k, need, r->npts, R->c.pos >= R->c.len ? "the end of the file" : "'-1'");
+                   k, need, r->claimed, R->c.pos >= R->c.len ? "the end of the file" : "'-1'");
+    }
     for (j = 0; j < nw && at < n && k < need; at += w[j], j++) {
       double v;
       char f[64];
@@ -430,8 +445,8 @@ static rcb_status dir_name(uff_reader *R, const uff_rec *r, long code, const cha
 
 static void station_of(const uff_reader *R, long node, char *buf, size_t size) {
   size_t i;
-  for (i = 0; i < R->nmap; i++)
-    if (R->map[i].node == node && R->map[i].station) {
+  for (i = 0; i < R->nmap; i++) /* a node entry: direction entries name one channel */
+    if (R->map[i].node == node && R->map[i].station && !R->map[i].dir) {
       snprintf(buf, size, "%s", R->map[i].station);
       return;
     }
@@ -578,30 +593,44 @@ typedef struct uff_set {
   char dirskip[200]; /* the first of them, for the message when nothing is left */
 } uff_set;
 
-/* An FRF or unbalance record whose response or reference is axial (3),
- * torsional (6) or scalar (0): the model has no such channel. Skipped with
- * a warning, not fatal (issue #25: one axial channel refused a whole
- * 4-channel file). 1 when skipped (*st: a warning that could not be kept). */
-static int skip_direction(uff_reader *R, uff_set *S, const uff_rec *r, rcb_status *st) {
+/* The channel of a record's response (k = 0) or reference (k = 1) into
+ * out: a direction entry of the map ("1.z=DA.x", "3.s=DB.y") names it in any
+ * direction; else x, y, rx, ry at the node's station (or "#N"). An axial (3),
+ * torsional (6) or scalar (0) direction without a direction entry has no model
+ * channel: the record is skipped (*skipped = 1) with a warning that names the
+ * entry that would read it, not fatal (issue #25: one axial channel refused a
+ * whole 4-channel file; issue #35: vendors export an accelerometer's own z). */
+static rcb_status chan_name(uff_reader *R, uff_set *S, const uff_rec *r, int k, char *out,
+                            size_t size, int *skipped) {
   static const char *const why[] = {"scalar (direction 0)", NULL, NULL, "axial (direction 3, z)",
                                     NULL, NULL, "torsional (direction 6, rz)"};
-  long d[2], a;
-  int k;
-  d[0] = r->rsp_dir;
-  d[1] = r->func_type == 4 ? r->ref_dir : 1;
-  for (k = 0; k < 2; k++) {
-    a = d[k] < 0 ? -d[k] : d[k];
-    if (a > 6 || !why[a]) continue;
+  long node = k ? r->ref_node : r->rsp_node, code = k ? r->ref_dir : r->rsp_dir;
+  long a = code < 0 ? -code : code;
+  const rcb_uff_node *e = rcb_uff_map_find(R->nmap, R->map, node, code);
+  const char *dir = NULL, *name = rcb_uff_dir_name(code);
+  char st[RCB_MEAS_CH_MAX];
+  rcb_status status;
+  *skipped = 0;
+  if (e && e->dir) {
+    snprintf(out, size, "%s.%s", e->station, e->model_dir);
+    return RCB_OK;
+  }
+  if (a <= 6 && why[a]) {
+    const char *station = e ? e->station : "STATION";
+    *skipped = 1;
     if (S->ndirskip++ == 0)
       snprintf(S->dirskip, sizeof S->dirskip, "%zu: dataset 58 record %zu: its %s is %s",
                r->line + 6, r->index, k ? "reference" : "response", why[a]);
-    *st = rcb_meas_warn(R->ms, "%s:%zu: dataset 58 record %zu: skipped: its %s (node %ld) is "
-                        "%s; the model's channels are x, y, rx, ry", R->path, r->line + 6,
-                        r->index, k ? "reference" : "response", k ? r->ref_node : r->rsp_node,
-                        why[a]);
-    return 1;
+    return rcb_meas_warn(R->ms, "%s:%zu: dataset 58 record %zu: skipped: its %s (node %ld) is "
+                         "%s; the model's channels are x, y, rx, ry: the map entry %ld.%s=%s.DIR "
+                         "(DIR one of them; rcbtool --map) would read it", R->path, r->line + 6,
+                         r->index, k ? "reference" : "response", node, why[a], node, name,
+                         station);
   }
-  return 0;
+  if ((status = dir_name(R, r, code, k ? "reference" : "response", &dir))) return status;
+  station_of(R, node, st, sizeof st);
+  snprintf(out, size, "%.*s.%s", (int)(size - 4), st, dir);
+  return RCB_OK;
 }
 
 static rcb_status match_first(uff_reader *R, uff_set *S, const uff_rec *r, int type,
@@ -634,19 +663,18 @@ static rcb_status match_first(uff_reader *R, uff_set *S, const uff_rec *r, int t
 static rcb_status accept(uff_reader *R, uff_set *S, uff_rec *r) {
   int frf = r->func_type == 4;
   int type = frf ? RCB_MEAS_FRF : RCB_MEAS_UNBALANCE;
-  const char *rd = NULL, *fd = NULL;
-  char st_r[RCB_MEAS_CH_MAX], st_f[RCB_MEAS_CH_MAX];
+  char ch_r[RCB_MEAS_CH_MAX], ch_f[RCB_MEAS_CH_MAX] = "";
   double scale, speed = 0.0, uscale = 1.0;
   rcb_frf_kind kind = RCB_RECEPTANCE;
   rcb_status st;
   struct uff_chan *c;
   size_t i;
+  int skipped = 0;
   if (!frf && r->ref_node != 0)
     return rfail(R, r, r->line + 6, "function type 1 with reference node %ld: read as an "
                  "unbalance response, which needs reference node 0", r->ref_node);
-  if (skip_direction(R, S, r, &st)) return st;
-  if ((st = dir_name(R, r, r->rsp_dir, "response", &rd))) return st;
-  if (frf && (st = dir_name(R, r, r->ref_dir, "reference", &fd))) return st;
+  if ((st = chan_name(R, S, r, 0, ch_r, sizeof ch_r, &skipped)) || skipped) return st;
+  if (frf && ((st = chan_name(R, S, r, 1, ch_f, sizeof ch_f, &skipped)) || skipped)) return st;
   if ((st = record_kind(R, r, frf, &kind))) return st;
   if ((st = unit_scale(R, r, frf, kind, &uscale))) return st;
   if (r->spec[0] == 19) {
@@ -674,12 +702,8 @@ static rcb_status accept(uff_reader *R, uff_set *S, uff_rec *r) {
   if (rcb_grow(&R->ms->alloc, (void **)&S->ch, &S->cap, S->n + 1, sizeof *S->ch))
     return rcb_meas_fail(R->ms, RCB_ERR_NOMEM, "%s: out of memory", R->path);
   c = &S->ch[S->n++];
-  station_of(R, r->rsp_node, st_r, sizeof st_r);
-  snprintf(c->resp, sizeof c->resp, "%.*s.%s", (int)(sizeof c->resp - 4), st_r, rd);
-  if (frf) {
-    station_of(R, r->ref_node, st_f, sizeof st_f);
-    snprintf(c->ref, sizeof c->ref, "%.*s.%s", (int)(sizeof c->ref - 4), st_f, fd);
-  }
+  memcpy(c->resp, ch_r, sizeof c->resp);
+  memcpy(c->ref, ch_f, sizeof c->ref);
   c->kind = kind;
   c->index = r->index;
   c->line = r->line;
@@ -747,6 +771,7 @@ static rcb_status time_units(uff_reader *R, const uff_rec *r, rcb_uff_time_rec *
  * values to SI, then handed to the caller, which decides what it uses. */
 static rcb_status accept_time(uff_reader *R, uff_rec *r) {
   rcb_uff_time_rec t;
+  const rcb_uff_node *e;
   char st_r[RCB_MEAS_CH_MAX];
   const char *dir = "";
   double f = 1.0;
@@ -754,11 +779,15 @@ static rcb_status accept_time(uff_reader *R, uff_rec *r) {
   rcb_status st;
   memset(&t, 0, sizeof t);
   if ((st = time_units(R, r, &t, &f)) || (st = time_dir(R, r, &dir))) return st;
+  e = rcb_uff_map_find(R->nmap, R->map, r->rsp_node, r->rsp_dir);
   station_of(R, r->rsp_node, st_r, sizeof st_r);
-  if (dir[0])
+  if (e && e->dir) /* "1.z=DA.x": the model channel it stands for (issue #35) */
+    snprintf(t.name, sizeof t.name, "%s.%s", e->station, e->model_dir);
+  else if (dir[0])
     snprintf(t.name, sizeof t.name, "%.*s.%s", (int)(sizeof t.name - 4), st_r, dir);
   else
     snprintf(t.name, sizeof t.name, "%s", st_r);
+  t.node = r->rsp_node;
   t.dir = r->rsp_dir;
   if (r->rsp_dir < 0) f = -f;
   for (i = 0; i < (size_t)r->npts; i++) r->y[i] *= f;
@@ -776,6 +805,7 @@ static rcb_status accept_time(uff_reader *R, uff_rec *r) {
                              r->x[i], t.t0 + (double)i * t.dt);
   }
   t.n = (size_t)r->npts;
+  t.claimed = r->claimed > r->npts ? (size_t)r->claimed : 0;
   t.y = r->y;
   t.index = r->index;
   t.line = r->line;
@@ -882,8 +912,10 @@ static rcb_status scan(uff_reader *R, uff_set *S) {
   }
   if (!st && S->type < 0 && !R->on_time && S->ndirskip)
     st = rcb_meas_fail(R->ms, RCB_ERR_PARSE, "%s:%s; the model's channels are x, y, rx, ry, "
-                       "and all %zu records were skipped so: nothing to read", R->path,
-                       S->dirskip, S->ndirskip);
+                       "and all %zu records were skipped so: nothing to read (a map entry "
+                       "NODE.DIR=STATION.DIR, e.g. rcbtool --map 1.z=DA.x, reads a channel "
+                       "of another direction as a model channel; the warnings name them)",
+                       R->path, S->dirskip, S->ndirskip);
   if (!st && S->type < 0 && !R->on_time) {
     char why[360];
     skipped_text(R, why, sizeof why);

@@ -25,8 +25,8 @@ static int node_of(const rcb_uff_node *map, size_t nmap, const char *st, size_t 
                    long *node) {
   size_t i;
   char *end;
-  for (i = 0; i < nmap; i++)
-    if (map[i].station && strlen(map[i].station) == len &&
+  for (i = 0; i < nmap; i++) /* node entries: a direction entry names one channel */
+    if (map[i].station && !map[i].dir && strlen(map[i].station) == len &&
         strncmp(map[i].station, st, len) == 0) {
       *node = map[i].node;
       return 0;
@@ -48,8 +48,21 @@ static rcb_status dof_of(rcb_meas *ms, const char *path, const char *ch, size_t 
   static const long code[] = {1, 2, 4, 5};
   size_t len;
   int dir = rcb_meas_channel_dir(ch, &len);
+  size_t i;
   if (dir < 0)
     return rcb_meas_fail(ms, RCB_ERR_ARG, "%s: channel '%s': unknown direction", path, ch);
+  for (i = 0; i < nmap; i++) /* "1.z=DA.x" writes DA.x back as node 1, direction z */
+    if (map[i].dir && map[i].model_dir && map[i].station &&
+        strlen(map[i].station) == len && strncmp(map[i].station, ch, len) == 0 &&
+        strcmp(map[i].model_dir, ch + len + 1) == 0) {
+      long k; /* the map is checked: its dir is one of the seven names */
+      for (k = 0; k < 6 && strcmp(rcb_uff_dir_name(k), map[i].dir) != 0; k++) continue;
+      d->node = map[i].node;
+      d->dir = k;
+      strcpy(d->ent, "NONE");
+      if (len <= 10 && !memchr(ch, ' ', len)) snprintf(d->ent, sizeof d->ent, "%.*s", (int)len, ch);
+      return RCB_OK;
+    }
   if (node_of(map, nmap, ch, len, &d->node))
     return rcb_meas_fail(ms, RCB_ERR_ARG, "%s: channel %s: station '%.*s' has no UFF node "
                          "number; add it to the node map (e.g. 1=%.*s) or use #N", path, ch,
@@ -169,7 +182,13 @@ rcb_status rcb_meas_write_uff(const rcb_meas *cms, const char *path, int binary,
   size_t c, i;
   rcb_status st = RCB_OK;
   if (!ms) return RCB_ERR_ARG;
-  if (nmap && !map) return rcb_meas_fail(ms, RCB_ERR_ARG, "write_uff: node map is NULL");
+  if ((st = rcb_meas_check_map(ms, "write_uff", nmap, map))) return st;
+  for (c = 0; c < ms->nch; c++)
+    if (ms->ch[c].mag_only)
+      return rcb_meas_fail(ms, RCB_ERR_ARG, "%s: channel %s%s%s holds magnitudes only: a "
+                           "dataset 58 FRF record is complex, and no phase is known; write CSV "
+                           "(a 'mag' column)", path ? path : "", ms->ch[c].resp,
+                           ms->ch[c].ref[0] ? "/" : "", ms->ch[c].ref);
   if (ms->n == 0 || ms->nch == 0)
     return rcb_meas_fail(ms, RCB_ERR_STATE, "%s: nothing to write (no abscissa or no "
                          "channels)", path ? path : "");

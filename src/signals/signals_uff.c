@@ -21,23 +21,20 @@ typedef struct uff_ctx {
   size_t caprec, capidx;
 } uff_ctx;
 
-/* What the model cannot use is skipped with a warning, not fatal (issue
- * #25): an axial or torsional channel (direction 3, 6: the model's channels
- * are x, y, rx, ry) and a scalar channel (direction 0) that is not a voltage
- * (a keyphasor is a voltage at direction 0; an accelerometer written without
- * a direction is not one, and has no model channel). 1 when skipped. */
-static int skipped(uff_ctx *c, const rcb_uff_time_rec *r, rcb_quantity q, rcb_status *st) {
-  long a = r->dir < 0 ? -r->dir : r->dir;
-  const char *why = NULL;
-  if (a == 3 || a == 6)
-    why = a == 3 ? "axial (direction 3, z)" : "torsional (direction 6, rz)";
-  else if (a == 0 && q != RCB_QTY_VOLTAGE)
-    why = "scalar (direction 0) and not a voltage (a keyphasor)";
-  if (!why) return 0;
+/* Every direction is read (issue #35): a signal verb (estimate, order) needs
+ * no model direction, so an axial (z), torsional (rz) or scalar record keeps
+ * its file name ("#1.z", "DA.z", "#5") until --outputs NAME=STATION.DIR or a
+ * map entry "1.z=DA.x" names the model channel it stands for. A record whose
+ * channel an earlier record already gave (a second sensor on one node and
+ * direction) is skipped with a warning naming both. 1 when skipped. */
+static int repeated(uff_ctx *c, const rcb_uff_time_rec *r, rcb_quantity q, rcb_status *st) {
+  size_t i;
+  if (rcb_signals_find(c->s, r->name, &i) != RCB_OK) return 0;
   c->nskip++;
-  *st = rcb_signals_warn(c->s, "%s:%zu: dataset 58 record %zu ('%s', %s): skipped: %s; the "
-                         "model's channels are x, y, rx, ry", c->path, r->line + 6, r->index,
-                         r->name, rcb_quantity_name(q), why);
+  *st = rcb_signals_warn(c->s, "%s:%zu: dataset 58 record %zu ('%s', %s): skipped: an earlier "
+                         "record gave channel '%s' (node %ld, direction %ld); each channel is "
+                         "read once", c->path, r->line + 6, r->index, r->name,
+                         rcb_quantity_name(q), r->name, r->node, r->dir);
   return 1;
 }
 
@@ -139,7 +136,19 @@ static rcb_status take_record(void *user, const rcb_uff_time_rec *r) {
   if (r->label_unknown && (st = unknown_label(c, r, &q, &f))) return st;
   if (q == RCB_QTY_UNKNOWN && rcb_signals_unit_override(s, r->name))
     rcb_unit_parse(rcb_signals_unit_override(s, r->name), &q, &f);
-  if (skipped(c, r, q, &st)) {
+  if (r->claimed && !s->allow_truncated)
+    return rcb_signals_fail(s, RCB_ERR_PARSE, "%s:%zu: dataset 58 record %zu ('%s'): record 7 "
+                            "claims %zu samples, but the record holds %zu before its %s: the "
+                            "file was cut (an excerpt of a longer recording?); to read the %zu "
+                            "samples present, allow truncated files (rcbtool --allow-truncated, "
+                            "rcb_signals_set_allow_truncated)", c->path, r->line + 7, r->index,
+                            r->name, r->claimed, r->n, "closing '-1'", r->n);
+  if (r->claimed && (st = rcb_signals_warn(s, "%s:%zu: dataset 58 record %zu ('%s'): record 7 "
+                                           "claims %zu samples, the record holds %zu: read "
+                                           "cut short, as allowed", c->path, r->line + 7,
+                                           r->index, r->name, r->claimed, r->n)))
+    return st;
+  if (repeated(c, r, q, &st)) {
     c->failed = st != RCB_OK;
     return st;
   }

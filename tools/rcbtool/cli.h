@@ -372,6 +372,11 @@ int cli_guard_outputs(const cli_args *a, const char *meas);
 /** Read a measurement by extension ("-": standard input, CSV or UFF by content) (UFF with --map or the model's [uff] map,
  * or CSV); exit code 0, 2, 3 or 4 with the message printed. */
 int cli_meas_read(const cli_args *a, const char *path, const rcb_model *m, rcb_meas **out);
+/** 0 when every channel of @p ms has its phase; else a usage error (2) naming
+ * the file @p path, a magnitude-only channel and @p what needs the phase
+ * ("--scale complex", "the monitor"; issue #35 item 4). */
+int cli_meas_need_phase(const cli_args *a, const rcb_meas *ms, const char *path,
+                        const char *what);
 
 /* ---- fitted parameters (cmd_fit.c; used by sensitivity) ---- */
 
@@ -469,6 +474,14 @@ int cli_sd_read(const char *path, const rcb_meas *ms, double **sd);
 int cli_signals_read(const cli_args *a, rcb_signals *s);
 /** cli_signals_read of the file @p path (estimate's further hit files). */
 int cli_signals_read_path(const cli_args *a, const char *path, rcb_signals *s);
+/** The index of channel @p name of the signals, else exit 3 with the channels
+ * the file holds listed. */
+int cli_signals_find(const cli_args *a, const rcb_signals *s, const char *name, size_t *idx);
+/** 0 when @p model (the model channel that file channel @p name stands for:
+ * NAME=STATION.DIR, else the name itself) is STATION.DIR with DIR x, y, rx or
+ * ry; else a usage error naming the --outputs item or the --map entry that
+ * names it ("#1.z": --map 1.z=STATION.DIR; issue #35). */
+int cli_signals_model_channel(const cli_args *a, const char *name, const char *model);
 
 /* ---- subcommands (one file each) ---- */
 

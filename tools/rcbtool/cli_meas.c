@@ -164,6 +164,11 @@ static int meas_read(const cli_args *a, const char *path, const rcb_model *m, in
               : rcb_meas_read_csv_map(ms, path, mp.n, mp.nodes);
   cli_uff_map_free(&mp);
   if (st) {
+    size_t w; /* what was skipped, and the map entry that would read it */
+    for (w = 0; w < rcb_meas_warning_count(ms); w++)
+      fprintf(stderr, "rcbtool: warning: %s\n", rcb_meas_warning(ms, w));
+  }
+  if (st) {
     const char *msg = cli_msg(rcb_meas_errmsg(ms), st);
     rc = cli_fail(st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC : CLI_EXIT_INPUT, "%s", msg);
     if (!strstr(msg, path)) (void)cli_fail(rc, "(while reading measurement '%s')", path);
@@ -221,4 +226,19 @@ static int cli_meas_speed_and_warnings(const cli_args *a, const rcb_model *m, rc
   for (w = 0; w < rcb_meas_warning_count(ms); w++)
     fprintf(stderr, "rcbtool: warning: %s\n", rcb_meas_warning(ms, w));
   return 0;
+}
+
+int cli_meas_need_phase(const cli_args *a, const rcb_meas *ms, const char *path,
+                        const char *what) {
+  size_t n = rcb_meas_magnitude_only_count(ms), c;
+  rcb_meas_channel_info ci;
+  if (n == 0) return 0;
+  for (c = 0; rcb_meas_channel(ms, c, &ci) == RCB_OK && !ci.magnitude_only; c++) continue;
+  return cli_usage(a->cmd, "'%s' holds magnitudes only (%zu of %zu channels, e.g. %s%s%s: a "
+                   "'mag' or 'dB' column without phase): %s needs the phase; %s", path, n,
+                   rcb_meas_channel_count(ms), ci.response, ci.reference ? "/" : "",
+                   ci.reference ? ci.reference : "", what,
+                   strstr(what, "scale") ? "fit on --scale log10, linear or db (the magnitudes "
+                                           "alone)"
+                                         : "give a file with phase (re/im or mag/phase_deg)");
 }

@@ -136,3 +136,40 @@ static int read_file(const cli_args *a, const char *path, rcb_signals *s) {
                     cli_msg(rcb_signals_errmsg(s), st));
   return 0;
 }
+
+int cli_signals_find(const cli_args *a, const rcb_signals *s, const char *name, size_t *idx) {
+  size_t i, n = rcb_signals_channel_count(s), at = 0;
+  char list[600];
+  list[0] = '\0';
+  if (rcb_signals_find(s, name, idx) == RCB_OK) return 0;
+  for (i = 0; i < n && at + 80 < sizeof list; i++) {
+    const char *ch = NULL;
+    rcb_signals_channel(s, i, &ch, NULL, NULL);
+    at += (size_t)snprintf(list + at, sizeof list - at, "%s'%s'", i ? ", " : "", ch);
+  }
+  if (i < n) snprintf(list + at, sizeof list - at, ", ...");
+  return cli_fail(CLI_EXIT_INPUT, "%s: no channel '%s' in the file; it holds %s", a->model, name,
+                  list);
+}
+
+int cli_signals_model_channel(const cli_args *a, const char *name, const char *model) {
+  static const char *const dirs[] = {"x", "y", "rx", "ry"};
+  const char *dot = strrchr(model, '.');
+  size_t k;
+  for (k = 0; dot && dot > model && k < 4; k++)
+    if (strcmp(dot + 1, dirs[k]) == 0) return 0;
+  if (model != name)
+    return cli_usage(a->cmd, "'%s=%s': '%s' is not a model channel: expected STATION.DIR with "
+                     "DIR x, y, rx or ry", name, model, model);
+  /* a UFF name "#N.d" or a scalar "#N": the map entry that names it */
+  if (name[0] == '#')
+    return cli_usage(a->cmd, "channel '%s' keeps its file name, which is not a model channel "
+                     "(STATION.DIR with DIR x, y, rx or ry) as the FRFs written need: name the "
+                     "one it stands for, --outputs '%s=STATION.DIR' or --map %s%s=STATION.DIR "
+                     "(e.g. %s%s=DA.x)", name, name, name + 1, strchr(name, '.') ? "" : ".s",
+                     name + 1, strchr(name, '.') ? "" : ".s");
+  return cli_usage(a->cmd, "channel '%s' is not a model channel (STATION.DIR with DIR x, y, rx "
+                   "or ry) as the FRFs written need: name the one it stands for, "
+                   "'%s=STATION.DIR' (e.g. '%s=DA.x'), or map it with --map NODE.DIR=STATION.DIR",
+                   name, name, name);
+}

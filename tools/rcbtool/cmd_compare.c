@@ -23,7 +23,9 @@ const char cli_help_compare[] =
     "point, as the measured kind (receptance, mobility, inertance).\n"
     "  --map LIST       UFF node number <-> model station, e.g. 10=DA,20=C.A, added to\n"
     "                   the model's [uff] map; nodes without one read as \"#N\" (warned);\n"
-    "                   a CSV's numeric stations (2.x/11.x_re) map through it too\n"
+    "                   a CSV's numeric stations (2.x/11.x_re) map through it too;\n"
+    "                   NODE.DIR=STATION.DIR maps one channel in any direction\n"
+    "                   (1.z=DA.x: an accelerometer's own z; 3.s=DB.y: a scalar)\n"
     "  --rpm R          rotor speed of an FRF test, rpm (default: the file's, else the\n"
     "                   model's [test] rpm, else 0 with a warning)\n"
     "  --sd FILE        standard deviations of the measured values (the --stats file\n"
@@ -281,6 +283,10 @@ static void print_text(FILE *fp, const cli_args *a, const cmp_job *j, const rcb_
   fprintf(fp, "%zu channels x %zu points, %.6g to %.6g %s\n", rcb_compare_channel_count(c),
           rcb_compare_point_count(c), rcb_compare_grid(c)[0] * j->xscale,
           rcb_compare_grid(c)[rcb_compare_point_count(c) - 1] * j->xscale, j->xunit);
+  if (rcb_meas_magnitude_only_count(ms)) /* issue #35 item 4 */
+    fprintf(fp, "# %zu of %zu channels hold magnitudes only (no phase): their FRAC and phase "
+            "error are nan, and they are left out of the mean FRAC, CSAC and CSF\n",
+            rcb_meas_magnitude_only_count(ms), rcb_meas_channel_count(ms));
   print_channels(fp, c);
   print_outliers(fp, c);
   print_bands(fp, c, j, ord);

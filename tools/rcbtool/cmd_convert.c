@@ -17,7 +17,14 @@ const char cli_help_convert[] =
     "               without an entry reads as model node \"#N\" (0-based node N);\n"
     "               writing UFF, a station without an entry gets the next free\n"
     "               number (the numbers used are printed on stderr); reading CSV,\n"
-    "               stations written as node numbers (2.x/11.x_re) map through it\n"
+    "               stations written as node numbers (2.x/11.x_re) map through it.\n"
+    "               NODE.DIR=STATION.DIR maps one channel of the file, in any\n"
+    "               direction, to a model channel: 1.z=DA.x (an accelerometer's\n"
+    "               own axis, UFF direction 3), 3.s=DB.y (a scalar record,\n"
+    "               direction 0); DIR x, y, z, rx, ry, rz or s, the model's DIR\n"
+    "               x, y, rx or ry; it wins over its node's NODE=STATION entry.\n"
+    "               A z, rz or scalar record without one is skipped, the warning\n"
+    "               naming the entry that would read it\n"
     "  --kind K     convert FRFs to receptance (m/N), mobility (m/(N s)) or\n"
     "               inertance (m/(N s^2)) before writing\n"
     "  --binary     write binary 58b instead of ASCII 58\n"
@@ -31,168 +38,11 @@ const char cli_help_convert[] =
     "(unbalance) and per channel 'RESP/REF re','RESP/REF im' (or mag/amp and\n"
     "phase_deg columns), as rcbtool frf and rcbtool unbalance write; the part may\n"
     "follow '_' (RESP/REF_re, _im, _mag, _phase_deg), as lab scripts write it.\n"
+    "A 'mag' or 'dB' column without phase is read as magnitudes only (written back\n"
+    "as a 'mag' column; UFF output refused: a dataset 58 FRF is complex).\n"
     "Exit codes: 2 usage, 3 unreadable or bad input data, 5 output not written.\n";
 
 static const char *const kind_names[] = {"receptance", "mobility", "inertance"};
-
-void cli_uff_map_free(cli_uff_map *mp) {
-  size_t i;
-  for (i = 0; i < mp->nowned; i++) free(mp->owned[i]);
-  free(mp->buf);
-  free(mp->nodes);
-  free(mp->owned);
-  memset(mp, 0, sizeof *mp);
-}
-
-/* One "NODE=STATION" item. */
-static int map_item(const cli_args *a, const char *opt, char *item, rcb_uff_node *out) {
-  char *eq = strchr(item, '='), *end;
-  long node;
-  if (!eq || eq == item || eq[1] == '\0')
-    return cli_usage(a->cmd, "option %s: item '%s': expected NODE=STATION (e.g. 10=DA)", opt,
-                     item);
-  *eq = '\0';
-  errno = 0;
-  node = strtol(item, &end, 10);
-  if (*end || errno || node < 0) {
-    *eq = '=';
-    return cli_usage(a->cmd, "option %s: item '%s': the UFF node must be a whole number >= 0",
-                     opt, item);
-  }
-  out->node = node;
-  out->station = eq + 1;
-  return 0;
-}
-
-/* The model's own [uff] map (station names stay owned by the model). */
-static int map_from_model(const rcb_model *m, cli_uff_map *mp) {
-  size_t i, n = rcb_model_uff_node_count(m);
-  if (n == 0) return 0;
-  mp->nodes = malloc(n * sizeof *mp->nodes);
-  if (!mp->nodes) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
-  for (i = 0; i < n; i++) rcb_model_uff_node(m, i, &mp->nodes[i].node, &mp->nodes[i].station);
-  mp->n = n;
-  return 0;
-}
-
-/* The option adds to the model's [uff] map (issue #17: a --map of one node
- * used to drop the model's whole map): the model's entries whose node and
- * station the option does not give follow the option's (mp->nodes has room). */
-static void add_model_entries(const rcb_model *m, cli_uff_map *mp) {
-  size_t i, j, nopt = mp->n, n = rcb_model_uff_node_count(m);
-  for (i = 0; i < n; i++) {
-    rcb_uff_node e;
-    int clash = 0;
-    if (rcb_model_uff_node(m, i, &e.node, &e.station)) continue;
-    for (j = 0; j < nopt && !clash; j++)
-      clash = mp->nodes[j].node == e.node || strcmp(mp->nodes[j].station, e.station) == 0;
-    if (!clash) mp->nodes[mp->n++] = e;
-  }
-}
-
-int cli_uff_map_parse(const cli_args *a, const char *opt, const rcb_model *m,
-                      cli_uff_map *mp) {
-  const char *list = cli_opt_value(a, opt);
-  size_t n = 1, i, j;
-  char *p;
-  int rc;
-  memset(mp, 0, sizeof *mp);
-  if (!list) return m ? map_from_model(m, mp) : 0;
-  mp->buf = malloc(strlen(list) + 1);
-  if (!mp->buf) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
-  strcpy(mp->buf, list);
-  for (p = mp->buf; *p; p++) n += (*p == ',');
-  mp->nodes = malloc((n + (m ? rcb_model_uff_node_count(m) : 0)) * sizeof *mp->nodes);
-  if (!mp->nodes) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
-  p = mp->buf;
-  for (i = 0; i < n; i++) {
-    char *comma = strchr(p, ',');
-    if (comma) *comma = '\0';
-    if ((rc = map_item(a, opt, p, &mp->nodes[i]))) return rc;
-    for (j = 0; j < i; j++)
-      if (mp->nodes[j].node == mp->nodes[i].node ||
-          strcmp(mp->nodes[j].station, mp->nodes[i].station) == 0)
-        return cli_usage(a->cmd, "option %s: node %ld or station '%s' appears twice", opt,
-                         mp->nodes[i].node, mp->nodes[i].station);
-    mp->n++;
-    if (comma) p = comma + 1;
-  }
-  if (m) add_model_entries(m, mp);
-  return 0;
-}
-
-static int map_has_station(const cli_uff_map *mp, const char *st, size_t len) {
-  size_t i;
-  for (i = 0; i < mp->n; i++)
-    if (strlen(mp->nodes[i].station) == len && strncmp(mp->nodes[i].station, st, len) == 0)
-      return 1;
-  return 0;
-}
-
-static int map_has_node(const cli_uff_map *mp, long node) {
-  size_t i;
-  for (i = 0; i < mp->n; i++)
-    if (mp->nodes[i].node == node) return 1;
-  return 0;
-}
-
-/* Add station (first len chars of ch) with the next free node number. */
-static int map_add(cli_uff_map *mp, const char *ch, size_t len, long *next) {
-  rcb_uff_node *nn = realloc(mp->nodes, (mp->n + 1) * sizeof *nn);
-  char **no;
-  char *s;
-  if (!nn) return -1;
-  mp->nodes = nn;
-  no = realloc(mp->owned, (mp->nowned + 1) * sizeof *no);
-  if (!no) return -1;
-  mp->owned = no;
-  s = malloc(len + 1);
-  if (!s) return -1;
-  memcpy(s, ch, len);
-  s[len] = '\0';
-  mp->owned[mp->nowned++] = s;
-  while (map_has_node(mp, *next)) ++*next;
-  mp->nodes[mp->n].node = (*next)++;
-  mp->nodes[mp->n].station = s;
-  mp->n++;
-  return 0;
-}
-
-/* Station part of channel "STATION.DIR" (length in *len). */
-static void station_part(const char *ch, size_t *len) {
-  const char *dot = strrchr(ch, '.');
-  *len = dot ? (size_t)(dot - ch) : strlen(ch);
-}
-
-static int automap_one(cli_uff_map *mp, const char *ch, long *next, int *added) {
-  size_t len;
-  if (!ch) return 0;
-  station_part(ch, &len);
-  if ((ch[0] == '#' && len > 1) || map_has_station(mp, ch, len)) return 0;
-  if (map_add(mp, ch, len, next)) return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
-  *added = 1;
-  return 0;
-}
-
-int cli_uff_automap(const char *cmd, const rcb_meas *ms, cli_uff_map *mp) {
-  size_t c, i, base = mp->n;
-  long next = 1;
-  int added = 0, rc;
-  for (c = 0; c < rcb_meas_channel_count(ms); c++) {
-    rcb_meas_channel_info info;
-    rcb_meas_channel(ms, c, &info);
-    if ((rc = automap_one(mp, info.response, &next, &added)) ||
-        (rc = automap_one(mp, info.reference, &next, &added)))
-      return rc;
-  }
-  if (added) {
-    fprintf(stderr, "rcbtool: %s: UFF node numbers given to stations: ", cmd);
-    for (i = base; i < mp->n; i++)
-      fprintf(stderr, "%s%ld=%s", i > base ? "," : "", mp->nodes[i].node, mp->nodes[i].station);
-    fputs(" (pass --map with these when reading the file back)\n", stderr);
-  }
-  return 0;
-}
 
 int cli_meas_format(const char *cmd, const char *path, int *is_uff) {
   const char *dot = strrchr(path, '.');
@@ -269,9 +119,13 @@ static int split_out(int argc, char **argv, char **args, int *nargs, const char 
 static int read_input(const cli_args *a, rcb_meas *ms, const cli_uff_map *mp) {
   int is_uff = 0, rc;
   rcb_status st;
+  size_t w;
   if ((rc = cli_meas_format(a->cmd, a->model, &is_uff))) return rc;
   st = is_uff ? rcb_meas_read_uff(ms, a->model, mp->n, mp->nodes)
               : rcb_meas_read_csv_map(ms, a->model, mp->n, mp->nodes);
+  /* what was skipped (and the map entry that would read it), the speed not stated */
+  for (w = 0; w < rcb_meas_warning_count(ms); w++)
+    fprintf(stderr, "rcbtool: warning: %s\n", rcb_meas_warning(ms, w));
   if (st)
     return cli_fail(st == RCB_ERR_NOMEM ? CLI_EXIT_NUMERIC : CLI_EXIT_INPUT, "%s",
                     cli_msg(rcb_meas_errmsg(ms), st));

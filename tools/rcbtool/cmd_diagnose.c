@@ -27,7 +27,10 @@ const char cli_help_diagnose[] =
     "(shaft.S.e<k>.stiffness | mass; 'rcbtool check' lists the elements), and\n"
     "(FRF data) an operating speed other than the stated one; a change along a\n"
     "span of a shaft (shaft.S.e<a>-<b>.stiffness | mass) is searched for when a\n"
-    "shaft's stiffness or mass leads and nothing explains. The score is the\n"
+    "shaft's stiffness or mass leads and nothing explains. A CSV of magnitudes\n"
+    "only ('mag' or 'dB' columns, no phase) is diagnosed on the magnitude scales:\n"
+    "--scale complex is refused, and the placement along the shaft (fitted on the\n"
+    "complex scale) is skipped, as the explanation says. The score is the\n"
     "error reduction the effect can explain (score test on the weighted\n"
     "objective, orthogonal to the fitted parameters); the best N (--refits,\n"
     "default 8) and the other coupling models are refitted. What may be said of\n"
@@ -467,6 +470,9 @@ static int run(const cli_args *a, diag_job *j) {
   pc.a = a;
   if ((rc = cli_load_model(a, &m))) return rc;
   if ((rc = cli_meas_read(a, j->meas_path, m, &ms))) goto done;
+  if (j->scale == RCB_SCALE_COMPLEX &&
+      (rc = cli_meas_need_phase(a, ms, j->meas_path, "--scale complex (Re and Im)")))
+    goto done;
   if ((st = rcb_diag_create(&d, m, ms, NULL))) {
     rc = cli_fail(cli_status_exit(st), "%s: %s", a->cmd, cli_msg(rcb_diag_errmsg(d), st));
     goto done;

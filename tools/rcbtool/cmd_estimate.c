@@ -78,7 +78,9 @@ const char cli_help_estimate[] =
     "  --report FILE  CSV of the per-hit table (hit, file, record, start_s, peak_N,\n"
     "                 width_s, second_frac, second_s, double_hit, overload,\n"
     "                 overload_channel, kept, reason) instead of stderr\n"
-    "  --map LIST     UFF node map for SIGNALS and OUT, NODE=STATION,... (as convert)\n"
+    "  --map LIST     UFF node map for SIGNALS and OUT, NODE=STATION,... and\n"
+    "                 NODE.DIR=STATION.DIR,... (1.z=DA.x, 3.s=DB.y; as convert); a\n"
+    "                 channel no entry names keeps its file name (#1.z, DA.z, #3)\n"
     "  --binary       write binary 58b\n"
     "  --plot FILE    also draw FILE (PNG): magnitude and phase of each FRF with the\n"
     "                 coherence below (Python 3 with matplotlib: RCB_PYTHON, RCB_PLOTS\n"
@@ -130,9 +132,9 @@ static int channels(est_job *j) {
   total = j->p + j->q;
   for (i = 0; i < total; i++) {
     rcb_quantity q;
-    if (rcb_signals_find(j->sig, j->names[i], &j->idx[i]))
-      return cli_fail(CLI_EXIT_INPUT, "%s: no channel '%s' in the file", j->a->model,
-                      j->names[i]);
+    if ((rc = cli_signals_find(j->a, j->sig, j->names[i], &j->idx[i])) ||
+        (rc = cli_signals_model_channel(j->a, j->names[i], j->model[i])))
+      return rc;
     rcb_signals_channel(j->sig, j->idx[i], NULL, &q, NULL);
     if (i < j->p && q != RCB_QTY_FORCE)
       return cli_fail(CLI_EXIT_INPUT, "%s: input channel '%s' is %s; expected a force (N, kN or "

@@ -48,7 +48,9 @@ const char cli_help_fit[] =
     "                 nlopt:ALG with an NLopt algorithm name (LN_BOBYQA, LN_SBPLX,\n"
     "                 LD_LBFGS, LD_MMA, GN_DIRECT_L, GN_CRS2_LM, G_MLSL_LDS, ...)\n"
     "  --scale S      residuals on |H| (linear), log10 |H| (log10, default: FRF\n"
-    "                 magnitudes span decades), 20 log10 |H| (db) or Re/Im (complex)\n"
+    "                 magnitudes span decades), 20 log10 |H| (db) or Re/Im (complex);\n"
+    "                 a CSV of magnitudes only ('mag' or 'dB' columns, no phase) fits\n"
+    "                 on the first three, and complex is refused\n"
     "  --band LO:HI   fit only points with LO <= abscissa <= HI: Hz for FRFs, rpm\n"
     "                 for unbalance responses\n"
     "  --noise A,S    noise-aware weights from the paper's eq. 19 noise model (random\n"
@@ -71,7 +73,9 @@ const char cli_help_fit[] =
     "                 the bounds and keep the best (default 8; 1: no restart)\n"
     "  --map LIST     UFF node number <-> model station, e.g. 10=DA,20=C.A, added to\n"
     "                 the model's [uff] map (nodes without one: model node \"#N\", warned;\n"
-    "                 a CSV's numeric stations, 2.x/11.x_re, map through it too)\n"
+    "                 a CSV's numeric stations, 2.x/11.x_re, map through it too);\n"
+    "                 NODE.DIR=STATION.DIR maps one channel in any direction\n"
+    "                 (1.z=DA.x: an accelerometer's own z; 3.s=DB.y: a scalar)\n"
     "  --rpm R        rotor speed of an FRF test, rpm (default: the file's, else the\n"
     "                 model's [test] rpm, else 0 with a warning)\n"
     "  -o FILE        write the fitted model as INI to FILE (atomically; never over\n"
@@ -300,7 +304,13 @@ static int parse_job(const cli_args *a, fit_job *j) {
 
 static int read_meas(const cli_args *a, fit_job *j, const rcb_model *m, rcb_meas **out) {
   int rc = strcmp(j->meas_path, "-") == 0 ? 0 : cli_meas_format(a->cmd, j->meas_path, &j->is_uff);
-  return rc ? rc : cli_meas_read(a, j->meas_path, m, out);
+  if (!rc) rc = cli_meas_read(a, j->meas_path, m, out);
+  if (!rc && j->scale == RCB_SCALE_COMPLEX &&
+      (rc = cli_meas_need_phase(a, *out, j->meas_path, "--scale complex (Re and Im)"))) {
+    rcb_meas_destroy(*out);
+    *out = NULL;
+  }
+  return rc;
 }
 
 /* Progress per iteration on stderr. */

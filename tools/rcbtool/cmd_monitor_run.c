@@ -129,6 +129,12 @@ static int read_file(mon_ctx *x, size_t k, rcb_meas **out) {
   const char *path = x->j->series.files[k];
   int rc = cli_meas_read(x->a, path, x->m, out);
   if (rc) return rc;
+  if ((rc = cli_meas_need_phase(x->a, *out, path, "the monitor (it fits on the complex "
+                                "scale)"))) {
+    rcb_meas_destroy(*out);
+    *out = NULL;
+    return rc;
+  }
   if (k > 0 &&
       (rc = match_layout(x->a->cmd, x->setup, x->j->series.files[0], *out, path, x->perm))) {
     rcb_meas_destroy(*out);

@@ -63,7 +63,9 @@ const char cli_help_order[] =
     "  --order2 FILE  write the 2X responses there too (same format as OUT)\n"
     "  --stats FILE   CSV: rpm, revolutions, per channel '<CH> 1X sd' and '<CH> 2X sd'\n"
     "                 (m, of Re and of Im of the bin's mean phasor)\n"
-    "  --map LIST     UFF node map, NODE=STATION,... (as rcbtool convert)\n"
+    "  --map LIST     UFF node map, NODE=STATION,... and NODE.DIR=STATION.DIR,...\n"
+    "                 (1.z=DA.x; as rcbtool convert); a channel no entry names keeps\n"
+    "                 its file name (#1.z, DA.z, #3)\n"
     "  --plot FILE    also draw FILE (PNG): Bode plot (1X amplitude and phase against\n"
     "                 speed) and polar plot of every channel (Python 3 with matplotlib:\n"
     "                 RCB_PYTHON, RCB_PLOTS as for compare --plot); drawn first, a\n"
@@ -111,9 +113,10 @@ static int ord_channels(ord_job *j) {
   }
   for (i = 0; i <= j->q; i++) {
     rcb_quantity qt;
-    if (rcb_signals_find(j->sig, j->names[i], &j->idx[i]))
-      return cli_fail(CLI_EXIT_INPUT, "%s: no channel '%s' in the file", j->a->model,
-                      j->names[i]);
+    int rc;
+    if ((rc = cli_signals_find(j->a, j->sig, j->names[i], &j->idx[i])) ||
+        (i > 0 && (rc = cli_signals_model_channel(j->a, j->names[i], j->model[i]))))
+      return rc;
     rcb_signals_channel(j->sig, j->idx[i], NULL, &qt, NULL);
     if (i > 0 && qt != RCB_QTY_DISPLACEMENT)
       return cli_fail(CLI_EXIT_INPUT, "%s: output channel '%s' is %s; the unbalance response "

@@ -71,11 +71,12 @@ class Mode(ctypes.Structure):
 
 class MeasChannelInfo(ctypes.Structure):
     _fields_ = [("response", c_char_p), ("reference", c_char_p), ("kind", c_int),
-                ("data", c_void_p)]
+                ("data", c_void_p), ("magnitude_only", c_int)]
 
 
 class UffNode(ctypes.Structure):
-    _fields_ = [("node", c_long), ("station", c_char_p)]
+    _fields_ = [("node", c_long), ("station", c_char_p), ("dir", c_char_p),
+                ("model_dir", c_char_p)]
 
 
 class FitReport(ctypes.Structure):
@@ -148,7 +149,7 @@ class CompareChannel(ctypes.Structure):
     _fields_ = [("response", c_char_p), ("reference", c_char_p), ("kind", c_int),
                 ("error_pct", c_double), ("frac", c_double), ("log_rms", c_double),
                 ("phase_rms_deg", c_double), ("meas", c_void_p), ("model", c_void_p),
-                ("floor_pct", c_double), ("chi2_dof", c_double)]
+                ("floor_pct", c_double), ("chi2_dof", c_double), ("magnitude_only", c_int)]
 
 
 class CompareOutlier(ctypes.Structure):
