@@ -1046,8 +1046,12 @@ static void test_uff_hit_records(void **state) {
   time_rec(fp, 2, 1, 13, "N", v2);
   fclose(fp);
   assert_int_equal(rcb_signals_create(&s, NULL), RCB_OK);
-  assert_int_equal(rcb_signals_read_uff(s, p, 2, map), RCB_ERR_PARSE);
-  assert_non_null(strstr(rcb_signals_errmsg(s), "channel 'DA.x' again (first in record 1)"));
+  /* not joined: each channel's first record read, the others skipped with a
+   * warning naming them (a vendor file's second sensor on a node) */
+  assert_int_equal(rcb_signals_read_uff(s, p, 2, map), RCB_OK);
+  assert_int_equal(rcb_signals_length(s), 4);
+  assert_int_equal(rcb_signals_warning_count(s), 2);
+  assert_non_null(strstr(rcb_signals_warning(s, 0), "skipped: an earlier record gave channel 'DA.x'"));
   rcb_signals_set_join_records(s, 1);
   if (rcb_signals_read_uff(s, p, 2, map)) fail_msg("%s", rcb_signals_errmsg(s));
   assert_int_equal(rcb_signals_record_count(s), 2);
@@ -1057,9 +1061,14 @@ static void test_uff_hit_records(void **state) {
   fp = fopen(p, "a");
   time_rec(fp, 1, 1, 8, "mm", v2);
   fclose(fp);
-  assert_int_equal(rcb_signals_read_uff(s, p, 2, map), RCB_ERR_PARSE);
-  assert_non_null(strstr(rcb_signals_errmsg(s), "channel 'DA.x' has 3 records, 'H.x' has 2"));
-  assert_int_equal(rcb_signals_channel_count(s), 0);
+  /* unequal counts are no hits: each channel's first record, with a warning */
+  assert_int_equal(rcb_signals_read_uff(s, p, 2, map), RCB_OK);
+  assert_int_equal(rcb_signals_record_count(s), 1);
+  assert_int_equal(rcb_signals_length(s), 4);
+  assert_non_null(strstr(rcb_signals_warning(s, rcb_signals_warning_count(s) - 1),
+                         "channel 'DA.x' has 3 records, 'H.x' has 2: not read as the hits"));
+  rcb_signals_channel(s, 1, NULL, NULL, &x); /* H.x, in N: its first record, v1 */
+  assert_true(x[1] == -2.0 && x[3] == 4.0);
   rcb_signals_destroy(s);
 }
 

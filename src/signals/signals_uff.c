@@ -24,9 +24,11 @@ typedef struct uff_ctx {
 /* Every direction is read (issue #35): a signal verb (estimate, order) needs
  * no model direction, so an axial (z), torsional (rz) or scalar record keeps
  * its file name ("#1.z", "DA.z", "#5") until --outputs NAME=STATION.DIR or a
- * map entry "1.z=DA.x" names the model channel it stands for. A record whose
- * channel an earlier record already gave (a second sensor on one node and
- * direction) is skipped with a warning naming both. 1 when skipped. */
+ * map entry "1.z=DA.x" names the model channel it stands for. Unless the
+ * caller joins records (an impact test's hits, rcb_signals_set_join_records),
+ * a record whose channel an earlier record already gave (a second sensor on
+ * one node and direction) is skipped with a warning naming both. 1 when
+ * skipped. */
 static int repeated(uff_ctx *c, const rcb_uff_time_rec *r, rcb_quantity q, rcb_status *st) {
   size_t i;
   if (rcb_signals_find(c->s, r->name, &i) != RCB_OK) return 0;
@@ -148,7 +150,7 @@ static rcb_status take_record(void *user, const rcb_uff_time_rec *r) {
                                            "cut short, as allowed", c->path, r->line + 7,
                                            r->index, r->name, r->claimed, r->n)))
     return st;
-  if (repeated(c, r, q, &st)) {
+  if (!s->join_records && repeated(c, r, q, &st)) {
     c->failed = st != RCB_OK;
     return st;
   }
@@ -181,16 +183,26 @@ static rcb_status take_record(void *user, const rcb_uff_time_rec *r) {
 }
 
 /* With joined records: every channel has as many (one per hit); the set is
- * that many records end to end. */
+ * that many records end to end. When the counts differ the records are not
+ * hits (a vendor file's second sensor on one node and direction): each
+ * channel keeps its first record (its first c->n values), the others are
+ * skipped with a warning, as without joining. */
 static rcb_status joined(uff_ctx *c) {
   rcb_signals *s = c->s;
   size_t i;
+  rcb_status st;
   for (i = 1; i < s->nch; i++)
-    if (c->rec[i] != c->rec[0])
-      return rcb_signals_fail(s, RCB_ERR_PARSE, "%s: channel '%s' has %zu records, '%s' has "
-                              "%zu: with several records of a channel (one per hit) every "
-                              "channel needs one for each hit", c->path, s->ch[0].name,
-                              c->rec[0], s->ch[i].name, c->rec[i]);
+    if (c->rec[i] != c->rec[0]) break;
+  if (i < s->nch) {
+    size_t a = c->rec[0] != c->rec[i] && c->rec[0] > c->rec[i] ? 0 : i;
+    if ((st = rcb_signals_warn(s, "%s: channel '%s' has %zu records, '%s' has %zu: not read "
+                               "as the hits of an impact test (each channel needs one per "
+                               "hit); each channel's first record kept, %zu skipped",
+                               c->path, s->ch[a].name, c->rec[a], s->ch[a ? 0 : i].name,
+                               c->rec[a ? 0 : i], c->rec[a] - 1)))
+      return st;
+    for (i = 0; i < s->nch; i++) c->rec[i] = 1;
+  }
   s->nrec = s->nch ? c->rec[0] : 0;
   s->n = s->nrec * c->n;
   return RCB_OK;
