@@ -168,7 +168,7 @@ rcb_status rcb_monitor_image_save(const rcb_monitor *mon, void *buf, size_t size
   if (!buf || size < need) return RCB_ERR_WORKSPACE;
   lr = mon->lr;
   memset(p, 0, need);
-  memcpy(p, IM_MAGIC, 4);
+  for (i = 0; i < 4; i++) p[i] = (unsigned char)IM_MAGIC[i]; /* 4 bytes, no terminator */
   for (i = 0; i < 4; i++) p[4 + i] = (unsigned char)(RCB_MONITOR_IMAGE_VERSION >> (8 * i));
   put_u64(p + 8, mon->img_fp);
   dims[0] = mon->n, dims[1] = mon->ncol, dims[2] = mon->k, dims[3] = mon->nt;

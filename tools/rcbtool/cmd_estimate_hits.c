@@ -487,7 +487,7 @@ int est_hits_average(est_job *j) {
   memset(&H, 0, sizeof H);
   H.j = j;
   H.nf = j->a->nfiles;
-  H.sig = calloc(H.nf, sizeof *H.sig);
+  H.sig = calloc(H.nf, sizeof(rcb_signals *));
   H.idx = calloc(H.nf * nc, sizeof *H.idx);
   H.range = calloc(nc, sizeof *H.range);
   rc = H.sig && H.idx && H.range ? run(&H) : cli_fail(CLI_EXIT_NUMERIC, "out of memory");
