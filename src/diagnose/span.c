@@ -81,6 +81,7 @@ static rcb_status span_eval(rcb_diag *d, span_search *s, size_t a, size_t b, dou
   *F = s->F[at];
   if (!isnan(*F)) return RCB_OK;
   memset(&c, 0, sizeof c);
+  memset(&rep, 0, sizeof rep);
   span_fill(d, s, a, b, &c);
   s->tried++;
   st = rcb_diag_candidate_model(d, &c, s->from, &m);
