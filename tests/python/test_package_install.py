@@ -1,7 +1,8 @@
 """The package's entry points and its LIBRCB_PATH override, from tools/python.
-`pip install ./tools/python` itself (scikit-build-core compiling librcb.so into
-the package) is tested in a fresh venv by tests/wheel/test_wheel.sh, the `wheel`
-stage of scripts/dev.sh test: it needs PyPI and a minute of compiling."""
+`pip install .` itself (pyproject.toml at the root: scikit-build-core compiling
+librcb.so into the package, from an sdist) is tested in a fresh venv by
+tests/wheel/test_wheel.sh, the `wheel` stage of scripts/dev.sh test: it needs
+PyPI and a minute of compiling."""
 
 import os
 import subprocess
@@ -14,7 +15,7 @@ PKG = REPO / "tools" / "python"
 
 
 def test_console_scripts_exist(rcb):
-    scripts = tomllib.loads((PKG / "pyproject.toml").read_text())["project"]["scripts"]
+    scripts = tomllib.loads((REPO / "pyproject.toml").read_text())["project"]["scripts"]
     assert set(scripts) == {"rcbplot", "rcbtool"}
     for target in scripts.values():
         module, func = target.split(":")
