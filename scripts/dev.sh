@@ -13,8 +13,9 @@
 #                               "slow|long", pytest -m "not slow"): a developer's suite
 #   ./scripts/dev.sh ctest      ctest in the build tree (everything)
 #   ./scripts/dev.sh pytest     tests/python against this build (extra arguments to pytest)
-#   ./scripts/dev.sh wheel      fresh venv, pip install ./tools/python (librcb.so inside),
-#                               import and an FRF against rcbtool, no LIBRCB_PATH (needs PyPI)
+#   ./scripts/dev.sh wheel      fresh venv, python -m build (sdist, wheel from it; librcb.so
+#                               inside), pip install the wheel, an FRF against rcbtool and the
+#                               package's tests, no LIBRCB_PATH (needs PyPI)
 #   ./scripts/dev.sh deps       all Debian packages + the pinned Python venv (.venv)
 #   ./scripts/dev.sh build      configure + build in build/ (Release; SUNDIALS and the
 #                               tests when their packages are installed)
@@ -346,11 +347,12 @@ cmd_pytest() {
   fi
 }
 
-# The wheel as a user installs it (issue #27): fresh venv, pip install
-# ./tools/python (scikit-build-core, librcb.so inside), import and one FRF
-# against the C CLI, with no build tree and no LIBRCB_PATH (tests/wheel).
+# The package as a user installs it (issues #27, #36): fresh venv, python -m
+# build at the root (the sdist, then the wheel from it: scikit-build-core,
+# librcb.so inside), the wheel installed, one FRF against the C CLI and the
+# package's tests, with no build tree and no LIBRCB_PATH (tests/wheel).
 cmd_wheel() {
-  say "Python wheel: fresh venv, pip install ./tools/python, FRF vs rcbtool"
+  say "Python wheel: fresh venv, python -m build (sdist -> wheel), FRF vs rcbtool, package tests"
   local ref
   ref=$(rcbtool_exe)
   [[ -x $ref && -f $ref ]] || ref=
