@@ -1,4 +1,4 @@
-# The Python package's build (tools/python/pyproject.toml, scikit-build-core):
+# The Python package's build (pyproject.toml at the root, scikit-build-core):
 # component "python" puts librcb.so and rcbtool inside the package folder,
 #   <site-packages>/librcb/librcb.so      found by librcb/_lib.py with no variable
 #   <site-packages>/librcb/bin/rcbtool    run by the `rcbtool` console script

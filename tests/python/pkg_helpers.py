@@ -1,8 +1,8 @@
 """Shared pieces of the librcb Python package tests (tests/python/test_package_*.py).
 
-The package is imported as installed (scripts/dev.sh test runs
-`pip install ./tools/python` into the venv); when it is not installed, from
-tools/python in this checkout. The shared library comes from LIBRCB_PATH:
+The package is imported as installed (`pip install .`; the wheel stage of
+scripts/dev.sh test runs these tests on the installed wheel); when it is not
+installed, from tools/python in this checkout. The shared library comes from LIBRCB_PATH:
   * unset and not found by the package -> the tests are skipped, with the reason;
   * set but not loadable                -> the tests fail (a wrong path must not pass).
 """
