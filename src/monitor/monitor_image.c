@@ -29,89 +29,51 @@
 
 #define IM_MAGIC "RCBI"
 #define IM_HEAD 96u
-#define FNV_OFFSET 0xcbf29ce484222325ull
-#define FNV_PRIME 0x100000001b3ull
-
-static void put_u64(unsigned char *p, uint64_t v) {
-  int i;
-  for (i = 0; i < 8; i++) p[i] = (unsigned char)(v >> (8 * i));
-}
-static uint64_t get_u64(const unsigned char *p) {
-  uint64_t v = 0;
-  int i;
-  for (i = 7; i >= 0; i--) v = (v << 8) | p[i];
-  return v;
-}
-static void put_f64(unsigned char *p, double x) {
-  uint64_t v;
-  memcpy(&v, &x, sizeof v);
-  put_u64(p, v);
-}
-static double get_f64(const unsigned char *p) {
-  uint64_t v = get_u64(p);
-  double x;
-  memcpy(&x, &v, sizeof x);
-  return x;
-}
 
 /* ---- fingerprint of the inputs: FNV-1a 64 over values in a fixed order ---- */
 
-static uint64_t fnv_bytes(uint64_t h, const void *data, size_t n) {
-  const unsigned char *p = data;
-  size_t i;
-  for (i = 0; i < n; i++) h = (h ^ p[i]) * FNV_PRIME;
-  return h;
-}
-static uint64_t fnv_u64(uint64_t h, uint64_t v) {
-  unsigned char b[8];
-  put_u64(b, v);
-  return fnv_bytes(h, b, 8);
-}
 static uint64_t fnv_f64s(uint64_t h, const double *x, size_t n) {
   size_t i;
   for (i = 0; i < n; i++) {
     unsigned char b[8];
-    put_f64(b, x[i]);
-    h = fnv_bytes(h, b, 8);
+    rcb_mon_put_f64(b, x[i]);
+    h = rcb_mon_fnv_bytes(h, b, 8);
   }
   return h;
-}
-static uint64_t fnv_str(uint64_t h, const char *s) {
-  return fnv_bytes(h, s ? s : "", (s ? strlen(s) : 0) + 1);
 }
 
 uint64_t rcb_mon_image_fingerprint(const rcb_monitor *mon, const rcb_diag *d,
                                    const struct col_plan *pl, unsigned effects) {
-  uint64_t h = fnv_u64(FNV_OFFSET, RCB_MONITOR_IMAGE_VERSION);
+  uint64_t h = rcb_mon_fnv_u64(RCB_MON_FNV_OFFSET, RCB_MONITOR_IMAGE_VERSION);
   const double *x = rcb_meas_grid(mon->setup);
   size_t a, c;
   /* the library that computes the image, the set-up exactly, the noise
    * (every residual's weight and frame), the baseline model's values on the
    * set-up, the options that shape the columns and the low-rank path */
-  h = fnv_u64(h, (uint64_t)rcb_version_number());
-  h = fnv_u64(fnv_u64(h, (uint64_t)rcb_meas_get_type(mon->setup)), mon->npts);
+  h = rcb_mon_fnv_u64(h, (uint64_t)rcb_version_number());
+  h = rcb_mon_fnv_u64(rcb_mon_fnv_u64(h, (uint64_t)rcb_meas_get_type(mon->setup)), mon->npts);
   h = fnv_f64s(fnv_f64s(h, x, mon->npts), (const double[1]){rcb_meas_speed(mon->setup)}, 1);
   for (c = 0; c < mon->nch; c++) {
     rcb_meas_channel_info ci;
     rcb_meas_channel(mon->setup, c, &ci);
-    h = fnv_u64(fnv_str(fnv_str(h, ci.response), ci.reference), (uint64_t)ci.kind);
+    h = rcb_mon_fnv_u64(rcb_mon_fnv_str(rcb_mon_fnv_str(h, ci.response), ci.reference), (uint64_t)ci.kind);
   }
   h = fnv_f64s(h, (const double *)(const void *)mon->e0, 2 * mon->npt);
   h = fnv_f64s(h, (const double *)(const void *)mon->u, 2 * mon->npt);
   h = fnv_f64s(h, mon->winv, mon->n);
   h = fnv_f64s(h, mon->rbase, mon->n);
-  h = fnv_u64(fnv_u64(fnv_u64(h, mon->relin), (uint64_t)effects), mon->nt);
+  h = rcb_mon_fnv_u64(rcb_mon_fnv_u64(rcb_mon_fnv_u64(h, mon->relin), (uint64_t)effects), mon->nt);
   for (a = 0; a < mon->nt; a++) {
-    h = fnv_str(h, mon->tname[a]);
+    h = rcb_mon_fnv_str(h, mon->tname[a]);
     h = fnv_f64s(fnv_f64s(fnv_f64s(h, &mon->t0[a], 1), &mon->tlo[a], 1), &mon->thi[a], 1);
   }
-  h = fnv_u64(fnv_u64(h, pl->ncand), pl->ncol);
+  h = rcb_mon_fnv_u64(rcb_mon_fnv_u64(h, pl->ncand), pl->ncol);
   for (c = 0; c < pl->ncand; c++) {
     rcb_diag_cand_desc cd;
     rcb_diag_catalogue_get(d, pl->cand[c], &cd);
-    h = fnv_u64(fnv_u64(h, (uint64_t)cd.effect), pl->col[c]);
-    h = fnv_str(fnv_str(fnv_str(h, cd.place), cd.desc), cd.params);
-    for (a = 0; a < cd.np; a++) h = fnv_f64s(fnv_str(h, cd.pname[a]), cd.hi + a, 1);
+    h = rcb_mon_fnv_u64(rcb_mon_fnv_u64(h, (uint64_t)cd.effect), pl->col[c]);
+    h = rcb_mon_fnv_str(rcb_mon_fnv_str(rcb_mon_fnv_str(h, cd.place), cd.desc), cd.params);
+    for (a = 0; a < cd.np; a++) h = fnv_f64s(rcb_mon_fnv_str(h, cd.pname[a]), cd.hi + a, 1);
   }
   return fnv_f64s(h, pl->neutral, pl->ncol);
 }
@@ -133,10 +95,10 @@ static size_t image_bytes(size_t n, size_t ncol, size_t k, size_t ncand, size_t 
  * then a final mix): it finds damage, as the state's CRC-32 does, at
  * several GB/s on the image's megabytes. */
 static uint64_t checksum(const unsigned char *p, size_t n) {
-  uint64_t h = FNV_OFFSET;
+  uint64_t h = RCB_MON_FNV_OFFSET;
   size_t i;
-  for (i = 0; i + 8 <= n; i += 8) h = (h ^ get_u64(p + i)) * FNV_PRIME;
-  for (; i < n; i++) h = (h ^ p[i]) * FNV_PRIME;
+  for (i = 0; i + 8 <= n; i += 8) h = (h ^ rcb_mon_get_u64(p + i)) * RCB_MON_FNV_PRIME;
+  for (; i < n; i++) h = (h ^ p[i]) * RCB_MON_FNV_PRIME;
   h ^= h >> 33;
   h *= 0xff51afd7ed558ccdull;
   return h ^ (h >> 33);
@@ -154,7 +116,7 @@ size_t rcb_monitor_image_size(const rcb_monitor *mon) {
 
 static unsigned char *put_cplx(unsigned char *p, const rcb_complex *z, size_t n) {
   size_t i;
-  for (i = 0; i < n; i++, p += 16) put_f64(p, creal(z[i])), put_f64(p + 8, cimag(z[i]));
+  for (i = 0; i < n; i++, p += 16) rcb_mon_put_f64(p, creal(z[i])), rcb_mon_put_f64(p + 8, cimag(z[i]));
   return p;
 }
 
@@ -170,21 +132,21 @@ rcb_status rcb_monitor_image_save(const rcb_monitor *mon, void *buf, size_t size
   memset(p, 0, need);
   for (i = 0; i < 4; i++) p[i] = (unsigned char)IM_MAGIC[i]; /* 4 bytes, no terminator */
   for (i = 0; i < 4; i++) p[4 + i] = (unsigned char)(RCB_MONITOR_IMAGE_VERSION >> (8 * i));
-  put_u64(p + 8, mon->img_fp);
+  rcb_mon_put_u64(p + 8, mon->img_fp);
   dims[0] = mon->n, dims[1] = mon->ncol, dims[2] = mon->k, dims[3] = mon->nt;
   dims[4] = mon->ncand, dims[5] = mon->nch, dims[6] = mon->npts, dims[7] = lr != NULL;
   dims[8] = lr ? lr->np : 0, dims[9] = lr ? lr->nin : 0;
-  for (i = 0; i < 10; i++) put_u64(p + 16 + 8 * i, dims[i]);
+  for (i = 0; i < 10; i++) rcb_mon_put_u64(p + 16 + 8 * i, dims[i]);
   q = p + IM_HEAD;
-  for (i = 0; i < mon->n * mon->k; i++, q += 8) put_f64(q, mon->Q[i]);
-  for (i = 0; i < mon->k * mon->ncol; i++, q += 8) put_f64(q, mon->G[i]);
+  for (i = 0; i < mon->n * mon->k; i++, q += 8) rcb_mon_put_f64(q, mon->Q[i]);
+  for (i = 0; i < mon->k * mon->ncol; i++, q += 8) rcb_mon_put_f64(q, mon->G[i]);
   if (lr) {
     q = put_cplx(q, lr->a, mon->npt * lr->np);
     q = put_cplx(q, lr->hpp, mon->npts * lr->np * lr->np);
     q = put_cplx(q, lr->b, mon->npts * lr->nin * lr->np);
   }
   for (i = 0; i < mon->ncand; i++) q[i] = mon->cand[i].ep != NULL;
-  put_u64(p + need - 8, checksum(p, need - 8));
+  rcb_mon_put_u64(p + need - 8, checksum(p, need - 8));
   if (written) *written = need;
   return RCB_OK;
 }
@@ -199,19 +161,19 @@ rcb_status rcb_mon_image_open(rcb_monitor *mon, const void *buf, size_t size, ui
   if (!p || size < IM_HEAD + 8 || memcmp(p, IM_MAGIC, 4) != 0)
     return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "commissioning image: not an image the monitor "
                         "writes (rcb_monitor_image_save)");
-  if ((get_u64(p) >> 32) != RCB_MONITOR_IMAGE_VERSION)
+  if ((rcb_mon_get_u64(p) >> 32) != RCB_MONITOR_IMAGE_VERSION)
     return rcb_mon_fail(mon, RCB_ERR_VERSION, "commissioning image: format version %lu, this "
-                        "library reads %u", (unsigned long)(get_u64(p) >> 32),
+                        "library reads %u", (unsigned long)(rcb_mon_get_u64(p) >> 32),
                         RCB_MONITOR_IMAGE_VERSION);
   for (i = 0; i < 10; i++) {
-    uint64_t v = get_u64(p + 16 + 8 * i);
+    uint64_t v = rcb_mon_get_u64(p + 16 + 8 * i);
     if (v > (uint64_t)(size / 8)) /* no dimension can pass the image's own size */
       return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "commissioning image: dimension %zu is %llu: "
                           "damaged", i + 1, (unsigned long long)v);
     dims[i] = (size_t)v;
   }
   if (dims[0] != mon->n || dims[1] != ncol || dims[3] != mon->nt || dims[4] != ncand ||
-      dims[5] != mon->nch || dims[6] != mon->npts || get_u64(p + 8) != fp)
+      dims[5] != mon->nch || dims[6] != mon->npts || rcb_mon_get_u64(p + 8) != fp)
     return rcb_mon_fail(mon, RCB_ERR_OTHER_SETUP, "commissioning image of another baseline "
                         "model, set-up or options (its fingerprint or dimensions differ)");
   if (!dims[2] || dims[2] > ncol || dims[2] > mon->n || dims[7] > 1 ||
@@ -224,12 +186,12 @@ rcb_status rcb_mon_image_open(rcb_monitor *mon, const void *buf, size_t size, ui
   if (size != need)
     return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "commissioning image: %zu bytes, its dimensions "
                         "make %zu", size, need);
-  if (get_u64(p + need - 8) != checksum(p, need - 8))
+  if (rcb_mon_get_u64(p + need - 8) != checksum(p, need - 8))
     return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "commissioning image: its checksum does not "
                         "match (damaged)");
   nd = mon->n * dims[2] + dims[2] * ncol + lr_doubles(mon->npt, mon->npts, dims[8], dims[9]);
   for (i = 0; i < nd; i++)
-    if (!isfinite(get_f64(p + IM_HEAD + 8 * i)))
+    if (!isfinite(rcb_mon_get_f64(p + IM_HEAD + 8 * i)))
       return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "commissioning image: value %zu is not "
                           "finite: damaged", i + 1);
   { /* Q's columns are orthonormal: each of unit length (a cheap check that
@@ -238,7 +200,7 @@ rcb_status rcb_mon_image_open(rcb_monitor *mon, const void *buf, size_t size, ui
     for (a = 0; a < kk; a++) {
       double s = 0;
       for (i = 0; i < mon->n; i++) {
-        double q = get_f64(p + IM_HEAD + 8 * (kk * i + a));
+        double q = rcb_mon_get_f64(p + IM_HEAD + 8 * (kk * i + a));
         s += q * q;
       }
       if (!(fabs(s - 1.0) <= 1e-6))
@@ -260,7 +222,7 @@ rcb_status rcb_mon_image_open(rcb_monitor *mon, const void *buf, size_t size, ui
 
 void rcb_mon_image_doubles(const mon_image *im, size_t at, double *x, size_t n) {
   size_t i;
-  for (i = 0; i < n; i++) x[i] = get_f64(im->p + at + 8 * i);
+  for (i = 0; i < n; i++) x[i] = rcb_mon_get_f64(im->p + at + 8 * i);
 }
 
 rcb_status rcb_mon_image_lowrank(rcb_monitor *mon, const mon_image *im, mon_lowrank *lr) {
@@ -280,7 +242,7 @@ rcb_status rcb_mon_image_lowrank(rcb_monitor *mon, const mon_image *im, mon_lowr
   cnt[0] = na, cnt[1] = nh, cnt[2] = nb;
   for (j = 0; j < 3; j++)
     for (i = 0; i < cnt[j]; i++, at += 16)
-      dst[j][i] = CMPLX(get_f64(im->p + at), get_f64(im->p + at + 8));
+      dst[j][i] = CMPLX(rcb_mon_get_f64(im->p + at), rcb_mon_get_f64(im->p + at + 8));
   /* the create's check against a sweep, as it came out */
   for (j = 0; j < mon->ncand; j++)
     if (!im->p[im->ep + j]) mon->cand[j].ep = NULL;

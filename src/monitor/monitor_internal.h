@@ -342,4 +342,18 @@ void rcb_mon_image_doubles(const mon_image *im, size_t at, double *x, size_t n);
 /* The low-rank blocks and the check's outcome into lr (after its layout). */
 rcb_status rcb_mon_image_lowrank(rcb_monitor *mon, const mon_image *im, mon_lowrank *lr);
 
+/* Little-endian fields and FNV-1a 64 fingerprints of the saved forms (the
+ * state, monitor_state.c; the commissioning image, monitor_image.c), in one
+ * place: 8 bytes, least significant first, whatever the host. */
+#define RCB_MON_FNV_OFFSET 0xcbf29ce484222325ull
+#define RCB_MON_FNV_PRIME 0x100000001b3ull
+void rcb_mon_put_u64(unsigned char *p, uint64_t v);
+uint64_t rcb_mon_get_u64(const unsigned char *p);
+void rcb_mon_put_f64(unsigned char *p, double x);
+double rcb_mon_get_f64(const unsigned char *p);
+uint64_t rcb_mon_fnv_bytes(uint64_t h, const void *data, size_t n);
+uint64_t rcb_mon_fnv_u64(uint64_t h, uint64_t v);
+uint64_t rcb_mon_fnv_f64(uint64_t h, double x);
+uint64_t rcb_mon_fnv_str(uint64_t h, const char *s);
+
 #endif

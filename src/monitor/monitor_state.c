@@ -25,20 +25,20 @@
  * RCB_MONITOR_MAX_UPDATES first, so no target's size_t may be narrower. */
 _Static_assert(SIZE_MAX >= RCB_MONITOR_MAX_UPDATES, "size_t holds every update count");
 
-/* ---- little-endian fields ---- */
+/* ---- little-endian fields (those of 8 bytes shared: monitor_internal.h) ---- */
 
 static void put_u32(unsigned char *p, uint32_t v) {
   int i;
   for (i = 0; i < 4; i++) p[i] = (unsigned char)(v >> (8 * i));
 }
-static void put_u64(unsigned char *p, uint64_t v) {
+void rcb_mon_put_u64(unsigned char *p, uint64_t v) {
   int i;
   for (i = 0; i < 8; i++) p[i] = (unsigned char)(v >> (8 * i));
 }
-static void put_f64(unsigned char *p, double x) {
+void rcb_mon_put_f64(unsigned char *p, double x) {
   uint64_t v;
   memcpy(&v, &x, sizeof v);
-  put_u64(p, v);
+  rcb_mon_put_u64(p, v);
 }
 static uint32_t get_u32(const unsigned char *p) {
   uint32_t v = 0;
@@ -46,14 +46,14 @@ static uint32_t get_u32(const unsigned char *p) {
   for (i = 3; i >= 0; i--) v = (v << 8) | p[i];
   return v;
 }
-static uint64_t get_u64(const unsigned char *p) {
+uint64_t rcb_mon_get_u64(const unsigned char *p) {
   uint64_t v = 0;
   int i;
   for (i = 7; i >= 0; i--) v = (v << 8) | p[i];
   return v;
 }
-static double get_f64(const unsigned char *p) {
-  uint64_t v = get_u64(p);
+double rcb_mon_get_f64(const unsigned char *p) {
+  uint64_t v = rcb_mon_get_u64(p);
   double x;
   memcpy(&x, &v, sizeof x);
   return x;
@@ -79,27 +79,24 @@ unsigned long rcb_monitor_crc32(unsigned long crc, const void *data, size_t n) {
 
 /* ---- fingerprints: FNV-1a 64 over values in a fixed byte order ---- */
 
-#define FNV_OFFSET 0xcbf29ce484222325ull
-#define FNV_PRIME 0x100000001b3ull
-
-static uint64_t fnv_bytes(uint64_t h, const void *data, size_t n) {
+uint64_t rcb_mon_fnv_bytes(uint64_t h, const void *data, size_t n) {
   const unsigned char *p = data;
   size_t i;
-  for (i = 0; i < n; i++) h = (h ^ p[i]) * FNV_PRIME;
+  for (i = 0; i < n; i++) h = (h ^ p[i]) * RCB_MON_FNV_PRIME;
   return h;
 }
-static uint64_t fnv_u64(uint64_t h, uint64_t v) {
+uint64_t rcb_mon_fnv_u64(uint64_t h, uint64_t v) {
   unsigned char b[8];
-  put_u64(b, v);
-  return fnv_bytes(h, b, 8);
+  rcb_mon_put_u64(b, v);
+  return rcb_mon_fnv_bytes(h, b, 8);
 }
-static uint64_t fnv_f64(uint64_t h, double x) {
+uint64_t rcb_mon_fnv_f64(uint64_t h, double x) {
   unsigned char b[8];
-  put_f64(b, x);
-  return fnv_bytes(h, b, 8);
+  rcb_mon_put_f64(b, x);
+  return rcb_mon_fnv_bytes(h, b, 8);
 }
-static uint64_t fnv_str(uint64_t h, const char *s) {
-  return fnv_bytes(h, s ? s : "", (s ? strlen(s) : 0) + 1);
+uint64_t rcb_mon_fnv_str(uint64_t h, const char *s) {
+  return rcb_mon_fnv_bytes(h, s ? s : "", (s ? strlen(s) : 0) + 1);
 }
 
 /* The tracked names and baseline values, the candidates (a structural
@@ -107,13 +104,13 @@ static uint64_t fnv_str(uint64_t h, const char *s) {
  * over the set-up's points (weights 1 and 1 + (p mod 7) / 7), compared with
  * a tolerance. */
 static uint64_t model_hash(const rcb_monitor *mon, double sig[2]) {
-  uint64_t h = FNV_OFFSET;
+  uint64_t h = RCB_MON_FNV_OFFSET;
   size_t a, p;
-  h = fnv_u64(h, mon->nt);
-  for (a = 0; a < mon->nt; a++) h = fnv_f64(fnv_str(h, mon->tname[a]), mon->t0[a]);
-  h = fnv_u64(h, mon->ncand);
+  h = rcb_mon_fnv_u64(h, mon->nt);
+  for (a = 0; a < mon->nt; a++) h = rcb_mon_fnv_f64(rcb_mon_fnv_str(h, mon->tname[a]), mon->t0[a]);
+  h = rcb_mon_fnv_u64(h, mon->ncand);
   for (a = 0; a < mon->ncand; a++)
-    h = fnv_str(fnv_u64(h, (uint64_t)mon->cand[a].effect), mon->cand[a].place);
+    h = rcb_mon_fnv_str(rcb_mon_fnv_u64(h, (uint64_t)mon->cand[a].effect), mon->cand[a].place);
   sig[0] = sig[1] = 0;
   for (p = 0; p < mon->npt; p++) {
     sig[0] += mon->h0abs[p];
@@ -124,33 +121,33 @@ static uint64_t model_hash(const rcb_monitor *mon, double sig[2]) {
 
 static uint64_t setup_hash(const rcb_monitor *mon) {
   const double *x = rcb_meas_grid(mon->setup);
-  uint64_t h = FNV_OFFSET;
+  uint64_t h = RCB_MON_FNV_OFFSET;
   size_t c, i;
-  h = fnv_u64(h, (uint64_t)rcb_meas_get_type(mon->setup));
-  h = fnv_f64(fnv_u64(h, mon->npts), rcb_meas_speed(mon->setup));
-  for (i = 0; i < mon->npts; i++) h = fnv_f64(h, x[i]);
-  h = fnv_u64(h, mon->nch);
+  h = rcb_mon_fnv_u64(h, (uint64_t)rcb_meas_get_type(mon->setup));
+  h = rcb_mon_fnv_f64(rcb_mon_fnv_u64(h, mon->npts), rcb_meas_speed(mon->setup));
+  for (i = 0; i < mon->npts; i++) h = rcb_mon_fnv_f64(h, x[i]);
+  h = rcb_mon_fnv_u64(h, mon->nch);
   for (c = 0; c < mon->nch; c++) {
     rcb_meas_channel_info ci;
     rcb_meas_channel(mon->setup, c, &ci);
-    h = fnv_u64(fnv_str(fnv_str(h, ci.response), ci.reference), (uint64_t)ci.kind);
+    h = rcb_mon_fnv_u64(rcb_mon_fnv_str(rcb_mon_fnv_str(h, ci.response), ci.reference), (uint64_t)ci.kind);
   }
-  for (i = 0; i < mon->npt; i++) h = fnv_f64(fnv_f64(h, creal(mon->e0[i])), cimag(mon->e0[i]));
+  for (i = 0; i < mon->npt; i++) h = rcb_mon_fnv_f64(rcb_mon_fnv_f64(h, creal(mon->e0[i])), cimag(mon->e0[i]));
   return h;
 }
 
 static uint64_t settings_hash(const rcb_monitor *mon) {
   const double v[] = {mon->alpha, mon->cusum_k, mon->cusum_h, mon->beta_a, mon->beta_s,
                       mon->navg_inv, mon->phase_var};
-  uint64_t h = FNV_OFFSET;
+  uint64_t h = RCB_MON_FNV_OFFSET;
   size_t i;
-  for (i = 0; i < sizeof v / sizeof v[0]; i++) h = fnv_f64(h, v[i]);
-  h = fnv_u64(fnv_u64(fnv_u64(h, mon->top), mon->relin), (uint64_t)mon->reweight);
+  for (i = 0; i < sizeof v / sizeof v[0]; i++) h = rcb_mon_fnv_f64(h, v[i]);
+  h = rcb_mon_fnv_u64(rcb_mon_fnv_u64(rcb_mon_fnv_u64(h, mon->top), mon->relin), (uint64_t)mon->reweight);
   for (i = 0; i < mon->nt; i++)
-    h = fnv_f64(fnv_f64(fnv_f64(h, mon->tlo[i]), mon->thi[i]), mon->tbv[i]);
-  for (i = 0; i < mon->nt * mon->nt; i++) h = fnv_f64(h, mon->bcov[i]); /* version 3 */
-  h = fnv_u64(h, (uint64_t)mon->have_sd0);
-  for (i = 0; mon->have_sd0 && i < mon->npt; i++) h = fnv_f64(h, mon->sd0[i]);
+    h = rcb_mon_fnv_f64(rcb_mon_fnv_f64(rcb_mon_fnv_f64(h, mon->tlo[i]), mon->thi[i]), mon->tbv[i]);
+  for (i = 0; i < mon->nt * mon->nt; i++) h = rcb_mon_fnv_f64(h, mon->bcov[i]); /* version 3 */
+  h = rcb_mon_fnv_u64(h, (uint64_t)mon->have_sd0);
+  for (i = 0; mon->have_sd0 && i < mon->npt; i++) h = rcb_mon_fnv_f64(h, mon->sd0[i]);
   return h;
 }
 
@@ -175,13 +172,13 @@ static size_t drift_bytes(const rcb_monitor *mon) {
 static unsigned char *put_s(const rcb_monitor *mon, const double *s, unsigned char *q) {
   size_t j, a;
   for (j = 0; j < mon->ncand; j++)
-    for (a = 0; a < mon->cand[j].dof; a++, q += 8) put_f64(q, s[j * RCB_MONITOR_MAXP + a]);
+    for (a = 0; a < mon->cand[j].dof; a++, q += 8) rcb_mon_put_f64(q, s[j * RCB_MONITOR_MAXP + a]);
   return q;
 }
 static const unsigned char *get_s(const rcb_monitor *mon, double *s, const unsigned char *r) {
   size_t j, a;
   for (j = 0; j < mon->ncand; j++)
-    for (a = 0; a < mon->cand[j].dof; a++, r += 8) s[j * RCB_MONITOR_MAXP + a] = get_f64(r);
+    for (a = 0; a < mon->cand[j].dof; a++, r += 8) s[j * RCB_MONITOR_MAXP + a] = rcb_mon_get_f64(r);
   return r;
 }
 
@@ -199,14 +196,14 @@ static void save_drift(const rcb_monitor *mon, unsigned char *q) {
   size_t i, s, k = mon->k, nt = mon->nt;
   put_u32(q, (uint32_t)k), put_u32(q + 4, (uint32_t)nt), put_u32(q + 8, MON_DRIFT_WINDOW);
   put_u32(q + 12, (uint32_t)mon->dcount), put_u32(q + 16, (uint32_t)mon->dhead);
-  put_u64(q + 20, (uint64_t)mon->dall), put_u32(q + 28, (uint32_t)mon->dfree);
+  rcb_mon_put_u64(q + 20, (uint64_t)mon->dall), put_u32(q + 28, (uint32_t)mon->dfree);
   q += ST_DRIFT_HEAD;
-  for (i = 0; i < k; i++, q += 8) put_f64(q, mon->dysum[i]);
-  for (i = 0; i < nt; i++, q += 8) put_f64(q, mon->dthsum[i]);
+  for (i = 0; i < k; i++, q += 8) rcb_mon_put_f64(q, mon->dysum[i]);
+  for (i = 0; i < nt; i++, q += 8) rcb_mon_put_f64(q, mon->dthsum[i]);
   q = put_s(mon, mon->dssum, q);
   for (s = 0; s < MON_DRIFT_WINDOW; s++) {
-    for (i = 0; i < k; i++, q += 8) put_f64(q, mon->dy[s * k + i]);
-    for (i = 0; i < nt; i++, q += 8) put_f64(q, mon->dth[s * RCB_MONITOR_MAX_TRACKED + i]);
+    for (i = 0; i < k; i++, q += 8) rcb_mon_put_f64(q, mon->dy[s * k + i]);
+    for (i = 0; i < nt; i++, q += 8) rcb_mon_put_f64(q, mon->dth[s * RCB_MONITOR_MAX_TRACKED + i]);
     q = put_s(mon, mon->ds + s * mon->ncand * RCB_MONITOR_MAXP, q);
   }
 }
@@ -219,7 +216,7 @@ static void save_drift(const rcb_monitor *mon, unsigned char *q) {
 static rcb_status check_drift(rcb_monitor *mon, const unsigned char *q, uint64_t updates,
                               int started) {
   const size_t W = MON_DRIFT_WINDOW, nsum = mon->k + mon->nt + cand_dofs(mon);
-  const uint64_t dall = get_u64(q + 20);
+  const uint64_t dall = rcb_mon_get_u64(q + 20);
   const uint32_t cnt = get_u32(q + 12), head = get_u32(q + 16);
   size_t i, n = (W + 1u) * nsum;
   if (get_u32(q) != mon->k || get_u32(q + 4) != mon->nt || get_u32(q + 8) != W)
@@ -242,7 +239,7 @@ static rcb_status check_drift(rcb_monitor *mon, const unsigned char *q, uint64_t
     return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: the drift window's free-offset flag %lu, "
                         "expected 0 or 1: " ST_NOT_WRITTEN, (unsigned long)get_u32(q + 28));
   for (i = 0, q += ST_DRIFT_HEAD; i < n; i++, q += 8) {
-    double v = get_f64(q);
+    double v = rcb_mon_get_f64(q);
     if (!isfinite(v) || (i < nsum && !dall && v != 0))
       return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: the drift window's %s %zu = %g, "
                           "expected %s: " ST_NOT_WRITTEN, i < nsum ? "sum" : "value",
@@ -255,15 +252,15 @@ static rcb_status check_drift(rcb_monitor *mon, const unsigned char *q, uint64_t
 static void load_drift(rcb_monitor *mon, const unsigned char *q) {
   size_t i, s, k = mon->k, nt = mon->nt;
   mon->dcount = get_u32(q + 12), mon->dhead = get_u32(q + 16);
-  mon->dall = (size_t)get_u64(q + 20), mon->dfree = get_u32(q + 28) != 0;
+  mon->dall = (size_t)rcb_mon_get_u64(q + 20), mon->dfree = get_u32(q + 28) != 0;
   q += ST_DRIFT_HEAD;
-  for (i = 0; i < k; i++, q += 8) mon->dysum[i] = get_f64(q);
+  for (i = 0; i < k; i++, q += 8) mon->dysum[i] = rcb_mon_get_f64(q);
   memset(mon->dthsum, 0, sizeof mon->dthsum);
-  for (i = 0; i < nt; i++, q += 8) mon->dthsum[i] = get_f64(q);
+  for (i = 0; i < nt; i++, q += 8) mon->dthsum[i] = rcb_mon_get_f64(q);
   q = get_s(mon, mon->dssum, q);
   for (s = 0; s < MON_DRIFT_WINDOW; s++) {
-    for (i = 0; i < k; i++, q += 8) mon->dy[s * k + i] = get_f64(q);
-    for (i = 0; i < nt; i++, q += 8) mon->dth[s * RCB_MONITOR_MAX_TRACKED + i] = get_f64(q);
+    for (i = 0; i < k; i++, q += 8) mon->dy[s * k + i] = rcb_mon_get_f64(q);
+    for (i = 0; i < nt; i++, q += 8) mon->dth[s * RCB_MONITOR_MAX_TRACKED + i] = rcb_mon_get_f64(q);
     q = get_s(mon, mon->ds + s * mon->ncand * RCB_MONITOR_MAXP, q);
   }
 }
@@ -280,22 +277,22 @@ rcb_status rcb_monitor_save(const rcb_monitor *mon, void *buf, size_t size, size
   put_u32(b + 4, RCB_MONITOR_STATE_VERSION);
   put_u32(b + 8, (uint32_t)need);
   put_u32(b + 12, (uint32_t)mon->nt);
-  put_u64(b + 16, model_hash(mon, sig));
-  put_f64(b + 24, sig[0]);
-  put_f64(b + 32, sig[1]);
-  put_u64(b + 40, setup_hash(mon));
-  put_u64(b + 48, settings_hash(mon));
-  put_u64(b + 56, (uint64_t)mon->updates);
+  rcb_mon_put_u64(b + 16, model_hash(mon, sig));
+  rcb_mon_put_f64(b + 24, sig[0]);
+  rcb_mon_put_f64(b + 32, sig[1]);
+  rcb_mon_put_u64(b + 40, setup_hash(mon));
+  rcb_mon_put_u64(b + 48, settings_hash(mon));
+  rcb_mon_put_u64(b + 56, (uint64_t)mon->updates);
   put_u32(b + 64, (uint32_t)mon->ref_started);
   for (a = 0, q = b + ST_HEAD; a < mon->nt; a++, q += ST_PER) {
-    put_f64(q, mon->cus_up[a]);
-    put_f64(q + 8, mon->cus_dn[a]);
-    put_f64(q + 16, mon->ref_sum[a]);
-    put_f64(q + 24, mon->ref_w[a]);
+    rcb_mon_put_f64(q, mon->cus_up[a]);
+    rcb_mon_put_f64(q + 8, mon->cus_dn[a]);
+    rcb_mon_put_f64(q + 16, mon->ref_sum[a]);
+    rcb_mon_put_f64(q + 24, mon->ref_w[a]);
     put_u32(q + 32, (uint32_t)mon->ref_frozen[a]);
   }
   for (a = 0; a < mon->nt * mon->nt; a++, q += 8)
-    put_f64(q, mon->bref[(a / mon->nt) * RCB_MONITOR_MAX_TRACKED + a % mon->nt]);
+    rcb_mon_put_f64(q, mon->bref[(a / mon->nt) * RCB_MONITOR_MAX_TRACKED + a % mon->nt]);
   save_drift(mon, q);
   put_u32(b + need - ST_CRC, (uint32_t)rcb_monitor_crc32(0, b, need - ST_CRC));
   if (written) *written = need;
@@ -331,16 +328,16 @@ static rcb_status check(rcb_monitor *mon, const unsigned char *b, size_t size) {
   if (get_u32(b + 12) != mon->nt)
     return rcb_mon_fail(mon, RCB_ERR_OTHER_MODEL, "state: %lu tracked parameters, this "
                         "monitor tracks %zu", (unsigned long)get_u32(b + 12), mon->nt);
-  if (get_u64(b + 16) != model_hash(mon, sig) || sig_differs(get_f64(b + 24), sig[0]) ||
-      sig_differs(get_f64(b + 32), sig[1]))
+  if (rcb_mon_get_u64(b + 16) != model_hash(mon, sig) || sig_differs(rcb_mon_get_f64(b + 24), sig[0]) ||
+      sig_differs(rcb_mon_get_f64(b + 32), sig[1]))
     return rcb_mon_fail(mon, RCB_ERR_OTHER_MODEL, "state: saved from another baseline model "
                         "(tracked parameters, their baseline values, the candidate effects "
                         "or the model's response differ); create the monitor from the model "
                         "the state was saved with");
-  if (get_u64(b + 40) != setup_hash(mon))
+  if (rcb_mon_get_u64(b + 40) != setup_hash(mon))
     return rcb_mon_fail(mon, RCB_ERR_OTHER_SETUP, "state: saved with another set-up "
                         "(channels, points, speed or commissioning values differ)");
-  if (get_u64(b + 48) != settings_hash(mon))
+  if (rcb_mon_get_u64(b + 48) != settings_hash(mon))
     return rcb_mon_fail(mon, RCB_ERR_OTHER_SETUP, "state: saved with other settings (alpha, "
                         "CUSUM k or h, noise, averages, re-linearisation, reweighting or "
                         "tracked ranges differ)");
@@ -353,7 +350,7 @@ static rcb_status check(rcb_monitor *mon, const unsigned char *b, size_t size) {
 /* The update count and the reference-started flag (then the padding after
  * it, written 0). */
 static rcb_status check_counts(rcb_monitor *mon, const unsigned char *b) {
-  uint64_t updates = get_u64(b + 56);
+  uint64_t updates = rcb_mon_get_u64(b + 56);
   if (updates > RCB_MONITOR_MAX_UPDATES)
     return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: update count %llu, more than a monitor "
                         "takes (%llu, RCB_MONITOR_MAX_UPDATES): " ST_NOT_WRITTEN,
@@ -397,7 +394,7 @@ static rcb_status check_tracked(rcb_monitor *mon, const unsigned char *b, size_t
   const char *want;
   double v[4];
   size_t i, j;
-  for (i = 0; i < 4; i++) v[i] = get_f64(q + 8 * i);
+  for (i = 0; i < 4; i++) v[i] = rcb_mon_get_f64(q + 8 * i);
   if ((want = tracked_want(mon, v, started, &i)))
     return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: tracked parameter %zu (%s): %s = %g, "
                         "expected %s: " ST_NOT_WRITTEN, a + 1, mon->tname[a], field[i], v[i],
@@ -408,7 +405,7 @@ static rcb_status check_tracked(rcb_monitor *mon, const unsigned char *b, size_t
                         mon->tname[a], (unsigned long)get_u32(q + 32),
                         (unsigned long)get_u32(q + 36), started ? "0 or 1" : "0");
   for (j = 0; j < mon->nt; j++, r += 8) {
-    double x = get_f64(r);
+    double x = rcb_mon_get_f64(r);
     if (!isfinite(x) || (x != 0 && (!mon->bcurv || v[3] == 0)))
       return rcb_mon_fail(mon, RCB_ERR_CORRUPT, "state: tracked parameter %zu (%s): the "
                           "reference's sum of step %zu = %g, expected %s: " ST_NOT_WRITTEN,
@@ -428,7 +425,7 @@ static rcb_status check_fields(rcb_monitor *mon, const unsigned char *b) {
   if ((st = check_counts(mon, b))) return st;
   for (a = 0; a < mon->nt; a++)
     if ((st = check_tracked(mon, b, a, started))) return st;
-  return check_drift(mon, b + ST_HEAD + ST_PER * mon->nt + bref_bytes(mon), get_u64(b + 56),
+  return check_drift(mon, b + ST_HEAD + ST_PER * mon->nt + bref_bytes(mon), rcb_mon_get_u64(b + 56),
                      started);
 }
 
@@ -445,14 +442,14 @@ rcb_status rcb_monitor_load(rcb_monitor *mon, const void *buf, size_t size) {
   load_drift(mon, b + ST_HEAD + ST_PER * mon->nt + bref_bytes(mon));
   memset(mon->bref, 0, sizeof mon->bref);
   for (a = 0, q = b + ST_HEAD + ST_PER * mon->nt; a < mon->nt * mon->nt; a++, q += 8)
-    mon->bref[(a / mon->nt) * RCB_MONITOR_MAX_TRACKED + a % mon->nt] = get_f64(q);
-  mon->updates = (size_t)get_u64(b + 56); /* <= RCB_MONITOR_MAX_UPDATES: check_counts */
+    mon->bref[(a / mon->nt) * RCB_MONITOR_MAX_TRACKED + a % mon->nt] = rcb_mon_get_f64(q);
+  mon->updates = (size_t)rcb_mon_get_u64(b + 56); /* <= RCB_MONITOR_MAX_UPDATES: check_counts */
   mon->ref_started = get_u32(b + 64) != 0;
   for (a = 0, q = b + ST_HEAD; a < mon->nt; a++, q += ST_PER) {
-    mon->cus_up[a] = get_f64(q);
-    mon->cus_dn[a] = get_f64(q + 8);
-    mon->ref_sum[a] = get_f64(q + 16);
-    mon->ref_w[a] = get_f64(q + 24);
+    mon->cus_up[a] = rcb_mon_get_f64(q);
+    mon->cus_dn[a] = rcb_mon_get_f64(q + 8);
+    mon->ref_sum[a] = rcb_mon_get_f64(q + 16);
+    mon->ref_w[a] = rcb_mon_get_f64(q + 24);
     mon->ref_frozen[a] = get_u32(q + 32) != 0;
   }
   return RCB_OK;
