@@ -633,6 +633,38 @@ static void test_no_alloc_in_update(void **state) {
     rcb_monitor_destroy(mon);
     assert_int_equal(cnt.allocs, cnt.frees);
   }
+  { /* the joint step by the prepared adjoint sweep (monitor.c, joint_gn):
+     * the rotor 3 % slower than stated, reweighted and re-linearised, every
+     * update alarms and names the speed, whose DOFs are not few */
+    rcb_model *slow = edited(f->truth, "speed.factor", 0.97); /* the set-up's machine */
+    rcb_meas *ms = frf_of(slow);
+    rcb_complex *fs = malloc(NPT * sizeof *fs);
+    rcb_monitor_candidate_info ci;
+    assert_non_null(fs);
+    values_of(ms, fs);
+    o.relinearise = 8;
+    o.reweight = 1;
+    /* the exact model as the baseline: the joint step's interval holds the truth */
+    assert_int_equal(rcb_monitor_create(&mon, f->truth, f->setup, &o, &a), RCB_OK);
+    before = cnt.allocs;
+    for (u = 0; u < 3; u++) {
+      eq19(fs, f->v, &seed);
+      assert_int_equal(rcb_monitor_update(mon, f->v, NULL, &r), RCB_OK);
+      assert_true(r.alarm);
+      assert_int_equal(rcb_monitor_candidate_info_get(mon, r.top[0].index, &ci), RCB_OK);
+      assert_int_equal(ci.effect, RCB_EFFECT_SPEED);
+      /* the joint step's size: the factor's change, -0.03 within its interval */
+      print_message("speed 0.97: change %.5f [%.5f, %.5f]\n", r.top[0].size[0], r.top[0].ci_lo[0],
+                    r.top[0].ci_hi[0]);
+      assert_true(r.top[0].ci_lo[0] <= -0.03 && -0.03 <= r.top[0].ci_hi[0]);
+    }
+    assert_int_equal(cnt.allocs, before);
+    rcb_monitor_destroy(mon);
+    assert_int_equal(cnt.allocs, cnt.frees);
+    rcb_meas_destroy(ms);
+    rcb_model_destroy(slow);
+    free(fs);
+  }
 }
 
 /* Allocation-failure walk over create on a small set-up (2 channels x 24
@@ -911,7 +943,8 @@ static size_t find_cand(const rcb_monitor *mon, rcb_effect e, const char *params
  * that channel, exact for any gain (the reading is linear in it), so the
  * first candidate is C.A.y's gain with a change of -0.1 to rounding, the
  * tracked kt unmoved; a gain of -1 (a probe wired the wrong way) is the
- * change -2, as exactly. By default (effects 0) no sensor is a candidate. */
+ * change -2, as exactly. By default (effects 0) every sensor is a
+ * candidate; a mask without RCB_EFFECT_SENSOR_GAIN leaves them out. */
 static void test_sensor_gain(void **state) {
   fixture *f = *state;
   rcb_monitor_param tp;
@@ -923,6 +956,7 @@ static void test_sensor_gain(void **state) {
   size_t j, i, g;
   assert_non_null(v);
   o.setup_averages = HUGE_VAL;
+  o.effects = (1u << RCB_EFFECT_ELEMENT_STIFFNESS) - 1u; /* rcbtool --no-sensors */
   assert_int_equal(rcb_monitor_create(&mon, f->truth, f->setup, &o, NULL), RCB_OK);
   for (j = 0; j < rcb_monitor_candidate_count(mon); j++) {
     rcb_monitor_candidate_info ci;
@@ -930,7 +964,7 @@ static void test_sensor_gain(void **state) {
     assert_int_not_equal(ci.effect, RCB_EFFECT_SENSOR_GAIN);
   }
   rcb_monitor_destroy(mon);
-  o.effects = ((1u << RCB_EFFECT_ELEMENT_STIFFNESS) - 1u) | (1u << RCB_EFFECT_SENSOR_GAIN);
+  o.effects = 0; /* the default: every measured sensor's gain among the candidates */
   assert_int_equal(rcb_monitor_create(&mon, f->truth, f->setup, &o, NULL), RCB_OK);
   (void)find_cand(mon, RCB_EFFECT_SENSOR_GAIN, "sensor.C.A.y.gain");
   for (g = 0; g < 2; g++) {

@@ -253,17 +253,69 @@ static rcb_status adj_alloc(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, adj_ws
   return rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory (adjoint)");
 }
 
-/* Every point: columns d r / d p of dz[0 .. ndz) into J, the model values
- * into Hmod. */
-static rcb_status sweep_adjoint(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, double *J) {
+/* Every point with workspace ws: columns d r / d p of dz[0 .. ndz) into J,
+ * the model values into Hmod. */
+static rcb_status adj_points(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, const adj_ws *ws,
+                             double *J) {
   size_t i;
+  rcb_status st = RCB_OK;
+  for (i = 0; !st && i < f->npts; i++)
+    if (f->pt_used[i]) st = score_point(f, i, dz, ndz, ws, J);
+  return st;
+}
+
+/* The same with a workspace of its own. */
+static rcb_status sweep_adjoint(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, double *J) {
   adj_ws ws;
   rcb_status st = adj_alloc(f, dz, ndz, &ws);
   if (st) return st;
-  for (i = 0; !st && i < f->npts; i++)
-    if (f->pt_used[i]) st = score_point(f, i, dz, ndz, &ws, J);
+  st = adj_points(f, dz, ndz, &ws, J);
   adj_free(f, &ws);
   return st;
+}
+
+struct rcb_fit_adj {
+  rcb_fit_dz *dz; /* ndz copies of the caller's (their entries stay the caller's) */
+  size_t ndz;
+  adj_ws ws;
+};
+
+rcb_status rcb_fit_adj_create(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, rcb_fit_adj **out) {
+  rcb_fit_adj *a;
+  rcb_status st;
+  if (!f || !out || (!dz && ndz)) return RCB_ERR_ARG;
+  *out = NULL;
+  if (!(a = rcb_alloc(&f->alloc, sizeof *a)))
+    return rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory (adjoint)");
+  if (!(a->dz = rcb_alloc(&f->alloc, (ndz ? ndz : 1) * sizeof *a->dz))) {
+    rcb_free(&f->alloc, a);
+    return rcb_fit_fail(f, RCB_ERR_NOMEM, "out of memory (adjoint)");
+  }
+  if (ndz) memcpy(a->dz, dz, ndz * sizeof *dz);
+  a->ndz = ndz;
+  if ((st = adj_alloc(f, a->dz, ndz, &a->ws))) {
+    rcb_free(&f->alloc, a->dz);
+    rcb_free(&f->alloc, a);
+    return st;
+  }
+  *out = a;
+  return RCB_OK;
+}
+
+rcb_status rcb_fit_adj_run(rcb_fit *f, rcb_fit_adj *a, double *J) {
+  rcb_status st;
+  if (!f || !a || !J) return RCB_ERR_ARG;
+  if ((st = rcb_fit_prepare(f))) return st;
+  rcb_frf_refresh(f->frf);
+  if (!(st = adj_points(f, a->dz, a->ndz, &a->ws, J))) f->sweeps++;
+  return st;
+}
+
+void rcb_fit_adj_destroy(rcb_fit *f, rcb_fit_adj *a) {
+  if (!f || !a) return;
+  adj_free(f, &a->ws);
+  rcb_free(&f->alloc, a->dz);
+  rcb_free(&f->alloc, a);
 }
 
 rcb_status rcb_fit_jacobian_dz(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, double *J) {

@@ -75,6 +75,16 @@ void rcb_fit_dz_free(const rcb_allocator *a, rcb_fit_dz *dz, size_t n);
  * neutral values): eq. 9 by the adjoint, one factorisation per point for
  * all of them (fit_score.c). One sweep. */
 rcb_status rcb_fit_jacobian_dz(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, double *J);
+/* The same sweep prepared once (the monitor's joint step, whose update
+ * allocates nothing): create copies the array dz (its entries stay the
+ * caller's, alive until destroy) and allocates the sweep's workspace from
+ * f's allocator; run gives rcb_fit_jacobian_dz's columns at f's current
+ * point without an allocation (rcb_fit_last_residuals then gives that
+ * sweep's residuals). */
+typedef struct rcb_fit_adj rcb_fit_adj;
+rcb_status rcb_fit_adj_create(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, rcb_fit_adj **out);
+rcb_status rcb_fit_adj_run(rcb_fit *f, rcb_fit_adj *a, double *J);
+void rcb_fit_adj_destroy(rcb_fit *f, rcb_fit_adj *a);
 
 /* The weighted residuals (nres values) of the model values of f's last
  * sweep, rcb_fit_jacobian_dz's included, without another: what

@@ -13,6 +13,11 @@
 /* A re-linearisation's chord correction below this many standard errors
  * of every tracked parameter ends the iterations (-). */
 #define MON_RELIN_TOL 0.05
+/* A joint step (joint_gn) of this many standard errors or more for some
+ * parameter: the next iteration re-evaluates the columns (Gauss-Newton);
+ * under it, on the adjoint path, the next keeps them (a chord step, one
+ * plain sweep). */
+#define MON_CHORD_SD 1.0
 /* Two-sided 95 % normal quantile. */
 #define MON_Z95 1.959963984540054
 
@@ -22,6 +27,9 @@ void rcb_monitor_destroy(rcb_monitor *mon) {
   if (!mon) return;
   a = mon->user;
   rcb_mon_lowrank_free(mon, mon->lr); /* before the candidates: it resets their ep */
+  for (j = 0; j < mon->ncand && mon->cand; j++) rcb_fit_adj_destroy(mon->fit, mon->cand[j].adj);
+  if (mon->tdz) rcb_fit_dz_free(&mon->alloc, mon->tdz, mon->nt);
+  rcb_free(&mon->alloc, mon->tdz);
   if (mon->cdz) rcb_fit_dz_free(&mon->alloc, mon->cdz, mon->ncdz);
   rcb_free(&mon->alloc, mon->cdz);
   for (j = 0; j < mon->ncand; j++) rcb_free(&mon->alloc, mon->cand[j].est);
@@ -104,13 +112,43 @@ void rcb_mon_model_restore(rcb_monitor *mon, const mon_cand *c) {
   for (k = 0; c && k < c->np; k++) rcb_model_set_param(mon->model, c->pname[k], c->neutral[k]);
 }
 
+/* The model at tracked values t0 + theta and, with c, candidate c's
+ * parameters at neutral + s (the caller restores them). */
+static rcb_status set_point(rcb_monitor *mon, const double *theta, const mon_cand *c,
+                            const double *s) {
+  size_t k;
+  rcb_status st = RCB_OK;
+  for (k = 0; !st && k < mon->nt; k++)
+    if ((st = rcb_model_set_param(mon->model, mon->tname[k], mon->t0[k] + theta[k])))
+      rcb_mon_fail(mon, st, "re-linearising at %s = %g: %s", mon->tname[k],
+                   mon->t0[k] + theta[k], rcb_model_errmsg(mon->model));
+  for (k = 0; !st && c && k < c->np; k++)
+    if ((st = rcb_model_set_param(mon->model, c->pname[k], c->neutral[k] + s[k])))
+      rcb_mon_fail(mon, st, "re-linearising at %s = %g: %s", c->pname[k], c->neutral[k] + s[k],
+                   rcb_model_errmsg(mon->model));
+  return st;
+}
+
+/* out (the fit's Re/Im layout, n values) less base (NULL: a derivative),
+ * whitened in place. */
+static void whiten_change(const rcb_monitor *mon, double *out, const double *base) {
+  size_t p;
+  for (p = 0; p < mon->npt; p++) {
+    double complex g = conj(mon->u[p]) *
+                       CMPLX(out[2 * p] - (base ? base[2 * p] : 0.0),
+                             out[2 * p + 1] - (base ? base[2 * p + 1] : 0.0));
+    out[2 * p] = creal(g) * mon->winv[2 * p];
+    out[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
+  }
+}
+
 /* out = W (m(theta, s) - m(0, 0)) (the whitened change, n values) for
  * tracked values t0 + theta and, with c, candidate c's parameters at
  * neutral + s (c->settable). The parameters stay set: the caller restores
  * them (rcb_mon_model_restore). */
 static rcb_status model_resid(rcb_monitor *mon, const double *theta, const mon_cand *c,
                               const double *s, double *out) {
-  size_t k, p;
+  size_t p;
   rcb_status st = RCB_OK;
   if (mon->lr && (!c || c->ep)) { /* without a sweep */
     rcb_complex *dm = mon->lr->dm;
@@ -122,26 +160,13 @@ static rcb_status model_resid(rcb_monitor *mon, const double *theta, const mon_c
     }
     return RCB_OK;
   }
-  for (k = 0; !st && k < mon->nt; k++)
-    if ((st = rcb_model_set_param(mon->model, mon->tname[k], mon->t0[k] + theta[k])))
-      rcb_mon_fail(mon, st, "re-linearising at %s = %g: %s", mon->tname[k],
-                   mon->t0[k] + theta[k], rcb_model_errmsg(mon->model));
-  for (k = 0; !st && c && k < c->np; k++)
-    if ((st = rcb_model_set_param(mon->model, c->pname[k], c->neutral[k] + s[k])))
-      rcb_mon_fail(mon, st, "re-linearising at %s = %g: %s", c->pname[k], c->neutral[k] + s[k],
-                   rcb_model_errmsg(mon->model));
-  if (!st && (st = rcb_fit_residuals(mon->fit, out)))
+  if (!(st = set_point(mon, theta, c, s)) && (st = rcb_fit_residuals(mon->fit, out)))
     rcb_mon_fail(mon, st, "re-linearising at the tracked estimate: %s", rcb_fit_errmsg(mon->fit));
   if (st) {
     rcb_mon_model_restore(mon, c);
     return st;
   }
-  for (p = 0; p < mon->npt; p++) {
-    double complex g = conj(mon->u[p]) * CMPLX(out[2 * p] - mon->rbase[2 * p],
-                                               out[2 * p + 1] - mon->rbase[2 * p + 1]);
-    out[2 * p] = creal(g) * mon->winv[2 * p];
-    out[2 * p + 1] = cimag(g) * mon->winv[2 * p + 1];
-  }
+  whiten_change(mon, out, mon->rbase);
   return RCB_OK;
 }
 
@@ -151,6 +176,31 @@ static rcb_status model_change(rcb_monitor *mon, const double *theta, const mon_
   rcb_status st = model_resid(mon, theta, c, s, mon->rm);
   if (!st) to_rank(mon, mon->rm, mon->ym);
   return st;
+}
+
+/* The tracked columns at the re-linearised step th (rank space, into
+ * mon->Jx; base = ym(th)): forward differences of one standard error each
+ * (nt model evaluations). The reweighted path projects them out of the
+ * update's change instead of the baseline's columns (rcb_mon_gls): with
+ * the baseline's, the tracked part of the commissioning's noise, shared
+ * by every update, leaked beyond the tracked directions in proportion to
+ * the tracked change (the columns turn as the parameters move: the ROSS
+ * kt_wear series' drift test alarmed at kt -8.5 to -10 %, a ramp the
+ * wear made of that shared noise). */
+static rcb_status tracked_columns(rcb_monitor *mon, double *th, const double *base) {
+  size_t a, i, k = mon->k;
+  rcb_status st;
+  for (a = 0; a < mon->nt; a++) {
+    double keep = th[a], h = mon->tse[a] > 0 ? mon->tse[a] : 1e-6 * fmax(fabs(mon->t0[a]), 1.0);
+    double *col = mon->Jx + k * a;
+    th[a] += h;
+    st = model_change(mon, th, NULL, NULL);
+    th[a] = keep;
+    if (st) return st;
+    for (i = 0; i < k; i++) col[i] = (mon->ym[i] - base[i]) / h;
+  }
+  mon->jt = 1;
+  return RCB_OK;
 }
 
 /* The re-linearised tracked step theta (chord iterations re-evaluating the
@@ -167,9 +217,13 @@ static rcb_status tracked_step(rcb_monitor *mon, double *theta) {
   double d[RCB_MONITOR_MAX_TRACKED];
   rcb_status st;
   int small = 0;
+  double *base = mon->rmx + mon->n * (1 + nt + RCB_MONITOR_MAXP), th[RCB_MONITOR_MAX_TRACKED];
+  mon->jt = 0;
   if (!mon->relin || !nt) return RCB_OK;
   for (it = 0; !small && it < mon->relin; it++) {
     if (it && (st = model_change(mon, theta, NULL, NULL))) return st;
+    memcpy(base, mon->ym, k * sizeof *base); /* ym at the step before this correction */
+    memcpy(th, theta, sizeof th);
     for (i = 0; i < k; i++) mon->ym[i] = mon->y[i] - mon->ym[i];
     small = 1;
     for (a = 0; a < nt; a++) {
@@ -187,7 +241,10 @@ static rcb_status tracked_step(rcb_monitor *mon, double *theta) {
   } else {
     if ((st = model_change(mon, theta, NULL, NULL))) return st;
     for (i = 0; i < k; i++) mon->y[i] -= mon->ym[i];
+    memcpy(base, mon->ym, k * sizeof *base);
+    memcpy(th, theta, sizeof th);
   }
+  if (mon->reweight && (st = tracked_columns(mon, th, base))) return st;
   rcb_mon_model_restore(mon, NULL);
   return RCB_OK;
 }
@@ -445,11 +502,13 @@ static void tracked_rest(const rcb_monitor *mon, int gls, const rcb_monitor_resu
  * sizes): w = y0 - ym(x) and the columns of ym at x by forward differences
  * (steps of a tenth of each standard error, rank space), both taken to
  * this update's metric on the reweighted path (U^-T), then the small QR:
- * x += R^-1 Qa^T w, sd the row norms of R^-1. 1 + nt + np model sweeps.
- * *ok = 0 when the model refused a value or a column is dependent, 2 when
- * some step was MON_RELIN_TOL standard errors or more, else 1. */
-static rcb_status joint_gn(rcb_monitor *mon, const mon_cand *c, int gls, double *x, double *sd,
-                           int *ok) {
+ * x += R^-1 Qa^T w, sd the row norms of R^-1. 1 + nt + np model sweeps,
+ * or with c->adj one adjoint sweep (fresh) or one plain sweep reusing the
+ * last columns (a chord step). *ok = 0 when the model refused a value or a
+ * column is dependent, 4 when some step was MON_CHORD_SD standard errors
+ * or more, 2 when MON_RELIN_TOL or more, else 1. */
+static rcb_status joint_gn(rcb_monitor *mon, const mon_cand *c, int gls, int fresh, double *x,
+                           double *sd, int *ok) {
   size_t a, i, k = mon->k, nt = mon->nt, p = nt + c->np;
   double qz[RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP], dx[RCB_MONITOR_MAX_TRACKED +
                                                             RCB_MONITOR_MAXP];
@@ -457,20 +516,40 @@ static rcb_status joint_gn(rcb_monitor *mon, const mon_cand *c, int gls, double 
          h[RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP];
   rcb_status st;
   *ok = 0;
-  /* the 1 + p evaluations first, then Q read once for their projections */
-  if (model_resid(mon, x, c, x + nt, Rm)) return RCB_OK;
-  for (a = 0; a < p; a++) {
-    double keep = x[a];
-    h[a] = 0.1 * sd[a];
-    x[a] += h[a];
-    st = model_resid(mon, x, c, x + nt, Rm + mon->n * (1 + a));
-    x[a] = keep;
-    if (st) return RCB_OK;
+  if (c->adj) {
+    /* the first iteration: one adjoint sweep, the change and its columns at
+     * x; the later ones: the change by a plain sweep, the columns kept
+     * (chord steps from a point already near the solution) */
+    if (set_point(mon, x, c, x + nt)) return RCB_OK;
+    if (fresh) {
+      if (rcb_fit_adj_run(mon->fit, c->adj, Rm + mon->n) || rcb_fit_last_residuals(mon->fit, Rm))
+        return RCB_OK;
+      whiten_change(mon, Rm, mon->rbase);
+      for (a = 0; a < p; a++) whiten_change(mon, Rm + mon->n * (1 + a), NULL);
+      to_rank_many(mon, Rm, 1 + p, Ym);
+    } else {
+      if (rcb_fit_residuals(mon->fit, Rm)) return RCB_OK;
+      whiten_change(mon, Rm, mon->rbase);
+      to_rank(mon, Rm, Ym);
+    }
+    for (i = 0; i < k; i++) w[i] = mon->y0[i] - Ym[i];
+    memcpy(J, Ym + k, k * p * sizeof *J);
+  } else {
+    /* the 1 + p evaluations first, then Q read once for their projections */
+    if (model_resid(mon, x, c, x + nt, Rm)) return RCB_OK;
+    for (a = 0; a < p; a++) {
+      double keep = x[a];
+      h[a] = 0.1 * sd[a];
+      x[a] += h[a];
+      st = model_resid(mon, x, c, x + nt, Rm + mon->n * (1 + a));
+      x[a] = keep;
+      if (st) return RCB_OK;
+    }
+    to_rank_many(mon, Rm, 1 + p, Ym);
+    for (i = 0; i < k; i++) w[i] = mon->y0[i] - Ym[i];
+    for (a = 0; a < p; a++)
+      for (i = 0; i < k; i++) J[i + k * a] = (Ym[i + k * (1 + a)] - mon->y0[i] + w[i]) / h[a];
   }
-  to_rank_many(mon, Rm, 1 + p, Ym);
-  for (i = 0; i < k; i++) w[i] = mon->y0[i] - Ym[i];
-  for (a = 0; a < p; a++)
-    for (i = 0; i < k; i++) J[i + k * a] = (Ym[i + k * (1 + a)] - mon->y0[i] + w[i]) / h[a];
   if (gls && (rcb_mon_gls_solve(mon, w, 1) || rcb_mon_gls_solve(mon, J, p)))
     return rcb_mon_fail(mon, RCB_ERR_LAPACK, "re-linearising the joint step: triangular "
                         "solve failed");
@@ -480,7 +559,8 @@ static rcb_status joint_gn(rcb_monitor *mon, const mon_cand *c, int gls, double 
   rcb_mon_gls_step(&mon->sw, qz, p, 0, p, dx, sd);
   for (a = 0; a < p; a++) {
     x[a] += dx[a];
-    if (!(fabs(dx[a]) < MON_RELIN_TOL * sd[a])) *ok = 2; /* not converged yet */
+    if (!(fabs(dx[a]) < MON_RELIN_TOL * sd[a]) && *ok != 4) *ok = 2; /* not converged yet */
+    if (!(fabs(dx[a]) < MON_CHORD_SD * sd[a])) *ok = 4; /* nor near: fresh columns next */
   }
   return RCB_OK;
 }
@@ -504,13 +584,14 @@ static rcb_status joint_relin(rcb_monitor *mon, int gls, rcb_monitor_result *res
          sd[RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP] = {0};
   size_t a, it, nt = mon->nt;
   rcb_status st = RCB_OK;
-  int ok = 1;
+  int ok = 1, fresh = 1;
   if (!c || !mon->relin || !c->settable) return RCB_OK;
   for (a = 0; a < nt; a++) x[a] = dth[a], sd[a] = se[a];
   for (a = 0; a < c->np; a++) x[nt + a] = c->size_now[a], sd[nt + a] = c->se_now[a];
   for (it = 0; ok == 1 && !st && it < mon->relin; it++) {
-    st = joint_gn(mon, c, gls, x, sd, &ok);
-    ok = ok == 2 ? 1 : ok ? 3 : 0; /* 3: converged */
+    st = joint_gn(mon, c, gls, fresh, x, sd, &ok);
+    fresh = ok == 4;
+    ok = ok == 2 || ok == 4 ? 1 : ok ? 3 : 0; /* 3: converged */
   }
   rcb_mon_model_restore(mon, c);
   if (st || !ok) return st;
@@ -636,5 +717,40 @@ rcb_status rcb_monitor_tracked_info(const rcb_monitor *mon, size_t k, const char
   if (!ready(mon) || k >= mon->nt) return RCB_ERR_ARG;
   if (name) *name = mon->tname[k];
   if (baseline) *baseline = mon->t0[k];
+  return RCB_OK;
+}
+
+/* The candidates whose joint step is re-linearised by sweeps (settable,
+ * with derivative matrices, not on the low-rank path: the operating speed,
+ * a shaft's material damping) get that step's columns by one adjoint sweep
+ * per iteration (rcb_fit_adj, prepared here so that the update allocates
+ * nothing) instead of 1 + nt + np forward-difference sweeps; the tracked
+ * parameters' derivative matrices are the baseline's (exact where Z is
+ * affine in them, as a coupling's; elsewhere the iteration still converges
+ * to the same step, more slowly). */
+rcb_status rcb_mon_adj_init(rcb_monitor *mon) {
+  enum { MT = RCB_MONITOR_MAX_TRACKED, MP = RCB_MONITOR_MAXP };
+  struct rcb_fit_dz dz[MT + MP];
+  size_t j, a, nt = mon->nt;
+  rcb_status st;
+  if (!mon->relin || !nt || !mon->fit) return RCB_OK;
+  for (j = 0; j < mon->ncand; j++)
+    if (mon->cand[j].dz && mon->cand[j].settable && !mon->cand[j].ep) break;
+  if (j == mon->ncand) return RCB_OK;
+  if (!(mon->tdz = rcb_mon_alloc(mon, nt, sizeof *mon->tdz)))
+    return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (tracked derivative matrices)");
+  if ((st = rcb_fit_dz_get(mon->fit, &mon->alloc, mon->tdz))) {
+    rcb_free(&mon->alloc, mon->tdz);
+    mon->tdz = NULL;
+    return rcb_mon_fail(mon, st, "tracked derivative matrices: %s", rcb_fit_errmsg(mon->fit));
+  }
+  for (j = 0; j < mon->ncand; j++) {
+    mon_cand *c = &mon->cand[j];
+    if (!c->dz || !c->settable || c->ep) continue;
+    for (a = 0; a < nt; a++) dz[a] = mon->tdz[a];
+    for (a = 0; a < c->np; a++) dz[nt + a] = c->dz[a];
+    if ((st = rcb_fit_adj_create(mon->fit, dz, nt + c->np, &c->adj)))
+      return rcb_mon_fail(mon, st, "%s: joint step: %s", c->desc, rcb_fit_errmsg(mon->fit));
+  }
   return RCB_OK;
 }

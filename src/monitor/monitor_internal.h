@@ -50,6 +50,9 @@ typedef struct mon_cand {
   int implausible;   /* this update: some parameter's 95 % interval outside [lo, hi] */
   const struct rcb_fit_dz *dz; /* np: its derivative matrices (batched candidates
                         with opts.relinearise; NULL otherwise) */
+  struct rcb_fit_adj *adj; /* its joint step's columns by one adjoint sweep
+                        (tracked then its own derivative matrices; settable,
+                        with dz, not on the low-rank path): rcb_mon_adj_init */
   size_t *ep;        /* per entry of dz: row's and column's place in the
                         low-rank P; NULL: not on the low-rank path */
   int settable;      /* its parameters are the baseline model's own, at their
@@ -173,6 +176,7 @@ struct rcb_monitor {
   mon_lowrank *lr;     /* the evaluations without a sweep, NULL: by sweeps */
   struct rcb_fit_dz *cdz; /* the batched candidates' derivative matrices, ncdz
                           (kept with opts.relinearise) */
+  struct rcb_fit_dz *tdz; /* nt: the tracked parameters' (with a candidate's adj) */
   size_t ncdz;
 
   /* noise of the reweighted path */
@@ -193,7 +197,10 @@ struct rcb_monitor {
   double *achan;       /* nch: eq. 19 additive amplitude of this update */
   double *Jx;          /* k x (nt + MAXP), column-major: the joint columns of the
                           tracked parameters and the best candidate at the
-                          current estimate (monitor.c, joint_relin) */
+                          current estimate (monitor.c, joint_relin); between the
+                          re-linearised tracked step and rcb_mon_gls its first nt
+                          columns are the tracked columns at that step (jt set) */
+  int jt;              /* Jx holds the tracked columns at this update's step */
   mon_small sw;
 
   /* update workspace */
@@ -260,6 +267,9 @@ void rcb_mon_model_restore(rcb_monitor *mon, const mon_cand *c);
  * (it marks the candidates it takes: c->ep); the change of every point's
  * model value (SI, channel-major) for tracked steps theta and, with c
  * (c->ep set), candidate c's parameters at neutral + s; free. */
+/* The prepared adjoint sweeps of the joint steps that are not on the
+ * low-rank path (monitor.c; after rcb_mon_lowrank_init). */
+rcb_status rcb_mon_adj_init(rcb_monitor *mon);
 rcb_status rcb_mon_lowrank_init(rcb_monitor *mon, const struct mon_image *im);
 rcb_status rcb_mon_lowrank_change(rcb_monitor *mon, const double *theta, const mon_cand *c,
                                   const double *s, rcb_complex *dm);

@@ -290,9 +290,10 @@ static int noisy_of(const rcb_model *m, double g0, unsigned long seed, rcb_compl
 int main(int argc, char **argv) {
   const char *only = argc > 2 ? argv[2] : NULL;
   size_t nonly = argc > 3 ? (size_t)strtoul(argv[3], NULL, 10) : 0;
-  rcb_model *m = NULL, *m2 = NULL;
+  rcb_model *m = NULL, *m2 = NULL, *m3 = NULL, *m4 = NULL;
   rcb_meas *setup;
-  rcb_complex *noisy[NNOISY], *changed[NNOISY], *probe[NNOISY];
+  rcb_complex *noisy[NNOISY], *changed[NNOISY], *probe[NNOISY], *slower[NNOISY],
+      *damped[NNOISY];
   double kt;
   size_t s, i;
   int rc = 0;
@@ -301,9 +302,8 @@ int main(int argc, char **argv) {
       (1u << RCB_EFFECT_BEARING_DAMPING) | (1u << RCB_EFFECT_COUPLING_TRANSLATIONAL_DAMPING) |
       (1u << RCB_EFFECT_COUPLING_ROTATIONAL_STIFFNESS) |
       (1u << RCB_EFFECT_COUPLING_ROTATIONAL_DAMPING);
-  /* rcbtool monitor --sensors: the default catalogue and every probe's gain */
-  const unsigned sensors =
-      ((1u << RCB_EFFECT_ELEMENT_STIFFNESS) - 1u) | (1u << RCB_EFFECT_SENSOR_GAIN);
+  /* rcbtool monitor --no-sensors: the default catalogue without the probes' gains */
+  const unsigned nosensors = (1u << RCB_EFFECT_ELEMENT_STIFFNESS) - 1u;
   /* label, relinearise, updates, reweight, effects, the probe series' settings */
   const row rows[] = {
       {"linear", 0, 400, 0, 0, 0},
@@ -311,12 +311,14 @@ int main(int argc, char **argv) {
       {"re-linearised (<= 8)", 8, 50, 0, 0, 0},
       {"reweighted + re-lin. 8", 8, 50, 1, 0, 0}, /* "ross" */
       {"the same, changed", 8, 20, 1, 0, 0},      /* "changed" */
-      {"changed, --sensors", 8, 20, 1, sensors, 0}, /* "sensors" */
-      {"probe DA.x 0.85, series", 8, 20, 1, sensors, 1}, /* "probe" */
+      {"changed, --no-sensors", 8, 20, 1, nosensors, 0}, /* "nosensors" */
+      {"probe DA.x 0.85, series", 8, 20, 1, 0, 1}, /* "probe" */
+      {"speed -3 %", 8, 20, 1, 0, 0},              /* "speed": a sweep-path effect */
+      {"shaft A material damping", 8, 20, 1, 0, 0}, /* "damping": another */
       {"linear", 0, 400, 0, bearings_coupling, 0},
       {"reweighted", 0, 100, 1, bearings_coupling, 0}};
   static const char *const names[] = {"linear", "reweighted", "relin", "ross", "changed",
-                                      "sensors", "probe"};
+                                      "nosensors", "probe", "speed", "damping"};
   if (argc < 2) {
     fprintf(stderr, "usage: bench_monitor MODEL.ini [ROW [UPDATES]]\n");
     return 2;
@@ -336,6 +338,8 @@ int main(int argc, char **argv) {
   memset(noisy, 0, sizeof noisy);
   memset(changed, 0, sizeof changed);
   memset(probe, 0, sizeof probe);
+  memset(slower, 0, sizeof slower);
+  memset(damped, 0, sizeof damped);
   /* the machine changed as in examples/firmware: kt -4 %, 5e5 N/m of
    * cross-coupling at B2 (every update alarms) */
   if (rcb_model_clone(&m2, m, NULL) || rcb_model_finalize(m2) ||
@@ -346,29 +350,48 @@ int main(int argc, char **argv) {
     rc = 1;
     goto done;
   }
+  /* effects whose DOFs are not few (no low-rank evaluation: the joint
+   * step by sweeps): the rotor 3 % slower than stated, and material damping
+   * in shaft A */
+  if (rcb_model_clone(&m3, m, NULL) || rcb_model_finalize(m3) ||
+      rcb_model_set_param(m3, "speed.factor", 0.97) || rcb_model_clone(&m4, m, NULL) ||
+      rcb_model_finalize(m4) || rcb_model_set_param(m4, "shaft.A.damping_stiffness", 4e-5)) {
+    fprintf(stderr, "changed machine: %s\n",
+            m4 ? rcb_model_errmsg(m4) : m3 ? rcb_model_errmsg(m3) : "out of memory");
+    rc = 1;
+    goto done;
+  }
   /* and the machine as it is, read by a DA.x probe at gain 0.85 (the end of
    * tests/python/monitor_cases.py's probe_DA_x series) */
   for (s = 0; s < NNOISY && !rc; s++) rc = noisy_of(m, 1.0, 1000 + s, &noisy[s]) ||
                                           noisy_of(m2, 1.0, 2000 + s, &changed[s]) ||
-                                          noisy_of(m, 0.85, 3000 + s, &probe[s]);
+                                          noisy_of(m, 0.85, 3000 + s, &probe[s]) ||
+                                          noisy_of(m3, 1.0, 4000 + s, &slower[s]) ||
+                                          noisy_of(m4, 1.0, 5000 + s, &damped[s]);
   if (rc) goto done;
   printf("paper system, %zu channels x %zu frequencies, kt tracked, eq. 19 noise 2 %% + 2 %%\n",
          NCH, NPTS);
   for (i = 0; only && i < sizeof names / sizeof names[0] && strcmp(only, names[i]); i++) continue;
   if (only && i == sizeof names / sizeof names[0]) {
     fprintf(stderr, "bench_monitor: unknown row '%s' (linear, reweighted, relin, ross, changed, "
-            "sensors or probe)\n", only);
+            "nosensors, probe, speed or damping)\n", only);
     rc = 2;
     goto done;
   }
   for (s = only ? i : 0; s < (only ? i + 1 : sizeof rows / sizeof rows[0]); s++) {
     row rw = rows[s];
     if (only && nonly) rw.nupd = nonly;
-    if (s == 7) printf("bearing and coupling effects only (opts.effects):\n");
-    rc |= run(m, setup, s == 4 || s == 5 ? changed : s == 6 ? probe : noisy, &rw);
+    if (s == 9) printf("bearing and coupling effects only (opts.effects):\n");
+    rc |= run(m, setup,
+              s == 4 || s == 5 ? changed : s == 6 ? probe : s == 7 ? slower : s == 8 ? damped
+                                                                              : noisy,
+              &rw);
   }
 done:
-  for (s = 0; s < NNOISY; s++) free(noisy[s]), free(changed[s]), free(probe[s]);
+  for (s = 0; s < NNOISY; s++)
+    free(noisy[s]), free(changed[s]), free(probe[s]), free(slower[s]), free(damped[s]);
+  rcb_model_destroy(m4);
+  rcb_model_destroy(m3);
   rcb_model_destroy(m2);
   rcb_meas_destroy(setup);
   rcb_model_destroy(m);
