@@ -27,4 +27,4 @@ for path, head, cols, rows in ((h1_out, hh, hcols, hrows), (stats_out, sh, scols
     with open(path, "w", encoding="utf-8") as f:
         f.write("\n".join(head + [cols] + [rows[i] for i in keep]) + "\n")
 print(f"kept {len(keep)} of {len(srows)} lines with coherence >= {cmin}:",
-      " ".join(srows[i].split(",")[0][:7] for i in keep))
+      " ".join(f"{float(srows[i].split(',')[0]):g}" for i in keep))
