@@ -18,6 +18,10 @@ A block can be marked on the line before its fence:
                                    --plot): run when the python3 on the PATH (the
                                    venv's with --venv) has it
   <!-- doc-test: slow REASON -->   minutes of computation: run with --slow only
+  <!-- doc-test: data:REL -->      reads a data file that is not in the repository (a
+                                   fetched measurement): run when $RCB_DATA_DIR/REL
+                                   exists (default ~/.cache/librcb/REL); the page
+                                   says how to get it
 (several may be combined: <!-- doc-test: venv slow about 2 min -->).
 Everything skipped is listed with its reason; a block that fails names its
 page and line, with the tail of its output.
@@ -35,7 +39,8 @@ import tempfile
 import time
 
 FENCE = re.compile(r"^```(\S*)\s*$")
-MARK = re.compile(r"^<!--\s*doc-test:\s*((?:(?:skip|venv|sundials|fft|matplotlib|slow)\b\s*)+)(.*?)\s*-->\s*$")
+MARK = re.compile(r"^<!--\s*doc-test:\s*((?:(?:(?:skip|venv|sundials|fft|matplotlib|slow)\b|data:\S+)\s*)+)"
+                  r"(.*?)\s*-->\s*$")
 PATH_LINE = re.compile(r"^export PATH=.*$", re.M)
 
 
@@ -71,6 +76,12 @@ def scratch_clone(src, build, venv):
     if venv:
         os.symlink(os.path.abspath(venv), os.path.join(d, ".venv"))
     return d
+
+
+def data_dir():
+    """Where data files that are not in the repository are (doc-test: data:REL)."""
+    return os.environ.get("RCB_DATA_DIR") or os.path.join(os.path.expanduser("~"), ".cache",
+                                                         "librcb")
 
 
 def with_option(build, *options):
@@ -135,6 +146,11 @@ def main():
             if "matplotlib" in mark and not mpl:
                 why.append("needs python3 with matplotlib on the PATH (--venv DIR, or "
                            "Debian's python3-matplotlib)")
+            for rel in sorted(m[5:] for m in mark if m.startswith("data:")):
+                if not os.path.isfile(os.path.join(data_dir(), rel)):
+                    why.append(f"needs the data file {os.path.join(data_dir(), rel)}, absent "
+                               "(not in the repository; RCB_DATA_DIR sets the directory; "
+                               "the page says how to get it)")
             if "slow" in mark and not args.slow:
                 why.append("slow (--slow)" + (": " + reason if reason else ""))
             why = "; ".join(why)
