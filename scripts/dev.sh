@@ -55,7 +55,8 @@
 #                               Debian 12 or must not change): nothing is installed on the host
 #   ./scripts/dev.sh wheel-manylinux  the self-contained wheel: built in a Debian 11 root,
 #                               auditwheel repair (its libraries inside, manylinux_2_31), tested
-#                               in a second root with only python3 and pip (root; out/manylinux/)
+#                               in a second root with only python3 and pip (root; out/manylinux/;
+#                               WHEEL_ARCH=arm64: the aarch64 wheel under qemu-user-static)
 #   ./scripts/dev.sh embedded   the "embedded" CMake preset (static, -Os, no optional backend,
 #                               build-embedded/): build and print the library size
 #
@@ -853,6 +854,9 @@ chroot_copy_tree() {
 chroot_make() {
   local suite=$1 dir=$2 sec=${CHROOT_MIRROR%/debian}/debian-security opts=()
   shift 2
+  # CHROOT_SECURITY=0: without the -security suite (a mirror that lacks it
+  # for an architecture: here bullseye-security arm64 answered 404)
+  [[ ${CHROOT_SECURITY:-1} != 0 ]] || sec=
   if (($#)); then
     opts+=("--include=$(
       IFS=,
@@ -861,16 +865,17 @@ chroot_make() {
     command -v mmdebstrap > /dev/null && opts+=(--aptopt='APT::Install-Recommends "false"')
   fi
   [[ -z ${CHROOT_ARCH:-} ]] || opts+=("--arch=$CHROOT_ARCH")
-  say "Debian $suite root in $dir (minbase; $suite, -updates, -security${CHROOT_ARCH:+; $CHROOT_ARCH})${*:+ with $*}"
+  say "Debian $suite root in $dir (minbase; $suite, -updates${sec:+, -security}${CHROOT_ARCH:+; $CHROOT_ARCH})${*:+ with $*}"
   mkdir -p "$dir"
   if command -v mmdebstrap > /dev/null; then
     mmdebstrap --variant=minbase --mode=root "${opts[@]}" "$suite" "$dir" \
       "deb $CHROOT_MIRROR $suite main" "deb $CHROOT_MIRROR $suite-updates main" \
-      "deb $sec $suite-security main"
+      ${sec:+"deb $sec $suite-security main"}
   elif command -v debootstrap > /dev/null; then
     debootstrap --variant=minbase "${opts[@]}" "$suite" "$dir" "$CHROOT_MIRROR"
-    printf 'deb %s %s main\ndeb %s %s-updates main\ndeb %s %s-security main\n' \
-      "$CHROOT_MIRROR" "$suite" "$CHROOT_MIRROR" "$suite" "$sec" "$suite" > "$dir/etc/apt/sources.list"
+    printf 'deb %s %s main\ndeb %s %s-updates main\n' \
+      "$CHROOT_MIRROR" "$suite" "$CHROOT_MIRROR" "$suite" > "$dir/etc/apt/sources.list"
+    [[ -z $sec ]] || printf 'deb %s %s-security main\n' "$sec" "$suite" >> "$dir/etc/apt/sources.list"
     chroot "$dir" sh -c 'apt-get update && DEBIAN_FRONTEND=noninteractive apt-get -y upgrade'
   else
     die "needs mmdebstrap or debootstrap (Debian/Ubuntu: apt-get install mmdebstrap; Fedora: dnf install mmdebstrap)"
@@ -896,9 +901,11 @@ cmd_cross_chroot() {
 # of a second Debian 11 root that holds only python3 and its venv/pip: import,
 # an FRF against a closed form, one fit, import times (tests/wheel/
 # manylinux_*.sh, docs/python.md). Roots cached in .chroot/ (git-ignored):
-# bullseye-wheel (build-essential and the -dev packages below, about 0.9 GB)
-# and bullseye-python (about 0.2 GB). The repaired wheel goes to out/manylinux/.
-# Needs root on the host, mmdebstrap or debootstrap and PyPI.
+# bullseye-<arch>-wheel (build-essential and the -dev packages below, about
+# 0.9 GB) and bullseye-<arch>-python (about 0.2 GB). The repaired wheel goes
+# to out/manylinux/. WHEEL_ARCH=arm64 makes the aarch64 wheel the same way in
+# arm64 roots, run under qemu-user-static through binfmt_misc. Needs root on
+# the host, mmdebstrap or debootstrap and PyPI.
 MANYLINUX_SUITE=${RCB_MANYLINUX_SUITE:-bullseye}
 # libopenblas-serial-dev: the -dev's serial variant, so that the only
 # libopenblas.so.0 in the root (and in the wheel) is the serial one
@@ -907,9 +914,16 @@ DEB_WHEEL=(build-essential pkg-config libopenblas-serial-dev libopenblas-dev lib
 cmd_wheel_manylinux() {
   [[ $(id -u) -eq 0 ]] || die "wheel-manylinux needs root (debootstrap, mount, chroot): sudo ./scripts/dev.sh wheel-manylinux"
   command -v git > /dev/null || die "wheel-manylinux needs git (it copies the files git knows of)"
-  local suite=$MANYLINUX_SUITE
-  local broot=$ROOT/.chroot/$suite-wheel croot=$ROOT/.chroot/$suite-python out=$ROOT/out/manylinux
-  local run=$croot-run t0=$SECONDS whl
+  local suite=$MANYLINUX_SUITE arch=${WHEEL_ARCH:-$(dpkg --print-architecture 2> /dev/null || echo amd64)}
+  local broot=$ROOT/.chroot/$suite-$arch-wheel croot=$ROOT/.chroot/$suite-$arch-python
+  local out=$ROOT/out/manylinux run t0=$SECONDS whl qemu
+  run=$croot-run
+  if [[ $arch != "$(dpkg --print-architecture 2> /dev/null || echo amd64)" ]]; then
+    qemu=$(case $arch in arm64) echo aarch64 ;; armhf) echo arm ;; *) echo "$arch" ;; esac)
+    grep -qs enabled "/proc/sys/fs/binfmt_misc/qemu-$qemu" ||
+      die "WHEEL_ARCH=$arch runs the roots under qemu through binfmt_misc: apt-get install qemu-user-static, then (without systemd-binfmt) cat /usr/lib/binfmt.d/qemu-$qemu.conf > /proc/sys/fs/binfmt_misc/register"
+  fi
+  export CHROOT_ARCH=$arch
   if [[ ! -x $broot/usr/bin/python3 || $(cat "$broot/.rcb-packages" 2> /dev/null) != "${DEB_WHEEL[*]}" ]]; then
     rm -rf "$broot"
     chroot_make "$suite" "$broot" "${DEB_WHEEL[@]}"
@@ -917,16 +931,16 @@ cmd_wheel_manylinux() {
   fi
   [[ -x $croot/usr/bin/python3 ]] || chroot_make "$suite" "$croot" python3-venv
   trap "chroot_umount '$broot'; chroot_umount '$run'" EXIT
-  say "wheel-manylinux: python -m build and auditwheel repair in $broot (Debian $suite)"
+  say "wheel-manylinux: python -m build and auditwheel repair in $broot (Debian $suite, $arch)"
   rm -rf "$broot/src"
   chroot_copy_tree "$broot/src"
   chroot_mount "$broot"
   chroot_run "$broot" bash /src/tests/wheel/manylinux_build.sh /src /src/wheelhouse
   chroot_umount "$broot"
-  rm -rf "$out"
   mkdir -p "$out"
-  cp "$broot"/src/wheelhouse/*.whl "$broot/src/wheelhouse/auditwheel-show.txt" "$out/"
-  whl=("$out"/*.whl)
+  whl=("$broot"/src/wheelhouse/*.whl)
+  cp "${whl[0]}" "$out/"
+  cp "$broot/src/wheelhouse/auditwheel-show.txt" "$out/auditwheel-show-$arch.txt"
   say "wheel-manylinux: ${whl[0]##*/} into a fresh copy of $croot (python3 and pip only)"
   rm -rf "$run"
   cp -a "$croot" "$run"
@@ -937,7 +951,7 @@ cmd_wheel_manylinux() {
   chroot_run "$run" OPENBLAS_NUM_THREADS=1 bash /test/manylinux_test.sh "/test/${whl[0]##*/}"
   chroot_umount "$run"
   rm -rf "$run"
-  say "wheel-manylinux: passed in $((SECONDS - t0)) s (the wheel: $out)"
+  say "wheel-manylinux: passed in $((SECONDS - t0)) s (the wheel: $out/${whl[0]##*/})"
 }
 
 usage() { awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$ROOT/scripts/dev.sh"; }
