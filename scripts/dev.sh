@@ -914,11 +914,13 @@ DEB_WHEEL=(build-essential pkg-config libopenblas-serial-dev libopenblas-dev lib
 cmd_wheel_manylinux() {
   [[ $(id -u) -eq 0 ]] || die "wheel-manylinux needs root (debootstrap, mount, chroot): sudo ./scripts/dev.sh wheel-manylinux"
   command -v git > /dev/null || die "wheel-manylinux needs git (it copies the files git knows of)"
-  local suite=$MANYLINUX_SUITE arch=${WHEEL_ARCH:-$(dpkg --print-architecture 2> /dev/null || echo amd64)}
+  local host suite=$MANYLINUX_SUITE arch
+  host=$(dpkg --print-architecture 2> /dev/null || uname -m | sed 's/x86_64/amd64/; s/aarch64/arm64/')
+  arch=${WHEEL_ARCH:-$host}
   local broot=$ROOT/.chroot/$suite-$arch-wheel croot=$ROOT/.chroot/$suite-$arch-python
   local out=$ROOT/out/manylinux run t0=$SECONDS whl qemu
   run=$croot-run
-  if [[ $arch != "$(dpkg --print-architecture 2> /dev/null || echo amd64)" ]]; then
+  if [[ $arch != "$host" ]]; then
     qemu=$(case $arch in arm64) echo aarch64 ;; armhf) echo arm ;; *) echo "$arch" ;; esac)
     grep -qs enabled "/proc/sys/fs/binfmt_misc/qemu-$qemu" ||
       die "WHEEL_ARCH=$arch runs the roots under qemu through binfmt_misc: apt-get install qemu-user-static, then (without systemd-binfmt) cat /usr/lib/binfmt.d/qemu-$qemu.conf > /proc/sys/fs/binfmt_misc/register"
@@ -929,7 +931,6 @@ cmd_wheel_manylinux() {
     chroot_make "$suite" "$broot" "${DEB_WHEEL[@]}"
     echo "${DEB_WHEEL[*]}" > "$broot/.rcb-packages"
   fi
-  [[ -x $croot/usr/bin/python3 ]] || chroot_make "$suite" "$croot" python3-venv
   trap "chroot_umount '$broot'; chroot_umount '$run'" EXIT
   say "wheel-manylinux: python -m build and auditwheel repair in $broot (Debian $suite, $arch)"
   rm -rf "$broot/src"
@@ -941,6 +942,7 @@ cmd_wheel_manylinux() {
   whl=("$broot"/src/wheelhouse/*.whl)
   cp "${whl[0]}" "$out/"
   cp "$broot/src/wheelhouse/auditwheel-show.txt" "$out/auditwheel-show-$arch.txt"
+  [[ -x $croot/usr/bin/python3 ]] || chroot_make "$suite" "$croot" python3-venv
   say "wheel-manylinux: ${whl[0]##*/} into a fresh copy of $croot (python3 and pip only)"
   rm -rf "$run"
   cp -a "$croot" "$run"
