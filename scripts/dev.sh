@@ -53,6 +53,10 @@
 #   ./scripts/dev.sh cross-chroot  `cross` inside a Debian 12 root made in .chroot/bookworm
 #                               (mmdebstrap or debootstrap; root; for hosts that are not
 #                               Debian 12 or must not change): nothing is installed on the host
+#   ./scripts/dev.sh wheel-manylinux  the self-contained wheel: built in a Debian 11 root,
+#                               auditwheel repair (its libraries inside, manylinux_2_31), tested
+#                               in a second root with only python3 and pip (root; out/manylinux/;
+#                               WHEEL_ARCH=arm64: the aarch64 wheel under qemu-user-static)
 #   ./scripts/dev.sh embedded   the "embedded" CMake preset (static, -Os, no optional backend,
 #                               build-embedded/): build and print the library size
 #
@@ -805,49 +809,151 @@ cmd_cross() {
 CHROOT=${RCB_CHROOT:-$ROOT/.chroot/bookworm}
 CHROOT_MIRROR=${RCB_CHROOT_MIRROR:-http://deb.debian.org/debian}
 
+# chroot_umount DIR / chroot_mount DIR: /proc, /dev and /dev/pts of a root.
 chroot_umount() {
   local m
-  for m in "$CHROOT/dev/pts" "$CHROOT/dev" "$CHROOT/proc"; do
+  for m in "$1/dev/pts" "$1/dev" "$1/proc"; do
     if mountpoint -q "$m"; then umount "$m" || umount -l "$m"; fi
   done
 }
+chroot_mount() {
+  cp -L /etc/resolv.conf "$1/etc/resolv.conf"
+  mount -t proc proc "$1/proc"
+  mount --bind /dev "$1/dev"
+  mount --bind /dev/pts "$1/dev/pts"
+}
+# chroot_run DIR CMD...: CMD as root in DIR, with a clean environment
+# (PATH, HOME, LANG, CI, JOBS; more as VAR=value before CMD). pip there uses
+# the host's CA bundle (copied in: a proxy or mirror the host trusts) and the
+# host's PIP_INDEX_URL / PIP_EXTRA_INDEX_URL when set.
+chroot_run() {
+  local dir=$1 pipenv=()
+  shift
+  if [[ -f /etc/ssl/certs/ca-certificates.crt ]]; then
+    cp /etc/ssl/certs/ca-certificates.crt "$dir/etc/rcb-host-ca.crt"
+    pipenv+=(PIP_CERT=/etc/rcb-host-ca.crt)
+  fi
+  [[ -z ${PIP_INDEX_URL:-} ]] || pipenv+=("PIP_INDEX_URL=$PIP_INDEX_URL")
+  [[ -z ${PIP_EXTRA_INDEX_URL:-} ]] || pipenv+=("PIP_EXTRA_INDEX_URL=$PIP_EXTRA_INDEX_URL")
+  chroot "$dir" /usr/bin/env -i PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin \
+    HOME=/root LANG=C.UTF-8 CI="$CI" JOBS="$JOBS" "${pipenv[@]}" "$@"
+}
+# chroot_copy_tree DIR: the working tree (tracked and untracked files, not
+# the ignored ones) to DIR.
+chroot_copy_tree() {
+  mkdir -p "$1"
+  git ls-files -z --cached --others --exclude-standard |
+    xargs -0 -r sh -c 'for f; do [ -e "$f" ] && printf "%s\0" "$f"; done' sh |
+    tar --null -T - -cf - | tar -xf - -C "$1"
+}
 
+# chroot_make SUITE DIR [PACKAGE...]: a minbase Debian SUITE root in DIR
+# (SUITE, -updates, -security; CHROOT_ARCH=arm64 etc. for a foreign one, which
+# needs qemu-user-static), with the PACKAGEs and what they depend on (their
+# Recommends are left out by debootstrap and, told so, by mmdebstrap).
 chroot_make() {
-  local sec=${CHROOT_MIRROR%/debian}/debian-security
-  say "Debian 12 root in $CHROOT (minbase; bookworm, -updates, -security)"
-  mkdir -p "$CHROOT"
+  local suite=$1 dir=$2 sec=${CHROOT_MIRROR%/debian}/debian-security opts=()
+  shift 2
+  # CHROOT_SECURITY=0: without the -security suite (a mirror that lacks it
+  # for an architecture: here bullseye-security arm64 answered 404)
+  [[ ${CHROOT_SECURITY:-1} != 0 ]] || sec=
+  if (($#)); then
+    opts+=("--include=$(
+      IFS=,
+      echo "$*"
+    )")
+    command -v mmdebstrap > /dev/null && opts+=(--aptopt='APT::Install-Recommends "false"')
+  fi
+  [[ -z ${CHROOT_ARCH:-} ]] || opts+=("--arch=$CHROOT_ARCH")
+  say "Debian $suite root in $dir (minbase; $suite, -updates${sec:+, -security}${CHROOT_ARCH:+; $CHROOT_ARCH})${*:+ with $*}"
+  mkdir -p "$dir"
   if command -v mmdebstrap > /dev/null; then
-    mmdebstrap --variant=minbase --mode=root bookworm "$CHROOT" \
-      "deb $CHROOT_MIRROR bookworm main" "deb $CHROOT_MIRROR bookworm-updates main" \
-      "deb $sec bookworm-security main"
+    mmdebstrap --variant=minbase --mode=root "${opts[@]}" "$suite" "$dir" \
+      "deb $CHROOT_MIRROR $suite main" "deb $CHROOT_MIRROR $suite-updates main" \
+      ${sec:+"deb $sec $suite-security main"}
   elif command -v debootstrap > /dev/null; then
-    debootstrap --variant=minbase bookworm "$CHROOT" "$CHROOT_MIRROR"
-    printf 'deb %s bookworm main\ndeb %s bookworm-updates main\ndeb %s bookworm-security main\n' \
-      "$CHROOT_MIRROR" "$CHROOT_MIRROR" "$sec" > "$CHROOT/etc/apt/sources.list"
-    chroot "$CHROOT" sh -c 'apt-get update && DEBIAN_FRONTEND=noninteractive apt-get -y upgrade'
+    debootstrap --variant=minbase "${opts[@]}" "$suite" "$dir" "$CHROOT_MIRROR"
+    printf 'deb %s %s main\ndeb %s %s-updates main\n' \
+      "$CHROOT_MIRROR" "$suite" "$CHROOT_MIRROR" "$suite" > "$dir/etc/apt/sources.list"
+    [[ -z $sec ]] || printf 'deb %s %s-security main\n' "$sec" "$suite" >> "$dir/etc/apt/sources.list"
+    chroot "$dir" sh -c 'apt-get update && DEBIAN_FRONTEND=noninteractive apt-get -y upgrade'
   else
-    die "cross-chroot needs mmdebstrap or debootstrap (Debian/Ubuntu: apt-get install mmdebstrap; Fedora: dnf install mmdebstrap)"
+    die "needs mmdebstrap or debootstrap (Debian/Ubuntu: apt-get install mmdebstrap; Fedora: dnf install mmdebstrap)"
   fi
 }
 
 cmd_cross_chroot() {
   [[ $(id -u) -eq 0 ]] || die "cross-chroot needs root (debootstrap, mount, chroot): sudo ./scripts/dev.sh cross-chroot"
   command -v git > /dev/null || die "cross-chroot needs git (it copies the files git knows of)"
-  [[ -x $CHROOT/usr/bin/apt-get ]] || chroot_make
-  trap chroot_umount EXIT
+  [[ -x $CHROOT/usr/bin/apt-get ]] || chroot_make bookworm "$CHROOT"
+  trap 'chroot_umount "$CHROOT"' EXIT
   say "the working tree to $CHROOT/src"
-  mkdir -p "$CHROOT/src"
-  git ls-files -z --cached --others --exclude-standard |
-    xargs -0 -r sh -c 'for f; do [ -e "$f" ] && printf "%s\0" "$f"; done' sh |
-    tar --null -T - -cf - | tar -xf - -C "$CHROOT/src"
-  cp -L /etc/resolv.conf "$CHROOT/etc/resolv.conf"
-  mount -t proc proc "$CHROOT/proc"
-  mount --bind /dev "$CHROOT/dev"
-  mount --bind /dev/pts "$CHROOT/dev/pts"
-  chroot "$CHROOT" /usr/bin/env -i PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin \
-    HOME=/root LANG=C.UTF-8 CI="$CI" JOBS="$JOBS" CROSS_TARGETS="${CROSS_TARGETS:-aarch64 armhf}" \
+  chroot_copy_tree "$CHROOT/src"
+  chroot_mount "$CHROOT"
+  chroot_run "$CHROOT" CROSS_TARGETS="${CROSS_TARGETS:-aarch64 armhf}" \
     bash -c 'cd /src && ./scripts/dev.sh cross'
   say "cross-chroot: passed (the builds are in $CHROOT/src/build-embedded-*)"
+}
+
+# The self-contained wheel (issue #36 item 1): the package built in a Debian
+# 11 root (glibc 2.31), repaired by auditwheel (the shared libraries it links
+# copied into the wheel, tag manylinux_2_31), then installed into a fresh copy
+# of a second Debian 11 root that holds only python3 and its venv/pip: import,
+# an FRF against a closed form, one fit, import times (tests/wheel/
+# manylinux_*.sh, docs/python.md). Roots cached in .chroot/ (git-ignored):
+# bullseye-<arch>-wheel (build-essential and the -dev packages below, about
+# 0.9 GB) and bullseye-<arch>-python (about 0.2 GB). The repaired wheel goes
+# to out/manylinux/. WHEEL_ARCH=arm64 makes the aarch64 wheel the same way in
+# arm64 roots, run under qemu-user-static through binfmt_misc. Needs root on
+# the host, mmdebstrap or debootstrap and PyPI.
+MANYLINUX_SUITE=${RCB_MANYLINUX_SUITE:-bullseye}
+# libopenblas-serial-dev: the -dev's serial variant, so that the only
+# libopenblas.so.0 in the root (and in the wheel) is the serial one
+DEB_WHEEL=(build-essential pkg-config libopenblas-serial-dev libopenblas-dev liblapacke-dev
+  libsuitesparse-dev libnlopt-dev libinih-dev libfftw3-dev python3-venv)
+cmd_wheel_manylinux() {
+  [[ $(id -u) -eq 0 ]] || die "wheel-manylinux needs root (debootstrap, mount, chroot): sudo ./scripts/dev.sh wheel-manylinux"
+  command -v git > /dev/null || die "wheel-manylinux needs git (it copies the files git knows of)"
+  local host suite=$MANYLINUX_SUITE arch
+  host=$(dpkg --print-architecture 2> /dev/null || uname -m | sed 's/x86_64/amd64/; s/aarch64/arm64/')
+  arch=${WHEEL_ARCH:-$host}
+  local broot=$ROOT/.chroot/$suite-$arch-wheel croot=$ROOT/.chroot/$suite-$arch-python
+  local out=$ROOT/out/manylinux run t0=$SECONDS whl qemu
+  run=$croot-run
+  if [[ $arch != "$host" ]]; then
+    qemu=$(case $arch in arm64) echo aarch64 ;; armhf) echo arm ;; *) echo "$arch" ;; esac)
+    grep -qs enabled "/proc/sys/fs/binfmt_misc/qemu-$qemu" ||
+      die "WHEEL_ARCH=$arch runs the roots under qemu through binfmt_misc: apt-get install qemu-user-static, then (without systemd-binfmt) cat /usr/lib/binfmt.d/qemu-$qemu.conf > /proc/sys/fs/binfmt_misc/register"
+  fi
+  export CHROOT_ARCH=$arch
+  if [[ ! -x $broot/usr/bin/python3 || $(cat "$broot/.rcb-packages" 2> /dev/null) != "${DEB_WHEEL[*]}" ]]; then
+    rm -rf "$broot"
+    chroot_make "$suite" "$broot" "${DEB_WHEEL[@]}"
+    echo "${DEB_WHEEL[*]}" > "$broot/.rcb-packages"
+  fi
+  trap "chroot_umount '$broot'; chroot_umount '$run'" EXIT
+  say "wheel-manylinux: python -m build and auditwheel repair in $broot (Debian $suite, $arch)"
+  rm -rf "$broot/src"
+  chroot_copy_tree "$broot/src"
+  chroot_mount "$broot"
+  chroot_run "$broot" bash /src/tests/wheel/manylinux_build.sh /src /src/wheelhouse
+  chroot_umount "$broot"
+  mkdir -p "$out"
+  whl=("$broot"/src/wheelhouse/*.whl)
+  cp "${whl[0]}" "$out/"
+  cp "$broot/src/wheelhouse/auditwheel-show.txt" "$out/auditwheel-show-$arch.txt"
+  [[ -x $croot/usr/bin/python3 ]] || chroot_make "$suite" "$croot" python3-venv
+  say "wheel-manylinux: ${whl[0]##*/} into a fresh copy of $croot (python3 and pip only)"
+  rm -rf "$run"
+  cp -a "$croot" "$run"
+  mkdir -p "$run/test"
+  cp "${whl[0]}" tests/wheel/manylinux_test.sh tests/wheel/manylinux_check.py \
+    tests/wheel/requirements-manylinux-test.txt examples/paper_system.ini "$run/test/"
+  chroot_mount "$run"
+  chroot_run "$run" OPENBLAS_NUM_THREADS=1 bash /test/manylinux_test.sh "/test/${whl[0]##*/}"
+  chroot_umount "$run"
+  rm -rf "$run"
+  say "wheel-manylinux: passed in $((SECONDS - t0)) s (the wheel: $out/${whl[0]##*/})"
 }
 
 usage() { awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$ROOT/scripts/dev.sh"; }
@@ -874,6 +980,7 @@ case ${1:-} in
   embedded) cmd_embedded ;;
   cross) cmd_cross ;;
   cross-chroot) cmd_cross_chroot ;;
+  wheel-manylinux) cmd_wheel_manylinux ;;
   -h | --help | help) usage ;;
   *) usage >&2; exit 2 ;;
 esac
