@@ -70,8 +70,8 @@ static void test_multiplicity(void **state) {
   assert_false(rcb_evidence_significant(&e));
 }
 
-/* Adequate: within the limit, or beyond it with a white residual; beyond
- * what the part can be: never "explains". */
+/* Adequate: within the limit, or beyond it with a white residual at most
+ * 2 x the declared level; beyond what the part can be: never "explains". */
 static void test_adequate_white_beyond(void **state) {
   rcb_evidence e = known(500.0, 1.0, 35000.0, 1.0, 139.0);
   (void)state;
@@ -82,6 +82,23 @@ static void test_adequate_white_beyond(void **state) {
   e.white = 1;
   assert_int_equal(rcb_evidence_adequate(&e), 1);
   assert_int_equal(rcb_evidence_claim(&e), RCB_CLAIM_EXPLAINS);
+  /* white, but how far above the declared noise: sqrt(phi) x its level,
+   * noise of another level up to RCB_WHITE_LEVEL_MAX = 2 x (phi 4) */
+  e.dispersion = 3.99, e.chi2 = 3.99 * 35000.0;
+  assert_true(fabs(rcb_evidence_level(&e) - sqrt(3.99)) < 1e-12);
+  assert_int_equal(rcb_evidence_claim(&e), RCB_CLAIM_EXPLAINS);
+  e.dispersion = 4.01, e.chi2 = 4.01 * 35000.0;
+  assert_int_equal(rcb_evidence_white_noise(&e), 0);
+  assert_int_equal(rcb_evidence_adequate(&e), 0);
+  assert_int_equal(rcb_evidence_claim(&e), RCB_CLAIM_IMPROVES);
+  e.dispersion = 96721.0; /* the case study: 311 x the declared (its drop of 500 over
+                             phi is no longer significant either) */
+  assert_int_equal(rcb_evidence_adequate(&e), 0);
+  assert_int_not_equal(rcb_evidence_claim(&e), RCB_CLAIM_EXPLAINS);
+  e.dispersion = 0.0; /* none given: chi2 over the limit, 4.01 N / (N + 2.33 sqrt(2 N)) */
+  assert_true(fabs(rcb_evidence_level(&e) - sqrt(e.chi2 / e.chi2_limit)) < 1e-12);
+  assert_int_equal(rcb_evidence_claim(&e), RCB_CLAIM_EXPLAINS);
+  e.dispersion = 1.0, e.chi2 = e.chi2_limit + 1.0;
   e.beyond = 1;
   assert_int_equal(rcb_evidence_claim(&e), RCB_CLAIM_IMPROVES);
   e.chi2_limit = (double)NAN; /* the noise unknown: adequacy unknown */

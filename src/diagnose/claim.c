@@ -58,9 +58,24 @@ int rcb_evidence_significant(const rcb_evidence *e) {
   return drop > chi2_upper(e->params, RCB_FALSE_ALARM / (e->tried > 1 ? e->tried : 1.0));
 }
 
+double rcb_evidence_level(const rcb_evidence *e) {
+  double phi;
+  if (!e || !known(e) || !isfinite(e->chi2)) return (double)NAN;
+  /* the dispersion when given, else chi2 over the limit (below chi2 /
+   * expected, so never a larger level than the data show) */
+  phi = e->dispersion > 0 && isfinite(e->dispersion) ? e->dispersion
+                                                      : e->chi2 / fmax(e->chi2_limit, 1e-300);
+  return sqrt(fmax(phi, 0.0));
+}
+
+int rcb_evidence_white_noise(const rcb_evidence *e) {
+  if (!e || e->white != 1 || !known(e) || !isfinite(e->chi2)) return 0;
+  return rcb_evidence_level(e) <= RCB_WHITE_LEVEL_MAX;
+}
+
 int rcb_evidence_adequate(const rcb_evidence *e) {
   if (!e || !known(e) || !isfinite(e->chi2)) return -1;
-  return e->chi2 <= e->chi2_limit || e->white == 1;
+  return e->chi2 <= e->chi2_limit || rcb_evidence_white_noise(e);
 }
 
 rcb_claim rcb_evidence_claim(const rcb_evidence *e) {

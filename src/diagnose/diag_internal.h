@@ -64,6 +64,10 @@ typedef struct diag_cand {
   double lo[RCB_DIAG_MAXP], hi[RCB_DIAG_MAXP];
   double plo[RCB_DIAG_MAXP], phi[RCB_DIAG_MAXP]; /* what the part can be (the bounds
                                        unless the family says tighter, issue #33) */
+  double lo_own[RCB_DIAG_MAXP];     /* > 0: the lower bound is this fraction of the
+                                       parameter's value in the model the fit starts
+                                       from (a ring's part of the disk's own), not lo:
+                                       the fitted and the nominal base differ */
   int logp[RCB_DIAG_MAXP];
   char params[RCB_DIAG_MAXP * RCB_DIAG_NAME];
   /* results */

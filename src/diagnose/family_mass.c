@@ -82,7 +82,10 @@ static rcb_status enumerate(rcb_diag *d, const rcb_model *m) {
           /* a ring adds to the disk: none of the three below the disk's own
            * (RCB_RING_LO of it to fit, RCB_RING_PLAUSIBLE of it to explain) */
           for (j = 0; j < 3; j++)
-            if (own[j] > 0) c->lo[j] = RCB_RING_LO * own[j], c->plo[j] = RCB_RING_PLAUSIBLE * own[j];
+            if (own[j] > 0) {
+              c->lo[j] = RCB_RING_LO * own[j], c->plo[j] = RCB_RING_PLAUSIBLE * own[j];
+              c->lo_own[j] = RCB_RING_LO; /* of the own value where each fit starts */
+            }
         }
         continue;
       }

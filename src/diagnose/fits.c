@@ -37,8 +37,14 @@ rcb_status rcb_diag_make_fit(rcb_diag *d, rcb_model *m, unsigned with_base, cons
       continue;
     st = rcb_fit_add_param(f, d->base[k].name, d->base[k].lo, d->base[k].hi, d->base[k].logp);
   }
-  for (k = 0; !st && k < npc; k++)
-    st = rcb_fit_add_param(f, c->pname[k], c->lo[k], c->hi[k], c->logp[k]);
+  for (k = 0; !st && k < npc; k++) {
+    /* a bound relative to the part's own value follows the model fitted
+     * (the nominal base's 0.1 kg disk, not the fitted base's 2 kg) */
+    double lo = c->lo[k], v;
+    if (c->lo_own[k] > 0 && !rcb_model_get_param(m, c->pname[k], &v) && v > 0 && v < c->hi[k])
+      lo = c->lo_own[k] * v;
+    st = rcb_fit_add_param(f, c->pname[k], lo, c->hi[k], c->logp[k]);
+  }
   if (!st) st = rcb_diag_carry_apply(d, f, (with_base & RCB_DIAG_FIT_BASE) != 0);
   for (k = 0; !st && c && c->chain_kept && k < c->np; k++)
     if (rcb_fit_param_is_chain(c->pname[k]))

@@ -201,26 +201,46 @@ static size_t say_rival(const rcb_diag *d, char *text, size_t size, size_t n) {
   return n < size ? n : size - 1;
 }
 
+/* The evidence of the adequacy test alone (F, its limit, whiteness and
+ * dispersion), for the one rule's words on it. */
+static rcb_evidence test_evidence(double F, double limit, int white, double phi) {
+  rcb_evidence e;
+  memset(&e, 0, sizeof e);
+  e.chi2 = F, e.chi2_limit = limit, e.white = white, e.dispersion = phi;
+  return e;
+}
+
 /* Whether the model as it is fits the data to their noise, by the one rule
  * (diag_internal.h; locate.c asks it too). */
 int rcb_diag_base_adequate(const rcb_diag *d) {
   rcb_evidence e;
-  memset(&e, 0, sizeof e);
   if (!d->adeq0.known) return -1;
-  e.chi2 = d->adeq0.chi2, e.chi2_limit = d->adeq0.limit, e.white = d->adeq0.white;
+  e = test_evidence(d->adeq0.chi2, d->adeq0.limit, d->adeq0.white, d->adeq0.dispersion);
   return rcb_evidence_adequate(&e);
 }
 
+/* What a white residual too far above the declared noise leaves open. */
+#define OPEN_QUESTION                                                                    \
+  "either the noise is declared too low or the model misses something these lines cannot " \
+  "localise; the data cannot tell which"
+
 /* The adequacy test in words: F against its limit, and when above it
- * with a white residual (rcb_evidence_adequate), what that means. */
+ * with a white residual, what the one rule lets that mean
+ * (rcb_evidence_white_noise): noise of another level, or an open question. */
 static void say_test(char *t, size_t size, double F, double limit, int white, double phi) {
+  rcb_evidence e = test_evidence(F, limit, white, phi);
   if (F <= limit || !white)
     snprintf(t, size, "chi-square %.6g %s the adequacy limit %.6g at 1 %%", F,
              F <= limit ? "within" : "above", limit);
-  else
+  else if (rcb_evidence_white_noise(&e))
     snprintf(t, size, "chi-square %.6g above the adequacy limit %.6g at 1 %%, and what is left is "
              "white along frequency: noise about %.3g x the declared level, not a missing effect",
-             F, limit, sqrt(phi));
+             F, limit, rcb_evidence_level(&e));
+  else
+    snprintf(t, size, "chi-square %.6g above the adequacy limit %.6g at 1 %%; what is left is "
+             "white along frequency but about %.3g x the declared noise, more than the %g x a "
+             "misdeclared level may be: " OPEN_QUESTION,
+             F, limit, rcb_evidence_level(&e), RCB_WHITE_LEVEL_MAX);
 }
 
 static const char *trend(double before, double after) {
@@ -266,6 +286,17 @@ rcb_status rcb_diag_explain(const rcb_diag *d, char *buf, size_t size, size_t *n
                c->desc, c->fitted, 100.0 * (d->F0 - c->F) / d->F0, trend(d->err0, c->err),
                d->err0, c->err, floor_txt, isfinite(c->chi2_limit) ? test : "noise unknown",
                c->pname[c->beyond_k], c->beyond_v, c->phi[c->beyond_k]);
+    } else if (isfinite(c->chi2_limit) && c->white_z <= RCB_ADEQUACY_Z) {
+      /* white, but too far above the declared noise to be called noise */
+      snprintf(text, sizeof text,
+               "The best candidate, %s (%s), improves the fit: it accounts for %.1f %% of the "
+               "misfit, the error %s from %.3g %% to %.3g %%%s, BIC %+.1f, chi-square %.6g above "
+               "the adequacy limit %.6g at 1 %%. What is left is white along frequency (lag-1 "
+               "statistic %.3g, 1 %% limit %.3g) but about %.3g x the declared noise, more than "
+               "the %g x a misdeclared level may be: " OPEN_QUESTION ".",
+               c->desc, c->fitted, 100.0 * (d->F0 - c->F) / d->F0, trend(d->err0, c->err),
+               d->err0, c->err, floor_txt, c->dbic, c->adeq_chi2, c->chi2_limit, c->white_z,
+               RCB_ADEQUACY_Z, rcb_evidence_level(&c->ev), RCB_WHITE_LEVEL_MAX);
     } else if (isfinite(c->chi2_limit)) {
       say_test(test, sizeof test, c->adeq_chi2, c->chi2_limit, 0, 1.0);
       snprintf(text, sizeof text,
@@ -326,6 +357,16 @@ rcb_status rcb_diag_explain(const rcb_diag *d, char *buf, size_t size, size_t *n
              "level.",
              d->adeq0.chi2, d->adeq0.limit, even, sqrt(d->adeq0.dispersion), d->err0,
              floor_txt);
+  } else if (base_ok == 0 && d->adeq0.white) { /* white, too far above the declared */
+    snprintf(text, sizeof text,
+             "No candidate is significant: the model as it is leaves an error of %.3g %%%s and "
+             "a chi-square of %.6g, above the adequacy limit %.6g at 1 %%, and no effect of the "
+             "catalogue is significant (BIC lower by more than %g on the noise's dispersion, "
+             "counting the %zu candidates tried). What is left is white along frequency (lag-1 "
+             "statistic %.3g, 1 %% limit %.3g) but about %.3g x the declared noise, more than "
+             "the %g x a misdeclared level may be: " OPEN_QUESTION ".",
+             d->err0, floor_txt, d->adeq0.chi2, d->adeq0.limit, -RCB_BIC_SIGNIFICANT, d->ncand,
+             d->adeq0.white_z, RCB_ADEQUACY_Z, sqrt(d->adeq0.dispersion), RCB_WHITE_LEVEL_MAX);
   } else if (base_ok == 0) {
     say_test(test, sizeof test, d->adeq0.chi2, d->adeq0.limit, 0, 1.0);
     snprintf(text, sizeof text,

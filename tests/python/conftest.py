@@ -214,6 +214,8 @@ SLOW_FILES = {
 SLOW_TESTS = {
     "test_ross_frf.py::test_frf_synchronous", "test_ross_modes.py::test_damped_modes",
     "test_ross_unbalance.py::test_unbalance_response",
+    "test_diag_white_level.py::test_white_far_above_declared_with_a_probe",
+    "test_diag_white_level.py::test_white_far_above_declared_nothing_missing",
 }
 
 

@@ -287,7 +287,9 @@ def claim(delta_bic, error_before_pct, error_after_pct, chi2=float("nan"),
     (and, noise unknown, the error by 2 % of itself; noise known, the drop
     over the dispersion passes the 1 % test over the candidates tried);
     "explains" only when also adequate (chi2 <= chi2_limit, or a white
-    residual) and no fitted size is beyond its part (rcb_diagnose.h)."""
+    residual at most RCB_WHITE_LEVEL_MAX = 2 x the declared noise level,
+    sqrt(dispersion); give the dispersion, else chi2 / chi2_limit stands in
+    for it) and no fitted size is beyond its part (rcb_diagnose.h)."""
     L = _lib.lib()
     e = _lib.Evidence(float(delta_bic), float(error_before_pct), float(error_after_pct),
                       float(chi2), float(chi2_limit), float(params), float(residuals),
