@@ -1,11 +1,13 @@
 # Install rules: public headers (plus the generated rcb_config.h), the shared
 # and static libraries, rcbtool, the rcb::rcb export (rcbConfig.cmake +
-# rcbConfigVersion.cmake) and rcb.pc for pkg-config users.
+# rcbConfigVersion.cmake) and rcb.pc for pkg-config users; the same package
+# also under the project's name, librcb (librcbConfig.cmake, librcb.pc).
 #
 # Consumers:
 #   find_package(rcb CONFIG REQUIRED)  ->  target_link_libraries(app PRIVATE rcb::rcb)
 #   cc app.c $(pkg-config --cflags --libs rcb)          (shared)
 #   cc app.c $(pkg-config --static --cflags --libs rcb) (static)
+#   find_package(librcb ...), pkg-config librcb: the same, the same targets
 # rcb::rcb is the shared library when it was built, else an alias of
 # rcb::rcb_static (made by rcbConfig.cmake).
 include(CMakePackageConfigHelpers)
@@ -67,6 +69,18 @@ if(RCB_WITH_SUITESPARSE)
 endif()
 install(FILES ${_rcb_cmake_files} DESTINATION ${RCB_INSTALL_CMAKEDIR} COMPONENT dev)
 
+# find_package(librcb): the same package under the project's name (issue #36;
+# cmake/librcbConfig.cmake.in says why), in a librcb directory beside rcb's.
+get_filename_component(_rcb_cmake_parent ${RCB_INSTALL_CMAKEDIR} DIRECTORY)
+file(RELATIVE_PATH RCB_LIBRCB_TO_RCB /${_rcb_cmake_parent}/librcb /${RCB_INSTALL_CMAKEDIR})
+configure_file(${PROJECT_SOURCE_DIR}/cmake/librcbConfig.cmake.in
+  ${PROJECT_BINARY_DIR}/librcbConfig.cmake @ONLY)
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/librcbConfigVersion.cmake
+  VERSION ${PROJECT_VERSION} COMPATIBILITY SameMajorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/librcbConfig.cmake
+  ${PROJECT_BINARY_DIR}/librcbConfigVersion.cmake
+  DESTINATION ${_rcb_cmake_parent}/librcb COMPONENT dev)
+
 # pkg-config: the shared library by default; --static adds Libs.private.
 set(RCB_PC_LIBS_PRIVATE "-llapacke -llapack -lblas")
 set(RCB_PC_REQUIRES_PRIVATE "inih")
@@ -106,3 +120,6 @@ endforeach()
 configure_file(${PROJECT_SOURCE_DIR}/cmake/rcb.pc.in ${PROJECT_BINARY_DIR}/rcb.pc @ONLY)
 install(FILES ${PROJECT_BINARY_DIR}/rcb.pc
   DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig COMPONENT dev)
+# pkg-config librcb: the same file under the project's name (issue #36)
+install(FILES ${PROJECT_BINARY_DIR}/rcb.pc
+  DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig RENAME librcb.pc COMPONENT dev)

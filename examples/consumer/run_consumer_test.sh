@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
 # ctest driver (test "install_consumer"): install a librcb build tree into a
 # scratch prefix, build this consumer against it with find_package(rcb) and
-# with pkg-config (shared and static), run each, and check the printed
-# values against the closed form below.
+# find_package(librcb), with pkg-config rcb (shared) and pkg-config librcb
+# (static, the firmware-style link), run each as it is and in the caller's
+# memory (--arena: the allocator hooks), and check the printed values against
+# the closed form below, and the hooks' counts: every allocation through them,
+# and in the static links (the C heap counted by --wrap) none from librcb.a.
 #
 # usage: run_consumer_test.sh CMAKE BUILD_DIR WORK_DIR [C_COMPILER]
 set -euo pipefail
@@ -27,6 +30,14 @@ fi
 "$cmake_cmd" --build "$work/build" > "$work/build.log"
 runs=("$work/build/rcb_consumer")
 [[ -x $work/build/rcb_consumer_static ]] && runs+=("$work/build/rcb_consumer_static")
+
+# 1a. The same package under the project's name: find_package(librcb).
+"$cmake_cmd" -S "$here" -B "$work/build-librcb" -DCMAKE_PREFIX_PATH="$prefix" -DRCB_PACKAGE=librcb \
+  -DCMAKE_C_COMPILER="$cc" -DCMAKE_BUILD_TYPE=Release > "$work/configure-librcb.log" 2>&1 ||
+  { cat "$work/configure-librcb.log"; echo "FAIL: find_package(librcb 0.1) does not find the package"; exit 1; }
+"$cmake_cmd" --build "$work/build-librcb" > "$work/build-librcb.log"
+runs+=("$work/build-librcb/rcb_consumer")
+[[ -x $work/build-librcb/rcb_consumer_static ]] && runs+=("$work/build-librcb/rcb_consumer_static")
 
 # 1b. A shared-library consumer on a machine without the static library's
 # dependencies (issue #17): NLopt and SUNDIALS made unfindable. find_package(rcb)
@@ -54,15 +65,23 @@ if [[ -f $(dirname "$cfg")/rcbTargets.cmake && -f $(dirname "$cfg")/rcbStaticTar
     { cat "$work/fw-nodeps.log"; echo "FAIL: the static refusal does not name the package"; exit 1; }
 fi
 
-# 1d. examples/firmware on its own (its own project(), the static library).
+# 1d. examples/firmware on its own (its own project(), the static library),
+# asking for find_package(librcb 0.1 COMPONENTS static): the component is
+# passed on to rcb (1c asks rcb itself).
 if [[ -f $(dirname "$cfg")/rcbStaticTargets.cmake ]]; then
-  "$cmake_cmd" -S "$here/../firmware" -B "$work/fw" -DCMAKE_PREFIX_PATH="$prefix" \
+  "$cmake_cmd" -S "$here/../firmware" -B "$work/fw" -DCMAKE_PREFIX_PATH="$prefix" -DRCB_PACKAGE=librcb \
     -DCMAKE_C_COMPILER="$cc" -DCMAKE_BUILD_TYPE=Release > "$work/fw-configure.log" 2>&1 ||
     { cat "$work/fw-configure.log"; echo "FAIL: examples/firmware does not configure on its own"; exit 1; }
   "$cmake_cmd" --build "$work/fw" > "$work/fw-build.log"
   OPENBLAS_NUM_THREADS=1 "$work/fw/firmware_example" | tee "$work/fw.out" | tail -n 1
   grep -q "OK: drift and fault alarmed on time and named, intervals covering, no allocation in the loop" "$work/fw.out" ||
     { echo "FAIL: examples/firmware (standalone) did not print its OK line"; exit 1; }
+  # its memory: all through the allocator hooks (the arena), none from the C heap
+  if [[ $(uname -s) == Linux ]]; then
+    grep '^heap: ' "$work/fw.out" || { echo "FAIL: examples/firmware counts no C heap call"; exit 1; }
+    grep -q '^heap: 0 calls' "$work/fw.out" ||
+      { echo "FAIL: examples/firmware: librcb.a called the C heap with the hooks set"; exit 1; }
+  fi
 fi
 
 # 1e. The installed rcbtool runs the installed plotting script
@@ -81,11 +100,15 @@ if [[ -e $prefix/bin/rcbtool ]]; then
   echo "installed rcbtool: plotting script $got"
 fi
 
-# 2. pkg-config, shared (rpath to the scratch prefix) and --static.
+# 2. pkg-config: rcb, shared (rpath to the scratch prefix), and librcb (the
+# same module under the project's name), --static, as a firmware build links:
+# librcb.a into the program, the C heap wrapped and counted.
 pcfile=$(find "$prefix" -name rcb.pc | head -n 1)
 PKG_CONFIG_PATH=$(dirname "$pcfile")
 export PKG_CONFIG_PATH
 libdir=$(pkg-config --variable=libdir rcb)
+[[ $(pkg-config --modversion librcb) == "$(pkg-config --modversion rcb)" ]] ||
+  { echo "FAIL: pkg-config librcb is not rcb's version"; exit 1; }
 if [[ -f $libdir/librcb.so ]]; then
   # shellcheck disable=SC2046
   "$cc" -std=c11 -O2 -o "$work/consumer_pc" "$here/main.c" \
@@ -94,9 +117,10 @@ if [[ -f $libdir/librcb.so ]]; then
 fi
 if [[ -f $libdir/librcb.a ]]; then
   # shellcheck disable=SC2046
-  "$cc" -std=c11 -O2 -o "$work/consumer_pc_static" "$here/main.c" \
-    $(pkg-config --static --cflags rcb) "$libdir/librcb.a" \
-    $(pkg-config --static --libs-only-l rcb | sed 's/-lrcb//') -lm
+  "$cc" -std=c11 -O2 -DRCB_EXAMPLE_COUNT_HEAP -o "$work/consumer_pc_static" "$here/main.c" \
+    $(pkg-config --static --cflags librcb) "$(pkg-config --variable=libdir librcb)/librcb.a" \
+    $(pkg-config --static --libs-only-l librcb | sed 's/-lrcb//') -lm \
+    -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc,--wrap=free
   runs+=("$work/consumer_pc_static")
 fi
 
@@ -116,16 +140,45 @@ expected=$(awk 'BEGIN {
 read -r f1_ref h_ref <<< "$expected"
 echo "closed form: f1 = $f1_ref Hz, H(2 Hz) = $h_ref m/N"
 
+# Each program twice: as it is (malloc) and with --arena (the hooks). With
+# --arena every allocation goes through the hooks and comes back (frees =
+# allocs > 0); a static link with the C heap wrapped (*_static, Linux) prints
+# heap_calls: above 0 as it is (librcb.a's mallocs are counted: the wrap
+# works), 0 with --arena (nothing in librcb.a goes around the hooks).
+key() { awk -v k="$1" '$1 == k { print $2 }' <<< "$2"; }
 status=0
 for exe in "${runs[@]}"; do
-  out=$("$exe")
-  f1=$(awk '$1 == "f1_hz" { print $2 }' <<< "$out")
-  h=$(awk '$1 == "h_dx_dx_m_per_n" { print $2 }' <<< "$out")
-  verdict=$(awk -v a="$f1" -v b="$f1_ref" -v c="$h" -v e="$h_ref" 'BEGIN {
-    if (a == "" || c == "") { print "FAIL missing output"; exit }
-    ra = (a - b) / b; rc = (c - e) / e; if (ra < 0) ra = -ra; if (rc < 0) rc = -rc;
-    printf "%s f1 rel.err %.2e, H rel.err %.2e", (ra < 0.01 && rc < 0.01) ? "ok" : "FAIL", ra, rc }')
-  echo "$(basename "$exe"): f1 = $f1 Hz, H = $h m/N: $verdict"
-  [[ $verdict == ok* ]] || status=1
+  for mode in "" --arena; do
+    out=$("$exe" $mode)
+    f1=$(key f1_hz "$out")
+    h=$(key h_dx_dx_m_per_n "$out")
+    verdict=$(awk -v a="$f1" -v b="$f1_ref" -v c="$h" -v e="$h_ref" 'BEGIN {
+      if (a == "" || c == "") { print "FAIL missing output"; exit }
+      ra = (a - b) / b; rc = (c - e) / e; if (ra < 0) ra = -ra; if (rc < 0) rc = -rc;
+      printf "%s f1 rel.err %.2e, H rel.err %.2e", (ra < 0.01 && rc < 0.01) ? "ok" : "FAIL", ra, rc }')
+    allocs=$(key arena_allocs "$out")
+    frees=$(key arena_frees "$out")
+    heap=$(key heap_calls "$out")
+    if [[ -n $mode ]]; then
+      if ((${allocs:-0} == 0 || ${frees:--1} != ${allocs:-0})); then
+        verdict="FAIL arena: ${allocs:-no} allocations, ${frees:-no} frees through the hooks"
+      else
+        verdict+=", arena $allocs allocations = frees, $(key arena_bytes "$out") bytes"
+      fi
+    fi
+    if [[ $exe == *_static && $(uname -s) == Linux ]]; then
+      if [[ -z $heap ]]; then
+        verdict="FAIL the static link counts no C heap call (heap_calls missing)"
+      elif [[ -z $mode ]] && ((heap == 0)); then
+        verdict="FAIL heap_calls 0 without --arena: the --wrap counter counts nothing"
+      elif [[ -n $mode ]] && ((heap != 0)); then
+        verdict="FAIL $heap calls of the C heap with the hooks set: librcb went around them"
+      else
+        verdict+=", C heap calls from the static objects $heap"
+      fi
+    fi
+    echo "$(basename "$(dirname "$exe")")/$(basename "$exe")${mode:+ $mode}: f1 = $f1 Hz, H = $h m/N: $verdict"
+    [[ $verdict == ok* ]] || status=1
+  done
 done
 exit $status

@@ -38,6 +38,9 @@
  *    after the reboot and the saved state at the year's end must be bit
  *    for bit the same.
  * It prints the arena used, the detection delays and the estimated sizes.
+ * Built on its own against an installed librcb (CMakeLists.txt), on Linux,
+ * the C heap is wrapped and counted (../heap_count.h): librcb.a must make no
+ * call of it from the first model to the last destroy.
  */
 #include <complex.h>
 #include <math.h>
@@ -48,32 +51,13 @@
 
 #include "rcb/rcb.h"
 
-/* ---- the caller's memory: a bump arena, free is a no-op ---- */
-typedef struct arena {
-  unsigned char *base;
-  size_t size, used;
-  size_t allocs, frees; /* calls through the hooks */
-  int sealed;           /* 1 after initialisation: any allocation is a bug */
-  size_t allocs_after_init;
-} arena;
+#include "../arena.h" /* arena, arena_alloc, arena_free */
+#ifdef RCB_EXAMPLE_COUNT_HEAP
+#include "../heap_count.h" /* heap_calls */
+#endif
 
-static void *arena_alloc(void *user, size_t n) {
-  arena *a = user;
-  size_t at = (a->used + 15u) & ~(size_t)15u; /* 16-byte alignment */
-  a->allocs++;
-  if (a->sealed) a->allocs_after_init++;
-  if (at > a->size || n > a->size - at) return NULL;
-  a->used = at + n;
-  return a->base + at;
-}
-
-static void arena_free(void *user, void *p) {
-  arena *a = user;
-  (void)p;
-  a->frees++;
-}
-
-/* Two monitors (the one that restarts and its never-restarted shadow) and
+/* ---- the caller's memory: a bump arena (../arena.h), free is a no-op ----
+ * Two monitors (the one that restarts and its never-restarted shadow) and
  * the restart's create: the bump arena reclaims nothing. */
 #define ARENA_BYTES (32u * 1024u * 1024u)
 static unsigned char g_memory[ARENA_BYTES]; /* the firmware's heap */
@@ -343,6 +327,9 @@ int main(void) {
   size_t differ = 0;
   double kt0, kt;
   int day;
+#ifdef RCB_EXAMPLE_COUNT_HEAP
+  heap_calls = 0; /* from here: librcb's calls only */
+#endif
   if (init(&p, &al)) return 1;
   if (rcb_model_get_param(p.machine, "coupling.C.kt", &kt0)) return 1;
   ar.sealed = 1; /* from here on the loop must not allocate */
@@ -395,6 +382,10 @@ int main(void) {
     fprintf(stderr, "%zu allocations, %zu frees\n", ar.allocs, ar.frees);
     v.errors++;
   }
+#ifdef RCB_EXAMPLE_COUNT_HEAP
+  printf("heap: %zu calls of the C heap from the static objects (librcb.a)\n", heap_calls);
+  if (heap_calls) v.errors++;
+#endif
   printf("%s\n", v.errors ? "FAILED" : "OK: drift and fault alarmed on time and named, "
                                         "intervals covering, no allocation in the loop, "
                                         "restart bit-identical");
