@@ -7,7 +7,8 @@
 #   ./scripts/dev.sh test       install everything, build with every backend, run every
 #                               test: ctest, Python cross-validation against ROSS, the wheel
 #                               in a fresh venv, the core configuration (no optional
-#                               backend), ASan+UBSan build, valgrind, fuzz replay, lint; ends
+#                               backend), the aarch64 firmware under qemu (arm), ASan+UBSan
+#                               build, valgrind, fuzz replay, lint; ends
 #                               with a table of stage times (docs/reliability.md)
 #   ./scripts/dev.sh quick      build + the tests labelled neither slow nor long (ctest -LE
 #                               "slow|long", pytest -m "not slow"): a developer's suite
@@ -57,6 +58,10 @@
 #                               auditwheel repair (its libraries inside, manylinux_2_31), tested
 #                               in a second root with only python3 and pip (root; out/manylinux/;
 #                               WHEEL_ARCH=arm64: the aarch64 wheel under qemu-user-static)
+#   ./scripts/dev.sh arm        `cross` for aarch64, light (part of `test`): the library and
+#                               examples/firmware cross-built, the example under qemu-aarch64
+#                               against the native embedded figures; on the host, else in the
+#                               cached root of cross-chroot, else SKIPPED with the reason
 #   ./scripts/dev.sh embedded   the "embedded" CMake preset (static, -Os, no optional backend,
 #                               build-embedded/): build and print the library size
 #
@@ -392,16 +397,27 @@ STAGE_SECS=()
 STAGE_CPU=()
 STAGE_RESULTS=()
 FAILED=()
-stage_done() { # NAME SECONDS RC CPU_SECONDS
+stage_done() { # NAME SECONDS RC CPU_SECONDS [SKIP_REASON]
   STAGE_NAMES+=("$1")
   STAGE_SECS+=("$2")
   STAGE_CPU+=("${4:-0}")
   if (($3 == 0)); then
     STAGE_RESULTS+=(ok)
+  elif (($3 == STAGE_SKIPPED)) && [[ -n ${5:-} ]]; then
+    STAGE_RESULTS+=("SKIPPED: $5")
   else
     STAGE_RESULTS+=("FAILED (exit $3)")
     FAILED+=("$1")
   fi
+}
+# A stage that cannot run here (not a failure of the code: no root, a host
+# that must not change) calls stage_skip REASON: it exits STAGE_SKIPPED and
+# the table shows "SKIPPED: REASON" instead of ok, so it never passes silently.
+STAGE_SKIPPED=77
+stage_skip() {
+  printf 'dev.sh: SKIPPED: %s\n' "$1" >&2
+  [[ -z ${STAGE_SKIP_FILE:-} ]] || printf '%s' "$1" > "$STAGE_SKIP_FILE"
+  exit "$STAGE_SKIPPED"
 }
 # CPU seconds (rounded) of a `times` output: the shell's and its children's
 # user and system times ("0m1.250s 0m0.031s" per line).
@@ -410,19 +426,21 @@ cpu_secs() {
        END { printf "%d\n", s + 0.5 }' "$1" 2> /dev/null || echo 0
 }
 run_stage() {
-  local name=$1 t=$SECONDS rc cpuf
+  local name=$1 t=$SECONDS rc cpuf skipf
   shift
   cpuf=$(mktemp)
+  skipf=$(mktemp)
   set +e
   (
     trap 'times > "$cpuf"' EXIT
     set -e
+    STAGE_SKIP_FILE=$skipf
     "$@"
   )
   rc=$?
   set -e
-  stage_done "$name" $((SECONDS - t)) $rc "$(cpu_secs "$cpuf")"
-  rm -f "$cpuf"
+  stage_done "$name" $((SECONDS - t)) $rc "$(cpu_secs "$cpuf")" "$(cat "$skipf")"
+  rm -f "$cpuf" "$skipf"
 }
 run_stage_bg() {
   local name=$1 log=$BUILD_DIR/stage-$1.log
@@ -484,9 +502,10 @@ cmd_test() {
   run_stage build cmd_build full
   stage_wait venv "$venv_pid"
   ((${#FAILED[@]} == 0)) || { stage_table; die "the build or the Python venv failed"; }
-  local stages=(ctest wheel core)
+  # issue #36: arm, the aarch64 library and firmware example under qemu
+  local stages=(ctest wheel core arm)
   if [[ ${RCB_TEST_SERIAL:-0} == 1 ]]; then
-    stages=(ctest pytest wheel core)
+    stages=(ctest pytest wheel core arm)
   else
     say "pytest starts in the background (its output comes when it ends)"
     run_stage_bg pytest cmd_pytest
@@ -731,6 +750,8 @@ cmd_embedded() {
 # qemu and diff its figures against the native run (the init line, arena sizes
 # from the pointer width, apart), then the C tests labelled neither slow, long
 # nor threads. CROSS_TARGETS (default "aarch64 armhf") picks the targets.
+# CROSS_LIGHT=1 (the `arm` stage of `test`, issue #36): the library and the
+# firmware example only (RCB_BUILD_TESTS=OFF, no cmocka), no ctest.
 declare -A CROSS_DEBARCH=([aarch64]=arm64 [armhf]=armhf)
 declare -A CROSS_QEMU=([aarch64]=qemu-aarch64 [armhf]=qemu-arm)
 declare -A CROSS_TRIPLET=([aarch64]=aarch64-linux-gnu [armhf]=arm-linux-gnueabihf)
@@ -738,16 +759,24 @@ declare -A CROSS_TRIPLET=([aarch64]=aarch64-linux-gnu [armhf]=arm-linux-gnueabih
 # Foreign-architecture packages must carry the host's versions of the shared
 # ones (libc6, libgcc...): when the host is behind its archive, apt would
 # upgrade host packages to install them. That is left to the administrator:
-# the simulation is checked first and nothing is installed then.
+# the simulation is checked first and nothing is installed then: exit
+# CROSS_WOULD_UPGRADE (the `arm` stage of `test` tells that from a failure).
+# cross_deps ARCH [light]: light leaves out cmocka (no tests are built).
+CROSS_WOULD_UPGRADE=3
+cross_want() { # ARCH [light]
+  printf '%s\n' "crossbuild-essential-$1" qemu-user "liblapacke-dev:$1" "libopenblas-dev:$1" \
+    "libinih-dev:$1" "libkissfft-dev:$1"
+  [[ ${2:-} == light ]] || echo "libcmocka-dev:$1"
+}
 cross_deps() {
-  local arch=$1 missing=() p plan
-  local want=("crossbuild-essential-$arch" qemu-user "liblapacke-dev:$arch"
-    "libopenblas-dev:$arch" "libinih-dev:$arch" "libkissfft-dev:$arch" "libcmocka-dev:$arch")
+  local arch=$1 missing=() p plan want added=0
+  mapfile -t want < <(cross_want "$arch" "${2:-}")
   for p in "${want[@]}"; do deb_installed "$p" || missing+=("$p"); done
   ((${#missing[@]})) || return 0
   if ! dpkg --print-foreign-architectures | grep -qx "$arch"; then
     say "dpkg --add-architecture $arch"
     as_root dpkg --add-architecture "$arch"
+    added=1
   fi
   # A mirror caught mid-sync fails one index (seen: bookworm-security's armhf
   # Packages): go on with the indexes apt has; the simulation below decides.
@@ -756,7 +785,14 @@ cross_deps() {
   plan=$(as_root apt-get -s install --no-install-recommends "${missing[@]}" 2>&1) ||
     { echo "$plan" | tail -n 20; die "apt cannot install: ${missing[*]}"; }
   if grep -E '^(Inst [^ ]+ \[|Remv )' <<< "$plan"; then
-    die "installing ${missing[*]} would upgrade or remove the host packages above (the host is behind its archive): upgrade the host first (apt-get upgrade), then run cross again (dpkg --remove-architecture $arch undoes the added architecture)"
+    # the architecture this run added goes again: the host is as it was
+    local undone=
+    if ((added)); then
+      as_root dpkg --remove-architecture "$arch" || true
+      undone=" (this run's dpkg --add-architecture $arch is undone)"
+    fi
+    printf 'dev.sh: %s\n' "installing ${missing[*]} would upgrade or remove the host packages above (the host is behind its archive): upgrade the host first (apt-get upgrade), then run cross again$undone" >&2
+    exit "$CROSS_WOULD_UPGRADE"
   fi
   say "installing: ${missing[*]}"
   as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends \
@@ -777,11 +813,13 @@ cmd_cross() {
   cmake --preset embedded > /dev/null
   cmake --build --preset embedded -j "$JOBS"
   OPENBLAS_NUM_THREADS=1 build-embedded/examples/firmware/firmware_example > "$native"
+  local light= tests=ON
+  [[ ${CROSS_LIGHT:-0} != 1 ]] || light=light tests=OFF
   for t in "${targets[@]}"; do
-    cross_deps "${CROSS_DEBARCH[$t]}"
+    cross_deps "${CROSS_DEBARCH[$t]}" $light
     dir=build-embedded-$t
-    say "embedded-$t: cross build (${CROSS_TRIPLET[$t]}, warnings as errors)"
-    cmake --preset "embedded-$t" > /dev/null
+    say "embedded-$t: cross build (${CROSS_TRIPLET[$t]}, warnings as errors, tests $tests)"
+    cmake --preset "embedded-$t" -DRCB_BUILD_TESTS=$tests > /dev/null
     cmake --build --preset "embedded-$t" -j "$JOBS"
     size "$dir/src/librcb.a" | awk 'NR > 1 { t += $1 } END { printf "  library text %d bytes\n", t }'
     say "embedded-$t: examples/firmware under ${CROSS_QEMU[$t]}, against the native figures"
@@ -791,11 +829,12 @@ cmd_cross() {
     diff <(grep -v '^init:' "$native") <(grep -v '^init:' "$dir/firmware.out") ||
       die "embedded-$t: the firmware example's figures differ from the native run (above)"
     echo "  the same figures as the native run (apart from the init line)"
+    [[ -z $light ]] || continue
     say "embedded-$t: C tests under qemu (ctest -LE 'slow|long|threads')"
     (cd "$dir" && ctest -N -L threads | sed -n 's/^ *Test *#[0-9]*: /  skipped under qemu-user (its user mode hangs or crashes in guest pthread_create, qemu 7.2): /p')
     run_ctest "$dir" -LE "slow|long|threads"
   done
-  say "cross: ${targets[*]} passed"
+  say "cross: ${targets[*]} passed${light:+ (CROSS_LIGHT: library and firmware example, no ctest)}"
 }
 
 # `cross` in a Debian 12 root, for a host that is not Debian 12 or whose
@@ -888,9 +927,12 @@ cmd_cross_chroot() {
   [[ -x $CHROOT/usr/bin/apt-get ]] || chroot_make bookworm "$CHROOT"
   trap 'chroot_umount "$CHROOT"' EXIT
   say "the working tree to $CHROOT/src"
+  # the last copy goes, its builds stay: a file gone from the tree must not
+  # linger there (src/ is globbed); tar keeps the mtimes, so builds stay current
+  find "$CHROOT/src" -mindepth 1 -maxdepth 1 ! -name 'build-embedded*' -exec rm -rf {} +
   chroot_copy_tree "$CHROOT/src"
   chroot_mount "$CHROOT"
-  chroot_run "$CHROOT" CROSS_TARGETS="${CROSS_TARGETS:-aarch64 armhf}" \
+  chroot_run "$CHROOT" CROSS_TARGETS="${CROSS_TARGETS:-aarch64 armhf}" CROSS_LIGHT="${CROSS_LIGHT:-0}" \
     bash -c 'cd /src && ./scripts/dev.sh cross'
   say "cross-chroot: passed (the builds are in $CHROOT/src/build-embedded-*)"
 }
@@ -956,6 +998,64 @@ cmd_wheel_manylinux() {
   say "wheel-manylinux: passed in $((SECONDS - t0)) s (the wheel: $out/${whl[0]##*/})"
 }
 
+# The `arm` stage of `test` (issue #36): `cross` for aarch64 in its light form
+# (CROSS_LIGHT=1: the native embedded build, the aarch64 library and
+# examples/firmware cross-built, no tests, the example under qemu-aarch64
+# diffed against the native figures), on the host when its arm64 packages are
+# there or install without changing a host package, else in the cached Debian
+# root of `cross-chroot`. When neither can be (no root, the host would change
+# and no root is cached, not Debian, RCB_SKIP_ARM=1) it is skipped with the
+# reason in the stage table: never a failure for lack of root, never a silent
+# pass. The full qemu ctest of both targets is `cross`, behind CI_CROSS=1 (.ci/run).
+cmd_arm() {
+  local want=() missing=() p rc why
+  [[ ${RCB_SKIP_ARM:-0} != 1 ]] || stage_skip "RCB_SKIP_ARM=1"
+  export CROSS_TARGETS=aarch64 CROSS_LIGHT=1
+  if command -v dpkg-query > /dev/null && command -v apt-get > /dev/null; then
+    mapfile -t want < <(cross_want arm64 light)
+    for p in "${want[@]}"; do deb_installed "$p" || missing+=("$p"); done
+    if ((${#missing[@]} == 0)); then
+      cmd_cross
+      return
+    fi
+    if [[ $(id -u) -ne 0 ]] && ! sudo -n true 2> /dev/null; then
+      why="installing ${missing[*]} needs root (not root, and no sudo without a password)"
+    else
+      set +e
+      (
+        set -e
+        cross_deps arm64 light
+      )
+      rc=$?
+      set -e
+      case $rc in
+        0)
+          cmd_cross
+          return
+          ;;
+        "$CROSS_WOULD_UPGRADE") why="installing the arm64 packages would upgrade or remove host packages (listed above)" ;;
+        *) die "arm: installing the arm64 packages failed (exit $rc, above)" ;;
+      esac
+    fi
+  else
+    why="not a Debian multiarch host (no dpkg-query/apt-get)"
+  fi
+  # cross-chroot makes the root when it is not there (mmdebstrap or
+  # debootstrap; 66 s here, 1.6 GB with the packages, once per RCB_CHROOT)
+  if [[ $(id -u) -eq 0 ]] && { [[ -x $CHROOT/usr/bin/apt-get ]] ||
+    command -v mmdebstrap > /dev/null || command -v debootstrap > /dev/null; }; then
+    say "arm: $why: in the Debian root $CHROOT"
+    (cmd_cross_chroot) # a subshell: its EXIT trap (the mounts) is its own
+    return
+  fi
+  if [[ $(id -u) -ne 0 ]]; then
+    why+="; the Debian root of cross-chroot needs root"
+  else
+    why+="; no Debian root in $CHROOT and neither mmdebstrap nor debootstrap to make one"
+  fi
+  stage_skip "$why"
+}
+
 usage() { awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$ROOT/scripts/dev.sh"; }
 
 case ${1:-} in
@@ -981,6 +1081,11 @@ case ${1:-} in
   cross) cmd_cross ;;
   cross-chroot) cmd_cross_chroot ;;
   wheel-manylinux) cmd_wheel_manylinux ;;
+  arm)
+    run_stage arm cmd_arm
+    stage_table
+    ((${#FAILED[@]} == 0)) || exit 1
+    ;;
   -h | --help | help) usage ;;
   *) usage >&2; exit 2 ;;
 esac
