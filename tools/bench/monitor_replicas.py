@@ -58,6 +58,7 @@ import warnings
 from pathlib import Path
 
 import numpy as np
+from scipy import stats
 
 REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO / "tests" / "python"))
@@ -298,25 +299,14 @@ def replica(rcb, model, H, case, rep, ci):
 # --------------------------------------------------------------------------
 
 
-def binom_upper(n, p, conf=0.99):
-    """The smallest k with P(X > k) <= 1 - conf, X ~ Bin(n, p)."""
-    cdf, k = 0.0, 0
-    while True:
-        cdf += math.comb(n, k) * p**k * (1 - p) ** (n - k)
-        if cdf >= conf or k >= n:
-            return k
-        k += 1
+def binom_upper(n, p):
+    """More than this many of n at rate p rejects the rate (binomial, 99 %)."""
+    return int(stats.binom.ppf(0.99, n, p))
 
 
-def binom_lower(n, p, conf=0.99):
-    """The largest k with P(X < k) <= 1 - conf, X ~ Bin(n, p)."""
-    cdf, k = 0.0, 0
-    while k <= n:
-        nxt = cdf + math.comb(n, k) * p**k * (1 - p) ** (n - k)
-        if nxt > 1 - conf:
-            return k
-        cdf, k = nxt, k + 1
-    return n
+def binom_lower(n, p):
+    """Fewer than this many of n rejects the rate p (binomial 1 % quantile)."""
+    return int(stats.binom.ppf(0.01, n, p))
 
 
 def null_update(case, j):
@@ -354,6 +344,13 @@ def summarise(case, recs):
           for s in u["statements"]]
     wrong = [x for x in st if x[3][1]]
     rival = [x for x in st if x[3][2]]
+    rep_wrong = sum(any(s[1] for u in r["updates"] for s in u["statements"]) for r in recs)
+    # the drift test's alarms: false on null updates; after the onset, naming
+    # another effect than the truth (its text names one candidate alone)
+    dfa = sum(bool(u["drift"]) for r in recs for u in r["updates"] if null_update(case, u["j"]))
+    dch = [u["drift"] for r in recs for u in r["updates"]
+           if u["drift"] and not null_update(case, u["j"])]
+    dwrong = sum(not is_truth(case, d, ONSET + 1) for d in dch)
     delays = [d for d in (first_named(case, r) for r in recs) if d is not None]
     cov = np.array([u["cover"] for r in recs for u in r["updates"]])
     last = np.array([r["updates"][-1]["cover"] for r in recs])
@@ -363,14 +360,22 @@ def summarise(case, recs):
              if case == "step" and u["alarm"] and u["top"] and is_truth(case, u["top"][0], u["j"])]
     forms = {}
     for r in recs:
-        f = forms.setdefault(r["form"], [0, 0, 0])
+        f = forms.setdefault(r["form"], [0] * 7)
+        nu = [u for u in r["updates"] if null_update(case, u["j"])]
         f[0] += 1
-        f[1] += sum(u["alarm"] for u in r["updates"] if null_update(case, u["j"]))
-        f[2] += sum(s[1] for u in r["updates"] for s in u["statements"])
+        f[1] += len(nu)
+        f[2] += sum(u["alarm"] for u in nu)
+        f[3] += sum(bool(u["drift"]) for u in nu)
+        f[4] += any(u["cusum"][k] for u in r["updates"] for k in watch
+                    if null_update(case, u["j"]) or case == "wear")
+        f[5] += sum(len(u["statements"]) for u in r["updates"])
+        f[6] += sum(s[1] for u in r["updates"] for s in u["statements"])
     return {"case": case, "replicas": len(recs), "null_updates": n_null, "test_fa": fa,
             "test_bound": binom_upper(n_null, ALPHA), "replicas_test_fa": rep_fa,
             "cusum_fa": cus, "cusum_bound": binom_upper(len(recs), p_cus), "p_cusum": p_cus,
             "told": len(st), "wrong": len(wrong), "rival": len(rival),
+            "replicas_wrong": rep_wrong, "replicas_wrong_bound": binom_upper(len(recs), 0.05),
+            "drift_fa": dfa, "drift_after": len(dch), "drift_wrong": dwrong,
             "wrong_bound": binom_upper(len(st), 0.05) if st else 0,
             "wrong_examples": wrong[:5], "named": len(delays),
             "delay_median": float(np.median(delays)) if delays else None,
@@ -382,6 +387,16 @@ def summarise(case, recs):
             "size_bound": binom_lower(len(sized), 0.95) if sized else 0,
             "cpu_create": float(np.mean([r["cpu_create"] for r in recs])),
             "cpu_update": float(np.sum([r["cpu_updates"] for r in recs]) / (len(recs) * UPDATES))}
+
+
+def saved(out, case):
+    """The replicas saved in OUT/CASE.json and OUT/CASE.FIRST.json (runs with
+    --first FIRST), one per replica number, in order."""
+    recs = {}
+    for p in sorted(out.glob(f"{case}.json")) + sorted(out.glob(f"{case}.*.json")):
+        for r in json.loads(p.read_text()):
+            recs.setdefault(r["rep"], r)
+    return [recs[k] for k in sorted(recs)]
 
 
 def sd_check(rcb, model):
@@ -408,11 +423,12 @@ def main():
     ap.add_argument("--out", default=str(REPO / "out" / "monitor_replicas"))
     ap.add_argument("--sd-check", action="store_true", help="print B4 kyy's sd and stop")
     ap.add_argument("--from-json", action="store_true",
-                    help="no runs: count the replicas saved in OUT/CASE.json (a partial run too)")
+                    help="no runs: count the replicas saved in OUT/CASE.json and "
+                    "OUT/CASE.FIRST.json (runs with --first; a partial run too)")
     args = ap.parse_args()
     if args.from_json:
-        return table([summarise(c, json.loads((Path(args.out) / f"{c}.json").read_text()))
-                      for c in args.cases.split(",") if (Path(args.out) / f"{c}.json").is_file()])
+        return table([summarise(c, recs) for c in args.cases.split(",")
+                      if (recs := saved(Path(args.out), c))])
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     import librcb as rcb
 
@@ -432,7 +448,8 @@ def main():
         recs = []
         for rep in range(args.first, args.first + args.replicas):
             recs.append(replica(rcb, model, H, case, rep, ci))
-            (out / f"{case}.json").write_text(json.dumps(recs))
+            name = f"{case}.json" if args.first == 0 else f"{case}.{args.first}.json"
+            (out / name).write_text(json.dumps(recs))
         s = summarise(case, recs)
         s["wall"] = time.time() - t0
         rows.append(s)
@@ -469,12 +486,26 @@ def table(rows):
               f"{', '.join(f'{100 * c:.1f} %' for c in s['cover'])} | "
               f"{', '.join(str(c) for c in s['cover_last'])} ({s['cover_last_bound']}) | "
               f"{s['cpu_update']:.3f}, {s['cpu_create']:.2f} |")
-    print("\nper noise form: replicas, TEST false alarms, wrong \"told apart\"\n")
-    print("| case | " + " | ".join(FORMS) + " |")
-    print("|---|" + "---|" * len(FORMS))
+    print("\nreplicas with any wrong \"told apart\" (bound at 5 %), and the drift test: false "
+          "alarms on null updates (bound at alpha), alarms after the onset naming another effect\n")
+    print("| case | replicas with a wrong \"told apart\" (bound) | drift false alarms (bound) | "
+          "drift alarms after the onset: another effect named |")
+    print("|---|---|---|---|")
     for s in rows:
-        print(f"| {s['case']} | " + " | ".join(
-            "{}: {}, {}".format(*s["forms"].get(f, [0, 0, 0])) for f in FORMS) + " |")
+        print(f"| {s['case']} | {s['replicas_wrong']} of {s['replicas']} "
+              f"({s['replicas_wrong_bound']}) | {s['drift_fa']} of {s['null_updates']} "
+              f"({s['test_bound']}) | {s['drift_wrong']} of {s['drift_after']} |")
+    print("\nper noise form: replicas; TEST and drift false alarms in the null updates; replicas "
+          "with a false CUSUM alarm; wrong \"told apart\" of all\n")
+    print("| case | form | replicas | TEST false alarms (bound) | drift false alarms | "
+          "false CUSUM replicas | wrong \"told apart\" |")
+    print("|---|---|---|---|---|---|---|")
+    for s in rows:
+        for f in FORMS:
+            if f in s["forms"]:
+                n, nu, fa, dfa, cus, st, wr = s["forms"][f]
+                print(f"| {s['case']} | {f} | {n} | {fa} of {nu} ({binom_upper(nu, ALPHA)}) | "
+                      f"{dfa} | {cus} | {wr} of {st} |")
     for s in rows:
         if s["size_named"]:
             print(f"\n{s['case']}: the named mass's 95 % interval holds {MASS_DB} kg on "
