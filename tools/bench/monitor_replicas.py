@@ -360,7 +360,7 @@ def summarise(case, recs):
              if case == "step" and u["alarm"] and u["top"] and is_truth(case, u["top"][0], u["j"])]
     forms = {}
     for r in recs:
-        f = forms.setdefault(r["form"], [0] * 7)
+        f = forms.setdefault(r["form"], [0] * 8 + [[0] * len(PARAMS), 0])
         nu = [u for u in r["updates"] if null_update(case, u["j"])]
         f[0] += 1
         f[1] += len(nu)
@@ -370,6 +370,9 @@ def summarise(case, recs):
                     if null_update(case, u["j"]) or case == "wear")
         f[5] += sum(len(u["statements"]) for u in r["updates"])
         f[6] += sum(s[1] for u in r["updates"] for s in u["statements"])
+        f[7] += first_named(case, r) is not None
+        f[8] = [a + sum(u["cover"][k] for u in r["updates"]) for k, a in enumerate(f[8])]
+        f[9] += len(r["updates"])
     return {"case": case, "replicas": len(recs), "null_updates": n_null, "test_fa": fa,
             "test_bound": binom_upper(n_null, ALPHA), "replicas_test_fa": rep_fa,
             "cusum_fa": cus, "cusum_bound": binom_upper(len(recs), p_cus), "p_cusum": p_cus,
@@ -498,14 +501,17 @@ def table(rows):
     print("\nper noise form: replicas; TEST and drift false alarms in the null updates; replicas "
           "with a false CUSUM alarm; wrong \"told apart\" of all\n")
     print("| case | form | replicas | TEST false alarms (bound) | drift false alarms | "
-          "false CUSUM replicas | wrong \"told apart\" |")
-    print("|---|---|---|---|---|---|---|")
+          "false CUSUM replicas | wrong \"told apart\" | truth named | value CI covers kt, kr, "
+          "ct |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for s in rows:
         for f in FORMS:
             if f in s["forms"]:
-                n, nu, fa, dfa, cus, st, wr = s["forms"][f]
+                n, nu, fa, dfa, cus, st, wr, nm, cov, ncov = s["forms"][f]
                 print(f"| {s['case']} | {f} | {n} | {fa} of {nu} ({binom_upper(nu, ALPHA)}) | "
-                      f"{dfa} | {cus} | {wr} of {st} |")
+                      f"{dfa} | {cus} | {wr} of {st} | "
+                      f"{'-' if s['case'] == 'null' else f'{nm} of {n}'} | "
+                      f"{', '.join(f'{100 * c / ncov:.1f} %' for c in cov)} |")
     for s in rows:
         if s["size_named"]:
             print(f"\n{s['case']}: the named mass's 95 % interval holds {MASS_DB} kg on "
