@@ -331,6 +331,10 @@ def first_named(case, rec):
     return None
 
 
+def forms_of(recs, rep):
+    return next(r["form"] for r in recs if r["rep"] == rep)
+
+
 def summarise(case, recs):
     n_null = sum(null_update(case, u["j"]) for r in recs for u in r["updates"])
     fa = sum(u["alarm"] for r in recs for u in r["updates"] if null_update(case, u["j"]))
@@ -344,6 +348,13 @@ def summarise(case, recs):
           for s in u["statements"]]
     wrong = [x for x in st if x[3][1]]
     rival = [x for x in st if x[3][2]]
+    kinds = {}
+    for x in st:
+        form = "eq19" if forms_of(recs, x[0]) == "eq19" else "other forms"
+        k = kinds.setdefault(f"{x[3][0]}, {form}", [0, 0, 0])
+        k[0] += 1
+        k[1] += x[3][1]
+        k[2] += x[3][2]
     rep_wrong = sum(any(s[1] for u in r["updates"] for s in u["statements"]) for r in recs)
     # the drift test's alarms: false on null updates; after the onset, naming
     # another effect than the truth (its text names one candidate alone)
@@ -386,7 +397,7 @@ def summarise(case, recs):
             "cover": cov.mean(axis=0).tolist() if cov.size else [], "cover_n": int(len(cov)),
             "cover_last": last.sum(axis=0).tolist(),
             "cover_last_bound": binom_lower(len(recs), 0.95),
-            "forms": forms, "size_named": len(sized), "size_covers": int(sum(sized)),
+            "forms": forms, "kinds": kinds, "size_named": len(sized), "size_covers": int(sum(sized)),
             "size_bound": binom_lower(len(sized), 0.95) if sized else 0,
             "cpu_create": float(np.mean([r["cpu_create"] for r in recs])),
             "cpu_update": float(np.sum([r["cpu_updates"] for r in recs]) / (len(recs) * UPDATES))}
@@ -498,6 +509,13 @@ def table(rows):
         print(f"| {s['case']} | {s['replicas_wrong']} of {s['replicas']} "
               f"({s['replicas_wrong_bound']}) | {s['drift_fa']} of {s['null_updates']} "
               f"({s['test_bound']}) | {s['drift_wrong']} of {s['drift_after']} |")
+    print("\n\"told apart\" by kind: statements, wrong (the truth the rival), the 99 % bound "
+          "of a 5 % rate\n")
+    print("| case | kind | statements | wrong (truth the rival) | bound |")
+    print("|---|---|---|---|---|")
+    for s in rows:
+        for k, (n, w, rv) in sorted(s["kinds"].items()):
+            print(f"| {s['case']} | {k} | {n} | {w} ({rv}) | {binom_upper(n, 0.05)} |")
     print("\nper noise form: replicas; TEST and drift false alarms in the null updates; replicas "
           "with a false CUSUM alarm; wrong \"told apart\" of all\n")
     print("| case | form | replicas | TEST false alarms (bound) | drift false alarms | "
