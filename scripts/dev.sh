@@ -36,6 +36,11 @@
 #                               (truth by ROSS and by rcbtool simulate, a two-effect and a null
 #                               case) x SEEDS (default 5) noise seeds, as a table (needs .venv;
 #                               several minutes); extra arguments go to tools/bench/diag_success.py
+#   ./scripts/dev.sh monitor-replicas  the monitor's rates at 32 x 1101 (issue #34 item 2): null,
+#                               drift, wear, step x REPLICAS (default 100) ROSS series, numpy noise
+#                               of four forms, every count against its binomial bound (needs .venv;
+#                               about 10 s CPU per replica); extra arguments go to
+#                               tools/bench/monitor_replicas.py (--cases null,drift --first N)
 #   ./scripts/dev.sh fuzz       libFuzzer smoke (issue #7): build fuzz/ with clang (ASan+UBSan),
 #                               replay the seed corpora, then fuzz each harness FUZZ_SECONDS
 #                               (default 30) s; needs clang and libclang-rt-dev (not in `test`)
@@ -611,6 +616,16 @@ cmd_diag_success() {
     --rcbtool "$(rcbtool_exe)" --seeds "${SEEDS:-5}" "$@"
 }
 
+# The monitor's rates by replicas (issue #34 item 2): tools/bench/monitor_replicas.py
+# prints the table docs/monitoring.md quotes; never fails on a count (it reports).
+cmd_monitor_replicas() {
+  cmd_build
+  [[ -x $VENV/bin/python ]] || die "no $VENV: run ./scripts/dev.sh deps (NumPy, ROSS)"
+  say "monitor rates: ${REPLICAS:-100} replicas per case at 32 x 1101 (one core, nice)"
+  OPENBLAS_NUM_THREADS=1 LIBRCB_PATH=$BUILD_DIR/src/librcb.so nice -n 10 "$VENV/bin/python" \
+    tools/bench/monitor_replicas.py --replicas "${REPLICAS:-100}" "$@"
+}
+
 # libFuzzer smoke: every seed replayed, then FUZZ_SECONDS of fuzzing per
 # harness on a scratch copy of the corpus (fuzz/corpus stays as committed).
 # Not part of `test`: it needs clang with its runtime (Debian: clang,
@@ -1082,6 +1097,7 @@ case ${1:-} in
   bench-fit) shift; cmd_bench_fit "$@" ;;
   bench-suite) shift; cmd_bench_suite "$@" ;;
   diag-success) shift; cmd_diag_success "$@" ;;
+  monitor-replicas) shift; cmd_monitor_replicas "$@" ;;
   fuzz) cmd_fuzz ;;
   fuzz-smoke) cmd_fuzz_smoke ;;
   valgrind) cmd_valgrind ;;
