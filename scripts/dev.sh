@@ -953,7 +953,8 @@ cmd_cross_chroot() {
   say "the working tree to $CHROOT/src"
   # the last copy goes, its builds stay: a file gone from the tree must not
   # linger there (src/ is globbed); tar keeps the mtimes, so builds stay current
-  find "$CHROOT/src" -mindepth 1 -maxdepth 1 ! -name 'build-embedded*' -exec rm -rf {} +
+  [[ ! -d $CHROOT/src ]] ||
+    find "$CHROOT/src" -mindepth 1 -maxdepth 1 ! -name 'build-embedded*' -exec rm -rf {} +
   chroot_copy_tree "$CHROOT/src"
   chroot_mount "$CHROOT"
   chroot_run "$CHROOT" CROSS_TARGETS="${CROSS_TARGETS:-aarch64 armhf}" CROSS_LIGHT="${CROSS_LIGHT:-0}" \

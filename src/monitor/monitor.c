@@ -217,9 +217,10 @@ static rcb_status tracked_step(rcb_monitor *mon, double *theta) {
   double d[RCB_MONITOR_MAX_TRACKED];
   rcb_status st;
   int small = 0;
-  double *base = mon->rmx + mon->n * (1 + nt + RCB_MONITOR_MAXP), th[RCB_MONITOR_MAX_TRACKED];
+  double *base, th[RCB_MONITOR_MAX_TRACKED];
   mon->jt = 0;
   if (!mon->relin || !nt) return RCB_OK;
+  base = mon->rmx + mon->n * (1 + nt + RCB_MONITOR_MAXP); /* rmx: with relinearise */
   for (it = 0; !small && it < mon->relin; it++) {
     if (it && (st = model_change(mon, theta, NULL, NULL))) return st;
     memcpy(base, mon->ym, k * sizeof *base); /* ym at the step before this correction */

@@ -294,6 +294,8 @@ def test_unrepresentable_elements_raise(ross):
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 ROUND_TRIP = {str(p.relative_to(EXAMPLES)): p.read_text() for p in sorted(EXAMPLES.rglob("*.ini"))}
 ROUND_TRIP.update({f"{k}-inline": v for k, v in rm.MODELS.items()})
+# Examples ROSS has no element for: the bridge refuses them, naming why.
+NO_ROSS = {"case_study/cantilever.ini": "rigid coupling across a gap"}
 
 
 @pytest.mark.parametrize("name", list(ROUND_TRIP))
@@ -301,6 +303,10 @@ def test_round_trip_ini_ross_ini(name, rcbtool, tmp_path, record):
     """Every example: INI -> ROSS (speed tables kept as tables) -> INI gives
     the same assembled matrices, in the node order of the ROSS rotor."""
     text = ROUND_TRIP[name]
+    if name in NO_ROSS:
+        with pytest.raises(NotImplementedError, match=NO_ROSS[name]):
+            rb.IniRotor(rb.Model(text))
+        return
     ini_rotor = rb.IniRotor(rb.Model(text))  # speed tables kept as ROSS frequency tables
     conv = rb.convert_rotor(ini_rotor.rotor, name=name)
     a, b = tmp_path / "a.ini", tmp_path / "b.ini"
