@@ -943,8 +943,7 @@ static size_t find_cand(const rcb_monitor *mon, rcb_effect e, const char *params
  * that channel, exact for any gain (the reading is linear in it), so the
  * first candidate is C.A.y's gain with a change of -0.1 to rounding, the
  * tracked kt unmoved; a gain of -1 (a probe wired the wrong way) is the
- * change -2, as exactly. By default (effects 0) every sensor is a
- * candidate; a mask without RCB_EFFECT_SENSOR_GAIN leaves them out. */
+ * change -2, as exactly. By default (effects 0) no sensor is a candidate. */
 static void test_sensor_gain(void **state) {
   fixture *f = *state;
   rcb_monitor_param tp;
@@ -956,7 +955,6 @@ static void test_sensor_gain(void **state) {
   size_t j, i, g;
   assert_non_null(v);
   o.setup_averages = HUGE_VAL;
-  o.effects = (1u << RCB_EFFECT_ELEMENT_STIFFNESS) - 1u; /* rcbtool --no-sensors */
   assert_int_equal(rcb_monitor_create(&mon, f->truth, f->setup, &o, NULL), RCB_OK);
   for (j = 0; j < rcb_monitor_candidate_count(mon); j++) {
     rcb_monitor_candidate_info ci;
@@ -964,7 +962,7 @@ static void test_sensor_gain(void **state) {
     assert_int_not_equal(ci.effect, RCB_EFFECT_SENSOR_GAIN);
   }
   rcb_monitor_destroy(mon);
-  o.effects = 0; /* the default: every measured sensor's gain among the candidates */
+  o.effects = ((1u << RCB_EFFECT_ELEMENT_STIFFNESS) - 1u) | (1u << RCB_EFFECT_SENSOR_GAIN);
   assert_int_equal(rcb_monitor_create(&mon, f->truth, f->setup, &o, NULL), RCB_OK);
   (void)find_cand(mon, RCB_EFFECT_SENSOR_GAIN, "sensor.C.A.y.gain");
   for (g = 0; g < 2; g++) {

@@ -225,11 +225,9 @@ typedef struct rcb_monitor_opts {
   double setup_averages; /**< measurements averaged into the set-up values
                               (>= 1); 0: 1; HUGE_VAL: a noise-free reference */
   unsigned effects;  /**< candidate effects: bit (1u << rcb_effect) set for
-                          each one catalogued; 0: the effects before the shaft
-                          elements (RCB_EFFECT_ELEMENT_STIFFNESS) and every
-                          measured sensor's gain (RCB_EFFECT_SENSOR_GAIN); the
-                          coupling model, refitted only by the diagnosis, has
-                          no neutral value and is always left out */
+                          each one catalogued; 0: every effect the catalogue
+                          scores (the coupling model, refitted only by the
+                          diagnosis, has no neutral value and is left out) */
   size_t top;        /**< candidates ranked in each result, 0: RCB_MONITOR_TOP */
   size_t relinearise; /**< chord iterations refining the tracked estimates per
                            update by re-evaluating the model (0: linear only;

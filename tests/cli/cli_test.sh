@@ -999,7 +999,6 @@ bad_monitor_series)
     usage monitor "$MODEL" "$W/s" $M --log "$W/log.txt"; err_has ".json or .csv"
     usage monitor "$MODEL" "$W/s" --params coupling.C.kt --noise 10,1,90; err_has "0 <= P < 90"
     usage monitor "$MODEL" $M; err_has "missing the measurements"
-    usage monitor "$MODEL" "$W/s" $M --sensors --no-sensors; err_has "give one of them"
     # an output that is one of the inputs
     cp "$W/s/m2.csv" "$W/m2.orig"
     run monitor "$MODEL" "$W/s" $M --log "$W/s/m2.csv"; expect_rc 5; err_has "refusing"

@@ -302,8 +302,9 @@ int main(int argc, char **argv) {
       (1u << RCB_EFFECT_BEARING_DAMPING) | (1u << RCB_EFFECT_COUPLING_TRANSLATIONAL_DAMPING) |
       (1u << RCB_EFFECT_COUPLING_ROTATIONAL_STIFFNESS) |
       (1u << RCB_EFFECT_COUPLING_ROTATIONAL_DAMPING);
-  /* rcbtool monitor --no-sensors: the default catalogue without the probes' gains */
-  const unsigned nosensors = (1u << RCB_EFFECT_ELEMENT_STIFFNESS) - 1u;
+  /* rcbtool monitor --sensors: the default catalogue and every probe's gain */
+  const unsigned sensors =
+      ((1u << RCB_EFFECT_ELEMENT_STIFFNESS) - 1u) | (1u << RCB_EFFECT_SENSOR_GAIN);
   /* label, relinearise, updates, reweight, effects, the probe series' settings */
   const row rows[] = {
       {"linear", 0, 400, 0, 0, 0},
@@ -311,14 +312,14 @@ int main(int argc, char **argv) {
       {"re-linearised (<= 8)", 8, 50, 0, 0, 0},
       {"reweighted + re-lin. 8", 8, 50, 1, 0, 0}, /* "ross" */
       {"the same, changed", 8, 20, 1, 0, 0},      /* "changed" */
-      {"changed, --no-sensors", 8, 20, 1, nosensors, 0}, /* "nosensors" */
-      {"probe DA.x 0.85, series", 8, 20, 1, 0, 1}, /* "probe" */
+      {"changed, --sensors", 8, 20, 1, sensors, 0}, /* "sensors" */
+      {"probe DA.x 0.85, series", 8, 20, 1, sensors, 1}, /* "probe" */
       {"speed -3 %", 8, 20, 1, 0, 0},              /* "speed": a sweep-path effect */
       {"shaft A material damping", 8, 20, 1, 0, 0}, /* "damping": another */
       {"linear", 0, 400, 0, bearings_coupling, 0},
       {"reweighted", 0, 100, 1, bearings_coupling, 0}};
   static const char *const names[] = {"linear", "reweighted", "relin", "ross", "changed",
-                                      "nosensors", "probe", "speed", "damping"};
+                                      "sensors", "probe", "speed", "damping"};
   if (argc < 2) {
     fprintf(stderr, "usage: bench_monitor MODEL.ini [ROW [UPDATES]]\n");
     return 2;
@@ -374,7 +375,7 @@ int main(int argc, char **argv) {
   for (i = 0; only && i < sizeof names / sizeof names[0] && strcmp(only, names[i]); i++) continue;
   if (only && i == sizeof names / sizeof names[0]) {
     fprintf(stderr, "bench_monitor: unknown row '%s' (linear, reweighted, relin, ross, changed, "
-            "nosensors, probe, speed or damping)\n", only);
+            "sensors, probe, speed or damping)\n", only);
     rc = 2;
     goto done;
   }

@@ -19,7 +19,7 @@ const char cli_help_monitor[] =
     "usage: rcbtool monitor BASELINE.ini DIR|MEAS... --params NAME[:LO:HI],...\n"
     "                       [--noise A,S[,P] | --sd STATS.csv|DIR] [--commission N]\n"
     "                       [--alpha A] [--cusum-h H] [--cusum-k K] [--relinearise N]\n"
-    "                       [--reweight] [--no-sensors] [--baseline-sd SD,...]\n"
+    "                       [--reweight] [--sensors] [--baseline-sd SD,...]\n"
     "                       [--map NODE=STATION,...] [--rpm R]\n"
     "                       [--log OUT.json|OUT.csv] [--plot TREND.png] [--json]\n"
     "                       [-o FILE] [--progress]\n"
@@ -65,11 +65,10 @@ const char cli_help_monitor[] =
     "                  its --sd file), statistics by generalised least squares: T\n"
     "                  stays chi-square after a large change of the tracked\n"
     "                  parameters (a moved resonance); slower per update\n"
-    "  --no-sensors    leave the probes' gains out of the candidate effects (by\n"
-    "                  default every measured probe's gain is one: a drifting or\n"
-    "                  miscalibrated probe, or one wired the wrong way, gain -1,\n"
-    "                  is named as the sensor, not read as the machine);\n"
-    "                  --sensors, the default, is accepted\n"
+    "  --sensors       every measured probe's gain among the candidate effects: a\n"
+    "                  drifting or miscalibrated probe (or one wired the wrong\n"
+    "                  way, gain -1) is named as the sensor, not read as the\n"
+    "                  machine\n"
     "  --baseline-sd L standard errors of the baseline's values of the --params, in\n"
     "                  their order and units (the 'stderr' of the rcbtool fit that\n"
     "                  made the baseline): they widen the values' intervals (the\n"
@@ -147,10 +146,7 @@ static int parse_job(const cli_args *a, mon_job *j) {
                      cli_opt_value(a, "--relinearise"));
   j->relinearise = (size_t)relin;
   j->reweight = cli_opt_value(a, "--reweight") != NULL;
-  if (cli_opt_value(a, "--sensors") && cli_opt_value(a, "--no-sensors"))
-    return cli_usage(a->cmd, "options --sensors and --no-sensors: give one of them (the "
-                     "probes' gains are candidates by default)");
-  j->sensors = cli_opt_value(a, "--no-sensors") == NULL;
+  j->sensors = cli_opt_value(a, "--sensors") != NULL;
   if (cli_opt_value(a, "--alpha") && !(j->alpha > 0.0 && j->alpha < 1.0))
     return cli_usage(a->cmd, "option --alpha expects a probability 0 < A < 1, got '%s'",
                      cli_opt_value(a, "--alpha"));
@@ -327,7 +323,7 @@ static int state_plan(int argc, char **argv, const cli_opt *opts, size_t nopts,
 static const char *const SETTING_OPTS[] = {"--params", "--noise",  "--sd",     "--commission",
                                            "--alpha",  "--cusum-h", "--cusum-k", "--relinearise",
                                            "--reweight", "--map",  "--rpm", "--baseline-sd",
-                                           "--sensors", "--no-sensors"};
+                                           "--sensors"};
 
 /* 1 + the number of strings @p argv[k] (with its value) takes when it is a
  * setting option, else 0. */
@@ -338,8 +334,7 @@ static int setting_at(int argc, char **argv, int k) {
     if (strncmp(argv[k], SETTING_OPTS[i], n) != 0) continue;
     if (argv[k][n] == '=') return 2;
     if (argv[k][n] != '\0') continue;
-    if (strcmp(SETTING_OPTS[i], "--reweight") == 0 || strcmp(SETTING_OPTS[i], "--sensors") == 0 ||
-        strcmp(SETTING_OPTS[i], "--no-sensors") == 0)
+    if (strcmp(SETTING_OPTS[i], "--reweight") == 0 || strcmp(SETTING_OPTS[i], "--sensors") == 0)
       return 2;
     return k + 1 < argc ? 3 : 2;
   }
@@ -410,7 +405,6 @@ int cmd_monitor(int argc, char **argv) {
                     {"--relinearise", "N", NULL},
                     {"--reweight", NULL, NULL},
                     {"--sensors", NULL, NULL},
-                    {"--no-sensors", NULL, NULL},
                     {"--baseline-sd", "SD,...", NULL},
                     {"--map", "NODE=STATION,...", NULL},
                     {"--rpm", "R", NULL},
