@@ -241,7 +241,8 @@ static rcb_status candidates_gls(rcb_monitor *mon) {
  * less those at the baseline's, to first order in d): an error every
  * update of a wear shares, growing with the wear, which the instant test
  * would otherwise read as a new effect (the ROSS kt_wear series from a
- * log10-fitted baseline: 7 TEST alarms in 101 updates, bound 4). */
+ * log10-fitted baseline, with --sensors: 7 TEST alarms in 101 updates,
+ * bound 4; 0 with this part). */
 static void baseline_part(rcb_monitor *mon) {
   enum { MT = RCB_MONITOR_MAX_TRACKED };
   size_t k = mon->k, nt = mon->nt, i, j, a, b;
