@@ -376,6 +376,130 @@ static void test_null_sd(void **state) {
   free(sd);
 }
 
+/* rcb_monitor_noise_scale in closed form: two measurements m +- d at every
+ * point, d = (dr along m, dt across it), so the scatter about their average
+ * m is 2 (dr^2 / vr + dt^2 / vt) per point, vr and vt one measurement's
+ * declared variance at m written out here from eq. 19 and the phase turn:
+ * vr = (beta_a/100 |m|)^2 / 3 + a^2 / 6, vt = a^2 / 6 + (phase_deg pi/180)^2
+ * |m|^2 / 3, a = beta_s / 100 x the channel's rms of m. Then with sd given,
+ * vr = vt = sd^2; and the refusals. */
+static void test_noise_scale_closed_form(void **state) {
+  fixture *f = *state;
+  rcb_monitor_opts o;
+  rcb_monitor_noise ns;
+  rcb_complex *v = malloc(2 * NPT * sizeof *v);
+  double *sd = malloc(NPT * sizeof *sd), want = 0, want_sd = 0;
+  const double ph = 2.0 * 3.14159265358979323846 / 180.0; /* 2 degrees, rad */
+  size_t c, i;
+  memset(&o, 0, sizeof o);
+  o.beta_a = BETA_A, o.beta_s = BETA_S, o.phase_deg = 2.0;
+  for (c = 0; c < NCH; c++) {
+    double s2 = 0, a;
+    for (i = 0; i < NPTS; i++) s2 += pow(cabs(f->fs[c * NPTS + i]), 2);
+    a = BETA_S / 100.0 * sqrt(s2) / (double)NPTS;
+    for (i = 0; i < NPTS; i++) {
+      size_t p = c * NPTS + i;
+      rcb_complex m = f->fs[p], u = m / cabs(m);
+      double am = cabs(m), dr = 0.01 * am * (1 + (double)(i % 7)), dt = 1e-3 * am * (double)(i % 5);
+      double vr = pow(BETA_A / 100.0 * am, 2) / 3 + a * a / 6, vt = a * a / 6 + ph * ph / 3 * am * am;
+      v[p] = m + (dr + CMPLX(0.0, dt)) * u;       /* measurement 1 */
+      v[NPT + p] = m - (dr + CMPLX(0.0, dt)) * u; /* measurement 2 */
+      want += 2 * (dr * dr / vr + dt * dt / vt);
+      sd[p] = 0.02 * am + 1e-9;
+      want_sd += 2 * (dr * dr + dt * dt) / (sd[p] * sd[p]);
+    }
+  }
+  assert_int_equal(rcb_monitor_noise_scale(f->setup, v, 2, &o, &ns), RCB_OK);
+  print_message("noise scale, closed form: chi2 %.10g (expected %.10g), dof %g, scale %.6g\n",
+                ns.chi2, want, ns.dof, ns.scale);
+  assert_true(fabs(ns.chi2 / want - 1) < 1e-10);
+  assert_true(ns.dof == 2.0 * NPT);
+  assert_true(fabs(ns.scale - sqrt(want / (2.0 * NPT))) < 1e-12 * ns.scale);
+  o.sd = sd;
+  assert_int_equal(rcb_monitor_noise_scale(f->setup, v, 2, &o, &ns), RCB_OK);
+  assert_true(fabs(ns.chi2 / want_sd - 1) < 1e-10);
+  /* refused: one measurement, a value not finite, no noise, a bad scale */
+  assert_int_equal(rcb_monitor_noise_scale(f->setup, v, 1, &o, &ns), RCB_ERR_ARG);
+  v[NPT + 7] = NAN;
+  assert_int_equal(rcb_monitor_noise_scale(f->setup, v, 2, &o, &ns), RCB_ERR_ARG);
+  v[NPT + 7] = v[7];
+  o.sd = NULL, o.beta_a = o.beta_s = 0;
+  assert_int_equal(rcb_monitor_noise_scale(f->setup, v, 2, &o, &ns), RCB_ERR_ARG);
+  o.beta_a = BETA_A, o.noise_scale = -1;
+  assert_int_equal(rcb_monitor_noise_scale(f->setup, v, 2, &o, &ns), RCB_ERR_ARG);
+  free(v);
+  free(sd);
+}
+
+/* Noise 25 % above the declared level, eq. 19's form (the test's own
+ * generator, both terms times LEVEL). The scale measured on NAVG
+ * commissioning measurements is LEVEL within 1.5 % (the estimate's relative
+ * sd is about sqrt(1 / (2 dof)) = 0.3 % here); a monitor commissioned on
+ * their average with that scale keeps the instant test's false alarms
+ * within the binomial 99 % interval over N null updates and T's mean at its
+ * dof; the same monitor without the scale (the noise as declared) does not
+ * (the case the scale is for: the test could fail). */
+static void test_noise_scale_null(void **state) {
+  fixture *f = *state;
+  enum { NAVG = 10 };
+  const double LEVEL = 1.25;
+  const size_t N = fast_mode() ? 30 : 300;
+  rcb_monitor_param tp;
+  rcb_monitor_opts o = opts_kt(&tp, f->kt);
+  rcb_monitor_noise ns;
+  rcb_monitor *mon = NULL, *mon1 = NULL;
+  rcb_monitor_result r, r1;
+  rcb_complex *files = malloc(NAVG * NPT * sizeof *files), *avg = calloc(NPT, sizeof *avg);
+  rcb_meas *setup;
+  size_t k, i, u, alarms = 0, alarms1 = 0, lo, hi;
+  double sumT = 0, tol;
+  uint64_t seed = 20261205;
+  for (k = 0; k < NAVG; k++) {
+    rcb_complex *x = files + k * NPT;
+    eq19(f->fs, x, &seed);
+    for (i = 0; i < NPT; i++) x[i] = f->fs[i] + LEVEL * (x[i] - f->fs[i]);
+    for (i = 0; i < NPT; i++) avg[i] += x[i] / (double)NAVG;
+  }
+  setup = with_values(f->setup, avg, 1.0);
+  assert_int_equal(rcb_monitor_noise_scale(setup, files, NAVG, &o, &ns), RCB_OK);
+  print_message("noise %g x the declared: measured scale %.4f (chi2 %.6g on %g dof)\n", LEVEL,
+                ns.scale, ns.chi2, ns.dof);
+  assert_true(fabs(ns.scale / LEVEL - 1) < 0.015);
+  o.alpha = 0.02;
+  o.setup_averages = NAVG;
+  assert_int_equal(rcb_monitor_create(&mon1, f->base, setup, &o, NULL), RCB_OK);
+  o.noise_scale = ns.scale;
+  assert_int_equal(rcb_monitor_create(&mon, f->base, setup, &o, NULL), RCB_OK);
+  for (u = 0; u < N; u++) {
+    eq19(f->fs, f->v, &seed);
+    for (i = 0; i < NPT; i++) f->v[i] = f->fs[i] + LEVEL * (f->v[i] - f->fs[i]);
+    assert_int_equal(rcb_monitor_update(mon, f->v, NULL, &r), RCB_OK);
+    assert_int_equal(rcb_monitor_update(mon1, f->v, NULL, &r1), RCB_OK);
+    alarms += (size_t)r.alarm, alarms1 += (size_t)r1.alarm;
+    sumT += r.T;
+    /* the same change whitened by a noise scale x larger: T / scale^2 (to
+     * 1e-3: the baseline fit of kt at create stops at a fraction of its
+     * standard error, which the scale changes; measured 6e-5) */
+    assert_int_equal(r.dof, r1.dof);
+    assert_true(fabs(r.T * ns.scale * ns.scale / r1.T - 1) < 1e-3);
+  }
+  binom99(N, o.alpha, &lo, &hi);
+  tol = 4 * sqrt(2.0 * (double)r.dof / (double)N);
+  print_message("null at %g x: with the scale %zu alarms, mean T %.2f (dof %zu); as declared "
+                "%zu alarms (99 %% interval [%zu, %zu])\n", LEVEL, alarms, sumT / (double)N,
+                r.dof, alarms1, lo, hi);
+  if (!fast_mode()) {
+    assert_true(alarms >= lo && alarms <= hi);
+    assert_true(fabs(sumT / (double)N - (double)r.dof) < tol);
+    assert_true(alarms1 > hi);
+  }
+  rcb_monitor_destroy(mon);
+  rcb_monitor_destroy(mon1);
+  rcb_meas_destroy(setup);
+  free(files);
+  free(avg);
+}
+
 /* The self-starting CUSUM (rcb_monitor.h). The commissioning values are the
  * average of NAVG noisy measurements, so every update's z carries the same
  * commissioning noise; the CUSUM's input u must not: over a null series u
@@ -1423,6 +1547,8 @@ int main(void) {
       cmocka_unit_test(test_null_phase),
       cmocka_unit_test(test_null_phase_reweighted),
       cmocka_unit_test(test_null_sd),
+      cmocka_unit_test(test_noise_scale_closed_form),
+      cmocka_unit_test(test_noise_scale_null),
       cmocka_unit_test(test_unbalance_null),
       cmocka_unit_test(test_self_starting_cusum),
       cmocka_unit_test(test_kt_change),

@@ -271,7 +271,25 @@ typedef struct rcb_monitor_opts {
                           other-version one; the caller then creates without
                           it. NULL (default): none */
   size_t image_size; /**< bytes at image */
+  double noise_scale; /**< the noise's measured level against the declared
+                          one (-): every declared standard deviation (beta_a,
+                          beta_s, phase_deg, sd) is multiplied by it, in the
+                          weights and in every test; e.g. the scale of
+                          rcb_monitor_noise_scale on the measurements averaged
+                          into the set-up. 0: 1 (the noise as declared) */
 } rcb_monitor_opts;
+
+/** @brief The noise's level measured on repeated measurements of one state
+ * (rcb_monitor_noise_scale). */
+typedef struct rcb_monitor_noise {
+  double scale; /**< sqrt(chi2 / dof) (-): the measured level against the
+                     declared one (1: as declared) */
+  double chi2;  /**< the measurements' scatter about their average, each
+                     point's (radial, tangential) deviation whitened by one
+                     measurement's declared variance at the average (-) */
+  double dof;   /**< its expectation under the declared noise:
+                     2 x channels x points x (measurements - 1) */
+} rcb_monitor_noise;
 
 /** @brief One ranked candidate effect in a result. */
 typedef struct rcb_monitor_candidate {
@@ -412,6 +430,24 @@ typedef struct rcb_monitor rcb_monitor;
 RCB_API rcb_status rcb_monitor_create(rcb_monitor **out, const rcb_model *baseline,
                                       const rcb_meas *setup, const rcb_monitor_opts *opts,
                                       const rcb_allocator *alloc);
+/**
+ * @brief The noise's level from @p nrep measurements of one state (the
+ * commissioning files, before they are averaged into the set-up): how many
+ * times the noise @p opts declares (beta_a, beta_s, phase_deg or sd; its
+ * noise_scale is ignored) their scatter about their average is. A noise of
+ * the declared form but another level gives scale = that level's ratio, to
+ * about sqrt(1 / (2 dof)); pass it as opts.noise_scale to rcb_monitor_create
+ * with the average as the set-up. Reads only; allocates nothing.
+ * @param setup channels and abscissa (its values are not read)
+ * @param values nrep x channels x points, values[(r * nch + c) * npoints + i],
+ * the set-up's channel order, the channels' units
+ * @param nrep measurements, >= 2
+ * @return RCB_OK; RCB_ERR_ARG for nrep < 2, a missing noise model, a value
+ * that is not finite or a point of zero declared variance
+ */
+RCB_API rcb_status rcb_monitor_noise_scale(const rcb_meas *setup, const rcb_complex *values,
+                                           size_t nrep, const rcb_monitor_opts *opts,
+                                           rcb_monitor_noise *out);
 RCB_API void rcb_monitor_destroy(rcb_monitor *mon);
 /** @brief Last error, naming the channel and point where it applies. */
 RCB_API const char *rcb_monitor_errmsg(const rcb_monitor *mon);

@@ -77,53 +77,80 @@ static rcb_status copy_setup(rcb_monitor *mon, const rcb_meas *setup) {
 
 /* ---- noise: the standard deviation of every residual ---- */
 
-/* Radial and tangential sd of one measurement at each point: eq. 19
- * (proportional part along e_0, variance (beta_a/100)^2 |e_0|^2 / 3 from
- * r1 uniform on [-1, 1]; additive part circular, a^2 / 3 split over two
- * components; a phase turn uniform in +-phase_deg, to first order
- * tangential, variance |e_0|^2 (phase_deg pi/180)^2 / 3) or the caller's
- * sd (circular). */
+double rcb_mon_eq19_amp(double beta_s, const rcb_complex *v, size_t n) {
+  double s2 = 0.0;
+  size_t i;
+  for (i = 0; i < n; i++) s2 += creal(v[i] * conj(v[i]));
+  return beta_s / 100.0 * sqrt(s2) / (double)n;
+}
+
+/* One measurement's declared variance at a point of modulus ae, radial
+ * (along the value) *vr and tangential *vt, the channel's units squared:
+ * eq. 19's proportional part along the value (variance (beta_a/100)^2 ae^2
+ * / 3, r1 uniform on [-1, 1]), its additive part of amplitude a circular
+ * (a^2 / 3 split over two components), a phase turn uniform in +-phase_deg
+ * to first order tangential (phase_var ae^2, phase_var = (phase_deg
+ * pi/180)^2 / 3). */
+static void eq19_var(double beta_a, double a, double phase_var, double ae, double *vr,
+                     double *vt) {
+  double pa = beta_a / 100.0 * ae;
+  *vt = a * a / 6.0;
+  *vr = pa * pa / 3.0 + *vt;
+  *vt += phase_var * ae * ae;
+}
+
+/* The declared noise of opts checked: the message into err (size n). */
+static rcb_status noise_opts(const rcb_monitor_opts *o, char *err, size_t n) {
+  if (!o->sd && !(o->beta_a > 0 || o->beta_s > 0))
+    return snprintf(err, n, "no noise: give beta_a/beta_s (eq. 19, %%) or per-point standard "
+                    "deviations (opts.sd)"), RCB_ERR_ARG;
+  if (!o->sd && (!(o->beta_a >= 0) || !(o->beta_s >= 0) || !isfinite(o->beta_a + o->beta_s)))
+    return snprintf(err, n, "noise: beta_a = %g, beta_s = %g %%: expected finite >= 0",
+                    o->beta_a, o->beta_s), RCB_ERR_ARG;
+  if (!(o->phase_deg >= 0) || !(o->phase_deg < 90))
+    return snprintf(err, n, "noise: phase_deg = %g degrees: expected 0 <= phase_deg < 90",
+                    o->phase_deg), RCB_ERR_ARG;
+  if (!(o->noise_scale >= 0) || !isfinite(o->noise_scale))
+    return snprintf(err, n, "noise: noise_scale = %g: expected finite >= 0 (0: as declared)",
+                    o->noise_scale), RCB_ERR_ARG;
+  return RCB_OK;
+}
+
+/* Radial and tangential sd of one measurement at each point: eq. 19 with the
+ * phase turn (eq19_var) or the caller's sd (circular), at the commissioning
+ * values, times opts.noise_scale. */
 static rcb_status noise(rcb_monitor *mon, const rcb_monitor_opts *o) {
   double navg = o->setup_averages > 0 ? o->setup_averages : 1.0;
   double f0 = isinf(navg) ? 1.0 : 1.0 + 1.0 / navg; /* new + commissioning variance */
+  double sc = o->noise_scale > 0 ? o->noise_scale : 1.0, ph = o->phase_deg * sc * RCB_MON_DEG;
+  char err[160];
   size_t c, i;
-  mon->navg_inv = isinf(navg) ? 0.0 : 1.0 / navg;
-  mon->beta_a = o->beta_a, mon->beta_s = o->beta_s;
-  mon->have_sd0 = o->sd != NULL;
-  mon->phase_var = (o->phase_deg * RCB_MON_DEG) * (o->phase_deg * RCB_MON_DEG) / 3.0;
+  rcb_status st;
   if (navg < 1.0)
     return rcb_mon_fail(mon, RCB_ERR_ARG, "setup_averages = %g: expected >= 1 (measurements "
                         "averaged into the commissioning values)", navg);
-  if (!o->sd && !(o->beta_a > 0 || o->beta_s > 0))
-    return rcb_mon_fail(mon, RCB_ERR_ARG, "no noise: give beta_a/beta_s (eq. 19, %%) or per-point "
-                        "standard deviations (opts.sd)");
-  if (!o->sd && (!(o->beta_a >= 0) || !(o->beta_s >= 0) || !isfinite(o->beta_a + o->beta_s)))
-    return rcb_mon_fail(mon, RCB_ERR_ARG, "noise: beta_a = %g, beta_s = %g %%: expected finite "
-                        ">= 0", o->beta_a, o->beta_s);
-  if (!(o->phase_deg >= 0) || !(o->phase_deg < 90))
-    return rcb_mon_fail(mon, RCB_ERR_ARG, "noise: phase_deg = %g degrees: expected 0 <= "
-                        "phase_deg < 90", o->phase_deg);
+  if ((st = noise_opts(o, err, sizeof err))) return rcb_mon_fail(mon, st, "%s", err);
+  mon->navg_inv = isinf(navg) ? 0.0 : 1.0 / navg;
+  mon->nscale = sc, mon->beta_a = o->beta_a * sc, mon->beta_s = o->beta_s * sc;
+  mon->have_sd0 = o->sd != NULL;
+  mon->phase_var = ph * ph / 3.0;
   for (c = 0; c < mon->nch; c++) {
     const rcb_complex *e = mon->e0 + c * mon->npts;
-    double s2 = 0.0, a;
-    for (i = 0; i < mon->npts; i++) s2 += creal(e[i] * conj(e[i]));
-    mon->e0norm2 += s2;
-    a = o->beta_s / 100.0 * sqrt(s2) / (double)mon->npts; /* eq. 19 additive amplitude */
+    double a = rcb_mon_eq19_amp(mon->beta_s, e, mon->npts); /* eq. 19 additive amplitude */
     for (i = 0; i < mon->npts; i++) {
       size_t p = c * mon->npts + i;
       double ae = cabs(e[i]), vr, vt;
+      mon->e0norm2 += creal(e[i] * conj(e[i]));
       mon->u[p] = ae > 0 ? e[i] / ae : 1.0;
       if (o->sd) {
-        double s = o->sd[p];
-        if (!(s > 0) || !isfinite(s))
+        double s = o->sd[p] * sc;
+        if (!(o->sd[p] > 0) || !isfinite(s))
           return rcb_mon_fail(mon, RCB_ERR_ARG, "opts.sd: channel %zu point %zu: sd = %g, "
-                              "expected finite > 0", c + 1, i + 1, s);
+                              "expected finite > 0", c + 1, i + 1, o->sd[p]);
         vr = vt = s * s;
+        mon->sd0[p] = s;
       } else {
-        double pa = o->beta_a / 100.0 * ae;
-        vt = a * a / 6.0;
-        vr = pa * pa / 3.0 + vt;
-        vt += mon->phase_var * ae * ae; /* the phase turn moves e_0 tangentially */
+        eq19_var(mon->beta_a, a, mon->phase_var, ae, &vr, &vt);
       }
       if (!(vr > 0) || !(vt > 0))
         return rcb_mon_fail(mon, RCB_ERR_ARG, "noise: channel %zu point %zu has zero standard "
@@ -132,12 +159,56 @@ static rcb_status noise(rcb_monitor *mon, const rcb_monitor_opts *o) {
       mon->sd_new_rad[p] = sqrt(vr);
       mon->e0abs[p] = ae;
       mon->var0[2 * p] = vr, mon->var0[2 * p + 1] = vt;
-      if (o->sd) mon->sd0[p] = o->sd[p];
       mon->winv[2 * p] = 1.0 / sqrt(vr * f0);
       mon->winv[2 * p + 1] = 1.0 / sqrt(vt * f0);
     }
   }
   for (i = 0; i < mon->npt; i++) mon->floor2 += mon->sd_new_rad[i] * mon->sd_new_rad[i];
+  return RCB_OK;
+}
+
+rcb_status rcb_monitor_noise_scale(const rcb_meas *setup, const rcb_complex *values, size_t nrep,
+                                   const rcb_monitor_opts *o, rcb_monitor_noise *out) {
+  size_t nch, npts, c, i, r;
+  double chi2 = 0.0, ph;
+  char err[160];
+  if (!setup || !values || !o || !out || nrep < 2 || noise_opts(o, err, sizeof err))
+    return RCB_ERR_ARG;
+  nch = rcb_meas_channel_count(setup), npts = rcb_meas_point_count(setup);
+  if (!nch || !npts) return RCB_ERR_ARG;
+  ph = o->phase_deg * RCB_MON_DEG;
+  for (c = 0; c < nch; c++) {
+    double a = 0.0;
+    for (i = 0; i < npts && !o->sd; i++) { /* the additive amplitude of the average */
+      rcb_complex m = 0.0;
+      for (r = 0; r < nrep; r++) m += values[(r * nch + c) * npts + i];
+      m /= (double)nrep;
+      a += creal(m * conj(m));
+    }
+    a = o->beta_s / 100.0 * sqrt(a) / (double)npts;
+    for (i = 0; i < npts; i++) {
+      rcb_complex m = 0.0, u;
+      double ae, vr, vt;
+      for (r = 0; r < nrep; r++) m += values[(r * nch + c) * npts + i];
+      m /= (double)nrep;
+      if (!isfinite(creal(m)) || !isfinite(cimag(m))) return RCB_ERR_ARG;
+      ae = cabs(m);
+      u = ae > 0 ? m / ae : 1.0;
+      if (o->sd) {
+        vr = vt = o->sd[c * npts + i] * o->sd[c * npts + i];
+      } else {
+        eq19_var(o->beta_a, a, ph * ph / 3.0, ae, &vr, &vt);
+      }
+      if (!(vr > 0) || !(vt > 0) || !isfinite(vr + vt)) return RCB_ERR_ARG;
+      for (r = 0; r < nrep; r++) { /* the deviation in the average's frame */
+        rcb_complex d = (values[(r * nch + c) * npts + i] - m) * conj(u);
+        chi2 += creal(d) * creal(d) / vr + cimag(d) * cimag(d) / vt;
+      }
+    }
+  }
+  out->chi2 = chi2;
+  out->dof = 2.0 * (double)nch * (double)npts * (double)(nrep - 1);
+  out->scale = sqrt(chi2 / out->dof);
   return RCB_OK;
 }
 

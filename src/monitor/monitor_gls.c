@@ -24,7 +24,7 @@ static void point_cov(const rcb_monitor *mon, const rcb_complex *v, const double
                       double a, double *d11, double *d12, double *d22) {
   double s11, s12 = 0, s22, w1 = mon->winv[2 * p], w2 = mon->winv[2 * p + 1];
   if (sd || mon->have_sd0) {
-    double s = sd ? sd[p] : mon->sd0[p];
+    double s = sd ? sd[p] * mon->nscale : mon->sd0[p]; /* sd0: scaled at create */
     s11 = s22 = s * s;
   } else {
     double av = cabs(v[p]), sp = mon->beta_a / 100.0 * av;
@@ -47,10 +47,7 @@ static void syrk(const rcb_monitor *mon, const double *B, size_t m, double *C) {
 
 /* Eq. 19 additive amplitude of channel c in values v. */
 static double amplitude(const rcb_monitor *mon, const rcb_complex *v, size_t c) {
-  double s2 = 0;
-  size_t p;
-  for (p = c * mon->npts; p < (c + 1) * mon->npts; p++) s2 += creal(v[p] * conj(v[p]));
-  return mon->beta_s / 100.0 * sqrt(s2) / (double)mon->npts;
+  return rcb_mon_eq19_amp(mon->beta_s, v + c * mon->npts, mon->npts);
 }
 
 /* Points p0 .. p1 into C (k x k, upper, added to): each point's whitened

@@ -181,7 +181,9 @@ struct rcb_monitor {
 
   /* noise of the reweighted path */
   int reweight, have_sd0;
-  double beta_a, beta_s, navg_inv;
+  double beta_a, beta_s, navg_inv; /* beta_a, beta_s: times nscale */
+  double nscale;       /* opts.noise_scale (1: as declared), applied to the declared
+                          noise at create and to the sd an update passes */
   double phase_var;    /* variance of the phase turn, rad^2 (phase_deg^2 / 3) */
   double *var0;        /* 2 per point: radial, tangential variance of one
                           measurement at the commissioning values */
@@ -247,6 +249,9 @@ struct rcb_monitor {
 double rcb_mon_chi2_logsf(double x, double dof);
 
 /* monitor_create.c: allocation through the monitor's counting hooks. */
+/* Eq. 19's additive amplitude of one channel's n values v (monitor_create.c):
+ * beta_s / 100 x their rms, the channel's units (beta_s, %). */
+double rcb_mon_eq19_amp(double beta_s, const rcb_complex *v, size_t n);
 void *rcb_mon_alloc(rcb_monitor *mon, size_t count, size_t size);
 
 /* The candidates kept for the monitor and their first columns in J. */

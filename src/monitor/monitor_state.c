@@ -146,6 +146,7 @@ static uint64_t settings_hash(const rcb_monitor *mon) {
   for (i = 0; i < mon->nt; i++)
     h = rcb_mon_fnv_f64(rcb_mon_fnv_f64(rcb_mon_fnv_f64(h, mon->tlo[i]), mon->thi[i]), mon->tbv[i]);
   for (i = 0; i < mon->nt * mon->nt; i++) h = rcb_mon_fnv_f64(h, mon->bcov[i]); /* version 3 */
+  if (mon->nscale != 1.0) h = rcb_mon_fnv_f64(h, mon->nscale); /* as before scales existed */
   h = rcb_mon_fnv_u64(h, (uint64_t)mon->have_sd0);
   for (i = 0; mon->have_sd0 && i < mon->npt; i++) h = rcb_mon_fnv_f64(h, mon->sd0[i]);
   return h;

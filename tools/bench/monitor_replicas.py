@@ -254,18 +254,24 @@ def _meas(rcb, data):
     return rcb.Meas.from_arrays(FREQ, data, resp, refs, kind="inertance", rpm=dc.RPM)
 
 
-def replica(rcb, model, H, case, rep, ci):
+def replica(rcb, model, H, case, rep, ci, scale="measured"):
     form = list(FORMS)[rep % len(FORMS)]
     seed0 = 100000 * ci + 1000 * rep
-    avg = np.mean([dc.calibration_noise(form, clean(H, case, 0), seed0 + i)
-                   for i in range(COMMISSION)], axis=0)
+    files = np.array([dc.calibration_noise(form, clean(H, case, 0), seed0 + i)
+                      for i in range(COMMISSION)])
+    avg = files.mean(axis=0)
     t0 = time.process_time()
     with _meas(rcb, avg) as setup:
+        # the noise's level from the commissioning files' scatter, as rcbtool
+        # monitor's default (--noise-scale auto); "declared": none
+        ns = (rcb.monitor.noise_scale(setup, files, noise=FORMS[form])["scale"]
+              if scale == "measured" else 1.0)
         mon = rcb.Monitor(model, setup, PARAMS, noise=FORMS[form], setup_averages=COMMISSION,
-                          alpha=ALPHA, reweight=True, relinearise=8)
+                          alpha=ALPHA, reweight=True, relinearise=8, noise_scale=ns)
     t_create = time.process_time() - t0
     base = [t["baseline"] for t in mon.tracked]
-    rec = {"case": case, "rep": rep, "form": form, "seed0": seed0, "updates": []}
+    rec = {"case": case, "rep": rep, "form": form, "seed0": seed0, "noise_scale": ns,
+           "updates": []}
     t_upd = 0.0
     try:
         for j in range(1, UPDATES + 1):
@@ -436,6 +442,11 @@ def main():
     ap.add_argument("--cases", default=",".join(CASES))
     ap.add_argument("--out", default=str(REPO / "out" / "monitor_replicas"))
     ap.add_argument("--sd-check", action="store_true", help="print B4 kyy's sd and stop")
+    ap.add_argument("--scale", choices=("measured", "declared"), default="measured",
+                    help="the noise's level: measured on the commissioning files' scatter "
+                    "(rcbtool monitor's default) or as declared")
+    ap.add_argument("--forms", default=",".join(FORMS),
+                    help="run only the replicas of these noise forms (they take turns)")
     ap.add_argument("--from-json", action="store_true",
                     help="no runs: count the replicas saved in OUT/CASE.json and "
                     "OUT/CASE.FIRST.json (runs with --first; a partial run too)")
@@ -460,8 +471,11 @@ def main():
         ci = CASES.index(case) + 1
         t0 = time.time()
         recs = []
+        forms = args.forms.split(",")
         for rep in range(args.first, args.first + args.replicas):
-            recs.append(replica(rcb, model, H, case, rep, ci))
+            if list(FORMS)[rep % len(FORMS)] not in forms:
+                continue
+            recs.append(replica(rcb, model, H, case, rep, ci, args.scale))
             name = f"{case}.json" if args.first == 0 else f"{case}.{args.first}.json"
             (out / name).write_text(json.dumps(recs))
         s = summarise(case, recs)

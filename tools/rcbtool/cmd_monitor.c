@@ -20,6 +20,7 @@ const char cli_help_monitor[] =
     "                       [--noise A,S[,P] | --sd STATS.csv|DIR] [--commission N]\n"
     "                       [--alpha A] [--cusum-h H] [--cusum-k K] [--relinearise N]\n"
     "                       [--reweight] [--sensors] [--baseline-sd SD,...]\n"
+    "                       [--noise-scale auto|S]\n"
     "                       [--map NODE=STATION,...] [--rpm R]\n"
     "                       [--log OUT.json|OUT.csv] [--plot TREND.png] [--json]\n"
     "                       [-o FILE] [--progress]\n"
@@ -53,7 +54,16 @@ const char cli_help_monitor[] =
     "  --sd PATH       per-point standard deviations instead (rcbtool estimate\n"
     "                  --stats or order --stats): one file for every update, or a\n"
     "                  directory holding STEM_stats.csv for each measurement STEM.*\n"
-    "  --commission N  files averaged into the reference (default 1)\n"
+    "  --commission N  files averaged into the reference (default 1); with N >= 2\n"
+    "                  their scatter measures the noise's level (--noise-scale)\n"
+    "  --noise-scale S the noise's level against --noise or --sd: every declared\n"
+    "                  standard deviation times S (1: as declared). auto (the\n"
+    "                  default): with --commission N >= 2, the scatter of the N\n"
+    "                  files about their average, whitened by the declared noise\n"
+    "                  (sqrt of chi-square over 2 x channels x points x (N - 1)\n"
+    "                  degrees of freedom; printed in the header), unless under\n"
+    "                  0.1 (repeated or noise-free files: then 1); else 1. Kept\n"
+    "                  in --state\n"
     "  --alpha A       false-alarm probability of the instant test per update\n"
     "                  (default: the library's, 1e-3)\n"
     "  --cusum-h H     CUSUM decision threshold, standard deviations (default: the\n"
@@ -122,6 +132,31 @@ static int baseline_sd_opt(const cli_args *a, mon_job *j) {
   return 0;
 }
 
+/* --noise-scale auto|S|scatter:CHI2:DOF: 0 (auto), S > 0, or the scatter
+ * measured before (what a state keeps, so a resumed run reports it as the
+ * first did). */
+static int noise_scale_opt(const cli_args *a, mon_job *j) {
+  const char *v = cli_opt_value(a, "--noise-scale");
+  int rc, n = 0;
+  j->noise_scale = 0.0;
+  if (!v || strcmp(v, "auto") == 0) return 0;
+  if (strncmp(v, "scatter:", 8) == 0) {
+    if (sscanf(v + 8, "%lg:%lg%n", &j->scatter[0], &j->scatter[1], &n) != 2 || v[8 + n] ||
+        !(j->scatter[0] >= 0) || !(j->scatter[1] >= 1) || !isfinite(j->scatter[0] + j->scatter[1]))
+      return cli_usage(a->cmd, "option --noise-scale scatter:CHI2:DOF expects a chi-square >= 0 "
+                       "and its degrees of freedom >= 1, got '%s'", v);
+    return 0;
+  }
+  if ((rc = cli_opt_nonneg(a, "--noise-scale", "-", 0.0, &j->noise_scale))) return rc;
+  if (!(j->noise_scale > 0.0) || !isfinite(j->noise_scale))
+    return cli_usage(a->cmd, "option --noise-scale expects 'auto' or a factor > 0 on the "
+                     "declared noise (1: as declared), got '%s'", v);
+  if (j->noise_scale > 1e6)
+    return cli_usage(a->cmd, "option --noise-scale %s: a noise 1e6 x the declared one; give "
+                     "--noise the level you mean", v);
+  return 0;
+}
+
 static int parse_job(const cli_args *a, mon_job *j) {
   int rc;
   double relin = 0.0;
@@ -154,6 +189,7 @@ static int parse_job(const cli_args *a, mon_job *j) {
       (cli_opt_value(a, "--cusum-k") && !(j->cusum_k > 0.0)))
     return cli_usage(a->cmd, "options --cusum-h and --cusum-k expect values > 0");
   if ((rc = baseline_sd_opt(a, j))) return rc;
+  if ((rc = noise_scale_opt(a, j))) return rc;
   if (cli_opt_value(a, "--noise") && j->sd_path)
     return cli_usage(a->cmd, "--noise and --sd exclude each other: give the eq. 19 model or "
                      "the per-point standard deviations");
@@ -323,7 +359,7 @@ static int state_plan(int argc, char **argv, const cli_opt *opts, size_t nopts,
 static const char *const SETTING_OPTS[] = {"--params", "--noise",  "--sd",     "--commission",
                                            "--alpha",  "--cusum-h", "--cusum-k", "--relinearise",
                                            "--reweight", "--map",  "--rpm", "--baseline-sd",
-                                           "--sensors"};
+                                           "--sensors", "--noise-scale"};
 
 /* 1 + the number of strings @p argv[k] (with its value) takes when it is a
  * setting option, else 0. */
@@ -406,6 +442,7 @@ int cmd_monitor(int argc, char **argv) {
                     {"--reweight", NULL, NULL},
                     {"--sensors", NULL, NULL},
                     {"--baseline-sd", "SD,...", NULL},
+                    {"--noise-scale", "auto|S", NULL},
                     {"--map", "NODE=STATION,...", NULL},
                     {"--rpm", "R", NULL},
                     {"--log", "FILE", NULL},

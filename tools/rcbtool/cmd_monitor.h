@@ -48,6 +48,11 @@ typedef struct mon_job {
   double alpha, cusum_h, cusum_k; /**< 0: the library's defaults */
   double beta_a, beta_s;          /**< --noise, % */
   double phase_deg;               /**< --noise's third number, degrees */
+  double noise_scale;             /**< --noise-scale S (-); 0: auto (the
+                                       commissioning files' scatter) */
+  double scatter[2];              /**< --noise-scale scatter:CHI2:DOF (as a
+                                       state keeps the measured scale; dof 0:
+                                       not given) */
   double baseline_sd[RCB_MONITOR_MAX_TRACKED]; /**< --baseline-sd, parameter units */
   int have_baseline_sd;
   const char *sd_path;            /**< --sd FILE or DIR, NULL */
@@ -84,8 +89,25 @@ typedef struct mon_state {
   size_t channels, points;
   mon_sep *seps;   /**< the pairs asked so far */
   size_t nseps;
+  double noise_scale; /**< the scale the monitor applies to the declared noise (-) */
+  rcb_monitor_noise scatter; /**< the commissioning files' scatter (dof 0: not measured) */
+  int scale_from;  /**< MON_SCALE_*: where noise_scale came from */
 } mon_state;
 
+/** Where the noise's scale came from (mon_state.scale_from). */
+enum {
+  MON_SCALE_ONE_FILE, /**< 1: one commissioning file, no scatter to measure */
+  MON_SCALE_MEASURED, /**< the commissioning files' scatter */
+  MON_SCALE_TOO_LOW,  /**< 1: the scatter under MON_SCALE_MIN (repeated files) */
+  MON_SCALE_GIVEN,    /**< --noise-scale S, or kept in the state */
+  MON_SCALE_SD_DIR    /**< 1: --sd DIR gives each file its own noise */
+};
+/** A measured scale under this is not used (-): repeated or noise-free
+ * files, whose scatter says nothing of the updates' noise. */
+#define MON_SCALE_MIN 0.1
+
+/** The header's line on the noise's scale (where it came from, the scatter). */
+void mon_print_scale(FILE *fp, const mon_state *s);
 /** Add a file, or every measurement file of a directory sorted by name
  * (none: exit 3 naming it); exit code 0, 3 or 4. */
 int mon_series_add(const char *cmd, mon_series *s, const char *path);

@@ -189,6 +189,16 @@ void mon_print_json(FILE *fp, const mon_state *s) {
     cli_json_str(fp, s->j->sd_path);
   else
     fprintf(fp, "[%.17g, %.17g, %.17g]", s->j->beta_a, s->j->beta_s, s->j->phase_deg);
+  json_key_num(fp, "noise_scale", s->noise_scale);
+  fprintf(fp, ", \"noise_scale_from\": \"%s\"",
+          s->scale_from == MON_SCALE_MEASURED  ? "commissioning scatter"
+          : s->scale_from == MON_SCALE_GIVEN   ? "option"
+          : s->scale_from == MON_SCALE_TOO_LOW ? "declared (scatter too low)"
+                                               : "declared");
+  if (s->scatter.dof > 0) {
+    json_key_num(fp, "scatter_chi2", s->scatter.chi2);
+    json_key_num(fp, "scatter_dof", s->scatter.dof);
+  }
   fputs(",\n\"tracked\": [", fp);
   for (k = 0; k < s->j->params.n; k++) {
     const char *name = NULL;

@@ -100,8 +100,14 @@ typedef struct mon_ctx {
   int new_image;   /* --state: write the image (none, or not this monitor's) */
   size_t n, nc, *perm;
   rcb_complex *values;
+  rcb_complex *reps; /* with the scale measured: the N commissioning files'
+                        values, N x nc x n (rcb_monitor_noise_scale) */
   double *sd;
   int have_sd;
+  double noise_scale; /* the scale passed to the monitor (-) */
+  rcb_monitor_noise scatter;
+  int scale_from;    /* MON_SCALE_* */
+  char scale_opt[80]; /* "--noise-scale=scatter:CHI2:DOF" kept in a new state ("": none) */
 } mon_ctx;
 
 /* --sd DIR: the sds of file @p path (read as @p ms, the set-up's layout) into
@@ -178,6 +184,12 @@ static int commission(mon_ctx *x) {
   if (x->j->commission == 1) return 0;
   gather(x->setup, x->perm, x->nc, x->n, x->values);
   if (saved) return 0; /* the average itself */
+  if (!x->j->noise_scale && !sd_is_dir(x->j->sd_path)) { /* the scale measured */
+    if (nv > (size_t)-1 / sizeof *x->reps / x->j->commission ||
+        !(x->reps = malloc(x->j->commission * nv * sizeof *x->reps)))
+      return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
+    memcpy(x->reps, x->values, nv * sizeof *x->reps);
+  }
   for (k = 1; k < x->j->commission; k++) {
     rcb_complex *v = x->values;
     if ((rc = read_file(x, k, &ms))) return rc;
@@ -186,6 +198,7 @@ static int commission(mon_ctx *x) {
       size_t p;
       rcb_meas_channel(ms, x->perm[i], &ci);
       for (p = 0; p < x->n; p++) v[i * x->n + p] += ci.data[p];
+      if (x->reps) memcpy(x->reps + (k * x->nc + i) * x->n, ci.data, x->n * sizeof *x->reps);
     }
     rcb_meas_destroy(ms);
   }
@@ -213,6 +226,47 @@ static int averaged_setup(mon_ctx *x, rcb_meas **out) {
     return rc;
   }
   *out = ms;
+  return 0;
+}
+
+/* The noise's scale (--noise-scale): given, measured on the commissioning
+ * files' scatter, or that measurement kept in the state; into x and o. 0 or
+ * an exit code. */
+static int noise_scale(mon_ctx *x, rcb_monitor_opts *o) {
+  rcb_status st;
+  x->noise_scale = 1.0;
+  if (x->j->noise_scale > 0) {
+    x->noise_scale = x->j->noise_scale, x->scale_from = MON_SCALE_GIVEN;
+  } else if (sd_is_dir(x->j->sd_path)) {
+    x->scale_from = MON_SCALE_SD_DIR;
+  } else if (x->j->scatter[1] > 0 || x->reps) {
+    if (x->j->scatter[1] > 0) { /* kept in the state: the same figures again */
+      x->scatter.chi2 = x->j->scatter[0], x->scatter.dof = x->j->scatter[1];
+      x->scatter.scale = sqrt(x->scatter.chi2 / x->scatter.dof);
+    } else if ((st = rcb_monitor_noise_scale(x->avg, x->reps, x->j->commission, o,
+                                             &x->scatter))) {
+      return cli_fail(CLI_EXIT_INPUT, "%s: --noise-scale auto: the scatter of the %zu "
+                      "commissioning files could not be measured against the declared noise "
+                      "(%s): give --noise-scale 1 or a noise model that is not zero anywhere",
+                      x->a->cmd, x->j->commission, cli_msg(NULL, st));
+    }
+    if (x->scatter.scale < MON_SCALE_MIN) {
+      x->scale_from = MON_SCALE_TOO_LOW;
+      cli_warn("%s: the %zu commissioning files scatter %.3g x the declared noise: repeated or "
+               "noise-free files say nothing of the updates' noise, so the noise is taken as "
+               "declared (--noise-scale S sets it)", x->a->cmd, x->j->commission,
+               x->scatter.scale);
+    } else {
+      x->noise_scale = x->scatter.scale, x->scale_from = MON_SCALE_MEASURED;
+    }
+    /* a new state keeps the measurement as a setting: a resumed run applies
+     * and reports it as this one */
+    snprintf(x->scale_opt, sizeof x->scale_opt, "--noise-scale=scatter:%.17g:%.17g",
+             x->scatter.chi2, x->scatter.dof);
+  } else {
+    x->scale_from = MON_SCALE_ONE_FILE;
+  }
+  o->noise_scale = x->noise_scale;
   return 0;
 }
 
@@ -256,6 +310,8 @@ static int create_monitor(mon_ctx *x, rcb_monitor **mon) {
     o.baseline_cov = cov;
   }
   if (x->j->commission > 1 && (rc = averaged_setup(x, &avg))) return rc;
+  x->avg = avg;
+  if ((rc = noise_scale(x, &o))) return rc;
   /* --state: from the commissioning image when there is a good one (then
    * not rewritten), else in full (rcb_monitor_opts.image) */
   x->new_image = x->j->image != NULL;
@@ -268,7 +324,6 @@ static int create_monitor(mon_ctx *x, rcb_monitor **mon) {
       x->new_image = 0;
   }
   if (!o.image) st = rcb_monitor_create(mon, x->m, avg ? avg : x->setup, &o, NULL);
-  x->avg = avg; /* kept for --state */
   if (st)
     return cli_fail(st == RCB_ERR_ARG || st == RCB_ERR_NOT_FOUND ? CLI_EXIT_INPUT
                                                                   : cli_status_exit(st),
@@ -279,6 +334,32 @@ static int create_monitor(mon_ctx *x, rcb_monitor **mon) {
 
 /* ---- the lines ---- */
 
+void mon_print_scale(FILE *fp, const mon_state *s) {
+  const rcb_monitor_noise *sc = &s->scatter;
+  switch (s->scale_from) {
+  case MON_SCALE_MEASURED:
+    fprintf(fp, "# noise: the declared x %.3f, measured on the %zu commissioning files' "
+            "scatter (chi-square %.4g on %.4g degrees of freedom)\n", s->noise_scale,
+            s->j->commission, sc->chi2, sc->dof);
+    break;
+  case MON_SCALE_TOO_LOW:
+    fprintf(fp, "# noise: as declared; the %zu commissioning files scatter only %.3g x it "
+            "(repeated or noise-free files)\n", s->j->commission, sc->scale);
+    break;
+  case MON_SCALE_GIVEN:
+    fprintf(fp, "# noise: the declared x %.6g (--noise-scale%s)\n", s->noise_scale,
+            s->j->saved ? ", kept in the state" : "");
+    break;
+  case MON_SCALE_SD_DIR:
+    fputs("# noise: each file's own --sd, as declared\n", fp);
+    break;
+  default:
+    fputs(s->j->commission > 1 ? "# noise: as declared\n"
+                               : "# noise: as declared (one commissioning file: --commission "
+                                 "N >= 2 measures its level)\n", fp);
+  }
+}
+
 static void print_header(FILE *fp, const mon_state *s) {
   size_t k;
   fputs("# commissioned on ", fp);
@@ -286,6 +367,7 @@ static void print_header(FILE *fp, const mon_state *s) {
   if (s->j->commission > 1) fprintf(fp, " and the next %zu files (averaged)", s->j->commission - 1);
   fprintf(fp, "; %zu channels x %zu points; %zu candidate effects; monitor memory %zu bytes\n",
           s->channels, s->points, s->candidates, s->memory);
+  mon_print_scale(fp, s);
   if (s->j->saved)
     fprintf(fp, "# resumed from the state '%s' after %zu updates\n", s->j->state,
             s->j->saved->nrec);
@@ -540,6 +622,7 @@ static void describe(mon_state *s, const mon_ctx *x, const rcb_monitor *mon) {
   s->channels = x->nc;
   s->points = x->n;
   s->kind = rcb_meas_get_type(x->setup) == RCB_MEAS_FRF ? "frf" : "unbalance";
+  s->noise_scale = x->noise_scale, s->scatter = x->scatter, s->scale_from = x->scale_from;
   s->rpm = rcb_meas_get_type(x->setup) == RCB_MEAS_FRF
                ? rcb_meas_speed(x->setup) / CLI_RPM_TO_RAD_S
                : (double)NAN;
@@ -569,7 +652,7 @@ static int resume(const mon_ctx *x, mon_state *s, rcb_monitor *mon) {
 static int save_state(const mon_ctx *x, const mon_state *s, const rcb_monitor *mon,
                       cli_tmpfile *t) {
   mon_saved sv;
-  char **names = NULL;
+  char **names = NULL, **opts = NULL;
   size_t k;
   int rc;
   memset(&sv, 0, sizeof sv);
@@ -583,6 +666,16 @@ static int save_state(const mon_ctx *x, const mon_state *s, const rcb_monitor *m
   }
   sv.opts = x->j->saved ? x->j->saved->opts : x->j->setopts;
   sv.nopts = x->j->saved ? x->j->saved->nopts : x->j->nsetopts;
+  if (!x->j->saved && x->scale_opt[0]) { /* the measured scale: a setting from now on */
+    opts = malloc((sv.nopts + 1) * sizeof *opts);
+    if (!opts) {
+      rc = cli_fail(CLI_EXIT_NUMERIC, "%s: out of memory (state)", x->a->cmd);
+      goto done;
+    }
+    memcpy(opts, sv.opts, sv.nopts * sizeof *opts);
+    opts[sv.nopts++] = (char *)x->scale_opt;
+    sv.opts = opts;
+  }
   sv.comm = x->j->series.files;
   sv.ncomm = x->j->commission;
   sv.setup = x->avg ? x->avg : x->setup;
@@ -594,6 +687,7 @@ static int save_state(const mon_ctx *x, const mon_state *s, const rcb_monitor *m
   sv.nrec = s->nrec;
   rc = mon_saved_write(x->a->cmd, x->j->state, &sv, t);
 done:
+  free(opts);
   free(sv.blob);
   free(sv.rec);
   free(names);
@@ -662,6 +756,7 @@ done:
   rcb_model_destroy(x.m);
   free(x.perm);
   free(x.values);
+  free(x.reps);
   free(x.sd);
   free(s.rec);
   free(s.seps);

@@ -180,7 +180,12 @@ class MonitorOpts(ctypes.Structure):
                 ("beta_a", c_double), ("beta_s", c_double), ("sd", c_void_p),
                 ("setup_averages", c_double), ("effects", ctypes.c_uint), ("top", c_size_t),
                 ("relinearise", c_size_t), ("reweight", c_int), ("phase_deg", c_double),
-                ("baseline_cov", c_void_p), ("image", c_void_p), ("image_size", c_size_t)]
+                ("baseline_cov", c_void_p), ("image", c_void_p), ("image_size", c_size_t),
+                ("noise_scale", c_double)]
+
+
+class MonitorNoise(ctypes.Structure):
+    _fields_ = [("scale", c_double), ("chi2", c_double), ("dof", c_double)]
 
 
 class MonitorCandidate(ctypes.Structure):
@@ -367,6 +372,8 @@ _PROTOTYPES = {
     "rcb_monitor_create": (c_int, [PP, c_void_p, c_void_p, ctypes.POINTER(MonitorOpts),
                                    c_void_p]),
     "rcb_monitor_destroy": (None, [c_void_p]),
+    "rcb_monitor_noise_scale": (c_int, [c_void_p, c_void_p, c_size_t, ctypes.POINTER(MonitorOpts),
+                                        ctypes.POINTER(MonitorNoise)]),
     "rcb_monitor_errmsg": (c_char_p, [c_void_p]),
     "rcb_monitor_update": (c_int, [c_void_p, c_void_p, c_void_p,
                                    ctypes.POINTER(MonitorResult)]),

@@ -37,6 +37,39 @@ def _tracked(model, params):
     return out
 
 
+def _noise_opts(noise, sd, shape):
+    """The declared noise into a MonitorOpts (and the sd array it points to)."""
+    o, sd0 = _lib.MonitorOpts(), None
+    if noise is not None:
+        o.beta_a, o.beta_s = float(noise[0]), float(noise[1])
+        o.phase_deg = float(noise[2]) if len(noise) > 2 else 0.0
+    if sd is not None:
+        sd0 = np.ascontiguousarray(sd, dtype=float)
+        if sd0.shape != shape:
+            raise ValueError(f"sd has shape {sd0.shape}, expected {shape}")
+        o.sd = sd0.ctypes.data
+    return o, sd0
+
+
+def noise_scale(setup, values, noise=None, sd=None):
+    """The noise's level measured on repeated measurements of one state
+    (rcb_monitor_noise_scale): values, shape (N, channels, points), complex,
+    the set-up's channel order (N >= 2, e.g. the commissioning measurements
+    before they are averaged); noise / sd: the declared noise as for Monitor.
+    Returns {"scale": sqrt(chi2 / dof), "chi2", "dof"}: pass the scale as
+    Monitor(..., noise_scale=...) with their average as the set-up."""
+    v = np.ascontiguousarray(values, dtype=np.complex128)
+    shape = (len(setup.channels), setup.n_points)
+    if v.ndim != 3 or v.shape[1:] != shape:
+        raise ValueError(f"values has shape {v.shape}, expected (N, {shape[0]}, {shape[1]})")
+    o, _sd0 = _noise_opts(noise, sd, shape)
+    out = _lib.MonitorNoise()
+    _lib.check(_lib.lib().rcb_monitor_noise_scale(setup.handle, v.ctypes.data, v.shape[0],
+                                                  ctypes.byref(o), ctypes.byref(out)),
+               call="rcb_monitor_noise_scale")
+    return {"scale": out.scale, "chi2": out.chi2, "dof": out.dof}
+
+
 class Monitor(Handle):
     """A monitor commissioned on a fitted model and one measurement set-up."""
 
@@ -45,7 +78,7 @@ class Monitor(Handle):
 
     def __init__(self, model, setup, params, noise=None, sd=None, alpha=None, cusum_h=None,
                  cusum_k=None, setup_averages=1, relinearise=0, reweight=False,
-                 baseline_sd=None):
+                 baseline_sd=None, noise_scale=None):
         """model: the fitted baseline (a Model); setup: the commissioning
         measurement (a Meas: channels, grid and the reference values); params:
         tracked parameter names or {name: (lo, hi)}; noise: eq. 19 (beta_a,
@@ -56,7 +89,10 @@ class Monitor(Handle):
         reweight: each update's noise from its own values (generalised least
         squares: T stays chi-square after large changes; O(n k^2) per update);
         baseline_sd: standard errors of the baseline's tracked values (the fit that
-        made it), which widen the values' intervals (the changes' stay)."""
+        made it), which widen the values' intervals (the changes' stay);
+        noise_scale: the noise's level against the declared one (every declared
+        standard deviation times it; None: 1), e.g. librcb.monitor.noise_scale
+        of the measurements averaged into setup."""
         super().__init__()
         self._names = [r if ref is None else f"{r}/{ref}" for r, ref, _ in setup.channels]
         self._shape = (len(self._names), setup.n_points)
@@ -65,15 +101,10 @@ class Monitor(Handle):
         arr = (_lib.MonitorParam * max(len(tp), 1))()
         for i, ((_, lo, hi), nb) in enumerate(zip(tp, self._keep)):
             arr[i].name, arr[i].lo, arr[i].hi = nb, lo, hi
-        o = _lib.MonitorOpts()
+        o, self._sd0 = _noise_opts(noise, sd, self._shape)
         o.ntracked, o.tracked = len(tp), arr
         o.alpha, o.cusum_h, o.cusum_k = alpha or 0.0, cusum_h or 0.0, cusum_k or 0.0
-        if noise is not None:
-            o.beta_a, o.beta_s = float(noise[0]), float(noise[1])
-            o.phase_deg = float(noise[2]) if len(noise) > 2 else 0.0
-        if sd is not None:
-            self._sd0 = self._layout_sd(sd)
-            o.sd = self._sd0.ctypes.data
+        o.noise_scale = float(noise_scale or 0.0)
         o.setup_averages = float(setup_averages)
         o.relinearise = int(relinearise)
         o.reweight = int(bool(reweight))
