@@ -18,10 +18,12 @@ A block can be marked on the line before its fence:
                                    --plot): run when the python3 on the PATH (the
                                    venv's with --venv) has it
   <!-- doc-test: slow REASON -->   minutes of computation: run with --slow only
-  <!-- doc-test: data:REL -->      reads a data file that is not in the repository (a
-                                   fetched measurement): run when $RCB_DATA_DIR/REL
-                                   exists (default ~/.cache/librcb/REL); the page
-                                   says how to get it
+  <!-- doc-test: data:NAME/FILE --> reads FILE of the external data set NAME (a
+                                   measurement not in the repository): run when
+                                   tools/data/get_data.py finds the set, checked
+                                   ($RCB_DATA_DIR/NAME, ../shared/data/NAME beside
+                                   the repository, ~/.cache/librcb/NAME) and it holds
+                                   FILE; the page says how to get it
 (several may be combined: <!-- doc-test: venv slow about 2 min -->).
 Everything skipped is listed with its reason; a block that fails names its
 page and line, with the tail of its output.
@@ -30,6 +32,8 @@ usage: doc_commands.py --source DIR --build DIR [--venv DIR] [--slow] [--list]
 exit 0 pass, 1 a block failed, 2 usage
 """
 import argparse
+import functools
+import importlib.util
 import os
 import re
 import shutil
@@ -78,10 +82,23 @@ def scratch_clone(src, build, venv):
     return d
 
 
-def data_dir():
-    """Where data files that are not in the repository are (doc-test: data:REL)."""
-    return os.environ.get("RCB_DATA_DIR") or os.path.join(os.path.expanduser("~"), ".cache",
-                                                         "librcb")
+@functools.lru_cache(maxsize=None)
+def data_missing(src, rel):
+    """Why the block marked data:NAME/FILE cannot run ("" when it can): the set
+    NAME as tools/data/get_data.py finds it (every file's SHA-256 checked)."""
+    spec = importlib.util.spec_from_file_location(
+        "rcb_get_data", os.path.join(src, "tools", "data", "get_data.py"))
+    getter = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(getter)
+    name, _, fname = rel.partition("/")
+    if name not in getter.DATASETS:
+        return f"data:{rel}: no data set '{name}' in tools/data/get_data.py"
+    found, _ = getter.locate(name)
+    if found is None:
+        return getter.how_to_get(name)
+    if not os.path.isfile(os.path.join(found, fname)):
+        return f"data:{rel}: the data set '{name}' at {found} has no file '{fname}'"
+    return ""
 
 
 def with_option(build, *options):
@@ -147,10 +164,12 @@ def main():
                 why.append("needs python3 with matplotlib on the PATH (--venv DIR, or "
                            "Debian's python3-matplotlib)")
             for rel in sorted(m[5:] for m in mark if m.startswith("data:")):
-                if not os.path.isfile(os.path.join(data_dir(), rel)):
-                    why.append(f"needs the data file {os.path.join(data_dir(), rel)}, absent "
-                               "(not in the repository; RCB_DATA_DIR sets the directory; "
-                               "the page says how to get it)")
+                missing = data_missing(src, rel)
+                if missing.startswith("data:"):  # a mark naming no file of a known set
+                    failed.append(where)
+                    print(f"FAIL {where}: {missing}")
+                if missing:
+                    why.append(missing)
             if "slow" in mark and not args.slow:
                 why.append("slow (--slow)" + (": " + reason if reason else ""))
             why = "; ".join(why)

@@ -9,6 +9,8 @@ the INI strings in ross_models.py (written to a temporary directory), so the
 comparison covers both the shipped examples and the variants described there.
 """
 
+import functools
+import importlib.util
 import json
 import os
 import subprocess
@@ -167,6 +169,41 @@ def case(request, tmp_path_factory):
         path = tmp_path_factory.mktemp("models") / f"{name}.ini"
         path.write_text(text)
     return Case(origin, name, text, path)
+
+
+# ---- external data sets: not in the repository -----------------------------
+# tools/data/get_data.py gets them (a pinned commit, SHA-256 checked) and says
+# where they are; a test that reads one is skipped, with the command, without it.
+
+@functools.lru_cache(maxsize=None)
+def _locate_data_set(name):
+    spec = importlib.util.spec_from_file_location(
+        "rcb_get_data", REPO / "tools" / "data" / "get_data.py")
+    getter = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(getter)
+    found, partial = getter.locate(name)
+    return found, partial, getter.how_to_get(name)
+
+
+@pytest.fixture(scope="session")
+def data_set():
+    """data_set(NAME) -> the directory holding the external data set NAME, every
+    file's SHA-256 checked (searched in $RCB_DATA_DIR/NAME, ../shared/data/NAME
+    beside the repository, ~/.cache/librcb/NAME); the test is skipped, with the
+    reason and the command that gets it, when it is absent, and fails when a
+    directory holds the set's files but not the pinned ones."""
+
+    def get(name):
+        found, partial, how = _locate_data_set(name)
+        if found is None:
+            wrong = [b for _, bad in partial for b in bad if "SHA-256" in b]
+            if wrong:
+                pytest.fail(f"data set '{name}': not the pinned files: {'; '.join(wrong)} "
+                            f"(run `python3 tools/data/get_data.py {name}`)")
+            pytest.skip(how)
+        return found
+
+    return get
 
 
 # ---- measured differences, printed at the end of the run ------------------

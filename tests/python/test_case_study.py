@@ -2,10 +2,12 @@
 what does not come from librcb.
 
 Data: signals.csv, 10 s of a real shaker test of a steel cantilever (ARTS-Lab,
-CC BY-SA 4.0; load cell in lbf, accelerometer in g), not in the repository: read from
-$RCB_DATA_DIR/arts_cantilever/ (default ~/.cache/librcb/arts_cantilever/), where
-`python3 examples/case_study/get_data.py` puts it. The tests that read it are skipped,
-with that command, when it is absent.
+CC BY-SA 4.0; load cell in lbf, accelerometer in g), not in the repository: the
+external data set arts_cantilever, which `python3 examples/case_study/get_data.py`
+(or `python3 tools/data/get_data.py arts_cantilever`) gets and which is found in
+$RCB_DATA_DIR/arts_cantilever/, ../shared/data/arts_cantilever/ beside the repository
+or ~/.cache/librcb/arts_cantilever/ (conftest.py's data_set). The tests that read it
+are skipped, with that command, when it is absent.
 
 Asserted:
 - `rcbtool estimate` (H1, Hann, 3200-sample segments, 50 % overlap, inertance)
@@ -47,8 +49,6 @@ import pytest
 signal = pytest.importorskip("scipy.signal")
 
 ROOT = Path(__file__).resolve().parents[2]
-DATA = (Path(os.environ.get("RCB_DATA_DIR") or Path.home() / ".cache" / "librcb")
-        / "arts_cantilever" / "signals.csv")
 MODEL = ROOT / "examples" / "case_study" / "cantilever.ini"
 KEEP = ROOT / "examples" / "case_study" / "keep_coherent.py"
 LBF, G = 4.4482216152605, 9.80665
@@ -62,12 +62,10 @@ def _rcbtool():
     return path
 
 
-def _data():
-    if not DATA.is_file():
-        pytest.skip(f"the case study's data is not at {DATA} (CC BY-SA 4.0, not in the "
-                    "repository): get it with `python3 examples/case_study/get_data.py` "
-                    "(RCB_DATA_DIR sets the directory)")
-    return DATA
+@pytest.fixture(scope="module")
+def signals(data_set):
+    """signals.csv of the case study (skipped, with the command, when absent)."""
+    return data_set("arts_cantilever") / "signals.csv"
 
 
 def _read(path):
@@ -76,9 +74,9 @@ def _read(path):
 
 
 @pytest.fixture(scope="module")
-def run(tmp_path_factory):
+def run(tmp_path_factory, signals):
     d = tmp_path_factory.mktemp("case_study")
-    subprocess.run([_rcbtool(), "estimate", str(_data()), "--input", "force=DRV.x",
+    subprocess.run([_rcbtool(), "estimate", str(signals), "--input", "force=DRV.x",
                     "--outputs", "ACC.x", "--nseg", str(NSEG), "--fmax", "400",
                     "--kind", "inertance", "--stats", str(d / "sd.csv"),
                     "-o", str(d / "h1.csv")], check=True, capture_output=True)
@@ -88,8 +86,8 @@ def run(tmp_path_factory):
     return d
 
 
-def _scipy():
-    x = np.loadtxt(_data(), delimiter=",", comments="#", skiprows=2)
+def _scipy(signals):
+    x = np.loadtxt(signals, delimiter=",", comments="#", skiprows=2)
     fs = 1.0 / (x[1, 0] - x[0, 0])
     f_n, a = x[:, 1] * LBF, x[:, 2] * G
     kw = dict(fs=fs, nperseg=NSEG, noverlap=NSEG // 2, window="hann", detrend="constant")
@@ -99,8 +97,8 @@ def _scipy():
     return fr, pff, pfa / pff, np.abs(pfa) ** 2 / (pff * paa)
 
 
-def test_h1_and_coherence_equal_scipy(run):
-    fr, _, h, coh = _scipy()
+def test_h1_and_coherence_equal_scipy(run, signals):
+    fr, _, h, coh = _scipy(signals)
     ours, st = _read(run / "h1.csv"), _read(run / "sd.csv")
     idx = np.searchsorted(fr, ours[:, 0] - 1e-9)
     assert np.allclose(fr[idx], ours[:, 0], rtol=1e-9)
@@ -111,8 +109,8 @@ def test_h1_and_coherence_equal_scipy(run):
     assert np.max(np.abs(st[:, 1] - coh[idx])) < 1e-9
 
 
-def test_kept_lines_are_the_excited_ones(run):
-    fr, pff, _, _ = _scipy()
+def test_kept_lines_are_the_excited_ones(run, signals):
+    fr, pff, _, _ = _scipy(signals)
     kept = _read(run / "h1_coh.csv")[:, 0]
     band = (fr >= 1) & (fr <= 400)
     level = 10 * np.log10(pff[band])

@@ -1,11 +1,14 @@
 """Vendor UFF files (issue #25 item 1): what librcb reads of them, what it
 skips and why, and the refusals that name the function type and the verb.
 
-tests/data/vendor_uff holds real files from pyuff's test data (MIT; its
-README says what each exercises). A 5-channel recording of an acquisition
-front end is written here by pyuff (an independent writer): force and two responses in
-x and y, one axial (direction 3) and one scalar (direction 0) accelerometer,
-one response labelled in a unit librcb does not know.
+Real files from pyuff's test data (MIT), the external data set vendor_uff: not
+in the repository, got by `python3 tools/data/get_data.py vendor_uff` (a pinned
+commit, SHA-256 checked; tools/data/README.md says what each file exercises).
+The tests that read them are skipped, with that command, when the set is absent.
+A 5-channel recording of an acquisition front end is written here by pyuff (an
+independent writer; these tests need no fetched file and always run): force and
+two responses in x and y, one axial (direction 3) and one scalar (direction 0)
+accelerometer, one response labelled in a unit librcb does not know.
 """
 
 import os
@@ -17,7 +20,12 @@ import pytest
 
 signal = pytest.importorskip("scipy.signal")
 
-DATA = Path(__file__).resolve().parent.parent / "data" / "vendor_uff"
+
+@pytest.fixture(scope="module")
+def vendor(data_set):
+    """The directory of pyuff's files (the test is skipped, with the command that
+    gets them, when absent)."""
+    return data_set("vendor_uff")
 
 
 def _rcbtool():
@@ -32,34 +40,34 @@ def _run(*args):
                           text=True, timeout=120)
 
 
-def test_scalar_channel_keeps_its_file_name(tmp_path: Path):
+def test_scalar_channel_keeps_its_file_name(vendor, tmp_path: Path):
     """binary8byte.uff: one acceleration record (g) at direction 0. A signal
     verb needs no model direction (issue #35 item 2): the channel is read as
     '#1', its file name, and the message lists it; convert names it a time
     record."""
-    res = _run("estimate", DATA / "binary8byte.uff", "--input", "f", "--outputs", "a",
+    res = _run("estimate", vendor / "binary8byte.uff", "--input", "f", "--outputs", "a",
                "-o", tmp_path / "h.csv")
     assert res.returncode == 3, res.stderr
     assert "skipped" not in res.stderr, res.stderr
     assert "binary8byte.uff: no channel 'f' in the file; it holds '#1'" in res.stderr
-    res = _run("convert", DATA / "binary8byte.uff", tmp_path / "o.csv")
+    res = _run("convert", vendor / "binary8byte.uff", tmp_path / "o.csv")
     assert res.returncode == 3
     assert ("record 1 is function type 1 (time response; a time record: rcbtool estimate "
             "and order read it)") in res.stderr, res.stderr
     assert not (tmp_path / "o.csv").exists()
 
 
-def test_utf8_superscript_two_is_a_unit():
+def test_utf8_superscript_two_is_a_unit(vendor):
     """HBM catman's 'm/s²' (UTF-8) is an acceleration; before, 'not a unit
     librcb knows'. The record is scalar (direction 0): read as '#0'."""
-    res = _run("estimate", DATA / "time-history-not-all-columns-filled.uff", "--input", "f",
+    res = _run("estimate", vendor / "time-history-not-all-columns-filled.uff", "--input", "f",
                "--outputs", "a", "-o", "unused.csv")
     assert res.returncode == 3
     assert "not a unit" not in res.stderr, res.stderr
     assert "no channel 'f' in the file; it holds '#0'" in res.stderr, res.stderr
 
 
-def test_axial_accelerometers_mapped_by_direction(tmp_path: Path):
+def test_axial_accelerometers_mapped_by_direction(vendor, tmp_path: Path):
     """MPSTD_excerpt.uff (an acquisition system's 58b export, cut to 2048
     samples by make_excerpt.py): four accelerometers on their own axis
     (direction 3, '1+Z', '2+Z', '3+Z', '1+Z' again). Before issue #35 all four
@@ -67,9 +75,9 @@ def test_axial_accelerometers_mapped_by_direction(tmp_path: Path):
     the model channel, and the fourth record (node 1, z again) is skipped
     with a warning (estimate: not read as hits, the counts differ)."""
     pyuff = pytest.importorskip("pyuff")
-    sets = pyuff.UFF(str(DATA / "MPSTD_excerpt.uff")).read_sets()
+    sets = pyuff.UFF(str(vendor / "MPSTD_excerpt.uff")).read_sets()
     assert [(d["rsp_node"], d["rsp_dir"]) for d in sets] == [(1, 3), (2, 3), (3, 3), (1, 3)]
-    res = _run("estimate", DATA / "MPSTD_excerpt.uff", "--input", "f", "--outputs", "a",
+    res = _run("estimate", vendor / "MPSTD_excerpt.uff", "--input", "f", "--outputs", "a",
                "-o", tmp_path / "h.csv")
     assert res.returncode == 3
     assert "it holds '#1.z', '#2.z', '#3.z'" in res.stderr, res.stderr
@@ -77,19 +85,19 @@ def test_axial_accelerometers_mapped_by_direction(tmp_path: Path):
     # many; here only node 1 z repeats, so each channel's first record is kept
     assert ("channel '#1.z' has 2 records, '#2.z' has 1: not read as the hits of an impact "
             "test") in res.stderr, res.stderr
-    res = _run("estimate", DATA / "MPSTD_excerpt.uff", "--map", "1.z=DA.x,2.z=DA.y,3=DB",
+    res = _run("estimate", vendor / "MPSTD_excerpt.uff", "--map", "1.z=DA.x,2.z=DA.y,3=DB",
                "--input", "f", "--outputs", "a", "-o", tmp_path / "h.csv")
     assert res.returncode == 3
     assert "it holds 'DA.x', 'DA.y', 'DB.z'" in res.stderr, res.stderr
     # a channel kept under its file name is named in the FRFs only through a map
-    res = _run("estimate", DATA / "MPSTD_excerpt.uff", "--input", "#1.z", "--outputs", "#2.z",
+    res = _run("estimate", vendor / "MPSTD_excerpt.uff", "--input", "#1.z", "--outputs", "#2.z",
                "-o", tmp_path / "h.csv")
     assert res.returncode == 2
     assert ("channel '#1.z' keeps its file name, which is not a model channel") in res.stderr
     assert "--map 1.z=STATION.DIR" in res.stderr, res.stderr
 
 
-def test_milestone_header_record_cut_short(tmp_path: Path):
+def test_milestone_header_record_cut_short(vendor, tmp_path: Path):
     """dataset_milestone_in_header.uff (pyuff's test of a > 4 GB file's
     header): record 7 claims 2508876 samples, the file holds the first 42 and
     the closing '-1'; pyuff reads the 42. Before: "record 7 claims 2508876
@@ -97,9 +105,9 @@ def test_milestone_header_record_cut_short(tmp_path: Path):
     as written (node 1, x, sound pressure in Pa); the record is named cut
     short, and --allow-truncated reads its 42 samples, as pyuff does."""
     pyuff = pytest.importorskip("pyuff")
-    d = pyuff.UFF(str(DATA / "dataset_milestone_in_header.uff")).read_sets(0)
+    d = pyuff.UFF(str(vendor / "dataset_milestone_in_header.uff")).read_sets(0)
     assert d["num_pts"] == 2508876 and len(d["data"]) == 42
-    args = ["estimate", DATA / "dataset_milestone_in_header.uff", "--input", "f",
+    args = ["estimate", vendor / "dataset_milestone_in_header.uff", "--input", "f",
             "--outputs", "a", "-o", tmp_path / "h.csv"]
     res = _run(*args)
     assert res.returncode == 3
@@ -112,9 +120,9 @@ def test_milestone_header_record_cut_short(tmp_path: Path):
     assert "no channel 'f' in the file; it holds '#1.x'" in res.stderr, res.stderr
 
 
-def test_psd_refusal_names_the_function_type(tmp_path: Path):
-    for cmd in (["convert", DATA / "sample_dataset58_psd.uff", tmp_path / "o.csv"],
-                ["estimate", DATA / "sample_dataset58_psd.uff", "--input", "f", "--outputs",
+def test_psd_refusal_names_the_function_type(vendor, tmp_path: Path):
+    for cmd in (["convert", vendor / "sample_dataset58_psd.uff", tmp_path / "o.csv"],
+                ["estimate", vendor / "sample_dataset58_psd.uff", "--input", "f", "--outputs",
                  "a", "-o", tmp_path / "o.csv"]):
         res = _run(*cmd)
         assert res.returncode == 3
@@ -177,11 +185,11 @@ def test_front_end_recording_reads_what_the_model_uses(tmp_path: Path):
     assert err < 1e-10
 
 
-def test_frf_of_scalar_channels_is_skipped_with_the_reason(tmp_path: Path):
+def test_frf_of_scalar_channels_is_skipped_with_the_reason(vendor, tmp_path: Path):
     """An FRF between two direction-0 channels: the model has no such channel;
     the message gives file:line and the direction (before: 'unknown response
     direction code 0', as for a corrupt file)."""
-    res = _run("convert", DATA / "non_ascii_header.uff", tmp_path / "o.csv")
+    res = _run("convert", vendor / "non_ascii_header.uff", tmp_path / "o.csv")
     assert res.returncode == 3
     assert ("non_ascii_header.uff:8: dataset 58 record 1: its response is scalar "
             "(direction 0)") in res.stderr, res.stderr

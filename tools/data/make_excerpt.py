@@ -2,9 +2,11 @@
 time records of 222400 samples) to its first N samples per record, headers
 as written but for the two counts that say how long a record is (the 58b
 id line's byte count, record 7's number of points). The result,
-MPSTD_excerpt.uff, is what tests/python/test_vendor_uff.py reads.
+MPSTD_excerpt.uff of the data set vendor_uff, is what tests/python/test_vendor_uff.py
+reads; tools/data/get_data.py runs this script with N = 2048 and checks the
+result's SHA-256.
 
-    python make_excerpt.py path/to/MPSTD#Set001_2024_10_08_10_27_07.uff [N]
+    python3 make_excerpt.py path/to/MPSTD#Set001_2024_10_08_10_27_07.uff OUT.uff [N]
 """
 
 import re
@@ -38,6 +40,7 @@ def excerpt(data: bytes, keep: int) -> bytes:
 
 
 if __name__ == "__main__":
-    src = Path(sys.argv[1])
-    keep = int(sys.argv[2]) if len(sys.argv) > 2 else 2048
-    Path(__file__).with_name("MPSTD_excerpt.uff").write_bytes(excerpt(src.read_bytes(), keep))
+    if not 3 <= len(sys.argv) <= 4:
+        sys.exit("usage: make_excerpt.py MPSTD_FILE.uff OUT.uff [N]")
+    keep = int(sys.argv[3]) if len(sys.argv) > 3 else 2048
+    Path(sys.argv[2]).write_bytes(excerpt(Path(sys.argv[1]).read_bytes(), keep))
