@@ -14,7 +14,9 @@ The clean inertances are cached in OUT/monitor_replicas_truth-<key>.npz.
 The monitor: librcb.Monitor on the truth's own model (exact baseline), kt, kr,
 ct tracked, --noise 10,1 (10,1,2 for the phase forms), --reweight
 --relinearise 8 --alpha 0.01 (docs/monitoring.md's recipe), the reference the
-average of COMMISSION = 10 files. Each replica is a new commissioning and a new
+average of COMMISSION = 10 files, the noise's level measured on their scatter
+(librcb.monitor.noise_scale, rcbtool monitor's default; --scale declared: the
+noise as declared, as before that existed). Each replica is a new commissioning and a new
 series (numpy PCG64, seed = 100000 * case + 1000 * replica + file).
 
 Noise forms, one per replica in turn (diag_cases.calibration_noise):
@@ -44,7 +46,8 @@ detection delay; and the tracked values' 95 % intervals covering the truth.
 
     OPENBLAS_NUM_THREADS=1 LIBRCB_PATH=build/src/librcb.so nice -n 10 \\
       .venv/bin/python tools/bench/monitor_replicas.py --replicas 100 \\
-      [--cases null,drift,wear,step] [--out out/monitor_replicas]
+      [--cases null,drift,wear,step] [--forms eq19,high,literal,phase]
+      [--scale measured|declared] [--out out/monitor_replicas]
 """
 
 import argparse
