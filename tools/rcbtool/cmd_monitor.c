@@ -137,12 +137,15 @@ static int baseline_sd_opt(const cli_args *a, mon_job *j) {
  * first did). */
 static int noise_scale_opt(const cli_args *a, mon_job *j) {
   const char *v = cli_opt_value(a, "--noise-scale");
-  int rc, n = 0;
+  int rc;
   j->noise_scale = 0.0;
   if (!v || strcmp(v, "auto") == 0) return 0;
   if (strncmp(v, "scatter:", 8) == 0) {
-    if (sscanf(v + 8, "%lg:%lg%n", &j->scatter[0], &j->scatter[1], &n) != 2 || v[8 + n] ||
-        !(j->scatter[0] >= 0) || !(j->scatter[1] >= 1) || !isfinite(j->scatter[0] + j->scatter[1]))
+    char *e1 = NULL, *e2 = NULL;
+    j->scatter[0] = strtod(v + 8, &e1);
+    if (e1 != v + 8 && *e1 == ':') j->scatter[1] = strtod(e1 + 1, &e2);
+    if (!e2 || e2 == e1 + 1 || *e2 || !(j->scatter[0] >= 0) || !(j->scatter[1] >= 1) ||
+        !isfinite(j->scatter[0] + j->scatter[1]))
       return cli_usage(a->cmd, "option --noise-scale scatter:CHI2:DOF expects a chi-square >= 0 "
                        "and its degrees of freedom >= 1, got '%s'", v);
     return 0;
@@ -152,7 +155,7 @@ static int noise_scale_opt(const cli_args *a, mon_job *j) {
     return cli_usage(a->cmd, "option --noise-scale expects 'auto' or a factor > 0 on the "
                      "declared noise (1: as declared), got '%s'", v);
   if (j->noise_scale > 1e6)
-    return cli_usage(a->cmd, "option --noise-scale %s: a noise 1e6 x the declared one; give "
+    return cli_usage(a->cmd, "option --noise-scale %s: a noise over 1e6 x the declared one; give "
                      "--noise the level you mean", v);
   return 0;
 }

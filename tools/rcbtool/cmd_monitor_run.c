@@ -184,8 +184,8 @@ static int commission(mon_ctx *x) {
   if (x->j->commission == 1) return 0;
   gather(x->setup, x->perm, x->nc, x->n, x->values);
   if (saved) return 0; /* the average itself */
-  if (!x->j->noise_scale && !sd_is_dir(x->j->sd_path)) { /* the scale measured */
-    if (nv > (size_t)-1 / sizeof *x->reps / x->j->commission ||
+  if (!x->j->noise_scale && !(x->j->scatter[1] > 0) && !sd_is_dir(x->j->sd_path)) { /* measured */
+    if (!nv || nv > (size_t)-1 / sizeof *x->reps / x->j->commission ||
         !(x->reps = malloc(x->j->commission * nv * sizeof *x->reps)))
       return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
     memcpy(x->reps, x->values, nv * sizeof *x->reps);
