@@ -93,6 +93,56 @@ def test_package_and_rcbtool_agree(rcb, tmp_path):
     assert py[-1]["alarm"]  # the cross-coupled day is a change
 
 
+def test_noise_scale_package_and_rcbtool_agree(rcb, tmp_path):
+    """The noise's level measured on the commissioning files (issue #34): the
+    package's librcb.monitor.noise_scale on the 3 files equals rcbtool
+    monitor --commission 3's (JSON noise_scale) to rounding, and a Monitor
+    given it on their average agrees with rcbtool update by update. The
+    scale is also the closed form on those files: the scatter whitened by
+    the eq. 19 variance written out here."""
+    exe = os.environ.get("RCBTOOL")
+    if not exe:
+        pytest.skip("RCBTOOL is not set")
+    paths = _series(rcb, tmp_path, 5)
+    ini = tmp_path / "model.ini"
+    ini.write_text(PAPER.read_text() + "\n[uff]\nmap = " +
+                   ", ".join(f"{k} {v}" for k, v in UFF_MAP.items()) + "\n")
+    res = subprocess.run([exe, "monitor", str(ini), *map(str, paths), "--params",
+                          ",".join(PARAMS), "--noise", "10,1", "--commission", "3",
+                          "--alpha", "0.01", "--json"], capture_output=True, text=True,
+                         timeout=300)
+    assert res.returncode == 0, res.stderr
+    log = json.loads(res.stdout)
+    files = []
+    for p in paths[:3]:
+        with rcb.Meas.from_bytes(p.read_bytes(), uff_map=UFF_MAP) as ms:
+            files.append(ms.data)
+            x, chans, rpm = ms.x, ms.channels, ms.rpm
+    files = np.array(files)
+    avg = files.mean(axis=0)
+    # closed form: one measurement's radial and tangential variance at the average
+    a = 0.01 * np.sqrt(np.sum(np.abs(avg) ** 2, axis=1, keepdims=True)) / avg.shape[1]
+    vt = a ** 2 / 6 + 0 * avg.real
+    vr = (0.10 * np.abs(avg)) ** 2 / 3 + vt
+    d = (files - avg) * np.conj(avg / np.abs(avg))
+    chi2 = float(np.sum(d.real ** 2 / vr + d.imag ** 2 / vt))
+    with rcb.Model.from_ini(ini) as m, \
+            rcb.Meas.from_arrays(x, avg, [c[0] for c in chans], [c[1] for c in chans],
+                                 kind=chans[0][2], rpm=rpm) as setup:
+        ns = rcb.monitor.noise_scale(setup, files, noise=(10, 1))
+        assert ns["dof"] == 2 * avg.size * 2 == log["scatter_dof"]
+        assert ns["chi2"] == pytest.approx(chi2, rel=1e-10)
+        assert ns["scale"] == pytest.approx(log["noise_scale"], rel=1e-10)
+        assert log["noise_scale_from"] == "commissioning scatter"
+        with rcb.Monitor(m, setup, PARAMS, noise=(10, 1), alpha=0.01, setup_averages=3,
+                         noise_scale=ns["scale"]) as mon:
+            for p, b in zip(paths[3:], log["updates"]):
+                with rcb.Meas.from_bytes(p.read_bytes(), uff_map=UFF_MAP) as ms:
+                    r = mon.update(ms)
+                assert r["T"] == pytest.approx(b["T"], rel=1e-9)
+                assert r["alarm"] == b["alarm"]
+
+
 def test_state_restart(rcb, tmp_path):
     """save_state / load_state (issue #24): a second monitor loaded from the first's
     state after 2 updates gives the first's next result exactly; bytes of another
