@@ -418,14 +418,16 @@ static void test_noise_scale_closed_form(void **state) {
   o.sd = sd;
   assert_int_equal(rcb_monitor_noise_scale(f->setup, v, 2, &o, &ns), RCB_OK);
   assert_true(fabs(ns.chi2 / want_sd - 1) < 1e-10);
-  /* refused: one measurement, a value not finite, no noise, a bad scale */
+  /* refused: one measurement, a value not finite, no noise, an sd <= 0 */
   assert_int_equal(rcb_monitor_noise_scale(f->setup, v, 1, &o, &ns), RCB_ERR_ARG);
   v[NPT + 7] = NAN;
   assert_int_equal(rcb_monitor_noise_scale(f->setup, v, 2, &o, &ns), RCB_ERR_ARG);
   v[NPT + 7] = v[7];
   o.sd = NULL, o.beta_a = o.beta_s = 0;
   assert_int_equal(rcb_monitor_noise_scale(f->setup, v, 2, &o, &ns), RCB_ERR_ARG);
-  o.beta_a = BETA_A, o.noise_scale = -1;
+  o.beta_a = BETA_A, o.noise_scale = -1; /* the scale o carries is not the declared noise */
+  assert_int_equal(rcb_monitor_noise_scale(f->setup, v, 2, &o, &ns), RCB_OK);
+  o.sd = sd, sd[3] = -sd[3];
   assert_int_equal(rcb_monitor_noise_scale(f->setup, v, 2, &o, &ns), RCB_ERR_ARG);
   free(v);
   free(sd);

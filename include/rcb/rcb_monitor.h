@@ -434,7 +434,7 @@ RCB_API rcb_status rcb_monitor_create(rcb_monitor **out, const rcb_model *baseli
  * @brief The noise's level from @p nrep measurements of one state (the
  * commissioning files, before they are averaged into the set-up): how many
  * times the noise @p opts declares (beta_a, beta_s, phase_deg or sd; its
- * noise_scale is ignored) their scatter about their average is. A noise of
+ * noise_scale is not applied) their scatter about their average is. A noise of
  * the declared form but another level gives scale = that level's ratio, to
  * about sqrt(1 / (2 dof)); pass it as opts.noise_scale to rcb_monitor_create
  * with the average as the set-up. Reads only; allocates nothing.

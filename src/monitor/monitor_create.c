@@ -172,8 +172,10 @@ rcb_status rcb_monitor_noise_scale(const rcb_meas *setup, const rcb_complex *val
   size_t nch, npts, c, i, r;
   double chi2 = 0.0, ph;
   char err[160];
-  if (!setup || !values || !o || !out || nrep < 2 || noise_opts(o, err, sizeof err))
-    return RCB_ERR_ARG;
+  rcb_monitor_opts od;
+  if (!setup || !values || !o || !out || nrep < 2) return RCB_ERR_ARG;
+  od = *o, od.noise_scale = 0.0; /* the declared noise, whatever scale o carries */
+  if (noise_opts(&od, err, sizeof err)) return RCB_ERR_ARG;
   nch = rcb_meas_channel_count(setup), npts = rcb_meas_point_count(setup);
   if (!nch || !npts) return RCB_ERR_ARG;
   ph = o->phase_deg * RCB_MON_DEG;
@@ -195,6 +197,7 @@ rcb_status rcb_monitor_noise_scale(const rcb_meas *setup, const rcb_complex *val
       ae = cabs(m);
       u = ae > 0 ? m / ae : 1.0;
       if (o->sd) {
+        if (!(o->sd[c * npts + i] > 0)) return RCB_ERR_ARG;
         vr = vt = o->sd[c * npts + i] * o->sd[c * npts + i];
       } else {
         eq19_var(o->beta_a, a, ph * ph / 3.0, ae, &vr, &vt);
