@@ -507,16 +507,17 @@ static void tracked_rest(const rcb_monitor *mon, int gls, const rcb_monitor_resu
  * or with c->adj one adjoint sweep (fresh) or one plain sweep reusing the
  * last columns (a chord step). *ok = 0 when the model refused a value or a
  * column is dependent, 4 when some step was MON_CHORD_SD standard errors
- * or more, 2 when MON_RELIN_TOL or more, else 1. */
+ * or more, 2 when MON_RELIN_TOL or more, else 1; *step the largest step
+ * in standard errors. */
 static rcb_status joint_gn(rcb_monitor *mon, const mon_cand *c, int gls, int fresh, double *x,
-                           double *sd, int *ok) {
+                           double *sd, int *ok, double *step) {
   size_t a, i, k = mon->k, nt = mon->nt, p = nt + c->np;
   double qz[RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP], dx[RCB_MONITOR_MAX_TRACKED +
                                                             RCB_MONITOR_MAXP];
   double *w = mon->z, *J = mon->Jx, *Rm = mon->rmx, *Ym = Rm + mon->n * (1 + p),
          h[RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP];
   rcb_status st;
-  *ok = 0;
+  *ok = 0, *step = 0.0;
   if (c->adj) {
     /* the first iteration: one adjoint sweep, the change and its columns at
      * x; the later ones: the change by a plain sweep, the columns kept
@@ -558,11 +559,14 @@ static rcb_status joint_gn(rcb_monitor *mon, const mon_cand *c, int gls, int fre
   if ((st = rcb_mon_small_qr(mon, &mon->sw, k, p, ok)) || !*ok) return st;
   (void)rcb_mon_gls_explained(&mon->sw, w, k, 0, p, qz);
   rcb_mon_gls_step(&mon->sw, qz, p, 0, p, dx, sd);
+  *step = 0.0;
   for (a = 0; a < p; a++) {
     x[a] += dx[a];
     if (!(fabs(dx[a]) < MON_RELIN_TOL * sd[a]) && *ok != 4) *ok = 2; /* not converged yet */
     if (!(fabs(dx[a]) < MON_CHORD_SD * sd[a])) *ok = 4; /* nor near: fresh columns next */
+    *step = fmax(*step, fabs(dx[a]) / sd[a]);
   }
+  if (!isfinite(*step)) *ok = 4;
   return RCB_OK;
 }
 
@@ -586,11 +590,18 @@ static rcb_status joint_relin(rcb_monitor *mon, int gls, rcb_monitor_result *res
   size_t a, it, nt = mon->nt;
   rcb_status st = RCB_OK;
   int ok = 1, fresh = 1;
+  double prev = 0, step;
   if (!c || !mon->relin || !c->settable) return RCB_OK;
   for (a = 0; a < nt; a++) x[a] = dth[a], sd[a] = se[a];
   for (a = 0; a < c->np; a++) x[nt + a] = c->size_now[a], sd[nt + a] = c->se_now[a];
+  for (a = 0; a < nt + c->np; a++) prev = fmax(prev, fabs(x[a]) / sd[a]);
   for (it = 0; ok == 1 && !st && it < mon->relin; it++) {
-    st = joint_gn(mon, c, gls, fresh, x, sd, &ok);
+    st = joint_gn(mon, c, gls, fresh, x, sd, &ok, &step);
+    /* a step under a standard error whose successor, at the contraction
+     * of the last two (the linear estimate from the baseline the first),
+     * would be under MON_RELIN_TOL: converged without another sweep */
+    if (ok == 2 && step * step < MON_RELIN_TOL * prev) ok = 1;
+    prev = step;
     fresh = ok == 4;
     ok = ok == 2 || ok == 4 ? 1 : ok ? 3 : 0; /* 3: converged */
   }
