@@ -100,12 +100,12 @@ static rcb_status inline_lu(const rcb_layout *L, double *ab, int *ipiv) {
       d[2 * i] = xr * rr - xi * ri, d[2 * i + 1] = xr * ri + xi * rr;
     }
     if (km <= INLINE_KL_MAX) { /* a plain loop over 2 km doubles: vectorised */
-      double sw[2 * INLINE_KL_MAX]; /* i l: (-im, re) of each multiplier */
-      const double *l = d + 2;
-      size_t t;
-      for (t = 0; t < 2 * km; t += 2) sw[t] = -l[t + 1], sw[t + 1] = l[t];
+      double sw[2 * INLINE_KL_MAX]; /* i d: (-im, re) of each multiplier */
+      for (i = 1; i <= km; i++) sw[2 * i - 2] = -d[2 * i + 1], sw[2 * i - 1] = d[2 * i];
       for (c = j + 1; c <= ju; c++) {
         double *col = ab + 2 * (kv + j - c + ld * c) + 2, ur = col[-2], ui = col[-1];
+        const double *l = d + 2;
+        size_t t;
         if (ur == 0.0 && ui == 0.0) continue;
         for (t = 0; t < 2 * km; t++) col[t] -= l[t] * ur + sw[t] * ui;
       }
