@@ -54,14 +54,9 @@ const rcb_zsolver_ops *rcb_zsolver_banded(void) { return &banded_ops; }
  * products in real arithmetic (the inputs are finite: no C99 Annex G
  * recovery), divisions by Smith's scaling. A(i, j) is ab[kv + i - j + ld j]. */
 
-/* 1 / (ar + i ai): one division where the squares cannot overflow or
- * underflow, else Smith's scaling. */
+/* 1 / (ar + i ai). */
 static void recip(double ar, double ai, double *rr, double *ri) {
-  double big = fmax(fabs(ar), fabs(ai));
-  if (big > 1e-150 && big < 1e150) {
-    double d = 1.0 / (ar * ar + ai * ai);
-    *rr = ar * d, *ri = -ai * d;
-  } else if (fabs(ar) >= fabs(ai)) {
+  if (fabs(ar) >= fabs(ai)) {
     double t = ai / ar, d = ar + ai * t;
     *rr = 1.0 / d, *ri = -t / d;
   } else {
@@ -70,9 +65,12 @@ static void recip(double ar, double ai, double *rr, double *ri) {
   }
 }
 
-/* Sub-diagonals up to which inline_lu keeps a column's multipliers times i
- * on the stack (wider bands: the complex loop). */
-#define INLINE_KL_MAX 32
+/* x /= a, complex (two doubles each). */
+static void cdiv(double *x, const double *a) {
+  double rr, ri, xr = x[0], xi = x[1];
+  recip(a[0], a[1], &rr, &ri);
+  x[0] = xr * rr - xi * ri, x[1] = xr * ri + xi * rr;
+}
 
 static rcb_status inline_lu(const rcb_layout *L, double *ab, int *ipiv) {
   size_t n = L->n, kl = L->kl, ku = L->ku, kv = kl + ku, ld = L->ld, j, i, c, ju = 0;
@@ -99,18 +97,6 @@ static rcb_status inline_lu(const rcb_layout *L, double *ab, int *ipiv) {
       double xr = d[2 * i], xi = d[2 * i + 1];
       d[2 * i] = xr * rr - xi * ri, d[2 * i + 1] = xr * ri + xi * rr;
     }
-    if (km <= INLINE_KL_MAX) { /* a plain loop over 2 km doubles: vectorised */
-      double sw[2 * INLINE_KL_MAX]; /* i d: (-im, re) of each multiplier */
-      for (i = 1; i <= km; i++) sw[2 * i - 2] = -d[2 * i + 1], sw[2 * i - 1] = d[2 * i];
-      for (c = j + 1; c <= ju; c++) {
-        double *col = ab + 2 * (kv + j - c + ld * c) + 2, ur = col[-2], ui = col[-1];
-        const double *l = d + 2;
-        size_t t;
-        if (ur == 0.0 && ui == 0.0) continue;
-        for (t = 0; t < 2 * km; t++) col[t] -= l[t] * ur + sw[t] * ui;
-      }
-      continue;
-    }
     for (c = j + 1; c <= ju; c++) {
       double *col = ab + 2 * (kv + j - c + ld * c), ur = col[0], ui = col[1];
       if (ur == 0.0 && ui == 0.0) continue;
@@ -124,74 +110,65 @@ static rcb_status inline_lu(const rcb_layout *L, double *ab, int *ipiv) {
   return RCB_OK;
 }
 
-/* b_r -= m t for rows 1 .. lm of m (complex, two doubles each). */
-static void axpy_rows(double *b, const double *m, size_t lm, double tr, double ti) {
-  size_t i;
-  for (i = 1; i <= lm; i++) {
-    b[2 * i] -= m[2 * i] * tr - m[2 * i + 1] * ti;
-    b[2 * i + 1] -= m[2 * i] * ti + m[2 * i + 1] * tr;
-  }
-}
-
-/* op(A) X = B with the factors of inline_lu, zgbtrs's order, nrhs columns
- * of n (complex, two doubles each) taken together at each step. */
-static rcb_status inline_resolve(const rcb_layout *L, const rcb_complex *Z, const int *ipiv,
-                                 rcb_complex *B, size_t nrhs, char trans) {
-  size_t n = L->n, kl = L->kl, kv = kl + L->ku, ld = L->ld, j, i, r;
-  const double *ab = (const double *)Z;
-  double *X = (double *)B, rr, ri;
-  if (trans != 'N' && trans != 'T') return RCB_ERR_ARG;
+/* op(A) x = b with the factors of inline_lu (zgbtrs's order), one column. */
+static void inline_solve(const rcb_layout *L, const double *ab, const int *ipiv, double *b,
+                         char trans) {
+  size_t n = L->n, kl = L->kl, kv = kl + L->ku, ld = L->ld, j, i;
   if (trans == 'N') {
     for (j = 0; j + 1 < n; j++) {
       size_t lm = kl < n - 1 - j ? kl : n - 1 - j, l = (size_t)ipiv[j] - 1;
-      for (r = 0; r < nrhs; r++) {
-        double *b = X + 2 * n * r, tr = b[2 * l], ti = b[2 * l + 1];
-        b[2 * l] = b[2 * j], b[2 * l + 1] = b[2 * j + 1], b[2 * j] = tr, b[2 * j + 1] = ti;
-        axpy_rows(b + 2 * j, ab + 2 * (kv + ld * j), lm, tr, ti);
+      const double *m = ab + 2 * (kv + ld * j);
+      double tr, ti;
+      if (l != j) tr = b[2 * l], ti = b[2 * l + 1], b[2 * l] = b[2 * j],
+                  b[2 * l + 1] = b[2 * j + 1], b[2 * j] = tr, b[2 * j + 1] = ti;
+      tr = b[2 * j], ti = b[2 * j + 1];
+      for (i = 1; i <= lm; i++) {
+        b[2 * (j + i)] -= m[2 * i] * tr - m[2 * i + 1] * ti;
+        b[2 * (j + i) + 1] -= m[2 * i] * ti + m[2 * i + 1] * tr;
       }
     }
     for (j = n; j-- > 0;) {
       const double *u = ab + 2 * (kv - j + ld * j); /* u[2 i]: A(i, j) */
-      size_t i0 = j > kv ? j - kv : 0;
-      while (i0 < j && u[2 * i0] == 0.0 && u[2 * i0 + 1] == 0.0) i0++; /* no fill there */
-      recip(u[2 * j], u[2 * j + 1], &rr, &ri);
-      for (r = 0; r < nrhs; r++) {
-        double *b = X + 2 * n * r, xr = b[2 * j], xi = b[2 * j + 1], tr, ti;
-        b[2 * j] = tr = xr * rr - xi * ri, b[2 * j + 1] = ti = xr * ri + xi * rr;
-        for (i = i0; i < j; i++) {
-          b[2 * i] -= u[2 * i] * tr - u[2 * i + 1] * ti;
-          b[2 * i + 1] -= u[2 * i] * ti + u[2 * i + 1] * tr;
-        }
+      double tr, ti;
+      cdiv(b + 2 * j, u + 2 * j);
+      tr = b[2 * j], ti = b[2 * j + 1];
+      for (i = j > kv ? j - kv : 0; i < j; i++) {
+        b[2 * i] -= u[2 * i] * tr - u[2 * i + 1] * ti;
+        b[2 * i + 1] -= u[2 * i] * ti + u[2 * i + 1] * tr;
       }
     }
-    return RCB_OK;
+    return;
   }
   for (j = 0; j < n; j++) {
     const double *u = ab + 2 * (kv - j + ld * j);
-    size_t i0 = j > kv ? j - kv : 0;
-    while (i0 < j && u[2 * i0] == 0.0 && u[2 * i0 + 1] == 0.0) i0++;
-    recip(u[2 * j], u[2 * j + 1], &rr, &ri);
-    for (r = 0; r < nrhs; r++) {
-      double *b = X + 2 * n * r, tr = b[2 * j], ti = b[2 * j + 1];
-      for (i = i0; i < j; i++) {
-        tr -= u[2 * i] * b[2 * i] - u[2 * i + 1] * b[2 * i + 1];
-        ti -= u[2 * i] * b[2 * i + 1] + u[2 * i + 1] * b[2 * i];
-      }
-      b[2 * j] = tr * rr - ti * ri, b[2 * j + 1] = tr * ri + ti * rr;
+    double tr = b[2 * j], ti = b[2 * j + 1];
+    for (i = j > kv ? j - kv : 0; i < j; i++) {
+      tr -= u[2 * i] * b[2 * i] - u[2 * i + 1] * b[2 * i + 1];
+      ti -= u[2 * i] * b[2 * i + 1] + u[2 * i + 1] * b[2 * i];
     }
+    b[2 * j] = tr, b[2 * j + 1] = ti;
+    cdiv(b + 2 * j, u + 2 * j);
   }
   for (j = n - 1; j-- > 0;) {
     size_t lm = kl < n - 1 - j ? kl : n - 1 - j, l = (size_t)ipiv[j] - 1;
     const double *m = ab + 2 * (kv + ld * j);
-    for (r = 0; r < nrhs; r++) {
-      double *b = X + 2 * n * r, tr = b[2 * j], ti = b[2 * j + 1];
-      for (i = 1; i <= lm; i++) {
-        tr -= m[2 * i] * b[2 * (j + i)] - m[2 * i + 1] * b[2 * (j + i) + 1];
-        ti -= m[2 * i] * b[2 * (j + i) + 1] + m[2 * i + 1] * b[2 * (j + i)];
-      }
-      b[2 * j] = b[2 * l], b[2 * j + 1] = b[2 * l + 1], b[2 * l] = tr, b[2 * l + 1] = ti;
+    double tr = b[2 * j], ti = b[2 * j + 1];
+    for (i = 1; i <= lm; i++) {
+      tr -= m[2 * i] * b[2 * (j + i)] - m[2 * i + 1] * b[2 * (j + i) + 1];
+      ti -= m[2 * i] * b[2 * (j + i) + 1] + m[2 * i + 1] * b[2 * (j + i)];
     }
+    b[2 * j] = tr, b[2 * j + 1] = ti;
+    if (l != j) tr = b[2 * l], ti = b[2 * l + 1], b[2 * l] = b[2 * j],
+                b[2 * l + 1] = b[2 * j + 1], b[2 * j] = tr, b[2 * j + 1] = ti;
   }
+}
+
+static rcb_status inline_resolve(const rcb_layout *L, const rcb_complex *Z, const int *ipiv,
+                                 rcb_complex *B, size_t nrhs, char trans) {
+  size_t r;
+  if (trans != 'N' && trans != 'T') return RCB_ERR_ARG;
+  for (r = 0; r < nrhs; r++)
+    inline_solve(L, (const double *)Z, ipiv, (double *)(B + L->n * r), trans);
   return RCB_OK;
 }
 
