@@ -30,10 +30,6 @@ const rcb_complex *rcb_frf_solution(const rcb_frf *f, size_t q);
 /* Solve again with the last factorisation: Z X = B for nrhs right-hand
  * sides (B: n x nrhs column-major, the caller's, overwritten by X). */
 rcb_status rcb_frf_solve_again(rcb_frf *f, rcb_complex *B, size_t nrhs);
-/* From now on, an FRF object on the LAPACK banded backend factors and
- * solves with the same algorithm written out (rcb_zsolver_banded_inline:
- * equal to rounding, faster on small bands); other backends unchanged. */
-rcb_status rcb_frf_use_inline_band(rcb_frf *f);
 /* The adjoint solutions of the outputs with the last factorisation:
  * Z^T Y = E_out, column o of Y (n x nout column-major, the caller's) being
  * the row of Z^-1 that output o reads, so that dH_oq/dp = -Y_o^T (dZ/dp) X_q. */

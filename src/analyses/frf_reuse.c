@@ -42,9 +42,3 @@ rcb_status rcb_frf_solve_adjoint(rcb_frf *f, rcb_complex *Y) {
   for (o = 0; o < f->nout; o++) Y[f->out_row[o] + n * o] = 1.0;
   return resolve(f, Y, f->nout, 'T');
 }
-
-rcb_status rcb_frf_use_inline_band(rcb_frf *f) {
-  if (!f) return RCB_ERR_ARG;
-  if (f->ops == rcb_zsolver_banded()) f->ops = rcb_zsolver_banded_inline();
-  return RCB_OK;
-}

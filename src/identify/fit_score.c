@@ -364,10 +364,6 @@ rcb_status rcb_fit_adj_run(rcb_fit *f, rcb_fit_adj *a, double *J) {
   return st;
 }
 
-void rcb_fit_use_inline_band(rcb_fit *f) {
-  if (f && f->frf) (void)rcb_frf_use_inline_band(f->frf);
-}
-
 void rcb_fit_adj_destroy(rcb_fit *f, rcb_fit_adj *a) {
   if (!f || !a) return;
   adj_free(f, &a->ws);

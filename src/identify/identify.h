@@ -85,9 +85,6 @@ typedef struct rcb_fit_adj rcb_fit_adj;
 rcb_status rcb_fit_adj_create(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, rcb_fit_adj **out);
 rcb_status rcb_fit_adj_run(rcb_fit *f, rcb_fit_adj *a, double *J);
 void rcb_fit_adj_destroy(rcb_fit *f, rcb_fit_adj *a);
-/* f's later sweeps on the banded backend by the factorisation written out
- * (rcb_frf_use_inline_band). */
-void rcb_fit_use_inline_band(rcb_fit *f);
 
 /* The weighted residuals (nres values) of the model values of f's last
  * sweep, rcb_fit_jacobian_dz's included, without another: what

@@ -870,8 +870,5 @@ rcb_status rcb_mon_adj_init(rcb_monitor *mon) {
     if ((st = rcb_fit_adj_create(mon->fit, dz, nt + c->np, &c->adj)))
       return rcb_mon_fail(mon, st, "%s: joint step: %s", c->desc, rcb_fit_errmsg(mon->fit));
   }
-  /* the update's sweeps (create's are done): the band written out, equal
-   * to rounding and a third faster than LAPACK's on the paper system */
-  rcb_fit_use_inline_band(mon->fit);
   return RCB_OK;
 }

@@ -40,10 +40,6 @@ typedef struct rcb_zsolver_ops_s {
 
 const rcb_zsolver_ops *rcb_zsolver_dense(void);
 const rcb_zsolver_ops *rcb_zsolver_banded(void);
-/* The banded backend's factorisation and solves written out (zgbtf2's
- * pivots and storage: zgbcon and LAPACK's zgbtrs read its factors), for
- * the small bands where LAPACK's calls per column dominate. */
-const rcb_zsolver_ops *rcb_zsolver_banded_inline(void);
 /* NULL when librcb was built without RCB_WITH_SUITESPARSE. */
 const rcb_zsolver_ops *rcb_zsolver_sparse(void);
 /* Full factorisations and kept-pivot refactorisations done so far by the
