@@ -4,6 +4,7 @@
  * in rcb_monitor.h; here they are applied in the rank space of the
  * whitened sensitivity columns (y = Q^T r, k values).
  */
+#include <cblas.h>
 #include <math.h>
 #include <string.h>
 
@@ -85,6 +86,15 @@ static void to_rank_many(const rcb_monitor *mon, const double *R, size_t m, doub
       for (a = 0; a < k; a++) o[a] += q[a] * ri;
     }
   }
+}
+
+/* The same by BLAS (dgemm: Q^T as the k x n column-major matrix it is):
+ * the joint step's sweep path, where Q is read once for 1 + nt + np
+ * columns (0.5 ms of a 7 ms iteration by the loop above). */
+static void to_rank_blas(const rcb_monitor *mon, const double *R, size_t m, double *out) {
+  cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, (blasint)mon->k, (blasint)m,
+              (blasint)mon->n, 1.0, mon->Q, (blasint)mon->k, R, (blasint)mon->n, 0.0, out,
+              (blasint)mon->k);
 }
 
 static double dot(const double *a, const double *b, size_t n) {
