@@ -185,6 +185,21 @@ static void factor_sensitivities(const char *const names[4], int one_element) {
     if (!(na > 0) || sqrt(dc / na) > 1e-6)
       fail_msg("%s batched: |J| = %g, mismatch %g", names[k], sqrt(na), sqrt(dc / na));
   }
+  /* the prepared sweep of the monitor's joint step (rcb_fit_adj): by the
+   * direct re-solve with one parameter (1 x 2 inputs < 3 outputs), by the
+   * adjoint with both; the same columns as the batched adjoint's above */
+  for (k = 1; k <= 2; k++) {
+    rcb_fit_adj *adj = NULL;
+    double *Ja = calloc(k * n, sizeof *Ja), na = 0, dd = 0;
+    assert_non_null(Ja);
+    assert_int_equal(rcb_fit_adj_create(f, dz, k, &adj), RCB_OK);
+    assert_int_equal(rcb_fit_adj_run(f, adj, Ja), RCB_OK);
+    for (j = 0; j < k * n; j++) na += J[j] * J[j], dd += (Ja[j] - J[j]) * (Ja[j] - J[j]);
+    print_message("  rcb_fit_adj, %zu parameter(s) vs the batched adjoint %.2e\n", k, sqrt(dd / na));
+    if (!(na > 0) || sqrt(dd / na) > 1e-10) fail_msg("rcb_fit_adj (%zu): mismatch %g", k, sqrt(dd / na));
+    rcb_fit_adj_destroy(f, adj);
+    free(Ja);
+  }
   rcb_fit_dz_free(&a, dz, 2);
   free(J), free(rp), free(rm), free(d1), free(d2);
   rcb_fit_destroy(fc);

@@ -211,6 +211,52 @@ static rcb_status score_point(rcb_fit *f, size_t i, const rcb_fit_dz *dz, size_t
   return RCB_OK;
 }
 
+/* One point by the direct re-solve instead (rcb_fit_adj with fewer
+ * parameters x inputs than outputs): dX_kq = Z^-1 (w^2 dF_k - dZ_k X_q)
+ * with the point's factors, ndz nq right-hand sides in ws->Y (n x nout
+ * holds them), and dH_oq/dp_k its output's row. */
+static rcb_status direct_point(rcb_fit *f, size_t i, const rcb_fit_dz *dz, size_t ndz,
+                               const adj_ws *ws, double *J) {
+  size_t n = f->m->ndof, k, c, q, a, jj, nq = f->unbalance || !f->nin ? 1 : f->nin;
+  double w = f->grid[i], W = rcb_fit_point_speed(f, w);
+  const rcb_complex *X;
+  rcb_status st;
+  if ((st = rcb_fit_solve_point(f, i))) return st;
+  if (!(X = rcb_frf_solution(f->frf, 0)))
+    return rcb_fit_fail(f, RCB_ERR_STATE, "direct re-solve at %g rad/s: no factors", w);
+  memset(ws->Y, 0, n * ndz * nq * sizeof *ws->Y);
+  for (k = 0; k < ndz; k++) {
+    double *y = (double *)(ws->Y + n * nq * k); /* re, im */
+    dz_values(&dz[k], w, W, ws->z);
+    for (a = 0; a < dz[k].ne; a++) {
+      double zr = ws->z[2 * a], zi = ws->z[2 * a + 1];
+      size_t row = dz[k].e[a].row, col = dz[k].e[a].col;
+      for (q = 0; q < nq; q++) {
+        double xr = creal(X[col + n * q]), xi = cimag(X[col + n * q]);
+        y[2 * (row + n * q)] -= zr * xr - zi * xi;
+        y[2 * (row + n * q) + 1] -= zr * xi + zi * xr;
+      }
+    }
+    for (a = 0; f->unbalance && dz[k].dF && a < n; a++) ws->Y[n * k + a] += (w * w) * dz[k].dF[a];
+  }
+  if ((st = rcb_frf_solve_again(f->frf, ws->Y, ndz * nq)))
+    return rcb_fit_fail(f, st, "direct re-solve at %g rad/s: %s", w, rcb_frf_errmsg(f->frf));
+  for (jj = f->pt_first[i]; jj < f->pt_first[i + 1]; jj++)
+    ws->g[jj - f->pt_first[i]] = rcb_fit_res_coef(f, f->pt_res[jj]);
+  for (k = 0; k < ndz; k++) {
+    for (c = 0; c < f->nch; c++) {
+      q = f->unbalance ? 0 : f->ch_in[c];
+      ws->dH[c] = ws->Y[rcb_frf_output_row(f->frf, f->ch_out[c]) + n * (q + nq * k)];
+    }
+    for (jj = f->pt_first[i]; jj < f->pt_first[i + 1]; jj++) {
+      size_t j = f->pt_res[jj];
+      rcb_complex g = ws->g[jj - f->pt_first[i]], dh = ws->dH[f->res_ch[j]];
+      J[j + f->nres * k] = creal(g) * creal(dh) - cimag(g) * cimag(dh); /* Re(g dh) */
+    }
+  }
+  return RCB_OK;
+}
+
 static void adj_free(rcb_fit *f, adj_ws *ws) {
   rcb_free(&f->alloc, ws->Y);
   rcb_free(&f->alloc, ws->dH);
@@ -277,6 +323,8 @@ static rcb_status sweep_adjoint(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, do
 struct rcb_fit_adj {
   rcb_fit_dz *dz; /* ndz copies of the caller's (their entries stay the caller's) */
   size_t ndz;
+  int direct;     /* ndz x the inputs < the outputs: direct_point's re-solves
+                     are fewer than the adjoint's (rcb_fit_adjoint_cheaper) */
   adj_ws ws;
 };
 
@@ -293,6 +341,7 @@ rcb_status rcb_fit_adj_create(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, rcb_
   }
   if (ndz) memcpy(a->dz, dz, ndz * sizeof *dz);
   a->ndz = ndz;
+  a->direct = ndz * (f->unbalance || !f->nin ? 1 : f->nin) < f->nout;
   if ((st = adj_alloc(f, a->dz, ndz, &a->ws))) {
     rcb_free(&f->alloc, a->dz);
     rcb_free(&f->alloc, a);
@@ -305,9 +354,13 @@ rcb_status rcb_fit_adj_create(rcb_fit *f, const rcb_fit_dz *dz, size_t ndz, rcb_
 rcb_status rcb_fit_adj_run(rcb_fit *f, rcb_fit_adj *a, double *J) {
   rcb_status st;
   if (!f || !a || !J) return RCB_ERR_ARG;
+  size_t i;
   if ((st = rcb_fit_prepare(f))) return st;
   rcb_frf_refresh(f->frf);
-  if (!(st = adj_points(f, a->dz, a->ndz, &a->ws, J))) f->sweeps++;
+  if (!a->direct) st = adj_points(f, a->dz, a->ndz, &a->ws, J);
+  for (i = 0; a->direct && !st && i < f->npts; i++)
+    if (f->pt_used[i]) st = direct_point(f, i, a->dz, a->ndz, &a->ws, J);
+  if (!st) f->sweeps++;
   return st;
 }
 

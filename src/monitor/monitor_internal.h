@@ -177,6 +177,8 @@ struct rcb_monitor {
   struct rcb_fit_dz *cdz; /* the batched candidates' derivative matrices, ncdz
                           (kept with opts.relinearise) */
   struct rcb_fit_dz *tdz; /* nt: the tracked parameters' (with a candidate's adj) */
+  double *rat;         /* with tdz: n, the joint step's one-pole model's
+                          coefficient per point (monitor.c, pole_step) */
   size_t ncdz;
 
   /* noise of the reweighted path */
