@@ -47,7 +47,7 @@ detection delay; and the tracked values' 95 % intervals covering the truth.
     OPENBLAS_NUM_THREADS=1 LIBRCB_PATH=build/src/librcb.so nice -n 10 \\
       .venv/bin/python tools/bench/monitor_replicas.py --replicas 100 \\
       [--cases null,drift,wear,step] [--forms eq19,high,literal,phase]
-      [--scale measured|declared] [--out out/monitor_replicas]
+      [--scale measured|declared] [--sensors] [--out out/monitor_replicas]
 """
 
 import argparse
@@ -257,7 +257,7 @@ def _meas(rcb, data):
     return rcb.Meas.from_arrays(FREQ, data, resp, refs, kind="inertance", rpm=dc.RPM)
 
 
-def replica(rcb, model, H, case, rep, ci, scale="measured"):
+def replica(rcb, model, H, case, rep, ci, scale="measured", sensors=False):
     form = list(FORMS)[rep % len(FORMS)]
     seed0 = 100000 * ci + 1000 * rep
     files = np.array([dc.calibration_noise(form, clean(H, case, 0), seed0 + i)
@@ -270,11 +270,12 @@ def replica(rcb, model, H, case, rep, ci, scale="measured"):
         ns = (rcb.monitor.noise_scale(setup, files, noise=FORMS[form])["scale"]
               if scale == "measured" else 1.0)
         mon = rcb.Monitor(model, setup, PARAMS, noise=FORMS[form], setup_averages=COMMISSION,
-                          alpha=ALPHA, reweight=True, relinearise=8, noise_scale=ns)
+                          alpha=ALPHA, reweight=True, relinearise=8, noise_scale=ns,
+                          sensors=sensors)
     t_create = time.process_time() - t0
     base = [t["baseline"] for t in mon.tracked]
     rec = {"case": case, "rep": rep, "form": form, "seed0": seed0, "noise_scale": ns,
-           "updates": []}
+           "sensors": bool(sensors), "updates": []}
     t_upd = 0.0
     try:
         for j in range(1, UPDATES + 1):
@@ -288,6 +289,7 @@ def replica(rcb, model, H, case, rep, ci, scale="measured"):
                 tv[0] = base[0] * (1 - WEAR_PER_UPDATE * max(j - ONSET, 0))
             rec["updates"].append({
                 "j": j, "alarm": r["alarm"], "separable": r["separable"], "T": r["T"],
+                "dof": r["dof"],
                 "threshold": r["threshold"],
                 "top": [{k: c[k] for k in ("effect", "place", "params", "size", "ci_lo",
                                            "ci_hi")} for c in r["top"][:2]],
@@ -408,6 +410,10 @@ def summarise(case, recs):
             "cover_last_bound": binom_lower(len(recs), 0.95),
             "forms": forms, "kinds": kinds, "size_named": len(sized), "size_covers": int(sum(sized)),
             "size_bound": binom_lower(len(sized), 0.95) if sized else 0,
+            # the instant test's T on the null updates against its degrees of freedom
+            "mean_T": float(np.mean([u["T"] for r in recs for u in r["updates"]
+                                     if null_update(case, u["j"])] or [math.nan])),
+            "dof": sorted({u.get("dof") for r in recs for u in r["updates"]} - {None}),
             "cpu_create": float(np.mean([r["cpu_create"] for r in recs])),
             "cpu_update": float(np.sum([r["cpu_updates"] for r in recs]) / (len(recs) * UPDATES))}
 
@@ -448,6 +454,8 @@ def main():
     ap.add_argument("--scale", choices=("measured", "declared"), default="measured",
                     help="the noise's level: measured on the commissioning files' scatter "
                     "(rcbtool monitor's default) or as declared")
+    ap.add_argument("--sensors", action="store_true",
+                    help="every probe's gain among the candidates (rcbtool monitor --sensors)")
     ap.add_argument("--forms", default=",".join(FORMS),
                     help="run only the replicas of these noise forms (they take turns)")
     ap.add_argument("--from-json", action="store_true",
@@ -478,7 +486,7 @@ def main():
         for rep in range(args.first, args.first + args.replicas):
             if list(FORMS)[rep % len(FORMS)] not in forms:
                 continue
-            recs.append(replica(rcb, model, H, case, rep, ci, args.scale))
+            recs.append(replica(rcb, model, H, case, rep, ci, args.scale, args.sensors))
             name = f"{case}.json" if args.first == 0 else f"{case}.{args.first}.json"
             (out / name).write_text(json.dumps(recs))
         s = summarise(case, recs)
@@ -517,6 +525,10 @@ def table(rows):
               f"{', '.join(f'{100 * c:.1f} %' for c in s['cover'])} | "
               f"{', '.join(str(c) for c in s['cover_last'])} ({s['cover_last_bound']}) | "
               f"{s['cpu_update']:.3f}, {s['cpu_create']:.2f} |")
+    for s in rows:
+        if "mean_T" in s:
+            print(f"\n{s['case']}: the instant test's mean T on the null updates {s['mean_T']:.1f} "
+                  f"on {', '.join(str(d) for d in s['dof'])} degrees of freedom")
     print("\nreplicas with any wrong \"told apart\" (bound at 5 %), and the drift test: false "
           "alarms on null updates (bound at alpha), alarms after the onset naming another effect\n")
     print("| case | replicas with a wrong \"told apart\" (bound) | drift false alarms (bound) | "

@@ -168,6 +168,9 @@ class CompareSummary(ctypes.Structure):
 # rcb_monitor.h (issue #16); the array sizes are RCB_MONITOR_MAX_TRACKED,
 # RCB_MONITOR_TOP and RCB_MONITOR_MAXP
 MONITOR_MAX_TRACKED, MONITOR_TOP, MONITOR_MAXP = 8, 8, 3
+# rcb_effect (include/rcb/rcb_diagnose.h): the monitor's catalogue ends before the
+# shaft elements; a sensor's gain is asked for
+EFFECT_ELEMENT_STIFFNESS, EFFECT_SENSOR_GAIN = 12, 14
 
 
 class MonitorParam(ctypes.Structure):
