@@ -13,9 +13,11 @@
  *    d = e_new - e_0 (SI units of the channel's kind), taken in the
  *    (radial, tangential) frame of e_0 and divided by its standard deviation:
  *    the eq. 19 noise model (beta_a along e_0 with variance
- *    (beta_a/100)^2 |e_0|^2 / 3, beta_s circular with variance a^2 / 6 per
+ *    (beta_a/100)^2 |m|^2 / 3, |m| the baseline model's modulus there, kept
+ *    within a factor 2 of |e_0| (not |e_0| itself: its own noise would
+ *    correlate with d), beta_s circular with variance a^2 / 6 per
  *    component, a = beta_s/100 sqrt(sum_j |e_0j|^2) / n; with phase noise
- *    +-phase_deg, uniform, (phase_deg pi/180)^2 |e_0|^2 / 3 more on the
+ *    +-phase_deg, uniform, (phase_deg pi/180)^2 |m|^2 / 3 more on the
  *    tangential axis) or per-point standard deviations, for the new measurement and for the commissioning
  *    one (divided by the number of measurements averaged into it). The
  *    baseline model's own bias (model minus commissioning measurement) is

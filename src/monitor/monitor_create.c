@@ -277,13 +277,9 @@ static rcb_status baseline(rcb_monitor *mon, const rcb_model *base, const rcb_mo
  * a diagnosis' finding, and one candidate per element would double the
  * columns of every update). Every measured sensor's gain
  * (RCB_EFFECT_SENSOR_GAIN in opts.effects; issue #34: a drifting probe named
- * as the sensor, not read as the machine) is asked for: by default, at the
- * users' size (32 channels x 1101 lines, ROSS truth, eq. 19 noise as
- * declared, tools/bench/monitor_replicas.py) the 8 gain directions carried
- * about twice the variance the noise model gives them (the instant test's
- * mean T 102 and 99 on 94 degrees of freedom in two null replicas, 8 false
- * alarms in 60 updates, bound 3; without them 86.9 on 86), not understood
- * yet. A sensor's sign is its gain at -1 and the gain's column is exact
+ * as the sensor, not read as the machine) is asked for (rcbtool monitor asks
+ * for it by default; the noise taken at the model's modulus, noise_modulus,
+ * is what lets the gains hold at the users' size). A sensor's sign is its gain at -1 and the gain's column is exact
  * (the model's values scale linearly with it), so the gain covers it; a
  * swap has no parameter and is left to the diagnosis. The catalogue is on
  * its default scale, so a sensor's phase is not among its parameters. */

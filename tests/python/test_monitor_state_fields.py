@@ -205,3 +205,48 @@ def test_untouched_copy_continues(series):
     res = run(tool, "monitor", MODEL, "--state", path, files[4], "--json")
     assert res.returncode == 0, res.stderr
     assert json.loads(res.stdout)["updates"] == oneshot["updates"]
+
+
+def _settings(data):
+    """The settings' options of a state file and the offset where they end."""
+    pos, out = 24, []  # after "RCBTOOL-MONSTATE" and the version
+    n = struct.unpack_from("<Q", data, pos)[0]
+    pos += 8
+    for _ in range(n):
+        has, ln = struct.unpack_from("<QQ", data, pos)
+        pos += 16
+        out.append(bytes(data[pos:pos + ln]).decode() if has else None)
+        pos += ln if has else 0
+    return out, pos
+
+
+def _with_settings(data, opts):
+    """The state file with its settings' options replaced, every CRC made again."""
+    _, end = _settings(data)
+    body = struct.pack("<Q", len(opts)) + b"".join(
+        struct.pack("<QQ", 1, len(o.encode())) + o.encode() for o in opts)
+    return Container(bytes(data[:24]) + body + bytes(data[end:])).seal()
+
+
+def test_sensors_choice_kept(series):
+    """The probes' gains are candidates by default (rcbtool monitor, issue #34)
+    and a new state stores the choice; a state that names neither --sensors nor
+    --no-sensors was written while the gains were asked for, and continues as
+    the series without them (the one-shot --no-sensors run's log)."""
+    tool, tmp, files, good, _ = series
+    assert "--sensors" in _settings(good)[0]
+    state = tmp / "nosens.rcbmon"
+    res = run(tool, "monitor", MODEL, *files[:4], *OPTS, "--no-sensors", "--state", state)
+    assert res.returncode == 0, res.stderr
+    opts = _settings(state.read_bytes())[0]
+    assert "--no-sensors" in opts and "--sensors" not in opts
+    old = tmp / "old.rcbmon"
+    old.write_bytes(_with_settings(state.read_bytes(), [o for o in opts if o != "--no-sensors"]))
+    assert "--no-sensors" not in _settings(old.read_bytes())[0]
+    oneshot = run(tool, "monitor", MODEL, *files, *OPTS, "--no-sensors", "--json")
+    assert oneshot.returncode == 0, oneshot.stderr
+    res = run(tool, "monitor", MODEL, "--state", old, files[4], "--json")
+    assert res.returncode == 0, res.stderr
+    assert json.loads(res.stdout)["updates"] == json.loads(oneshot.stdout)["updates"]
+    both = run(tool, "monitor", MODEL, *files, *OPTS, "--sensors", "--no-sensors")
+    assert both.returncode == 2 and "--no-sensors" in both.stderr, both.stderr

@@ -434,7 +434,7 @@ def sd_check(rcb, model):
     y = kyy0()
     ky = _affine(lambda v: dc.bearing_keys("B4", kyy=v), y, 0.5 * y, 0.8 * y)
     with _meas(rcb, ky(y)) as setup:
-        mon = rcb.Monitor(model, setup, PARAMS, noise=(10, 1), alpha=ALPHA,
+        mon = rcb.Monitor(model, setup, PARAMS, noise=(10, 1), alpha=ALPHA, sensors=False,
                           setup_averages=COMMISSION)
     with _meas(rcb, ky(y - 10 * SD_KYY)) as ms:
         r = mon.update(ms)

@@ -19,7 +19,7 @@ const char cli_help_monitor[] =
     "usage: rcbtool monitor BASELINE.ini DIR|MEAS... --params NAME[:LO:HI],...\n"
     "                       [--noise A,S[,P] | --sd STATS.csv|DIR] [--commission N]\n"
     "                       [--alpha A] [--cusum-h H] [--cusum-k K] [--relinearise N]\n"
-    "                       [--reweight] [--sensors] [--baseline-sd SD,...]\n"
+    "                       [--reweight] [--no-sensors] [--baseline-sd SD,...]\n"
     "                       [--noise-scale auto|S]\n"
     "                       [--map NODE=STATION,...] [--rpm R]\n"
     "                       [--log OUT.json|OUT.csv] [--plot TREND.png] [--json]\n"
@@ -75,10 +75,12 @@ const char cli_help_monitor[] =
     "                  its --sd file), statistics by generalised least squares: T\n"
     "                  stays chi-square after a large change of the tracked\n"
     "                  parameters (a moved resonance); slower per update\n"
-    "  --sensors       every measured probe's gain among the candidate effects: a\n"
-    "                  drifting or miscalibrated probe (or one wired the wrong\n"
-    "                  way, gain -1) is named as the sensor, not read as the\n"
-    "                  machine\n"
+    "  --no-sensors    leave the measured probes' gains out of the candidate\n"
+    "                  effects (by default each is one: a drifting or\n"
+    "                  miscalibrated probe, or one wired the wrong way, gain -1,\n"
+    "                  is named as the sensor, not read as the machine; --sensors,\n"
+    "                  the default, is accepted). A --state series keeps its\n"
+    "                  choice; one saved without either was made without them\n"
     "  --baseline-sd L standard errors of the baseline's values of the --params, in\n"
     "                  their order and units (the 'stderr' of the rcbtool fit that\n"
     "                  made the baseline): they widen the values' intervals (the\n"
@@ -184,7 +186,9 @@ static int parse_job(const cli_args *a, mon_job *j) {
                      cli_opt_value(a, "--relinearise"));
   j->relinearise = (size_t)relin;
   j->reweight = cli_opt_value(a, "--reweight") != NULL;
-  j->sensors = cli_opt_value(a, "--sensors") != NULL;
+  if (cli_opt_value(a, "--sensors") && cli_opt_value(a, "--no-sensors"))
+    return cli_usage(a->cmd, "options --sensors and --no-sensors: give one of them");
+  j->sensors = cli_opt_value(a, "--no-sensors") == NULL; /* the probes' gains by default */
   if (cli_opt_value(a, "--alpha") && !(j->alpha > 0.0 && j->alpha < 1.0))
     return cli_usage(a->cmd, "option --alpha expects a probability 0 < A < 1, got '%s'",
                      cli_opt_value(a, "--alpha"));
@@ -362,7 +366,7 @@ static int state_plan(int argc, char **argv, const cli_opt *opts, size_t nopts,
 static const char *const SETTING_OPTS[] = {"--params", "--noise",  "--sd",     "--commission",
                                            "--alpha",  "--cusum-h", "--cusum-k", "--relinearise",
                                            "--reweight", "--map",  "--rpm", "--baseline-sd",
-                                           "--sensors", "--noise-scale"};
+                                           "--sensors", "--noise-scale", "--no-sensors"};
 
 /* 1 + the number of strings @p argv[k] (with its value) takes when it is a
  * setting option, else 0. */
@@ -373,10 +377,19 @@ static int setting_at(int argc, char **argv, int k) {
     if (strncmp(argv[k], SETTING_OPTS[i], n) != 0) continue;
     if (argv[k][n] == '=') return 2;
     if (argv[k][n] != '\0') continue;
-    if (strcmp(SETTING_OPTS[i], "--reweight") == 0 || strcmp(SETTING_OPTS[i], "--sensors") == 0)
+    if (strcmp(SETTING_OPTS[i], "--reweight") == 0 || strcmp(SETTING_OPTS[i], "--sensors") == 0 ||
+        strcmp(SETTING_OPTS[i], "--no-sensors") == 0)
       return 2;
     return k + 1 < argc ? 3 : 2;
   }
+  return 0;
+}
+
+/* Whether the settings opts[0 .. n) choose the probes' gains either way. */
+static int sensors_set(char *const *opts, size_t n) {
+  size_t k;
+  for (k = 0; k < n; k++)
+    if (strcmp(opts[k], "--sensors") == 0 || strcmp(opts[k], "--no-sensors") == 0) return 1;
   return 0;
 }
 
@@ -422,12 +435,15 @@ static int with_saved(int argc, char **argv, const char *state, mon_saved *sv, c
   }
   free(own);
   if ((rc = mon_saved_read(argv[0], state, sv))) return rc;
-  if (!(*nargv = malloc(((size_t)argc + sv->nopts + 1) * sizeof **nargv)))
+  if (!(*nargv = malloc(((size_t)argc + sv->nopts + 2) * sizeof **nargv)))
     return cli_fail(CLI_EXIT_NUMERIC, "out of memory");
   /* right after the command, before any "--" */
   (*nargv)[0] = argv[0];
   *nargc = 1;
   for (k = 0; k < sv->nopts; k++) (*nargv)[(*nargc)++] = sv->opts[k];
+  /* saved before the probes' gains were the default and chosen in every
+   * new state: a series made without them */
+  if (!sensors_set(sv->opts, sv->nopts)) (*nargv)[(*nargc)++] = "--no-sensors";
   for (k = 1; k < (size_t)argc; k++) (*nargv)[(*nargc)++] = argv[k];
   (*nargv)[*nargc] = NULL;
   return 0;
@@ -444,6 +460,7 @@ int cmd_monitor(int argc, char **argv) {
                     {"--relinearise", "N", NULL},
                     {"--reweight", NULL, NULL},
                     {"--sensors", NULL, NULL},
+                    {"--no-sensors", NULL, NULL},
                     {"--baseline-sd", "SD,...", NULL},
                     {"--noise-scale", "auto|S", NULL},
                     {"--map", "NODE=STATION,...", NULL},
@@ -481,6 +498,8 @@ int cmd_monitor(int argc, char **argv) {
     goto done;
   }
   j.nsetopts = settings_of(argc, argv, j.setopts);
+  if (!j.saved && !sensors_set(j.setopts, j.nsetopts)) /* the default, stored as chosen */
+    j.setopts[j.nsetopts++] = "--sensors";
   j.state = state;
   split_series(argc, argv, opts, nopts, args, &nargs, series, &nseries);
   for (k = 0; k < nseries; k++) cli_plan_input(series[k], "measurement"); /* a DIR too */

@@ -44,7 +44,7 @@ typedef struct mon_job {
   size_t commission;  /**< files averaged into the reference (>= 1) */
   size_t relinearise; /**< chord iterations per update */
   int reweight;       /**< --reweight: each update's noise from its own values */
-  int sensors;        /**< --sensors: the probes' gains among the candidates */
+  int sensors;        /**< the probes' gains among the candidates (0: --no-sensors) */
   double alpha, cusum_h, cusum_k; /**< 0: the library's defaults */
   double beta_a, beta_s;          /**< --noise, % */
   double phase_deg;               /**< --noise's third number, degrees */

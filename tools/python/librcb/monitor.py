@@ -78,7 +78,7 @@ class Monitor(Handle):
 
     def __init__(self, model, setup, params, noise=None, sd=None, alpha=None, cusum_h=None,
                  cusum_k=None, setup_averages=1, relinearise=0, reweight=False,
-                 baseline_sd=None, noise_scale=None, sensors=False):
+                 baseline_sd=None, noise_scale=None, sensors=True):
         """model: the fitted baseline (a Model); setup: the commissioning
         measurement (a Meas: channels, grid and the reference values); params:
         tracked parameter names or {name: (lo, hi)}; noise: eq. 19 (beta_a,
@@ -93,7 +93,8 @@ class Monitor(Handle):
         noise_scale: the noise's level against the declared one (every declared
         standard deviation times it; None: 1), e.g. librcb.monitor.noise_scale
         of the measurements averaged into setup; sensors: every measured probe's
-        gain among the candidates (rcbtool monitor --sensors)."""
+        gain among the candidates (as rcbtool monitor by default; False:
+        --no-sensors)."""
         super().__init__()
         self._names = [r if ref is None else f"{r}/{ref}" for r, ref, _ in setup.channels]
         self._shape = (len(self._names), setup.n_points)
