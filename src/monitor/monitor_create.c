@@ -125,9 +125,10 @@ static rcb_status noise_opts(const rcb_monitor_opts *o, char *err, size_t n) {
  * sensor's gain is such a direction (its column is the channel's values,
  * whitened by sds proportional to them: about constant). At 32 channels x
  * 1101 lines (eq. 19 10 %, 1 %, commissioning 10 files) the 8 gain
- * directions' x^2 averaged 1.88 with the sd at the commissioning values,
- * 0.99 at the truth (numpy, 30 draws). The model's modulus is kept within a
- * factor 2 of ae (a baseline that does not fit there: the value's). */
+ * directions' x^2 averaged 2.02 with the sds at the commissioning values,
+ * 1.09 at the truth (tools/bench/monitor_noise_weights.py --numpy, 200
+ * draws). The model's modulus is kept within a factor 2 of ae (a baseline
+ * that does not fit there: the value's). */
 static double noise_modulus(const rcb_monitor *mon, size_t p, double ae) {
   return fmin(fmax(mon->h0abs[p], 0.5 * ae), 2.0 * ae);
 }
