@@ -136,7 +136,20 @@ static double noise_modulus(const rcb_monitor *mon, size_t p, double ae) {
 /* Radial and tangential sd of one measurement at each point: eq. 19 with the
  * phase turn (eq19_var) or the caller's sd (circular), at the baseline
  * model's modulus (noise_modulus; its additive amplitude and the radial
- * frame at the commissioning values), times opts.noise_scale. */
+ * frame at the commissioning values), times opts.noise_scale.
+ *
+ * On the reweighted path (opts.reweight) the frame u is the baseline
+ * model's values' too: there the metric is the covariance C made each
+ * update (monitor_gls.c, which turns the commissioning's share var0, radial
+ * to e_0, into u) and the frame only sets the coordinates. At e_0 each
+ * point's frame turns with that point's own commissioning noise d_0 (its
+ * phase noise), which every update's change carries (-d_0): with radial and
+ * tangential weights unequal, the same kind of bias as noise_modulus's,
+ * shared by all updates (issue #34 item 2; tools/bench/monitor_replicas.py
+ * at 32 x 1101, eq. 19 and +-2 deg declared 10,1,2, noise-free updates: the
+ * operating speed's drift input +0.47 sd on average over 6 commissionings
+ * with the frame at e_0, -0.08 at h_0; tests/test_monitor.c,
+ * test_commissioning_noise_unbiased). */
 static rcb_status noise(rcb_monitor *mon, const rcb_monitor_opts *o) {
   double navg = o->setup_averages > 0 ? o->setup_averages : 1.0;
   double f0 = isinf(navg) ? 1.0 : 1.0 + 1.0 / navg; /* new + commissioning variance */
@@ -169,6 +182,8 @@ static rcb_status noise(rcb_monitor *mon, const rcb_monitor_opts *o) {
         mon->sd0[p] = s;
       } else {
         eq19_var(mon->beta_a, a, mon->phase_var, noise_modulus(mon, p, ae), &vr, &vt);
+        if (mon->reweight && mon->h0abs[p] > 0) /* the model's frame */
+          mon->u[p] = (e[i] + CMPLX(mon->rbase[2 * p], mon->rbase[2 * p + 1])) / mon->h0abs[p];
       }
       if (!(vr > 0) || !(vt > 0))
         return rcb_mon_fail(mon, RCB_ERR_ARG, "noise: channel %zu point %zu has zero standard "
