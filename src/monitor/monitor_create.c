@@ -138,8 +138,8 @@ static double noise_modulus(const rcb_monitor *mon, size_t p, double ae) {
  * model's modulus (noise_modulus; its additive amplitude and the radial
  * frame at the commissioning values), times opts.noise_scale.
  *
- * On the reweighted path (opts.reweight) the frame u is the baseline
- * model's values' too: there the metric is the covariance C made each
+ * With the phase term on the reweighted path (opts.reweight, phase_deg > 0)
+ * the frame u is the baseline model's values' too: there the metric is the covariance C made each
  * update (monitor_gls.c, which turns the commissioning's share var0, radial
  * to e_0, into u) and the frame only sets the coordinates. At e_0 each
  * point's frame turns with that point's own commissioning noise d_0 (its
@@ -182,7 +182,7 @@ static rcb_status noise(rcb_monitor *mon, const rcb_monitor_opts *o) {
         mon->sd0[p] = s;
       } else {
         eq19_var(mon->beta_a, a, mon->phase_var, noise_modulus(mon, p, ae), &vr, &vt);
-        if (mon->reweight && mon->h0abs[p] > 0) /* the model's frame */
+        if (mon->reweight && mon->phase_var > 0 && mon->h0abs[p] > 0) /* the model's frame */
           mon->u[p] = (e[i] + CMPLX(mon->rbase[2 * p], mon->rbase[2 * p + 1])) / mon->h0abs[p];
       }
       if (!(vr > 0) || !(vt > 0))

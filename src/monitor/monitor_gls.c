@@ -20,14 +20,18 @@
 
 /* The commissioning values' share of point p's covariance, added to s11,
  * s12, s22 (unwhitened, in the frame u): var0 is radial and tangential to
- * e_0, and the frame may be turned from e_0 (on the reweighted path it is
- * the baseline model's values', monitor_create.c, noise). */
+ * e_0, and with the phase term on the reweighted path the frame is the
+ * baseline model's values' (monitor_create.c, noise), turned from e_0. */
 static void share(const rcb_monitor *mon, size_t p, double *s11, double *s12, double *s22) {
   double r = mon->var0[2 * p] * mon->navg_inv, t = mon->var0[2 * p + 1] * mon->navg_inv;
   double ae = mon->e0abs[p];
-  double complex w = ae > 0 ? conj(mon->u[p]) * mon->e0[p] / ae : 1.0;
-  double c = creal(w), s = cimag(w);
-  *s11 += r * c * c + t * s * s, *s12 += (r - t) * c * s, *s22 += r * s * s + t * c * c;
+  if (mon->reweight && mon->phase_var > 0 && !mon->have_sd0 && ae > 0) {
+    double complex w = conj(mon->u[p]) * mon->e0[p] / ae;
+    double c = creal(w), s = cimag(w);
+    *s11 += r * c * c + t * s * s, *s12 += (r - t) * c * s, *s22 += r * s * s + t * c * c;
+  } else {
+    *s11 += r, *s22 += t;
+  }
 }
 
 /* The 2 x 2 covariance of point p's (radial, tangential) residual, whitened:
@@ -61,22 +65,18 @@ static double amplitude(const rcb_monitor *mon, const rcb_complex *v, size_t c) 
   return rcb_mon_eq19_amp(mon->beta_s, v + c * mon->npts, mon->npts);
 }
 
-/* Points p0 .. p1 into C (k x k, upper, added to): each point's rows times
- * the factor L of its whitened covariance (shared: the commissioning's
- * share, else the unit circular one). */
-static void fixed_part(rcb_monitor *mon, size_t p0, size_t p1, int shared, double *C) {
+/* Points p0 .. p1 into C (k x k, upper, added to): each point's whitened
+ * rows scaled by f[0], f[1] per unit (the commissioning's share: sqrt(var0
+ * / N), else 1). */
+static void fixed_part(rcb_monitor *mon, size_t p0, size_t p1, int share, double *C) {
   size_t k = mon->k, p, a, nb = 0;
   for (p = p0; p < p1; p++) {
     const double *q1 = mon->Q + k * (2 * p), *q2 = q1 + k;
     double *b1 = mon->b1 + k * (2 * nb), *b2 = b1 + k;
-    double w1 = mon->winv[2 * p], w2 = mon->winv[2 * p + 1], l11 = w1, l21 = 0, l22 = w2;
-    if (shared) { /* the share's 2 x 2, whitened, L L^T */
-      double s11 = 0, s12 = 0, s22 = 0;
-      share(mon, p, &s11, &s12, &s22);
-      l11 = sqrt(s11) * w1, l21 = s12 * w1 * w2 / l11;
-      l22 = sqrt(fmax(s22 * w2 * w2 - l21 * l21, 0.0));
-    }
-    for (a = 0; a < k; a++) b1[a] = l11 * q1[a] + l21 * q2[a], b2[a] = l22 * q2[a];
+    double f1 = mon->winv[2 * p], f2 = mon->winv[2 * p + 1];
+    if (share)
+      f1 *= sqrt(mon->var0[2 * p] * mon->navg_inv), f2 *= sqrt(mon->var0[2 * p + 1] * mon->navg_inv);
+    for (a = 0; a < k; a++) b1[a] = f1 * q1[a], b2[a] = f2 * q2[a];
     if (++nb == MON_SYRK_POINTS || p + 1 == p1) syrk(mon, mon->b1, 2 * nb, C), nb = 0;
   }
 }
