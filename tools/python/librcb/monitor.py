@@ -37,6 +37,14 @@ def _tracked(model, params):
     return out
 
 
+def _layout_sd(sd, shape):
+    """sd as a contiguous float array of the set-up's shape (channels, points)."""
+    sd = np.ascontiguousarray(sd, dtype=float)
+    if sd.shape != shape:
+        raise ValueError(f"sd has shape {sd.shape}, expected {shape}")
+    return sd
+
+
 def _noise_opts(noise, sd, shape):
     """The declared noise into a MonitorOpts (and the sd array it points to)."""
     o, sd0 = _lib.MonitorOpts(), None
@@ -44,9 +52,7 @@ def _noise_opts(noise, sd, shape):
         o.beta_a, o.beta_s = float(noise[0]), float(noise[1])
         o.phase_deg = float(noise[2]) if len(noise) > 2 else 0.0
     if sd is not None:
-        sd0 = np.ascontiguousarray(sd, dtype=float)
-        if sd0.shape != shape:
-            raise ValueError(f"sd has shape {sd0.shape}, expected {shape}")
+        sd0 = _layout_sd(sd, shape)
         o.sd = sd0.ctypes.data
     return o, sd0
 
@@ -127,12 +133,6 @@ class Monitor(Handle):
         self.check(_lib.lib().rcb_monitor_tracked_info(self.handle, k, ctypes.byref(name),
                                                        ctypes.byref(base)))
         return {"name": _lib.text(name.value), "baseline": base.value}
-
-    def _layout_sd(self, sd):
-        sd = np.ascontiguousarray(sd, dtype=float)
-        if sd.shape != self._shape:
-            raise ValueError(f"sd has shape {sd.shape}, expected {self._shape}")
-        return sd
 
     def _values(self, meas):
         """The set-up's channel order from meas (any order; names must match)."""
@@ -217,7 +217,7 @@ class Monitor(Handle):
         """One new measurement (a Meas with the set-up's channels and grid);
         sd: its own standard deviations (channels, points), SI, or None."""
         v = self._values(meas)
-        s = self._layout_sd(sd) if sd is not None else None
+        s = _layout_sd(sd, self._shape) if sd is not None else None
         r = _lib.MonitorResult()
         self.check(_lib.lib().rcb_monitor_update(self.handle, v.ctypes.data,
                                                  None if s is None else s.ctypes.data,
