@@ -14,6 +14,10 @@
  *    gain within 3 standard errors of 1;
  *  - a sign flipped or two probes swapped in the data, with the matching
  *    fixed edit: the objective equals that of the unedited data (1e-12);
+ *  - the monitor's linear swap (rcb_fit_swap_column): on the complex scale
+ *    the residuals are affine in the prediction, so the column equals the
+ *    residuals with the probes swapped (rcb_fit_swap_sensors) minus those
+ *    without, to 1e-10 of the column, with one probe's factor edited;
  *  - unknown sensors, references that differ, a sensor parameter asked for
  *    its dZ/dp: clear errors.
  */
@@ -363,6 +367,44 @@ static void test_chain_sign_swap_identity(void **state) {
   rcb_model_destroy(truth);
 }
 
+static void test_swap_column_identity(void **state) {
+  rcb_model *m = rcb_test_model_from_example("paper_system.ini");
+  const char *outs[] = {"C.A.x", "DB.x", "DB.y"}, *ins[] = {"DA.x", "C.B.x"};
+  rcb_meas *ms = rcb_test_frf_meas(m, outs, 3, ins, 2, 200, 400, 101, 10000, RCB_INERTANCE);
+  rcb_fit *f = NULL;
+  size_t n, j;
+  double *J, *r0, *r1, dmax = 0.0, jmax = 0.0, kt;
+  (void)state;
+  assert_int_equal(rcb_meas_add_noise(ms, 10.0, 1.0, 5u), RCB_OK);
+  assert_int_equal(rcb_model_get_param(m, "coupling.C.kt", &kt), RCB_OK);
+  assert_int_equal(rcb_model_set_param(m, "coupling.C.kt", 1.2 * kt), RCB_OK);
+  assert_int_equal(rcb_fit_create(&f, m, ms, NULL), RCB_OK);
+  assert_int_equal(rcb_fit_set_scale(f, RCB_SCALE_COMPLEX), RCB_OK);
+  assert_int_equal(rcb_fit_set_noise_model(f, 10.0, 1.0), RCB_OK);
+  assert_int_equal(rcb_fit_set_sensor(f, "DB.x", 1.3, 0.2), RCB_OK); /* its own factor */
+  n = rcb_fit_residual_count(f);
+  J = calloc(n, sizeof *J), r0 = calloc(n, sizeof *r0), r1 = calloc(n, sizeof *r1);
+  assert_int_equal(rcb_fit_swap_column(f, "DB.x", "DB.y", J), RCB_ERR_STATE); /* no evaluation */
+  assert_int_equal(rcb_fit_residuals(f, r0), RCB_OK);
+  assert_int_equal(rcb_fit_swap_column(f, "DB.x", "DB.y", J), RCB_OK);
+  assert_int_equal(rcb_fit_swap_column(f, "DB.x", "DB.x", J), RCB_ERR_ARG);
+  assert_int_equal(rcb_fit_swap_column(f, "DB.x", "DA.y", J), RCB_ERR_ARG);
+  assert_int_equal(rcb_fit_swap_sensors(f, "DB.x", "DB.y"), RCB_OK);
+  assert_int_equal(rcb_fit_residuals(f, r1), RCB_OK);
+  for (j = 0; j < n; j++) {
+    dmax = fmax(dmax, fabs(r1[j] - r0[j] - J[j]));
+    jmax = fmax(jmax, fabs(J[j]));
+  }
+  if (!(jmax > 0) || !(dmax <= 1e-10 * jmax))
+    fail_msg("swap column against the swapped residuals: max |difference| %g, max |column| %g",
+             dmax, jmax);
+  assert_int_equal(rcb_fit_swap_column(f, "DB.x", "DB.y", J), RCB_ERR_STATE); /* swapped */
+  free(J), free(r0), free(r1);
+  rcb_fit_destroy(f);
+  rcb_meas_destroy(ms);
+  rcb_model_destroy(m);
+}
+
 static void test_chain_errors(void **state) {
   rcb_model *m = rcb_test_model_from_example("paper_system.ini");
   const char *outs[] = {"C.A.x", "DB.x", "DB.y"}, *ins[] = {"DA.x", "C.B.x"};
@@ -449,6 +491,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_chain_errors),
       cmocka_unit_test(test_chain_sign_swap_identity),
+      cmocka_unit_test(test_swap_column_identity),
       cmocka_unit_test(test_chain_jacobian),
       cmocka_unit_test(test_chain_recovers_gain_phase),
       cmocka_unit_test(test_chain_null),

@@ -1152,13 +1152,17 @@ static size_t find_cand(const rcb_monitor *mon, rcb_effect e, const char *params
   return 0;
 }
 
-/* Issue #34 item 1: a probe's gain among the candidates (opts.effects with
- * RCB_EFFECT_SENSOR_GAIN). Without noise the update is the set-up with
- * channel C.A.y read at 0.9 x: the gain's column is the model's values on
- * that channel, exact for any gain (the reading is linear in it), so the
- * first candidate is C.A.y's gain with a change of -0.1 to rounding, the
- * tracked kt unmoved; a gain of -1 (a probe wired the wrong way) is the
- * change -2, as exactly. By default (effects 0) no sensor is a candidate. */
+/* Issue #34 item 1: the measurement chain among the candidates
+ * (RCB_MONITOR_EFFECTS_SENSORS). Without noise the update is the set-up
+ * with channel C.A.y read through a factor: the gain and phase columns are
+ * the model's values on that channel, H and i H, so a factor g e^{i phi}
+ * (g cos phi H + g sin phi i H) is fitted exactly, changes g cos phi - 1
+ * and g sin phi (rad) to rounding, for any g and phi: 0.9 (a probe reading
+ * low), -1 (wired the wrong way: -2, 0), e^{-0.3 i} (a lag of 0.3 rad:
+ * cos 0.3 - 1, -sin 0.3). The C.A.x and C.A.y channels exchanged are the
+ * swap's column times 1 exactly (the reading is linear in the fraction).
+ * Every one is named first, the tracked kt unmoved. By default (effects 0)
+ * no sensor is a candidate. */
 static void test_sensor_gain(void **state) {
   fixture *f = *state;
   rcb_monitor_param tp;
@@ -1166,7 +1170,7 @@ static void test_sensor_gain(void **state) {
   rcb_monitor *mon = NULL;
   rcb_monitor_result r;
   rcb_complex *v = malloc(NPT * sizeof *v);
-  const double gains[2] = {0.9, -1.0};
+  const double complex fac[4] = {0.9, -1.0, CMPLX(cos(0.3), -sin(0.3)), 1.0};
   size_t j, i, g;
   assert_non_null(v);
   o.setup_averages = HUGE_VAL;
@@ -1175,23 +1179,40 @@ static void test_sensor_gain(void **state) {
     rcb_monitor_candidate_info ci;
     assert_int_equal(rcb_monitor_candidate_info_get(mon, j, &ci), RCB_OK);
     assert_int_not_equal(ci.effect, RCB_EFFECT_SENSOR_GAIN);
+    assert_int_not_equal(ci.effect, RCB_EFFECT_SENSOR_SWAP);
   }
   rcb_monitor_destroy(mon);
-  o.effects = ((1u << RCB_EFFECT_ELEMENT_STIFFNESS) - 1u) | (1u << RCB_EFFECT_SENSOR_GAIN);
+  o.effects = RCB_MONITOR_EFFECTS_SENSORS;
   assert_int_equal(rcb_monitor_create(&mon, f->truth, f->setup, &o, NULL), RCB_OK);
-  (void)find_cand(mon, RCB_EFFECT_SENSOR_GAIN, "sensor.C.A.y.gain");
-  for (g = 0; g < 2; g++) {
+  (void)find_cand(mon, RCB_EFFECT_SENSOR_GAIN, "sensor.C.A.y.gain, sensor.C.A.y.phase");
+  for (g = 0; g < 4; g++) {
     rcb_monitor_candidate_info ci;
+    const int swap = g == 3;
+    const double want[2] = {swap ? 1.0 : cabs(fac[g]) * cos(carg(fac[g])) - 1.0,
+                            cabs(fac[g]) * sin(carg(fac[g]))};
     memcpy(v, f->fs, NPT * sizeof *v);
-    for (i = 0; i < NPTS; i++) v[3 * NPTS + i] *= gains[g]; /* OUTS[3] = C.A.y */
+    for (i = 0; i < NPTS; i++) { /* OUTS[2], [3] = C.A.x, C.A.y */
+      if (swap) v[2 * NPTS + i] = f->fs[3 * NPTS + i], v[3 * NPTS + i] = f->fs[2 * NPTS + i];
+      else v[3 * NPTS + i] *= fac[g];
+    }
     assert_int_equal(rcb_monitor_update(mon, v, NULL, &r), RCB_OK);
     assert_true(r.alarm);
     assert_int_equal(rcb_monitor_candidate_info_get(mon, r.top[0].index, &ci), RCB_OK);
-    assert_int_equal(ci.effect, RCB_EFFECT_SENSOR_GAIN);
-    assert_string_equal(ci.params, "sensor.C.A.y.gain");
-    print_message("C.A.y read at %g x: gain change %.9f (truth %g); kt change %.3g N/m\n",
-                  gains[g], r.top[0].size[0], gains[g] - 1.0, r.tracked[0].change);
-    assert_true(rcb_test_close(r.top[0].size[0], gains[g] - 1.0, 1e-6, 0));
+    print_message("C.A.y read at %g%+gi x%s: %s %s change %.9f, %.9f (truth %.9f, %.9f); kt "
+                  "change %.3g N/m\n", creal(fac[g]), cimag(fac[g]), swap ? ", swapped" : "",
+                  ci.place, ci.params, r.top[0].size[0], r.top[0].np > 1 ? r.top[0].size[1] : 0,
+                  want[0], swap ? 0 : want[1], r.tracked[0].change);
+    if (swap) {
+      assert_int_equal(ci.effect, RCB_EFFECT_SENSOR_SWAP);
+      assert_string_equal(ci.place, "sensors C.A.x, C.A.y");
+      assert_int_equal(r.top[0].np, 1);
+    } else {
+      assert_int_equal(ci.effect, RCB_EFFECT_SENSOR_GAIN);
+      assert_string_equal(ci.params, "sensor.C.A.y.gain, sensor.C.A.y.phase");
+      assert_int_equal(r.top[0].np, 2);
+      assert_true(fabs(r.top[0].size[1] - want[1]) < 1e-6);
+    }
+    assert_true(rcb_test_close(r.top[0].size[0], want[0], 1e-6, 0));
     assert_true(fabs(r.tracked[0].change) < 1e-6 * f->kt);
   }
   rcb_monitor_destroy(mon);

@@ -207,6 +207,15 @@ typedef struct rcb_monitor_param {
 
 /** @brief Monitor settings: zero-initialise, then set what you need (0 means
  * the default stated on each field). */
+/** The candidates rcbtool monitor asks for by default (issue #34): the
+ *  machine's effects of opts.effects = 0 and the measurement chain, each
+ *  measured probe's gain and phase (a sign flipped is its gain at -1) and
+ *  each station's x and y probes swapped (one parameter: the fraction
+ *  swapped, 0 as wired, 1 exchanged). */
+#define RCB_MONITOR_EFFECTS_SENSORS                                                        \
+  (((1u << RCB_EFFECT_ELEMENT_STIFFNESS) - 1u) | (1u << RCB_EFFECT_SENSOR_GAIN) |          \
+   (1u << RCB_EFFECT_SENSOR_SWAP))
+
 typedef struct rcb_monitor_opts {
   size_t ntracked;                  /**< tracked parameters, 0 .. RCB_MONITOR_MAX_TRACKED */
   const rcb_monitor_param *tracked; /**< ntracked entries */
@@ -227,9 +236,11 @@ typedef struct rcb_monitor_opts {
   double setup_averages; /**< measurements averaged into the set-up values
                               (>= 1); 0: 1; HUGE_VAL: a noise-free reference */
   unsigned effects;  /**< candidate effects: bit (1u << rcb_effect) set for
-                          each one catalogued; 0: every effect the catalogue
-                          scores (the coupling model, refitted only by the
-                          diagnosis, has no neutral value and is left out) */
+                          each one catalogued; 0: the effects of the machine
+                          before the shaft elements (the coupling model,
+                          refitted only by the diagnosis, has no neutral value
+                          and is left out); RCB_MONITOR_EFFECTS_SENSORS: those
+                          and the measurement chain */
   size_t top;        /**< candidates ranked in each result, 0: RCB_MONITOR_TOP */
   size_t relinearise; /**< chord iterations refining the tracked estimates per
                            update by re-evaluating the model (0: linear only;

@@ -217,6 +217,7 @@ rcb_status rcb_diag_catalogue_get(const rcb_diag *d, size_t i, rcb_diag_cand_des
   out->refit_only = c->refit_only;
   out->adds_dofs = (c->fam->flags & DIAG_FAM_ADDS_DOFS) != 0;
   out->chain = (c->fam->flags & DIAG_FAM_CHAIN) != 0;
+  if (c->effect == RCB_EFFECT_SENSOR_SWAP) out->swap_a = c->target, out->swap_b = c->target2;
   return RCB_OK;
 }
 

@@ -31,6 +31,8 @@ typedef struct rcb_diag_cand_desc {
   int refit_only; /* no neutral value (another coupling model): not scored */
   int adds_dofs;  /* its model has DOFs the base model lacks (a pedestal) */
   int chain;      /* it edits the measurement chain (a sensor), not the model */
+  const char *swap_a, *swap_b; /* a swap of two probes (RCB_EFFECT_SENSOR_SWAP): their
+                                  measured responses (rcb_fit_swap_sensors); else NULL */
 } rcb_diag_cand_desc;
 size_t rcb_diag_catalogue_count(const rcb_diag *d);
 rcb_status rcb_diag_catalogue_get(const rcb_diag *d, size_t i, rcb_diag_cand_desc *out);

@@ -239,6 +239,48 @@ rcb_status rcb_fit_chain_jacobian(rcb_fit *f, const char *const *names, size_t n
   return RCB_OK;
 }
 
+/* The channel of sensor s that reads channel c's reference (and kind):
+ * (size_t)-1 when none does (any of s's channels with unbalance responses). */
+static size_t partner_channel(const rcb_fit *f, size_t s, size_t c) {
+  size_t d;
+  for (d = 0; d < f->nch; d++)
+    if (f->ch_sens[d] == s && f->ch_kind[d] == f->ch_kind[c] &&
+        (f->unbalance || f->ch_in[d] == f->ch_in[c]))
+      return d;
+  return (size_t)-1;
+}
+
+rcb_status rcb_fit_swap_column(rcb_fit *f, const char *a, const char *b, double *J) {
+  size_t sa, sb, j, c;
+  if (!f || !a || !b || !J) return RCB_ERR_ARG;
+  if (!f->prepared || !f->sweeps)
+    return rcb_fit_fail(f, RCB_ERR_STATE, "swap column: no evaluation of the model yet");
+  sa = find_sensor(f, a), sb = find_sensor(f, b);
+  if (sa == (size_t)-1 || sb == (size_t)-1 || sa == sb)
+    return rcb_fit_fail(f, RCB_ERR_ARG, "swap column %s, %s: two different measured responses "
+                        "expected", a, b);
+  if (f->sens[sa].swap != sa || f->sens[sb].swap != sb)
+    return rcb_fit_fail(f, RCB_ERR_STATE, "swap column %s, %s: a probe is swapped already", a,
+                        b);
+  for (c = 0; c < f->nch; c++) /* every channel of the two has its partner */
+    if ((f->ch_sens[c] == sa || f->ch_sens[c] == sb) &&
+        partner_channel(f, f->ch_sens[c] == sa ? sb : sa, c) == (size_t)-1)
+      return rcb_fit_fail(f, RCB_ERR_ARG, "swap column %s, %s: not measured with the same "
+                          "references and kinds", a, b);
+  for (j = 0; j < f->nres; j++) {
+    size_t ch = f->res_ch[j], pt = f->res_pt[j], d;
+    size_t s = f->ch_sens[ch];
+    if (s != sa && s != sb) {
+      J[j] = 0.0;
+      continue;
+    }
+    d = partner_channel(f, s == sa ? sb : sa, ch);
+    J[j] = rcb_fit_res_deriv_pred(f, j, f->ch_fac[ch] * (f->Hraw[d * f->npts + pt] -
+                                                         f->Hraw[ch * f->npts + pt]));
+  }
+  return RCB_OK;
+}
+
 /* ---- fixed edits (public API) ---- */
 
 rcb_status rcb_fit_set_sensor(rcb_fit *f, const char *response, double gain, double phase_rad) {

@@ -131,6 +131,16 @@ void rcb_fit_chain_response(const char *name, char *r, size_t size);
  * RCB_ERR_ARG for a name that is not a measured sensor's. */
 rcb_status rcb_fit_chain_jacobian(rcb_fit *f, const char *const *names, size_t n, double *J);
 
+/* The column d r / d s (nres values) of a swap of the probes of measured
+ * responses a and b by a fraction s (issue #34, the monitor's linear
+ * swap): each of the two reads (1 - s) its own response + s the other's,
+ * at the same reference and kind (0: as wired, 1: exchanged, as
+ * rcb_fit_swap_sensors), times its chain's factor, at f's last evaluation
+ * and s = 0; exact, the reading is linear in s. RCB_ERR_STATE before an
+ * evaluation or with either probe swapped already, RCB_ERR_ARG when a
+ * channel of one has no channel of the other with its reference. */
+rcb_status rcb_fit_swap_column(rcb_fit *f, const char *a, const char *b, double *J);
+
 /* The sensors of f's measurement chain: one per distinct measured response,
  * in order of first appearance among the channels; the response name
  * (owned by the measurement), NULL past the end. */

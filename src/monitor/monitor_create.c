@@ -291,18 +291,35 @@ static rcb_status baseline(rcb_monitor *mon, const rcb_model *base, const rcb_mo
 /* The candidates the monitor tracks: effects with parameters; by default
  * the catalogue of issue #4, not the shaft elements of issue #23 (a crack is
  * a diagnosis' finding, and one candidate per element would double the
- * columns of every update). Every measured sensor's gain
- * (RCB_EFFECT_SENSOR_GAIN in opts.effects; issue #34: a drifting probe named
- * as the sensor, not read as the machine) is asked for (rcbtool monitor asks
- * for it by default; the noise taken at the model's modulus, noise_modulus,
- * is what lets the gains hold at the users' size). A sensor's sign is its gain at -1 and the gain's column is exact
- * (the model's values scale linearly with it), so the gain covers it; a
- * swap has no parameter and is left to the diagnosis. The catalogue is on
- * its default scale, so a sensor's phase is not among its parameters. */
+ * columns of every update). The measurement chain (issue #34: a drifting
+ * probe named as the sensor, not read as the machine) when opts.effects
+ * asks for it (rcbtool monitor does by default; the noise taken at the
+ * model's modulus, noise_modulus, is what lets the gains hold at the users'
+ * size): the catalogue is on the complex scale, so each measured sensor's
+ * candidate is its gain and phase (RCB_EFFECT_SENSOR_GAIN); a sign flipped
+ * is its gain at -1 (the gain's column is exact: the model's values scale
+ * linearly with it; cand_space mirrors its range), and a swap of a
+ * station's x and y probes (RCB_EFFECT_SENSOR_SWAP) is made linear by
+ * rcb_mon_cand_desc. */
 static int wanted(const rcb_diag_cand_desc *c, unsigned mask) {
   if (c->refit_only || !c->np) return 0;
   if (mask) return (mask >> (unsigned)c->effect) & 1u;
   return !c->chain && c->effect < RCB_EFFECT_ELEMENT_STIFFNESS;
+}
+
+/* The diagnosis has a swap as a fixed edit (no parameter, refitted only).
+ * The monitor's update is linear, so here a swap has one parameter, the
+ * fraction swapped: each of the two probes reads (1 - s) its own response
+ * + s the other's (0: as wired, 1: exchanged; rcb_fit_swap_column, exact).
+ * A swap is whole: its plausible range is [0.5, 1.5], so a fraction whose
+ * 95 % interval lies under a half (another effect's leakage into the
+ * direction) ranks after every plausible candidate. */
+void rcb_mon_cand_desc(const rcb_diag *d, size_t i, rcb_diag_cand_desc *c) {
+  rcb_diag_catalogue_get(d, i, c);
+  if (!c->swap_a) return;
+  c->np = 1, c->refit_only = 0;
+  c->params = c->pname[0] = "fraction";
+  c->lo[0] = 0.5, c->hi[0] = 1.5, c->logp[0] = 0;
 }
 
 /* A candidate whose columns are not a batched adjoint sweep of the base
@@ -338,12 +355,14 @@ static rcb_status cand_columns(rcb_monitor *mon, rcb_diag *d, const col_plan *pl
     rcb_diag_cand_desc c;
     rcb_model *cm = NULL;
     rcb_fit *cf = NULL;
-    rcb_diag_catalogue_get(d, pl->cand[j], &c);
-    if (c.chain) { /* a sensor's gain and phase at neutral (1, 0 rad): the model's values */
+    rcb_mon_cand_desc(d, pl->cand[j], &c);
+    if (c.chain) { /* a sensor's gain and phase at neutral (1, 0 rad), a swap at 0 */
+      double *Jc = J ? J + mon->n * pl->col[j] : NULL;
       for (k = 0; k < c.np; k++)
         pl->neutral[pl->col[j] + k] = rcb_fit_param_is_chain(c.pname[k]) == RCB_CHAIN_GAIN;
-      if (J && (st = rcb_fit_chain_jacobian(mon->fit, c.pname, c.np, J + mon->n * pl->col[j])))
-        rcb_mon_fail(mon, st, "%s: %s", c.desc, rcb_fit_errmsg(mon->fit));
+      if (Jc && c.swap_a) st = rcb_fit_swap_column(mon->fit, c.swap_a, c.swap_b, Jc);
+      else if (Jc) st = rcb_fit_chain_jacobian(mon->fit, c.pname, c.np, Jc);
+      if (st) rcb_mon_fail(mon, st, "%s: %s", c.desc, rcb_fit_errmsg(mon->fit));
       continue;
     }
     if ((st = rcb_diag_catalogue_model(d, pl->cand[j], mon->model, &cm))) {
@@ -398,7 +417,7 @@ static rcb_status plan(rcb_monitor *mon, rcb_diag *d, unsigned mask, col_plan *p
   for (pass = 0; pass < 2; pass++)
     for (i = 0; i < nc; i++) {
       rcb_diag_cand_desc c;
-      rcb_diag_catalogue_get(d, i, &c);
+      rcb_mon_cand_desc(d, i, &c);
       if (!wanted(&c, mask) || own_columns(&c) != (int)pass) continue;
       pl->own[pl->ncand] = own_columns(&c);
       pl->cand[pl->ncand] = i;
@@ -523,6 +542,7 @@ static rcb_status commission(rcb_monitor *mon, const rcb_model *base, const rcb_
   if ((st = baseline(mon, base, o)) || (st = noise(mon, o))) return st; /* noise: h0abs */
   if ((st = rcb_diag_create(&d, mon->model, mon->setup, &mon->alloc)))
     st = rcb_mon_fail(mon, st, "catalogue: %s", d ? rcb_diag_errmsg(d) : "out of memory");
+  if (!st) st = rcb_diag_set_scale(d, RCB_SCALE_COMPLEX); /* the update's: a sensor's phase */
   for (k = 0; !st && k < mon->nt; k++)
     if ((st = rcb_diag_add_fitted_param(d, mon->tname[k], mon->tlo[k], mon->thi[k], 0)))
       rcb_mon_fail(mon, st, "catalogue: %s", rcb_diag_errmsg(d));

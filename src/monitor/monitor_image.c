@@ -70,7 +70,7 @@ uint64_t rcb_mon_image_fingerprint(const rcb_monitor *mon, const rcb_diag *d,
   h = rcb_mon_fnv_u64(rcb_mon_fnv_u64(h, pl->ncand), pl->ncol);
   for (c = 0; c < pl->ncand; c++) {
     rcb_diag_cand_desc cd;
-    rcb_diag_catalogue_get(d, pl->cand[c], &cd);
+    rcb_mon_cand_desc(d, pl->cand[c], &cd);
     h = rcb_mon_fnv_u64(rcb_mon_fnv_u64(h, (uint64_t)cd.effect), pl->col[c]);
     h = rcb_mon_fnv_str(rcb_mon_fnv_str(rcb_mon_fnv_str(h, cd.place), cd.desc), cd.params);
     for (a = 0; a < cd.np; a++) h = fnv_f64s(rcb_mon_fnv_str(h, cd.pname[a]), cd.hi + a, 1);

@@ -255,6 +255,10 @@ double rcb_mon_chi2_logsf(double x, double dof);
  * beta_s / 100 x their rms, the channel's units (beta_s, %). */
 double rcb_mon_eq19_amp(double beta_s, const rcb_complex *v, size_t n);
 void *rcb_mon_alloc(rcb_monitor *mon, size_t count, size_t size);
+struct rcb_diag_cand_desc; /* diagnose/diagnose.h */
+/* Candidate i of the catalogue as the monitor fits it (monitor_create.c):
+ * the diagnosis' description, with a swap of two probes made linear. */
+void rcb_mon_cand_desc(const rcb_diag *d, size_t i, struct rcb_diag_cand_desc *c);
 
 /* The candidates kept for the monitor and their first columns in J. */
 typedef struct col_plan {

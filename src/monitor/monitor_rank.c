@@ -96,7 +96,7 @@ static rcb_status cand_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl,
     rcb_diag_cand_desc c;
     size_t p;
     int ok;
-    rcb_diag_catalogue_get(d, pl->cand[j], &c);
+    rcb_mon_cand_desc(d, pl->cand[j], &c);
     mc->effect = c.effect;
     snprintf(mc->place, sizeof mc->place, "%s", c.place);
     snprintf(mc->desc, sizeof mc->desc, "%s", c.desc);

@@ -26,7 +26,14 @@ The series (SERIES):
             for the COMMISSION files, then falls linearly to 0.85 over 70
             updates (issue #34: a drifting probe, not a drifting machine);
 * mass_DB:  a point mass of 0.05 kg appears at disk DB at update 37 of 60 and
-            stays (issue #34: a step named, then quiet).
+            stays (issue #34: a step named, then quiet);
+* phase_DA_y: the machine as it is, read by a DA.y probe whose phase stays 0
+            for the COMMISSION files, then lags linearly to -PHASE_LAG_DEG
+            over 50 updates (issue #34: a probe's phase drifting, e.g. its
+            driver's filter);
+* swap_DA:  the machine as it is; from update 37 of 60 the DA.x and DA.y
+            probes' cables are exchanged (issue #34: a swap, a step of the
+            measurement chain).
 
 Truth: ROSS 2.3 (an implementation that is not ours). Its rotor is built from
 the INI by the independent parser of the ROSS bridge (ross_models.py), the
@@ -88,7 +95,7 @@ class Series:
     cross_from the first update with the cross-coupling at B3 (None: never)."""
 
     def __init__(self, name, n, seed0, what, kt=None, cross_from=None, phase_deg=0.0,
-                 probe=None, step=None):
+                 probe=None, step=None, lag=None, swap=None):
         self.name = name
         # (edit key of STEPS, first update): an untracked step; cross_from is
         # the cross-coupling's
@@ -96,6 +103,11 @@ class Series:
         # (response, gain(u)): a probe's gain, applied last (the sensor reads
         # the machine's motion and the noise alike)
         self.probe = probe
+        # (response, phase(u) in rad, positive = the sensor leads): a probe's
+        # phase, applied last as the gain
+        self.lag = lag
+        # (response a, response b, first update): the two probes exchanged
+        self.swap = swap
         self.phase_deg = phase_deg  # uniform phase noise, +- degrees
         self.n = n
         self.seed0 = seed0  # update u has noise seed seed0 + u
@@ -129,7 +141,21 @@ class Series:
             "probe": self.probe[0] if self.probe else None,
             "probe_gain": [float(self.probe[1](u)) for u in range(self.n)] if self.probe
             else None,
+            "lag_probe": self.lag[0] if self.lag else None,
+            "lag_rad": [float(self.lag[1](u)) for u in range(self.n)] if self.lag else None,
+            "swap": list(self.swap) if self.swap else None,
         }
+
+    def chain(self, m, u):
+        """What the probes do to update u's measured values m (rows OUTS)."""
+        if self.probe:
+            m[OUTS.index(self.probe[0])] *= self.probe[1](u)
+        if self.lag:
+            m[OUTS.index(self.lag[0])] *= np.exp(1j * self.lag[1](u))
+        if self.swap and u >= self.swap[2]:
+            a, b = OUTS.index(self.swap[0]), OUTS.index(self.swap[1])
+            m[[a, b]] = m[[b, a]]
+        return m
 
 
 COMMISSION = 10  # files averaged into the reference (rcbtool monitor --commission)
@@ -157,6 +183,15 @@ def _probe(u):
     return 1.0 - (1.0 - PROBE_GAIN) * k / PROBE_UPDATES
 
 
+LAG_UPDATES = 50  # phase_DA_y: DA.y's phase lags to -PHASE_LAG_DEG over these updates
+PHASE_LAG_DEG = 3.0
+
+
+def _lag(u):
+    k = min(max(u - COMMISSION, 0), LAG_UPDATES)
+    return -math.radians(PHASE_LAG_DEG) * k / LAG_UPDATES
+
+
 SERIES = {
     "null": Series("null", 200, 160000, "nothing changes"),
     "null_phase": Series("null_phase", 200, 163000, "nothing changes; 2 degrees of phase noise",
@@ -174,6 +209,12 @@ SERIES = {
                          f"the machine unchanged; the DA.x probe's gain steady for "
                          f"{COMMISSION} files, then falling linearly to {PROBE_GAIN} at file "
                          f"{COMMISSION + PROBE_UPDATES}", probe=("DA.x", _probe)),
+    "phase_DA_y": Series("phase_DA_y", COMMISSION + LAG_UPDATES + 1, 166000,
+                         f"the machine unchanged; the DA.y probe's phase 0 for {COMMISSION} "
+                         f"files, then lagging linearly to -{PHASE_LAG_DEG} degrees at file "
+                         f"{COMMISSION + LAG_UPDATES}", lag=("DA.y", _lag)),
+    "swap_DA": Series("swap_DA", 60, 167000, "the machine unchanged; the DA.x and DA.y probes "
+                      "exchanged from update 37", swap=("DA.x", "DA.y", 37)),
 }
 
 
@@ -287,9 +328,7 @@ def write_series(outdir, names=None, truth=None):
             key = (round(s.kt(u), 9), s.edit(u))
             if key not in clean:
                 clean[key] = truth.inertance(s.kt(u), s.edit(u))
-            m = measurement(clean[key], s.seed0 + u, s.phase_deg)
-            if s.probe:
-                m[OUTS.index(s.probe[0])] *= s.probe[1](u)
+            m = s.chain(measurement(clean[key], s.seed0 + u, s.phase_deg), u)
             dc.write_uff(d / file_name(u), m, FREQ_HZ)
         (d / "truth.json").write_text(json.dumps(s.truth(), indent=1) + "\n")
     return outdir

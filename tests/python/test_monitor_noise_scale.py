@@ -14,7 +14,10 @@ in the machine.
   (its relative sd here is about sqrt(1 / (2 dof)) = 0.4 %, the whitening at
   the average a little more), printed in the header and in JSON;
 * with it, the instant test's false alarms over N null updates stay within
-  the binomial 99 % interval of alpha, and no CUSUM alarms;
+  the binomial 99 % interval of alpha, and the tracked parameters whose CUSUM
+  alarms within the binomial 99 % bound of the CUSUM's own rate (2 N / ARL0
+  per parameter, Siegmund's ARL0 at k = 0.5, h = 8: at most 1 of 3 here;
+  the CUSUM's rate at the users' size is the replica benchmark's);
 * the same series with `--noise-scale 1` (the noise as declared, as before)
   has false alarms above that interval: the failure the scale removes (the
   test can fail);
@@ -77,11 +80,19 @@ def test_high_noise_measured_and_held(high):
     assert n == UPDATES
     count = sum(u["alarm"] for u in log["updates"])
     cusum = sum(u["cusum_alarm"] for u in log["updates"])
+    # tracked parameters whose CUSUM alarmed, against the rate the CUSUM states:
+    # each side's ARL0 by Siegmund's approximation at the library's k = 0.5, h = 8
+    alarmed = sum(any(u["tracked"][k]["cusum_alarm"] for u in log["updates"])
+                  for k in range(len(log["tracked"])))
+    b = 2 * 0.5 * (8.0 + 1.166)
+    arl0 = (np.exp(b) - b - 1) / (2 * 0.5 ** 2)
+    cbound = stats.binom.ppf(0.99, len(log["tracked"]), min(1.0, 2 * n / arl0))
     lo, hi = stats.binom.interval(0.99, n, ALPHA)
     print(f"noise {LEVEL} x declared: measured {log['noise_scale']:.4f}; {count} TEST alarms "
-          f"in {n} (99 % interval [{lo:.0f}, {hi:.0f}]), {cusum} CUSUM")
+          f"in {n} (99 % interval [{lo:.0f}, {hi:.0f}]), {cusum} updates with a CUSUM alarm, "
+          f"{alarmed} parameters (bound {cbound:.0f} at ARL0 {arl0:.0f} per side)")
     assert count <= hi
-    assert cusum == 0
+    assert alarmed <= cbound
 
 
 def test_high_noise_as_declared_fails(high):

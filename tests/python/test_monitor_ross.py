@@ -34,6 +34,13 @@ up to 8 re-linearisations of the tracked parameters, until converged).
   truth, and the tracked parameters are left alone (no CUSUM alarm);
 * mass_DB (0.05 kg appears at disk DB at update 37 and stays): named at once
   with its size, then no CUSUM alarm of the tracked parameters;
+* phase_DA_y (issue #34: the machine unchanged, DA.y's phase lagging to -3
+  degrees over 50 updates) and swap_DA (DA.x and DA.y exchanged from update
+  37), monitored with the measurement chain among the candidates (the
+  default): the lag is named as the sensor DA.y (its gain and phase) before
+  it reaches 1 degree, its phase interval covers the truth, the machine is
+  left alone; the swap is named at once as the two probes swapped, its
+  fraction's interval holding 1, and nothing is alarmed before it;
 * null_phase (the null series with 2 degrees of phase noise per point, issue
   #14's), monitored with --noise 10,1,2 (the phase term of rcb_monitor_opts):
   false alarms as for null.
@@ -53,6 +60,7 @@ docs/monitoring.md.
 """
 
 import json
+import math
 import os
 import subprocess
 
@@ -315,6 +323,75 @@ def test_step_then_quiet(tool):
     assert after and after[0]["index"] == change, FIGURES["mass_DB"]
     assert len(named) == len(after) == truth["updates"] - change, FIGURES["mass_DB"]
     assert size >= lo_s and len(before) <= hi and not cusum, FIGURES["mass_DB"]
+
+
+def _chain_figures(log):
+    ups = log["updates"]
+    lo_t, _ = stats.binom.interval(0.99, len(ups), 0.95)
+    tracked = {b["name"]: sum(u["tracked"][k]["ci_lo"] <= b["baseline"] <= u["tracked"][k]["ci_hi"]
+                              for u in ups) for k, b in enumerate(log["tracked"])}
+    cusum = [u["update"] for u in _alarms(log, "cusum_alarm")]
+    return lo_t, tracked, cusum
+
+
+def test_phase_lag_named_as_the_sensor(tool):
+    """Issue #34 item 1, a probe's phase: DA.y lags linearly to -3 degrees over
+    50 updates (ROSS truth, eq. 19 noise; the machine unchanged). The first
+    alarm (instant or drift test) names the sensor DA.y before its lag reaches
+    1 degree; every TEST alarm names it, its phase's 95 % interval (rad) holds
+    the truth's change at the binomial 99 % lower end of 95 %; the tracked
+    parameters are left alone (intervals as often, no CUSUM)."""
+    log, truth = monitor(tool, "phase_DA_y", "--alpha", 0.01)
+    ups = log["updates"]
+    sensor = "sensor " + truth["lag_probe"]
+    lag = truth["lag_rad"]
+    first = next((u for u in ups if u["alarm"] or (u["drift"] and u["drift"]["alarm"])), None)
+    assert first is not None, "no alarm on the lagging probe"
+    named_first = first["top"][0]["place"] if first["alarm"] else first["drift"]["place"]
+    tests = _alarms(log)
+    named = [u for u in tests if u["top"][0]["place"] == sensor]
+    # the candidate's parameters are the gain and the phase (rad), in that order
+    size = [u["top"][0]["ci_lo"][1] <= lag[u["index"]] <= u["top"][0]["ci_hi"][1] for u in named]
+    lo_s, _ = stats.binom.interval(0.99, max(len(size), 1), 0.95)
+    lo_t, tracked, cusum = _chain_figures(log)
+    FIGURES["phase_DA_y"] = (
+        f"first alarm at file {first['index']} (lag {math.degrees(-lag[first['index']]):.3f} deg) "
+        f"names {named_first}; {len(named)} of {len(tests)} TEST alarms name {sensor}; its phase's "
+        f"95 % interval covers the truth on {sum(size)} of {len(size)} (99 % lower end "
+        f"{lo_s:.0f}); tracked intervals cover their values on {tracked} of {len(ups)} (lower "
+        f"end {lo_t:.0f}); CUSUM alarms at {cusum}")
+    assert named_first == sensor and -lag[first["index"]] < math.radians(1.0), FIGURES["phase_DA_y"]
+    assert len(named) == len(tests) and sum(size) >= lo_s, FIGURES["phase_DA_y"]
+    assert all(v >= lo_t for v in tracked.values()) and not cusum, FIGURES["phase_DA_y"]
+
+
+def test_swapped_probes_named(tool):
+    """Issue #34 item 1, a swap: DA.x's and DA.y's cables are exchanged from
+    update 37 (ROSS truth, eq. 19 noise; the machine unchanged). No alarm
+    before beyond the binomial 99 % bound of alpha 0.01; the instant test
+    alarms on the first swapped update and every one after names the two
+    probes swapped, the fraction's 95 % interval holding 1 at the binomial
+    lower end of 95 %; no CUSUM alarm of the tracked parameters."""
+    log, truth = monitor(tool, "swap_DA", "--alpha", 0.01)
+    a, b, change = truth["swap"]
+    place = f"sensors {a}, {b}"
+    before = _alarms(log, hi=change)
+    n_before = sum(1 for u in log["updates"] if u["index"] < change)
+    _, hi = stats.binom.interval(0.99, n_before, 0.01)
+    after = _alarms(log, lo=change)
+    named = [u for u in after if u["top"][0]["place"] == place]
+    size = sum(u["top"][0]["ci_lo"][0] <= 1.0 <= u["top"][0]["ci_hi"][0] for u in named)
+    lo_s, _ = stats.binom.interval(0.99, max(len(named), 1), 0.95)
+    cusum = [u["update"] for u in _alarms(log, "cusum_alarm")]
+    FIGURES["swap_DA"] = (
+        f"first TEST alarm at file {after[0]['index'] if after else None} (swap at {change}); "
+        f"{len(named)} of {len(after)} alarms name {place}: "
+        f"{[round(u['top'][0]['size'][0], 4) for u in named[:3]]}...; the fraction's interval "
+        f"holds 1 on {size} (lower end {lo_s:.0f}); {len(before)} alarms before (bound "
+        f"{hi:.0f}); CUSUM alarms at {cusum}")
+    assert after and after[0]["index"] == change, FIGURES["swap_DA"]
+    assert len(named) == len(after) == truth["updates"] - change, FIGURES["swap_DA"]
+    assert size >= lo_s and len(before) <= hi and not cusum, FIGURES["swap_DA"]
 
 
 def test_sensors_null(tool):

@@ -302,9 +302,8 @@ int main(int argc, char **argv) {
       (1u << RCB_EFFECT_BEARING_DAMPING) | (1u << RCB_EFFECT_COUPLING_TRANSLATIONAL_DAMPING) |
       (1u << RCB_EFFECT_COUPLING_ROTATIONAL_STIFFNESS) |
       (1u << RCB_EFFECT_COUPLING_ROTATIONAL_DAMPING);
-  /* rcbtool monitor --sensors: the default catalogue and every probe's gain */
-  const unsigned sensors =
-      ((1u << RCB_EFFECT_ELEMENT_STIFFNESS) - 1u) | (1u << RCB_EFFECT_SENSOR_GAIN);
+  /* rcbtool monitor --sensors: the default catalogue and the measurement chain */
+  const unsigned sensors = RCB_MONITOR_EFFECTS_SENSORS;
   /* label, relinearise, updates, reweight, effects, the probe series' settings */
   const row rows[] = {
       {"linear", 0, 400, 0, 0, 0},

@@ -300,9 +300,9 @@ static int create_monitor(mon_ctx *x, rcb_monitor **mon) {
   o.relinearise = x->j->relinearise;
   o.reweight = x->j->reweight;
   /* the default catalogue (rcb_monitor_opts.effects 0: the effects before the
-   * shaft elements) and, unless --no-sensors, every probe's gain */
+   * shaft elements) and, unless --no-sensors, the measurement chain */
   if (x->j->sensors)
-    o.effects = ((1u << RCB_EFFECT_ELEMENT_STIFFNESS) - 1u) | (1u << RCB_EFFECT_SENSOR_GAIN);
+    o.effects = RCB_MONITOR_EFFECTS_SENSORS;
   if (x->j->have_baseline_sd) { /* the fit's standard errors: the diagonal */
     memset(cov, 0, sizeof cov);
     for (k = 0; k < x->j->params.n; k++)

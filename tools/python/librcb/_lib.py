@@ -169,8 +169,11 @@ class CompareSummary(ctypes.Structure):
 # RCB_MONITOR_TOP and RCB_MONITOR_MAXP
 MONITOR_MAX_TRACKED, MONITOR_TOP, MONITOR_MAXP = 8, 8, 3
 # rcb_effect (include/rcb/rcb_diagnose.h): the monitor's catalogue ends before the
-# shaft elements; a sensor's gain is asked for
-EFFECT_ELEMENT_STIFFNESS, EFFECT_SENSOR_GAIN = 12, 14
+# shaft elements; the measurement chain (a sensor's gain and phase, a swap) is asked
+# for: RCB_MONITOR_EFFECTS_SENSORS of rcb_monitor.h
+EFFECT_ELEMENT_STIFFNESS, EFFECT_SENSOR_GAIN, EFFECT_SENSOR_SWAP = 12, 14, 16
+MONITOR_EFFECTS_SENSORS = (((1 << EFFECT_ELEMENT_STIFFNESS) - 1) | (1 << EFFECT_SENSOR_GAIN)
+                           | (1 << EFFECT_SENSOR_SWAP))
 
 
 class MonitorParam(ctypes.Structure):

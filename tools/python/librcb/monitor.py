@@ -116,9 +116,8 @@ class Monitor(Handle):
         o.setup_averages = float(setup_averages)
         o.relinearise = int(relinearise)
         o.reweight = int(bool(reweight))
-        if sensors:  # the default catalogue and every probe's gain, as rcbtool
-            o.effects = (((1 << _lib.EFFECT_ELEMENT_STIFFNESS) - 1)
-                         | (1 << _lib.EFFECT_SENSOR_GAIN))
+        if sensors:  # the default catalogue and the measurement chain, as rcbtool
+            o.effects = _lib.MONITOR_EFFECTS_SENSORS
         if baseline_sd is not None:
             sdb = np.asarray(baseline_sd, dtype=float)
             if sdb.shape != (len(tp),):
