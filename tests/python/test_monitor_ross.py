@@ -257,6 +257,28 @@ def test_cross_coupling_B3_intervals(tool):
     assert not cusum, FIGURES["cross_B3 intervals"]
 
 
+def _sensor_named(log, sensor, truth, i):
+    """A probe's drift: the first alarm (instant or drift test) and what it
+    names, the TEST alarms and those naming sensor first, whether their
+    parameter i's 95 % interval holds truth[update] and the binomial 99 %
+    lower end of 95 % of them, and the tracked parameters' coverage of their
+    unchanged values (count per name, its lower end) and CUSUM alarms."""
+    ups = log["updates"]
+    first = next((u for u in ups if u["alarm"] or (u["drift"] and u["drift"]["alarm"])), None)
+    assert first is not None, f"no alarm on the probe {sensor}"
+    named_first = first["top"][0]["place"] if first["alarm"] else first["drift"]["place"]
+    tests = _alarms(log)
+    named = [u for u in tests if u["top"][0]["place"] == sensor]
+    size = [u["top"][0]["ci_lo"][i] <= truth[u["index"]] <= u["top"][0]["ci_hi"][i]
+            for u in named]
+    lo_s, _ = stats.binom.interval(0.99, max(len(size), 1), 0.95)
+    lo_t, _ = stats.binom.interval(0.99, len(ups), 0.95)
+    tracked = {b["name"]: sum(u["tracked"][k]["ci_lo"] <= b["baseline"] <= u["tracked"][k]["ci_hi"]
+                              for u in ups) for k, b in enumerate(log["tracked"])}
+    cusum = [u["update"] for u in _alarms(log, "cusum_alarm")]
+    return first, named_first, tests, named, size, lo_s, lo_t, tracked, cusum
+
+
 def test_drifting_probe_named_as_the_sensor(tool):
     """Issue #34 item 1: DA.x's gain falls linearly to 0.85 over 70 updates
     (the machine unchanged). The first alarm, of the instant or the drift
@@ -268,18 +290,9 @@ def test_drifting_probe_named_as_the_sensor(tool):
     ups = log["updates"]
     sensor = "sensor " + truth["probe"]
     gain = truth["probe_gain"]
-    first = next((u for u in ups if u["alarm"] or (u["drift"] and u["drift"]["alarm"])), None)
-    assert first is not None, "no alarm on the drifting probe"
-    named_first = (first["top"][0]["place"] if first["alarm"] else first["drift"]["place"])
-    tests = _alarms(log)
-    named = sum(u["top"][0]["place"] == sensor for u in tests)
-    size = [u["top"][0]["ci_lo"][0] <= gain[u["index"]] - 1 <= u["top"][0]["ci_hi"][0]
-            for u in tests if u["top"][0]["place"] == sensor]
-    lo_s, _ = stats.binom.interval(0.99, len(size), 0.95)
-    lo_t, _ = stats.binom.interval(0.99, len(ups), 0.95)
-    tracked = {b["name"]: sum(u["tracked"][k]["ci_lo"] <= b["baseline"] <= u["tracked"][k]["ci_hi"]
-                              for u in ups) for k, b in enumerate(log["tracked"])}
-    cusum = [u["update"] for u in _alarms(log, "cusum_alarm")]
+    first, named_first, tests, named, size, lo_s, lo_t, tracked, cusum = _sensor_named(
+        log, sensor, [g - 1 for g in gain], 0)
+    named = len(named)
     FIGURES["probe_DA_x"] = (
         f"first alarm at file {first['index']} (gain {gain[first['index']]:.4f}) names "
         f"{named_first}; {named} of {len(tests)} TEST alarms name {sensor}; its gain's 95 % "
@@ -294,6 +307,38 @@ def test_drifting_probe_named_as_the_sensor(tool):
     assert not cusum, FIGURES["probe_DA_x"]
 
 
+def _step(log, change, is_truth, size):
+    """A step at update index change: the alarms before it and their 99 % bound
+    at alpha 0.01, the alarms from it, those whose first candidate is_truth,
+    how many of those hold size in their first parameter's 95 % interval and
+    the binomial 99 % lower end of 95 % of them, and the CUSUM alarms."""
+    before = _alarms(log, hi=change)
+    n_before = sum(1 for u in log["updates"] if u["index"] < change)
+    _, hi = stats.binom.interval(0.99, n_before, 0.01)
+    after = _alarms(log, lo=change)
+    named = [u for u in after if is_truth(u["top"][0])]
+    held = sum(u["top"][0]["ci_lo"][0] <= size <= u["top"][0]["ci_hi"][0] for u in named)
+    lo_s, _ = stats.binom.interval(0.99, max(len(named), 1), 0.95)
+    cusum = [u["update"] for u in _alarms(log, "cusum_alarm")]
+    return before, hi, after, named, held, lo_s, cusum
+
+
+def _step_holds(after, named, held, lo_s, before, hi, cusum, n_after):
+    """Every one of the n_after updates from the step alarmed naming the truth,
+    its size held as often as the bound asks, no more alarms before than the
+    bound, no CUSUM alarm."""
+    return (len(named) == len(after) == n_after and held >= lo_s and len(before) <= hi
+            and not cusum)
+
+
+def _step_text(after, change, named, what, size, held, lo_s, before, hi, cusum):
+    return (f"first TEST alarm at file {after[0]['index'] if after else None} (step at "
+            f"{change}); {len(named)} of {len(after)} alarms name {what}, sizes "
+            f"{[round(u['top'][0]['size'][0], 4) for u in named[:3]]}...; the interval holds "
+            f"{size} on {held} (lower end {lo_s:.0f}); {len(before)} alarms before (bound "
+            f"{hi:.0f}); CUSUM alarms at {cusum}")
+
+
 def test_step_then_quiet(tool):
     """Issue #34 item 2: a point mass of 0.05 kg appears at disk DB at update 37
     (mass_DB, about 125 of its standard errors) and stays. The instant test
@@ -305,33 +350,15 @@ def test_step_then_quiet(tool):
     is refined jointly with the named effect while the test fires)."""
     log, truth = monitor(tool, "mass_DB", "--alpha", 0.01)
     change = truth["change_update"]
-    before = _alarms(log, hi=change)
-    n_before = sum(1 for u in log["updates"] if u["index"] < change)
-    _, hi = stats.binom.interval(0.99, n_before, 0.01)
-    after = _alarms(log, lo=change)
-    named = [u for u in after if u["top"][0]["place"] == truth["place"] and
-             u["top"][0]["effect"] == truth["effect"]]
-    size = sum(u["top"][0]["ci_lo"][0] <= truth["step_size"] <= u["top"][0]["ci_hi"][0]
-               for u in named)
-    lo_s, _ = stats.binom.interval(0.99, max(len(named), 1), 0.95)
-    cusum = [u["update"] for u in _alarms(log, "cusum_alarm")]
-    FIGURES["mass_DB"] = (
-        f"first TEST alarm at file {after[0]['index'] if after else None} (change at {change}); "
-        f"{len(named)} of {len(after)} alarms name {truth['effect']} at {truth['place']}; its "
-        f"mass interval holds {truth['step_size']} kg on {size} (lower end {lo_s:.0f}); "
-        f"{len(before)} alarms before (bound {hi:.0f}); CUSUM alarms at {cusum}")
+    before, hi, after, named, size, lo_s, cusum = _step(
+        log, change, lambda t: t["place"] == truth["place"] and t["effect"] == truth["effect"],
+        truth["step_size"])
+    FIGURES["mass_DB"] = _step_text(after, change, named, f"{truth['effect']} at "
+                                    f"{truth['place']}", f"{truth['step_size']} kg", size,
+                                    lo_s, before, hi, cusum)
     assert after and after[0]["index"] == change, FIGURES["mass_DB"]
-    assert len(named) == len(after) == truth["updates"] - change, FIGURES["mass_DB"]
-    assert size >= lo_s and len(before) <= hi and not cusum, FIGURES["mass_DB"]
-
-
-def _chain_figures(log):
-    ups = log["updates"]
-    lo_t, _ = stats.binom.interval(0.99, len(ups), 0.95)
-    tracked = {b["name"]: sum(u["tracked"][k]["ci_lo"] <= b["baseline"] <= u["tracked"][k]["ci_hi"]
-                              for u in ups) for k, b in enumerate(log["tracked"])}
-    cusum = [u["update"] for u in _alarms(log, "cusum_alarm")]
-    return lo_t, tracked, cusum
+    assert _step_holds(after, named, size, lo_s, before, hi, cusum, truth["updates"] - change), \
+        FIGURES["mass_DB"]
 
 
 def test_phase_lag_named_as_the_sensor(tool):
@@ -345,15 +372,9 @@ def test_phase_lag_named_as_the_sensor(tool):
     ups = log["updates"]
     sensor = "sensor " + truth["lag_probe"]
     lag = truth["lag_rad"]
-    first = next((u for u in ups if u["alarm"] or (u["drift"] and u["drift"]["alarm"])), None)
-    assert first is not None, "no alarm on the lagging probe"
-    named_first = first["top"][0]["place"] if first["alarm"] else first["drift"]["place"]
-    tests = _alarms(log)
-    named = [u for u in tests if u["top"][0]["place"] == sensor]
     # the candidate's parameters are the gain and the phase (rad), in that order
-    size = [u["top"][0]["ci_lo"][1] <= lag[u["index"]] <= u["top"][0]["ci_hi"][1] for u in named]
-    lo_s, _ = stats.binom.interval(0.99, max(len(size), 1), 0.95)
-    lo_t, tracked, cusum = _chain_figures(log)
+    first, named_first, tests, named, size, lo_s, lo_t, tracked, cusum = _sensor_named(
+        log, sensor, lag, 1)
     FIGURES["phase_DA_y"] = (
         f"first alarm at file {first['index']} (lag {math.degrees(-lag[first['index']]):.3f} deg) "
         f"names {named_first}; {len(named)} of {len(tests)} TEST alarms name {sensor}; its phase's "
@@ -375,23 +396,13 @@ def test_swapped_probes_named(tool):
     log, truth = monitor(tool, "swap_DA", "--alpha", 0.01)
     a, b, change = truth["swap"]
     place = f"sensors {a}, {b}"
-    before = _alarms(log, hi=change)
-    n_before = sum(1 for u in log["updates"] if u["index"] < change)
-    _, hi = stats.binom.interval(0.99, n_before, 0.01)
-    after = _alarms(log, lo=change)
-    named = [u for u in after if u["top"][0]["place"] == place]
-    size = sum(u["top"][0]["ci_lo"][0] <= 1.0 <= u["top"][0]["ci_hi"][0] for u in named)
-    lo_s, _ = stats.binom.interval(0.99, max(len(named), 1), 0.95)
-    cusum = [u["update"] for u in _alarms(log, "cusum_alarm")]
-    FIGURES["swap_DA"] = (
-        f"first TEST alarm at file {after[0]['index'] if after else None} (swap at {change}); "
-        f"{len(named)} of {len(after)} alarms name {place}: "
-        f"{[round(u['top'][0]['size'][0], 4) for u in named[:3]]}...; the fraction's interval "
-        f"holds 1 on {size} (lower end {lo_s:.0f}); {len(before)} alarms before (bound "
-        f"{hi:.0f}); CUSUM alarms at {cusum}")
+    before, hi, after, named, size, lo_s, cusum = _step(
+        log, change, lambda t: t["place"] == place, 1.0)  # the fraction swapped: 1
+    FIGURES["swap_DA"] = _step_text(after, change, named, place, "a fraction of 1", size,
+                                    lo_s, before, hi, cusum)
     assert after and after[0]["index"] == change, FIGURES["swap_DA"]
-    assert len(named) == len(after) == truth["updates"] - change, FIGURES["swap_DA"]
-    assert size >= lo_s and len(before) <= hi and not cusum, FIGURES["swap_DA"]
+    assert _step_holds(after, named, size, lo_s, before, hi, cusum, truth["updates"] - change), \
+        FIGURES["swap_DA"]
 
 
 def test_sensors_null(tool):
