@@ -455,7 +455,7 @@ def main():
                     help="the noise's level: measured on the commissioning files' scatter "
                     "(rcbtool monitor's default) or as declared")
     ap.add_argument("--sensors", action="store_true",
-                    help="every probe's gain among the candidates (rcbtool monitor --sensors)")
+                    help="the measurement chain among the candidates (rcbtool monitor --sensors)")
     ap.add_argument("--forms", default=",".join(FORMS),
                     help="run only the replicas of these noise forms (they take turns)")
     ap.add_argument("--from-json", action="store_true",
