@@ -23,6 +23,14 @@
  * errors, at the rate they moved between the last two evaluations of the
  * columns, would move by less than this share over its last step (-). */
 #define MON_SD_TOL 0.01
+/* The step, in standard errors of each of its parameters, of the sweep
+ * that prepares a candidate's one-pole model at create (pole_init): as
+ * the low-rank path's check (LR_CAND_STEP), a change well above the
+ * sweep's rounding and well below a far-from-linear one; on shaft A's
+ * material damping the model's prediction from the linear estimate of a
+ * 2.2e4-standard-error change landed 16.5 of them short at 30-300 (8 at
+ * 1e4). */
+#define MON_POLE_STEP 100.0
 /* Two-sided 95 % normal quantile. */
 #define MON_Z95 1.959963984540054
 
@@ -32,7 +40,10 @@ void rcb_monitor_destroy(rcb_monitor *mon) {
   if (!mon) return;
   a = mon->user;
   rcb_mon_lowrank_free(mon, mon->lr); /* before the candidates: it resets their ep */
-  for (j = 0; j < mon->ncand && mon->cand; j++) rcb_fit_adj_destroy(mon->fit, mon->cand[j].adj);
+  for (j = 0; j < mon->ncand && mon->cand; j++) {
+    rcb_fit_adj_destroy(mon->fit, mon->cand[j].adj);
+    rcb_free(&mon->alloc, mon->cand[j].pole);
+  }
   rcb_free(&mon->alloc, mon->rat);
   if (mon->tdz) rcb_fit_dz_free(&mon->alloc, mon->tdz, mon->nt);
   rcb_free(&mon->alloc, mon->tdz);
@@ -597,6 +608,96 @@ static rcb_status joint_gn(rcb_monitor *mon, const mon_cand *c, int gls, int fre
   return gn_step(mon, gls, p, x, sd, ok, step);
 }
 
+/* The baseline's whitened columns of the joint step (the tracked ones,
+ * then candidate c's) on the residuals, Q G, into W (n x p). */
+static void pole_columns(rcb_monitor *mon, const mon_cand *c, size_t p, double *W) {
+  size_t a, k = mon->k, nt = mon->nt;
+  for (a = 0; a < p; a++)
+    memcpy(mon->Jx + k * a, mon->G + k * (a < nt ? a : c->col + a - nt), k * sizeof *mon->Jx);
+  cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, (blasint)mon->n, (blasint)p, (blasint)k,
+              1.0, mon->Q, (blasint)k, mon->Jx, (blasint)k, 0.0, W, (blasint)mon->n);
+}
+
+/* Point q's value of whitened column a of W (n x p), unwhitened (complex). */
+static double complex unw(const rcb_monitor *mon, const double *W, size_t q, size_t a) {
+  return CMPLX(W[2 * q + mon->n * a] / mon->winv[2 * q], W[2 * q + 1 + mon->n * a] / mon->winv[2 * q + 1]);
+}
+
+/* The one-pole model's coefficient per point, gam (Re, Im), from the
+ * whitened change R at x0 and the baseline columns W (n x p): g = 1 / r -
+ * 1 / v, r the change and v = W x0 the linear one (unwhitened, complex);
+ * 0 (linear) where a part is left out or the two differ by half or more. */
+static void pole_coef(const rcb_monitor *mon, const double *W, const double *R,
+                      const double *x0, size_t p, double *gam) {
+  size_t a, q;
+  for (q = 0; q < mon->npt; q++) {
+    double w1 = mon->winv[2 * q], w2 = mon->winv[2 * q + 1];
+    double complex v = 0, r, g = 0;
+    if (w1 > 0 && w2 > 0) {
+      for (a = 0; a < p; a++) v += unw(mon, W, q, a) * x0[a];
+      r = CMPLX(R[2 * q] / w1, R[2 * q + 1] / w2);
+      g = cabs(v) > 0 && cabs(r) > 0 && cabs(r / v - 1.0) < 0.5 ? 1.0 / r - 1.0 / v : 0.0;
+    }
+    gam[2 * q] = creal(g), gam[2 * q + 1] = cimag(g);
+  }
+}
+
+/* The one-pole model of each point's change (pole_solve): its
+ * coefficients, the baseline's columns W (n x p, pole_columns) and, when
+ * D is not NULL, D (n x p) added as D (x - xr). */
+typedef struct pole_model {
+  const double *gam, *W, *D, *xr;
+} pole_model;
+
+/* x minimising the misfit of the one-pole model of each point's change,
+ * v / (1 + g v) (v = W x, g from gam) plus D (x - xr), by up to maxit
+ * Gauss-Newton steps on it (no sweep), ending after one under tol standard
+ * errors (*step: the last); sd those of the model's columns. Uses
+ * mon->rmx. */
+static rcb_status pole_solve(rcb_monitor *mon, const mon_cand *c, int gls, const pole_model *pm,
+                             double tol, size_t maxit, double *x, double *sd, int *ok,
+                             double *step) {
+  size_t a, q, it, k = mon->k, p = mon->nt + c->np, n = mon->n, npt = mon->npt;
+  double *R = mon->rmx, *J = R + n, *Ym = R + n * (1 + p);
+  const double *W = pm->W, *gam = pm->gam, *D = pm->D, *xr = pm->xr;
+  rcb_status st = RCB_OK;
+  *ok = 0, *step = 0;
+  for (it = 0; it < maxit; it++) {
+    for (q = 0; q < npt; q++) {
+      double w1 = mon->winv[2 * q], w2 = mon->winv[2 * q + 1];
+      double complex v = 0, g, d, e;
+      if (!(w1 > 0 && w2 > 0)) { /* a part left out: linear */
+        for (a = 0, R[2 * q] = R[2 * q + 1] = 0; a < p; a++) {
+          R[2 * q] += W[2 * q + n * a] * x[a], R[2 * q + 1] += W[2 * q + 1 + n * a] * x[a];
+          J[2 * q + n * a] = W[2 * q + n * a], J[2 * q + 1 + n * a] = W[2 * q + 1 + n * a];
+        }
+      } else {
+        for (a = 0; a < p; a++) v += unw(mon, W, q, a) * x[a];
+        g = CMPLX(gam[2 * q], gam[2 * q + 1]);
+        d = 1.0 + g * v;
+        e = v / d;
+        R[2 * q] = creal(e) * w1, R[2 * q + 1] = cimag(e) * w2;
+        d = 1.0 / (d * d);
+        for (a = 0; a < p; a++) {
+          e = unw(mon, W, q, a) * d;
+          J[2 * q + n * a] = creal(e) * w1, J[2 * q + 1 + n * a] = cimag(e) * w2;
+        }
+      }
+      for (a = 0; D && a < p; a++) {
+        size_t i = 2 * q + n * a;
+        R[2 * q] += D[i] * (x[a] - xr[a]), R[2 * q + 1] += D[i + 1] * (x[a] - xr[a]);
+        J[i] += D[i], J[i + 1] += D[i + 1];
+      }
+    }
+    to_rank_blas(mon, R, 1 + p, Ym);
+    for (q = 0; q < k; q++) mon->z[q] = mon->y0[q] - Ym[q];
+    memcpy(mon->Jx, Ym + k, k * p * sizeof *mon->Jx);
+    st = gn_step(mon, gls, p, x, sd, ok, step);
+    if (st || !*ok || *step < tol) break;
+  }
+  return st;
+}
+
 /* After the first fresh evaluation at x0 of a joint step far from linear
  * (its step MON_CHORD_SD standard errors or more): the next point from a
  * one-pole model of each point's change instead of the columns at x0. Near
@@ -604,68 +705,99 @@ static rcb_status joint_gn(rcb_monitor *mon, const mon_cand *c, int gls, int fre
  * linear change (complex, per point, unwhitened) and g fixed by the
  * evaluation at x0 (exact for a single mode whose pole moves with x: a
  * shaft's material damping, a stiffness); x minimises the model's misfit
- * by Gauss-Newton steps on it (no sweep) until they are under
- * MON_RELIN_TOL standard errors. On entry mon->rmx holds the whitened
- * change at x0 (joint_gn) and x, sd the columns' step from x0; x and sd
- * are left so when the model fails (a dependent column) or lands farther
- * from that step than the step is long. On shaft A's material damping
- * 2300 standard errors above the baseline (bench_monitor damping), the
- * columns' step landed 60 standard errors short, the model's 3.9. */
+ * (pole_solve). On entry mon->rmx holds the whitened change at x0
+ * (joint_gn) and x, sd the columns' step from x0; x and sd are left so
+ * when the model fails (a dependent column) or lands farther from that
+ * step than the step is long. On shaft A's material damping 2300 standard
+ * errors above the baseline (bench_monitor damping), the columns' step
+ * landed 60 standard errors short, the model's 3.9. */
 static rcb_status pole_step(rcb_monitor *mon, const mon_cand *c, int gls, const double *x0,
                             double *x, double *sd) {
   enum { MX = RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP };
-  size_t a, q, it, k = mon->k, nt = mon->nt, p = nt + c->np, n = mon->n, npt = mon->npt;
-  double *R = mon->rmx, *W = R + n, *gam = mon->rat, *Ym = R + n * (1 + p);
+  size_t a, p = mon->nt + c->np;
   double keep[MX], ksd[MX], step = 0, far;
-  rcb_status st = RCB_OK;
+  pole_model pm = {mon->rat, c->pole ? c->pole + mon->n : mon->rat + mon->n, NULL, NULL};
+  rcb_status st;
   int ok = 0;
   memcpy(keep, x, p * sizeof *x), memcpy(ksd, sd, p * sizeof *sd);
-  for (it = 0; it < 2 * mon->relin; it++) {
-    /* the baseline's whitened columns on the residuals, Q G (into R's
-     * columns 1 .. p, which the model's columns then overwrite) */
-    for (a = 0; a < p; a++)
-      memcpy(mon->Jx + k * a, mon->G + k * (a < nt ? a : c->col + a - nt), k * sizeof *mon->Jx);
-    cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, (blasint)n, (blasint)p, (blasint)k,
-                1.0, mon->Q, (blasint)k, mon->Jx, (blasint)k, 0.0, W, (blasint)n);
-    for (q = 0; q < npt; q++) {
-      double w1 = mon->winv[2 * q], w2 = mon->winv[2 * q + 1];
-      double complex v = 0, g, d, e;
-      if (!(w1 > 0 && w2 > 0)) { /* a part left out: linear */
-        gam[2 * q] = gam[2 * q + 1] = 0.0;
-        for (a = 0, R[2 * q] = R[2 * q + 1] = 0; a < p; a++)
-          R[2 * q] += W[2 * q + n * a] * x[a], R[2 * q + 1] += W[2 * q + 1 + n * a] * x[a];
-        continue;
-      }
-      for (a = 0; a < p; a++)
-        v += CMPLX(W[2 * q + n * a] / w1, W[2 * q + 1 + n * a] / w2) * (it ? x[a] : x0[a]);
-      if (!it) { /* g from the change at x0, R's column 0 on entry */
-        double complex r = CMPLX(R[2 * q] / w1, R[2 * q + 1] / w2);
-        g = cabs(v) > 0 && cabs(r) > 0 && cabs(r / v - 1.0) < 0.5 ? 1.0 / r - 1.0 / v : 0.0;
-        gam[2 * q] = creal(g), gam[2 * q + 1] = cimag(g);
-        for (a = 0, v = 0; a < p; a++)
-          v += CMPLX(W[2 * q + n * a] / w1, W[2 * q + 1 + n * a] / w2) * x[a];
-      }
-      g = CMPLX(gam[2 * q], gam[2 * q + 1]);
-      d = 1.0 + g * v;
-      e = v / d;
-      R[2 * q] = creal(e) * w1, R[2 * q + 1] = cimag(e) * w2;
-      d = 1.0 / (d * d);
-      for (a = 0; a < p; a++) {
-        e = CMPLX(W[2 * q + n * a] / w1, W[2 * q + 1 + n * a] / w2) * d;
-        W[2 * q + n * a] = creal(e) * w1, W[2 * q + 1 + n * a] = cimag(e) * w2;
-      }
-    }
-    to_rank_blas(mon, R, 1 + p, Ym);
-    for (q = 0; q < k; q++) mon->z[q] = mon->y0[q] - Ym[q];
-    memcpy(mon->Jx, Ym + k, k * p * sizeof *mon->Jx);
-    if ((st = gn_step(mon, gls, p, x, sd, &ok, &step)) || !ok || step < MON_RELIN_TOL) break;
-  }
+  if (!c->pole) pole_columns(mon, c, p, mon->rat + mon->n);
+  pole_coef(mon, pm.W, mon->rmx, x0, p, mon->rat);
+  st = pole_solve(mon, c, gls, &pm, MON_RELIN_TOL, 2 * mon->relin, x, sd, &ok, &step);
   /* kept only when no farther from the columns' step than that step is long */
   for (a = 0, step = 0, far = 0; a < p; a++) {
     step = fmax(step, fabs(x[a] - keep[a]) / ksd[a]);
     far = fmax(far, fabs(keep[a] - x0[a]) / ksd[a]);
   }
   if (st || !ok || !(step <= far)) memcpy(x, keep, p * sizeof *x), memcpy(sd, ksd, p * sizeof *sd);
+  return st;
+}
+
+/* Before the first evaluation of candidate c's joint step: the point its
+ * one-pole model prepared at create (c->pole, pole_init) predicts from the
+ * linear estimate x, taken (*pred = 1) when the model's first step from x
+ * is one that would not end the iterations (joint_relin's rule, with the
+ * linear step's length as the contraction's distance): the step is far
+ * from linear. Else x and sd are left as they are, and the iterations go
+ * on as without the model. */
+static rcb_status pole_predict(rcb_monitor *mon, const mon_cand *c, int gls, double *x,
+                               double *sd, int *pred) {
+  enum { MX = RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP };
+  size_t a, p = mon->nt + c->np;
+  double xl[MX], sdl[MX], dist = 0, step = 0;
+  pole_model pm = {c->pole, c->pole + mon->n, NULL, NULL};
+  rcb_status st;
+  int ok = 0;
+  *pred = 0;
+  memcpy(xl, x, p * sizeof *x), memcpy(sdl, sd, p * sizeof *sd);
+  for (a = 0; a < p; a++) dist = fmax(dist, fabs(x[a]) / sd[a]);
+  st = pole_solve(mon, c, gls, &pm, MON_CHORD_SD, 1, x, sd, &ok, &step);
+  if (!st && ok && step * step >= MON_RELIN_TOL * dist) {
+    *pred = 1;
+    st = pole_solve(mon, c, gls, &pm, MON_CHORD_SD, 2 * mon->relin, x, sd, &ok, &step);
+  }
+  if (st || !ok || !*pred) {
+    memcpy(x, xl, p * sizeof *x), memcpy(sd, sdl, p * sizeof *sd);
+    *pred = 0;
+  }
+  return st;
+}
+
+/* After the fresh evaluation at the predicted point xp (pole_predict) and
+ * its Gauss-Newton step to x: that step corrected for the curvature the
+ * one-pole model through the evaluation shows. The model, v / (1 + g v)
+ * with g from the change at xp (pole_coef), plus D (x - xp), D the
+ * evaluated columns at xp less the model's own there, has the evaluation's
+ * value and columns at xp; x moves to its solution. *corr: the move, in
+ * standard errors. On entry mon->rmx holds the whitened change and columns
+ * at xp (joint_gn). x and sd are left so when the model fails. */
+static rcb_status pole_correct(rcb_monitor *mon, const mon_cand *c, int gls, const double *xp,
+                               double *x, double *sd, double *corr) {
+  enum { MX = RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP };
+  size_t a, q, n = mon->n, p = mon->nt + c->np;
+  double x1[MX], sd1[MX], *gam = mon->rat, *D = gam + n, step;
+  const double *R = mon->rmx, *Jp = R + n, *W = c->pole + n;
+  pole_model pm = {gam, W, D, xp};
+  rcb_status st;
+  int ok = 0;
+  memcpy(x1, x, p * sizeof *x), memcpy(sd1, sd, p * sizeof *sd);
+  pole_coef(mon, W, R, xp, p, gam);
+  for (q = 0; q < mon->npt; q++) {
+    double w1 = mon->winv[2 * q], w2 = mon->winv[2 * q + 1];
+    double complex v = 0, d;
+    for (a = 0; w1 > 0 && w2 > 0 && a < p; a++) v += unw(mon, W, q, a) * xp[a];
+    d = 1.0 + CMPLX(gam[2 * q], gam[2 * q + 1]) * v;
+    d = w1 > 0 && w2 > 0 ? 1.0 / (d * d) : 1.0;
+    for (a = 0; a < p; a++) {
+      size_t i = 2 * q + n * a;
+      double complex e = w1 > 0 && w2 > 0 ? unw(mon, W, q, a) * d : 0.0;
+      D[i] = Jp[i] - (w1 > 0 && w2 > 0 ? creal(e) * w1 : W[i]);
+      D[i + 1] = Jp[i + 1] - (w1 > 0 && w2 > 0 ? cimag(e) * w2 : W[i + 1]);
+    }
+  }
+  st = pole_solve(mon, c, gls, &pm, MON_RELIN_TOL * MON_RELIN_TOL, 2 * mon->relin, x, sd, &ok,
+                  &step);
+  for (a = 0, *corr = 0; a < p; a++) *corr = fmax(*corr, fabs(x[a] - x1[a]) / sd1[a]);
+  if (st || !ok) memcpy(x, x1, p * sizeof *x), memcpy(sd, sd1, p * sizeof *sd), *corr = INFINITY;
   return st;
 }
 
@@ -690,12 +822,13 @@ static rcb_status joint_relin(rcb_monitor *mon, int gls, rcb_monitor_result *res
   double xa[MX], xp[MX] = {0}, sdp[MX], prev = 0, step, dist, drift;
   size_t a, it, nt = mon->nt, p;
   rcb_status st = RCB_OK;
-  int ok = 1, fresh = 1;
+  int ok = 1, fresh = 1, pred = 0;
   if (!c || !mon->relin || !c->settable) return RCB_OK;
   p = nt + c->np;
   for (a = 0; a < nt; a++) x[a] = dth[a], sd[a] = se[a];
   for (a = 0; a < c->np; a++) x[nt + a] = c->size_now[a], sd[nt + a] = c->se_now[a];
   memcpy(sdp, sd, sizeof sdp); /* the baseline's columns: the linear estimate's */
+  if (c->pole && mon->rat && (st = pole_predict(mon, c, gls, x, sd, &pred))) return st;
   for (it = 0; ok == 1 && !st && it < mon->relin; it++) {
     memcpy(xa, x, sizeof xa);
     st = joint_gn(mon, c, gls, fresh, x, sd, &ok, &step);
@@ -711,7 +844,14 @@ static rcb_status joint_relin(rcb_monitor *mon, int gls, rcb_monitor_result *res
       }
       if (ok != 1 && step * step < MON_RELIN_TOL * dist && drift * step < MON_SD_TOL * dist) ok = 1;
       memcpy(xp, xa, sizeof xp), memcpy(sdp, sd, sizeof sdp);
-      if (ok == 4 && !it && c->adj && mon->rat) st = pole_step(mon, c, gls, xa, x, sd);
+      if (pred && !it && ok != 1) {
+        double corr, sdn[MX], dr = 0;
+        memcpy(sdn, sd, sizeof sdn);
+        st = pole_correct(mon, c, gls, xa, x, sd, &corr);
+        for (a = 0; a < p; a++) dr = fmax(dr, fabs(sd[a] - sdn[a]) / sd[a]);
+        /* the same rule on the correction after the step */
+        if (!st && corr * corr < MON_RELIN_TOL * step && dr * corr < MON_SD_TOL * step) ok = 1;
+      } else if (ok == 4 && !it && c->adj && mon->rat) st = pole_step(mon, c, gls, xa, x, sd);
     } else if (!st && ok == 2 && step * step < MON_RELIN_TOL * prev) {
       ok = 1; /* the same on kept columns, at the contraction of the last two steps */
     }
@@ -846,6 +986,29 @@ rcb_status rcb_monitor_tracked_info(const rcb_monitor *mon, size_t k, const char
   return RCB_OK;
 }
 
+/* Candidate c's one-pole model (pole_predict): its coefficient per point
+ * from one sweep with its parameters MON_POLE_STEP standard errors from
+ * their neutral values (the tracked ones at the baseline); none (c->pole
+ * NULL) when the model refuses that value or the sweep fails. */
+static rcb_status pole_init(rcb_monitor *mon, mon_cand *c) {
+  enum { MX = RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP };
+  double x0[MX] = {0}, *R = mon->rmx;
+  size_t a, nt = mon->nt, p = nt + c->np;
+  rcb_status st = RCB_OK;
+  for (a = 0; a < c->np; a++) x0[nt + a] = MON_POLE_STEP * c->se[a];
+  if (!(st = set_point(mon, x0, c, x0 + nt)) && !(st = rcb_fit_residuals(mon->fit, R))) {
+    whiten_change(mon, R, mon->rbase);
+    if (!(c->pole = rcb_mon_alloc(mon, mon->n * (1 + p), sizeof *c->pole))) st = RCB_ERR_NOMEM;
+    else {
+      pole_columns(mon, c, p, c->pole + mon->n);
+      pole_coef(mon, c->pole + mon->n, R, x0, p, c->pole);
+    }
+  }
+  rcb_mon_model_restore(mon, c);
+  return st == RCB_ERR_NOMEM ? rcb_mon_fail(mon, st, "out of memory (joint step's model)")
+                             : RCB_OK;
+}
+
 /* The candidates whose joint step is re-linearised by sweeps (settable,
  * with derivative matrices, not on the low-rank path: the operating speed,
  * a shaft's material damping) get that step's columns by one adjoint sweep
@@ -857,13 +1020,16 @@ rcb_status rcb_monitor_tracked_info(const rcb_monitor *mon, size_t k, const char
 rcb_status rcb_mon_adj_init(rcb_monitor *mon) {
   enum { MT = RCB_MONITOR_MAX_TRACKED, MP = RCB_MONITOR_MAXP };
   struct rcb_fit_dz dz[MT + MP];
-  size_t j, a, nt = mon->nt;
+  size_t j, a, pm, nt = mon->nt;
   rcb_status st;
   if (!mon->relin || !nt || !mon->fit) return RCB_OK;
   for (j = 0; j < mon->ncand; j++)
     if (mon->cand[j].dz && mon->cand[j].settable && !mon->cand[j].ep) break;
   if (j == mon->ncand) return RCB_OK;
-  if (!(mon->rat = rcb_mon_alloc(mon, mon->n, sizeof *mon->rat)))
+  for (j = 0, pm = 0; j < mon->ncand; j++)
+    if (mon->cand[j].dz && mon->cand[j].settable && !mon->cand[j].ep && mon->cand[j].np > pm)
+      pm = mon->cand[j].np;
+  if (!(mon->rat = rcb_mon_alloc(mon, mon->n * (1 + nt + pm), sizeof *mon->rat)))
     return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (joint step's model)");
   if (!(mon->tdz = rcb_mon_alloc(mon, nt, sizeof *mon->tdz)))
     return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (tracked derivative matrices)");
@@ -879,6 +1045,7 @@ rcb_status rcb_mon_adj_init(rcb_monitor *mon) {
     for (a = 0; a < c->np; a++) dz[nt + a] = c->dz[a];
     if ((st = rcb_fit_adj_create(mon->fit, dz, nt + c->np, &c->adj)))
       return rcb_mon_fail(mon, st, "%s: joint step: %s", c->desc, rcb_fit_errmsg(mon->fit));
+    if ((st = pole_init(mon, c))) return st;
   }
   return RCB_OK;
 }

@@ -53,6 +53,8 @@ typedef struct mon_cand {
   struct rcb_fit_adj *adj; /* its joint step's columns by one adjoint sweep
                         (tracked then its own derivative matrices; settable,
                         with dz, not on the low-rank path): rcb_mon_adj_init */
+  double *pole;      /* with adj, n or NULL: its one-pole model's coefficient per
+                        point (Re, Im; monitor.c, pole_init and pole_predict) */
   size_t *ep;        /* per entry of dz: row's and column's place in the
                         low-rank P; NULL: not on the low-rank path */
   int settable;      /* its parameters are the baseline model's own, at their
