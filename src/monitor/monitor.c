@@ -23,13 +23,14 @@
  * errors, at the rate they moved between the last two evaluations of the
  * columns, would move by less than this share over its last step (-). */
 #define MON_SD_TOL 0.01
-/* The step, in standard errors of each of its parameters, of the sweep
- * that prepares a candidate's one-pole model at create (pole_init): as
- * the low-rank path's check (LR_CAND_STEP), a change well above the
- * sweep's rounding and well below a far-from-linear one; on shaft A's
- * material damping the model's prediction from the linear estimate of a
- * 2.2e4-standard-error change landed 16.5 of them short at 30-300 (8 at
- * 1e4). */
+/* The step, in standard errors (create's) of each of its parameters, of
+ * the sweep that prepares a candidate's one-pole model at create
+ * (pole_init): as the low-rank path's check (LR_CAND_STEP), a change well
+ * above the sweep's rounding and well below a far-from-linear one. On
+ * shaft A's material damping (bench_monitor damping: a change of 2.2e4 of
+ * these, 1800 of the update's) the model's prediction from the linear
+ * estimate, 640 of the update's standard errors off, landed 16.5 off with
+ * the step at 30 to 300, 8 at 1e4. */
 #define MON_POLE_STEP 100.0
 /* Two-sided 95 % normal quantile. */
 #define MON_Z95 1.959963984540054
@@ -620,7 +621,8 @@ static void pole_columns(rcb_monitor *mon, const mon_cand *c, size_t p, double *
 
 /* Point q's value of whitened column a of W (n x p), unwhitened (complex). */
 static double complex unw(const rcb_monitor *mon, const double *W, size_t q, size_t a) {
-  return CMPLX(W[2 * q + mon->n * a] / mon->winv[2 * q], W[2 * q + 1 + mon->n * a] / mon->winv[2 * q + 1]);
+  const double *w = W + 2 * q + mon->n * a;
+  return CMPLX(w[0] / mon->winv[2 * q], w[1] / mon->winv[2 * q + 1]);
 }
 
 /* The one-pole model's coefficient per point, gam (Re, Im), from the
@@ -773,7 +775,7 @@ static rcb_status pole_predict(rcb_monitor *mon, const mon_cand *c, int gls, dou
 static rcb_status pole_correct(rcb_monitor *mon, const mon_cand *c, int gls, const double *xp,
                                double *x, double *sd, double *corr) {
   enum { MX = RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP };
-  size_t a, q, n = mon->n, p = mon->nt + c->np;
+  size_t a, q, i, j, n = mon->n, p = mon->nt + c->np;
   double x1[MX], sd1[MX], *gam = mon->rat, *D = gam + n, step;
   const double *R = mon->rmx, *Jp = R + n, *W = c->pole + n;
   pole_model pm = {gam, W, D, xp};
@@ -781,17 +783,21 @@ static rcb_status pole_correct(rcb_monitor *mon, const mon_cand *c, int gls, con
   int ok = 0;
   memcpy(x1, x, p * sizeof *x), memcpy(sd1, sd, p * sizeof *sd);
   pole_coef(mon, W, R, xp, p, gam);
-  for (q = 0; q < mon->npt; q++) {
+  for (q = 0; q < mon->npt; q++) { /* D = Jp less the model's columns at xp */
     double w1 = mon->winv[2 * q], w2 = mon->winv[2 * q + 1];
     double complex v = 0, d;
-    for (a = 0; w1 > 0 && w2 > 0 && a < p; a++) v += unw(mon, W, q, a) * xp[a];
+    if (!(w1 > 0 && w2 > 0)) { /* a part left out: linear */
+      for (a = 0; a < p; a++)
+        for (i = 2 * q + n * a, j = 0; j < 2; j++) D[i + j] = Jp[i + j] - W[i + j];
+      continue;
+    }
+    for (a = 0; a < p; a++) v += unw(mon, W, q, a) * xp[a];
     d = 1.0 + CMPLX(gam[2 * q], gam[2 * q + 1]) * v;
-    d = w1 > 0 && w2 > 0 ? 1.0 / (d * d) : 1.0;
+    d = 1.0 / (d * d);
     for (a = 0; a < p; a++) {
-      size_t i = 2 * q + n * a;
-      double complex e = w1 > 0 && w2 > 0 ? unw(mon, W, q, a) * d : 0.0;
-      D[i] = Jp[i] - (w1 > 0 && w2 > 0 ? creal(e) * w1 : W[i]);
-      D[i + 1] = Jp[i + 1] - (w1 > 0 && w2 > 0 ? cimag(e) * w2 : W[i + 1]);
+      double complex e = unw(mon, W, q, a) * d;
+      i = 2 * q + n * a;
+      D[i] = Jp[i] - creal(e) * w1, D[i + 1] = Jp[i + 1] - cimag(e) * w2;
     }
   }
   st = pole_solve(mon, c, gls, &pm, MON_RELIN_TOL * MON_RELIN_TOL, 2 * mon->relin, x, sd, &ok,
@@ -812,7 +818,13 @@ static rcb_status pole_correct(rcb_monitor *mon, const mon_cand *c, int gls, con
  * cross-coupling of the ROSS series came out 5 % short, and the tracked
  * parameters 17-68 standard errors off; chord iterations with the
  * baseline's columns converged at a rate of about 0.8. A step the model
- * refuses (a negative stiffness) keeps the linear estimate. */
+ * refuses (a negative stiffness) keeps the linear estimate. On the sweep
+ * path a step the candidate's one-pole model finds far from linear starts
+ * at that model's prediction (pole_predict), and the step from the first
+ * evaluation there is corrected by the model through it (pole_correct):
+ * on shaft A's material damping the correction was 0.04-0.05 standard
+ * errors and left the estimate 2e-4 of them from the converged one, so one
+ * sweep where there were two (bench_monitor damping 22.9 -> 13 ms). */
 static rcb_status joint_relin(rcb_monitor *mon, int gls, rcb_monitor_result *res, double *dth,
                               double *se) {
   mon_cand *c = res->alarm && res->ntop ? &mon->cand[res->top[0].index] : NULL;
@@ -845,11 +857,13 @@ static rcb_status joint_relin(rcb_monitor *mon, int gls, rcb_monitor_result *res
       if (ok != 1 && step * step < MON_RELIN_TOL * dist && drift * step < MON_SD_TOL * dist) ok = 1;
       memcpy(xp, xa, sizeof xp), memcpy(sdp, sd, sizeof sdp);
       if (pred && !it && ok != 1) {
+        /* the same rule on the correction after the step: its successor at
+         * the contraction from the step to it under MON_RELIN_TOL, and the
+         * standard errors' move at the rate they moved over it */
         double corr, sdn[MX], dr = 0;
         memcpy(sdn, sd, sizeof sdn);
         st = pole_correct(mon, c, gls, xa, x, sd, &corr);
         for (a = 0; a < p; a++) dr = fmax(dr, fabs(sd[a] - sdn[a]) / sd[a]);
-        /* the same rule on the correction after the step */
         if (!st && corr * corr < MON_RELIN_TOL * step && dr * corr < MON_SD_TOL * step) ok = 1;
       } else if (ok == 4 && !it && c->adj && mon->rat) st = pole_step(mon, c, gls, xa, x, sd);
     } else if (!st && ok == 2 && step * step < MON_RELIN_TOL * prev) {
@@ -986,17 +1000,22 @@ rcb_status rcb_monitor_tracked_info(const rcb_monitor *mon, size_t k, const char
   return RCB_OK;
 }
 
-/* Candidate c's one-pole model (pole_predict): its coefficient per point
- * from one sweep with its parameters MON_POLE_STEP standard errors from
- * their neutral values (the tracked ones at the baseline); none (c->pole
- * NULL) when the model refuses that value or the sweep fails. */
+/* Candidate c's one-pole model (pole_predict): the baseline's columns of
+ * its joint step (Q G, n x p) and the coefficient per point from one sweep
+ * with its parameters MON_POLE_STEP standard errors from their neutral
+ * values (the tracked ones at the baseline), into c->pole (n x (1 + p):
+ * the coefficients, then the columns); none (c->pole NULL) when the model
+ * refuses that value or the sweep fails. */
 static rcb_status pole_init(rcb_monitor *mon, mon_cand *c) {
   enum { MX = RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP };
   double x0[MX] = {0}, *R = mon->rmx;
   size_t a, nt = mon->nt, p = nt + c->np;
   rcb_status st = RCB_OK;
-  for (a = 0; a < c->np; a++) x0[nt + a] = MON_POLE_STEP * c->se[a];
-  if (!(st = set_point(mon, x0, c, x0 + nt)) && !(st = rcb_fit_residuals(mon->fit, R))) {
+  for (a = 0; !st && a < c->np; a++) {
+    x0[nt + a] = MON_POLE_STEP * c->se[a];
+    st = rcb_model_set_param(mon->model, c->pname[a], c->neutral[a] + x0[nt + a]);
+  }
+  if (!st && !(st = rcb_fit_residuals(mon->fit, R))) {
     whiten_change(mon, R, mon->rbase);
     if (!(c->pole = rcb_mon_alloc(mon, mon->n * (1 + p), sizeof *c->pole))) st = RCB_ERR_NOMEM;
     else {

@@ -53,8 +53,9 @@ typedef struct mon_cand {
   struct rcb_fit_adj *adj; /* its joint step's columns by one adjoint sweep
                         (tracked then its own derivative matrices; settable,
                         with dz, not on the low-rank path): rcb_mon_adj_init */
-  double *pole;      /* with adj, n or NULL: its one-pole model's coefficient per
-                        point (Re, Im; monitor.c, pole_init and pole_predict) */
+  double *pole;      /* with adj, n x (1 + nt + np) or NULL: its one-pole model,
+                        the coefficient per point (Re, Im) then the baseline's
+                        columns of its joint step, Q G (monitor.c, pole_init) */
   size_t *ep;        /* per entry of dz: row's and column's place in the
                         low-rank P; NULL: not on the low-rank path */
   int settable;      /* its parameters are the baseline model's own, at their
@@ -179,8 +180,11 @@ struct rcb_monitor {
   struct rcb_fit_dz *cdz; /* the batched candidates' derivative matrices, ncdz
                           (kept with opts.relinearise) */
   struct rcb_fit_dz *tdz; /* nt: the tracked parameters' (with a candidate's adj) */
-  double *rat;         /* with tdz: n, the joint step's one-pole model's
-                          coefficient per point (monitor.c, pole_step) */
+  double *rat;         /* with tdz: n x (1 + nt + the most np of a candidate
+                          with adj), the joint step's one-pole model's
+                          coefficient per point, then its columns' correction
+                          D or, for a candidate without c->pole, the baseline's
+                          columns (monitor.c, pole_step, pole_correct) */
   size_t ncdz;
 
   /* noise of the reweighted path */
