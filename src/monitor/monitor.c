@@ -745,13 +745,19 @@ static rcb_status pole_predict(rcb_monitor *mon, const mon_cand *c, int gls, dou
                                double *sd, int *pred) {
   enum { MX = RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP };
   size_t a, p = mon->nt + c->np;
-  double xl[MX], sdl[MX], dist = 0, step = 0;
+  double xl[MX], sdl[MX], dist = 0, step = 0, s = 0, nl = 0;
   pole_model pm = {c->pole, c->pole + mon->n, NULL, NULL};
   rcb_status st;
   int ok = 0;
   *pred = 0;
-  memcpy(xl, x, p * sizeof *x), memcpy(sdl, sd, p * sizeof *sd);
   for (a = 0; a < p; a++) dist = fmax(dist, fabs(x[a]) / sd[a]);
+  for (a = 0; a < c->np; a++) s = fmax(s, fabs(x[mon->nt + a]) / c->se[a]);
+  /* the step the sweep's part beyond the linear change makes at s
+   * standard errors, about c->pole_dx s^2 (its own grows more slowly with
+   * s): at under half of what would not end the iterations, no model */
+  for (a = 0; a < p; a++) nl = fmax(nl, fabs(c->pole_dx[a]) * s * s / sd[a]);
+  if (!(4.0 * nl * nl >= MON_RELIN_TOL * dist)) return RCB_OK;
+  memcpy(xl, x, p * sizeof *x), memcpy(sdl, sd, p * sizeof *sd);
   st = pole_solve(mon, c, gls, &pm, MON_CHORD_SD, 1, x, sd, &ok, &step);
   if (!st && ok && step * step >= MON_RELIN_TOL * dist) {
     *pred = 1;
@@ -1019,8 +1025,18 @@ static rcb_status pole_init(rcb_monitor *mon, mon_cand *c) {
     whiten_change(mon, R, mon->rbase);
     if (!(c->pole = rcb_mon_alloc(mon, mon->n * (1 + p), sizeof *c->pole))) st = RCB_ERR_NOMEM;
     else {
-      pole_columns(mon, c, p, c->pole + mon->n);
-      pole_coef(mon, c->pole + mon->n, R, x0, p, c->pole);
+      double *W = c->pole + mon->n, sd[MX], step;
+      size_t i;
+      int ok;
+      pole_columns(mon, c, p, W); /* also G's columns into mon->Jx */
+      pole_coef(mon, W, R, x0, p, c->pole);
+      for (i = 0; i < mon->n; i++) /* the change's part beyond the linear one */
+        for (a = nt; a < p; a++) R[i] -= W[i + mon->n * a] * x0[a];
+      to_rank(mon, R, mon->z);
+      memset(c->pole_dx, 0, sizeof c->pole_dx);
+      if (!(st = gn_step(mon, 0, p, c->pole_dx, sd, &ok, &step)) && ok)
+        for (a = 0; a < p; a++) c->pole_dx[a] /= MON_POLE_STEP * MON_POLE_STEP;
+      else memset(c->pole_dx, 0, sizeof c->pole_dx), st = st == RCB_ERR_NOMEM ? st : RCB_OK;
     }
   }
   rcb_mon_model_restore(mon, c);

@@ -56,6 +56,10 @@ typedef struct mon_cand {
   double *pole;      /* with adj, n x (1 + nt + np) or NULL: its one-pole model,
                         the coefficient per point (Re, Im) then the baseline's
                         columns of its joint step, Q G (monitor.c, pole_init) */
+  double pole_dx[RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP]; /* with pole: the
+                        joint step (parameter units) the sweep's change beyond the
+                        linear one at MON_POLE_STEP standard errors makes, over
+                        MON_POLE_STEP^2 */
   size_t *ep;        /* per entry of dz: row's and column's place in the
                         low-rank P; NULL: not on the low-rank path */
   int settable;      /* its parameters are the baseline model's own, at their
