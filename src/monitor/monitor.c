@@ -25,7 +25,7 @@
 #define MON_SD_TOL 0.01
 /* The step, in standard errors (create's) of each of its parameters, of
  * the sweep that prepares a candidate's one-pole model at create
- * (pole_init): as the low-rank path's check (LR_CAND_STEP), a change well
+ * (pole_fill): as the low-rank path's check (LR_CAND_STEP), a change well
  * above the sweep's rounding and well below a far-from-linear one. On
  * shaft A's material damping (bench_monitor damping: a change of 2.2e4 of
  * these, 1800 of the update's) the model's prediction from the linear
@@ -718,11 +718,12 @@ static rcb_status pole_step(rcb_monitor *mon, const mon_cand *c, int gls, const 
   enum { MX = RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP };
   size_t a, p = mon->nt + c->np;
   double keep[MX], ksd[MX], step = 0, far;
-  pole_model pm = {mon->rat, c->pole ? c->pole + mon->n : mon->rat + mon->n, NULL, NULL};
+  int own = c->pole_ready > 0; /* the baseline's columns held with the model */
+  pole_model pm = {mon->rat, own ? c->pole + mon->n : mon->rat + mon->n, NULL, NULL};
   rcb_status st;
   int ok = 0;
   memcpy(keep, x, p * sizeof *x), memcpy(ksd, sd, p * sizeof *sd);
-  if (!c->pole) pole_columns(mon, c, p, mon->rat + mon->n);
+  if (!own) pole_columns(mon, c, p, mon->rat + mon->n);
   pole_coef(mon, pm.W, mon->rmx, x0, p, mon->rat);
   st = pole_solve(mon, c, gls, &pm, MON_RELIN_TOL, 2 * mon->relin, x, sd, &ok, &step);
   /* kept only when no farther from the columns' step than that step is long */
@@ -735,7 +736,7 @@ static rcb_status pole_step(rcb_monitor *mon, const mon_cand *c, int gls, const 
 }
 
 /* Before the first evaluation of candidate c's joint step: the point its
- * one-pole model prepared at create (c->pole, pole_init) predicts from the
+ * one-pole model (c->pole, pole_fill) predicts from the
  * linear estimate x, taken (*pred = 1) when the model's first step from x
  * is one that would not end the iterations (joint_relin's rule, with the
  * linear step's length as the contraction's distance): the step is far
@@ -813,6 +814,39 @@ static rcb_status pole_correct(rcb_monitor *mon, const mon_cand *c, int gls, con
   return st;
 }
 
+/* Candidate c's one-pole model (pole_predict) into c->pole (n x (1 + p),
+ * held since create): the baseline's columns of its joint step (Q G) after
+ * the coefficient per point from one sweep with its parameters
+ * MON_POLE_STEP standard errors from their neutral values (the tracked
+ * ones at the baseline), and c->pole_dx. c->pole_ready 1, or -1 (no model)
+ * when the model refuses that value or the sweep fails. Done by create,
+ * or, by a create from an image, by the first update that needs it (the
+ * same values: the baseline's alone), so that such a create stays cheap. */
+static void pole_fill(rcb_monitor *mon, mon_cand *c) {
+  enum { MX = RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP };
+  double x0[MX] = {0}, sd[MX], step, *R = mon->rmx, *W = c->pole + mon->n;
+  size_t a, i, nt = mon->nt, p = nt + c->np;
+  rcb_status st = RCB_OK;
+  int ok = 0;
+  for (a = 0; !st && a < c->np; a++) {
+    x0[nt + a] = MON_POLE_STEP * c->se[a];
+    st = rcb_model_set_param(mon->model, c->pname[a], c->neutral[a] + x0[nt + a]);
+  }
+  if (!st && !(st = rcb_fit_residuals(mon->fit, R))) {
+    whiten_change(mon, R, mon->rbase);
+    pole_columns(mon, c, p, W); /* also G's columns into mon->Jx */
+    pole_coef(mon, W, R, x0, p, c->pole);
+    for (i = 0; i < mon->n; i++) /* the change's part beyond the linear one */
+      for (a = nt; a < p; a++) R[i] -= W[i + mon->n * a] * x0[a];
+    to_rank(mon, R, mon->z);
+    memset(c->pole_dx, 0, sizeof c->pole_dx);
+    st = gn_step(mon, 0, p, c->pole_dx, sd, &ok, &step);
+    for (a = 0; a < p; a++) c->pole_dx[a] /= MON_POLE_STEP * MON_POLE_STEP;
+  }
+  rcb_mon_model_restore(mon, c);
+  c->pole_ready = !st && ok ? 1 : -1;
+}
+
 /* With opts.relinearise and while the instant test fires: the joint step
  * of the tracked parameters and the best candidate, linearised at the
  * baseline, refined by up to as many Gauss-Newton iterations (until a
@@ -846,7 +880,8 @@ static rcb_status joint_relin(rcb_monitor *mon, int gls, rcb_monitor_result *res
   for (a = 0; a < nt; a++) x[a] = dth[a], sd[a] = se[a];
   for (a = 0; a < c->np; a++) x[nt + a] = c->size_now[a], sd[nt + a] = c->se_now[a];
   memcpy(sdp, sd, sizeof sdp); /* the baseline's columns: the linear estimate's */
-  if (c->pole && mon->rat && (st = pole_predict(mon, c, gls, x, sd, &pred))) return st;
+  if (c->pole && mon->rat && !c->pole_ready) pole_fill(mon, c);
+  if (c->pole_ready > 0 && (st = pole_predict(mon, c, gls, x, sd, &pred))) return st;
   for (it = 0; ok == 1 && !st && it < mon->relin; it++) {
     memcpy(xa, x, sizeof xa);
     st = joint_gn(mon, c, gls, fresh, x, sd, &ok, &step);
@@ -1006,44 +1041,6 @@ rcb_status rcb_monitor_tracked_info(const rcb_monitor *mon, size_t k, const char
   return RCB_OK;
 }
 
-/* Candidate c's one-pole model (pole_predict): the baseline's columns of
- * its joint step (Q G, n x p) and the coefficient per point from one sweep
- * with its parameters MON_POLE_STEP standard errors from their neutral
- * values (the tracked ones at the baseline), into c->pole (n x (1 + p):
- * the coefficients, then the columns); none (c->pole NULL) when the model
- * refuses that value or the sweep fails. */
-static rcb_status pole_init(rcb_monitor *mon, mon_cand *c) {
-  enum { MX = RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP };
-  double x0[MX] = {0}, *R = mon->rmx;
-  size_t a, nt = mon->nt, p = nt + c->np;
-  rcb_status st = RCB_OK;
-  for (a = 0; !st && a < c->np; a++) {
-    x0[nt + a] = MON_POLE_STEP * c->se[a];
-    st = rcb_model_set_param(mon->model, c->pname[a], c->neutral[a] + x0[nt + a]);
-  }
-  if (!st && !(st = rcb_fit_residuals(mon->fit, R))) {
-    whiten_change(mon, R, mon->rbase);
-    if (!(c->pole = rcb_mon_alloc(mon, mon->n * (1 + p), sizeof *c->pole))) st = RCB_ERR_NOMEM;
-    else {
-      double *W = c->pole + mon->n, sd[MX], step;
-      size_t i;
-      int ok;
-      pole_columns(mon, c, p, W); /* also G's columns into mon->Jx */
-      pole_coef(mon, W, R, x0, p, c->pole);
-      for (i = 0; i < mon->n; i++) /* the change's part beyond the linear one */
-        for (a = nt; a < p; a++) R[i] -= W[i + mon->n * a] * x0[a];
-      to_rank(mon, R, mon->z);
-      memset(c->pole_dx, 0, sizeof c->pole_dx);
-      if (!(st = gn_step(mon, 0, p, c->pole_dx, sd, &ok, &step)) && ok)
-        for (a = 0; a < p; a++) c->pole_dx[a] /= MON_POLE_STEP * MON_POLE_STEP;
-      else memset(c->pole_dx, 0, sizeof c->pole_dx), st = st == RCB_ERR_NOMEM ? st : RCB_OK;
-    }
-  }
-  rcb_mon_model_restore(mon, c);
-  return st == RCB_ERR_NOMEM ? rcb_mon_fail(mon, st, "out of memory (joint step's model)")
-                             : RCB_OK;
-}
-
 /* The candidates whose joint step is re-linearised by sweeps (settable,
  * with derivative matrices, not on the low-rank path: the operating speed,
  * a shaft's material damping) get that step's columns by one adjoint sweep
@@ -1051,8 +1048,9 @@ static rcb_status pole_init(rcb_monitor *mon, mon_cand *c) {
  * nothing) instead of 1 + nt + np forward-difference sweeps; the tracked
  * parameters' derivative matrices are the baseline's (exact where Z is
  * affine in them, as a coupling's; elsewhere the iteration still converges
- * to the same step, more slowly). */
-rcb_status rcb_mon_adj_init(rcb_monitor *mon) {
+ * to the same step, more slowly). Each also gets its one-pole model's
+ * block, filled here (pole_fill) unless lazy (a create from an image). */
+rcb_status rcb_mon_adj_init(rcb_monitor *mon, int lazy) {
   enum { MT = RCB_MONITOR_MAX_TRACKED, MP = RCB_MONITOR_MAXP };
   struct rcb_fit_dz dz[MT + MP];
   size_t j, a, pm, nt = mon->nt;
@@ -1080,7 +1078,9 @@ rcb_status rcb_mon_adj_init(rcb_monitor *mon) {
     for (a = 0; a < c->np; a++) dz[nt + a] = c->dz[a];
     if ((st = rcb_fit_adj_create(mon->fit, dz, nt + c->np, &c->adj)))
       return rcb_mon_fail(mon, st, "%s: joint step: %s", c->desc, rcb_fit_errmsg(mon->fit));
-    if ((st = pole_init(mon, c))) return st;
+    if (!(c->pole = rcb_mon_alloc(mon, mon->n * (1 + nt + c->np), sizeof *c->pole)))
+      return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (joint step's model)");
+    if (!lazy) pole_fill(mon, c);
   }
   return RCB_OK;
 }

@@ -53,9 +53,12 @@ typedef struct mon_cand {
   struct rcb_fit_adj *adj; /* its joint step's columns by one adjoint sweep
                         (tracked then its own derivative matrices; settable,
                         with dz, not on the low-rank path): rcb_mon_adj_init */
-  double *pole;      /* with adj, n x (1 + nt + np) or NULL: its one-pole model,
-                        the coefficient per point (Re, Im) then the baseline's
-                        columns of its joint step, Q G (monitor.c, pole_init) */
+  double *pole;      /* with adj, n x (1 + nt + np): its one-pole model, the
+                        coefficient per point (Re, Im) then the baseline's
+                        columns of its joint step, Q G (monitor.c, pole_fill) */
+  int pole_ready;    /* 1: pole and pole_dx filled; 0: not yet (a create from
+                        an image fills them at the first update that needs
+                        them); -1: no model (the sweep failed) */
   double pole_dx[RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP]; /* with pole: the
                         joint step (parameter units) the sweep's change beyond the
                         linear one at MON_POLE_STEP standard errors makes, over
@@ -290,7 +293,7 @@ void rcb_mon_model_restore(rcb_monitor *mon, const mon_cand *c);
  * (c->ep set), candidate c's parameters at neutral + s; free. */
 /* The prepared adjoint sweeps of the joint steps that are not on the
  * low-rank path (monitor.c; after rcb_mon_lowrank_init). */
-rcb_status rcb_mon_adj_init(rcb_monitor *mon);
+rcb_status rcb_mon_adj_init(rcb_monitor *mon, int lazy);
 rcb_status rcb_mon_lowrank_init(rcb_monitor *mon, const struct mon_image *im);
 rcb_status rcb_mon_lowrank_change(rcb_monitor *mon, const double *theta, const mon_cand *c,
                                   const double *s, rcb_complex *dm);
