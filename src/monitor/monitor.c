@@ -718,7 +718,7 @@ static rcb_status pole_step(rcb_monitor *mon, const mon_cand *c, int gls, const 
   enum { MX = RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP };
   size_t a, p = mon->nt + c->np;
   double keep[MX], ksd[MX], step = 0, far;
-  int own = c->pole_ready > 0; /* the baseline's columns held with the model */
+  int own = c->pole && c->pole_ready > 0; /* the baseline's columns held with the model */
   pole_model pm = {mon->rat, own ? c->pole + mon->n : mon->rat + mon->n, NULL, NULL};
   rcb_status st;
   int ok = 0;
@@ -747,10 +747,12 @@ static rcb_status pole_predict(rcb_monitor *mon, const mon_cand *c, int gls, dou
   enum { MX = RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP };
   size_t a, p = mon->nt + c->np;
   double xl[MX], sdl[MX], dist = 0, step = 0, s = 0, nl = 0;
-  pole_model pm = {c->pole, c->pole + mon->n, NULL, NULL};
+  pole_model pm = {NULL, NULL, NULL, NULL};
   rcb_status st;
   int ok = 0;
   *pred = 0;
+  if (!c->pole) return RCB_OK;
+  pm.gam = c->pole, pm.W = c->pole + mon->n;
   for (a = 0; a < p; a++) dist = fmax(dist, fabs(x[a]) / sd[a]);
   for (a = 0; a < c->np; a++) s = fmax(s, fabs(x[mon->nt + a]) / c->se[a]);
   /* the step the sweep's part beyond the linear change makes at s
@@ -784,10 +786,14 @@ static rcb_status pole_correct(rcb_monitor *mon, const mon_cand *c, int gls, con
   enum { MX = RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP };
   size_t a, q, i, j, n = mon->n, p = mon->nt + c->np;
   double x1[MX], sd1[MX], *gam = mon->rat, *D = gam + n, step;
-  const double *R = mon->rmx, *Jp = R + n, *W = c->pole + n;
-  pole_model pm = {gam, W, D, xp};
+  const double *R = mon->rmx, *Jp = R + n, *W;
+  pole_model pm = {NULL, NULL, NULL, NULL};
   rcb_status st;
   int ok = 0;
+  *corr = INFINITY;
+  if (!c->pole) return RCB_OK;
+  W = c->pole + n;
+  pm.gam = gam, pm.W = W, pm.D = D, pm.xr = xp;
   memcpy(x1, x, p * sizeof *x), memcpy(sd1, sd, p * sizeof *sd);
   pole_coef(mon, W, R, xp, p, gam);
   for (q = 0; q < mon->npt; q++) { /* D = Jp less the model's columns at xp */
