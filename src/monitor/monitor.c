@@ -23,6 +23,15 @@
  * errors, at the rate they moved between the last two evaluations of the
  * columns, would move by less than this share over its last step (-). */
 #define MON_SD_TOL 0.01
+/* The step, in standard errors (create's) of each of its parameters, of
+ * the sweep that prepares a candidate's one-pole model at create
+ * (pole_fill): as the low-rank path's check (LR_CAND_STEP), a change well
+ * above the sweep's rounding and well below a far-from-linear one. On
+ * shaft A's material damping (bench_monitor damping: a change of 2.2e4 of
+ * these, 1800 of the update's) the model's prediction from the linear
+ * estimate, 640 of the update's standard errors off, landed 16.5 off with
+ * the step at 30 to 300, 8 at 1e4. */
+#define MON_POLE_STEP 100.0
 /* Two-sided 95 % normal quantile. */
 #define MON_Z95 1.959963984540054
 
@@ -32,7 +41,10 @@ void rcb_monitor_destroy(rcb_monitor *mon) {
   if (!mon) return;
   a = mon->user;
   rcb_mon_lowrank_free(mon, mon->lr); /* before the candidates: it resets their ep */
-  for (j = 0; j < mon->ncand && mon->cand; j++) rcb_fit_adj_destroy(mon->fit, mon->cand[j].adj);
+  for (j = 0; j < mon->ncand && mon->cand; j++) {
+    rcb_fit_adj_destroy(mon->fit, mon->cand[j].adj);
+    rcb_free(&mon->alloc, mon->cand[j].pole);
+  }
   rcb_free(&mon->alloc, mon->rat);
   if (mon->tdz) rcb_fit_dz_free(&mon->alloc, mon->tdz, mon->nt);
   rcb_free(&mon->alloc, mon->tdz);
@@ -597,6 +609,97 @@ static rcb_status joint_gn(rcb_monitor *mon, const mon_cand *c, int gls, int fre
   return gn_step(mon, gls, p, x, sd, ok, step);
 }
 
+/* The baseline's whitened columns of the joint step (the tracked ones,
+ * then candidate c's) on the residuals, Q G, into W (n x p). */
+static void pole_columns(rcb_monitor *mon, const mon_cand *c, size_t p, double *W) {
+  size_t a, k = mon->k, nt = mon->nt;
+  for (a = 0; a < p; a++)
+    memcpy(mon->Jx + k * a, mon->G + k * (a < nt ? a : c->col + a - nt), k * sizeof *mon->Jx);
+  cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, (blasint)mon->n, (blasint)p, (blasint)k,
+              1.0, mon->Q, (blasint)k, mon->Jx, (blasint)k, 0.0, W, (blasint)mon->n);
+}
+
+/* Point q's value of whitened column a of W (n x p), unwhitened (complex). */
+static double complex unw(const rcb_monitor *mon, const double *W, size_t q, size_t a) {
+  const double *w = W + 2 * q + mon->n * a;
+  return CMPLX(w[0] / mon->winv[2 * q], w[1] / mon->winv[2 * q + 1]);
+}
+
+/* The one-pole model's coefficient per point, gam (Re, Im), from the
+ * whitened change R at x0 and the baseline columns W (n x p): g = 1 / r -
+ * 1 / v, r the change and v = W x0 the linear one (unwhitened, complex);
+ * 0 (linear) where a part is left out or the two differ by half or more. */
+static void pole_coef(const rcb_monitor *mon, const double *W, const double *R,
+                      const double *x0, size_t p, double *gam) {
+  size_t a, q;
+  for (q = 0; q < mon->npt; q++) {
+    double w1 = mon->winv[2 * q], w2 = mon->winv[2 * q + 1];
+    double complex v = 0, r, g = 0;
+    if (w1 > 0 && w2 > 0) {
+      for (a = 0; a < p; a++) v += unw(mon, W, q, a) * x0[a];
+      r = CMPLX(R[2 * q] / w1, R[2 * q + 1] / w2);
+      g = cabs(v) > 0 && cabs(r) > 0 && cabs(r / v - 1.0) < 0.5 ? 1.0 / r - 1.0 / v : 0.0;
+    }
+    gam[2 * q] = creal(g), gam[2 * q + 1] = cimag(g);
+  }
+}
+
+/* The one-pole model of each point's change (pole_solve): its
+ * coefficients, the baseline's columns W (n x p, pole_columns) and, when
+ * D is not NULL, D (n x p) added as D (x - xr). */
+typedef struct pole_model {
+  const double *gam, *W, *D, *xr;
+} pole_model;
+
+/* x minimising the misfit of the one-pole model of each point's change,
+ * v / (1 + g v) (v = W x, g from gam) plus D (x - xr), by up to maxit
+ * Gauss-Newton steps on it (no sweep), ending after one under tol standard
+ * errors (*step: the last); sd those of the model's columns. Uses
+ * mon->rmx. */
+static rcb_status pole_solve(rcb_monitor *mon, const mon_cand *c, int gls, const pole_model *pm,
+                             double tol, size_t maxit, double *x, double *sd, int *ok,
+                             double *step) {
+  size_t a, q, it, k = mon->k, p = mon->nt + c->np, n = mon->n, npt = mon->npt;
+  double *R = mon->rmx, *J = R + n, *Ym = R + n * (1 + p);
+  const double *W = pm->W, *gam = pm->gam, *D = pm->D, *xr = pm->xr;
+  rcb_status st = RCB_OK;
+  *ok = 0, *step = 0;
+  for (it = 0; it < maxit; it++) {
+    for (q = 0; q < npt; q++) {
+      double w1 = mon->winv[2 * q], w2 = mon->winv[2 * q + 1];
+      double complex v = 0, g, d, e;
+      if (!(w1 > 0 && w2 > 0)) { /* a part left out: linear */
+        for (a = 0, R[2 * q] = R[2 * q + 1] = 0; a < p; a++) {
+          R[2 * q] += W[2 * q + n * a] * x[a], R[2 * q + 1] += W[2 * q + 1 + n * a] * x[a];
+          J[2 * q + n * a] = W[2 * q + n * a], J[2 * q + 1 + n * a] = W[2 * q + 1 + n * a];
+        }
+      } else {
+        for (a = 0; a < p; a++) v += unw(mon, W, q, a) * x[a];
+        g = CMPLX(gam[2 * q], gam[2 * q + 1]);
+        d = 1.0 + g * v;
+        e = v / d;
+        R[2 * q] = creal(e) * w1, R[2 * q + 1] = cimag(e) * w2;
+        d = 1.0 / (d * d);
+        for (a = 0; a < p; a++) {
+          e = unw(mon, W, q, a) * d;
+          J[2 * q + n * a] = creal(e) * w1, J[2 * q + 1 + n * a] = cimag(e) * w2;
+        }
+      }
+      for (a = 0; D && a < p; a++) {
+        size_t i = 2 * q + n * a;
+        R[2 * q] += D[i] * (x[a] - xr[a]), R[2 * q + 1] += D[i + 1] * (x[a] - xr[a]);
+        J[i] += D[i], J[i + 1] += D[i + 1];
+      }
+    }
+    to_rank_blas(mon, R, 1 + p, Ym);
+    for (q = 0; q < k; q++) mon->z[q] = mon->y0[q] - Ym[q];
+    memcpy(mon->Jx, Ym + k, k * p * sizeof *mon->Jx);
+    st = gn_step(mon, gls, p, x, sd, ok, step);
+    if (st || !*ok || *step < tol) break;
+  }
+  return st;
+}
+
 /* After the first fresh evaluation at x0 of a joint step far from linear
  * (its step MON_CHORD_SD standard errors or more): the next point from a
  * one-pole model of each point's change instead of the columns at x0. Near
@@ -604,62 +707,25 @@ static rcb_status joint_gn(rcb_monitor *mon, const mon_cand *c, int gls, int fre
  * linear change (complex, per point, unwhitened) and g fixed by the
  * evaluation at x0 (exact for a single mode whose pole moves with x: a
  * shaft's material damping, a stiffness); x minimises the model's misfit
- * by Gauss-Newton steps on it (no sweep) until they are under
- * MON_RELIN_TOL standard errors. On entry mon->rmx holds the whitened
- * change at x0 (joint_gn) and x, sd the columns' step from x0; x and sd
- * are left so when the model fails (a dependent column) or lands farther
- * from that step than the step is long. On shaft A's material damping
- * 2300 standard errors above the baseline (bench_monitor damping), the
- * columns' step landed 60 standard errors short, the model's 3.9. */
+ * (pole_solve). On entry mon->rmx holds the whitened change at x0
+ * (joint_gn) and x, sd the columns' step from x0; x and sd are left so
+ * when the model fails (a dependent column) or lands farther from that
+ * step than the step is long. On shaft A's material damping 2300 standard
+ * errors above the baseline (bench_monitor damping), the columns' step
+ * landed 60 standard errors short, the model's 3.9. */
 static rcb_status pole_step(rcb_monitor *mon, const mon_cand *c, int gls, const double *x0,
                             double *x, double *sd) {
   enum { MX = RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP };
-  size_t a, q, it, k = mon->k, nt = mon->nt, p = nt + c->np, n = mon->n, npt = mon->npt;
-  double *R = mon->rmx, *W = R + n, *gam = mon->rat, *Ym = R + n * (1 + p);
+  size_t a, p = mon->nt + c->np;
   double keep[MX], ksd[MX], step = 0, far;
-  rcb_status st = RCB_OK;
+  int own = c->pole && c->pole_ready > 0; /* the baseline's columns held with the model */
+  pole_model pm = {mon->rat, own ? c->pole + mon->n : mon->rat + mon->n, NULL, NULL};
+  rcb_status st;
   int ok = 0;
   memcpy(keep, x, p * sizeof *x), memcpy(ksd, sd, p * sizeof *sd);
-  for (it = 0; it < 2 * mon->relin; it++) {
-    /* the baseline's whitened columns on the residuals, Q G (into R's
-     * columns 1 .. p, which the model's columns then overwrite) */
-    for (a = 0; a < p; a++)
-      memcpy(mon->Jx + k * a, mon->G + k * (a < nt ? a : c->col + a - nt), k * sizeof *mon->Jx);
-    cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, (blasint)n, (blasint)p, (blasint)k,
-                1.0, mon->Q, (blasint)k, mon->Jx, (blasint)k, 0.0, W, (blasint)n);
-    for (q = 0; q < npt; q++) {
-      double w1 = mon->winv[2 * q], w2 = mon->winv[2 * q + 1];
-      double complex v = 0, g, d, e;
-      if (!(w1 > 0 && w2 > 0)) { /* a part left out: linear */
-        gam[2 * q] = gam[2 * q + 1] = 0.0;
-        for (a = 0, R[2 * q] = R[2 * q + 1] = 0; a < p; a++)
-          R[2 * q] += W[2 * q + n * a] * x[a], R[2 * q + 1] += W[2 * q + 1 + n * a] * x[a];
-        continue;
-      }
-      for (a = 0; a < p; a++)
-        v += CMPLX(W[2 * q + n * a] / w1, W[2 * q + 1 + n * a] / w2) * (it ? x[a] : x0[a]);
-      if (!it) { /* g from the change at x0, R's column 0 on entry */
-        double complex r = CMPLX(R[2 * q] / w1, R[2 * q + 1] / w2);
-        g = cabs(v) > 0 && cabs(r) > 0 && cabs(r / v - 1.0) < 0.5 ? 1.0 / r - 1.0 / v : 0.0;
-        gam[2 * q] = creal(g), gam[2 * q + 1] = cimag(g);
-        for (a = 0, v = 0; a < p; a++)
-          v += CMPLX(W[2 * q + n * a] / w1, W[2 * q + 1 + n * a] / w2) * x[a];
-      }
-      g = CMPLX(gam[2 * q], gam[2 * q + 1]);
-      d = 1.0 + g * v;
-      e = v / d;
-      R[2 * q] = creal(e) * w1, R[2 * q + 1] = cimag(e) * w2;
-      d = 1.0 / (d * d);
-      for (a = 0; a < p; a++) {
-        e = CMPLX(W[2 * q + n * a] / w1, W[2 * q + 1 + n * a] / w2) * d;
-        W[2 * q + n * a] = creal(e) * w1, W[2 * q + 1 + n * a] = cimag(e) * w2;
-      }
-    }
-    to_rank_blas(mon, R, 1 + p, Ym);
-    for (q = 0; q < k; q++) mon->z[q] = mon->y0[q] - Ym[q];
-    memcpy(mon->Jx, Ym + k, k * p * sizeof *mon->Jx);
-    if ((st = gn_step(mon, gls, p, x, sd, &ok, &step)) || !ok || step < MON_RELIN_TOL) break;
-  }
+  if (!own) pole_columns(mon, c, p, mon->rat + mon->n);
+  pole_coef(mon, pm.W, mon->rmx, x0, p, mon->rat);
+  st = pole_solve(mon, c, gls, &pm, MON_RELIN_TOL, 2 * mon->relin, x, sd, &ok, &step);
   /* kept only when no farther from the columns' step than that step is long */
   for (a = 0, step = 0, far = 0; a < p; a++) {
     step = fmax(step, fabs(x[a] - keep[a]) / ksd[a]);
@@ -667,6 +733,124 @@ static rcb_status pole_step(rcb_monitor *mon, const mon_cand *c, int gls, const 
   }
   if (st || !ok || !(step <= far)) memcpy(x, keep, p * sizeof *x), memcpy(sd, ksd, p * sizeof *sd);
   return st;
+}
+
+/* Before the first evaluation of candidate c's joint step: the point its
+ * one-pole model (c->pole, pole_fill) predicts from the
+ * linear estimate x, taken (*pred = 1) when the model's first step from x
+ * is one that would not end the iterations (joint_relin's rule, with the
+ * linear step's length as the contraction's distance): the step is far
+ * from linear. Else x and sd are left as they are, and the iterations go
+ * on as without the model. */
+static rcb_status pole_predict(rcb_monitor *mon, const mon_cand *c, int gls, double *x,
+                               double *sd, int *pred) {
+  enum { MX = RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP };
+  size_t a, p = mon->nt + c->np;
+  double xl[MX], sdl[MX], dist = 0, step = 0, s = 0, nl = 0;
+  pole_model pm = {NULL, NULL, NULL, NULL};
+  rcb_status st;
+  int ok = 0;
+  *pred = 0;
+  if (!c->pole) return RCB_OK;
+  pm.gam = c->pole, pm.W = c->pole + mon->n;
+  for (a = 0; a < p; a++) dist = fmax(dist, fabs(x[a]) / sd[a]);
+  for (a = 0; a < c->np; a++) s = fmax(s, fabs(x[mon->nt + a]) / c->se[a]);
+  /* the step the sweep's part beyond the linear change makes at s
+   * standard errors, about c->pole_dx s^2 (its own grows more slowly with
+   * s): at under half of what would not end the iterations, no model */
+  for (a = 0; a < p; a++) nl = fmax(nl, fabs(c->pole_dx[a]) * s * s / sd[a]);
+  if (!(4.0 * nl * nl >= MON_RELIN_TOL * dist)) return RCB_OK;
+  memcpy(xl, x, p * sizeof *x), memcpy(sdl, sd, p * sizeof *sd);
+  st = pole_solve(mon, c, gls, &pm, MON_CHORD_SD, 1, x, sd, &ok, &step);
+  if (!st && ok && step * step >= MON_RELIN_TOL * dist) {
+    *pred = 1;
+    st = pole_solve(mon, c, gls, &pm, MON_CHORD_SD, 2 * mon->relin, x, sd, &ok, &step);
+  }
+  if (st || !ok || !*pred) {
+    memcpy(x, xl, p * sizeof *x), memcpy(sd, sdl, p * sizeof *sd);
+    *pred = 0;
+  }
+  return st;
+}
+
+/* After the fresh evaluation at the predicted point xp (pole_predict) and
+ * its Gauss-Newton step to x: that step corrected for the curvature the
+ * one-pole model through the evaluation shows. The model, v / (1 + g v)
+ * with g from the change at xp (pole_coef), plus D (x - xp), D the
+ * evaluated columns at xp less the model's own there, has the evaluation's
+ * value and columns at xp; x moves to its solution. *corr: the move, in
+ * standard errors. On entry mon->rmx holds the whitened change and columns
+ * at xp (joint_gn). x and sd are left so when the model fails. */
+static rcb_status pole_correct(rcb_monitor *mon, const mon_cand *c, int gls, const double *xp,
+                               double *x, double *sd, double *corr) {
+  enum { MX = RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP };
+  size_t a, q, i, j, n = mon->n, p = mon->nt + c->np;
+  double x1[MX], sd1[MX], *gam = mon->rat, *D = gam + n, step;
+  const double *R = mon->rmx, *Jp = R + n, *W;
+  pole_model pm = {NULL, NULL, NULL, NULL};
+  rcb_status st;
+  int ok = 0;
+  *corr = INFINITY;
+  if (!c->pole) return RCB_OK;
+  W = c->pole + n;
+  pm.gam = gam, pm.W = W, pm.D = D, pm.xr = xp;
+  memcpy(x1, x, p * sizeof *x), memcpy(sd1, sd, p * sizeof *sd);
+  pole_coef(mon, W, R, xp, p, gam);
+  for (q = 0; q < mon->npt; q++) { /* D = Jp less the model's columns at xp */
+    double w1 = mon->winv[2 * q], w2 = mon->winv[2 * q + 1];
+    double complex v = 0, d;
+    if (!(w1 > 0 && w2 > 0)) { /* a part left out: linear */
+      for (a = 0; a < p; a++)
+        for (i = 2 * q + n * a, j = 0; j < 2; j++) D[i + j] = Jp[i + j] - W[i + j];
+      continue;
+    }
+    for (a = 0; a < p; a++) v += unw(mon, W, q, a) * xp[a];
+    d = 1.0 + CMPLX(gam[2 * q], gam[2 * q + 1]) * v;
+    d = 1.0 / (d * d);
+    for (a = 0; a < p; a++) {
+      double complex e = unw(mon, W, q, a) * d;
+      i = 2 * q + n * a;
+      D[i] = Jp[i] - creal(e) * w1, D[i + 1] = Jp[i + 1] - cimag(e) * w2;
+    }
+  }
+  st = pole_solve(mon, c, gls, &pm, MON_RELIN_TOL * MON_RELIN_TOL, 2 * mon->relin, x, sd, &ok,
+                  &step);
+  for (a = 0, *corr = 0; a < p; a++) *corr = fmax(*corr, fabs(x[a] - x1[a]) / sd1[a]);
+  if (st || !ok) memcpy(x, x1, p * sizeof *x), memcpy(sd, sd1, p * sizeof *sd), *corr = INFINITY;
+  return st;
+}
+
+/* Candidate c's one-pole model (pole_predict) into c->pole (n x (1 + p),
+ * held since create): the baseline's columns of its joint step (Q G) after
+ * the coefficient per point from one sweep with its parameters
+ * MON_POLE_STEP standard errors from their neutral values (the tracked
+ * ones at the baseline), and c->pole_dx. c->pole_ready 1, or -1 (no model)
+ * when the model refuses that value or the sweep fails. Done by create,
+ * or, by a create from an image, by the first update that needs it (the
+ * same values: the baseline's alone), so that such a create stays cheap. */
+static void pole_fill(rcb_monitor *mon, mon_cand *c) {
+  enum { MX = RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP };
+  double x0[MX] = {0}, sd[MX], step, *R = mon->rmx, *W = c->pole + mon->n;
+  size_t a, i, nt = mon->nt, p = nt + c->np;
+  rcb_status st = RCB_OK;
+  int ok = 0;
+  for (a = 0; !st && a < c->np; a++) {
+    x0[nt + a] = MON_POLE_STEP * c->se[a];
+    st = rcb_model_set_param(mon->model, c->pname[a], c->neutral[a] + x0[nt + a]);
+  }
+  if (!st && !(st = rcb_fit_residuals(mon->fit, R))) {
+    whiten_change(mon, R, mon->rbase);
+    pole_columns(mon, c, p, W); /* also G's columns into mon->Jx */
+    pole_coef(mon, W, R, x0, p, c->pole);
+    for (i = 0; i < mon->n; i++) /* the change's part beyond the linear one */
+      for (a = nt; a < p; a++) R[i] -= W[i + mon->n * a] * x0[a];
+    to_rank(mon, R, mon->z);
+    memset(c->pole_dx, 0, sizeof c->pole_dx);
+    st = gn_step(mon, 0, p, c->pole_dx, sd, &ok, &step);
+    for (a = 0; a < p; a++) c->pole_dx[a] /= MON_POLE_STEP * MON_POLE_STEP;
+  }
+  rcb_mon_model_restore(mon, c);
+  c->pole_ready = !st && ok ? 1 : -1;
 }
 
 /* With opts.relinearise and while the instant test fires: the joint step
@@ -680,7 +864,13 @@ static rcb_status pole_step(rcb_monitor *mon, const mon_cand *c, int gls, const 
  * cross-coupling of the ROSS series came out 5 % short, and the tracked
  * parameters 17-68 standard errors off; chord iterations with the
  * baseline's columns converged at a rate of about 0.8. A step the model
- * refuses (a negative stiffness) keeps the linear estimate. */
+ * refuses (a negative stiffness) keeps the linear estimate. On the sweep
+ * path a step the candidate's one-pole model finds far from linear starts
+ * at that model's prediction (pole_predict), and the step from the first
+ * evaluation there is corrected by the model through it (pole_correct):
+ * on shaft A's material damping the correction was 0.04-0.05 standard
+ * errors and left the estimate 2e-4 of them from the converged one, so one
+ * sweep where there were two (bench_monitor damping 22.9 -> 13 ms). */
 static rcb_status joint_relin(rcb_monitor *mon, int gls, rcb_monitor_result *res, double *dth,
                               double *se) {
   mon_cand *c = res->alarm && res->ntop ? &mon->cand[res->top[0].index] : NULL;
@@ -690,12 +880,14 @@ static rcb_status joint_relin(rcb_monitor *mon, int gls, rcb_monitor_result *res
   double xa[MX], xp[MX] = {0}, sdp[MX], prev = 0, step, dist, drift;
   size_t a, it, nt = mon->nt, p;
   rcb_status st = RCB_OK;
-  int ok = 1, fresh = 1;
+  int ok = 1, fresh = 1, pred = 0;
   if (!c || !mon->relin || !c->settable) return RCB_OK;
   p = nt + c->np;
   for (a = 0; a < nt; a++) x[a] = dth[a], sd[a] = se[a];
   for (a = 0; a < c->np; a++) x[nt + a] = c->size_now[a], sd[nt + a] = c->se_now[a];
   memcpy(sdp, sd, sizeof sdp); /* the baseline's columns: the linear estimate's */
+  if (c->pole && mon->rat && !c->pole_ready) pole_fill(mon, c);
+  if (c->pole_ready > 0 && (st = pole_predict(mon, c, gls, x, sd, &pred))) return st;
   for (it = 0; ok == 1 && !st && it < mon->relin; it++) {
     memcpy(xa, x, sizeof xa);
     st = joint_gn(mon, c, gls, fresh, x, sd, &ok, &step);
@@ -711,7 +903,16 @@ static rcb_status joint_relin(rcb_monitor *mon, int gls, rcb_monitor_result *res
       }
       if (ok != 1 && step * step < MON_RELIN_TOL * dist && drift * step < MON_SD_TOL * dist) ok = 1;
       memcpy(xp, xa, sizeof xp), memcpy(sdp, sd, sizeof sdp);
-      if (ok == 4 && !it && c->adj && mon->rat) st = pole_step(mon, c, gls, xa, x, sd);
+      if (pred && !it && ok != 1) {
+        /* the same rule on the correction after the step: its successor at
+         * the contraction from the step to it under MON_RELIN_TOL, and the
+         * standard errors' move at the rate they moved over it */
+        double corr, sdn[MX], dr = 0;
+        memcpy(sdn, sd, sizeof sdn);
+        st = pole_correct(mon, c, gls, xa, x, sd, &corr);
+        for (a = 0; a < p; a++) dr = fmax(dr, fabs(sd[a] - sdn[a]) / sd[a]);
+        if (!st && corr * corr < MON_RELIN_TOL * step && dr * corr < MON_SD_TOL * step) ok = 1;
+      } else if (ok == 4 && !it && c->adj && mon->rat) st = pole_step(mon, c, gls, xa, x, sd);
     } else if (!st && ok == 2 && step * step < MON_RELIN_TOL * prev) {
       ok = 1; /* the same on kept columns, at the contraction of the last two steps */
     }
@@ -853,17 +1054,21 @@ rcb_status rcb_monitor_tracked_info(const rcb_monitor *mon, size_t k, const char
  * nothing) instead of 1 + nt + np forward-difference sweeps; the tracked
  * parameters' derivative matrices are the baseline's (exact where Z is
  * affine in them, as a coupling's; elsewhere the iteration still converges
- * to the same step, more slowly). */
-rcb_status rcb_mon_adj_init(rcb_monitor *mon) {
+ * to the same step, more slowly). Each also gets its one-pole model's
+ * block, filled here (pole_fill) unless lazy (a create from an image). */
+rcb_status rcb_mon_adj_init(rcb_monitor *mon, int lazy) {
   enum { MT = RCB_MONITOR_MAX_TRACKED, MP = RCB_MONITOR_MAXP };
   struct rcb_fit_dz dz[MT + MP];
-  size_t j, a, nt = mon->nt;
+  size_t j, a, pm, nt = mon->nt;
   rcb_status st;
   if (!mon->relin || !nt || !mon->fit) return RCB_OK;
   for (j = 0; j < mon->ncand; j++)
     if (mon->cand[j].dz && mon->cand[j].settable && !mon->cand[j].ep) break;
   if (j == mon->ncand) return RCB_OK;
-  if (!(mon->rat = rcb_mon_alloc(mon, mon->n, sizeof *mon->rat)))
+  for (j = 0, pm = 0; j < mon->ncand; j++)
+    if (mon->cand[j].dz && mon->cand[j].settable && !mon->cand[j].ep && mon->cand[j].np > pm)
+      pm = mon->cand[j].np;
+  if (!(mon->rat = rcb_mon_alloc(mon, mon->n * (1 + nt + pm), sizeof *mon->rat)))
     return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (joint step's model)");
   if (!(mon->tdz = rcb_mon_alloc(mon, nt, sizeof *mon->tdz)))
     return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (tracked derivative matrices)");
@@ -879,6 +1084,9 @@ rcb_status rcb_mon_adj_init(rcb_monitor *mon) {
     for (a = 0; a < c->np; a++) dz[nt + a] = c->dz[a];
     if ((st = rcb_fit_adj_create(mon->fit, dz, nt + c->np, &c->adj)))
       return rcb_mon_fail(mon, st, "%s: joint step: %s", c->desc, rcb_fit_errmsg(mon->fit));
+    if (!(c->pole = rcb_mon_alloc(mon, mon->n * (1 + nt + c->np), sizeof *c->pole)))
+      return rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (joint step's model)");
+    if (!lazy) pole_fill(mon, c);
   }
   return RCB_OK;
 }

@@ -595,7 +595,7 @@ static rcb_status commission(rcb_monitor *mon, const rcb_model *base, const rcb_
   }
   if (!st) st = rcb_mon_pass_init(mon);
   if (!st) st = rcb_mon_lowrank_init(mon, o->image ? &im : NULL);
-  if (!st) st = rcb_mon_adj_init(mon);
+  if (!st) st = rcb_mon_adj_init(mon, o->image != NULL);
   if (!st && mon->bcurv) st = rcb_mon_curvature(mon);
   if (!st) {
     size_t dof = mon->k > mon->nt ? mon->k - mon->nt : 0;

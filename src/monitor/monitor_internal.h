@@ -53,6 +53,16 @@ typedef struct mon_cand {
   struct rcb_fit_adj *adj; /* its joint step's columns by one adjoint sweep
                         (tracked then its own derivative matrices; settable,
                         with dz, not on the low-rank path): rcb_mon_adj_init */
+  double *pole;      /* with adj, n x (1 + nt + np): its one-pole model, the
+                        coefficient per point (Re, Im) then the baseline's
+                        columns of its joint step, Q G (monitor.c, pole_fill) */
+  int pole_ready;    /* 1: pole and pole_dx filled; 0: not yet (a create from
+                        an image fills them at the first update that needs
+                        them); -1: no model (the sweep failed) */
+  double pole_dx[RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP]; /* with pole: the
+                        joint step (parameter units) the sweep's change beyond the
+                        linear one at MON_POLE_STEP standard errors makes, over
+                        MON_POLE_STEP^2 */
   size_t *ep;        /* per entry of dz: row's and column's place in the
                         low-rank P; NULL: not on the low-rank path */
   int settable;      /* its parameters are the baseline model's own, at their
@@ -177,8 +187,11 @@ struct rcb_monitor {
   struct rcb_fit_dz *cdz; /* the batched candidates' derivative matrices, ncdz
                           (kept with opts.relinearise) */
   struct rcb_fit_dz *tdz; /* nt: the tracked parameters' (with a candidate's adj) */
-  double *rat;         /* with tdz: n, the joint step's one-pole model's
-                          coefficient per point (monitor.c, pole_step) */
+  double *rat;         /* with tdz: n x (1 + nt + the most np of a candidate
+                          with adj), the joint step's one-pole model's
+                          coefficient per point, then its columns' correction
+                          D or, for a candidate without c->pole, the baseline's
+                          columns (monitor.c, pole_step, pole_correct) */
   size_t ncdz;
 
   /* noise of the reweighted path */
@@ -280,7 +293,7 @@ void rcb_mon_model_restore(rcb_monitor *mon, const mon_cand *c);
  * (c->ep set), candidate c's parameters at neutral + s; free. */
 /* The prepared adjoint sweeps of the joint steps that are not on the
  * low-rank path (monitor.c; after rcb_mon_lowrank_init). */
-rcb_status rcb_mon_adj_init(rcb_monitor *mon);
+rcb_status rcb_mon_adj_init(rcb_monitor *mon, int lazy);
 rcb_status rcb_mon_lowrank_init(rcb_monitor *mon, const struct mon_image *im);
 rcb_status rcb_mon_lowrank_change(rcb_monitor *mon, const double *theta, const mon_cand *c,
                                   const double *s, rcb_complex *dm);
