@@ -682,17 +682,22 @@ static void test_kt_change(void **state) {
   free(fs2);
 }
 
-/* rcb_monitor_named is the diagnosis' one rule on the first two candidates'
- * BIC changes -score + dof ln n (n = 2 x channels x points): checked on
- * update r as it came, and on r with the second moved within and beyond 10
- * of the first, and with one candidate only. */
+/* rcb_monitor_named is the diagnosis' one rule on the BIC changes -score +
+ * dof ln n (n = 2 x channels x points) of the first candidate and its
+ * closest rival, the second: checked on update r as it came (the second's
+ * BIC change the lowest of the others ranked, a plausible one when the
+ * first is), and on r with the second moved within and beyond 10 of the
+ * first, on either side (a second better supported by more than 10 is not
+ * the first told apart), and with one candidate only. */
 static void named_rule(const rcb_monitor *mon, const rcb_monitor_result *r) {
   rcb_monitor_result t = *r;
-  double ln_n = log(2.0 * (double)NPT);
+  double ln_n = log(2.0 * (double)NPT), b[RCB_MONITOR_TOP];
   int want = -1;
-  if (r->ntop >= 2)
-    want = fabs((-r->top[0].score + (double)r->top[0].dof * ln_n) -
-                (-r->top[1].score + (double)r->top[1].dof * ln_n)) > 10.0;
+  size_t k;
+  for (k = 0; k < r->ntop; k++) b[k] = -r->top[k].score + (double)r->top[k].dof * ln_n;
+  for (k = 2; k < r->ntop; k++)
+    if (r->top[0].implausible || !r->top[k].implausible) assert_true(b[k] >= b[1]);
+  if (r->ntop >= 2) want = b[1] - b[0] > 10.0;
   assert_int_equal(rcb_monitor_named(mon, r), want);
   if (r->ntop < 2) return;
   t.top[1].dof = t.top[0].dof;
@@ -700,6 +705,8 @@ static void named_rule(const rcb_monitor *mon, const rcb_monitor_result *r) {
   assert_int_equal(rcb_monitor_named(mon, &t), 0);
   t.top[1].score = t.top[0].score - 10.5;
   assert_int_equal(rcb_monitor_named(mon, &t), 1);
+  t.top[1].score = t.top[0].score + 10.5; /* the second better supported */
+  assert_int_equal(rcb_monitor_named(mon, &t), 0);
   t.ntop = 1;
   assert_int_equal(rcb_monitor_named(mon, &t), -1);
 }

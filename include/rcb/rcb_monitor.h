@@ -397,7 +397,11 @@ typedef struct rcb_monitor_result {
   int alarm;          /**< 1 when T > threshold */
   int cusum_alarm;    /**< 1 when some tracked parameter's CUSUM is past h */
   size_t ntop;        /**< ranked candidates written */
-  rcb_monitor_candidate top[RCB_MONITOR_TOP]; /**< best first (smallest p) */
+  rcb_monitor_candidate top[RCB_MONITOR_TOP]; /**< best first (smallest p);
+                            second the first's closest rival, the other
+                            candidate with the lowest BIC change -score + dof
+                            ln n (a plausible one when the first is); then by
+                            p */
   size_t ntracked;    /**< tracked parameters */
   rcb_monitor_tracked tracked[RCB_MONITOR_MAX_TRACKED];
   /* the drift test (the method above): the candidate whose drift is best
@@ -524,12 +528,14 @@ typedef struct rcb_monitor_candidate_info {
 } rcb_monitor_candidate_info;
 /**
  * @brief Whether an alarmed update's first candidate is told apart from its
- * second by the data, by the diagnosis' one rule (rcb_evidence_separable):
- * each candidate's BIC change is -score + dof ln n (n: the update's real
- * residuals, 2 x channels x points), and they are separable when those
- * differ by more than 10. 1: the first may be named alone; 0: "A or B: not
- * separable on these channels" (the data cannot choose); -1: fewer than two
- * candidates ranked (nothing to tell apart) or a bad argument.
+ * second, its closest rival (rcb_monitor_result.top), by the diagnosis' one
+ * rule (rcb_evidence_separable): each candidate's BIC change is -score + dof
+ * ln n (n: the update's real residuals, 2 x channels x points), and the
+ * first is told apart when its own is lower than the second's by more than
+ * 10, hence lower than every other candidate's. 1: the first may be named
+ * alone; 0: "A or B: not separable on these channels" (the data cannot
+ * choose, or they prefer B by the BIC); -1: fewer than two candidates ranked
+ * (nothing to tell apart) or a bad argument.
  */
 RCB_API int rcb_monitor_named(const rcb_monitor *mon, const rcb_monitor_result *r);
 /** @brief The measurement that would tell a tracked parameter from a

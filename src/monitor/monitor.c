@@ -449,6 +449,33 @@ static int implausible(const mon_cand *c) {
   return 0;
 }
 
+/* The second place goes to the first's closest rival: of the other nsc
+ * scored candidates (mon->order, the first ranked), the one with the
+ * lowest BIC change -score + dof ln n (rcb_mon_bic), the implausible ones
+ * only when the first is; the rest keep their order. rcb_monitor_named
+ * tells the first apart from it, hence from every candidate. Ranked by p
+ * alone, the second was often not the closest: a 2- or 3-dof runner-up
+ * pays 1-2 ln n more, so the first was "told apart" from it while a 1-dof
+ * candidate behind it, the truth, was within 10 (ROSS drift of B4 kyy,
+ * eq. 19: sensor C.A.x's gain 7.89 told apart from B4's damping, 2 dof,
+ * 6.47, with B4 kyy third at 3.82), and a 3-dof first was "told apart"
+ * from 1-dof runners-up whose BIC was lower than its own. */
+static void rival_second(rcb_monitor *mon, size_t nsc) {
+  size_t t, best = 0;
+  double bb = 0;
+  int any = mon->cand[mon->order[0]].implausible;
+  for (t = 1; t < nsc; t++) {
+    const mon_cand *c = &mon->cand[mon->order[t]];
+    double b = rcb_mon_bic(mon, c->score_now, c->dof);
+    if ((any || !c->implausible) && (!best || b < bb)) best = t, bb = b;
+  }
+  if (best > 1) {
+    size_t keep = mon->order[best];
+    memmove(mon->order + 2, mon->order + 1, (best - 1) * sizeof *mon->order);
+    mon->order[1] = keep;
+  }
+}
+
 /* Scores and sizes (on the reweighted path) were left in the candidates
  * by the caller when gls != 0. */
 static void candidates(rcb_monitor *mon, int gls, rcb_monitor_result *res) {
@@ -478,6 +505,7 @@ static void candidates(rcb_monitor *mon, int gls, rcb_monitor_result *res) {
       mon->order[t] = mon->order[best], mon->order[best] = s;
     }
   }
+  if (res->ntop >= 2) rival_second(mon, nsc);
   for (t = 0; t < res->ntop; t++) {
     const mon_cand *c = &mon->cand[mon->order[t]];
     rcb_monitor_candidate *o = &res->top[t];

@@ -255,8 +255,14 @@ double rcb_mon_bic(const rcb_monitor *mon, double score, size_t dof) {
   return -score + (double)dof * log((double)mon->n);
 }
 
+/* The first told apart from its closest rival, the second (monitor.c,
+ * rival_second): separable, and the first the better supported. A second
+ * better supported by more than 10 is no licence to name the first alone
+ * (as the absolute difference was): "A or B: not separable". */
 int rcb_monitor_named(const rcb_monitor *mon, const rcb_monitor_result *r) {
+  double b0, b1;
   if (!mon || !r || r->ntop < 2) return -1;
-  return rcb_evidence_separable(rcb_mon_bic(mon, r->top[0].score, r->top[0].dof),
-                                rcb_mon_bic(mon, r->top[1].score, r->top[1].dof));
+  b0 = rcb_mon_bic(mon, r->top[0].score, r->top[0].dof);
+  b1 = rcb_mon_bic(mon, r->top[1].score, r->top[1].dof);
+  return rcb_evidence_separable(b0, b1) && b0 < b1;
 }

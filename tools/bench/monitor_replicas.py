@@ -293,6 +293,8 @@ def replica(rcb, model, H, case, rep, ci, scale="measured", sensors=False):
                 "threshold": r["threshold"],
                 "top": [{k: c[k] for k in ("effect", "place", "params", "size", "ci_lo",
                                            "ci_hi")} for c in r["top"][:2]],
+                # every ranked candidate's score (the one rule's BIC inputs)
+                "scores": [[c["params"], c["score"], c["dof"]] for c in r["top"]],
                 "cusum": [t["cusum_alarm"] for t in r["tracked"]],
                 "named": [t["named"] if t["cusum_alarm"] else None for t in r["tracked"]],
                 "cover": [bool(t["ci_lo"] <= v <= t["ci_hi"]) for t, v in zip(r["tracked"], tv)],
