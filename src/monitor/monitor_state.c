@@ -334,7 +334,8 @@ static rcb_status check(rcb_monitor *mon, const unsigned char *b, size_t size) {
     return rcb_mon_fail(mon, RCB_ERR_OTHER_MODEL, "state: saved from another baseline model "
                         "(tracked parameters, their baseline values, the candidate effects "
                         "or the model's response differ); create the monitor from the model "
-                        "the state was saved with");
+                        "the state was saved with, or, when a newer library changed the "
+                        "candidates, replay the series to rebuild the state");
   if (rcb_mon_get_u64(b + 40) != setup_hash(mon))
     return rcb_mon_fail(mon, RCB_ERR_OTHER_SETUP, "state: saved with another set-up "
                         "(channels, points, speed or commissioning values differ)");
