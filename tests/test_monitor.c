@@ -36,6 +36,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <cmocka.h>
+#include <lapacke.h>
 
 #include "monitor/monitor_internal.h" /* rcb_mon_chi2_logsf */
 #include "rcb/rcb.h"
@@ -684,11 +685,13 @@ static void test_kt_change(void **state) {
 
 /* rcb_monitor_named is the diagnosis' one rule on the BIC changes -score +
  * dof ln n (n = 2 x channels x points) of the first candidate and its
- * closest rival, the second: checked on update r as it came (the second's
- * BIC change the lowest of the others ranked, a plausible one when the
- * first is), and on r with the second moved within and beyond 10 of the
- * first, on either side (a second better supported by more than 10 is not
- * the first told apart), and with one candidate only. */
+ * closest rival, the second, and the test half (apart_p below
+ * RCB_MONITOR_APART_ALPHA, computed only when the BIC half holds):
+ * checked on update r as it came (the second's BIC change the lowest of
+ * the others ranked, a plausible one when the first is), and on r with the
+ * second moved within and beyond 10 of the first, on either side (a second
+ * better supported by more than 10 is not the first told apart), a rival
+ * not rejected, and with one candidate only. */
 static void named_rule(const rcb_monitor *mon, const rcb_monitor_result *r) {
   rcb_monitor_result t = *r;
   double ln_n = log(2.0 * (double)NPT), b[RCB_MONITOR_TOP];
@@ -697,14 +700,22 @@ static void named_rule(const rcb_monitor *mon, const rcb_monitor_result *r) {
   for (k = 0; k < r->ntop; k++) b[k] = -r->top[k].score + (double)r->top[k].dof * ln_n;
   for (k = 2; k < r->ntop; k++)
     if (r->top[0].implausible || !r->top[k].implausible) assert_true(b[k] >= b[1]);
-  if (r->ntop >= 2) want = b[1] - b[0] > 10.0;
+  if (r->ntop >= 2) {
+    want = b[1] - b[0] > 10.0;
+    assert_int_equal(isnan(r->apart_p), !want); /* the test half only after the BIC half */
+    want = want && r->apart_p < RCB_MONITOR_APART_ALPHA;
+  }
   assert_int_equal(rcb_monitor_named(mon, r), want);
   if (r->ntop < 2) return;
   t.top[1].dof = t.top[0].dof;
+  t.apart_p = 0.5 * RCB_MONITOR_APART_ALPHA; /* every rival rejected */
   t.top[1].score = t.top[0].score - 9.5; /* within 10: the data cannot choose */
   assert_int_equal(rcb_monitor_named(mon, &t), 0);
   t.top[1].score = t.top[0].score - 10.5;
   assert_int_equal(rcb_monitor_named(mon, &t), 1);
+  t.apart_p = RCB_MONITOR_APART_ALPHA; /* a rival the data do not reject */
+  assert_int_equal(rcb_monitor_named(mon, &t), 0);
+  t.apart_p = 0.5 * RCB_MONITOR_APART_ALPHA;
   t.top[1].score = t.top[0].score + 10.5; /* the second better supported */
   assert_int_equal(rcb_monitor_named(mon, &t), 0);
   t.ntop = 1;
@@ -1656,6 +1667,142 @@ static void test_bad_input(void **state) {
   free(sd);
 }
 
+/* ---- the naming rule's test half (monitor_rank.c, rcb_mon_adds) ---- */
+
+/* The change of y0 (rank space, plain path) that [G_t G_c G_a] explains
+ * beyond [G_t G_c], by two least-squares solves (LAPACK dgels), not the
+ * monitor's QR. */
+static double excess_dgels(const rcb_monitor *mon, const double *y0, size_t c, size_t a) {
+  size_t k = mon->k, nt = mon->nt, q = nt + mon->cand[c].np, m = q + mon->cand[a].np, i, pass;
+  double *X = malloc(k * m * sizeof *X), *b = malloc(k * sizeof *b), rss[2];
+  memcpy(X, mon->G, k * nt * sizeof *X);
+  memcpy(X + k * nt, mon->G + k * mon->cand[c].col, k * mon->cand[c].np * sizeof *X);
+  memcpy(X + k * q, mon->G + k * mon->cand[a].col, k * mon->cand[a].np * sizeof *X);
+  for (pass = 0; pass < 2; pass++) {
+    size_t n = pass ? m : q;
+    double *Xc = malloc(k * n * sizeof *Xc);
+    memcpy(Xc, X, k * n * sizeof *Xc);
+    memcpy(b, y0, k * sizeof *b);
+    assert_int_equal(LAPACKE_dgels(LAPACK_COL_MAJOR, 'N', (lapack_int)k, (lapack_int)n, 1, Xc,
+                                   (lapack_int)k, b, (lapack_int)k), 0);
+    rss[pass] = 0;
+    for (i = n; i < k; i++) rss[pass] += b[i] * b[i];
+    free(Xc);
+  }
+  free(X), free(b);
+  return rss[0] - rss[1];
+}
+
+/* With the first candidate a of an alarmed update (a cross-coupling at B2,
+ * the plain path): 1. for every other scored candidate c, rcb_mon_adds'
+ * p is the chi-square(np_a) tail of the excess two dgels solves give; 2.
+ * the excess does not move when any multiple of c's and the tracked
+ * columns is added to the change (what makes the rate the same for every
+ * size of the truth); 3. the result's apart_p is the largest p over the
+ * rivals (within the screen's bound), and a rival at or above the level
+ * is the second; 4. the rate: for the first's four closest rivals as the
+ * truth (y0 = G_c v + e, e standard normal in the rank space, the rival
+ * at a size whose score is ~200), the count of draws that reject it at
+ * RCB_MONITOR_APART_ALPHA is within the binomial 99.9 % interval. */
+static void test_apart_rule(void **state) {
+  fixture *f = *state;
+  rcb_monitor_param tp;
+  rcb_monitor_opts o = opts_kt(&tp, f->kt);
+  rcb_monitor *mon = NULL;
+  rcb_monitor_result r;
+  rcb_model *m2 = edited(f->truth, "bearing.B2.kcross", 1e5);
+  rcb_meas *ms = frf_of(m2);
+  rcb_complex *fs2 = malloc(NPT * sizeof *fs2);
+  uint64_t seed = 23;
+  size_t j, a, k, i, t, near[4], nnear = 0, nrival = 0;
+  double *y0, worst = -1, q;
+  const size_t DRAWS = fast_mode() ? 200 : 2000;
+  o.setup_averages = HUGE_VAL;
+  values_of(ms, fs2);
+  assert_int_equal(rcb_monitor_create(&mon, f->base, f->setup, &o, NULL), RCB_OK);
+  eq19(fs2, f->v, &seed);
+  assert_int_equal(rcb_monitor_update(mon, f->v, NULL, &r), RCB_OK);
+  assert_int_equal(r.alarm, 1);
+  k = mon->k, a = r.top[0].index;
+  y0 = malloc(k * sizeof *y0);
+  memcpy(y0, mon->y0, k * sizeof *y0);
+  q = rcb_chi2_quantile(1 - RCB_MONITOR_APART_ALPHA, (double)mon->cand[a].np);
+  for (j = 0; j < mon->ncand; j++) {
+    const mon_cand *c = &mon->cand[j];
+    double p, e, gap = mon->cand[a].score_now - c->score_now;
+    if (!c->dof || j == a) continue;
+    assert_int_equal(rcb_mon_adds(mon, 0, &mon->cand[a], c, &p), RCB_OK);
+    e = excess_dgels(mon, y0, j, a);
+    assert_true(e >= gap - 1e-9 * (1 + fabs(gap))); /* at least the score gap */
+    assert_true(rcb_test_close(p, rcb_chi2_sf(e, (double)mon->cand[a].np), 1e-6, 1e-300));
+    if (!r.top[0].implausible && c->implausible) continue;
+    nrival++;
+    worst = fmax(worst, gap > q ? rcb_chi2_sf(gap, (double)mon->cand[a].np) : p);
+    /* the four closest rivals by score */
+    if (nnear < 4) near[nnear++] = j;
+    else {
+      size_t lo = 0;
+      for (t = 1; t < 4; t++)
+        if (mon->cand[near[t]].score_now < mon->cand[near[lo]].score_now) lo = t;
+      if (c->score_now > mon->cand[near[lo]].score_now) near[lo] = j;
+    }
+  }
+  assert_true(nrival >= 4);
+  if (!isnan(r.apart_p)) {
+    assert_true(rcb_test_close(r.apart_p, worst, 1e-12, 1e-300));
+    if (r.apart_p >= RCB_MONITOR_APART_ALPHA) {
+      double p1;
+      assert_int_equal(rcb_mon_adds(mon, 0, &mon->cand[a], &mon->cand[r.top[1].index], &p1),
+                       RCB_OK);
+      assert_true(rcb_test_close(p1, r.apart_p, 1e-12, 1e-300));
+    }
+  }
+  /* 2. size invariance: 1e3 x c's first column and 7 x kt's added */
+  {
+    size_t c = near[0];
+    double e0 = excess_dgels(mon, y0, c, a), p0, p1, e1;
+    assert_int_equal(rcb_mon_adds(mon, 0, &mon->cand[a], &mon->cand[c], &p0), RCB_OK);
+    for (i = 0; i < k; i++)
+      mon->y0[i] = y0[i] + 1e3 * mon->G[i + k * mon->cand[c].col] + 7.0 * mon->G[i];
+    e1 = excess_dgels(mon, mon->y0, c, a);
+    assert_int_equal(rcb_mon_adds(mon, 0, &mon->cand[a], &mon->cand[c], &p1), RCB_OK);
+    print_message("apart: excess over %s %.6g, moved %.3g (p %.4g, %.4g)\n", mon->cand[c].desc,
+                  e0, e1 - e0, p0, p1);
+    assert_true(fabs(e1 - e0) <= 1e-7 * (1 + e0));
+    assert_true(rcb_test_close(p1, p0, 1e-6, 1e-300));
+  }
+  /* 4. the rate with each near rival the truth */
+  for (t = 0; t < nnear; t++) {
+    const mon_cand *c = &mon->cand[near[t]];
+    size_t d, rej = 0, lo, hi, np = c->np;
+    double nrm = 0, v;
+    for (i = 0; i < k; i++) nrm += mon->G[i + k * c->col] * mon->G[i + k * c->col];
+    v = sqrt(200.0 / nrm); /* a size with a score of ~200 */
+    for (d = 0; d < DRAWS; d++) {
+      double p;
+      for (i = 0; i < k; i++) {
+        double m = 0;
+        size_t b;
+        for (b = 0; b < np; b++) m += v * mon->G[i + k * (c->col + b)];
+        mon->y0[i] = m + rng_normal(&seed);
+      }
+      assert_int_equal(rcb_mon_adds(mon, 0, &mon->cand[a], c, &p), RCB_OK);
+      rej += p < RCB_MONITOR_APART_ALPHA;
+    }
+    /* binomial(DRAWS, 0.01): 2000 -> 99.9 % interval [8, 35]; 200 -> [0, 7] */
+    lo = DRAWS >= 2000 ? 8 : 0, hi = DRAWS >= 2000 ? 35 : 7;
+    print_message("apart: truth %s (%zu dof), first %s: rejected %zu of %zu at level %.2g "
+                  "(99.9 %% interval [%zu, %zu])\n", c->desc, np, mon->cand[a].desc, rej,
+                  DRAWS, RCB_MONITOR_APART_ALPHA, lo, hi);
+    assert_true(rej >= lo && rej <= hi);
+  }
+  free(y0);
+  rcb_monitor_destroy(mon);
+  rcb_meas_destroy(ms);
+  rcb_model_destroy(m2);
+  free(fs2);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_chi2),
@@ -1674,6 +1821,7 @@ int main(void) {
       cmocka_unit_test(test_kt_change),
       cmocka_unit_test(test_cross_coupling),
       cmocka_unit_test(test_cross_coupling_relin),
+      cmocka_unit_test(test_apart_rule),
       cmocka_unit_test(test_no_alloc_in_update),
       cmocka_unit_test(test_alloc_walk),
       cmocka_unit_test(test_bad_input),

@@ -197,6 +197,11 @@ extern "C" {
 #define RCB_MONITOR_TOP 8
 /** @brief Most parameters of one candidate effect (as the diagnosis). */
 #define RCB_MONITOR_MAXP 3
+/** @brief Level of the test that tells an alarm's first candidate apart
+ * from each rival (rcb_monitor_named, rcb_monitor_result.apart_p): when the
+ * truth is a rival, of any size, the first is told apart from it at this
+ * rate at most, linearly and with the noise as declared (-). */
+#define RCB_MONITOR_APART_ALPHA 0.01
 
 /** @brief A parameter to track (rcb_model_get_param names, e.g. "C.kt"). */
 typedef struct rcb_monitor_param {
@@ -419,6 +424,20 @@ typedef struct rcb_monitor_result {
                            7, 10, 14, 19, 25, 32) */
   double drift_rate[RCB_MONITOR_MAXP]; /**< its parameters' change per update,
                            parameter units per update */
+  double apart_p;     /**< when the BIC half of rcb_monitor_named's rule holds
+                           (else NAN): the largest, over the first's rivals
+                           (the other scored candidates; the plausible ones
+                           when the first is), of the upper-tail probability
+                           of the test that the first adds to the rival's fit
+                           (the change the first's columns explain beyond the
+                           tracked and the rival's, chi-square(first's dof)
+                           when the rival is the truth, whatever its size).
+                           A rival the first outscores by more than that
+                           chi-square's 1 - RCB_MONITOR_APART_ALPHA quantile
+                           counts with the bound of its p the score gap gives
+                           (below the level, not computed). When it is at or
+                           above RCB_MONITOR_APART_ALPHA that rival is the
+                           second (top[1]) */
 } rcb_monitor_result;
 
 typedef struct rcb_monitor rcb_monitor;
@@ -528,14 +547,20 @@ typedef struct rcb_monitor_candidate_info {
 } rcb_monitor_candidate_info;
 /**
  * @brief Whether an alarmed update's first candidate is told apart from its
- * second, its closest rival (rcb_monitor_result.top), by the diagnosis' one
- * rule (rcb_evidence_separable): each candidate's BIC change is -score + dof
- * ln n (n: the update's real residuals, 2 x channels x points), and the
- * first is told apart when its own is lower than the second's by more than
- * 10, hence lower than every other candidate's. 1: the first may be named
- * alone; 0: "A or B: not separable on these channels" (the data cannot
- * choose, or they prefer B by the BIC); -1: fewer than two candidates ranked
- * (nothing to tell apart) or a bad argument.
+ * second, its closest rival (rcb_monitor_result.top), and from every other.
+ * Two halves. The diagnosis' rule (rcb_evidence_separable): each
+ * candidate's BIC change is -score + dof ln n (n: the update's real
+ * residuals, 2 x channels x points), and the first's must be lower than the
+ * second's by more than 10, hence lower than every other candidate's. And
+ * a test with a stated rate: every rival's hypothesis rejected at level
+ * RCB_MONITOR_APART_ALPHA by the change the first explains beyond it
+ * (rcb_monitor_result.apart_p): whatever the rival and its size, when it is
+ * the truth the first is told apart from it at that rate at most (the BIC
+ * half alone has no such bound: a 1-dof first beats a 3-dof truth by 2 ln
+ * n). 1: the first may be named alone; 0: "A or B: not separable on these
+ * channels" (the data cannot choose, prefer B by the BIC, or cannot reject
+ * B: then B is the second); -1: fewer than two candidates ranked (nothing
+ * to tell apart) or a bad argument.
  */
 RCB_API int rcb_monitor_named(const rcb_monitor *mon, const rcb_monitor_result *r);
 /** @brief The measurement that would tell a tracked parameter from a

@@ -449,6 +449,15 @@ static int implausible(const mon_cand *c) {
   return 0;
 }
 
+/* The second place to the candidate at place t (mon->order), the others
+ * between keeping their order. */
+static void to_second(rcb_monitor *mon, size_t t) {
+  size_t keep = mon->order[t];
+  if (t < 2) return;
+  memmove(mon->order + 2, mon->order + 1, (t - 1) * sizeof *mon->order);
+  mon->order[1] = keep;
+}
+
 /* The second place goes to the first's closest rival: of the other nsc
  * scored candidates (mon->order, the first ranked), the one with the
  * lowest BIC change -score + dof ln n (rcb_mon_bic), the implausible ones
@@ -469,16 +478,67 @@ static void rival_second(rcb_monitor *mon, size_t nsc) {
     double b = rcb_mon_bic(mon, c->score_now, c->dof);
     if ((any || !c->implausible) && (!best || b < bb)) best = t, bb = b;
   }
-  if (best > 1) {
-    size_t keep = mon->order[best];
-    memmove(mon->order + 2, mon->order + 1, (best - 1) * sizeof *mon->order);
-    mon->order[1] = keep;
+  to_second(mon, best);
+}
+
+/* res->top from mon->order. */
+static void fill_top(const rcb_monitor *mon, rcb_monitor_result *res) {
+  size_t t, a;
+  for (t = 0; t < res->ntop; t++) {
+    const mon_cand *c = &mon->cand[mon->order[t]];
+    rcb_monitor_candidate *o = &res->top[t];
+    o->index = mon->order[t];
+    o->effect = c->effect;
+    o->np = c->np;
+    o->score = c->score_now;
+    o->dof = c->dof;
+    o->p_value = exp(mon->pscore[mon->order[t]]);
+    o->implausible = c->implausible;
+    for (a = 0; a < c->np; a++) {
+      double se = c->se_now[a];
+      o->size[a] = c->size_now[a];
+      o->ci_lo[a] = o->size[a] - MON_Z95 * se;
+      o->ci_hi[a] = o->size[a] + MON_Z95 * se;
+    }
   }
+}
+
+/* The test half of the one naming rule (rcb_monitor_named): res->apart_p,
+ * the largest p over the first's rivals (rival_second's set) of the test
+ * that the first adds to the rival's fit (rcb_mon_adds), only while the
+ * BIC half holds. A rival the first outscores by more than the test's
+ * quantile is rejected whatever the joint fit (it explains at least the
+ * first's score): its p is bounded by the gap's, with no QR. The rival
+ * the data do not reject becomes the second, so the text names it. */
+static rcb_status apart(rcb_monitor *mon, int gls, size_t nsc, rcb_monitor_result *res) {
+  const mon_cand *a = &mon->cand[mon->order[0]];
+  double q, worst = -1;
+  size_t t, wt = 0;
+  int any = a->implausible;
+  rcb_status st;
+  res->apart_p = (double)NAN;
+  if (res->ntop < 2 || !rcb_mon_bic_apart(mon, res)) return RCB_OK;
+  q = rcb_chi2_quantile(1.0 - RCB_MONITOR_APART_ALPHA, (double)a->dof);
+  for (t = 1; t < nsc; t++) {
+    const mon_cand *c = &mon->cand[mon->order[t]];
+    double gap = a->score_now - c->score_now, p;
+    if (!any && c->implausible) continue;
+    if (gap > q) p = rcb_chi2_sf(gap, (double)a->dof);
+    else if ((st = rcb_mon_adds(mon, gls, a, c, &p))) return st;
+    if (p > worst) worst = p, wt = t;
+  }
+  if (!wt) return RCB_OK;
+  res->apart_p = worst;
+  if (worst >= RCB_MONITOR_APART_ALPHA && wt > 1) {
+    to_second(mon, wt);
+    fill_top(mon, res);
+  }
+  return RCB_OK;
 }
 
 /* Scores and sizes (on the reweighted path) were left in the candidates
  * by the caller when gls != 0. */
-static void candidates(rcb_monitor *mon, int gls, rcb_monitor_result *res) {
+static rcb_status candidates(rcb_monitor *mon, int gls, rcb_monitor_result *res) {
   size_t j, a, k = mon->k, nsc = 0, t;
   for (j = 0; j < mon->ncand; j++) {
     mon_cand *c = &mon->cand[j];
@@ -506,23 +566,8 @@ static void candidates(rcb_monitor *mon, int gls, rcb_monitor_result *res) {
     }
   }
   if (res->ntop >= 2) rival_second(mon, nsc);
-  for (t = 0; t < res->ntop; t++) {
-    const mon_cand *c = &mon->cand[mon->order[t]];
-    rcb_monitor_candidate *o = &res->top[t];
-    o->index = mon->order[t];
-    o->effect = c->effect;
-    o->np = c->np;
-    o->score = c->score_now;
-    o->dof = c->dof;
-    o->p_value = exp(mon->pscore[mon->order[t]]);
-    o->implausible = c->implausible;
-    for (a = 0; a < c->np; a++) {
-      double se = c->se_now[a];
-      o->size[a] = c->size_now[a];
-      o->ci_lo[a] = o->size[a] - MON_Z95 * se;
-      o->ci_hi[a] = o->size[a] + MON_Z95 * se;
-    }
-  }
+  fill_top(mon, res);
+  return apart(mon, gls, nsc, res);
 }
 
 /* Paper's error %, change % and the noise floor % of this measurement. */
@@ -1019,7 +1064,7 @@ rcb_status rcb_monitor_update(rcb_monitor *mon, const rcb_complex *values, const
   res->threshold = mon->threshold;
   res->p_value = res->dof ? rcb_chi2_sf(res->T, (double)res->dof) : 1.0;
   res->alarm = res->dof && res->T > mon->threshold;
-  candidates(mon, gls, res);
+  if ((st = candidates(mon, gls, res))) return st;
   tracked_rest(mon, gls, res, theta, dth, se);
   if ((st = joint_relin(mon, gls, res, dth, se))) return st;
   for (a = 0; a < mon->nt; a++) theta[a] += dth[a];

@@ -355,6 +355,13 @@ void rcb_mon_drift_update(rcb_monitor *mon, const double *theta, int gls,
 void rcb_mon_drift_reset(rcb_monitor *mon);
 /* The one naming rule's BIC change of a score with dof degrees of freedom. */
 double rcb_mon_bic(const rcb_monitor *mon, double score, size_t dof);
+/* The BIC half of rcb_monitor_named's rule (r->ntop >= 2). */
+int rcb_mon_bic_apart(const rcb_monitor *mon, const rcb_monitor_result *r);
+/* *p: the upper-tail probability of the test that candidate a adds to
+ * candidate c's fit in this update (gls: the reweighted metric), 1 when
+ * a's columns lie in the span of c's and the tracked ones. Uses mon->sw. */
+rcb_status rcb_mon_adds(rcb_monitor *mon, int gls, const mon_cand *a, const mon_cand *c,
+                        double *p);
 
 /* monitor_image.c: the commissioning image (rcb_monitor_image_save). Byte
  * offsets of its sections once checked (rcb_mon_image_open: every

@@ -24,7 +24,7 @@
  * below MON_RANK_TOL of its column's norm (a dependent column). */
 rcb_status rcb_mon_small_qr(rcb_monitor *mon, mon_small *w, size_t k, size_t p, int *ok) {
   size_t i, j;
-  double norm[RCB_MONITOR_MAX_TRACKED + RCB_MONITOR_MAXP];
+  double norm[RCB_MONITOR_MAX_TRACKED + 2 * RCB_MONITOR_MAXP];
   double *A = w->A, *R = w->R, *Ri = w->Ri;
   lapack_int info;
   *ok = p <= k;
@@ -209,7 +209,7 @@ static void transpose_q(rcb_monitor *mon, double *Qr) {
  * commissioning image G is its, and Q (row-major) was taken from it. */
 rcb_status rcb_mon_rank_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl, double *J,
                               const mon_image *im) {
-  size_t k = mon->k, nt = mon->nt, pmax = nt + RCB_MONITOR_MAXP, lw, pq;
+  size_t k = mon->k, nt = mon->nt, pmax = nt + 2 * RCB_MONITOR_MAXP, lw, pq;
   double q1 = 0, q2 = 0;
   mon_small *w = &mon->sw;
   rcb_status st;
@@ -255,14 +255,46 @@ double rcb_mon_bic(const rcb_monitor *mon, double score, size_t dof) {
   return -score + (double)dof * log((double)mon->n);
 }
 
-/* The first told apart from its closest rival, the second (monitor.c,
- * rival_second): separable, and the first the better supported. A second
- * better supported by more than 10 is no licence to name the first alone
- * (as the absolute difference was): "A or B: not separable". */
-int rcb_monitor_named(const rcb_monitor *mon, const rcb_monitor_result *r) {
-  double b0, b1;
-  if (!mon || !r || r->ntop < 2) return -1;
-  b0 = rcb_mon_bic(mon, r->top[0].score, r->top[0].dof);
-  b1 = rcb_mon_bic(mon, r->top[1].score, r->top[1].dof);
+/* The BIC half of the one naming rule: the first's BIC change lower than
+ * its closest rival's, the second (monitor.c, rival_second), by more than
+ * rcb_evidence_separable's 10. A second better supported by more than 10
+ * is no licence to name the first alone (as the absolute difference was). */
+int rcb_mon_bic_apart(const rcb_monitor *mon, const rcb_monitor_result *r) {
+  double b0 = rcb_mon_bic(mon, r->top[0].score, r->top[0].dof);
+  double b1 = rcb_mon_bic(mon, r->top[1].score, r->top[1].dof);
   return rcb_evidence_separable(b0, b1) && b0 < b1;
+}
+
+/* The one naming rule: the BIC half, and every rival's hypothesis rejected
+ * by the test that the first adds to its fit (rcb_mon_adds; apart_p, the
+ * largest p over the rivals, below RCB_MONITOR_APART_ALPHA). */
+int rcb_monitor_named(const rcb_monitor *mon, const rcb_monitor_result *r) {
+  if (!mon || !r || r->ntop < 2) return -1;
+  return rcb_mon_bic_apart(mon, r) && r->apart_p < RCB_MONITOR_APART_ALPHA;
+}
+
+/* Does candidate a add to candidate c's fit? The change explained by the
+ * tracked columns, c's and a's beyond the tracked and c's (the small QR
+ * of [G_t G_c G_a], in this update's metric on the reweighted path:
+ * mon->Atw and z0 = U^-T y0; else G and y0), chi-square(np_a) whatever the
+ * size of c when the truth is c, linearly and with the noise as declared:
+ * so P(c rejected at level alpha | c) = alpha for every pair. *p: its
+ * upper-tail probability; 1 when a's columns lie in the span of the others
+ * (nothing in the data can reject c). */
+rcb_status rcb_mon_adds(rcb_monitor *mon, int gls, const mon_cand *a, const mon_cand *c,
+                        double *p) {
+  size_t k = mon->k, nt = mon->nt, q = nt + c->np, m = q + a->np;
+  const double *B = gls ? mon->Atw : mon->G, *z = gls ? mon->z0 : mon->y0;
+  double qz[RCB_MONITOR_MAX_TRACKED + 2 * RCB_MONITOR_MAXP], x;
+  mon_small *w = &mon->sw;
+  int ok;
+  rcb_status st;
+  memcpy(w->A, B, k * nt * sizeof *w->A);
+  memcpy(w->A + k * nt, B + k * c->col, k * c->np * sizeof *w->A);
+  memcpy(w->A + k * q, B + k * a->col, k * a->np * sizeof *w->A);
+  *p = 1.0;
+  if ((st = rcb_mon_small_qr(mon, w, k, m, &ok)) || !ok) return st;
+  x = rcb_mon_gls_explained(w, z, k, q, m, qz);
+  *p = rcb_chi2_sf(x, (double)a->np);
+  return RCB_OK;
 }

@@ -151,6 +151,7 @@ static void json_update(FILE *fp, const mon_state *s, size_t k) {
   { /* rcb_monitor_named: the first told apart from the second (null: < 2 ranked) */
     int named = rcb_monitor_named(s->mon, r);
     fprintf(fp, "], \"separable\": %s", named < 0 ? "null" : named ? "true" : "false");
+    json_key_num(fp, "apart_p", r->apart_p); /* null when the BIC half fails */
   }
   fputs(",\n   \"drift\": ", fp); /* the drift test's best supported candidate */
   if (!r->drift_dof) {

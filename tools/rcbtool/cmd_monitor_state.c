@@ -12,6 +12,7 @@
 #include <limits.h>
 #include <stdarg.h>
 #include <stdint.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -20,7 +21,7 @@
 #include "cmd_monitor.h"
 
 #define ST_MAGIC "RCBTOOL-MONSTATE"
-#define ST_VERSION 4u
+#define ST_VERSION 5u
 
 /* A growing or consumed byte buffer: one codec writes and reads. bad: 1
  * truncated or damaged, 2 not a state, 3 another version, 4 CRC, 5 a field
@@ -156,6 +157,8 @@ static void check_result(st_buf *b, const rcb_monitor_result *r, size_t k) {
            r->drift_alarm);
   else if (r->drift_dof > RCB_MONITOR_MAXP)
     st_bad(b, "update %zu: the drift's degrees of freedom %zu", k + 1, r->drift_dof);
+  else if (!isnan(r->apart_p) && !(r->apart_p >= 0 && r->apart_p <= 1))
+    st_bad(b, "update %zu: the naming test's p-value %g", k + 1, r->apart_p);
   for (i = 0; !b->bad && i < r->ntop; i++) {
     const rcb_monitor_candidate *c = &r->top[i];
     if (c->np < 1 || c->np > RCB_MONITOR_MAXP || c->dof > RCB_MONITOR_MAXP ||
@@ -210,6 +213,7 @@ static void io_result(st_buf *b, rcb_monitor_result *r) {
   io_f64(b, &r->drift_glr), io_size(b, &r->drift_dof), io_f64(b, &r->drift_p);
   io_int(b, &r->drift_alarm), io_size(b, &r->drift_index), io_size(b, &r->drift_onset);
   io_f64s(b, r->drift_rate, RCB_MONITOR_MAXP);
+  io_f64(b, &r->apart_p); /* version 5 */
 }
 
 /* The set-up: written from @p ms, read into a new *ms. */

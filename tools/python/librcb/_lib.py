@@ -228,7 +228,7 @@ class MonitorResult(ctypes.Structure):
                 ("tracked", MonitorTracked * MONITOR_MAX_TRACKED),
                 ("drift_glr", c_double), ("drift_dof", c_size_t), ("drift_p", c_double),
                 ("drift_alarm", c_int), ("drift_index", c_size_t), ("drift_onset", c_size_t),
-                ("drift_rate", c_double * MONITOR_MAXP)]
+                ("drift_rate", c_double * MONITOR_MAXP), ("apart_p", c_double)]
 
 
 class MonitorCandidateInfo(ctypes.Structure):

@@ -265,6 +265,8 @@ class Monitor(Handle):
                 # the one rule (rcb_monitor_named): the first candidate told apart from
                 # the second; None with fewer than two ranked
                 "separable": None if named < 0 else bool(named),
+                # its test half: the largest p over the rivals (None: the BIC half fails)
+                "apart_p": None if math.isnan(r.apart_p) else r.apart_p,
                 # the drift test: the candidate whose linear drift is best supported
                 "drift": (None if not r.drift_dof else
                           dict(self.candidate(r.drift_index), glr=r.drift_glr,
