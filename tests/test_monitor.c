@@ -1702,8 +1702,9 @@ static double excess_dgels(const rcb_monitor *mon, const double *y0, size_t c, s
  * rivals (within the screen's bound), and a rival at or above the level
  * is the second; 4. the rate: for the first's four closest rivals as the
  * truth (y0 = G_c v + e, e standard normal in the rank space, the rival
- * at a size whose score is ~200), the count of draws that reject it at
- * RCB_MONITOR_APART_ALPHA is within the binomial 99.9 % interval. */
+ * at a size whose score is ~200), the count of 20 / alpha draws that
+ * reject it at RCB_MONITOR_APART_ALPHA is within the binomial 99.9 %
+ * interval. */
 static void test_apart_rule(void **state) {
   fixture *f = *state;
   rcb_monitor_param tp;
@@ -1716,7 +1717,8 @@ static void test_apart_rule(void **state) {
   uint64_t seed = 23;
   size_t j, a, k, i, t, near[4], nnear = 0, nrival = 0;
   double *y0, worst = -1, q;
-  const size_t DRAWS = fast_mode() ? 200 : 2000;
+  /* 20 expected rejections (2 in the sanitizer build's tenth) */
+  const size_t DRAWS = (size_t)((fast_mode() ? 2.0 : 20.0) / RCB_MONITOR_APART_ALPHA);
   o.setup_averages = HUGE_VAL;
   values_of(ms, fs2);
   assert_int_equal(rcb_monitor_create(&mon, f->base, f->setup, &o, NULL), RCB_OK);
@@ -1789,8 +1791,8 @@ static void test_apart_rule(void **state) {
       assert_int_equal(rcb_mon_adds(mon, 0, &mon->cand[a], c, &p), RCB_OK);
       rej += p < RCB_MONITOR_APART_ALPHA;
     }
-    /* binomial(DRAWS, 0.01): 2000 -> 99.9 % interval [8, 35]; 200 -> [0, 7] */
-    lo = DRAWS >= 2000 ? 8 : 0, hi = DRAWS >= 2000 ? 35 : 7;
+    /* binomial(DRAWS, alpha), mean 20: 99.9 % interval [8, 35]; mean 2: [0, 7] */
+    lo = fast_mode() ? 0 : 8, hi = fast_mode() ? 7 : 35;
     print_message("apart: truth %s (%zu dof), first %s: rejected %zu of %zu at level %.2g "
                   "(99.9 %% interval [%zu, %zu])\n", c->desc, np, mon->cand[a].desc, rej,
                   DRAWS, RCB_MONITOR_APART_ALPHA, lo, hi);

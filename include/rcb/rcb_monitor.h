@@ -165,12 +165,18 @@
  *    the other tracked parameters free in both (nuisance); each fit's GLR
  *    (the explained sum of squares beyond the nuisance) gives the BIC
  *    change -GLR + dof ln n of rcb_monitor_named's one rule, and the best
- *    candidate is compared with a by rcb_evidence_separable:
- *    rcb_monitor_tracked.named says a alone, "a or the candidate: not
- *    separable on these channels", or the candidate told apart from a; in
+ *    candidate is compared with a by rcb_evidence_separable, then by the
+ *    rule's test half on the accumulated change (a alone only when every
+ *    candidate's hypothesis is rejected at RCB_MONITOR_APART_ALPHA by what
+ *    a's column adds to it, else the one not rejected is the rival; the
+ *    candidate told apart from a only when a's is rejected by what the
+ *    candidate adds): rcb_monitor_tracked.named says a alone, "a or the
+ *    candidate: not separable on these channels", or the candidate told
+ *    apart from a; in
  *    the second case rcb_monitor_separating names the channel or speed that
  *    would separate them (the diagnosis' plan). The candidate is told apart
- *    alone only when the runner-up candidate is told apart from it too; else
+ *    alone only when the runner-up candidate is told apart from it too (by
+ *    the BIC, and every other candidate rejected by the test half); else
  *    both are given (rival2: on one channel a B4 kyy drift and B1 kxx fit
  *    the change within 1.5 of BIC, so "not kr" holds but not which bearing).
  *    Untracked before tracked (issue #34): while the same update's instant
@@ -199,9 +205,11 @@ extern "C" {
 #define RCB_MONITOR_MAXP 3
 /** @brief Level of the test that tells an alarm's first candidate apart
  * from each rival (rcb_monitor_named, rcb_monitor_result.apart_p): when the
- * truth is a rival, of any size, the first is told apart from it at this
- * rate at most, linearly and with the noise as declared (-). */
-#define RCB_MONITOR_APART_ALPHA 0.01
+ * truth is a rival, of any size, an update tells the first apart from it
+ * at this rate at most, linearly and with the noise as declared, so a
+ * series of 50 alarmed updates at 5 % at most (the union bound: the
+ * issue's rate, per series, for every pair) (-). */
+#define RCB_MONITOR_APART_ALPHA 0.001
 
 /** @brief A parameter to track (rcb_model_get_param names, e.g. "C.kt"). */
 typedef struct rcb_monitor_param {

@@ -178,6 +178,46 @@ static double explained(rcb_monitor *mon, size_t a, size_t col, size_t q, double
   return g;
 }
 
+/* The test half of the one naming rule on the accumulated change: the
+ * part of Y that q2 columns from col2 explain beyond the nuisance (the
+ * tracked ones but a) and q1 columns from col1, chi-square(q2) when the
+ * truth lies in the span of those; its upper-tail probability (1 when the
+ * q2 columns lie in that span: nothing can reject it). */
+static double adds(rcb_monitor *mon, size_t a, size_t col1, size_t q1, size_t col2, size_t q2) {
+  size_t k = mon->k, nt = mon->nt, b, p = 0;
+  double qz[RCB_MONITOR_MAX_TRACKED + 2 * RCB_MONITOR_MAXP];
+  int ok = 0;
+  for (b = 0; b < nt; b++)
+    if (b != a) memcpy(mon->sw.A + k * p++, mon->G + k * b, k * sizeof *mon->sw.A);
+  memcpy(mon->sw.A + k * p, mon->G + k * col1, k * q1 * sizeof *mon->sw.A);
+  memcpy(mon->sw.A + k * (p + q1), mon->G + k * col2, k * q2 * sizeof *mon->sw.A);
+  if (rcb_mon_small_qr(mon, &mon->sw, k, p + q1 + q2, &ok) || !ok) return 1.0;
+  return rcb_chi2_sf(rcb_mon_gls_explained(&mon->sw, mon->dY, k, p + q1, p + q1 + q2, qz),
+                     (double)q2);
+}
+
+/* The largest p over the candidates but skip (and a's own column) of the
+ * test that q columns from col add to each (adds): a candidate they
+ * outscore (g, explained beyond the nuisance) by more than the test's
+ * quantile is rejected whatever the joint fit, its p bounded by the gap.
+ * *at: the candidate of the largest (ncand: none). */
+static double worst_rival(rcb_monitor *mon, size_t a, size_t col, size_t q, double g,
+                          size_t skip, size_t *at) {
+  double x[RCB_MONITOR_MAXP], worst = 0;
+  double lim = rcb_chi2_quantile(1.0 - RCB_MONITOR_APART_ALPHA, (double)q);
+  size_t j;
+  *at = mon->ncand;
+  for (j = 0; j < mon->ncand; j++) {
+    const mon_cand *c = &mon->cand[j];
+    double gc, p;
+    if (!c->dof || j == skip || c->col == col || (gc = explained(mon, a, c->col, c->np, x)) < 0)
+      continue;
+    p = g - gc > lim ? rcb_chi2_sf(g - gc, (double)q) : adds(mon, a, c->col, c->np, col, q);
+    if (p > worst) worst = p, *at = j;
+  }
+  return worst;
+}
+
 /* A CUSUM alarm of tracked parameter a: is the accumulated change (the
  * drift-weighted sum of the whole window, GLS in the shared noise) better
  * explained by a candidate than by a, the other tracked parameters free? */
@@ -239,6 +279,22 @@ static void attribute(rcb_monitor *mon, size_t a, size_t pointed, rcb_monitor_tr
   }
   if (rcb_evidence_separable(ba, bbest)) t->named = ba <= bbest ? 1 : -1;
   else t->named = 0;
+  /* the test half of the one rule (rcb_monitor_named): a alone only when
+   * every candidate's hypothesis is rejected by what a adds to it, else "a
+   * or the candidate not rejected: not separable"; the rival told apart
+   * from a only when a's hypothesis is rejected by what the rival adds */
+  if (t->named == 1) {
+    size_t at;
+    if (worst_rival(mon, a, a, 1, ga, mon->ncand, &at) >= RCB_MONITOR_APART_ALPHA &&
+        explained(mon, a, mon->cand[at].col, mon->cand[at].np, x) >= 0) {
+      t->named = 0, t->rival = at, t->rival_dof = mon->cand[at].np;
+      for (b = 0; b < mon->cand[at].np; b++) t->rival_rate[b] = x[b] / (den * scale);
+    }
+  } else if (t->named == -1 &&
+             adds(mon, a, a, 1, mon->cand[t->rival].col, mon->cand[t->rival].np) >=
+                 RCB_MONITOR_APART_ALPHA) {
+    t->named = 0;
+  }
   /* untracked before tracked (issue #34 item 3): while this update's instant
    * or drift test points at an untracked candidate, the CUSUM alarm is not
    * the tracked parameter alone: "a, or that candidate: not separable" */
@@ -253,6 +309,15 @@ static void attribute(rcb_monitor *mon, size_t a, size_t pointed, rcb_monitor_tr
    * on few channels two candidates can fit the change equally well */
   if (t->named == -1 && have2 && !rcb_evidence_separable(bbest, b2))
     t->rival2 = r2, t->rival2_dof = mon->cand[r2].np;
+  /* and only when every other candidate's hypothesis is rejected by what
+   * the rival adds to it (the test half), else that one is the runner-up */
+  if (t->named == -1 && !t->rival2_dof) {
+    const mon_cand *c = &mon->cand[t->rival];
+    double g = (double)c->dof * log((double)mon->n) - bbest; /* rcb_mon_bic inverted */
+    size_t at;
+    if (worst_rival(mon, a, c->col, c->np, g, t->rival, &at) >= RCB_MONITOR_APART_ALPHA)
+      t->rival2 = at, t->rival2_dof = mon->cand[at].np;
+  }
 }
 
 void rcb_mon_drift_update(rcb_monitor *mon, const double *theta, int gls,

@@ -87,7 +87,7 @@ def test_package_and_rcbtool_agree(rcb, tmp_path):
         # one rule in both (rcb_monitor_named): the first's BIC change -score + dof
         # ln n lower by more than 10 than its closest rival's, the second, and
         # every rival rejected by the test that the first adds to it (apart_p
-        # below 0.01, RCB_MONITOR_APART_ALPHA); a rival not rejected is the second
+        # below RCB_MONITOR_APART_ALPHA); a rival not rejected is the second
         assert a["separable"] == b["separable"]
         assert (a["apart_p"] is None) == (b["apart_p"] is None)
         if a["apart_p"] is not None:
@@ -97,8 +97,9 @@ def test_package_and_rcbtool_agree(rcb, tmp_path):
             bic = [-c["score"] + c["dof"] * math.log(n) for c in a["top"]]
             bic_half = bic[1] - bic[0] > 10.0
             assert (a["apart_p"] is not None) == bic_half
-            assert a["separable"] == (bic_half and a["apart_p"] < 0.01)
-            if not bic_half or a["apart_p"] < 0.01:  # else the rival not rejected
+            level = rcb._lib.MONITOR_APART_ALPHA
+            assert a["separable"] == (bic_half and a["apart_p"] < level)
+            if not bic_half or a["apart_p"] < level:  # else the rival not rejected
                 assert all(bic[1] <= x for c, x in zip(a["top"][2:], bic[2:])
                            if a["top"][0]["implausible"] or not c["implausible"])
     assert py[-1]["alarm"]  # the cross-coupled day is a change

@@ -168,6 +168,8 @@ class CompareSummary(ctypes.Structure):
 # rcb_monitor.h (issue #16); the array sizes are RCB_MONITOR_MAX_TRACKED,
 # RCB_MONITOR_TOP and RCB_MONITOR_MAXP
 MONITOR_MAX_TRACKED, MONITOR_TOP, MONITOR_MAXP = 8, 8, 3
+# rcb_monitor.h's level of the naming rule's test half (rcb_monitor_named)
+MONITOR_APART_ALPHA = 0.001
 # rcb_effect (include/rcb/rcb_diagnose.h): the monitor's catalogue ends before the
 # shaft elements; the measurement chain (a sensor's gain and phase, a swap) is asked
 # for: RCB_MONITOR_EFFECTS_SENSORS of rcb_monitor.h
