@@ -722,6 +722,29 @@ static void named_rule(const rcb_monitor *mon, const rcb_monitor_result *r) {
   assert_int_equal(rcb_monitor_named(mon, &t), -1);
 }
 
+/* The truth with a cross-coupled stiffness kc (N/m) at bearing B2: its
+ * model, FRFs and their values (fs2). */
+typedef struct cross_truth {
+  rcb_model *m2;
+  rcb_meas *ms;
+  rcb_complex *fs2;
+} cross_truth;
+
+static cross_truth cross_open(const fixture *f, double kc) {
+  cross_truth x;
+  x.m2 = edited(f->truth, "bearing.B2.kcross", kc);
+  x.ms = frf_of(x.m2);
+  x.fs2 = malloc(NPT * sizeof *x.fs2);
+  values_of(x.ms, x.fs2);
+  return x;
+}
+
+static void cross_close(cross_truth *x) {
+  rcb_meas_destroy(x->ms);
+  rcb_model_destroy(x->m2);
+  free(x->fs2);
+}
+
 /* A cross-coupled stiffness appears at bearing B2. */
 static void cross_case(fixture *f, int reweight, size_t relin, double kc /* N/m */) {
   rcb_monitor_param tp[3];
@@ -729,9 +752,7 @@ static void cross_case(fixture *f, int reweight, size_t relin, double kc /* N/m 
   rcb_monitor *mon = NULL;
   rcb_monitor_result r;
   rcb_monitor_candidate_info ci;
-  rcb_model *m2 = edited(f->truth, "bearing.B2.kcross", kc);
-  rcb_meas *ms = frf_of(m2);
-  rcb_complex *fs2 = malloc(NPT * sizeof *fs2);
+  cross_truth x = cross_open(f, kc);
   uint64_t seed = 11;
   size_t u, t, named = 0, cover = 0;
   const size_t N = 20;
@@ -747,10 +768,9 @@ static void cross_case(fixture *f, int reweight, size_t relin, double kc /* N/m 
     }
     o.ntracked = 3;
   }
-  values_of(ms, fs2);
   assert_int_equal(rcb_monitor_create(&mon, f->base, f->setup, &o, NULL), RCB_OK);
   for (u = 0; u < N; u++) {
-    eq19(fs2, f->v, &seed);
+    eq19(x.fs2, f->v, &seed);
     assert_int_equal(rcb_monitor_update(mon, f->v, NULL, &r), RCB_OK);
     assert_int_equal(r.alarm, 1);
     assert_true(r.ntop >= 1);
@@ -772,9 +792,7 @@ static void cross_case(fixture *f, int reweight, size_t relin, double kc /* N/m 
   assert_int_equal(named, N);
   assert_true(cover >= 16);
   rcb_monitor_destroy(mon);
-  rcb_meas_destroy(ms);
-  rcb_model_destroy(m2);
-  free(fs2);
+  cross_close(&x);
 }
 
 static void test_cross_coupling(void **state) { cross_case(*state, 0, 0, 1e5); }
@@ -1711,18 +1729,15 @@ static void test_apart_rule(void **state) {
   rcb_monitor_opts o = opts_kt(&tp, f->kt);
   rcb_monitor *mon = NULL;
   rcb_monitor_result r;
-  rcb_model *m2 = edited(f->truth, "bearing.B2.kcross", 1e5);
-  rcb_meas *ms = frf_of(m2);
-  rcb_complex *fs2 = malloc(NPT * sizeof *fs2);
+  cross_truth x = cross_open(f, 1e5);
   uint64_t seed = 23;
   size_t j, a, k, i, t, near[4], nnear = 0, nrival = 0;
   double *y0, worst = -1, q;
   /* 20 expected rejections (2 in the sanitizer build's tenth) */
   const size_t DRAWS = (size_t)((fast_mode() ? 2.0 : 20.0) / RCB_MONITOR_APART_ALPHA);
   o.setup_averages = HUGE_VAL;
-  values_of(ms, fs2);
   assert_int_equal(rcb_monitor_create(&mon, f->base, f->setup, &o, NULL), RCB_OK);
-  eq19(fs2, f->v, &seed);
+  eq19(x.fs2, f->v, &seed);
   assert_int_equal(rcb_monitor_update(mon, f->v, NULL, &r), RCB_OK);
   assert_int_equal(r.alarm, 1);
   k = mon->k, a = r.top[0].index;
@@ -1800,9 +1815,7 @@ static void test_apart_rule(void **state) {
   }
   free(y0);
   rcb_monitor_destroy(mon);
-  rcb_meas_destroy(ms);
-  rcb_model_destroy(m2);
-  free(fs2);
+  cross_close(&x);
 }
 
 int main(void) {
