@@ -41,6 +41,11 @@
 #                               of four forms, every count against its binomial bound (needs .venv;
 #                               about 10 s CPU per replica); extra arguments go to
 #                               tools/bench/monitor_replicas.py (--cases null,drift --first N)
+#   ./scripts/dev.sh monitor-pairs  the wrong "told apart" for each truth the monitor's
+#                               catalogue can hold at 32 x 1101 (issue #34 item 2): 28 ROSS-made
+#                               truths x 8 commissionings x 25 updates, four noise forms (needs
+#                               .venv; about 40 min CPU); extra arguments go to
+#                               tools/bench/monitor_pairs.py (--truths B4.kyy,gain.DA.x)
 #   ./scripts/dev.sh fuzz       libFuzzer smoke (issue #7): build fuzz/ with clang (ASan+UBSan),
 #                               replay the seed corpora, then fuzz each harness FUZZ_SECONDS
 #                               (default 30) s; needs clang and libclang-rt-dev (not in `test`)
@@ -626,6 +631,14 @@ cmd_monitor_replicas() {
     tools/bench/monitor_replicas.py --replicas "${REPLICAS:-100}" "$@"
 }
 
+cmd_monitor_pairs() {
+  cmd_build
+  [[ -x $VENV/bin/python ]] || die "no $VENV: run ./scripts/dev.sh deps (NumPy, ROSS)"
+  say "monitor naming: every truth of tools/bench/monitor_pairs.py at 32 x 1101 (one core, nice)"
+  OPENBLAS_NUM_THREADS=1 LIBRCB_PATH=$BUILD_DIR/src/librcb.so nice -n 10 "$VENV/bin/python" \
+    tools/bench/monitor_pairs.py --blocks "${BLOCKS:-8}" "$@"
+}
+
 # libFuzzer smoke: every seed replayed, then FUZZ_SECONDS of fuzzing per
 # harness on a scratch copy of the corpus (fuzz/corpus stays as committed).
 # Not part of `test`: it needs clang with its runtime (Debian: clang,
@@ -1099,6 +1112,7 @@ case ${1:-} in
   bench-suite) shift; cmd_bench_suite "$@" ;;
   diag-success) shift; cmd_diag_success "$@" ;;
   monitor-replicas) shift; cmd_monitor_replicas "$@" ;;
+  monitor-pairs) shift; cmd_monitor_pairs "$@" ;;
   fuzz) cmd_fuzz ;;
   fuzz-smoke) cmd_fuzz_smoke ;;
   valgrind) cmd_valgrind ;;

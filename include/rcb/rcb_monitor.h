@@ -445,7 +445,8 @@ typedef struct rcb_monitor_result {
                            counts with the bound of its p the score gap gives
                            (below the level, not computed). When it is at or
                            above RCB_MONITOR_APART_ALPHA that rival is the
-                           second (top[1]) */
+                           second (top[1]); 0 when there is no rival (every
+                           other candidate implausible, the first not) */
 } rcb_monitor_result;
 
 typedef struct rcb_monitor rcb_monitor;

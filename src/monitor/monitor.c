@@ -512,7 +512,7 @@ static void fill_top(const rcb_monitor *mon, rcb_monitor_result *res) {
  * the data do not reject becomes the second, so the text names it. */
 static rcb_status apart(rcb_monitor *mon, int gls, size_t nsc, rcb_monitor_result *res) {
   const mon_cand *a = &mon->cand[mon->order[0]];
-  double q, worst = -1;
+  double q, worst = 0; /* 0: no rival (every other implausible, the first not) */
   size_t t, wt = 0;
   int any = a->implausible;
   rcb_status st;
@@ -527,7 +527,6 @@ static rcb_status apart(rcb_monitor *mon, int gls, size_t nsc, rcb_monitor_resul
     else if ((st = rcb_mon_adds(mon, gls, a, c, &p))) return st;
     if (p > worst) worst = p, wt = t;
   }
-  if (!wt) return RCB_OK;
   res->apart_p = worst;
   if (worst >= RCB_MONITOR_APART_ALPHA && wt > 1) {
     to_second(mon, wt);
