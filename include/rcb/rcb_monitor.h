@@ -390,9 +390,16 @@ typedef struct rcb_monitor_tracked {
                             separable from the rival's by the one rule (the
                             data say "not this parameter" but not which of
                             the two: "rival, or rival2: not separable on these
-                            channels"); index as rival */
+                            channels"): the BIC's runner-up within 10, else
+                            the candidate the test half rejects least when it
+                            does not reject it; index as rival */
   size_t rival2_dof;   /**< its parameters; 0 when the rival is told apart
                             from every other candidate too (or named is not -1) */
+  size_t rivals_open;  /**< while cusum_alarm and named is 0 or -1: the other
+                            candidates, beyond rival and rival2, whose
+                            hypothesis the test half of the one rule does not
+                            reject either ("or N other candidates": the list
+                            is not complete); 0 else */
 } rcb_monitor_tracked;
 
 /** @brief What one update found. Plain value type, owns nothing. */

@@ -196,23 +196,26 @@ static double adds(rcb_monitor *mon, size_t a, size_t col1, size_t q1, size_t co
                      (double)q2);
 }
 
-/* The largest p over the candidates but skip (and a's own column) of the
+/* The largest p over the candidates but skip, skip2 (and a's own column) of the
  * test that q columns from col add to each (adds): a candidate they
  * outscore (g, explained beyond the nuisance) by more than the test's
  * quantile is rejected whatever the joint fit, its p bounded by the gap.
- * *at: the candidate of the largest (ncand: none). */
+ * *at: the candidate of the largest (ncand: none); *open: how many are not
+ * rejected (p at or above RCB_MONITOR_APART_ALPHA). */
 static double worst_rival(rcb_monitor *mon, size_t a, size_t col, size_t q, double g,
-                          size_t skip, size_t *at) {
+                          size_t skip, size_t skip2, size_t *at, size_t *open) {
   double x[RCB_MONITOR_MAXP], worst = 0;
   double lim = rcb_chi2_quantile(1.0 - RCB_MONITOR_APART_ALPHA, (double)q);
   size_t j;
-  *at = mon->ncand;
+  *at = mon->ncand, *open = 0;
   for (j = 0; j < mon->ncand; j++) {
     const mon_cand *c = &mon->cand[j];
     double gc, p;
-    if (!c->dof || j == skip || c->col == col || (gc = explained(mon, a, c->col, c->np, x)) < 0)
+    if (!c->dof || j == skip || j == skip2 || c->col == col ||
+        (gc = explained(mon, a, c->col, c->np, x)) < 0)
       continue;
     p = g - gc > lim ? rcb_chi2_sf(g - gc, (double)q) : adds(mon, a, c->col, c->np, col, q);
+    *open += p >= RCB_MONITOR_APART_ALPHA;
     if (p > worst) worst = p, *at = j;
   }
   return worst;
@@ -284,10 +287,11 @@ static void attribute(rcb_monitor *mon, size_t a, size_t pointed, rcb_monitor_tr
    * or the candidate not rejected: not separable"; the rival told apart
    * from a only when a's hypothesis is rejected by what the rival adds */
   if (t->named == 1) {
-    size_t at;
-    if (worst_rival(mon, a, a, 1, ga, mon->ncand, &at) >= RCB_MONITOR_APART_ALPHA &&
+    size_t at, open;
+    if (worst_rival(mon, a, a, 1, ga, mon->ncand, mon->ncand, &at, &open) >=
+            RCB_MONITOR_APART_ALPHA &&
         explained(mon, a, mon->cand[at].col, mon->cand[at].np, x) >= 0) {
-      t->named = 0, t->rival = at, t->rival_dof = mon->cand[at].np;
+      t->named = 0, t->rival = at, t->rival_dof = mon->cand[at].np, t->rivals_open = open - 1;
       for (b = 0; b < mon->cand[at].np; b++) t->rival_rate[b] = x[b] / (den * scale);
     }
   } else if (t->named == -1 &&
@@ -310,13 +314,18 @@ static void attribute(rcb_monitor *mon, size_t a, size_t pointed, rcb_monitor_tr
   if (t->named == -1 && have2 && !rcb_evidence_separable(bbest, b2))
     t->rival2 = r2, t->rival2_dof = mon->cand[r2].np;
   /* and only when every other candidate's hypothesis is rejected by what
-   * the rival adds to it (the test half), else that one is the runner-up */
-  if (t->named == -1 && !t->rival2_dof) {
+   * the rival adds to it (the test half): else, without the BIC's
+   * runner-up, the one rejected least is it, and the others not rejected
+   * are counted (the list is not complete) */
+  if (t->named == -1) {
     const mon_cand *c = &mon->cand[t->rival];
     double g = (double)c->dof * log((double)mon->n) - bbest; /* rcb_mon_bic inverted */
-    size_t at;
-    if (worst_rival(mon, a, c->col, c->np, g, t->rival, &at) >= RCB_MONITOR_APART_ALPHA)
-      t->rival2 = at, t->rival2_dof = mon->cand[at].np;
+    size_t at, open, skip2 = t->rival2_dof ? t->rival2 : mon->ncand;
+    if (worst_rival(mon, a, c->col, c->np, g, t->rival, skip2, &at, &open) >=
+        RCB_MONITOR_APART_ALPHA) {
+      if (!t->rival2_dof) t->rival2 = at, t->rival2_dof = mon->cand[at].np, open--;
+      t->rivals_open = open;
+    }
   }
 }
 

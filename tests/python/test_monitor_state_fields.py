@@ -89,7 +89,7 @@ class Container:
         ntop = self.u64()
         self.pos += ntop * 8 * 16
         ntracked = self.u64()
-        self.pos += ntracked * 8 * 23
+        self.pos += ntracked * 8 * 24
         self.pos += 8 * 10  # the drift test .. apart_p
 
     def put(self, off, fmt, value):

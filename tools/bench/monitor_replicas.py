@@ -239,10 +239,14 @@ def statements(case, j, r):
                         f"{t['name']} {'falling' if falling else 'rising'}"))
         elif t["named"] == -1:  # told apart from the tracked parameter
             named = [t["rival"]] + ([t["rival2"]] if t["rival2"] else [])
-            right = any(is_truth(case, d, j) for d in named)
+            # "or N other candidates": the claim is only "not this parameter"
+            right = (any(is_truth(case, d, j) for d in named) if not t.get("rivals_open")
+                     else tracked_truth(case, j) != k)
             rival = tracked_truth(case, j) == k
             out.append(("told apart from tracked", not right, bool(rival and not right),
-                        " or ".join(f"{d['params']}" for d in named) + f" (not {t['name']})"))
+                        " or ".join(f"{d['params']}" for d in named)
+                        + (f" or {t['rivals_open']} others" if t.get("rivals_open") else "")
+                        + f" (not {t['name']})"))
     return out
 
 

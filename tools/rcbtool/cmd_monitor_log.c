@@ -106,6 +106,8 @@ static void json_tracked(FILE *fp, const mon_state *s, const rcb_monitor_tracked
   } else {
     fputs("null", fp);
   }
+  /* candidates beyond rival and rival2 the rule's test does not reject */
+  fprintf(fp, ", \"rivals_open\": %zu", t->cusum_alarm ? t->rivals_open : (size_t)0);
   json_key_num(fp, "cusum_allow", t->cusum_allow);
   /* not separable: the measurement the plan names (rcb_monitor_separating) */
   fputs(", \"separate_by\": ", fp);

@@ -404,7 +404,8 @@ static void put_cand(FILE *fp, const rcb_monitor_candidate_info *ci, int with_pa
  * <candidate> falling: not separable on these channels", the candidate
  * told apart from kr, or, when a runner-up fits as well as that candidate,
  * "<candidate> falling, or <runner-up>: not separable on these channels;
- * the first told apart from kr". */
+ * the first told apart from kr"; ", or N other candidates" before the
+ * colon when more are not rejected (rivals_open). */
 static void print_attribution(FILE *fp, const mon_state *s, const rcb_monitor_result *r,
                               size_t k) {
   const rcb_monitor_tracked *t = &r->tracked[k];
@@ -424,7 +425,9 @@ static void print_attribution(FILE *fp, const mon_state *s, const rcb_monitor_re
     char resp[256], ref[256];
     fprintf(fp, "  %s %s, or ", name, dir);
     put_cand(fp, &ci, 1);
-    fprintf(fp, " %s: not separable on these channels", rdir);
+    fprintf(fp, " %s", rdir);
+    if (t->rivals_open) fprintf(fp, ", or %zu other candidates", t->rivals_open);
+    fputs(": not separable on these channels", fp);
     if (sp)
       fprintf(fp, "; %s per %s at %.6g rpm would separate them", cli_text(sp->response, resp,
               sizeof resp), cli_text(sp->reference, ref, sizeof ref),
@@ -435,6 +438,7 @@ static void print_attribution(FILE *fp, const mon_state *s, const rcb_monitor_re
     put_cand(fp, &ci, 1);
     fprintf(fp, " %s, or ", rdir);
     put_cand(fp, &ci2, 1);
+    if (t->rivals_open) fprintf(fp, ", or %zu other candidates", t->rivals_open);
     fprintf(fp, ": not separable on these channels; the first told apart from %s", name);
   } else {
     fputs("  ", fp);

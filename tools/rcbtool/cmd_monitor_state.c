@@ -169,7 +169,8 @@ static void check_result(st_buf *b, const rcb_monitor_result *r, size_t k) {
   for (i = 0; !b->bad && i < r->ntracked; i++) {
     const rcb_monitor_tracked *t = &r->tracked[i];
     if (!flag(t->cusum_alarm, -1) || !flag(t->out_of_range, 0) || !flag(t->named, -1) ||
-        t->rival_dof > RCB_MONITOR_MAXP || t->rival2_dof > RCB_MONITOR_MAXP)
+        t->rival_dof > RCB_MONITOR_MAXP || t->rival2_dof > RCB_MONITOR_MAXP ||
+        (t->rivals_open && t->named == 1))
       st_bad(b, "update %zu: tracked parameter %zu's flags (CUSUM %d, range %d, named %d) or "
              "rivals' parameters (%zu, %zu)", k + 1, i + 1, t->cusum_alarm, t->out_of_range,
              t->named, t->rival_dof, t->rival2_dof);
@@ -209,6 +210,7 @@ static void io_result(st_buf *b, rcb_monitor_result *r) {
     io_f64s(b, t->rival_rate, RCB_MONITOR_MAXP);
     io_f64(b, &t->cusum_allow); /* version 3 */
     io_size(b, &t->rival2), io_size(b, &t->rival2_dof); /* version 4 */
+    io_size(b, &t->rivals_open);                          /* version 5 */
   }
   io_f64(b, &r->drift_glr), io_size(b, &r->drift_dof), io_f64(b, &r->drift_p);
   io_int(b, &r->drift_alarm), io_size(b, &r->drift_index), io_size(b, &r->drift_onset);

@@ -211,7 +211,8 @@ class MonitorTracked(ctypes.Structure):
                 ("abs_stderr", c_double), ("change", c_double), ("change_lo", c_double),
                 ("change_hi", c_double), ("named", c_int), ("rival", c_size_t),
                 ("rival_dof", c_size_t), ("rival_rate", c_double * MONITOR_MAXP),
-                ("cusum_allow", c_double), ("rival2", c_size_t), ("rival2_dof", c_size_t)]
+                ("cusum_allow", c_double), ("rival2", c_size_t), ("rival2_dof", c_size_t),
+                ("rivals_open", c_size_t)]
 
 
 class MonitorSeparator(ctypes.Structure):

@@ -246,6 +246,9 @@ class Monitor(Handle):
                             "rival2": (self.candidate(t.rival2)
                                        if t.cusum_alarm and t.named == -1 and t.rival2_dof
                                        else None),
+                            # candidates beyond rival and rival2 the rule's test does
+                            # not reject either (the list is not complete)
+                            "rivals_open": t.rivals_open if t.cusum_alarm else 0,
                             # not separable: the measurement the plan names
                             "separate_by": self.separate_by(k, t.rival)
                             if t.cusum_alarm and t.named == 0 and t.rival_dof else None})
