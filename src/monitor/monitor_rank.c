@@ -209,7 +209,7 @@ static void transpose_q(rcb_monitor *mon, double *Qr) {
  * commissioning image G is its, and Q (row-major) was taken from it. */
 rcb_status rcb_mon_rank_space(rcb_monitor *mon, rcb_diag *d, const col_plan *pl, double *J,
                               const mon_image *im) {
-  size_t k = mon->k, nt = mon->nt, pmax = nt + 2 * RCB_MONITOR_MAXP, lw, pq;
+  size_t k = mon->k, nt = mon->nt, pmax = nt + 2 * (size_t)RCB_MONITOR_MAXP, lw, pq;
   double q1 = 0, q2 = 0;
   mon_small *w = &mon->sw;
   rcb_status st;
