@@ -623,21 +623,28 @@ cmd_diag_success() {
 
 # The monitor's rates by replicas (issue #34 item 2): tools/bench/monitor_replicas.py
 # prints the table docs/monitoring.md quotes; never fails on a count (it reports).
-cmd_monitor_replicas() {
+# A monitor benchmark of tools/bench (WHAT: its words; SCRIPT: its file) on
+# the built library, one core, nice; the rest of the arguments go to it.
+monitor_bench() {
+  local what=$1 script=$2
+  shift 2
   cmd_build
   [[ -x $VENV/bin/python ]] || die "no $VENV: run ./scripts/dev.sh deps (NumPy, ROSS)"
-  say "monitor rates: ${REPLICAS:-100} replicas per case at 32 x 1101 (one core, nice)"
+  say "monitor $what at 32 x 1101 (one core, nice)"
   OPENBLAS_NUM_THREADS=1 LIBRCB_PATH=$BUILD_DIR/src/librcb.so nice -n 10 "$VENV/bin/python" \
-    tools/bench/monitor_replicas.py --replicas "${REPLICAS:-100}" "$@"
+    "tools/bench/$script" "$@"
+}
+
+cmd_monitor_replicas() {
+  monitor_bench "rates: ${REPLICAS:-100} replicas per case" monitor_replicas.py \
+    --replicas "${REPLICAS:-100}" "$@"
 }
 
 cmd_monitor_pairs() {
-  cmd_build
-  [[ -x $VENV/bin/python ]] || die "no $VENV: run ./scripts/dev.sh deps (NumPy, ROSS)"
-  say "monitor naming: every truth of tools/bench/monitor_pairs.py at 32 x 1101 (one core, nice)"
-  OPENBLAS_NUM_THREADS=1 LIBRCB_PATH=$BUILD_DIR/src/librcb.so nice -n 10 "$VENV/bin/python" \
-    tools/bench/monitor_pairs.py --blocks "${BLOCKS:-8}" "$@"
+  monitor_bench "naming: every truth of monitor_pairs.py" monitor_pairs.py \
+    --blocks "${BLOCKS:-8}" "$@"
 }
+
 
 # libFuzzer smoke: every seed replayed, then FUZZ_SECONDS of fuzzing per
 # harness on a scratch copy of the corpus (fuzz/corpus stays as committed).
