@@ -567,13 +567,14 @@ static rcb_status commission(rcb_monitor *mon, const rcb_model *base, const rcb_
   if (!st && !(st = rcb_mon_rank_space(mon, d, &pl, J, o->image ? &im : NULL)))
     J = NULL; /* now mon->Q */
   if (!st) {
-    mon->y = rcb_mon_alloc(mon, 3 * mon->k + 2 * (mon->ncand ? mon->ncand : 1), sizeof *mon->y);
+    mon->y = rcb_mon_alloc(mon, 3 * mon->k + 3 * (mon->ncand ? mon->ncand : 1), sizeof *mon->y);
     if (!mon->y) st = rcb_mon_fail(mon, RCB_ERR_NOMEM, "out of memory (update workspace)");
     else {
       mon->ym = mon->y + mon->k;
       mon->y0 = mon->ym + mon->k;
       mon->pscore = mon->y0 + mon->k;
-      mon->order = (size_t *)(void *)(mon->pscore + (mon->ncand ? mon->ncand : 1));
+      mon->gatt = mon->pscore + (mon->ncand ? mon->ncand : 1);
+      mon->order = (size_t *)(void *)(mon->gatt + (mon->ncand ? mon->ncand : 1));
     }
   }
   if (!st) {

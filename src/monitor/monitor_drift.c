@@ -198,21 +198,20 @@ static double adds(rcb_monitor *mon, size_t a, size_t col1, size_t q1, size_t co
 
 /* The largest p over the candidates but skip, skip2 (and a's own column) of the
  * test that q columns from col add to each (adds): a candidate they
- * outscore (g, explained beyond the nuisance) by more than the test's
- * quantile is rejected whatever the joint fit, its p bounded by the gap.
+ * outscore (g, explained beyond the nuisance; each candidate's in
+ * mon->gatt, from attribute) by more than the test's quantile is rejected
+ * whatever the joint fit, its p bounded by the gap.
  * *at: the candidate of the largest (ncand: none); *open: how many are not
  * rejected (p at or above RCB_MONITOR_APART_ALPHA). */
 static double worst_rival(rcb_monitor *mon, size_t a, size_t col, size_t q, double g,
                           size_t skip, size_t skip2, size_t *at, size_t *open) {
-  double x[RCB_MONITOR_MAXP], worst = 0;
-  double lim = rcb_chi2_quantile(1.0 - RCB_MONITOR_APART_ALPHA, (double)q);
+  double worst = 0, lim = rcb_chi2_quantile(1.0 - RCB_MONITOR_APART_ALPHA, (double)q);
   size_t j;
   *at = mon->ncand, *open = 0;
   for (j = 0; j < mon->ncand; j++) {
     const mon_cand *c = &mon->cand[j];
     double gc, p;
-    if (!c->dof || j == skip || j == skip2 || c->col == col ||
-        (gc = explained(mon, a, c->col, c->np, x)) < 0)
+    if (!c->dof || j == skip || j == skip2 || c->col == col || (gc = mon->gatt[j]) < 0)
       continue;
     p = g - gc > lim ? rcb_chi2_sf(g - gc, (double)q) : adds(mon, a, c->col, c->np, col, q);
     *open += p >= RCB_MONITOR_APART_ALPHA;
@@ -254,7 +253,8 @@ static void attribute(rcb_monitor *mon, size_t a, size_t pointed, rcb_monitor_tr
   for (j = 0; j < mon->ncand; j++) {
     const mon_cand *c = &mon->cand[j];
     double g, bj;
-    if (!c->dof || (g = explained(mon, a, c->col, c->np, x)) < 0) continue;
+    mon->gatt[j] = -1.0;
+    if (!c->dof || (g = mon->gatt[j] = explained(mon, a, c->col, c->np, x)) < 0) continue;
     bj = rcb_mon_bic(mon, g, c->dof);
     if (!have || bj < bbest) {
       if (have) have2 = 1, b2 = bbest, r2 = t->rival;

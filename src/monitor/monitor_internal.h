@@ -226,6 +226,8 @@ struct rcb_monitor {
   double *y0;          /* k: y before the re-linearised tracked step, the change
                           from the baseline the candidates are scored on */
   double *pscore;      /* ncand: log p-value of each candidate's score */
+  double *gatt;        /* ncand: a CUSUM attribution's explained part per candidate
+                          (monitor_drift.c; negative: dependent, not compared) */
   size_t *order;       /* ncand */
   size_t updates;
 
