@@ -129,10 +129,9 @@ def truths():
     out["C.hub"] = ("model", 0.0, lambda H0: _model_truth(
         lambda s: dc.hub_mass_edit(_hub_mass() * (1 + s)), 0.0, 0.5, 0.2),
         lambda d: d["effect"] == dc.HUB, (0, _hub_mass()))
-    for disk, at in (("DA", "A"), ("DB", "B")):
-        z = _disk_z(disk)
-        out[f"mass.{disk}"] = ("model", 0.0, lambda H0, at=at, z=z: _model_truth(
-            lambda m: dc.point_mass_edit(f"{at} {z}", m), 0.0, 0.2, 0.05),
+    for disk in ("DA", "DB"):
+        out[f"mass.{disk}"] = ("model", 0.0, lambda H0, disk=disk: _model_truth(
+            lambda m: _mass_at_disk(disk, m), 0.0, 0.2, 0.05),
             lambda d, disk=disk: d["effect"] == dc.MASS and f"disk {disk}" in d["place"],
             (0, 1.0))
     for shaft in ("A", "B"):
@@ -188,11 +187,14 @@ def _hub_mass():
     return dc._hub(rm.Model(dc.BASE_INI))[0]
 
 
-def _disk_z(name):
-    for line in dc.BASE_INI.split(f"[disk {name}]", 1)[1].splitlines():
-        if line.strip().startswith("at"):
-            return float(line.split("=", 1)[1].split()[1])
-    raise ValueError(name)
+def _mass_at_disk(name, mass):
+    """model_edit: a point mass (kg; no inertia) at disk NAME's station, as
+    dc.point_mass_edit places one at a station it is given."""
+
+    def edit(model):
+        model.disks.append((f"added_{len(model.disks)}", dc._disk(model, name)[1], mass, 0.0, 0.0))
+
+    return edit
 
 
 def _scaled(data, probe, factor):
@@ -356,30 +358,29 @@ def main():
     recs = json.loads(path.read_text()) if path.is_file() else []
     done = {r["truth"] for r in recs}
     model = rcb.Model.from_ini(ini)
-    if True:
-        if args.list:
-            with mr._meas(rcb, H0) as setup:
-                mon = rcb.Monitor(model, setup, mr.PARAMS, noise=mr.FORMS["eq19"],
-                                  setup_averages=1e9, sensors=True)
-            for i in range(mon.candidate_count()):
-                c = mon.candidate(i)
-                print(f"{i:3d} {c['effect']:32s} {c['place']:40s} {c['params']}")
-            mon.close()
-            print("truths:", ", ".join(every))
-            return 0
-        for ti, n in enumerate(names):
-            if n in done:
-                continue
-            rec = run_truth(rcb, model, n, every[n], H0, args.blocks, args.updates,
-                            7000000 + 100000 * list(every).index(n))
-            recs.append(rec)
-            tmp = path.with_suffix(".tmp")
-            tmp.write_text(json.dumps(recs))
-            tmp.replace(path)
-            rows, _ = summary([rec])
-            t, sd, al, right, apn, wr = rows[0][:6]
-            print(f"# {t}: sd {sd}, alarms {al}, first right {right}, told apart {apn}, "
-                  f"wrong {wr} ({rec['cpu']:.0f} s CPU)", flush=True)
+    if args.list:
+        with mr._meas(rcb, H0) as setup:
+            mon = rcb.Monitor(model, setup, mr.PARAMS, noise=mr.FORMS["eq19"],
+                              setup_averages=1e9, sensors=True)
+        for i in range(mon.candidate_count()):
+            c = mon.candidate(i)
+            print(f"{i:3d} {c['effect']:32s} {c['place']:40s} {c['params']}")
+        mon.close()
+        print("truths:", ", ".join(every))
+        return 0
+    for n in names:
+        if n in done:
+            continue
+        rec = run_truth(rcb, model, n, every[n], H0, args.blocks, args.updates,
+                        7000000 + 100000 * list(every).index(n))
+        recs.append(rec)
+        tmp = path.with_suffix(".tmp")
+        tmp.write_text(json.dumps(recs))
+        tmp.replace(path)
+        rows, _ = summary([rec])
+        t, sd, al, right, apn, wr = rows[0][:6]
+        print(f"# {t}: sd {sd}, alarms {al}, first right {right}, told apart {apn}, "
+              f"wrong {wr} ({rec['cpu']:.0f} s CPU)", flush=True)
     print_table(*summary([r for r in recs if r["truth"] in names]))
     return 0
 
