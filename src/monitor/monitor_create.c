@@ -182,7 +182,7 @@ static rcb_status noise(rcb_monitor *mon, const rcb_monitor_opts *o) {
         mon->sd0[p] = s;
       } else {
         eq19_var(mon->beta_a, a, mon->phase_var, noise_modulus(mon, p, ae), &vr, &vt);
-        if (mon->reweight && mon->phase_var > 0 && mon->h0abs[p] > 0) /* the model's frame */
+        if (mon->reweight && mon->h0abs[p] > 0) /* the model's frame */
           mon->u[p] = (e[i] + CMPLX(mon->rbase[2 * p], mon->rbase[2 * p + 1])) / mon->h0abs[p];
       }
       if (!(vr > 0) || !(vt > 0))

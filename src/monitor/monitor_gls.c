@@ -18,20 +18,26 @@
 
 #include "monitor/monitor_internal.h"
 
-/* The commissioning values' share of point p's covariance, added to s11,
- * s12, s22 (unwhitened, in the frame u): var0 is radial and tangential to
- * e_0, and with the phase term on the reweighted path the frame is the
- * baseline model's values' (monitor_create.c, noise), turned from e_0. */
-static void share(const rcb_monitor *mon, size_t p, double *s11, double *s12, double *s22) {
-  double r = mon->var0[2 * p] * mon->navg_inv, t = mon->var0[2 * p + 1] * mon->navg_inv;
+/* The turn from point p's frame u to its commissioning value e_0 (cos, sin
+ * of arg(conj(u) e_0)): on the reweighted path the frame u is the baseline
+ * model's values' (monitor_create.c, noise), while var0 is radial and
+ * tangential to e_0; elsewhere (or e_0 = 0) no turn. */
+static void share_turn(const rcb_monitor *mon, size_t p, double *c, double *s) {
   double ae = mon->e0abs[p];
-  if (mon->reweight && mon->phase_var > 0 && !mon->have_sd0 && ae > 0) {
+  *c = 1.0, *s = 0.0;
+  if (mon->reweight && !mon->have_sd0 && ae > 0) {
     double complex w = conj(mon->u[p]) * mon->e0[p] / ae;
-    double c = creal(w), s = cimag(w);
-    *s11 += r * c * c + t * s * s, *s12 += (r - t) * c * s, *s22 += r * s * s + t * c * c;
-  } else {
-    *s11 += r, *s22 += t;
+    *c = creal(w), *s = cimag(w);
   }
+}
+
+/* The commissioning values' share of point p's covariance, added to s11,
+ * s12, s22 (unwhitened, in the frame u): R diag(var0 / N) R^T, R the turn
+ * from e_0's radial frame into u (share_turn). */
+static void share(const rcb_monitor *mon, size_t p, double *s11, double *s12, double *s22) {
+  double r = mon->var0[2 * p] * mon->navg_inv, t = mon->var0[2 * p + 1] * mon->navg_inv, c, s;
+  share_turn(mon, p, &c, &s);
+  *s11 += r * c * c + t * s * s, *s12 += (r - t) * c * s, *s22 += r * s * s + t * c * c;
 }
 
 /* The 2 x 2 covariance of point p's (radial, tangential) residual, whitened:
@@ -65,18 +71,25 @@ static double amplitude(const rcb_monitor *mon, const rcb_complex *v, size_t c) 
   return rcb_mon_eq19_amp(mon->beta_s, v + c * mon->npts, mon->npts);
 }
 
-/* Points p0 .. p1 into C (k x k, upper, added to): each point's whitened
- * rows scaled by f[0], f[1] per unit (the commissioning's share: sqrt(var0
- * / N), else 1). */
+/* Points p0 .. p1 into C (k x k, upper, added to): with share, the
+ * commissioning's share W R diag(var0 / N) R^T W (share), as two columns
+ * per point, W (q1 c + q2 s) sqrt(var0_r / N) and W (q2 c - q1 s)
+ * sqrt(var0_t / N) (c, s: share_turn); else W W (the channel's additive
+ * term per unit). */
 static void fixed_part(rcb_monitor *mon, size_t p0, size_t p1, int share, double *C) {
   size_t k = mon->k, p, a, nb = 0;
   for (p = p0; p < p1; p++) {
     const double *q1 = mon->Q + k * (2 * p), *q2 = q1 + k;
     double *b1 = mon->b1 + k * (2 * nb), *b2 = b1 + k;
-    double f1 = mon->winv[2 * p], f2 = mon->winv[2 * p + 1];
-    if (share)
-      f1 *= sqrt(mon->var0[2 * p] * mon->navg_inv), f2 *= sqrt(mon->var0[2 * p + 1] * mon->navg_inv);
-    for (a = 0; a < k; a++) b1[a] = f1 * q1[a], b2[a] = f2 * q2[a];
+    double w1 = mon->winv[2 * p], w2 = mon->winv[2 * p + 1], c = 1.0, s = 0.0, fr = 1.0, ft = 1.0;
+    if (share) {
+      share_turn(mon, p, &c, &s);
+      fr = sqrt(mon->var0[2 * p] * mon->navg_inv), ft = sqrt(mon->var0[2 * p + 1] * mon->navg_inv);
+    }
+    for (a = 0; a < k; a++) {
+      b1[a] = fr * (w1 * c * q1[a] + w2 * s * q2[a]);
+      b2[a] = ft * (w2 * c * q2[a] - w1 * s * q1[a]);
+    }
     if (++nb == MON_SYRK_POINTS || p + 1 == p1) syrk(mon, mon->b1, 2 * nb, C), nb = 0;
   }
 }
