@@ -138,10 +138,11 @@ static double noise_modulus(const rcb_monitor *mon, size_t p, double ae) {
  * model's modulus (noise_modulus; its additive amplitude and the radial
  * frame at the commissioning values), times opts.noise_scale.
  *
- * With the phase term on the reweighted path (opts.reweight, phase_deg > 0)
- * the frame u is the baseline model's values' too: there the metric is the covariance C made each
- * update (monitor_gls.c, which turns the commissioning's share var0, radial
- * to e_0, into u) and the frame only sets the coordinates. At e_0 each
+ * On the reweighted path (opts.reweight, eq. 19 noise, with or without the
+ * phase term) the frame u is the baseline model's values' too: there the
+ * metric is the covariance C made each update (monitor_gls.c, which turns
+ * the commissioning's share var0, radial to e_0, into u, on the split path
+ * too) and the frame only sets the coordinates. At e_0 each
  * point's frame turns with that point's own commissioning noise d_0 (its
  * phase noise), which every update's change carries (-d_0): with radial and
  * tangential weights unequal, the same kind of bias as noise_modulus's,
