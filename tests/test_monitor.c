@@ -407,6 +407,22 @@ static void test_commissioning_noise_unbiased(void **state) {
   free(acc);
 }
 
+/* A commissioning: navg files of eq. 19 noise on the fixture's truth,
+ * averaged (f->v left with the last file). */
+static rcb_meas *averaged_setup(fixture *f, size_t navg, uint64_t *seed) {
+  rcb_complex *acc = calloc(NPT, sizeof *acc);
+  rcb_meas *setup;
+  size_t u, i;
+  assert_non_null(acc);
+  for (u = 0; u < navg; u++) {
+    eq19(f->fs, f->v, seed);
+    for (i = 0; i < NPT; i++) acc[i] += f->v[i] / (double)navg;
+  }
+  setup = with_values(f->setup, acc, 1.0);
+  free(acc);
+  return setup;
+}
+
 /* The reweighted covariance's two paths agree: without a phase term its
  * set-up parts are made once at create (monitor_gls.c, Cfix: the
  * commissioning's share turned point by point from e_0's radial frame into
@@ -422,17 +438,9 @@ static void test_reweighted_paths_agree(void **state) {
   rcb_monitor_opts o = opts_kt(&tp, f->kt);
   rcb_monitor *mon[2] = {NULL, NULL};
   rcb_monitor_result r[2];
-  rcb_complex *acc = malloc(NPT * sizeof *acc);
-  rcb_meas *setup;
   uint64_t seed = 5521;
-  size_t u, i, j;
-  assert_non_null(acc);
-  memset(acc, 0, NPT * sizeof *acc);
-  for (u = 0; u < NAVG; u++) {
-    eq19(f->fs, f->v, &seed);
-    for (i = 0; i < NPT; i++) acc[i] += f->v[i] / NAVG;
-  }
-  setup = with_values(f->setup, acc, 1.0);
+  rcb_meas *setup = averaged_setup(f, NAVG, &seed);
+  size_t u, j;
   o.setup_averages = NAVG;
   o.reweight = 1;
   for (j = 0; j < 2; j++) {
@@ -448,7 +456,6 @@ static void test_reweighted_paths_agree(void **state) {
   }
   for (j = 0; j < 2; j++) rcb_monitor_destroy(mon[j]);
   rcb_meas_destroy(setup);
-  free(acc);
 }
 
 /* Per-point standard deviations (as #15's estimators give), circular
@@ -1506,7 +1513,7 @@ static void test_state_restart(void **state) {
   rcb_monitor_result ra, rb;
   rcb_model *m2 = edited(f->truth, KT_NAME, (1 + DK) * f->kt);
   rcb_meas *ms = frf_of(m2), *setup, *setup2;
-  rcb_complex *acc = calloc(NPT, sizeof *acc), *dh = malloc(NPT * sizeof *dh);
+  rcb_complex *dh = malloc(NPT * sizeof *dh);
   static unsigned char buf[1 << 15], buf2[1 << 15], keep[1 << 15];
   size_t u, i, n = 0, n2 = 0, before, first_alarm = 0;
   double cusum_at_restart = 0;
@@ -1517,11 +1524,7 @@ static void test_state_restart(void **state) {
   assert_int_equal(rcb_monitor_crc32(0, check, 9), 0xCBF43926ul);
   values_of(ms, dh);
   for (i = 0; i < NPT; i++) dh[i] = (dh[i] - f->fs[i]) / (DK * f->kt);
-  for (u = 0; u < NAVG; u++) {
-    eq19(f->fs, f->v, &seed);
-    for (i = 0; i < NPT; i++) acc[i] += f->v[i] / NAVG;
-  }
-  setup = with_values(f->setup, acc, 1.0);
+  setup = averaged_setup(f, NAVG, &seed);
   o.setup_averages = NAVG;
   o.relinearise = 2;
   o.baseline_cov = &bvar; /* the baseline's share of the allowance, saved with the state */
@@ -1610,7 +1613,6 @@ static void test_state_restart(void **state) {
   rcb_meas_destroy(setup2);
   rcb_meas_destroy(ms);
   rcb_model_destroy(m2);
-  free(acc);
   free(dh);
 }
 
