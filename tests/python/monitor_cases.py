@@ -22,6 +22,9 @@ The series (SERIES):
             0.1 % per update to -10 % at file COMMISSION + 100 (111 files);
 * cross_B3: a cross-coupled stiffness kxy = -kyx = 1.5e7 N/m appears at
             bearing B3 at update 37 of 60 and stays;
+* cross_B3_r1 .. cross_B3_r5: cross_B3 again with other noise seeds (its
+            interval's coverage is a rate: one series' 23 alarmed updates
+            share one commissioning and prove little);
 * probe_DA_x: the machine as it is, read by a DA.x probe whose gain stays 1
             for the COMMISSION files, then falls linearly to 0.85 over 70
             updates (issue #34: a drifting probe, not a drifting machine);
@@ -87,6 +90,7 @@ NOISE = dc.NOISE  # eq. 19 (10 % random, 1 % systematic)
 PHASE_DEG = 2.0  # null_phase: uniform in +-2 degrees per point
 KT0 = float(rm.Model(dc.BASE_INI).couplings[0][3]["kt"][-1])  # N/m, the model's kt
 CROSS_B3 = 1.5e7  # N/m, kxy = -kyx at B3 (diag_cases' ross_cross_B3)
+CROSS_REPLICAS = 5  # cross_B3_r1 .. r5: the same change under other noise seeds
 FIT_PARAMS = "coupling.C.kt,coupling.C.kr,coupling.C.ct"  # what the monitor tracks
 
 
@@ -202,6 +206,9 @@ SERIES = {
     "cross_B3": Series("cross_B3", 60, 162000,
                        "kxy = -kyx = 1.5e7 N/m appears at bearing B3 at update 37",
                        cross_from=37),
+    **{f"cross_B3_r{r}": Series(f"cross_B3_r{r}", 60, 170000 + 1000 * r,
+                                 "cross_B3 with other noise seeds", cross_from=37)
+       for r in range(1, CROSS_REPLICAS + 1)},
     "mass_DB": Series("mass_DB", 60, 165000,
                       f"a point mass of {MASS_DB} kg appears at disk DB at update 37 (issue #34: "
                       f"a step, then quiet)", step=("mass_DB", 37)),

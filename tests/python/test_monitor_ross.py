@@ -19,7 +19,8 @@ up to 8 re-linearisations of the tracked parameters, until converged).
   stay silent, and kt's 95 % interval covers the
   truth in at least the lower end of the binomial 99 % interval of 95 %
   coverage;
-* cross_B3 (kxy = -kyx = 1.5e7 N/m at B3 from file 37): no alarm before the
+* cross_B3 (kxy = -kyx = 1.5e7 N/m at B3 from file 37, and cross_B3_r1 .. r5,
+  the same change under other noise seeds, for the intervals): no alarm before the
   change beyond the false-alarm interval, the instant test alarms within
   CROSS_DELAY updates of it, and the first candidate of the alarm is the
   cross-coupled stiffness at bearing B3; its 95 % interval covers the truth
@@ -238,23 +239,43 @@ def test_cross_coupling_B3_named(tool):
 
 
 def test_cross_coupling_B3_intervals(tool):
-    log, truth, change, before, n_before, hi, after = _cross(tool)
-    size = [u["top"][0]["ci_lo"][0] <= truth["cross_kxy"] <= u["top"][0]["ci_hi"][0]
-            for u in after if u["top"][0]["place"] == truth["place"]]
+    """The cross-coupling's 95 % interval on the alarmed updates that name it,
+    and the tracked parameters' on every update, over cross_B3 and its
+    CROSS_REPLICAS other noise draws (a coverage is a rate: one series' 23
+    alarms share one commissioning), at the binomial 99 % lower end of 95 %;
+    no CUSUM alarm in any of them. The mean of (estimate - truth) / stated sd
+    is printed: about -0.3 (docs/monitoring.md's limits: a bias of second
+    order in the noise, -0.2 at half the noise, -0.7 at twice)."""
+    names = ["cross_B3"] + [f"cross_B3_r{r}" for r in range(1, mc.CROSS_REPLICAS + 1)]
+    size, z, tracked, cusum, nups = [], [], {}, {}, 0
+    for name in names:
+        log, truth = monitor(tool, name, "--alpha", 0.01)
+        after = _alarms(log, lo=truth["change_update"])
+        for u in after:
+            top = u["top"][0]
+            if top["place"] != truth["place"]:
+                continue
+            size.append(top["ci_lo"][0] <= truth["cross_kxy"] <= top["ci_hi"][0])
+            z.append((top["size"][0] - truth["cross_kxy"]) /
+                     ((top["ci_hi"][0] - top["ci_lo"][0]) / (2 * stats.norm.ppf(0.975))))
+        ups = log["updates"]
+        nups += len(ups)
+        for k, b in enumerate(log["tracked"]):
+            tracked[b["name"]] = tracked.get(b["name"], 0) + sum(
+                u["tracked"][k]["ci_lo"] <= b["baseline"] <= u["tracked"][k]["ci_hi"] for u in ups)
+        cusum[name] = [u["update"] for u in _alarms(log, "cusum_alarm")]
     lo_s, _ = stats.binom.interval(0.99, len(size), 0.95)
-    ups = log["updates"]
-    lo_t, _ = stats.binom.interval(0.99, len(ups), 0.95)
-    tracked = {b["name"]: sum(u["tracked"][k]["ci_lo"] <= b["baseline"] <= u["tracked"][k]["ci_hi"]
-                              for u in ups) for k, b in enumerate(log["tracked"])}
-    cusum = [u["update"] for u in _alarms(log, "cusum_alarm")]
+    lo_t, _ = stats.binom.interval(0.99, nups, 0.95)
     FIGURES["cross_B3 intervals"] = (
-        f"the cross-coupling's 95 % interval covers {truth['cross_kxy']:g} N/m on {sum(size)} of "
-        f"{len(size)} alarms (99 % binomial lower end {lo_s:.0f}); the tracked parameters' "
-        f"cover their unchanged values on {tracked} of {len(ups)} updates (lower end "
-        f"{lo_t:.0f}); CUSUM alarms at {cusum}")
+        f"{len(names)} series: the cross-coupling's 95 % interval covers {mc.CROSS_B3:g} N/m on "
+        f"{sum(size)} of {len(size)} alarms naming it (99 % binomial lower end {lo_s:.0f}), "
+        f"mean (estimate - truth) / sd {sum(z) / max(len(z), 1):+.2f}; the tracked parameters' "
+        f"cover their unchanged values on {tracked} of {nups} updates (lower end {lo_t:.0f}); "
+        f"CUSUM alarms {cusum}")
+    assert len(size) >= len(names) * 20, FIGURES["cross_B3 intervals"]
     assert sum(size) >= lo_s, FIGURES["cross_B3 intervals"]
     assert all(v >= lo_t for v in tracked.values()), FIGURES["cross_B3 intervals"]
-    assert not cusum, FIGURES["cross_B3 intervals"]
+    assert not any(cusum.values()), FIGURES["cross_B3 intervals"]
 
 
 def _sensor_named(log, sensor, truth, i):
