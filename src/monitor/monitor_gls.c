@@ -40,19 +40,46 @@ static void share(const rcb_monitor *mon, size_t p, double *s11, double *s12, do
   *s11 += r * c * c + t * s * s, *s12 += (r - t) * c * s, *s22 += r * s * s + t * c * c;
 }
 
+/* The modulus eq. 19's proportional and phase terms are taken at for point
+ * p of values v (a: its channel's additive amplitude): the fitted value's,
+ * e_0 + the update's change projected onto the rank space (yq1 = q1 . y,
+ * yq2 = q2 . y: whitened, in the frame u), unless that misses |v| by more
+ * than MON_FIT_MISS of v's declared sds (a change the rank space does not
+ * hold: then |v|). Taken at |v|, every sd carries the point's own noise: a
+ * value pulled towards zero by it weighs more and pulls the estimates with
+ * it. On the ROSS cross-coupling series (12 noise draws, eq. 19,
+ * tools/bench/monitor_step_bias.py) the step's size read -0.27 of its
+ * standard error low at |v|, -0.10 at the fitted moduli (-0.09 with no
+ * miss test, -0.18 at 3 sds: the projection misses a fifth of the points
+ * after that step); its second-order part alone, by antithetic draws
+ * (test_monitor_replicas.py), -0.217 and +0.007. The projection carries the noise of k of the n
+ * residuals; e_0's own (1 / N of a measurement's variance) is left. The
+ * same rule as rcb_fit's weights at the model (issue #24) and noise_modulus
+ * at the commissioning (monitor_create.c). */
+#define MON_FIT_MISS 6.0
+static double fitted_abs(const rcb_monitor *mon, const rcb_complex *v, size_t p, double a,
+                         double yq1, double yq2) {
+  double av = cabs(v[p]), pa = mon->beta_a / 100.0 * av;
+  double complex d = mon->u[p] * CMPLX(yq1 / mon->winv[2 * p], yq2 / mon->winv[2 * p + 1]);
+  double m = cabs(mon->e0[p] + d);
+  double lim = MON_FIT_MISS * sqrt(pa * pa / 3.0 + a * a / 6.0 + mon->phase_var * av * av);
+  return fabs(m - av) <= lim ? m : av;
+}
+
 /* The 2 x 2 covariance of point p's (radial, tangential) residual, whitened:
- * this update's noise plus the commissioning values' share. */
+ * this update's noise (eq. 19's proportional and phase terms at modulus m,
+ * along and across v[p]; or the sd) plus the commissioning values' share. */
 static void point_cov(const rcb_monitor *mon, const rcb_complex *v, const double *sd, size_t p,
-                      double a, double *d11, double *d12, double *d22) {
+                      double a, double m, double *d11, double *d12, double *d22) {
   double s11, s12 = 0, s22, w1 = mon->winv[2 * p], w2 = mon->winv[2 * p + 1];
   if (sd || mon->have_sd0) {
     double s = sd ? sd[p] * mon->nscale : mon->sd0[p]; /* sd0: scaled at create */
     s11 = s22 = s * s;
   } else {
-    double av = cabs(v[p]), sp = mon->beta_a / 100.0 * av;
+    double av = cabs(v[p]), sp = mon->beta_a / 100.0 * m;
     double complex w = av > 0 ? conj(mon->u[p]) * v[p] / av : 1.0;
     double c = creal(w), s = cimag(w), vp = sp * sp / 3.0, va = a * a / 6.0;
-    double vph = mon->phase_var * av * av; /* phase turn: across the new value */
+    double vph = mon->phase_var * m * m; /* phase turn: across the new value */
     s11 = vp * c * c + vph * s * s + va, s12 = (vp - vph) * c * s;
     s22 = vp * s * s + vph * c * c + va;
   }
@@ -95,10 +122,11 @@ static void fixed_part(rcb_monitor *mon, size_t p0, size_t p1, int share, double
 }
 
 /* Create: the joint step's workspace and the tracked estimator on the
- * residuals (mon->rmx, mon->tres, with re-linearisation) and, on eq. 19 noise without a phase term, the parts of
- * the reweighted covariance that depend on the set-up only (mon->Cfix).
- * There a point's whitened covariance is W (var0 / N + a_c^2 / 6 I + s^2 g
- * g^T) W, g = conj(u) v in the radial frame, s = beta_a / (100 sqrt 3), a_c
+ * residuals (mon->rmx, mon->tres, with re-linearisation) and, on eq. 19
+ * noise without a phase term, the parts of the reweighted covariance that
+ * depend on the set-up only (mon->Cfix). There a point's whitened
+ * covariance is W (var0 / N + a_c^2 / 6 I + s^2 g g^T) W, g = conj(u) v
+ * |v|_fit / |v| in the radial frame (fitted_abs), s = beta_a / (100 sqrt 3), a_c
  * its channel's additive amplitude (point_cov): C = C_0 + sum_c a_c^2 / 6
  * C_c + the update's rank-one terms, one column per point instead of two. */
 rcb_status rcb_mon_pass_init(rcb_monitor *mon) {
@@ -141,28 +169,23 @@ static void fixed_c(rcb_monitor *mon) {
   }
 }
 
-/* The update's one pass over Q (row-major, read once): y = Q^T r, with
- * proj ym = Q^T rm, and with gls C = Q^T D Q (upper triangle), D the
- * update's whitened noise covariance (2 x 2 per point): the rows of B^T =
- * L^T Q (D = L L^T), or with mon->Cfix only the rank-one columns s W g
- * (rcb_mon_pass_init), 2 MON_SYRK_POINTS columns of B at a time, then C +=
- * B B^T (BLAS dsyrk). */
+/* The update's passes over Q (row-major): y = Q^T r, with proj ym = Q^T
+ * rm; then with gls C = Q^T D Q (upper triangle), D the update's whitened
+ * noise covariance (2 x 2 per point) at the fitted moduli (fitted_abs, from
+ * y: hence a second pass): the rows of B^T = L^T Q (D = L L^T), or with
+ * mon->Cfix only the rank-one columns s W g (rcb_mon_pass_init), 2
+ * MON_SYRK_POINTS columns of B at a time, then C += B B^T (BLAS dsyrk). */
 void rcb_mon_pass(rcb_monitor *mon, const rcb_complex *v, const double *sd, int gls, int proj) {
   size_t k = mon->k, p, a, c = 0, nb = 0;
-  int split = gls && !sd && mon->Cfix, per = split ? 1 : 2;
+  int split = gls && !sd && mon->Cfix, per = split ? 1 : 2, eq19 = gls && !sd && !mon->have_sd0;
   double *restrict B = mon->b1, *restrict y = mon->y, *restrict ym = mon->ym;
   double s = mon->beta_a / 100.0 / sqrt(3.0);
   const double *r = mon->r, *rm = mon->rm;
   memset(y, 0, k * sizeof *y);
   if (proj) memset(ym, 0, k * sizeof *ym);
-  if (gls && !sd && !mon->have_sd0)
-    for (c = 0; c < mon->nch; c++) mon->achan[c] = amplitude(mon, v, c);
-  if (split) fixed_c(mon);
-  else if (gls) memset(mon->C, 0, k * k * sizeof *mon->C);
-  c = 0;
   for (p = 0; p < mon->npt; p++) {
     const double *restrict q1 = mon->Q + k * (2 * p), *restrict q2 = q1 + k;
-    double r1 = r[2 * p], r2 = r[2 * p + 1], *restrict b1 = B + k * nb;
+    double r1 = r[2 * p], r2 = r[2 * p + 1];
     /* the same products and order as a pass residual by residual */
     if (proj) {
       double m1 = rm[2 * p], m2 = rm[2 * p + 1];
@@ -173,15 +196,29 @@ void rcb_mon_pass(rcb_monitor *mon, const rcb_complex *v, const double *sd, int 
     } else {
       for (a = 0; a < k; a++) y[a] = y[a] + q1[a] * r1 + q2[a] * r2;
     }
-    if (!gls) continue;
+  }
+  if (!gls) return;
+  if (eq19)
+    for (c = 0; c < mon->nch; c++) mon->achan[c] = amplitude(mon, v, c);
+  if (split) fixed_c(mon);
+  else memset(mon->C, 0, k * k * sizeof *mon->C);
+  c = 0;
+  for (p = 0; p < mon->npt; p++) {
+    const double *restrict q1 = mon->Q + k * (2 * p), *restrict q2 = q1 + k;
+    double *restrict b1 = B + k * nb, m = 0, yq1 = 0, yq2 = 0;
+    if (p && p == (c + 1) * mon->npts) c++; /* the channel of point p */
+    if (eq19) {
+      for (a = 0; a < k; a++) yq1 += q1[a] * y[a], yq2 += q2[a] * y[a];
+      m = fitted_abs(mon, v, p, mon->achan[c], yq1, yq2);
+    }
     if (split) {
-      double complex g = conj(mon->u[p]) * v[p];
+      double av = cabs(v[p]);
+      double complex g = av > 0 ? conj(mon->u[p]) * v[p] * (m / av) : 0.0;
       double f1 = s * creal(g) * mon->winv[2 * p], f2 = s * cimag(g) * mon->winv[2 * p + 1];
       for (a = 0; a < k; a++) b1[a] = f1 * q1[a] + f2 * q2[a];
     } else {
       double d11, d12, d22, l11, l21, l22, *b2 = b1 + k;
-      if (p && p == (c + 1) * mon->npts) c++; /* the channel of point p */
-      point_cov(mon, v, sd, p, mon->achan[c], &d11, &d12, &d22);
+      point_cov(mon, v, sd, p, mon->achan[c], m, &d11, &d12, &d22);
       l11 = sqrt(d11), l21 = d12 / l11, l22 = sqrt(fmax(d22 - l21 * l21, 0.0));
       for (a = 0; a < k; a++) b1[a] = l11 * q1[a] + l21 * q2[a], b2[a] = l22 * q2[a];
     }

@@ -44,7 +44,8 @@ def run(tool, d, model):
         if (not u["alarm"] or truth["files"].index(u["file"]) < truth["change_update"]
                 or top["place"] != truth["place"]):
             continue
-        z.append((top["size"][0] - truth["cross_kxy"]) / ((top["ci_hi"][0] - top["ci_lo"][0]) / 3.92))
+        sd = (top["ci_hi"][0] - top["ci_lo"][0]) / 3.92  # the stated 95 % interval's sd
+        z.append((top["size"][0] - truth["cross_kxy"]) / sd)
     return z
 
 
