@@ -52,10 +52,10 @@ static void share(const rcb_monitor *mon, size_t p, double *s11, double *s12, do
  * standard error low at |v|, -0.10 at the fitted moduli (-0.09 with no
  * miss test, -0.18 at 3 sds: the projection misses a fifth of the points
  * after that step); its second-order part alone, by antithetic draws
- * (test_monitor_replicas.py), -0.217 and +0.007. The projection carries the noise of k of the n
- * residuals; e_0's own (1 / N of a measurement's variance) is left. The
- * same rule as rcb_fit's weights at the model (issue #24) and noise_modulus
- * at the commissioning (monitor_create.c). */
+ * (test_monitor_replicas.py), -0.217 and +0.007. The projection carries
+ * the noise of k of the n residuals; e_0's own (1 / N of a measurement's
+ * variance) is left. The same rule as rcb_fit's weights at the model
+ * (issue #24) and noise_modulus at the commissioning (monitor_create.c). */
 #define MON_FIT_MISS 6.0
 static double fitted_abs(const rcb_monitor *mon, const rcb_complex *v, size_t p, double a,
                          double yq1, double yq2) {
@@ -126,9 +126,10 @@ static void fixed_part(rcb_monitor *mon, size_t p0, size_t p1, int share, double
  * noise without a phase term, the parts of the reweighted covariance that
  * depend on the set-up only (mon->Cfix). There a point's whitened
  * covariance is W (var0 / N + a_c^2 / 6 I + s^2 g g^T) W, g = conj(u) v
- * |v|_fit / |v| in the radial frame (fitted_abs), s = beta_a / (100 sqrt 3), a_c
- * its channel's additive amplitude (point_cov): C = C_0 + sum_c a_c^2 / 6
- * C_c + the update's rank-one terms, one column per point instead of two. */
+ * |v|_fit / |v| in the radial frame (fitted_abs), s = beta_a / (100 sqrt
+ * 3), a_c its channel's additive amplitude (point_cov): C = C_0 + sum_c
+ * a_c^2 / 6 C_c + the update's rank-one terms, one column per point
+ * instead of two. */
 rcb_status rcb_mon_pass_init(rcb_monitor *mon) {
   size_t k = mon->k, nt = mon->nt, n = mon->n, a, i, c;
   if (mon->relin &&
