@@ -280,15 +280,15 @@ ANTI_DRAWS = int(os.environ.get("RCB_ANTI_DRAWS", "16"))
 def test_step_size_weights_at_the_fit(truth):
     """Eq. 19's proportional noise weighed at the update's fitted moduli, not
     its own noisy ones (monitor_gls.c, fitted_abs): antithetic draws. The
-    commissioning is ANTI_DRAWS-independent pairs H0 + n, H0 - n (their mean is
-    H0 exactly); each draw n of eq. 19 noise on the cross-coupled truth Hx is
+    commissioning is COMMISSION / 2 pairs H0 + n, H0 - n (their mean is H0
+    exactly); each of ANTI_DRAWS draws n of eq. 19 noise on the cross-coupled truth Hx is
     given as Hx + n and Hx - n, and Hx itself once. Half their difference in
     sizes of the B3 cross-coupling is the estimate's first-order error (its
     rms in standard errors of the noise-free update's interval: about 1, a
     little less since the commissioning's share is declared and not there);
-    their mean minus the noise-free size is its second-order error, which
-    the sds at |v| make -0.27 standard errors on the ROSS series
-    (tools/bench/monitor_step_bias.py) and the fitted moduli -0.10. Asserted:
+    their mean minus the noise-free size is its second-order error: -0.217
+    standard errors (spread 0.027 over the draws) with the sds at |v|, +0.007
+    (0.185) at the fitted moduli (2026-12-06). Asserted:
     the mean second-order error within +-0.12 standard errors, and the rms
     first-order error in [0.75, 1.3]."""
     H0, Hx, _, ini = truth
