@@ -42,9 +42,9 @@
 #                               about 10 s CPU per replica); extra arguments go to
 #                               tools/bench/monitor_replicas.py (--cases null,drift --first N)
 #   ./scripts/dev.sh monitor-pairs  the wrong "told apart" for each truth the monitor's
-#                               catalogue can hold at 32 x 1101 (issue #34 item 2): 31 ROSS-made
+#                               catalogue can hold at 32 x 1101 (issue #34 item 2): 36 ROSS-made
 #                               truths x 8 commissionings x 25 updates, four noise forms (needs
-#                               .venv; about 60 min CPU); extra arguments go to
+#                               .venv; about 80 min CPU); extra arguments go to
 #                               tools/bench/monitor_pairs.py (--truths B4.kyy,gain.DA.x)
 #   ./scripts/dev.sh fuzz       libFuzzer smoke (issue #7): build fuzz/ with clang (ASan+UBSan),
 #                               replay the seed corpora, then fuzz each harness FUZZ_SECONDS
