@@ -212,17 +212,23 @@ def _pedestal_truth(bearing):
     return at
 
 
-def clean_T(rcb, model, H0, H):
-    """T of a clean update H against the clean reference H0."""
+def clean_update(rcb, model, H0, H):
+    """The result of one clean update H against the clean reference H0 (the
+    commissioning exact: setup_averages 1e9)."""
     with mr._meas(rcb, H0) as setup:
         mon = rcb.Monitor(model, setup, mr.PARAMS, noise=mr.FORMS["eq19"],
                           setup_averages=1e9, alpha=mr.ALPHA, reweight=True, relinearise=8,
                           sensors=True)
     try:
         with mr._meas(rcb, H) as ms:
-            return mon.update(ms)["T"]
+            return mon.update(ms)
     finally:
         mon.close()
+
+
+def clean_T(rcb, model, H0, H):
+    """T of a clean update H against the clean reference H0."""
+    return clean_update(rcb, model, H0, H)["T"]
 
 
 def _speed_truth():
@@ -286,17 +292,9 @@ def _data(at, v, form, seed):
 def per_update_sd(rcb, model, H0, at, v_small, is_truth, conv):
     """The truth's per-update sd (parameter units): the interval of its first
     ranked candidate on a clean update at v_small, the reference clean."""
-    with mr._meas(rcb, H0) as setup:
-        mon = rcb.Monitor(model, setup, mr.PARAMS, noise=mr.FORMS["eq19"],
-                          setup_averages=1e9, alpha=mr.ALPHA, reweight=True, relinearise=8,
-                          sensors=True)
-    try:
-        out = at(v_small)
-        H, after = out if isinstance(out, tuple) else (out, None)
-        with mr._meas(rcb, after(H) if after else H) as ms:
-            r = mon.update(ms)
-    finally:
-        mon.close()
+    out = at(v_small)
+    H, after = out if isinstance(out, tuple) else (out, None)
+    r = clean_update(rcb, model, H0, after(H) if after else H)
     i, factor = conv
     for c in r["top"]:
         if is_truth(c):
